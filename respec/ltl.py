@@ -1,0 +1,210 @@
+"""LTL formulas for the GR(1) fragment, as immutable trees with slugs printers.
+
+Every formula the project builds or parses is one of these nodes; text is only made by the
+printers here, so the infix (``.structuredslugs``) and prefix (``.slugsin``) syntaxes live
+in one place.
+
+    >>> f = implies(var('a'), next_(neg(var('b'))))
+    >>> to_infix(f)
+    'a -> next(!b)'
+    >>> to_prefix(f)
+    "| ! a ! b'"
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Iterable
+
+
+@dataclass(frozen=True)
+class Formula:
+    """Base class of all formula nodes (immutable, hashable, ordered by printing)."""
+
+
+@dataclass(frozen=True)
+class Const(Formula):
+    value: bool
+
+
+@dataclass(frozen=True)
+class Var(Formula):
+    name: str
+
+
+@dataclass(frozen=True)
+class Not(Formula):
+    arg: Formula
+
+
+@dataclass(frozen=True)
+class And(Formula):
+    args: tuple[Formula, ...]
+
+
+@dataclass(frozen=True)
+class Or(Formula):
+    args: tuple[Formula, ...]
+
+
+@dataclass(frozen=True)
+class Implies(Formula):
+    left: Formula
+    right: Formula
+
+
+@dataclass(frozen=True)
+class Iff(Formula):
+    left: Formula
+    right: Formula
+
+
+@dataclass(frozen=True)
+class Next(Formula):
+    """The value of ``arg`` in the next time step (LTL's "next" operator, ◯)."""
+
+    arg: Formula
+
+
+TRUE = Const(True)
+FALSE = Const(False)
+
+
+def var(name: str) -> Var:
+    return Var(name)
+
+
+def neg(arg: Formula) -> Formula:
+    """Negation; folds constants and double negation."""
+    if isinstance(arg, Const):
+        return Const(not arg.value)
+    if isinstance(arg, Not):
+        return arg.arg
+    return Not(arg)
+
+
+def conj(args: Iterable[Formula]) -> Formula:
+    """Conjunction of any number of formulas (TRUE when empty; flattens nested ands)."""
+    return _associative(And, args, unit=TRUE, zero=FALSE)
+
+
+def disj(args: Iterable[Formula]) -> Formula:
+    """Disjunction of any number of formulas (FALSE when empty; flattens nested ors)."""
+    return _associative(Or, args, unit=FALSE, zero=TRUE)
+
+
+def implies(left: Formula, right: Formula) -> Formula:
+    return Implies(left, right)
+
+
+def iff(left: Formula, right: Formula) -> Formula:
+    return Iff(left, right)
+
+
+def next_(arg: Formula) -> Formula:
+    return Next(arg)
+
+
+def _associative(kind, args, unit, zero):
+    flat = []
+    for arg in args:
+        if arg == unit:
+            continue
+        if arg == zero:
+            return zero
+        flat.extend(arg.args if isinstance(arg, kind) else (arg,))
+    if not flat:
+        return unit
+    if len(flat) == 1:
+        return flat[0]
+    return kind(tuple(flat))
+
+
+# --- printers ---------------------------------------------------------------------------
+
+# Binding strength in structured slugs, tightest first; used to print minimal parentheses.
+_PRECEDENCE = {Const: 6, Var: 6, Next: 6, Not: 5, And: 4, Or: 3, Implies: 2, Iff: 1}
+
+
+def to_infix(formula: Formula) -> str:
+    """Print in structured-slugs infix syntax (``!``, ``&``, ``|``, ``->``, ``<->``, ``next()``)."""
+    if isinstance(formula, Const):
+        return 'TRUE' if formula.value else 'FALSE'
+    if isinstance(formula, Var):
+        return formula.name
+    if isinstance(formula, Next):
+        return f'next({to_infix(formula.arg)})'
+    if isinstance(formula, Not):
+        return '!' + _infix_operand(formula.arg, Not, strict=False)
+    if isinstance(formula, (And, Or)):
+        symbol = ' & ' if isinstance(formula, And) else ' | '
+        return symbol.join(_infix_operand(arg, type(formula), strict=True) for arg in formula.args)
+    if isinstance(formula, (Implies, Iff)):
+        symbol = ' -> ' if isinstance(formula, Implies) else ' <-> '
+        # Both operators are printed non-associatively: nested ones always get parentheses.
+        return (_infix_operand(formula.left, type(formula), strict=True) + symbol
+                + _infix_operand(formula.right, type(formula), strict=True))
+    raise TypeError(f'not a formula: {formula!r}')
+
+
+def _infix_operand(operand: Formula, parent: type, strict: bool) -> str:
+    text = to_infix(operand)
+    mine, theirs = _PRECEDENCE[type(operand)], _PRECEDENCE[parent]
+    needs_parentheses = mine <= theirs if strict else mine < theirs
+    return f'({text})' if needs_parentheses else text
+
+
+def to_prefix(formula: Formula) -> str:
+    """Print in slugsin prefix syntax: ``! a``, ``& a b``, ``| a b``, ``^ a b``, ``a'``.
+
+    slugsin primes variables only, so ``next`` is pushed down to the variables.
+    """
+    return ' '.join(_prefix_tokens(formula, primed=False))
+
+
+def _prefix_tokens(formula: Formula, primed: bool) -> list[str]:
+    if isinstance(formula, Const):
+        return ['1' if formula.value else '0']
+    if isinstance(formula, Var):
+        return [formula.name + ("'" if primed else '')]
+    if isinstance(formula, Next):
+        if primed:
+            raise ValueError(f'nested next is not GR(1): {to_infix(formula)}')
+        return _prefix_tokens(formula.arg, primed=True)
+    if isinstance(formula, Not):
+        return ['!'] + _prefix_tokens(formula.arg, primed)
+    if isinstance(formula, (And, Or)):
+        operator = '&' if isinstance(formula, And) else '|'
+        tokens = _prefix_tokens(formula.args[-1], primed)
+        for arg in reversed(formula.args[:-1]):
+            tokens = [operator] + _prefix_tokens(arg, primed) + tokens
+        return tokens
+    if isinstance(formula, Implies):
+        return ['|', '!'] + _prefix_tokens(formula.left, primed) + _prefix_tokens(formula.right, primed)
+    if isinstance(formula, Iff):
+        return ['!', '^'] + _prefix_tokens(formula.left, primed) + _prefix_tokens(formula.right, primed)
+    raise TypeError(f'not a formula: {formula!r}')
+
+
+def variables(formula: Formula) -> set[str]:
+    """Names of all variables in the formula, whether current or next step."""
+    if isinstance(formula, Var):
+        return {formula.name}
+    if isinstance(formula, Const):
+        return set()
+    return set().union(*(variables(child) for child in children(formula)))
+
+
+def children(formula: Formula) -> tuple[Formula, ...]:
+    if isinstance(formula, (Not, Next)):
+        return (formula.arg,)
+    if isinstance(formula, (And, Or)):
+        return formula.args
+    if isinstance(formula, (Implies, Iff)):
+        return (formula.left, formula.right)
+    return ()
+
+
+def mentions_next(formula: Formula) -> bool:
+    """True if the formula refers to the next time step anywhere."""
+    return isinstance(formula, Next) or any(mentions_next(c) for c in children(formula))

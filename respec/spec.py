@@ -1,0 +1,60 @@
+"""GR(1) specifications: eight sections over environment (input) and system (output) propositions.
+
+The section names follow the LTLSpecification message; the slugs section headers follow
+slugs' file formats. Formulas are ``respec.ltl`` trees; text is made only by the printers.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from respec.ltl import Formula, to_infix, to_prefix
+
+PROPOSITION_SECTIONS = ('env_props', 'sys_props')
+FORMULA_SECTIONS = ('env_init', 'sys_init', 'env_trans', 'sys_trans', 'env_liveness', 'sys_liveness')
+SECTIONS = PROPOSITION_SECTIONS + FORMULA_SECTIONS
+
+# slugs' section headers, in the order slugs' own tools write them.
+SLUGS_HEADERS = {
+    'env_props': 'INPUT', 'sys_props': 'OUTPUT',
+    'env_init': 'ENV_INIT', 'sys_init': 'SYS_INIT',
+    'env_trans': 'ENV_TRANS', 'sys_trans': 'SYS_TRANS',
+    'env_liveness': 'ENV_LIVENESS', 'sys_liveness': 'SYS_LIVENESS',
+}
+
+
+@dataclass
+class GR1Specification:
+    """A GR(1) specification: propositions and six formula sections (lists of conjuncts)."""
+
+    env_props: list[str] = field(default_factory=list)
+    sys_props: list[str] = field(default_factory=list)
+    env_init: list[Formula] = field(default_factory=list)
+    sys_init: list[Formula] = field(default_factory=list)
+    env_trans: list[Formula] = field(default_factory=list)
+    sys_trans: list[Formula] = field(default_factory=list)
+    env_liveness: list[Formula] = field(default_factory=list)
+    sys_liveness: list[Formula] = field(default_factory=list)
+
+    def to_text_sections(self) -> dict[str, list[str]]:
+        """The LTLSpecification message shape: each section as a list of infix strings."""
+        sections = {name: list(getattr(self, name)) for name in PROPOSITION_SECTIONS}
+        sections.update({name: [to_infix(f) for f in getattr(self, name)] for name in FORMULA_SECTIONS})
+        return sections
+
+    def to_structuredslugs(self) -> str:
+        """The specification as a ``.structuredslugs`` file (infix formulas)."""
+        return self._slugs_text(to_infix)
+
+    def to_slugsin(self) -> str:
+        """The specification as a ``.slugsin`` file (prefix formulas, primed next-step variables)."""
+        return self._slugs_text(to_prefix)
+
+    def _slugs_text(self, printer) -> str:
+        blocks = []
+        for name in SECTIONS:
+            lines = getattr(self, name)
+            if name in FORMULA_SECTIONS:
+                lines = [printer(f) for f in lines]
+            blocks.append('\n'.join([f'[{SLUGS_HEADERS[name]}]', *lines]))
+        return '\n\n'.join(blocks) + '\n'

@@ -1,0 +1,84 @@
+"""Locating and loading robot system configuration files.
+
+Each robot system has one YAML file, ``<config_dir>/<system>.yaml``, with the sections
+``abstraction`` (read by respec), ``flexbe`` (read by sm_generation) and ``simulation``
+(read by atlas_sim). This module only finds and parses the file; each section is validated
+by the package that owns it.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+from pathlib import Path
+
+import yaml
+
+CONFIG_DIR_ENV = 'BEHAVIOR_SYNTHESIS_CONFIG_DIR'
+_SYSTEM_NAME = re.compile(r'^[A-Za-z][A-Za-z0-9_]*$')
+
+
+class SystemConfigError(Exception):
+    """A system configuration problem; ``item`` names the offending system, file or key."""
+
+    def __init__(self, message: str, item: str = ''):
+        super().__init__(message)
+        self.item = item
+
+
+class UnknownSystemError(SystemConfigError):
+    """No configuration file exists for the requested system."""
+
+
+class ConfigFileInvalidError(SystemConfigError):
+    """The configuration file exists but cannot be parsed or lacks a required section."""
+
+
+def default_config_dir() -> Path:
+    """The config directory: ``$BEHAVIOR_SYNTHESIS_CONFIG_DIR`` or the repository's ``config/``."""
+    override = os.environ.get(CONFIG_DIR_ENV)
+    if override:
+        return Path(override)
+    return Path(__file__).resolve().parent.parent / 'config'
+
+
+def available_systems(config_dir: str | Path | None = None) -> list[str]:
+    """Names of all systems that have a configuration file, sorted."""
+    directory = Path(config_dir) if config_dir else default_config_dir()
+    return sorted(p.stem for p in directory.glob('*.yaml') if _SYSTEM_NAME.match(p.stem))
+
+
+def system_config_path(system: str, config_dir: str | Path | None = None) -> Path:
+    """Path of the configuration file of ``system``; raises UnknownSystemError if absent."""
+    directory = Path(config_dir) if config_dir else default_config_dir()
+    if not isinstance(system, str) or not _SYSTEM_NAME.match(system):
+        raise UnknownSystemError(f'invalid system name {system!r}', item=str(system))
+    path = directory / f'{system}.yaml'
+    if not path.is_file():
+        known = ', '.join(available_systems(directory)) or 'none'
+        raise UnknownSystemError(
+            f'unknown system {system!r}: no {path.name} in {directory} (known systems: {known})',
+            item=system)
+    return path
+
+
+def load_system_file(system: str, config_dir: str | Path | None = None) -> dict:
+    """Parse the whole configuration file of ``system`` into a dict."""
+    path = system_config_path(system, config_dir)
+    try:
+        document = yaml.safe_load(path.read_text())
+    except yaml.YAMLError as error:
+        raise ConfigFileInvalidError(f'{path}: not valid YAML: {error}', item=str(path)) from error
+    if not isinstance(document, dict):
+        raise ConfigFileInvalidError(f'{path}: expected a mapping at the top level', item=str(path))
+    return document
+
+
+def load_section(system: str, section: str, config_dir: str | Path | None = None) -> dict:
+    """One top-level section of a system's configuration; raises if it is missing."""
+    document = load_system_file(system, config_dir)
+    content = document.get(section)
+    if not isinstance(content, dict):
+        raise ConfigFileInvalidError(
+            f'{system}.yaml: missing or invalid section {section!r}', item=section)
+    return content

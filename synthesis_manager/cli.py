@@ -1,0 +1,53 @@
+"""``behavior-synthesis``: the suite's command line (there is no ``ros2`` command on PyPI).
+
+Each subcommand lives in the package that owns it and provides ``add_arguments(parser)``
+and ``run(args) -> int``; modules are imported only when their subcommand is built, so
+``--help`` stays fast.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+
+# name -> (module providing add_arguments/run, one-line help)
+SUBCOMMANDS = {
+    'demo': ('synthesis_manager.demo', "run the paper's task end to end and write the artifacts"),
+    'serve': ('synthesis_manager.serve', 'run the synthesis suite until SIGINT/SIGTERM'),
+    'send-goal': ('synthesis_manager.send_goal', 'send a goal to /behavior_synthesis and show the result'),
+    'compile': ('ltl_specification.cli', 'compile a task into a GR(1) specification (no ROS)'),
+    'generate-sm': ('sm_generation.cli', 'turn an automaton into a FlexBE state machine (no ROS)'),
+    'execute': ('atlas_sim.cli', 'synthesize a behavior and run it on the simulated ATLAS'),
+    'gui': ('synthesis_manager.gui', 'serve the synthesis web GUI on 127.0.0.1'),
+}
+
+
+def build_parser(only: str | None = None) -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog='behavior-synthesis',
+        description='Reactive high-level behavior synthesis: goals -> GR(1) LTL -> FlexBE state machine.')
+    subparsers = parser.add_subparsers(dest='command', metavar='COMMAND')
+    for name, (module_name, help_text) in SUBCOMMANDS.items():
+        subparser = subparsers.add_parser(name, help=help_text, description=help_text)
+        if only in (None, name):
+            module = importlib.import_module(module_name)
+            module.add_arguments(subparser)
+            subparser.set_defaults(run=module.run)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    argv = sys.argv[1:] if argv is None else argv
+    # Import only the module of the requested subcommand (fast start, isolated failures).
+    command = next((word for word in argv if word in SUBCOMMANDS), None)
+    parser = build_parser(only=command or '')
+    args = parser.parse_args(argv)
+    if not getattr(args, 'run', None):
+        parser.print_help()
+        return 0 if not argv or '-h' in argv or '--help' in argv else 2
+    return args.run(args)
+
+
+if __name__ == '__main__':
+    sys.exit(main())

@@ -29,3 +29,64 @@ def test_command_line_help_lists_subcommands():
     assert result.returncode == 0, result.stderr
     for command in ('demo', 'serve', 'send-goal', 'compile', 'execute', 'gui'):
         assert command in result.stdout
+
+
+PACKAGES = ('respec', 'ltl_specification', 'ltl_synthesizer', 'sm_generation', 'synthesis_manager',
+            'atlas_sim')
+ROS_INIT_OWNERS = {'synthesis_manager/ros_env.py', 'synthesis_manager/harness.py'}
+
+
+def test_rclpy_is_initialised_only_by_the_loopback_helpers():
+    """Every entry point reaches rclpy.init() through ros_env.init_ros or RosHarness."""
+    import re
+    from pathlib import Path
+
+    call = re.compile(r'^\s*(\w+\s*=\s*)?rclpy\.init\(', re.MULTILINE)
+    root = Path(__file__).resolve().parent.parent
+    offenders = [str(path.relative_to(root)) for package in PACKAGES
+                 for path in (root / package).rglob('*.py')
+                 if call.search(path.read_text())
+                 and str(path.relative_to(root)) not in ROS_INIT_OWNERS]
+    assert ROS_INIT_OWNERS <= {str(p.relative_to(root)) for p in (root / 'synthesis_manager').glob('*.py')
+                               if call.search(p.read_text())}
+    assert offenders == []
+
+
+def capture_environment_at_init(monkeypatch):
+    import rclpy
+
+    seen = {}
+
+    def fake_init(*args, **kwargs):
+        seen.update(os.environ)
+        raise RuntimeError('stop here')
+
+    monkeypatch.setattr(rclpy, 'init', fake_init)
+    return seen
+
+
+def test_init_ros_applies_loopback_before_rclpy_init(monkeypatch):
+    import pytest
+
+    from synthesis_manager.ros_env import init_ros
+
+    monkeypatch.setenv('ROS_AUTOMATIC_DISCOVERY_RANGE', 'SUBNET')
+    monkeypatch.setenv('ROS_STATIC_PEERS', '192.0.2.1')
+    seen = capture_environment_at_init(monkeypatch)
+    with pytest.raises(RuntimeError, match='stop here'):
+        init_ros()
+    assert seen['ROS_AUTOMATIC_DISCOVERY_RANGE'] == 'LOCALHOST'
+    assert 'ROS_STATIC_PEERS' not in seen
+
+
+def test_harness_applies_loopback_before_rclpy_init(monkeypatch):
+    import pytest
+
+    from synthesis_manager.harness import RosHarness
+
+    monkeypatch.setenv('ROS_AUTOMATIC_DISCOVERY_RANGE', 'SUBNET')
+    seen = capture_environment_at_init(monkeypatch)
+    with pytest.raises(RuntimeError, match='stop here'):
+        with RosHarness():
+            pass
+    assert seen['ROS_AUTOMATIC_DISCOVERY_RANGE'] == 'LOCALHOST'

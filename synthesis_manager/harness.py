@@ -1,4 +1,4 @@
-"""A launch-free harness for running ROS 2 nodes in-process (tests, benchmarks, demos).
+"""A launch-free harness for running ROS 2 nodes in-process (tests, benchmarks, demo, clients).
 
 ``RosHarness`` owns a private rclpy context on a reserved ROS_DOMAIN_ID and a
 MultiThreadedExecutor spinning in a background thread, so several test runs on one machine
@@ -21,19 +21,21 @@ from synthesis_manager.ros_env import prepare_ros_environment
 class RosHarness:
     """Context manager: reserved domain, own rclpy context, executor thread, clean teardown."""
 
-    def __init__(self, num_threads: int = 8):
+    def __init__(self, num_threads: int = 8, domain_id: int | None = None):
+        """``domain_id=None`` reserves a free domain; give one to join an existing system."""
         self._num_threads = num_threads
+        self.domain_id = domain_id
         self._stack = contextlib.ExitStack()
         self.nodes = []
         self.context = None
         self.executor = None
-        self.domain_id = None
         self._thread = None
 
     def __enter__(self) -> 'RosHarness':
         from domain_coordinator import domain_id
 
-        self.domain_id = self._stack.enter_context(domain_id())
+        if self.domain_id is None:
+            self.domain_id = self._stack.enter_context(domain_id())
         prepare_ros_environment(self.domain_id)
         import rclpy
         from rclpy.executors import MultiThreadedExecutor
@@ -77,3 +79,10 @@ def wait_for(future, timeout: float = 10.0):
     if not done.wait(timeout):
         raise TimeoutError(f'no result within {timeout} s')
     return future.result()
+
+
+def environment_domain_id() -> int:
+    """The ROS_DOMAIN_ID of this process's environment (0 when unset), as clients use."""
+    import os
+
+    return int(os.environ.get('ROS_DOMAIN_ID') or 0)

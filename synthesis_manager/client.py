@@ -1,0 +1,105 @@
+"""A client of ``/behavior_synthesis`` shared by send-goal, demo, execute and the web GUI."""
+
+from __future__ import annotations
+
+import threading
+import time
+from dataclasses import dataclass, field
+
+from synthesis_manager.conversions import error_name, msg_to_sections, msg_to_state_dict
+from synthesis_manager.harness import wait_for
+from synthesis_msgs.action import BehaviorSynthesis
+from synthesis_msgs.msg import BehaviorSynthesisRequest, LTLSpecification, SynthesisOptions
+
+ACTION_NAME = 'behavior_synthesis'
+
+
+@dataclass
+class SynthesisOutcome:
+    """What a goal ended with, in plain Python types."""
+
+    error_code: int
+    error_name: str
+    message: str
+    states: list[dict] = field(default_factory=list)
+    ltl_specification: dict = field(default_factory=dict)
+    automaton: dict = field(default_factory=dict)
+    seconds: float = 0.0
+
+    @property
+    def succeeded(self) -> bool:
+        return self.error_name == 'SUCCESS'
+
+    def to_dict(self) -> dict:
+        return {'error_code': self.error_code, 'error_name': self.error_name,
+                'message': self.message, 'states': self.states,
+                'ltl_specification': self.ltl_specification, 'automaton': self.automaton,
+                'seconds': round(self.seconds, 4)}
+
+
+def make_goal(system: str, initial_conditions, goals, sm_outcomes=('finished', 'failed'),
+              option: str | None = None, name: str = '', ltl_specification: dict | None = None,
+              unordered: bool = False, timeout: float = 0.0) -> BehaviorSynthesis.Goal:
+    """Build a goal; list arguments are joined the original way (comma-separated)."""
+    join = lambda names: names if isinstance(names, str) else ', '.join(names)  # noqa: E731
+    request = BehaviorSynthesisRequest(
+        system=system, initial_condition=join(initial_conditions), goal=join(goals),
+        sm_outcomes=list(sm_outcomes), name=name, unordered_goals=unordered, timeout=float(timeout),
+        ltl_specification=LTLSpecification(**(ltl_specification or {})))
+    options = SynthesisOptions()
+    if option:
+        setattr(options, option, True)
+    return BehaviorSynthesis.Goal(request=request, synthesis_options=options)
+
+
+def automaton_to_dict(automaton) -> dict:
+    return {'output_variables': list(automaton.output_variables),
+            'input_variables': list(automaton.input_variables),
+            'initial_states': list(automaton.initial_states),
+            'states': [{'name': s.name, 'output_valuation': [bool(v) for v in s.output_valuation],
+                        'input_valuation': [bool(v) for v in s.input_valuation],
+                        'transitions': list(s.transitions), 'rank': int(s.rank)}
+                       for s in automaton.automaton]}
+
+
+def outcome_from_result(result, seconds: float) -> SynthesisOutcome:
+    return SynthesisOutcome(
+        error_code=result.error_code.value, error_name=error_name(result.error_code.value),
+        message=result.error_code.message, states=[msg_to_state_dict(s) for s in result.states],
+        ltl_specification=msg_to_sections(result.ltl_specification),
+        automaton=automaton_to_dict(result.automaton), seconds=seconds)
+
+
+class SynthesisClient:
+    """Sends goals from a (spinning) node and waits for them in the calling thread."""
+
+    def __init__(self, node, action_name: str = ACTION_NAME):
+        from rclpy.action import ActionClient
+
+        self.node = node
+        self.action_client = ActionClient(node, BehaviorSynthesis, action_name)
+
+    def wait_for_server(self, timeout: float = 10.0) -> bool:
+        return self.action_client.wait_for_server(timeout_sec=timeout)
+
+    def run(self, goal, feedback=None, cancel: threading.Event | None = None,
+            timeout: float = 600.0) -> SynthesisOutcome:
+        """Send ``goal``; call ``feedback(status, progress)``; cancel when ``cancel`` is set."""
+        started = time.monotonic()
+        on_feedback = (lambda msg: feedback(msg.feedback.status, msg.feedback.progress)) if feedback else None
+        handle = wait_for(self.action_client.send_goal_async(goal, feedback_callback=on_feedback),
+                            timeout)
+        if not handle.accepted:
+            return SynthesisOutcome(-2, 'INVALID_REQUEST', 'the server rejected the goal')
+        result_future = handle.get_result_async()
+        done = threading.Event()
+        result_future.add_done_callback(lambda _: done.set())
+        cancel_sent = False
+        while not done.wait(0.02):
+            if cancel is not None and cancel.is_set() and not cancel_sent:
+                handle.cancel_goal_async()
+                cancel_sent = True
+            if time.monotonic() - started > timeout:
+                handle.cancel_goal_async()
+                raise TimeoutError(f'no result within {timeout:g} s')
+        return outcome_from_result(result_future.result().result, time.monotonic() - started)

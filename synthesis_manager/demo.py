@@ -1,0 +1,79 @@
+"""``behavior-synthesis demo`` (``make run``): the paper's task end to end, in one process.
+
+Starts the four nodes in-process on a private ROS domain, sends I={stand_prep},
+G=[look_down, pickup_object], prints the specification size, realizability, automaton size
+and the state machine as a tree, and writes every artifact to an output folder.
+"""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+from synthesis_manager.send_goal import ProgressBar, add_goal_arguments, goal_from_args, print_summary
+from synthesis_manager.suite import add_suite_arguments, suite_node_factories
+
+
+def add_arguments(parser):
+    add_goal_arguments(parser, with_options=False)
+    parser.set_defaults(name='demo')
+    add_suite_arguments(parser)
+    parser.add_argument('--output-dir', default='out/demo', help='where to write the artifacts')
+
+
+def write_artifacts(outcome, directory: Path) -> list[Path]:
+    """StateInstantiation YAML/JSON and pictures of the state machine (byproducts are already there)."""
+    from sm_generation import StateInstantiation
+    from sm_generation.export import render, to_dot, to_json, to_yaml
+
+    states = [StateInstantiation.from_dict(s) for s in outcome.states]
+    written = []
+    for name, text in (('state_machine.yaml', to_yaml(states)), ('state_machine.json', to_json(states)),
+                       ('state_machine.dot', to_dot(states))):
+        path = directory / name
+        path.write_text(text)
+        written.append(path)
+    for suffix in ('svg', 'png'):
+        path = directory / f'state_machine.{suffix}'
+        try:
+            render(to_dot(states), path)
+            written.append(path)
+        except Exception as error:  # Graphviz is optional: say so and carry on
+            print(f'(no {suffix} picture: {error})', file=sys.stderr)
+    return written
+
+
+def run(args) -> int:
+    from rclpy.node import Node
+
+    from synthesis_manager.client import SynthesisClient
+    from synthesis_manager.harness import RosHarness
+
+    directory = Path(args.output_dir).resolve()
+    directory.mkdir(parents=True, exist_ok=True)
+    args.byproducts_dir = str(directory)
+    print(f'Task: from {args.initial_conditions}: {args.goals} (system {args.system})')
+    try:
+        with RosHarness() as ros:
+            for factory in suite_node_factories(args):
+                ros.add_node(factory)
+            client = SynthesisClient(ros.add_node(Node, 'demo_client'))
+            if not client.wait_for_server(timeout=10.0):
+                print('demo: the action server did not come up', file=sys.stderr)
+                return 1
+            progress = ProgressBar()
+            outcome = client.run(goal_from_args(args), feedback=progress)
+            progress.close()
+    except KeyboardInterrupt:
+        print('\ndemo: interrupted', file=sys.stderr)
+        return 130
+    print_summary(outcome)
+    if not outcome.succeeded:
+        return 1
+    print('realizable: yes')
+    written = write_artifacts(outcome, directory)
+    byproducts = sorted(directory.glob(f'{args.name}.*'))
+    print(f'artifacts in {directory}:')
+    for path in byproducts + written:
+        print(f'  {path.name}')
+    return 0

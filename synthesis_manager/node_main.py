@@ -1,0 +1,45 @@
+"""Run nodes until SIGINT/SIGTERM: the body of every node's console script and of ``serve``."""
+
+from __future__ import annotations
+
+import signal
+import sys
+
+from synthesis_manager.ros_env import init_ros
+
+
+def run_nodes(*node_factories, argv: list[str] | None = None, ready_message: str = '') -> int:
+    """Create each node in one process, spin them on a MultiThreadedExecutor, shut down cleanly."""
+    import rclpy
+    from rclpy.executors import ExternalShutdownException, MultiThreadedExecutor
+
+    context = init_ros(args=argv)
+    executor = MultiThreadedExecutor(num_threads=16, context=context)
+    nodes = []
+
+    def stop(signum, frame):
+        raise KeyboardInterrupt
+
+    previous_sigterm = signal.signal(signal.SIGTERM, stop)
+    try:
+        for factory in node_factories:
+            node = factory(context=context)
+            nodes.append(node)
+            executor.add_node(node)
+        if ready_message:
+            print(ready_message, flush=True)
+        executor.spin()
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass
+    finally:
+        signal.signal(signal.SIGTERM, previous_sigterm)
+        executor.shutdown(timeout_sec=5.0)
+        for node in reversed(nodes):
+            node.destroy_node()
+        context.try_shutdown()
+    return 0
+
+
+def node_main(node_factory, name: str):
+    """Console-script body for a single node."""
+    sys.exit(run_nodes(node_factory, argv=sys.argv, ready_message=f'{name} ready'))

@@ -1,0 +1,136 @@
+"""``behavior-synthesis send-goal``: send one goal to a running suite, show progress and the result."""
+
+from __future__ import annotations
+
+import json
+import sys
+import threading
+from pathlib import Path
+
+from synthesis_manager.requests import parse_names
+from synthesis_manager.summary import spec_size, state_machine_tree
+
+
+def add_goal_arguments(parser, with_options: bool = True):
+    """The task description shared by send-goal, demo and execute."""
+    parser.add_argument('--system', default='atlas', help='robot system (a config/<system>.yaml)')
+    parser.add_argument('--initial-conditions', default='stand_prep',
+                        help='comma-separated initial conditions')
+    parser.add_argument('--goals', default='look_down,pickup_object', help='comma-separated goals, in order')
+    parser.add_argument('--sm-outcomes', default='finished,failed',
+                        help='state machine outcomes: finished,failed or finished (retry on failure)')
+    parser.add_argument('--unordered', action='store_true', help='goals may be achieved in any order')
+    parser.add_argument('--name', default='', help='behavior name (names the byproduct files)')
+    if with_options:
+        stop = parser.add_mutually_exclusive_group()
+        stop.add_argument('--compile-only', action='store_true', help='stop after LTL compilation')
+        stop.add_argument('--synthesis-only', metavar='SPEC',
+                          help='synthesize this .structuredslugs or LTLSpecification .json file')
+        stop.add_argument('--ltl-steps-only', action='store_true', help='stop at the automaton')
+
+
+def add_arguments(parser):
+    add_goal_arguments(parser)
+    parser.add_argument('--timeout', type=float, default=120.0, help='seconds to wait for the result')
+    parser.add_argument('--json', action='store_true', help='print the result as one JSON object')
+    parser.add_argument('-o', '--output', help='also write the JSON result to this file')
+
+
+def goal_from_args(args):
+    from synthesis_manager.client import make_goal
+
+    option, spec = None, None
+    if getattr(args, 'compile_only', False):
+        option = 'ltl_compilation_only'
+    elif getattr(args, 'ltl_steps_only', False):
+        option = 'ltl_steps_only'
+    elif getattr(args, 'synthesis_only', None):
+        option, spec = 'ltl_synthesis_only', read_spec_file(args.synthesis_only)
+    return make_goal(args.system, parse_names(args.initial_conditions), parse_names(args.goals),
+                     parse_names(args.sm_outcomes), option=option, name=args.name,
+                     ltl_specification=spec, unordered=args.unordered,
+                     timeout=getattr(args, 'timeout', 0.0))
+
+
+def read_spec_file(path: str) -> dict:
+    """A complete specification from a .structuredslugs file or an LTLSpecification JSON dict."""
+    text = Path(path).read_text()
+    if path.endswith('.json'):
+        return json.loads(text)
+    from respec.parsing import parse_structuredslugs
+
+    return parse_structuredslugs(text, filename=path).to_text_sections()
+
+
+class ProgressBar:
+    """A one-line progress bar on stderr driven by the action's feedback."""
+
+    def __init__(self, stream=sys.stderr, width: int = 30):
+        self.stream, self.width = stream, width
+
+    def __call__(self, status: str, progress: float):
+        filled = int(round(progress * self.width))
+        self.stream.write(f'\r[{"#" * filled}{"." * (self.width - filled)}] {progress:4.0%} {status:<60.60}')
+        self.stream.flush()
+
+    def close(self):
+        self.stream.write('\n')
+        self.stream.flush()
+
+
+def print_summary(outcome, stream=sys.stdout):
+    print(f'result: {outcome.error_name} ({outcome.error_code}) in {outcome.seconds * 1000:.0f} ms',
+          file=stream)
+    if outcome.message:
+        print(f'message: {outcome.message}', file=stream)
+    if outcome.ltl_specification:
+        print(f'specification: {spec_size(outcome.ltl_specification)}', file=stream)
+    if outcome.automaton.get('states'):
+        print(f"automaton: {len(outcome.automaton['states'])} states", file=stream)
+    if outcome.states:
+        print(f'state machine ({len(outcome.states)} state instantiations):', file=stream)
+        print(state_machine_tree(outcome.states), file=stream)
+
+
+def run(args) -> int:
+    from synthesis_manager.client import SynthesisClient
+    from synthesis_manager.harness import RosHarness, environment_domain_id
+
+    try:
+        goal = goal_from_args(args)
+    except Exception as error:
+        print(f'send-goal: cannot read the request: {error}', file=sys.stderr)
+        return 2
+    from rclpy.node import Node
+
+    with RosHarness(domain_id=environment_domain_id()) as ros:
+        client = SynthesisClient(ros.add_node(Node, 'behavior_synthesis_client'))
+        if not client.wait_for_server(timeout=10.0):
+            print('send-goal: no /behavior_synthesis action server (start one with '
+                  '`behavior-synthesis serve`)', file=sys.stderr)
+            return 1
+        progress = None if args.json else ProgressBar()
+        cancel = threading.Event()
+        outcome_box = {}
+        worker = threading.Thread(target=lambda: outcome_box.update(
+            outcome=client.run(goal, feedback=progress, cancel=cancel, timeout=args.timeout + 30)))
+        worker.start()
+        try:
+            while worker.is_alive():
+                worker.join(0.1)
+        except KeyboardInterrupt:  # Ctrl-C cancels the goal, then we wait for its result
+            cancel.set()
+            worker.join()
+        if progress:
+            progress.close()
+    outcome = outcome_box.get('outcome')
+    if outcome is None:
+        print('send-goal: no result', file=sys.stderr)
+        return 1
+    if args.output:
+        Path(args.output).write_text(json.dumps(outcome.to_dict(), indent=1))
+    if args.json:
+        print(json.dumps(outcome.to_dict()))
+    else:
+        print_summary(outcome)
+    return 0 if outcome.succeeded else 1

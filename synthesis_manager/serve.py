@@ -1,0 +1,24 @@
+"""``behavior-synthesis serve``: the whole suite in one process until SIGINT/SIGTERM."""
+
+from __future__ import annotations
+
+from synthesis_manager.suite import SUITE_NODE_NAMES, add_suite_arguments, suite_node_factories
+
+
+def add_arguments(parser):
+    add_suite_arguments(parser)
+    parser.add_argument('--nodes', default=','.join(SUITE_NODE_NAMES),
+                        help=f'comma-separated subset of: {", ".join(SUITE_NODE_NAMES)}')
+
+
+def run(args) -> int:
+    from synthesis_manager.node_main import run_nodes
+
+    names = [name for name in args.nodes.split(',') if name]
+    unknown = sorted(set(names) - set(SUITE_NODE_NAMES))
+    if unknown:
+        print(f'behavior-synthesis serve: unknown node {unknown[0]!r}')
+        return 2
+    return run_nodes(*suite_node_factories(args, names),
+                     ready_message=f'behavior synthesis suite up: {", ".join(names)} '
+                                   '(action /behavior_synthesis); Ctrl-C to stop')

@@ -1,0 +1,49 @@
+"""The four nodes of the synthesis suite and their shared settings."""
+
+from __future__ import annotations
+
+import functools
+
+SUITE_NODE_NAMES = ('ltl_compilation', 'ltl_synthesis', 'sm_generation', 'behavior_synthesis_server')
+
+
+def add_suite_arguments(parser):
+    """Command-line settings shared by ``serve``, ``demo`` and ``execute``."""
+    group = parser.add_argument_group('suite settings')
+    group.add_argument('--config-dir', default='', help='robot system configurations (default: config/)')
+    group.add_argument('--byproducts-dir', default='', help='where the synthesizer writes its byproducts')
+    group.add_argument('--backend', choices=('builtin', 'slugs'), default='builtin',
+                       help='synthesizer: our own (builtin) or a slugs executable on PATH')
+    group.add_argument('--slugs-executable', default='slugs', help='the executable for --backend slugs')
+    group.add_argument('--synthesis-timeout', type=float, default=120.0, help='seconds per synthesis')
+    group.add_argument('--service-timeout', type=float, default=5.0,
+                       help='seconds to wait for a pipeline service to appear')
+
+
+def suite_node_factories(args=None, names=SUITE_NODE_NAMES):
+    """Factories (taking ``context=``) for the suite's nodes, parametrised from ``args``."""
+    from rclpy.parameter import Parameter
+
+    from ltl_specification.node import LTLCompilationNode
+    from ltl_synthesizer.node import LTLSynthesisNode
+    from sm_generation.node import SMGenerationNode
+    from synthesis_manager.server_node import BehaviorSynthesisServer
+
+    def overrides(**values):
+        return [Parameter(name, value=value) for name, value in values.items()
+                if value not in ('', None)]
+
+    settings = {
+        'ltl_compilation': (LTLCompilationNode, overrides(config_dir=getattr(args, 'config_dir', ''))),
+        'ltl_synthesis': (LTLSynthesisNode, overrides(
+            byproducts_dir=getattr(args, 'byproducts_dir', ''),
+            backend=getattr(args, 'backend', ''),
+            slugs_executable=getattr(args, 'slugs_executable', ''),
+            timeout=getattr(args, 'synthesis_timeout', None))),
+        'sm_generation': (SMGenerationNode, overrides(config_dir=getattr(args, 'config_dir', ''))),
+        'behavior_synthesis_server': (BehaviorSynthesisServer, overrides(
+            synthesis_timeout=getattr(args, 'synthesis_timeout', None),
+            service_timeout=getattr(args, 'service_timeout', None))),
+    }
+    return [functools.partial(settings[name][0], parameter_overrides=settings[name][1])
+            for name in names]

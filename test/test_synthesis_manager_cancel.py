@@ -1,0 +1,100 @@
+"""Cancel at every stage, missing and hanging services: clear codes, never a hang."""
+
+import threading
+import time
+from argparse import Namespace
+
+import pytest
+from rclpy.node import Node
+from rclpy.parameter import Parameter
+
+from synthesis_manager.client import SynthesisClient, make_goal
+from synthesis_manager.server_node import BehaviorSynthesisServer
+from synthesis_manager.suite import suite_node_factories
+from synthesis_msgs.srv import GenerateFlexBESM, GenerateLTLSpecification
+
+PAPER_TASK = dict(system='atlas', initial_conditions=['stand_prep'], goals=['look_down', 'pickup_object'])
+
+
+def make_slow_service(service_type, name, seconds):
+    """A stand-in pipeline service that takes ``seconds`` to answer (or forever)."""
+    def factory(context, **kwargs):
+        from rclpy.callback_groups import ReentrantCallbackGroup
+
+        node = Node(f'slow_{name}', context=context)
+        release = threading.Event()
+        node.release = release
+
+        def handle(request, response):
+            release.wait(seconds)
+            response.error_code.value = response.error_code.FAILURE
+            response.error_code.message = 'slow stand-in answered'
+            return response
+
+        node.create_service(service_type, name, handle, callback_group=ReentrantCallbackGroup())
+        return node
+    return factory
+
+
+def start(ros, tmp_path, replace=None, server_parameters=()):
+    """The suite with some services replaced by stand-ins; returns a client."""
+    names = ['ltl_compilation', 'ltl_synthesis', 'sm_generation']
+    args = Namespace(config_dir='', byproducts_dir=str(tmp_path), backend='builtin',
+                     slugs_executable='slugs', synthesis_timeout=60.0, service_timeout=1.0)
+    replace = replace or {}
+    real = [n for n in names if n not in replace and n is not None]
+    for factory in suite_node_factories(args, real):
+        ros.add_node(factory)
+    stand_ins = [ros.add_node(factory) for factory in replace.values() if factory is not None]
+    ros.add_node(BehaviorSynthesisServer, parameter_overrides=[
+        Parameter('service_timeout', value=1.0), *server_parameters])
+    client = SynthesisClient(ros.add_node(Node, 'cancel_client'))
+    assert client.wait_for_server(timeout=10.0)
+    return client, stand_ins
+
+
+def cancel_when(client, goal, status_prefix):
+    """Run ``goal`` and cancel it as soon as feedback says ``status_prefix``."""
+    cancel = threading.Event()
+
+    def feedback(status, progress):
+        if status.startswith(status_prefix):
+            cancel.set()
+
+    started = time.monotonic()
+    outcome = client.run(goal, feedback=feedback, cancel=cancel, timeout=60)
+    return outcome, time.monotonic() - started
+
+
+def test_cancel_during_compilation(ros, tmp_path):
+    client, _ = start(ros, tmp_path, replace={
+        'ltl_compilation': make_slow_service(GenerateLTLSpecification, 'ltl_compilation', 30)})
+    outcome, seconds = cancel_when(client, make_goal(**PAPER_TASK), 'Compiling')
+    assert outcome.error_name == 'PREEMPTED'
+    assert seconds < 10
+
+
+def test_cancel_during_generation(ros, tmp_path):
+    client, _ = start(ros, tmp_path, replace={
+        'sm_generation': make_slow_service(GenerateFlexBESM, 'sm_generate', 30)})
+    outcome, seconds = cancel_when(client, make_goal(**PAPER_TASK), 'Generating')
+    assert outcome.error_name == 'PREEMPTED'
+    assert seconds < 10
+
+
+def test_missing_service_gives_service_unavailable(ros, tmp_path):
+    client, _ = start(ros, tmp_path, replace={'ltl_compilation': None})
+    outcome = client.run(make_goal(**PAPER_TASK), timeout=30)
+    assert outcome.error_name == 'SERVICE_UNAVAILABLE'
+    assert 'ltl_compilation' in outcome.message
+
+
+def test_hanging_service_times_out(ros, tmp_path):
+    client, stand_ins = start(
+        ros, tmp_path,
+        replace={'sm_generation': make_slow_service(GenerateFlexBESM, 'sm_generate', 60)},
+        server_parameters=[Parameter('generation_timeout', value=1.0)])
+    outcome = client.run(make_goal(**PAPER_TASK), timeout=30)
+    stand_ins[0].release.set()
+    assert outcome.error_name == 'TIMEOUT'
+    assert 'sm_generate' in outcome.message

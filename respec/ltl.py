@@ -208,3 +208,29 @@ def children(formula: Formula) -> tuple[Formula, ...]:
 def mentions_next(formula: Formula) -> bool:
     """True if the formula refers to the next time step anywhere."""
     return isinstance(formula, Next) or any(mentions_next(c) for c in children(formula))
+
+
+def evaluate(formula: Formula, current: dict[str, bool], next_step: dict[str, bool] | None = None) -> bool:
+    """Truth value of ``formula`` on a step from valuation ``current`` to ``next_step``.
+
+    Variables under ``next`` are read from ``next_step``; a missing variable raises KeyError.
+    """
+    if isinstance(formula, Const):
+        return formula.value
+    if isinstance(formula, Var):
+        return current[formula.name]
+    if isinstance(formula, Next):
+        if next_step is None:
+            raise ValueError(f'{to_infix(formula)} needs the next step')
+        return evaluate(formula.arg, next_step, None)
+    if isinstance(formula, Not):
+        return not evaluate(formula.arg, current, next_step)
+    if isinstance(formula, And):
+        return all(evaluate(arg, current, next_step) for arg in formula.args)
+    if isinstance(formula, Or):
+        return any(evaluate(arg, current, next_step) for arg in formula.args)
+    if isinstance(formula, Implies):
+        return (not evaluate(formula.left, current, next_step)) or evaluate(formula.right, current, next_step)
+    if isinstance(formula, Iff):
+        return evaluate(formula.left, current, next_step) == evaluate(formula.right, current, next_step)
+    raise TypeError(f'not a formula: {formula!r}')

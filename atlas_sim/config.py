@@ -1,0 +1,170 @@
+"""Loading a robot-system config (``config/<system>.yaml``) for atlas_sim.
+
+Two sections matter here:
+
+``abstraction``  the discrete model shared with the specification compiler:
+                 ``control_modes`` (mode -> adjacent modes, self-loops implied),
+                 ``actions`` (action -> capabilities that must have completed),
+                 ``outcomes`` and ``sensors``.
+``simulation``   how atlas_sim emulates the system (all keys optional)::
+
+    simulation:
+      initial_mode: stand_prep      # default: abstraction.initial_mode, else first mode
+      timestep: 0.002               # physics step (s)
+      control_period: 0.01          # sim time advanced by one Simulator.step() (s)
+      real_time_factor: 0.0         # 0 = as fast as possible, 1 = wall-clock pace
+      seed: 0                       # seed of probabilistic faults
+      fault_delay: 0.1              # sim time before an injected fault is reported (s)
+      settle: {timeout: 3.0, position_tolerance: 0.15, velocity_tolerance: 0.2}
+      fall: {min_pelvis_height: 0.45, max_torso_tilt_deg: 40.0}
+      modes:                        # control mode -> motion (see atlas_sim.motions)
+        stand: {motion: posture, posture: stand, duration: 1.5}
+        walk:  {motion: gait, steps: 4, step_length: 0.15}
+      actions:                      # action -> motion
+        look_down: {motion: head_tilt, tilt_deg: 45}
+        object_template: {motion: operator_input}
+      invalidations:                # on completion of key, forget these completions
+        footstep_execution: [footstep_plan]
+      scenario:
+        operator_inputs: {object_template: true, target_pose: true}
+        sensors: {obj_detected: true}
+      faults:                       # capability -> fault (see atlas_sim.faults)
+        pickup_object: {fail_first: 1}
+
+Capabilities without a motion entry get a default: control modes take the
+``stand`` posture, actions are short computations (they always complete
+unless a precondition or an injected fault says otherwise).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Dict, Mapping, Optional, Tuple
+
+import yaml
+
+#: config/ next to the atlas_sim package (the repository layout).
+CONFIG_DIR = Path(__file__).resolve().parent.parent / "config"
+DEFAULT_CONFIG = CONFIG_DIR / "atlas.yaml"
+
+
+@dataclass(frozen=True)
+class AbstractionConfig:
+    """The ``abstraction:`` section: the discrete model of the robot system."""
+
+    control_modes: Dict[str, Tuple[str, ...]]
+    actions: Dict[str, Tuple[str, ...]]
+    outcomes: Tuple[str, ...] = ("completed", "failed")
+    sensors: Tuple[str, ...] = ()
+    initial_mode: Optional[str] = None
+
+    @classmethod
+    def from_dict(cls, section: Mapping[str, Any]) -> "AbstractionConfig":
+        modes = {str(m): tuple(adj or ()) for m, adj in (section.get("control_modes") or {}).items()}
+        actions = {str(a): tuple(pre or ()) for a, pre in (section.get("actions") or {}).items()}
+        return cls(
+            control_modes=modes,
+            actions=actions,
+            outcomes=tuple(section.get("outcomes") or ("completed", "failed")),
+            sensors=tuple(section.get("sensors") or ()),
+            initial_mode=section.get("initial_mode"),
+        )
+
+
+@dataclass(frozen=True)
+class SettleConfig:
+    """When a motion counts as settled and how long it may take."""
+
+    timeout: float = 3.0
+    position_tolerance: float = 0.15
+    velocity_tolerance: float = 0.2
+
+
+@dataclass(frozen=True)
+class ScenarioConfig:
+    """What the (simulated) operator and environment provide."""
+
+    operator_inputs: Dict[str, bool] = field(default_factory=dict)
+    sensors: Dict[str, bool] = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
+class SimulationConfig:
+    """The ``simulation:`` section (see the module docstring for the schema)."""
+
+    initial_mode: Optional[str] = None
+    timestep: float = 0.002
+    control_period: float = 0.01
+    real_time_factor: float = 0.0
+    seed: int = 0
+    fault_delay: float = 0.1
+    settle: SettleConfig = SettleConfig()
+    min_pelvis_height: float = 0.45
+    max_torso_tilt_deg: float = 40.0
+    modes: Dict[str, Dict[str, Any]] = field(default_factory=dict)
+    actions: Dict[str, Dict[str, Any]] = field(default_factory=dict)
+    invalidations: Dict[str, Tuple[str, ...]] = field(default_factory=dict)
+    scenario: ScenarioConfig = ScenarioConfig()
+    faults: Dict[str, Dict[str, Any]] = field(default_factory=dict)
+
+    @classmethod
+    def from_dict(cls, section: Optional[Mapping[str, Any]]) -> "SimulationConfig":
+        section = dict(section or {})
+        unknown = set(section) - _SIMULATION_KEYS
+        if unknown:
+            raise ValueError(f"unknown keys in simulation section: {sorted(unknown)}")
+        settle = SettleConfig(**(section.get("settle") or {}))
+        fall = section.get("fall") or {}
+        scenario_section = section.get("scenario") or {}
+        scenario = ScenarioConfig(
+            operator_inputs={str(k): bool(v) for k, v in (scenario_section.get("operator_inputs") or {}).items()},
+            sensors={str(k): bool(v) for k, v in (scenario_section.get("sensors") or {}).items()},
+        )
+        return cls(
+            initial_mode=section.get("initial_mode"),
+            timestep=float(section.get("timestep", cls.timestep)),
+            control_period=float(section.get("control_period", cls.control_period)),
+            real_time_factor=float(section.get("real_time_factor", cls.real_time_factor)),
+            seed=int(section.get("seed", cls.seed)),
+            fault_delay=float(section.get("fault_delay", cls.fault_delay)),
+            settle=settle,
+            min_pelvis_height=float(fall.get("min_pelvis_height", cls.min_pelvis_height)),
+            max_torso_tilt_deg=float(fall.get("max_torso_tilt_deg", cls.max_torso_tilt_deg)),
+            modes={str(k): dict(v or {}) for k, v in (section.get("modes") or {}).items()},
+            actions={str(k): dict(v or {}) for k, v in (section.get("actions") or {}).items()},
+            invalidations={str(k): tuple(v or ()) for k, v in (section.get("invalidations") or {}).items()},
+            scenario=scenario,
+            faults={str(k): dict(v or {}) for k, v in (section.get("faults") or {}).items()},
+        )
+
+
+_SIMULATION_KEYS = {
+    "initial_mode", "timestep", "control_period", "real_time_factor", "seed", "fault_delay",
+    "settle", "fall", "modes", "actions", "invalidations", "scenario", "faults",
+}
+
+
+@dataclass(frozen=True)
+class SystemConfig:
+    """A robot system: its name, discrete abstraction and simulation settings."""
+
+    system: str
+    abstraction: AbstractionConfig
+    simulation: SimulationConfig
+
+    @classmethod
+    def from_dict(cls, document: Mapping[str, Any]) -> "SystemConfig":
+        if "abstraction" not in document:
+            raise ValueError("robot config has no 'abstraction' section")
+        return cls(
+            system=str(document.get("system", "unnamed")),
+            abstraction=AbstractionConfig.from_dict(document["abstraction"]),
+            simulation=SimulationConfig.from_dict(document.get("simulation")),
+        )
+
+
+def load_system_config(path: Path | str = DEFAULT_CONFIG) -> SystemConfig:
+    """Read a robot-system YAML file."""
+    with open(path, "r", encoding="utf-8") as stream:
+        return SystemConfig.from_dict(yaml.safe_load(stream))

@@ -1,0 +1,187 @@
+"""MuJoCo wrapper for the humanoid: loading, position targets, measurements.
+
+This is the only module (besides ``rendering``) that imports MuJoCo; the
+discrete semantics in ``atlas_sim.discrete`` stay importable without it.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Iterable, Mapping, Optional
+
+import mujoco
+import numpy as np
+
+from .kinematics import LegGeometry, POSTURES, JointTargets
+
+MODEL_PATH = Path(__file__).resolve().parent / "models" / "humanoid.xml"
+
+
+@dataclass(frozen=True)
+class FallCriteria:
+    """The robot counts as fallen when the pelvis drops below ``min_pelvis_height``
+    (metres) or the torso leans more than ``max_torso_tilt_deg`` from vertical."""
+
+    min_pelvis_height: float = 0.45
+    max_torso_tilt_deg: float = 40.0
+
+
+class HumanoidPhysics:
+    """Owns the MuJoCo model/data of one humanoid and its position targets."""
+
+    def __init__(
+        self,
+        model_path: Path = MODEL_PATH,
+        timestep: Optional[float] = None,
+        fall_criteria: FallCriteria = FallCriteria(),
+    ) -> None:
+        self.model = mujoco.MjModel.from_xml_path(str(model_path))
+        if timestep:
+            self.model.opt.timestep = timestep
+        self.data = mujoco.MjData(self.model)
+        self.fall_criteria = fall_criteria
+        self.geometry = self._read_leg_geometry()
+        self._actuator_ids = {
+            mujoco.mj_id2name(self.model, mujoco.mjtObj.mjOBJ_ACTUATOR, i): i
+            for i in range(self.model.nu)
+        }
+        self._joint_qpos = {
+            name: self.model.jnt_qposadr[self._joint_id(name)] for name in self._actuator_ids
+        }
+        self._joint_dof = {
+            name: self.model.jnt_dofadr[self._joint_id(name)] for name in self._actuator_ids
+        }
+        self._pelvis = self._body_id("pelvis")
+        self._torso = self._body_id("torso")
+        self._mocap = self.model.body_mocapid[self._body_id("pelvis_target")]
+        self._weld = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_EQUALITY, "balance_assist")
+
+    # ----------------------------------------------------------- model lookup
+    def _joint_id(self, name: str) -> int:
+        return mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_JOINT, name)
+
+    def _body_id(self, name: str) -> int:
+        body = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_BODY, name)
+        if body < 0:
+            raise KeyError(f"model has no body {name!r}")
+        return body
+
+    def _read_leg_geometry(self) -> LegGeometry:
+        """Leg dimensions from the model so IK stays in sync with the MJCF."""
+        thigh = self.model.body_pos[self._body_id("left_thigh")]
+        shin = self.model.body_pos[self._body_id("left_shin")]
+        foot = self.model.body_pos[self._body_id("left_foot")]
+        sole = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_GEOM, "left_foot")
+        ankle_height = -(self.model.geom_pos[sole][2] - self.model.geom_size[sole][2])
+        return LegGeometry(
+            thigh_length=float(-shin[2]),
+            shin_length=float(-foot[2]),
+            hip_offset_y=float(thigh[1]),
+            hip_offset_z=float(thigh[2]),
+            ankle_height=float(ankle_height),
+        )
+
+    @property
+    def joint_names(self) -> tuple:
+        """Names of the actuated joints (actuators share their joint's name)."""
+        return tuple(self._actuator_ids)
+
+    @property
+    def timestep(self) -> float:
+        return float(self.model.opt.timestep)
+
+    @property
+    def time(self) -> float:
+        return float(self.data.time)
+
+    # ------------------------------------------------------------ state setup
+    def reset_to_posture(self, posture_name: str, settle_time: float = 0.5) -> None:
+        """Place the robot in a named posture with its feet on the floor, let it
+        settle under gravity for ``settle_time`` seconds, and restart the clock
+        at 0 so every run starts from rest."""
+        mujoco.mj_resetData(self.model, self.data)
+        posture = POSTURES[posture_name]
+        targets = posture.targets(self.geometry)
+        for name, angle in targets.items():
+            self.data.qpos[self._joint_qpos[name]] = angle
+        self.data.qpos[2] = self.geometry.pelvis_height(posture.hip_height)
+        self.set_targets(targets)
+        self.set_balance_assist(False)
+        mujoco.mj_forward(self.model, self.data)
+        self.step(round(settle_time / self.timestep))
+        self.data.time = 0.0
+
+    # ---------------------------------------------------------------- control
+    def set_targets(self, targets: Mapping[str, float]) -> None:
+        """Set the position-actuator setpoints of the named joints (radians)."""
+        for name, angle in targets.items():
+            self.data.ctrl[self._actuator_ids[name]] = angle
+
+    def targets(self, names: Optional[Iterable[str]] = None) -> JointTargets:
+        names = self.joint_names if names is None else names
+        return {name: float(self.data.ctrl[self._actuator_ids[name]]) for name in names}
+
+    def set_balance_assist(self, active: bool) -> None:
+        """Switch the pelvis weld on or off.  When switching on, the target is
+        first moved onto the current pelvis pose so the weld does not jerk."""
+        if active and not self.balance_assist_active:
+            self.move_pelvis_target(self.pelvis_position(), self.data.xquat[self._pelvis])
+        self.data.eq_active[self._weld] = 1 if active else 0
+
+    @property
+    def balance_assist_active(self) -> bool:
+        return bool(self.data.eq_active[self._weld])
+
+    def move_pelvis_target(self, position, quaternion=None) -> None:
+        self.data.mocap_pos[self._mocap] = position
+        if quaternion is not None:
+            self.data.mocap_quat[self._mocap] = quaternion
+
+    def set_external_force(self, body: str, force) -> None:
+        """Apply a constant world-frame force (N) at a body's origin until changed."""
+        self.data.xfrc_applied[self._body_id(body), :3] = force
+
+    def step(self, count: int = 1) -> None:
+        mujoco.mj_step(self.model, self.data, nstep=count)
+
+    # ----------------------------------------------------------- measurements
+    def joint_positions(self, names: Optional[Iterable[str]] = None) -> JointTargets:
+        names = self.joint_names if names is None else names
+        return {name: float(self.data.qpos[self._joint_qpos[name]]) for name in names}
+
+    def joint_speeds(self, names: Iterable[str]) -> np.ndarray:
+        return np.array([self.data.qvel[self._joint_dof[name]] for name in names])
+
+    def pelvis_position(self) -> np.ndarray:
+        return self.data.xpos[self._pelvis].copy()
+
+    def pelvis_speed(self) -> float:
+        """Linear speed of the floating base (m/s)."""
+        return float(np.linalg.norm(self.data.qvel[0:3]))
+
+    def pelvis_yaw(self) -> float:
+        """Heading of the pelvis x axis in the floor plane (radians)."""
+        axis_x = self.data.xmat[self._pelvis].reshape(3, 3)[:, 0]
+        return math.atan2(float(axis_x[1]), float(axis_x[0]))
+
+    def body_position(self, name: str) -> np.ndarray:
+        return self.data.xpos[self._body_id(name)].copy()
+
+    def torso_tilt(self) -> float:
+        """Angle (radians) between the torso's z axis and the world vertical."""
+        torso_z = self.data.xmat[self._torso].reshape(3, 3)[:, 2]
+        return math.acos(max(-1.0, min(1.0, float(torso_z[2]))))
+
+    def has_fallen(self) -> bool:
+        criteria = self.fall_criteria
+        return bool(
+            self.pelvis_position()[2] < criteria.min_pelvis_height
+            or math.degrees(self.torso_tilt()) > criteria.max_torso_tilt_deg
+        )
+
+    def fall_reason(self) -> str:
+        height = self.pelvis_position()[2]
+        tilt = math.degrees(self.torso_tilt())
+        return f"robot fell (pelvis height {height:.2f} m, torso tilt {tilt:.0f} deg)"

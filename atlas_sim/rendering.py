@@ -1,0 +1,119 @@
+"""Offscreen rendering of the simulator to PNG files.
+
+MuJoCo picks its OpenGL backend from ``MUJOCO_GL`` when it is *first
+imported*, so headless programs must set it before importing anything that
+imports mujoco (``atlas_sim.physics``, ``atlas_sim.simulator``)::
+
+    import os
+    os.environ.setdefault("MUJOCO_GL", "egl")   # or "osmesa"
+    from atlas_sim import AtlasSimulator, FrameRenderer
+
+The PNG encoder below is a small self-contained writer (zlib + CRC chunks), so
+no imaging library is needed.
+"""
+
+from __future__ import annotations
+
+import re
+import struct
+import zlib
+from pathlib import Path
+from typing import List, Union
+
+import numpy as np
+
+PathLike = Union[str, Path]
+
+
+def encode_png(image: np.ndarray) -> bytes:
+    """Encode an ``(height, width, 3)`` uint8 RGB array as PNG bytes."""
+    if image.ndim != 3 or image.shape[2] != 3:
+        raise ValueError(f"expected an (h, w, 3) RGB image, got shape {image.shape}")
+    pixels = np.ascontiguousarray(image, dtype=np.uint8)
+    height, width, _ = pixels.shape
+    # Every scanline starts with filter type 0 (no filter).
+    scanlines = np.concatenate([np.zeros((height, 1), np.uint8), pixels.reshape(height, -1)], axis=1)
+
+    def chunk(kind: bytes, payload: bytes) -> bytes:
+        body = kind + payload
+        return struct.pack(">I", len(payload)) + body + struct.pack(">I", zlib.crc32(body) & 0xFFFFFFFF)
+
+    header = struct.pack(">IIBBBBB", width, height, 8, 2, 0, 0, 0)  # 8-bit RGB
+    return (
+        b"\x89PNG\r\n\x1a\n"
+        + chunk(b"IHDR", header)
+        + chunk(b"IDAT", zlib.compress(scanlines.tobytes(), 6))
+        + chunk(b"IEND", b"")
+    )
+
+
+def save_png(path: PathLike, image: np.ndarray) -> Path:
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_bytes(encode_png(image))
+    return path
+
+
+class FrameRenderer:
+    """Renders the current frame of a simulator (or ``HumanoidPhysics``).
+
+    ``camera`` is a camera name of the model: ``overview`` (follows the pelvis
+    from the front-right) or ``head_camera`` (what the robot sees).
+    """
+
+    def __init__(self, simulator, width: int = 640, height: int = 480, camera: str = "overview"):
+        import mujoco  # local: only rendering users need a GL context
+
+        self.physics = getattr(simulator, "physics", simulator)
+        self.camera = camera
+        self._renderer = mujoco.Renderer(self.physics.model, height=height, width=width)
+
+    def render(self) -> np.ndarray:
+        """The current frame as an ``(height, width, 3)`` uint8 array."""
+        self._renderer.update_scene(self.physics.data, camera=self.camera)
+        return self._renderer.render()
+
+    def save(self, path: PathLike) -> Path:
+        return save_png(path, self.render())
+
+    def close(self) -> None:
+        self._renderer.close()
+
+    def __enter__(self) -> "FrameRenderer":
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+
+class KeyFrameRecorder:
+    """Saves a PNG whenever a request starts or finishes (the key moments).
+
+    Files are named ``<index>_<sim time>_<capability>_<event>.png`` in
+    ``directory``; ``paths`` lists them in order.  Call ``capture(label)`` for
+    extra frames and ``close()`` when done.
+    """
+
+    def __init__(self, simulator, directory: PathLike, width: int = 640, height: int = 480,
+                 camera: str = "overview"):
+        self.simulator = simulator
+        self.directory = Path(directory)
+        self.directory.mkdir(parents=True, exist_ok=True)
+        self.renderer = FrameRenderer(simulator, width, height, camera)
+        self.paths: List[Path] = []
+        simulator.add_listener(self._on_event)
+
+    def _on_event(self, event: str, request) -> None:
+        label = event if event == "started" else request.result.outcome
+        self.capture(f"{request.name}_{label}")
+
+    def capture(self, label: str) -> Path:
+        safe = re.sub(r"[^A-Za-z0-9_.-]+", "_", label)
+        name = f"{len(self.paths):03d}_{self.simulator.time:07.2f}s_{safe}.png"
+        path = self.renderer.save(self.directory / name)
+        self.paths.append(path)
+        return path
+
+    def close(self) -> None:
+        self.simulator.remove_listener(self._on_event)
+        self.renderer.close()

@@ -13,7 +13,7 @@ os.environ.setdefault('MUJOCO_GL', 'egl')
 
 @pytest.fixture
 def ros():
-    from synthesis_manager.testing import RosHarness
+    from synthesis_manager.harness import RosHarness
 
     with RosHarness() as harness:
         yield harness

@@ -1,0 +1,86 @@
+"""``behavior-synthesis compile``: print the GR(1) specification of a task (ROS-free).
+
+    behavior-synthesis compile --system atlas --initial-conditions stand_prep \\
+        --goals look_down,pickup_object [--sm-outcomes finished,failed] [--unordered] \\
+        [--format structuredslugs|slugsin|json] [-o FILE] [--config-dir DIR] \\
+        [--custom-ltl FILE] [--explain]
+
+Bad input exits with status 2 and one line on stderr naming the error code and the item.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+import yaml
+
+from ltl_specification.compiler import compile_task, explain
+from ltl_specification.errors import InvalidFormulaError, SpecificationError
+
+FORMATS = ('structuredslugs', 'slugsin', 'json')
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """Add the ``compile`` options to ``parser``."""
+    parser.add_argument('--system', required=True, help='robot system, e.g. atlas (config/<system>.yaml)')
+    parser.add_argument('--initial-conditions', default='',
+                        help='comma-separated actions/control modes that hold initially '
+                             '(default: the system\'s initial_mode)')
+    parser.add_argument('--goals', required=True, help='comma-separated actions/control modes to achieve')
+    parser.add_argument('--sm-outcomes', default='finished,failed',
+                        help='finished,failed (stop on failure) or finished (retry failures)')
+    parser.add_argument('--unordered', action='store_true', help='goals may be achieved in any order')
+    parser.add_argument('--format', choices=FORMATS, default='structuredslugs', help='output format')
+    parser.add_argument('-o', '--output', help='write to FILE instead of standard output')
+    parser.add_argument('--config-dir', help='directory of <system>.yaml files')
+    parser.add_argument('--custom-ltl', metavar='FILE',
+                        help='YAML/JSON mapping of LTLSpecification sections to extra formulas')
+    parser.add_argument('--explain', action='store_true', help='also print why each item is included (stderr)')
+
+
+def run(args: argparse.Namespace) -> int:
+    """Compile and write the specification; returns the process exit status."""
+    try:
+        custom_ltl = _read_custom_ltl(args.custom_ltl)
+        spec = compile_task(args.system, args.initial_conditions, args.goals,
+                            sm_outcomes=_split(args.sm_outcomes), strict_order=not args.unordered,
+                            custom_ltl=custom_ltl, config_dir=args.config_dir)
+    except SpecificationError as error:
+        message = ' '.join(str(error).split())
+        print(f'error: {error.code}: {message} [item: {error.item!r}]', file=sys.stderr)
+        return 2
+    if args.format == 'json':
+        text = json.dumps(spec.to_text_sections(), indent=2) + '\n'
+    elif args.format == 'slugsin':
+        text = spec.to_slugsin()
+    else:
+        text = spec.to_structuredslugs()
+    if args.output:
+        Path(args.output).write_text(text)
+    else:
+        sys.stdout.write(text)
+    if args.explain:
+        print(explain(spec), file=sys.stderr)
+    return 0
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog='behavior-synthesis compile', description=__doc__.split('\n')[0])
+    add_arguments(parser)
+    return run(parser.parse_args(argv))
+
+
+def _split(text: str) -> list[str]:
+    return [part.strip() for part in text.split(',') if part.strip()]
+
+
+def _read_custom_ltl(path: str | None):
+    if not path:
+        return None
+    try:
+        return yaml.safe_load(Path(path).read_text())
+    except (OSError, yaml.YAMLError) as error:
+        raise InvalidFormulaError(f'cannot read custom LTL file {path}: {error}', item=path) from error

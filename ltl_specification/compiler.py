@@ -1,0 +1,375 @@
+"""Compile a task (system, initial conditions, goals) into a GR(1) specification.
+
+The specification is the merge, in this fixed order, of: the control-mode formulas, the
+action formulas, the initial conditions, the goal formulas, the sensors that custom LTL
+uses and the user's custom LTL
+(see ``respec.components`` and ``respec.spec.merge_specifications``). Pertinent actions and
+modes are inferred from the task (``ltl_specification.pertinence``) and listed in
+configuration order, so the same request always gives a byte-identical specification.
+
+State-machine outcomes
+----------------------
+``('finished', 'failed')``: any failure outcome of a pertinent action or mode change makes
+the state machine end in ``failed`` (18b); reaching all goals ends it in ``finished`` (18a).
+
+``('finished',)`` — retry after failure. The original encoding keeps (3) and (7) and is
+unrealizable for every task: (3) makes the system deactivate an action after ANY outcome,
+and (7) only promises SOME outcome, so an environment that fails every attempt satisfies
+all assumptions while no goal is ever reached. Adding □◇(¬π_a ∨ ◯π_a^c) alone does not
+help, because the deactivation step forced after each failure already satisfies ¬π_a.
+
+Our encoding:
+
+* (3) applies to the completion outcome only: after a failure the system may keep ``π_a``
+  on, which means "execute a again" (or switch it off).
+* The fairness assumptions become completion fairness: □◇(¬π_a ∨ ◯π_a^c) for each
+  action (variant of (7)) and □◇(⋁_m (φ_m ∧ ◯π_m^c) ∨ φ_M^none) for mode changes
+  (variant of (13)): an action or mode change that stays activated eventually completes.
+
+Why this is sound: (a) the assumptions cannot be falsified by the system — whatever the
+system does, the environment can satisfy every safety assumption and both fairness
+conditions by answering each activation with completion, which (4)-(6) and (10)-(12)
+always allow — so the system cannot win vacuously by forcing the environment into a
+violation; (b) the system wins honestly by working through the precondition order along
+the pertinent modes and keeping each activation on until it completes: failures merely
+repeat a step, and fairness rules out failing forever. So the specification is realizable
+exactly under the stated assumption that a retried action eventually succeeds, and a
+controller synthesized from it retries each failed action or mode change.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass, field, fields
+from pathlib import Path
+from typing import Mapping, Sequence
+
+from respec.abstraction import AbstractionConfigError, RobotAbstraction, load_abstraction
+from respec.activation_outcomes import activation, outcome_proposition
+from respec.components import (
+    action_specification, control_mode_specification, goal_specification,
+    initial_conditions_specification,
+)
+from respec.ltl import variables
+from respec.parsing import ParseError, UnknownVariableError, parse_formula, spec_from_text_sections
+from respec.spec import (
+    FORMULA_SECTIONS, PROPOSITION_SECTIONS, SECTIONS, GR1Specification, PropositionConflictError,
+    merge_specifications,
+)
+from respec.systems import ConfigFileInvalidError, UnknownSystemError as UnknownSystemConfig
+
+from ltl_specification.errors import (
+    InvalidAbstractionError, InvalidFormulaError, InvalidGoalsError, InvalidInitialConditionsError,
+    InvalidSmOutcomesError, UnknownPropositionError, UnknownSystemError,
+)
+from ltl_specification.pertinence import Pertinence, infer_pertinence
+
+FINISHED, FAILED = 'finished', 'failed'
+SUPPORTED_SM_OUTCOMES = ((FINISHED, FAILED), (FINISHED,))
+
+
+@dataclass
+class Provenance:
+    """What a compiled specification was made from, and why each item is in it."""
+
+    system: str
+    initial_conditions: tuple[str, ...]
+    goals: tuple[str, ...]
+    sm_outcomes: tuple[str, ...]
+    strict_order: bool
+    pertinence: Pertinence
+    custom_sections: tuple[str, ...] = ()
+
+
+@dataclass
+class CompiledSpecification(GR1Specification):
+    """A GR1Specification that also records its ``provenance`` (not part of equality)."""
+
+    provenance: Provenance | None = field(default=None, compare=False, repr=False)
+
+    def explain(self) -> str:
+        return explain(self)
+
+
+def compile_task(system: str, initial_conditions: Sequence[str] | str, goals: Sequence[str] | str,
+                 sm_outcomes: Sequence[str] = (FINISHED, FAILED), strict_order: bool = True,
+                 custom_ltl: Mapping[str, Sequence[str]] | None = None,
+                 config_dir: str | Path | None = None) -> CompiledSpecification:
+    """Compile the GR(1) specification of reaching ``goals`` from ``initial_conditions``.
+
+    Goals and initial conditions are action or control-mode names (a list, or one
+    comma-separated string). At most one initial condition may be a control mode; without
+    one, the system's ``initial_mode`` is used. ``strict_order`` selects (20) over (17).
+    ``custom_ltl`` maps LTLSpecification section names to infix formulas (or, for
+    env_props / sys_props, new proposition names) that are conjoined to the result.
+    Raises a ``SpecificationError`` subclass naming the offending item.
+    """
+    abstraction = _load_abstraction(system, config_dir)
+    sm_outcomes = _check_sm_outcomes(sm_outcomes)
+    goals = _check_goals(abstraction, goals)
+    initial_conditions = _check_initial_conditions(abstraction, initial_conditions)
+    initial_mode = _initial_mode(abstraction, initial_conditions)
+    custom_formulas = _parse_custom_ltl(custom_ltl)
+    mentioned, sensors = _items_mentioned(abstraction, custom_formulas)
+
+    pertinence = infer_pertinence(abstraction, initial_mode, initial_conditions, goals, mentioned)
+    parts = _sub_specifications(abstraction, pertinence, initial_conditions, goals, sm_outcomes, strict_order)
+    parts.append(GR1Specification(env_props=sensors))
+    parts.append(_custom_specification(custom_ltl, custom_formulas))
+    try:
+        spec = merge_specifications(parts)
+    except PropositionConflictError as error:
+        raise InvalidFormulaError(
+            f'custom LTL declares {error.item!r} with the wrong kind: {error}', item=error.item) from error
+    _check_custom_scopes(spec, custom_ltl)
+    provenance = Provenance(system, tuple(initial_conditions), tuple(goals), sm_outcomes, strict_order,
+                            pertinence, tuple(s for s in SECTIONS if custom_ltl and custom_ltl.get(s)))
+    return CompiledSpecification(**{f.name: getattr(spec, f.name) for f in fields(GR1Specification)},
+                                 provenance=provenance)
+
+
+def _sub_specifications(abstraction: RobotAbstraction, pertinence: Pertinence, initial_conditions: list[str],
+                        goals: list[str], sm_outcomes: tuple[str, ...], strict_order: bool) -> list[GR1Specification]:
+    """The generated parts of the task specification, in merge order (modes, actions, init, goals)."""
+    retry = FAILED not in sm_outcomes
+    outcomes = abstraction.outcomes
+    adjacency = {m: (m, *(t for t in abstraction.control_modes[m] if t in pertinence.modes))
+                 for m in pertinence.modes}
+    items = [*pertinence.modes, *pertinence.actions]
+    # The default initial mode holds initially just as if it had been named.
+    initially_completed = [i for i in [*initial_conditions, pertinence.initial_mode] if i in items]
+    failures = [outcome_proposition(item, o) for item in items for o in abstraction.failure_outcomes]
+    return [
+        control_mode_specification(adjacency, outcomes, retry),
+        action_specification({a: abstraction.actions[a] for a in pertinence.actions}, outcomes, retry),
+        initial_conditions_specification(items, initially_completed, outcomes),
+        goal_specification(goals, sm_outcomes, strict_order, failures, abstraction.success_outcome),
+    ]
+
+
+def explain(self) -> str:
+        return explain(self)
+
+
+def compile_task(system: str, initial_conditions: Sequence[str] | str, goals: Sequence[str] | str,
+                 sm_outcomes: Sequence[str] = (FINISHED, FAILED), strict_order: bool = True,
+                 custom_ltl: Mapping[str, Sequence[str]] | None = None,
+                 config_dir: str | Path | None = None) -> CompiledSpecification:
+    """Compile the GR(1) specification of reaching ``goals`` from ``initial_conditions``.
+
+    Goals and initial conditions are action or control-mode names (a list, or one
+    comma-separated string). At most one initial condition may be a control mode; without
+    one, the system's ``initial_mode`` is used. ``strict_order`` selects (20) over (17).
+    ``custom_ltl`` maps LTLSpecification section names to infix formulas (or, for
+    env_props / sys_props, new proposition names) that are conjoined to the result.
+    Raises a ``SpecificationError`` subclass naming the offending item.
+    """
+    abstraction = _load_abstraction(system, config_dir)
+    sm_outcomes = _check_sm_outcomes(sm_outcomes)
+    goals = _check_goals(abstraction, goals)
+    initial_conditions = _check_initial_conditions(abstraction, initial_conditions)
+    initial_mode = _initial_mode(abstraction, initial_conditions)
+    custom_formulas = _parse_custom_ltl(custom_ltl)
+    mentioned, sensors = _items_mentioned(abstraction, custom_formulas)
+
+    pertinence = infer_pertinence(abstraction, initial_mode, initial_conditions, goals, mentioned)
+    retry = FAILED not in sm_outcomes
+    outcomes = abstraction.outcomes
+    adjacency = {m: (m, *(t for t in abstraction.control_modes[m] if t in pertinence.modes))
+                 for m in pertinence.modes}
+    items = [*pertinence.modes, *pertinence.actions]
+    # The default initial mode holds initially just as if it had been named.
+    initially_completed = [i for i in [*initial_conditions, initial_mode] if i in items]
+    failures = [outcome_proposition(item, o) for item in items for o in abstraction.failure_outcomes]
+    try:
+        spec = merge_specifications([
+            control_mode_specification(adjacency, outcomes, retry),
+            action_specification({a: abstraction.actions[a] for a in pertinence.actions}, outcomes, retry),
+            initial_conditions_specification(items, initially_completed, outcomes),
+            goal_specification(goals, sm_outcomes, strict_order, failures, abstraction.success_outcome),
+            GR1Specification(env_props=list(sensors)),
+            _custom_specification(custom_ltl, custom_formulas),
+        ])
+    except PropositionConflictError as error:
+        raise InvalidFormulaError(
+            f'custom LTL declares {error.item!r} with the wrong kind: {error}', item=error.item) from error
+    _check_custom_scopes(spec, custom_ltl)
+    provenance = Provenance(system, tuple(initial_conditions), tuple(goals), sm_outcomes, strict_order,
+                            pertinence, tuple(s for s in SECTIONS if custom_ltl and custom_ltl.get(s)))
+    return CompiledSpecification(**{f.name: getattr(spec, f.name) for f in fields(GR1Specification)},
+                                 provenance=provenance)
+
+
+def explain(spec: CompiledSpecification) -> str:
+    """A short human-readable account of what the specification contains and why."""
+    p = spec.provenance
+    if p is None:
+        return 'no provenance recorded'
+    order = 'in this order' if p.strict_order else 'in any order'
+    lines = [f'Task on {p.system}: from {", ".join(p.initial_conditions) or p.pertinence.initial_mode}'
+             f' reach {", ".join(p.goals)} ({order}); state-machine outcomes: {", ".join(p.sm_outcomes)}'
+             + (' (failures are retried)' if FAILED not in p.sm_outcomes else '') + '.']
+    for title, items in (('Control modes', p.pertinence.modes), ('Actions', p.pertinence.actions)):
+        described = ', '.join(f'{i} ({p.pertinence.reasons[i]})' for i in items) or 'none'
+        lines.append(f'{title}: {described}.')
+    if p.pertinence.left_out:
+        lines.append('Left out: ' + ', '.join(f'{i} ({why})' for i, why in p.pertinence.left_out.items()) + '.')
+    if p.custom_sections:
+        lines.append(f'Custom LTL in: {", ".join(p.custom_sections)}.')
+    counts = ', '.join(f'{len(getattr(spec, s))} {s}' for s in FORMULA_SECTIONS)
+    lines.append(f'Size: {len(spec.env_props)} environment and {len(spec.sys_props)} system '
+                 f'propositions; {counts}.')
+    return '\n'.join(lines)
+
+
+# --- request validation ---------------------------------------------------------------------
+
+def _load_abstraction(system: str, config_dir) -> RobotAbstraction:
+    try:
+        return load_abstraction(system, config_dir)
+    except UnknownSystemConfig as error:
+        raise UnknownSystemError(str(error), item=error.item) from error
+    except (AbstractionConfigError, ConfigFileInvalidError) as error:
+        raise InvalidAbstractionError(str(error), item=error.item) from error
+
+
+def _names(value: Sequence[str] | str | None, what: str, error) -> list[str]:
+    if value is None:
+        return []
+    if isinstance(value, str):
+        value = [v for v in (part.strip() for part in value.split(',')) if v]
+    if not isinstance(value, (list, tuple)):
+        raise error(f'{what} must be a list of names, got {value!r}', item=repr(value))
+    names = list(value)
+    for name in names:
+        if not isinstance(name, str) or not name:
+            raise error(f'{what} must be non-empty names, got {name!r}', item=repr(name))
+    return names
+
+
+def _check_sm_outcomes(sm_outcomes) -> tuple[str, ...]:
+    names = _names(sm_outcomes, 'state-machine outcomes', InvalidSmOutcomesError)
+    for name in names:
+        if name not in (FINISHED, FAILED):
+            raise InvalidSmOutcomesError(
+                f'unsupported state-machine outcome {name!r} (supported: [finished, failed] or [finished])',
+                item=name)
+    normalized = tuple(o for o in (FINISHED, FAILED) if o in names)
+    if len(names) != len(set(names)) or normalized not in SUPPORTED_SM_OUTCOMES:
+        raise InvalidSmOutcomesError(
+            f'unsupported state-machine outcomes {names} (supported: [finished, failed] or [finished])',
+            item=','.join(names))
+    return normalized
+
+
+def _check_goals(abstraction: RobotAbstraction, goals) -> list[str]:
+    names = _names(goals, 'goals', InvalidGoalsError)
+    if not names:
+        raise InvalidGoalsError('no goals given: name at least one action or control mode', item='')
+    for index, goal in enumerate(names):
+        if abstraction.kind_of(goal) is None:
+            raise InvalidGoalsError(
+                f'unknown goal {goal!r}: not an action or control mode of {abstraction.system} '
+                f'(known: {", ".join(abstraction.items())})', item=goal)
+        if goal in names[:index]:
+            raise InvalidGoalsError(f'goal {goal!r} is given twice', item=goal)
+    return names
+
+
+def _check_initial_conditions(abstraction: RobotAbstraction, initial_conditions) -> list[str]:
+    names = _names(initial_conditions, 'initial conditions', InvalidInitialConditionsError)
+    for name in names:
+        if abstraction.kind_of(name) is None:
+            raise InvalidInitialConditionsError(
+                f'unknown initial condition {name!r}: not an action or control mode of '
+                f'{abstraction.system} (known: {", ".join(abstraction.items())})', item=name)
+    return list(dict.fromkeys(names))
+
+
+def _initial_mode(abstraction: RobotAbstraction, initial_conditions: list[str]) -> str | None:
+    modes = [i for i in initial_conditions if abstraction.kind_of(i) == 'control_mode']
+    if len(modes) > 1:
+        raise InvalidInitialConditionsError(
+            f'the robot can only start in one control mode, got {", ".join(modes)}', item=modes[1])
+    if modes:
+        return modes[0]
+    if abstraction.control_modes and abstraction.initial_mode is None:
+        raise InvalidInitialConditionsError(
+            f'no initial control mode: name one of {", ".join(abstraction.control_modes)} among the '
+            f'initial conditions ({abstraction.system} defines no initial_mode)', item='')
+    return abstraction.initial_mode
+
+
+# --- custom LTL -----------------------------------------------------------------------------------
+
+def _parse_custom_ltl(custom_ltl) -> dict[str, list]:
+    """Parse the custom formulas (syntax only); names are checked once the task is known."""
+    if not custom_ltl:
+        return {}
+    if not isinstance(custom_ltl, Mapping):
+        raise InvalidFormulaError(f'custom LTL must map section names to lists, got {custom_ltl!r}',
+                                  item=repr(custom_ltl))
+    parsed = {}
+    for section, entries in custom_ltl.items():
+        if section not in SECTIONS:
+            raise InvalidFormulaError(
+                f'unknown custom LTL section {section!r} (expected one of {", ".join(SECTIONS)})', item=str(section))
+        if isinstance(entries, str) or not isinstance(entries, (list, tuple)):
+            raise InvalidFormulaError(f'custom LTL section {section} must be a list of strings', item=repr(entries))
+        if section in PROPOSITION_SECTIONS:
+            for name in entries:
+                if not isinstance(name, str):
+                    raise InvalidFormulaError(f'custom {section} entry {name!r} is not a name', item=repr(name))
+            continue
+        parsed[section] = []
+        for text in entries:
+            try:
+                parsed[section].append(parse_formula(text))
+            except ParseError as error:
+                raise InvalidFormulaError(f'custom {section} formula {text!r}: {error}', item=str(text)) from error
+    return parsed
+
+
+def _items_mentioned(abstraction: RobotAbstraction, custom_formulas: dict[str, list]):
+    """Actions/modes and sensors whose propositions the custom formulas use (config order)."""
+    owner_of = {}
+    for item in abstraction.items():
+        owner_of[activation(item)] = item
+        for o in abstraction.outcomes:
+            owner_of[outcome_proposition(item, o)] = item
+    used = set().union(*(variables(f) for formulas in custom_formulas.values() for f in formulas))
+    owners = {owner_of[name] for name in used if name in owner_of}
+    items = [item for item in abstraction.items() if item in owners]
+    sensors = [s for s in abstraction.sensors if s in used]
+    return items, sensors
+
+
+def _custom_specification(custom_ltl, custom_formulas: dict[str, list]) -> GR1Specification:
+    if not custom_ltl:
+        return GR1Specification()
+    return GR1Specification(env_props=list(custom_ltl.get('env_props', [])),
+                            sys_props=list(custom_ltl.get('sys_props', [])), **custom_formulas)
+
+
+def _check_custom_scopes(spec: GR1Specification, custom_ltl) -> None:
+    """Re-parse the custom formulas against the task's declarations and slugs' section rules."""
+    if not custom_ltl:
+        return
+    sections = {'env_props': spec.env_props, 'sys_props': spec.sys_props}
+    sections.update({s: list(custom_ltl[s]) for s in FORMULA_SECTIONS if s in custom_ltl})
+    try:
+        spec_from_text_sections(sections)
+    except UnknownVariableError as error:
+        raise UnknownPropositionError(
+            f'custom LTL names unknown proposition {error.token!r} ({error}); '
+            f'the task defines: {", ".join(spec.propositions())}', item=error.token) from error
+    except ParseError as error:
+        raise InvalidFormulaError(f'custom LTL: {error}', item=_custom_entry(custom_ltl, error)) from error
+
+
+def _custom_entry(custom_ltl, error: ParseError) -> str:
+    """The custom formula (or name) a parse error is about: its filename is 'section[index]'."""
+    match = re.fullmatch(r'(\w+)\[(\d+)\]', error.filename)
+    if match and match[1] in custom_ltl and int(match[2]) < len(custom_ltl[match[1]]):
+        return str(custom_ltl[match[1]][int(match[2])])
+    return error.item

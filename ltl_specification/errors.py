@@ -1,0 +1,60 @@
+"""Errors of specification compilation.
+
+Every error carries ``item`` (the offending system, goal, initial condition, outcome,
+formula or proposition) and ``code``, the name of the synthesis_msgs/SynthesisErrorCodes
+constant that reports it.
+"""
+
+from __future__ import annotations
+
+
+class SpecificationError(Exception):
+    """Compiling a task specification failed; ``item`` names what was wrong."""
+
+    code = 'LTL_SPEC_COMPILATION_FAILED'
+
+    def __init__(self, message: str, item: str = ''):
+        super().__init__(message)
+        self.item = item
+
+
+class UnknownSystemError(SpecificationError):
+    """No configuration file exists for the requested system."""
+
+    code = 'UNKNOWN_SYSTEM'
+
+
+class InvalidAbstractionError(SpecificationError):
+    """The system's configuration file or its ``abstraction:`` section is invalid."""
+
+    code = 'ABSTRACTION_CONFIG_INVALID'
+
+
+class InvalidInitialConditionsError(SpecificationError):
+    """An initial condition is unknown, or the initial control mode is missing or ambiguous."""
+
+    code = 'INVALID_INITIAL_CONDITIONS'
+
+
+class InvalidGoalsError(SpecificationError):
+    """No goals, an unknown or repeated goal, or a goal that cannot be reached."""
+
+    code = 'INVALID_GOALS'
+
+
+class InvalidSmOutcomesError(SpecificationError):
+    """The requested state-machine outcomes are not [finished, failed] or [finished]."""
+
+    code = 'INVALID_SM_OUTCOMES'
+
+
+class InvalidFormulaError(SpecificationError):
+    """A custom LTL formula does not parse or does not fit its GR(1) section."""
+
+    code = 'INVALID_FORMULA'
+
+
+class UnknownPropositionError(SpecificationError):
+    """A custom LTL formula names a proposition that the task does not define."""
+
+    code = 'UNKNOWN_PROPOSITION'

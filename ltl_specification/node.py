@@ -1,0 +1,46 @@
+"""The ``ltl_compilation`` service node (GenerateLTLSpecification): a thin adapter around compile_task."""
+
+from __future__ import annotations
+
+from rclpy.callback_groups import ReentrantCallbackGroup
+from rclpy.node import Node
+
+from ltl_specification import compile_task
+from synthesis_manager.conversions import error_code, msg_to_sections, spec_to_msg
+from synthesis_msgs.srv import GenerateLTLSpecification
+
+
+class LTLCompilationNode(Node):
+    """Compiles partial tasks into complete GR(1) specifications.
+
+    Parameters: ``config_dir`` (robot system configurations; empty = the packaged config/).
+    """
+
+    def __init__(self, **kwargs):
+        super().__init__('ltl_compilation', **kwargs)
+        self.declare_parameter('config_dir', '')
+        self.create_service(GenerateLTLSpecification, 'ltl_compilation', self.handle,
+                            callback_group=ReentrantCallbackGroup())
+
+    def handle(self, request, response):
+        try:
+            spec = compile_task(
+                request.system, list(request.initial_conditions), list(request.goals),
+                sm_outcomes=tuple(request.sm_outcomes) or ('finished', 'failed'),
+                strict_order=not request.unordered_goals,
+                custom_ltl=msg_to_sections(request.custom_ltl) or None,
+                config_dir=self.get_parameter('config_dir').value or None)
+        except Exception as error:  # every failure becomes an error code; the node keeps serving
+            code = getattr(error, 'code', 'LTL_SPEC_COMPILATION_FAILED')
+            response.error_code = error_code(code, f'LTL compilation failed: {error}')
+            self.get_logger().warning(response.error_code.message)
+            return response
+        response.ltl_specification = spec_to_msg(spec)
+        response.error_code = error_code('SUCCESS')
+        return response
+
+
+def main():
+    from synthesis_manager.node_main import node_main
+
+    node_main(LTLCompilationNode, 'ltl_compilation')

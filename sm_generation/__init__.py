@@ -1,0 +1,28 @@
+"""sm_generation: synthesized automata -> FlexBE state machines (ROS-free).
+
+    >>> from sm_generation import generate_state_machine, load_automaton, validate_state_machine
+    >>> states = generate_state_machine(load_automaton('test/automata/look_down.yaml'), 'atlas')
+    >>> validate_state_machine(states)
+    []
+
+Modules:
+    instantiation  StateInstantiation / OutcomeCondition (fields of flexbe_msgs)
+    config         the validated ``flexbe:`` section of config/<system>.yaml
+    automaton_io   reading and writing automata (our YAML/JSON, slugs strategies)
+    machine        automaton -> abstract machine (observations, pass-through, exits)
+    reduction      merging bisimilar states
+    layout         positions for the FlexBE editor
+    generator      generate_state_machine
+    validation     validate_state_machine
+    export         YAML, JSON, Graphviz DOT, SVG/PNG
+    cli            ``behavior-synthesis generate-sm`` / ``python -m sm_generation``
+"""
+
+from sm_generation.automaton_io import Automaton, AutomatonState, load_automaton
+from sm_generation.errors import SMGenerationError
+from sm_generation.generator import generate_state_machine
+from sm_generation.instantiation import OutcomeCondition, StateInstantiation
+from sm_generation.validation import validate_state_machine
+
+__all__ = ['Automaton', 'AutomatonState', 'OutcomeCondition', 'SMGenerationError', 'StateInstantiation',
+           'generate_state_machine', 'load_automaton', 'validate_state_machine']

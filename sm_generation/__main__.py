@@ -1,0 +1,5 @@
+import sys
+
+from sm_generation.cli import main
+
+sys.exit(main())

@@ -1,0 +1,84 @@
+"""``behavior-synthesis generate-sm`` and ``python -m sm_generation``.
+
+    behavior-synthesis generate-sm --system atlas --automaton task.yaml [--format yaml|json|dot|svg|png] [-o FILE]
+    behavior-synthesis generate-sm --automaton strategy.json --spec task.structuredslugs -o task.svg
+
+Exit status: 0 on success, 1 when generation fails (the error code and offending item
+are printed), 2 on bad usage.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from sm_generation.automaton_io import load_automaton
+from sm_generation.errors import SMGenerationError
+from sm_generation.export import RENDER_FORMATS, RenderError, render, to_dot, to_json, to_yaml
+from sm_generation.generator import generate_state_machine
+from sm_generation.validation import validate_state_machine
+
+FORMATS = ('yaml', 'json', 'dot', *RENDER_FORMATS)
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument('--system', default='atlas', help='robot system (config/<system>.yaml); default atlas')
+    parser.add_argument('--automaton', required=True, type=Path,
+                        help='automaton file: our YAML/JSON format, or a slugs JSON strategy (needs --spec)')
+    parser.add_argument('--spec', type=Path, help='the .structuredslugs spec a slugs strategy was made from')
+    parser.add_argument('--config-dir', type=Path, help='directory of system configuration files')
+    parser.add_argument('--initial-conditions', default=None,
+                        help='comma-separated initial conditions, e.g. stand_prep')
+    parser.add_argument('--reduce', action='store_true', help='merge equivalent states')
+    parser.add_argument('--format', choices=FORMATS, help='output format (default: from -o suffix, else yaml)')
+    parser.add_argument('-o', '--output', type=Path, help='output file (default: standard output)')
+
+
+def run(args: argparse.Namespace) -> int:
+    fmt = args.format or _format_from_suffix(args.output) or 'yaml'
+    if fmt in RENDER_FORMATS and args.output is None:
+        print(f'error: --format {fmt} needs -o FILE', file=sys.stderr)
+        return 2
+    initial_conditions = None
+    if args.initial_conditions is not None:
+        initial_conditions = [c.strip() for c in args.initial_conditions.split(',') if c.strip()]
+    try:
+        automaton = load_automaton(args.automaton, args.spec)
+        states = generate_state_machine(automaton, args.system, args.config_dir, initial_conditions, args.reduce)
+    except SMGenerationError as error:
+        print(f'error: {error.code}: {error} (item: {error.item})', file=sys.stderr)
+        return 1
+    problems = validate_state_machine(states)
+    if problems:  # would be a bug in this package; report rather than write a broken file
+        print('error: SM_GENERATION_FAILED: generated machine is inconsistent:\n  ' + '\n  '.join(problems),
+              file=sys.stderr)
+        return 1
+    if fmt in RENDER_FORMATS:
+        try:
+            render(to_dot(states), args.output, fmt)
+        except RenderError as error:
+            print(f'error: {error} (item: {error.item})', file=sys.stderr)
+            return 1
+        return 0
+    text = {'yaml': to_yaml, 'json': to_json, 'dot': to_dot}[fmt](states)
+    if args.output is None:
+        sys.stdout.write(text)
+    else:
+        args.output.write_text(text)
+    return 0
+
+
+def _format_from_suffix(path: Path | None) -> str | None:
+    if path is None:
+        return None
+    suffix = path.suffix.lstrip('.').lower()
+    suffix = {'yml': 'yaml', 'gv': 'dot'}.get(suffix, suffix)
+    return suffix if suffix in FORMATS else None
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog='python -m sm_generation',
+                                     description='Turn a synthesized automaton into a FlexBE state machine.')
+    add_arguments(parser)
+    return run(parser.parse_args(argv))

@@ -1,0 +1,230 @@
+"""The ``flexbe:`` section of a system configuration, validated.
+
+::
+
+    flexbe:
+      sm_outcomes:              # SM-outcome proposition -> outcome of the generated machine
+        finished: finished
+        failed: failed
+      states:                   # activation proposition <p>_a (or sensor) -> FlexBE state
+        look_down_a:
+          class_decl: {name: TiltHeadState, param_names: [desired_tilt], param_values: [TiltHeadState.DOWN_45]}
+          output_mapping: {look_down_c: [done], look_down_f: [failed]}
+          autonomy: 0           # one level for all outcomes, or a list in outcome order
+          userdata_keys: []     # optional, same length as userdata_remapping
+          userdata_remapping: []
+
+``class_decl.name`` is a state class, or ``:BEHAVIOR`` together with ``behavior_class``.
+A state's outcomes are the values of its ``output_mapping`` in file order; a list-valued
+``autonomy`` follows that order. Every problem raises ``SMGenerationError`` whose ``item``
+is the dotted key of the offending entry (e.g. ``flexbe.states.look_down_a.autonomy``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+from respec.systems import ConfigFileInvalidError, UnknownSystemError, load_section
+from sm_generation.errors import SMGenerationError
+
+BEHAVIOR_CLASS = ':BEHAVIOR'
+ACTIVATION_SUFFIX = '_a'
+# FlexBE autonomy levels: Off/Inherit 0, Low 1, High 2, Full 3.
+AUTONOMY_LEVELS = range(0, 4)
+
+
+@dataclass(frozen=True)
+class StateConfig:
+    """How one proposition is implemented: a parametrized FlexBE state and its outcomes."""
+
+    proposition: str
+    state_class: str
+    behavior_class: str
+    parameter_names: tuple[str, ...]
+    parameter_values: tuple[str, ...]
+    output_mapping: dict[str, tuple[str, ...]]  # outcome proposition -> state outcomes
+    autonomy: dict[str, int]                     # state outcome -> autonomy level
+    userdata_keys: tuple[str, ...]
+    userdata_remapping: tuple[str, ...]
+
+    @property
+    def label(self) -> str:
+        """Readable name: the proposition without its activation suffix (``look_down_a`` -> ``look_down``)."""
+        if self.proposition.endswith(ACTIVATION_SUFFIX) and len(self.proposition) > len(ACTIVATION_SUFFIX):
+            return self.proposition[:-len(ACTIVATION_SUFFIX)]
+        return self.proposition
+
+    @property
+    def outcomes(self) -> tuple[str, ...]:
+        """All outcomes of the state, in the order of ``output_mapping``."""
+        return tuple(o for outcomes in self.output_mapping.values() for o in outcomes)
+
+    def is_behavior(self) -> bool:
+        return self.state_class == BEHAVIOR_CLASS
+
+
+@dataclass(frozen=True)
+class FlexBEConfig:
+    """The validated ``flexbe:`` section of one system."""
+
+    system: str
+    sm_outcomes: dict[str, str]          # SM-outcome proposition -> machine outcome
+    states: dict[str, StateConfig]       # proposition -> state configuration
+
+    def owner_of_outcome(self, outcome_proposition: str) -> StateConfig | None:
+        """The state whose ``output_mapping`` contains ``outcome_proposition``."""
+        for state in self.states.values():
+            if outcome_proposition in state.output_mapping:
+                return state
+        return None
+
+
+def load_flexbe_config(system: str, config_dir: str | Path | None = None) -> FlexBEConfig:
+    """Load and validate the ``flexbe:`` section of ``config/<system>.yaml``."""
+    if config_dir is not None and not Path(config_dir).is_dir():
+        raise SMGenerationError('SYSTEM_CONFIG_NOT_FOUND', f'configuration directory {config_dir} does not exist',
+                                str(config_dir))
+    try:
+        section = load_section(system, 'flexbe', config_dir)
+    except UnknownSystemError as error:
+        raise SMGenerationError('NO_SYSTEM_CONFIG', str(error), error.item or system) from error
+    except ConfigFileInvalidError as error:
+        raise SMGenerationError('CONFIG_FILE_INVALID', str(error), error.item) from error
+    return parse_flexbe_config(section, system)
+
+
+def parse_flexbe_config(section: dict, system: str = '') -> FlexBEConfig:
+    """Validate an already-parsed ``flexbe:`` mapping."""
+    if not isinstance(section, dict):
+        raise SMGenerationError('CONFIG_FILE_INVALID', 'the flexbe section must be a mapping', 'flexbe')
+    sm_outcomes = _sm_outcomes(section.get('sm_outcomes'))
+    raw_states = section.get('states')
+    if not isinstance(raw_states, dict) or not raw_states:
+        raise SMGenerationError('CONFIG_FILE_INVALID',
+                                'flexbe.states must be a non-empty mapping of propositions to states',
+                                'flexbe.states')
+    states = {}
+    for proposition, entry in raw_states.items():
+        if not isinstance(proposition, str) or not proposition:
+            raise SMGenerationError('CONFIG_VARIABLE_CONFIG_INVALID',
+                                    f'flexbe.states: invalid proposition name {proposition!r}',
+                                    f'flexbe.states.{proposition}')
+        if proposition in sm_outcomes:
+            raise SMGenerationError('CONFIG_VARIABLE_CONFIG_INVALID',
+                                    f'{proposition!r} is both an SM outcome and a state',
+                                    f'flexbe.states.{proposition}')
+        states[proposition] = _state_config(proposition, entry)
+    _check_unique_outcome_owners(states)
+    return FlexBEConfig(system=system, sm_outcomes=sm_outcomes, states=states)
+
+
+def _sm_outcomes(raw) -> dict[str, str]:
+    key = 'flexbe.sm_outcomes'
+    if not isinstance(raw, dict) or not raw:
+        raise SMGenerationError('CONFIG_FILE_INVALID',
+                                f'{key} must map SM-outcome propositions to outcome names', key)
+    for proposition, outcome in raw.items():
+        if not isinstance(proposition, str) or not isinstance(outcome, str) or not outcome:
+            raise SMGenerationError('CONFIG_FILE_INVALID',
+                                    f'{key}.{proposition}: expected a non-empty outcome name, got {outcome!r}',
+                                    f'{key}.{proposition}')
+    return dict(raw)
+
+
+def _string_list(value, key: str, code: str) -> tuple[str, ...]:
+    if value is None:
+        return ()
+    if not isinstance(value, list) or any(isinstance(v, (list, dict)) or v is None for v in value):
+        raise SMGenerationError(code, f'{key} must be a list of strings, got {value!r}', key)
+    # YAML reads False or 3 as bool/int; FlexBE parameters and keys are source text.
+    return tuple(str(v) for v in value)
+
+
+def _state_config(proposition: str, entry) -> StateConfig:
+    where = f'flexbe.states.{proposition}'
+    invalid = 'CONFIG_VARIABLE_CONFIG_INVALID'
+    if not isinstance(entry, dict):
+        raise SMGenerationError(invalid, f'{where} must be a mapping', where)
+    for required in ('class_decl', 'output_mapping'):
+        if required not in entry:
+            raise SMGenerationError(invalid, f'{where} lacks {required!r}', f'{where}.{required}')
+
+    decl = entry['class_decl']
+    if not isinstance(decl, dict) or not isinstance(decl.get('name'), str) or not decl['name']:
+        raise SMGenerationError(invalid, f'{where}.class_decl needs a class name', f'{where}.class_decl.name')
+    behavior_class = decl.get('behavior_class', '')
+    if decl['name'] == BEHAVIOR_CLASS and (not isinstance(behavior_class, str) or not behavior_class):
+        raise SMGenerationError(invalid, f'{where}.class_decl: a {BEHAVIOR_CLASS} needs behavior_class',
+                                f'{where}.class_decl.behavior_class')
+    names = _string_list(decl.get('param_names'), f'{where}.class_decl.param_names', invalid)
+    values = _string_list(decl.get('param_values'), f'{where}.class_decl.param_values', invalid)
+    if len(names) != len(values):
+        raise SMGenerationError(invalid, f'{where}.class_decl: {len(names)} param_names but '
+                                f'{len(values)} param_values', f'{where}.class_decl.param_values')
+
+    output_mapping = _output_mapping(entry['output_mapping'], f'{where}.output_mapping')
+    outcomes = [o for os in output_mapping.values() for o in os]
+    autonomy = _autonomy(entry.get('autonomy', 0), outcomes, f'{where}.autonomy')
+
+    keys = _string_list(entry.get('userdata_keys'), f'{where}.userdata_keys', 'CONFIG_USERDATA_INVALID')
+    remapping = _string_list(entry.get('userdata_remapping'), f'{where}.userdata_remapping',
+                             'CONFIG_USERDATA_INVALID')
+    if len(keys) != len(remapping):
+        raise SMGenerationError('CONFIG_USERDATA_INVALID', f'{where}: {len(keys)} userdata_keys but '
+                                f'{len(remapping)} userdata_remapping', f'{where}.userdata_remapping')
+    if len(set(keys)) != len(keys):
+        raise SMGenerationError('CONFIG_USERDATA_INVALID', f'{where}.userdata_keys lists a key twice',
+                                f'{where}.userdata_keys')
+    return StateConfig(proposition=proposition, state_class=decl['name'],
+                       behavior_class=behavior_class if decl['name'] == BEHAVIOR_CLASS else '',
+                       parameter_names=names, parameter_values=values,
+                       output_mapping=output_mapping, autonomy=autonomy,
+                       userdata_keys=keys, userdata_remapping=remapping)
+
+
+def _output_mapping(raw, where: str) -> dict[str, tuple[str, ...]]:
+    invalid = 'CONFIG_VARIABLE_CONFIG_INVALID'
+    if not isinstance(raw, dict) or not raw:
+        raise SMGenerationError(invalid, f'{where} must map outcome propositions to state outcomes', where)
+    mapping, seen = {}, {}
+    for proposition, outcomes in raw.items():
+        if isinstance(outcomes, str):
+            outcomes = [outcomes]
+        if not isinstance(outcomes, list) or not outcomes or not all(isinstance(o, str) and o for o in outcomes):
+            raise SMGenerationError(invalid, f'{where}.{proposition}: expected a non-empty list of outcomes',
+                                    f'{where}.{proposition}')
+        for outcome in outcomes:
+            if outcome in seen:
+                raise SMGenerationError(invalid, f'{where}: outcome {outcome!r} means both '
+                                        f'{seen[outcome]!r} and {proposition!r}', f'{where}.{proposition}')
+            seen[outcome] = proposition
+        mapping[str(proposition)] = tuple(outcomes)
+    return mapping
+
+
+def _autonomy(raw, outcomes: list[str], where: str) -> dict[str, int]:
+    def level(value) -> int:
+        if isinstance(value, bool) or not isinstance(value, int) or value not in AUTONOMY_LEVELS:
+            raise SMGenerationError('CONFIG_AUTONOMY_INVALID',
+                                    f'{where}: autonomy must be an integer 0..3, got {value!r}', where)
+        return value
+
+    if isinstance(raw, list):
+        if len(raw) != len(outcomes):
+            raise SMGenerationError('CONFIG_AUTONOMY_INVALID', f'{where}: {len(raw)} levels for '
+                                    f'{len(outcomes)} outcomes {outcomes}', where)
+        return {outcome: level(value) for outcome, value in zip(outcomes, raw)}
+    return {outcome: level(raw) for outcome in outcomes}
+
+
+def _check_unique_outcome_owners(states: dict[str, StateConfig]) -> None:
+    owners: dict[str, str] = {}
+    for state in states.values():
+        for proposition in state.output_mapping:
+            if proposition in owners:
+                raise SMGenerationError('CONFIG_VARIABLE_CONFIG_INVALID',
+                                        f'outcome proposition {proposition!r} is mapped by both '
+                                        f'{owners[proposition]!r} and {state.proposition!r}',
+                                        f'flexbe.states.{state.proposition}.output_mapping.{proposition}')
+            owners[proposition] = state.proposition

@@ -1,0 +1,262 @@
+"""``generate_state_machine``: automaton + system configuration -> StateInstantiation list.
+
+The list, in order:
+
+1. the root (``state_path='/'``, ``:STATEMACHINE``): ``initial_state_name`` is the first
+   state to run, ``outcomes`` the machine's outcomes (e.g. ``finished``, ``failed``);
+   its ``transitions`` repeat them (each outcome leaves as itself) and ``autonomy`` is 0;
+2. one entry per state, breadth-first from the initial state (``/look_down``). A state
+   with one part is that FlexBE state: ``outcomes`` are its configured outcomes that some
+   observation maps to (in configuration order) and ``transitions`` the next state or
+   machine outcome for each. A state with several parts is a ``:CONCURRENCY`` container
+   (``/look_down_and_stand``) followed by its inner states (``/look_down_and_stand/stand``):
+   one container outcome per observation, named after the outcome propositions it
+   contains (``look_down_c__stand_c``; a sensor event is ``obj_detected_true``);
+   ``cond_outcome[i]`` is returned when all inner outcomes of ``cond_transition[i]``
+   have been returned (an outcome proposition mapped to
+   several state outcomes gives one condition per combination, all with the same
+   container outcome; conditions with more inner states come first, because FlexBE
+   returns the first that holds). Inner states list the outcomes used in conditions and,
+   as transition, the first container outcome each one takes part in;
+3. one ``:OUTCOME`` entry per machine outcome (``/finished``), which only places it in
+   the drawing (FlexBE 4.x editor).
+
+Names come from the activated propositions without ``_a`` (sorted, joined with
+``_and_``); repeated names get ``_1``, ``_2``, ... in breadth-first order.
+"""
+
+from __future__ import annotations
+
+import logging
+from pathlib import Path
+
+from sm_generation.config import FlexBEConfig, StateConfig, load_flexbe_config
+from sm_generation.errors import SMGenerationError
+from sm_generation.instantiation import OutcomeCondition, StateInstantiation
+from sm_generation.layout import inner_positions, layered_positions
+from sm_generation.machine import (
+    DECISION, NOTHING_TO_DO, AutomatonView, Machine, MachineState, Target, build_machine)
+from sm_generation.reduction import bisimulation_blocks, reduce_machine, target_class
+
+_LOG = logging.getLogger(__name__)
+
+NAME_SEPARATOR = '_and_'
+CONDITION_SEPARATOR = '__'
+SENSOR_EVENT_SUFFIX = '_true'
+# Helper states from flexbe_states, used where the automaton itself has no state.
+DECISION_NAME = 'choose_initial_state'
+DECISION_CLASS = 'OperatorDecisionState'
+DECISION_AUTONOMY = 3  # Full: the operator confirms where to start unless in full autonomy
+NOTHING_NAME = 'nothing_to_do'
+NOTHING_CLASS = 'LogState'
+
+
+def generate_state_machine(automaton, system: str, config_dir: str | Path | None = None,
+                           initial_conditions: list[str] | None = None,
+                           reduce: bool = False) -> list[StateInstantiation]:
+    """The FlexBE state machine implementing ``automaton`` on ``system``.
+
+    Initial state: the automaton's ``initial_states`` (kept only if they satisfy the
+    ``initial_conditions``), or else the states that activate nothing, exit nothing and
+    have the completion proposition of every initial condition true (with no initial
+    conditions given, those nothing leads back to are preferred). Each is resolved to the
+    first state that does something (or to a machine outcome). If they all behave the same
+    (bisimilar) the first is used; otherwise an operator decision (``choose_initial_state``,
+    flexbe_states' OperatorDecisionState) offers one start per behaviour. A start that is
+    already an outcome gets a ``nothing_to_do`` LogState. ``reduce`` merges equivalent
+    states. Raises ``SMGenerationError``.
+    """
+    config = load_flexbe_config(system, config_dir)
+    return generate_from_config(automaton, config, initial_conditions, reduce)
+
+
+def generate_from_config(automaton, config: FlexBEConfig, initial_conditions: list[str] | None = None,
+                         reduce: bool = False) -> list[StateInstantiation]:
+    """As ``generate_state_machine``, with an already loaded configuration."""
+    view = AutomatonView(automaton, config)
+    machine = machine_from_view(view, initial_conditions)
+    for source, target in machine.dropped:
+        _LOG.warning('automaton step %s -> %s changes the activations without any outcome or sensor event; '
+                     'FlexBE cannot take it, so it is left out', source, target)
+    if reduce:
+        machine = reduce_machine(machine)
+    return _instantiate(machine)
+
+
+def machine_from_view(view: AutomatonView, initial_conditions: list[str] | None) -> Machine:
+    """The abstract machine, with a helper state when the start needs one."""
+    starts = list(dict.fromkeys(view.resolve(name) for name in view.initial_candidates(initial_conditions)))
+    if len(starts) > 1:
+        # Starts that behave the same need no choice: keep the first of each kind.
+        blocks = bisimulation_blocks(build_machine(view, starts))
+        first_of_class = {}
+        for target in starts:
+            first_of_class.setdefault(target_class(target, blocks), target)
+        starts = list(first_of_class.values())
+    if len(starts) == 1 and starts[0][0] == 'state':
+        return build_machine(view, starts)
+    machine = build_machine(view, starts)
+    helper = DECISION if len(starts) > 1 else NOTHING_TO_DO
+    transitions = [((('', f'choice{index}'),), target) for index, target in enumerate(starts)]
+    start = MachineState(key=f'<{helper}>', parts=(), transitions=transitions, helper=helper)
+    machine.states = {start.key: start, **machine.states}
+    machine.initial = start.key
+    return machine
+
+
+# --- naming -----------------------------------------------------------------------------
+
+def _base_name(state: MachineState) -> str:
+    if state.helper == DECISION:
+        return DECISION_NAME
+    if state.helper == NOTHING_TO_DO:
+        return NOTHING_NAME
+    return NAME_SEPARATOR.join(part.label for part in state.parts)
+
+
+def _assign_names(machine: Machine) -> dict[str, str]:
+    bases = {key: _base_name(state) for key, state in machine.states.items()}
+    counts: dict[str, int] = {}
+    for base in bases.values():
+        counts[base] = counts.get(base, 0) + 1
+    taken = set(machine.outcomes)
+    names, next_index, plain = {}, {}, set(bases.values())
+    for key, base in bases.items():
+        if counts[base] == 1 and base not in taken:
+            name = base
+        else:
+            index = next_index.get(base, 1)
+            while f'{base}_{index}' in taken or f'{base}_{index}' in plain:
+                index += 1
+            name = f'{base}_{index}'
+            next_index[base] = index + 1
+        taken.add(name)
+        names[key] = name
+    return names
+
+
+# --- StateInstantiation entries -----------------------------------------------------------
+
+def _instantiate(machine: Machine) -> list[StateInstantiation]:
+    names = _assign_names(machine)
+
+    def target_name(target: Target) -> str:
+        kind, name = target
+        return names[name] if kind == 'state' else name
+
+    edges = {names[key]: [target_name(t) for _, t in state.transitions] for key, state in machine.states.items()}
+    positions = layered_positions(edges, names[machine.initial], machine.outcomes)
+    root = StateInstantiation(
+        state_path='/', state_class=StateInstantiation.CLASS_STATEMACHINE,
+        initial_state_name=names[machine.initial], outcomes=list(machine.outcomes),
+        transitions=list(machine.outcomes), autonomy=[0] * len(machine.outcomes), position=[0.0, 0.0])
+    entries = [root]
+    for key, state in machine.states.items():
+        name = names[key]
+        if state.helper:
+            new = [_helper_entry(state, name, target_name)]
+        elif len(state.parts) == 1:
+            new = [_single_entry(state, f'/{name}', target_name)]
+        else:
+            new = _concurrency_entries(state, name, target_name)
+        new[0].position = positions[name]
+        entries.extend(new)
+    entries.extend(StateInstantiation(state_path=f'/{outcome}', state_class=StateInstantiation.CLASS_OUTCOME,
+                                      position=positions[outcome]) for outcome in machine.outcomes)
+    return entries
+
+
+def _part_entry(part: StateConfig, path: str) -> StateInstantiation:
+    return StateInstantiation(
+        state_path=path, state_class=part.state_class, behavior_class=part.behavior_class,
+        parameter_names=list(part.parameter_names), parameter_values=list(part.parameter_values),
+        userdata_keys=list(part.userdata_keys), userdata_remapping=list(part.userdata_remapping))
+
+
+def _single_entry(state: MachineState, path: str, target_name) -> StateInstantiation:
+    part = state.parts[0]
+    entry = _part_entry(part, path)
+    by_proposition = {observation[0][1]: target for observation, target in state.transitions}
+    for proposition, outcomes in part.output_mapping.items():
+        if proposition in by_proposition:
+            for outcome in outcomes:
+                entry.outcomes.append(outcome)
+                entry.transitions.append(target_name(by_proposition[proposition]))
+                entry.autonomy.append(part.autonomy[outcome])
+    return entry
+
+
+def _concurrency_entries(state: MachineState, name: str, target_name) -> list[StateInstantiation]:
+    parts = {part.proposition: part for part in state.parts}
+    labels = _inner_labels(state.parts)
+    container = StateInstantiation(state_path=f'/{name}', state_class=StateInstantiation.CLASS_CONCURRENCY)
+    first_use: dict[tuple[str, str], str] = {}  # (inner state, outcome) -> first container outcome
+    for observation, target in state.transitions:
+        outcome_name = _container_outcome(observation)
+        autonomy = 0
+        for combination in _combinations([parts[p].output_mapping[prop] for p, prop in observation]):
+            inner = [labels[p] for p, _ in observation]
+            container.cond_outcome.append(outcome_name)
+            container.cond_transition.append(OutcomeCondition(state_name=inner, state_outcome=list(combination)))
+            for (p, _), outcome, label in zip(observation, combination, inner):
+                autonomy = max(autonomy, parts[p].autonomy[outcome])
+                first_use.setdefault((label, outcome), outcome_name)
+        container.outcomes.append(outcome_name)
+        container.transitions.append(target_name(target))
+        container.autonomy.append(autonomy)
+    keys = sorted({key for part in state.parts for key in part.userdata_remapping})
+    container.input_keys, container.output_keys = list(keys), list(keys)
+    container.initial_state_name = labels[state.parts[0].proposition]
+
+    entries = [container]
+    for part, position in zip(state.parts, inner_positions(len(state.parts))):
+        inner = _part_entry(part, f'/{name}/{labels[part.proposition]}')
+        inner.position = position
+        for outcome in part.outcomes:
+            if (labels[part.proposition], outcome) in first_use:
+                inner.outcomes.append(outcome)
+                inner.transitions.append(first_use[(labels[part.proposition], outcome)])
+                inner.autonomy.append(part.autonomy[outcome])
+        entries.append(inner)
+    return entries
+
+
+def _container_outcome(observation) -> str:
+    """Container outcome of an observation: its outcome propositions, joined.
+
+    A sensor event (observed as the pair (sensor, sensor)) is written ``<sensor>_true``,
+    so that the outcome differs from the name of the sensor's inner state.
+    """
+    return CONDITION_SEPARATOR.join(f'{proposition}{SENSOR_EVENT_SUFFIX}' if part == proposition else proposition
+                                    for part, proposition in observation)
+
+
+def _inner_labels(parts: tuple[StateConfig, ...]) -> dict[str, str]:
+    labels = {part.proposition: part.label for part in parts}
+    if len(set(labels.values())) < len(labels):  # e.g. sensor 'x' next to activation 'x_a'
+        labels = {part.proposition: part.proposition for part in parts}
+    return labels
+
+
+def _combinations(choices: list[tuple[str, ...]]) -> list[tuple[str, ...]]:
+    result = [()]
+    for options in choices:
+        result = [(*prefix, option) for prefix in result for option in options]
+    return result
+
+
+def _helper_entry(state: MachineState, name: str, target_name) -> StateInstantiation:
+    targets = [target_name(target) for _, target in state.transitions]
+    if state.helper == DECISION:
+        return StateInstantiation(
+            state_path=f'/{name}', state_class=DECISION_CLASS,
+            parameter_names=['outcomes', 'hint', 'suggestion'],
+            parameter_values=[repr(targets), '"Several initial states are possible: choose where to start"',
+                              'None'],
+            outcomes=list(targets), transitions=list(targets), autonomy=[DECISION_AUTONOMY] * len(targets))
+    if state.helper == NOTHING_TO_DO:
+        return StateInstantiation(
+            state_path=f'/{name}', state_class=NOTHING_CLASS, parameter_names=['text', 'severity'],
+            parameter_values=[f'"Nothing to do: the task ends with {targets[0]}"', 'Logger.REPORT_HINT'],
+            outcomes=['done'], transitions=targets[:1], autonomy=[0])
+    raise SMGenerationError('SM_GENERATION_FAILED', f'unknown helper state {state.helper!r}', name)

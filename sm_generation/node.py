@@ -1,0 +1,47 @@
+"""The ``sm_generate`` service node (GenerateFlexBESM): a thin adapter around generate_state_machine."""
+
+from __future__ import annotations
+
+from rclpy.callback_groups import ReentrantCallbackGroup
+from rclpy.node import Node
+
+from sm_generation import generate_state_machine
+from synthesis_manager.conversions import error_code, msg_to_automaton, state_to_msg
+from synthesis_msgs.srv import GenerateFlexBESM
+
+
+class SMGenerationNode(Node):
+    """Turns synthesized automata into FlexBE state instantiations.
+
+    Parameters: ``config_dir`` (robot system configurations; empty = the packaged config/),
+    ``reduce`` (merge equivalent automaton states).
+    """
+
+    def __init__(self, **kwargs):
+        super().__init__('sm_generation', **kwargs)
+        self.declare_parameter('config_dir', '')
+        self.declare_parameter('reduce', False)
+        self.create_service(GenerateFlexBESM, 'sm_generate', self.handle,
+                            callback_group=ReentrantCallbackGroup())
+
+    def handle(self, request, response):
+        try:
+            states = generate_state_machine(
+                msg_to_automaton(request.automaton), request.system,
+                config_dir=self.get_parameter('config_dir').value or None,
+                initial_conditions=list(request.initial_conditions) or None,
+                reduce=self.get_parameter('reduce').value)
+        except Exception as error:  # every failure becomes an error code; the node keeps serving
+            code = getattr(error, 'code', 'SM_GENERATION_FAILED')
+            response.error_code = error_code(code, f'state machine generation failed: {error}')
+            self.get_logger().warning(response.error_code.message)
+            return response
+        response.state_definition = [state_to_msg(state) for state in states]
+        response.error_code = error_code('SUCCESS')
+        return response
+
+
+def main():
+    from synthesis_manager.node_main import node_main
+
+    node_main(SMGenerationNode, 'sm_generation')

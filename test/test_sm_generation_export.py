@@ -1,0 +1,101 @@
+"""YAML / JSON / DOT exports, rendering with Graphviz, and the generate-sm command line."""
+
+import json
+from pathlib import Path
+
+import pytest
+
+from sm_generation import generate_state_machine, load_automaton
+from sm_generation import export
+from sm_generation.cli import main
+from sm_generation.export import RenderError, from_text, render, to_dot, to_json, to_yaml
+
+AUTOMATA = Path(__file__).resolve().parent / 'automata'
+
+
+@pytest.fixture(scope='module')
+def concurrent():
+    return generate_state_machine(load_automaton(AUTOMATA / 'concurrent.yaml'), 'atlas')
+
+
+def test_yaml_and_json_round_trip(concurrent):
+    assert from_text(to_yaml(concurrent)) == concurrent
+    assert from_text(to_json(concurrent)) == concurrent
+    entries = json.loads(to_json(concurrent))
+    assert all(len(entry) == 16 for entry in entries)
+    assert entries[0]['state_path'] == '/'
+
+
+def test_dot_draws_states_containers_outcomes_and_start(concurrent):
+    dot = to_dot(concurrent)
+    assert dot.startswith('digraph state_machine {') and dot.rstrip().endswith('}')
+    assert '"outcome:finished" [label="finished", shape=doublecircle];' in dot
+    assert 'subgraph "cluster_0"' in dot and 'object_template_and_stand (concurrent)' in dot
+    assert '"start" -> "state:object_template_and_stand/object_template" [label="initial", lhead="cluster_0"];' in dot
+    assert ('"state:pregrasp_pose" -> "outcome:failed" [label="not_available"];') in dot
+    assert '[label="stand_c", ltail="cluster_0"]' in dot
+    assert to_dot(concurrent) == dot
+
+
+def test_dot_labels_behaviours_and_escapes_quotes():
+    states = generate_state_machine(load_automaton(AUTOMATA / 'two_behaviors.yaml'), 'atlas')
+    states[2].state_path = '/say "hi"'
+    states[1].transitions = ['say "hi"', 'failed']
+    dot = to_dot(states)
+    assert '[Grasp Object]' in dot
+    assert '"state:say \\"hi\\""' in dot
+
+
+@pytest.mark.parametrize('fmt, magic', [('svg', b'<svg'), ('png', b'\x89PNG')])
+def test_render(concurrent, tmp_path, fmt, magic):
+    path = render(to_dot(concurrent), tmp_path / f'machine.{fmt}')
+    assert magic in path.read_bytes()[:400]
+
+
+def test_render_without_graphviz(concurrent, tmp_path, monkeypatch):
+    monkeypatch.setattr(export.shutil, 'which', lambda name: None)
+    with pytest.raises(RenderError, match='apt-get install graphviz') as caught:
+        render(to_dot(concurrent), tmp_path / 'machine.svg')
+    assert caught.value.item == 'dot'
+
+
+def test_render_rejects_other_formats(concurrent, tmp_path):
+    with pytest.raises(RenderError, match='pdf'):
+        render(to_dot(concurrent), tmp_path / 'machine.pdf')
+
+
+def test_cli_writes_yaml_to_stdout(capsys):
+    assert main(['--system', 'atlas', '--automaton', str(AUTOMATA / 'look_down.yaml')]) == 0
+    out = capsys.readouterr().out
+    assert from_text(out) == generate_state_machine(load_automaton(AUTOMATA / 'look_down.yaml'), 'atlas')
+
+
+def test_cli_formats_from_suffix_and_flag(tmp_path):
+    automaton = str(AUTOMATA / 'sensors.yaml')
+    assert main(['--automaton', automaton, '-o', str(tmp_path / 'm.json'), '--reduce']) == 0
+    assert json.loads((tmp_path / 'm.json').read_text())[0]['state_path'] == '/'
+    assert main(['--automaton', automaton, '--format', 'dot', '-o', str(tmp_path / 'm.txt')]) == 0
+    assert (tmp_path / 'm.txt').read_text().startswith('digraph')
+    assert main(['--automaton', automaton, '-o', str(tmp_path / 'm.svg')]) == 0  # needs Graphviz
+    assert b'<svg' in (tmp_path / 'm.svg').read_bytes()
+
+
+def test_cli_initial_conditions(capsys):
+    assert main(['--automaton', str(AUTOMATA / 'no_initial_states.yaml'), '--initial-conditions', 'stand']) == 0
+    assert from_text(capsys.readouterr().out)[0].initial_state_name == 'look_down'
+
+
+def test_cli_reports_errors(capsys):
+    assert main(['--automaton', str(AUTOMATA / 'invalid' / 'bad_next_state.yaml')]) == 1
+    err = capsys.readouterr().err
+    assert 'AUTOMATON_NEXT_STATE_INVALID' in err and "'7'" in err
+    assert main(['--automaton', str(AUTOMATA / 'look_down.yaml'), '--format', 'svg']) == 2
+    assert 'needs -o' in capsys.readouterr().err
+
+
+def test_cli_subcommand_of_behavior_synthesis(tmp_path):
+    from synthesis_manager.cli import main as suite_main
+    out = tmp_path / 'm.yaml'
+    assert suite_main(['generate-sm', '--system', 'atlas', '--automaton', str(AUTOMATA / 'look_down.yaml'),
+                       '-o', str(out)]) == 0
+    assert from_text(out.read_text())[0].initial_state_name == 'stand'

@@ -268,7 +268,7 @@ def _check_goals(abstraction: RobotAbstraction, goals) -> list[str]:
         raise InvalidGoalsError('no goals given: name at least one action or control mode', item='')
     for index, goal in enumerate(names):
         if abstraction.kind_of(goal) is None:
-            raise InvalidGoalsError(
+            raise UnknownPropositionError(
                 f'unknown goal {goal!r}: not an action or control mode of {abstraction.system} '
                 f'(known: {", ".join(abstraction.items())})', item=goal)
         if goal in names[:index]:
@@ -280,7 +280,7 @@ def _check_initial_conditions(abstraction: RobotAbstraction, initial_conditions)
     names = _names(initial_conditions, 'initial conditions', InvalidInitialConditionsError)
     for name in names:
         if abstraction.kind_of(name) is None:
-            raise InvalidInitialConditionsError(
+            raise UnknownPropositionError(
                 f'unknown initial condition {name!r}: not an action or control mode of '
                 f'{abstraction.system} (known: {", ".join(abstraction.items())})', item=name)
     return list(dict.fromkeys(names))

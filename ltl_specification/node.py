@@ -19,10 +19,10 @@ class LTLCompilationNode(Node):
     def __init__(self, **kwargs):
         super().__init__('ltl_compilation', **kwargs)
         self.declare_parameter('config_dir', '')
-        self.create_service(GenerateLTLSpecification, 'ltl_compilation', self.handle,
+        self.create_service(GenerateLTLSpecification, 'ltl_compilation', self.on_request,
                             callback_group=ReentrantCallbackGroup())
 
-    def handle(self, request, response):
+    def on_request(self, request, response):
         try:
             spec = compile_task(
                 request.system, list(request.initial_conditions), list(request.goals),

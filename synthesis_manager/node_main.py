@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import signal
 import sys
 
 from synthesis_manager.ros_env import init_ros
@@ -13,14 +12,11 @@ def run_nodes(*node_factories, argv: list[str] | None = None, ready_message: str
     import rclpy
     from rclpy.executors import ExternalShutdownException, MultiThreadedExecutor
 
+    # rclpy's own signal handlers (installed by init) turn SIGINT and SIGTERM into a
+    # context shutdown, which wakes the executor: spin() then raises ExternalShutdownException.
     context = init_ros(args=argv)
     executor = MultiThreadedExecutor(num_threads=16, context=context)
     nodes = []
-
-    def stop(signum, frame):
-        raise KeyboardInterrupt
-
-    previous_sigterm = signal.signal(signal.SIGTERM, stop)
     try:
         for factory in node_factories:
             node = factory(context=context)
@@ -32,7 +28,6 @@ def run_nodes(*node_factories, argv: list[str] | None = None, ready_message: str
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
     finally:
-        signal.signal(signal.SIGTERM, previous_sigterm)
         executor.shutdown(timeout_sec=5.0)
         for node in reversed(nodes):
             node.destroy_node()

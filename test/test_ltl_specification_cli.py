@@ -54,7 +54,7 @@ def test_custom_ltl_file_and_explain(tmp_path):
 
 
 @pytest.mark.parametrize('args, code, item', [
-    (['--system', 'atlas', '--goals', 'look_down,dance'], 'INVALID_GOALS', "'dance'"),
+    (['--system', 'atlas', '--goals', 'look_down,dance'], 'UNKNOWN_PROPOSITION', "'dance'"),
     (['--system', 'robby', '--goals', 'look_down'], 'UNKNOWN_SYSTEM', "'robby'"),
     (['--system', 'atlas', '--initial-conditions', 'stand,walk', '--goals', 'look_down'],
      'INVALID_INITIAL_CONDITIONS', "'walk'"),

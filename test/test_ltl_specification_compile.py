@@ -254,13 +254,13 @@ def test_unknown_system():
 
 
 def test_unknown_goal():
-    error = raised(InvalidGoalsError, goals=['look_down', 'dance'])
-    assert error.item == 'dance' and error.code == 'INVALID_GOALS' and 'unknown goal' in str(error)
+    error = raised(UnknownPropositionError, goals=['look_down', 'dance'])
+    assert error.item == 'dance' and error.code == 'UNKNOWN_PROPOSITION' and 'unknown goal' in str(error)
 
 
 def test_unknown_initial_condition():
-    error = raised(InvalidInitialConditionsError, initial_conditions=['sitting'])
-    assert error.item == 'sitting' and error.code == 'INVALID_INITIAL_CONDITIONS'
+    error = raised(UnknownPropositionError, initial_conditions=['sitting'])
+    assert error.item == 'sitting' and error.code == 'UNKNOWN_PROPOSITION'
 
 
 def test_two_control_modes_as_initial_conditions():

@@ -144,7 +144,8 @@ class BehaviorSynthesisServer(Node):
             'state machine generation', self.parameter('generation_timeout'))
         self.check(generated.error_code)
         result.states = generated.state_definition
-        feedback(f'Generated a state machine with {len(result.states)} states', 1.0)
+        states = [s for s in result.states if s.state_path != '/' and s.state_class != s.CLASS_OUTCOME]
+        feedback(f'Generated a state machine with {len(states)} states', 1.0)
         result.error_code = error_code('SUCCESS')
 
     @staticmethod

@@ -1,0 +1,141 @@
+"""``behavior-synthesis gui``: the synthesis web GUI on http://127.0.0.1:PORT/.
+
+By default the four suite nodes run in this process on a private ROS domain, next to the
+GUI's action client; ``--connect`` instead joins a suite already running on the
+environment's ROS_DOMAIN_ID (e.g. ``behavior-synthesis serve``). The page and its API are
+``synthesis_manager.webapp``; this module only wires them to ROS and runs uvicorn.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import socket
+import sys
+import threading
+import time
+
+from synthesis_manager.suite import add_suite_arguments
+
+DEFAULT_PORT = 8080
+LOOPBACK_HOSTS = ('127.0.0.1', 'localhost', '::1')
+
+
+def add_arguments(parser):
+    parser.add_argument('--port', type=int, default=DEFAULT_PORT,
+                        help=f'TCP port of the page (default {DEFAULT_PORT}; 0 picks a free one)')
+    parser.add_argument('--host', default='127.0.0.1',
+                        help='address to listen on (default 127.0.0.1: this machine only)')
+    parser.add_argument('--connect', action='store_true',
+                        help='use the suite already running on $ROS_DOMAIN_ID instead of starting one')
+    parser.add_argument('--goal-timeout', type=float, default=600.0,
+                        help='seconds to wait for the result of one goal')
+    add_suite_arguments(parser)
+
+
+class RosGoalRunner:
+    """``run_goal`` for SynthesisBackend: sends each job to ``/behavior_synthesis``."""
+
+    def __init__(self, client, server_timeout: float = 5.0, goal_timeout: float = 600.0):
+        self.client = client
+        self.server_timeout = server_timeout
+        self.goal_timeout = goal_timeout
+
+    def __call__(self, request, feedback, cancel) -> dict:
+        from synthesis_manager.client import SynthesisOutcome, make_goal
+
+        if not self.client.wait_for_server(timeout=self.server_timeout):
+            return SynthesisOutcome(
+                -3, 'SERVICE_UNAVAILABLE', 'no /behavior_synthesis action server answered within '
+                f'{self.server_timeout:g} s (start one with `behavior-synthesis serve`)').to_dict()
+        goal = make_goal(request.system, request.initial_conditions, request.goals, request.sm_outcomes,
+                         option=request.option, name=request.name, unordered=request.unordered)
+        return self.client.run(goal, feedback=feedback, cancel=cancel, timeout=self.goal_timeout).to_dict()
+
+
+@contextlib.contextmanager
+def ros_backend(args=None, connect: bool = False):
+    """A SynthesisBackend sending jobs over ROS: to an in-process suite, or (connect) a running one."""
+    from rclpy.node import Node
+
+    from synthesis_manager.client import SynthesisClient
+    from synthesis_manager.harness import RosHarness, environment_domain_id
+    from synthesis_manager.suite import suite_node_factories
+    from synthesis_manager.webapp import SynthesisBackend
+
+    with RosHarness(domain_id=environment_domain_id() if connect else None) as ros:
+        if not connect:
+            for factory in suite_node_factories(args):
+                ros.add_node(factory)
+        client = SynthesisClient(ros.add_node(Node, 'behavior_synthesis_gui'))
+        where = (f'the suite on ROS_DOMAIN_ID {ros.domain_id}' if connect
+                 else f'an in-process suite (private ROS domain {ros.domain_id})')
+        yield SynthesisBackend(
+            RosGoalRunner(client, goal_timeout=getattr(args, 'goal_timeout', 600.0)),
+            config_dir=getattr(args, 'config_dir', '') or None, description=f'synthesizing with {where}')
+
+
+def listening_socket(host: str, port: int) -> socket.socket:
+    """A socket bound to ``host:port`` and listening (port 0: the OS picks a free port)."""
+    family = socket.AF_INET6 if ':' in host else socket.AF_INET
+    sock = socket.socket(family, socket.SOCK_STREAM)
+    sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+    sock.bind((host, port))
+    sock.listen(64)
+    return sock
+
+
+def make_server(app, sock: socket.socket):
+    """A uvicorn server for ``app`` on an already bound socket (call ``.run(sockets=[sock])``)."""
+    import uvicorn
+
+    host, port = sock.getsockname()[:2]
+    return uvicorn.Server(uvicorn.Config(app, host=host, port=port, log_level='warning',
+                                         timeout_graceful_shutdown=2, ws='none'))
+
+
+@contextlib.contextmanager
+def background_server(app, host: str = '127.0.0.1', port: int = 0, startup_timeout: float = 10.0):
+    """Serve ``app`` from a thread (tests, screenshots); yields the page's URL."""
+    sock = listening_socket(host, port)
+    server = make_server(app, sock)
+    thread = threading.Thread(target=server.run, kwargs={'sockets': [sock]}, name='gui-http', daemon=True)
+    thread.start()
+    try:
+        deadline = time.monotonic() + startup_timeout
+        while not server.started:
+            if not thread.is_alive() or time.monotonic() > deadline:
+                raise RuntimeError('the GUI web server did not start')
+            time.sleep(0.02)
+        yield f'http://{host}:{sock.getsockname()[1]}/'
+    finally:
+        server.should_exit = True
+        thread.join(timeout=10.0)
+        sock.close()
+
+
+def run(args) -> int:
+    import os
+
+    os.environ.setdefault('MUJOCO_GL', 'egl')  # the simulation renders frames off-screen
+    from synthesis_manager.webapp import create_app
+
+    if args.host not in LOOPBACK_HOSTS:
+        print(f'gui: warning: listening on {args.host}: other machines can reach the page and '
+              'start synthesis jobs', file=sys.stderr)
+    try:
+        sock = listening_socket(args.host, args.port)
+    except OSError as error:
+        print(f'gui: cannot listen on {args.host}:{args.port}: {error.strerror}', file=sys.stderr)
+        return 1
+    with sock:
+        try:
+            with ros_backend(args, connect=args.connect) as backend:
+                server = make_server(create_app(backend), sock)
+                host, port = sock.getsockname()[:2]
+                shown = f'[{host}]' if ':' in host else host
+                print(f'behavior synthesis GUI: http://{shown}:{port}/ ({backend.description}); '
+                      'Ctrl-C to stop', flush=True)
+                server.run(sockets=[sock])
+        except KeyboardInterrupt:
+            pass
+    return 0

@@ -1,0 +1,244 @@
+"""The web GUI's JSON API against the real pipeline (suite in-process), without a browser."""
+
+import json
+
+import pytest
+import yaml
+from fastapi.testclient import TestClient
+
+from synthesis_manager.cli import build_parser
+from synthesis_manager.gui import ros_backend
+from synthesis_manager.webapp import create_app
+
+PAPER_TASK = {'system': 'atlas', 'initial_conditions': ['stand_prep'], 'goals': ['look_down', 'pickup_object']}
+# Seven ordered goals: its synthesis runs for minutes, so a cancel always lands in the middle.
+SLOW_TASK = {'system': 'atlas', 'initial_conditions': ['stand_prep'],
+             'goals': ['look_down', 'pickup_object', 'grasp_object', 'pregrasp', 'approach_object',
+                       'footstep_execution', 'walk']}
+STATE_FIELDS = {'state_path', 'state_class', 'initial_state_name', 'input_keys', 'output_keys',
+                'cond_outcome', 'cond_transition', 'behavior_class', 'parameter_names',
+                'parameter_values', 'position', 'outcomes', 'transitions', 'autonomy',
+                'userdata_keys', 'userdata_remapping'}
+
+
+def gui_args(byproducts_dir):
+    """The settings ``behavior-synthesis gui`` would get, parsed by the real command line."""
+    return build_parser(only='gui').parse_args(
+        ['gui', '--byproducts-dir', str(byproducts_dir), '--synthesis-timeout', '60',
+         '--goal-timeout', '120'])
+
+
+@pytest.fixture(scope='module')
+def backend(tmp_path_factory):
+    with ros_backend(gui_args(tmp_path_factory.mktemp('gui-api'))) as backend:
+        yield backend
+
+
+@pytest.fixture(scope='module')
+def client(backend):
+    with TestClient(create_app(backend)) as client:
+        yield client
+
+
+def follow(client, job_id):
+    """Read the job's event stream to its end; returns (progress events, final job)."""
+    progress, final = [], None
+    with client.stream('GET', f'/api/jobs/{job_id}/events', timeout=180) as response:
+        assert response.status_code == 200
+        assert response.headers['content-type'].startswith('text/event-stream')
+        kind = None
+        for line in response.iter_lines():
+            if line.startswith('event: '):
+                kind = line[len('event: '):]
+            elif line.startswith('data: '):
+                job = json.loads(line[len('data: '):])
+                if kind == 'finished':
+                    final = job
+                else:
+                    progress.append(job)
+    return progress, final
+
+
+def run_job(client, request):
+    response = client.post('/api/jobs', json=request)
+    assert response.status_code == 202, response.text
+    return follow(client, response.json()['id'])
+
+
+def test_systems_and_their_choices(client):
+    assert 'atlas' in client.get('/api/systems').json()['systems']
+    choices = client.get('/api/systems/atlas').json()
+    modes = {m['name']: m['next'] for m in choices['control_modes']}
+    actions = {a['name']: a['preconditions'] for a in choices['actions']}
+    assert modes['stand_prep'] == ['stand'] and 'walk' in modes['stand']
+    assert actions['pickup_object'] == ['object_template', 'manipulate']
+    assert 'look_down' in actions
+    assert choices['default_initial_conditions'] == ['stand_prep']
+
+
+def test_paper_task_succeeds_with_progress_states_and_downloads(client):
+    progress, job = run_job(client, PAPER_TASK)
+    assert job['outcome']['error_name'] == 'SUCCESS', job['outcome']['message']
+    statuses = [entry['status'] for entry in job['timeline']]
+    assert any(s.startswith('Compiling') for s in statuses)
+    assert any(s.startswith('Synthesiz') for s in statuses)
+    values = [entry['progress'] for entry in job['timeline']]
+    assert values == sorted(values) and values[-1] == pytest.approx(1.0)
+    assert progress and progress[0]['state'] in ('queued', 'running')
+
+    summary = job['summary']
+    assert summary['realizable'] is True
+    assert summary['automaton_states'] == len(job['outcome']['automaton']['states']) > 0
+    assert summary['input_propositions'] == len(job['outcome']['ltl_specification']['env_props'])
+    names = {s['state_path'].rsplit('/', 1)[-1] for s in job['outcome']['states']}
+    assert {'look_down', 'pickup_object', 'stand', 'manipulate'} <= names
+    assert summary['state_machine_states'] == len(job['outcome']['states']) - 1  # without the root
+
+    base = f"/api/jobs/{job['id']}/artifacts"
+    listing = yaml.safe_load(client.get(f'{base}/state_machine.yaml').text)
+    assert listing == job['outcome']['states']
+    assert all(set(entry) == STATE_FIELDS for entry in listing)
+    assert json.loads(client.get(f'{base}/state_machine.json').text) == listing
+    download = client.get(f'{base}/state_machine.yaml')
+    assert download.headers['content-disposition'].startswith('attachment')
+
+    from respec.parsing import parse_slugsin, parse_structuredslugs
+
+    sections = job['outcome']['ltl_specification']
+    structured = client.get(f'{base}/specification.structuredslugs').text
+    assert parse_structuredslugs(structured).to_text_sections() == sections
+    slugsin = client.get(f'{base}/specification.slugsin').text
+    assert parse_structuredslugs(structured).to_slugsin() == slugsin  # the two files agree
+    assert parse_slugsin(slugsin).sys_props == sections['sys_props']
+
+    svg = client.get(f'{base}/state_machine.svg?inline=1')
+    assert svg.headers['content-type'].startswith('image/svg+xml')
+    assert svg.headers['content-disposition'].startswith('inline')
+    assert all(name in svg.text for name in ('look_down', 'pickup_object', 'finished', 'failed'))
+    assert client.get(f'{base}/state_machine.png').content.startswith(b'\x89PNG')
+
+
+def test_same_request_gives_byte_identical_downloads(client):
+    first = run_job(client, PAPER_TASK)[1]
+    second = run_job(client, PAPER_TASK)[1]
+    for name in ('state_machine.yaml', 'specification.slugsin'):
+        assert (client.get(f"/api/jobs/{first['id']}/artifacts/{name}").content
+                == client.get(f"/api/jobs/{second['id']}/artifacts/{name}").content)
+
+
+def test_compile_only_has_a_specification_and_no_state_machine(client):
+    _, job = run_job(client, {**PAPER_TASK, 'option': 'ltl_compilation_only'})
+    assert job['outcome']['error_name'] == 'SUCCESS'
+    assert job['summary']['realizable'] is None and job['summary']['formulas'] > 0
+    assert 'specification.slugsin' in job['artifacts'] and 'state_machine.yaml' not in job['artifacts']
+    missing = client.get(f"/api/jobs/{job['id']}/artifacts/state_machine.yaml")
+    assert missing.status_code == 409 and missing.json()['item'] == 'state_machine.yaml'
+
+
+def test_pipeline_errors_come_back_with_their_message(client):
+    _, unknown = run_job(client, {**PAPER_TASK, 'goals': ['look_down', 'fly']})
+    assert unknown['state'] == 'finished'
+    assert unknown['outcome']['error_name'] in ('INVALID_GOALS', 'UNKNOWN_PROPOSITION')
+    assert "'fly'" in unknown['outcome']['message']
+    assert unknown['artifacts'] == ['result.json']
+
+    _, two_modes = run_job(client, {**PAPER_TASK, 'initial_conditions': ['stand_prep', 'walk']})
+    assert two_modes['outcome']['error_name'] == 'INVALID_INITIAL_CONDITIONS'
+    assert 'walk' in two_modes['outcome']['message']
+
+
+@pytest.mark.parametrize('request_body, status, item', [
+    ({**PAPER_TASK, 'system': 'nao'}, 404, 'nao'),
+    ({**PAPER_TASK, 'goals': []}, 422, 'goals'),
+    ({**PAPER_TASK, 'goals': ' , '}, 422, 'goals'),
+    ({**PAPER_TASK, 'goal': 'look_down'}, 422, 'goal'),
+    ({**PAPER_TASK, 'option': 'ltl_synthesis_only'}, 422, 'ltl_synthesis_only'),
+    ({**PAPER_TASK, 'name': '../etc'}, 422, '../etc'),
+    ({**PAPER_TASK, 'initial_conditions': ['stand prep!']}, 422, 'prep!'),
+    (['look_down'], 422, 'body'),
+])
+def test_bad_requests_are_4xx_naming_the_item(client, request_body, status, item):
+    response = client.post('/api/jobs', json=request_body)
+    assert response.status_code == status
+    assert response.json()['item'] == item
+    assert item in response.json()['message'] or item == 'body'
+
+
+def test_unknown_names_in_urls_are_404_and_the_server_keeps_serving(client):
+    for path, item in (('/api/systems/nao', 'nao'), ('/api/jobs/no-such-job', 'no-such-job'),
+                       ('/api/jobs/no-such-job/artifacts/state_machine.yaml', 'no-such-job')):
+        response = client.get(path)
+        assert response.status_code == 404 and response.json()['item'] == item
+    assert client.post('/api/jobs/no-such-job/cancel').status_code == 404
+    _, job = run_job(client, {**PAPER_TASK, 'option': 'ltl_compilation_only'})
+    wrong = client.get(f"/api/jobs/{job['id']}/artifacts/state_machine.gif")
+    assert wrong.status_code == 404 and wrong.json()['item'] == 'state_machine.gif'
+    again = client.post(f"/api/jobs/{job['id']}/cancel")
+    assert again.status_code == 409 and 'already finished' in again.json()['message']
+    assert client.get('/api/systems').status_code == 200
+
+
+def test_cancel_a_job_before_it_is_sent(client, backend):
+    backend.job_gate.clear()  # hold new jobs in the queue
+    try:
+        job = client.post('/api/jobs', json=PAPER_TASK).json()
+        assert client.get(f"/api/jobs/{job['id']}").json()['state'] == 'queued'
+        assert client.post(f"/api/jobs/{job['id']}/cancel").status_code == 202
+        _, final = follow(client, job['id'])
+    finally:
+        backend.job_gate.set()
+    assert final['outcome']['error_name'] == 'PREEMPTED'
+    assert final['timeline'] == []  # nothing reached the pipeline
+
+
+def test_cancel_a_running_synthesis(client):
+    job = client.post('/api/jobs', json=SLOW_TASK).json()
+    with client.stream('GET', f"/api/jobs/{job['id']}/events", timeout=120) as response:
+        for line in response.iter_lines():
+            if line.startswith('data: ') and 'Synthesizing' in json.loads(line[6:])['status']:
+                break
+    assert client.post(f"/api/jobs/{job['id']}/cancel").json()['cancel_requested'] is True
+    _, final = follow(client, job['id'])
+    assert final['outcome']['error_name'] == 'PREEMPTED'
+    assert final['outcome']['seconds'] < 30
+
+
+def follow_simulation(client, simulation_id):
+    with client.stream('GET', f'/api/simulations/{simulation_id}/events', timeout=300) as response:
+        last = None
+        for line in response.iter_lines():
+            if line.startswith('data: '):
+                last = json.loads(line[len('data: '):])
+    return last
+
+
+def test_simulate_the_synthesized_machine_with_and_without_a_fault(client, backend):
+    assert client.get('/api/info').json()['simulation'] is True
+    _, job = run_job(client, PAPER_TASK)
+    started = client.post(f"/api/jobs/{job['id']}/simulations", json={})
+    assert started.status_code == 202
+    run = follow_simulation(client, started.json()['id'])
+    assert run['state'] == 'finished' and run['error'] is None
+    assert run['outcome'] == 'finished' and run['check']['ok'] is True
+    assert [step['state'] for step in run['steps']][-1] == '/pickup_object'
+    assert len(run['frames']) >= 2
+    base = f"/api/simulations/{run['id']}"
+    assert client.get(f'{base}/frames/0').content.startswith(b'\x89PNG')
+    assert client.get(f'{base}/timeline.png').content.startswith(b'\x89PNG')
+
+    faulty = client.post(f"/api/jobs/{job['id']}/simulations", json={'fail_first': ['pickup_object']}).json()
+    run = follow_simulation(client, faulty['id'])
+    assert run['outcome'] == 'failed' and run['check']['ok'] is True
+    assert any(r == {**r, 'capability': 'pickup_object', 'outcome': 'failed'}
+               for step in run['steps'] for r in step['results'])
+
+
+def test_bad_simulation_requests_name_the_item(client):
+    _, compiled = run_job(client, {**PAPER_TASK, 'option': 'ltl_compilation_only'})
+    no_machine = client.post(f"/api/jobs/{compiled['id']}/simulations", json={})
+    assert no_machine.status_code == 409 and no_machine.json()['item'] == compiled['id']
+    wrong_field = client.post(f"/api/jobs/{compiled['id']}/simulations", json={'faults': 'x'})
+    assert wrong_field.status_code == 422 and wrong_field.json()['item'] == 'faults'
+    assert client.post('/api/jobs/no-such-job/simulations', json={}).status_code == 404
+    unknown = client.get('/api/simulations/no-such-run')
+    assert unknown.status_code == 404 and unknown.json()['item'] == 'no-such-run'

@@ -1,0 +1,184 @@
+"""The web GUI in headless Chromium (Playwright) against the real server and pipeline.
+
+Set BEHAVIOR_SYNTHESIS_GUI_SCREENSHOT=docs/gui-result.png to also write the result page
+picture used by the documentation.
+"""
+
+import os
+import shutil
+import tempfile
+from pathlib import Path
+
+import pytest
+import yaml
+
+from synthesis_manager.cli import build_parser
+from synthesis_manager.gui import background_server, ros_backend
+from synthesis_manager.webapp import create_app
+
+CHROMIUM = '/usr/bin/chromium'
+CHROMIUM_ARGS = ['--headless', '--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run',
+                 '--disable-background-networking', '--disable-component-update', '--disable-sync']
+SLOW_GOALS = ['look_down', 'pickup_object', 'grasp_object', 'pregrasp', 'approach_object',
+              'footstep_execution', 'walk']
+SCREENSHOT_ENV = 'BEHAVIOR_SYNTHESIS_GUI_SCREENSHOT'
+
+
+@pytest.fixture(scope='module')
+def gui(tmp_path_factory):
+    """The GUI served over HTTP on 127.0.0.1, the suite in-process; yields (url, backend)."""
+    args = build_parser(only='gui').parse_args(
+        ['gui', '--byproducts-dir', str(tmp_path_factory.mktemp('gui-browser')),
+         '--synthesis-timeout', '60', '--goal-timeout', '120'])
+    with ros_backend(args) as backend, background_server(create_app(backend)) as url:
+        yield url, backend
+
+
+@pytest.fixture(scope='module')
+def browser_context():
+    from playwright.sync_api import sync_playwright
+
+    with sync_playwright() as playwright, tempfile.TemporaryDirectory() as profile:
+        context = playwright.chromium.launch_persistent_context(
+            profile, executable_path=CHROMIUM, args=CHROMIUM_ARGS, headless=True,
+            accept_downloads=True, viewport={'width': 1400, 'height': 1000})
+        yield context
+        context.close()
+
+
+@pytest.fixture
+def page(gui, browser_context):
+    url, _ = gui
+    page = browser_context.new_page()
+    errors = []
+    page.on('pageerror', lambda error: errors.append(str(error)))
+    page.goto(url)
+    page.wait_for_selector('body.ready')
+    yield page
+    page.close()
+    assert errors == []
+
+
+def choose_task(page, goals, initial_conditions=('stand_prep',)):
+    page.select_option('#system', 'atlas')
+    page.wait_for_selector('#initial-actions input[value="look_down"]')
+    for box in page.locator('input[name="initial-condition"]').all():
+        box.set_checked(box.get_attribute('value') in initial_conditions)
+    for goal in goals:
+        page.select_option('#goal-choice', goal)
+        page.click('#add-goal')
+
+
+def result_code(page, timeout=120_000):
+    page.wait_for_selector('#result:not([hidden]) #result-code:not(:empty)', timeout=timeout)
+    return page.inner_text('#result-code')
+
+
+def test_paper_task_shows_progress_draws_the_machine_and_downloads_yaml(page, tmp_path):
+    assert page.is_checked('input[name="initial-condition"][value="stand_prep"]')  # the default
+    choose_task(page, ['look_down', 'pickup_object'])
+    assert page.locator('#goals li').evaluate_all('items => items.map(i => i.dataset.goal)') == [
+        'look_down', 'pickup_object']
+    page.click('#synthesize')
+    assert result_code(page) == 'SUCCESS'
+    timeline = page.inner_text('#timeline')
+    assert 'Compiling' in timeline and 'Synthesiz' in timeline and 'Generat' in timeline
+    assert page.eval_on_selector('#progress', 'bar => bar.value') == 1
+
+    page.wait_for_selector('#graph svg g.node')
+    node_labels = page.locator('#graph svg g.node text').all_text_contents()
+    assert {'look_down', 'pickup_object', 'stand', 'manipulate', 'finished', 'failed'} <= set(node_labels)
+    edge_labels = page.locator('#graph svg g.edge text').all_text_contents()
+    assert {'initial', 'done', 'changed'} <= set(edge_labels)
+    assert 'Realizable\tyes' in page.inner_text('#summary')
+    assert page.is_visible('#simulate') and page.is_hidden('#simulation-view')  # offered, not run
+    page.click('details[data-section="sys_liveness"] summary')
+    assert page.is_visible('details[data-section="sys_liveness"] pre')
+
+    with page.expect_download() as download_info:
+        page.click('a[data-artifact="state_machine.yaml"]')
+    download = download_info.value
+    assert download.suggested_filename.endswith('state_machine.yaml')
+    states = yaml.safe_load(Path(download.path()).read_text())
+    assert {s['state_path'] for s in states} >= {'/', '/look_down', '/pickup_object'}
+    assert all(len(s) == 16 for s in states)
+
+    picture = tmp_path / 'gui-result.png'
+    page.screenshot(path=str(picture), full_page=True)
+    assert picture.read_bytes().startswith(b'\x89PNG') and picture.stat().st_size > 20_000
+    if os.environ.get(SCREENSHOT_ENV):
+        shutil.copyfile(picture, os.environ[SCREENSHOT_ENV])
+
+
+def test_goals_can_be_reordered_and_removed(page):
+    choose_task(page, ['pickup_object', 'look_down', 'walk'])
+    page.click('#goals li[data-goal="look_down"] button[title="move up"]')
+    page.click('#goals li[data-goal="walk"] button[title="remove"]')
+    page.check('input[name="option"][value="ltl_compilation_only"]')
+    page.click('#synthesize')
+    assert result_code(page) == 'SUCCESS'
+    assert 'from stand_prep: look_down, then pickup_object' in page.inner_text('#result-message')
+    assert 'Realizable\tnot checked' in page.inner_text('#summary')
+    assert page.is_hidden('#graph-section')
+    assert page.locator('a[data-artifact="specification.structuredslugs"]').count() == 1
+
+
+def test_a_bad_request_shows_the_pipeline_message(page):
+    choose_task(page, ['look_down'], initial_conditions=('stand_prep', 'walk'))
+    page.click('#synthesize')
+    assert result_code(page) == 'INVALID_INITIAL_CONDITIONS'
+    assert 'walk' in page.inner_text('#result-message')
+    assert page.locator('#result-banner.bad').count() == 1
+
+
+def test_a_request_without_goals_is_refused_with_a_message(page):
+    choose_task(page, [])
+    page.click('#synthesize')
+    assert result_code(page) == 'INVALID_REQUEST'
+    assert 'at least one goal' in page.inner_text('#result-message')
+    assert page.is_enabled('#synthesize')
+
+
+def test_cancel_a_queued_job(page, gui):
+    _, backend = gui
+    backend.job_gate.clear()  # jobs wait before being sent: cancel is deterministic
+    try:
+        choose_task(page, ['look_down'])
+        page.click('#synthesize')
+        page.wait_for_selector('#cancel:enabled')
+        assert page.inner_text('#status') == 'waiting to be sent'
+        page.click('#cancel')
+        assert result_code(page) == 'PREEMPTED'
+    finally:
+        backend.job_gate.set()
+    assert 'cancelled' in page.inner_text('#result-message')
+    assert page.is_enabled('#synthesize') and page.is_disabled('#cancel')
+
+
+def test_cancel_a_running_synthesis(page):
+    choose_task(page, SLOW_GOALS)
+    page.click('#synthesize')
+    page.wait_for_function("document.getElementById('status').textContent.startsWith('Synthesizing')",
+                           timeout=60_000)
+    page.click('#cancel')
+    assert result_code(page, timeout=30_000) == 'PREEMPTED'
+    assert page.locator('#result-banner.bad').count() == 1
+
+
+def test_simulate_with_a_fault_shows_steps_frames_and_timeline(page):
+    choose_task(page, ['look_down', 'pickup_object'])
+    page.click('#synthesize')
+    assert result_code(page) == 'SUCCESS'
+    page.select_option('#fail-first', 'pickup_object')
+    page.click('#simulate')
+    page.wait_for_selector('#simulation-steps tr[data-state]', timeout=60_000)  # live, while running
+    assert page.is_visible('#simulation-view')
+    page.wait_for_selector('#simulation-timeline:not([hidden])', timeout=120_000)
+    assert page.inner_text('#simulation-status').startswith('Outcome: failed')
+    rows = page.locator('#simulation-steps tr[data-state]')
+    assert rows.last.get_attribute('data-state') == '/pickup_object'
+    assert 'pickup_object failed' in rows.last.inner_text()
+    assert 'ok' in page.inner_text('#simulation-check')
+    page.wait_for_function("document.getElementById('simulation-timeline').naturalWidth > 0")
+    page.wait_for_function("document.getElementById('simulation-frame').naturalWidth > 0")
+    assert page.locator('#simulation-frames img').count() >= 2

@@ -1,0 +1,587 @@
+"""A small FlexBE-compatible executive that runs synthesized state machines on a robot (ROS-free).
+
+Input: a StateInstantiation list as returned by ``/behavior_synthesis`` (dicts of the 16
+fields, or ``sm_generation.StateInstantiation`` objects). Semantics (FlexBE's):
+
+* the root (``state_path='/'``, ``:STATEMACHINE``) starts at ``initial_state_name`` and
+  ends when a transition names one of its ``outcomes`` (``:OUTCOME`` entries only place
+  those outcomes in the editor's drawing);
+* a state returning ``outcomes[i]`` continues with ``transitions[i]``;
+* a ``:CONCURRENCY`` container starts all its children (``/<container>/<child>``) together
+  and returns ``cond_outcome[k]`` as soon as ``cond_transition[k]`` holds (every named
+  child has returned the named outcome; the first condition that holds wins);
+* a state (class + parameter values, or ``:BEHAVIOR`` + behavior_class) is identified
+  through the system config's ``flexbe.states`` section: activation proposition ``<p>_a``
+  -> capability ``<p>`` of the robot; the capability's result ``completed``/``failed``
+  becomes the first state outcome listed under ``<p>_c``/``<p>_f`` in ``output_mapping``.
+  Sensor states return their outcome when the sensor turns true. The generator's helper
+  states (``LogState``: returns at once; ``OperatorDecisionState``: the ``decide`` hook or
+  its first outcome) take no robot time.
+
+Activation–outcome semantics on the robot: a capability activated by a state that is
+still running from the previous state (a concurrency container returned before all its
+children did) keeps running, as its activation proposition stays true; a running request
+that the next state does not activate is abandoned (the robot cannot cancel it) and
+whatever it still reports is recorded, so the trace check sees it.
+
+The robot is anything with the :class:`Robot` protocol: :class:`SimulatedRobot` drives an
+``AtlasSimulator`` directly; ``atlas_sim.ros_robot.RosRobot`` drives the simulator node.
+
+    sim = make_simulator('atlas', initial_conditions=['stand_prep'])
+    run = execute_state_machine(states, SimulatedRobot(sim), system='atlas')
+    run.outcome, run.trace                  # 'finished', Trace (see atlas_sim.trace_check)
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import re
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Callable, Protocol, Sequence
+
+from atlas_sim.trace_check import OutcomeTracker, Trace, TraceStep, outcome_proposition
+
+ROOT_PATH = '/'
+STATEMACHINE = ':STATEMACHINE'
+CONCURRENCY = ':CONCURRENCY'
+BEHAVIOR = ':BEHAVIOR'
+OUTCOME = ':OUTCOME'
+ACTIVATION_SUFFIX = '_a'
+# The generator's helper states (flexbe_states) and how they return.
+LOG_STATE = 'LogState'
+DECISION_STATE = 'OperatorDecisionState'
+
+
+# --- errors -----------------------------------------------------------------------------------
+
+class ExecutionError(Exception):
+    """The run could not go on; ``item`` names the offending state, ``trace`` holds what ran."""
+
+    code = 'BEHAVIOR_SYNTHESIS_FAILED'
+
+    def __init__(self, message: str, item: str, trace: Trace | None = None):
+        super().__init__(message)
+        self.item = item
+        self.trace = trace
+
+
+class MachineInvalidError(ExecutionError):
+    """The StateInstantiation list is not a machine this executive can run."""
+
+    code = 'INVALID_REQUEST'
+
+
+class UnmappedStateError(ExecutionError):
+    """A state whose class/parameters match no entry of the system's ``flexbe.states``."""
+
+    code = 'CONFIG_VARIABLE_CONFIG_INVALID'
+
+
+class UndeclaredOutcomeError(ExecutionError):
+    """A state returned an outcome that it does not declare (so it has no transition)."""
+
+    code = 'AUTOMATON_INVALID'
+
+
+class ExecutionLimitError(ExecutionError):
+    """The run reached its robot-time or state-count limit without an SM outcome."""
+
+    code = 'TIMEOUT'
+
+
+class InitialConditionError(ValueError):
+    """An initial condition the simulator cannot start in; ``item`` names it."""
+
+    code = 'INVALID_INITIAL_CONDITIONS'
+
+    def __init__(self, message: str, item: str):
+        super().__init__(message)
+        self.item = item
+
+
+class FaultSpecError(ValueError):
+    """A malformed fault ('capability:k') or one naming an unknown capability; ``item`` names it."""
+
+    code = 'INVALID_REQUEST'
+
+    def __init__(self, message: str, item: str):
+        super().__init__(message)
+        self.item = item
+
+
+# --- the robot ---------------------------------------------------------------------------------
+
+@dataclass(frozen=True)
+class CapabilityResult:
+    """How one activation of a capability ended, on the robot's clock."""
+
+    capability: str
+    outcome: str  # 'completed' or 'failed'
+    reason: str
+    time: float
+
+
+class Robot(Protocol):
+    """What the executive needs from a robot (or its simulator)."""
+
+    def start_concurrently(self, capabilities: Sequence[str]) -> list[Any]:
+        """Start capabilities in one instant; returns one opaque handle per capability."""
+
+    def step(self) -> None:
+        """Let the robot run for a short while (one control period)."""
+
+    def result(self, handle) -> CapabilityResult | None:
+        """The result of a started capability, or None while it runs."""
+
+    def snapshot(self) -> dict:
+        """Robot state: at least time, mode, completed_actions, sensors, pelvis_height, fallen."""
+
+
+class SimulatedRobot:
+    """The :class:`Robot` protocol on an in-process ``AtlasSimulator`` (fast: no ROS)."""
+
+    def __init__(self, simulator):
+        self.simulator = simulator
+
+    def start_concurrently(self, capabilities):
+        return self.simulator.start_concurrently(list(capabilities))
+
+    def step(self) -> None:
+        self.simulator.step()
+
+    def result(self, handle) -> CapabilityResult | None:
+        done = handle.result
+        return None if done is None else CapabilityResult(done.name, done.outcome, done.reason, done.finished_at)
+
+    def snapshot(self) -> dict:
+        return self.simulator.snapshot()
+
+
+def parse_faults(fail=(), fail_first=(), probability=()) -> dict:
+    """Fault entries (``simulation.faults`` shape) from command-line style lists.
+
+    ``fail``: capability names that always fail; ``fail_first``: 'capability:k' (the first
+    k attempts fail); ``probability``: 'capability:p'. Raises FaultSpecError naming the entry.
+    """
+    faults: dict[str, dict] = {}
+    for name in fail:
+        faults.setdefault(name, {})['always'] = True
+    for entry, key, convert in [(e, 'fail_first', int) for e in fail_first] + \
+                               [(e, 'probability', float) for e in probability]:
+        name, _, value = entry.partition(':')
+        try:
+            faults.setdefault(name.strip(), {})[key] = convert(value)
+        except ValueError:
+            raise FaultSpecError(f'expected CAPABILITY:{"K" if convert is int else "P"}, got {entry!r}',
+                                 item=entry) from None
+    return faults
+
+
+def make_simulator(system: str = 'atlas', config_dir: str | Path | None = None, initial_conditions=(),
+                   faults: dict | None = None, seed: int | None = None, **simulation_changes):
+    """An ``AtlasSimulator`` for ``system``, started in the given initial conditions.
+
+    ``initial_conditions`` name at most one control mode (the initial mode; default: the
+    config's) and actions that have already completed. ``faults`` (capability -> entry of
+    ``simulation.faults``) are added to the config's, ``seed`` replaces its seed.
+    """
+    from atlas_sim.config import load_system_config
+    from atlas_sim.simulator import AtlasSimulator
+    from respec.systems import system_config_path
+
+    config = load_system_config(system_config_path(system, config_dir))
+    modes = [c for c in initial_conditions if c in config.abstraction.control_modes]
+    actions = [c for c in initial_conditions if c in config.abstraction.actions]
+    unknown = [c for c in initial_conditions if c not in modes and c not in actions]
+    if unknown:
+        raise InitialConditionError(f'initial condition {unknown[0]!r} is neither a control mode nor an '
+                                    f'action of {system}', item=unknown[0])
+    if len(modes) > 1:
+        raise InitialConditionError(f'initial conditions name several control modes: {modes[0]!r} and '
+                                    f'{modes[1]!r}', item=modes[1])
+    capabilities = {*config.abstraction.control_modes, *config.abstraction.actions}
+    for name in faults or {}:
+        if name not in capabilities:
+            raise FaultSpecError(f'fault for {name!r}, which is not a capability of {system}', item=name)
+    changes = dict(simulation_changes)
+    if modes:
+        changes['initial_mode'] = modes[0]
+    if faults:
+        changes['faults'] = {**config.simulation.faults, **faults}
+    if seed is not None:
+        changes['seed'] = int(seed)
+    config = dataclasses.replace(config, simulation=dataclasses.replace(config.simulation, **changes))
+    simulator = AtlasSimulator(config)
+    for action in actions:  # completed before the run: as if they had just reported completion
+        simulator.semantics.finish(simulator.state, action, 'completed')
+    return simulator
+
+
+# --- the machine -----------------------------------------------------------------------------
+
+@dataclass
+class StateNode:
+    """One entry of the StateInstantiation list, as the executive needs it."""
+
+    path: str
+    state_class: str
+    behavior_class: str = ''
+    parameter_values: tuple[str, ...] = ()
+    outcomes: list[str] = field(default_factory=list)
+    transitions: list[str] = field(default_factory=list)
+    initial_state_name: str = ''
+    conditions: list[tuple[str, list[tuple[str, str]]]] = field(default_factory=list)
+    children: list[StateNode] = field(default_factory=list)
+
+    @property
+    def name(self) -> str:
+        return self.path.rstrip('/').rsplit('/', 1)[-1]
+
+    def next_target(self, outcome: str) -> str:
+        if outcome not in self.outcomes:
+            raise UndeclaredOutcomeError(f'state {self.path!r} returned {outcome!r}, which is not one of its '
+                                         f'outcomes {self.outcomes}', item=self.path)
+        return self.transitions[self.outcomes.index(outcome)]
+
+
+def _as_dict(entry) -> dict:
+    if isinstance(entry, dict):
+        return entry
+    if hasattr(entry, 'to_dict'):
+        return entry.to_dict()
+    raise MachineInvalidError(f'not a StateInstantiation: {entry!r}', item=repr(entry)[:60])
+
+
+def load_machine(states) -> StateNode:
+    """The root node with its top-level states (and their children), validated."""
+    entries = [_as_dict(e) for e in states]
+    nodes: dict[str, StateNode] = {}
+    for entry in entries:
+        path = str(entry.get('state_path', ''))
+        if not path.startswith('/'):
+            raise MachineInvalidError(f'state path {path!r} does not start with "/"', item=path)
+        if path in nodes:
+            raise MachineInvalidError(f'two entries have the state path {path!r}', item=path)
+        outcomes, transitions = list(entry.get('outcomes', [])), list(entry.get('transitions', []))
+        if len(outcomes) != len(transitions) and entry.get('state_class') != OUTCOME:
+            raise MachineInvalidError(f'state {path!r} has {len(outcomes)} outcomes but '
+                                      f'{len(transitions)} transitions', item=path)
+        conditions = []
+        for outcome, condition in zip(entry.get('cond_outcome', []), entry.get('cond_transition', [])):
+            condition = condition if isinstance(condition, dict) else condition.to_dict()
+            conditions.append((str(outcome), list(zip(condition['state_name'], condition['state_outcome']))))
+        nodes[path] = StateNode(
+            path=path, state_class=str(entry.get('state_class', '')),
+            behavior_class=str(entry.get('behavior_class', '')),
+            parameter_values=tuple(str(v) for v in entry.get('parameter_values', [])),
+            outcomes=outcomes, transitions=transitions,
+            initial_state_name=str(entry.get('initial_state_name', '')), conditions=conditions)
+    root = nodes.get(ROOT_PATH)
+    if root is None or root.state_class != STATEMACHINE:
+        raise MachineInvalidError('no root entry (state_path "/", class :STATEMACHINE)', item=ROOT_PATH)
+    for path, node in nodes.items():
+        if path == ROOT_PATH or node.state_class == OUTCOME:
+            continue
+        parent = nodes.get(path.rsplit('/', 1)[0] or ROOT_PATH)
+        if parent is None:
+            raise MachineInvalidError(f'state {path!r} has no parent entry', item=path)
+        if parent is not root and parent.state_class != CONCURRENCY:
+            raise MachineInvalidError(f'state {path!r} is nested in {parent.path!r} ({parent.state_class}); '
+                                      'only concurrency containers may hold states here', item=path)
+        parent.children.append(node)
+    _validate_targets(root)
+    return root
+
+
+def _validate_targets(root: StateNode) -> None:
+    names = {child.name for child in root.children}
+    if root.initial_state_name not in names:
+        raise MachineInvalidError(f'initial state {root.initial_state_name!r} is not a state of the machine',
+                                  item=root.initial_state_name)
+    for state in root.children:
+        for target in state.transitions:
+            if target not in names and target not in root.outcomes:
+                raise MachineInvalidError(f'state {state.path!r} leads to {target!r}, which is neither a state '
+                                          'nor an outcome of the machine', item=state.path)
+        if state.state_class == CONCURRENCY:
+            if not state.children:
+                raise MachineInvalidError(f'container {state.path!r} has no states', item=state.path)
+            inner = {child.name for child in state.children}
+            for outcome, condition in state.conditions:
+                if outcome not in state.outcomes:
+                    raise MachineInvalidError(f'container {state.path!r} has condition outcome {outcome!r} '
+                                              'that it does not declare', item=state.path)
+                for name, _ in condition:
+                    if name not in inner:
+                        raise MachineInvalidError(f'a condition of {state.path!r} names {name!r}, which is '
+                                                  'not one of its states', item=state.path)
+
+
+# --- mapping states to capabilities ---------------------------------------------------------------
+
+@dataclass(frozen=True)
+class Part:
+    """A primitive state being run: on the robot (capability), a sensor, or a helper."""
+
+    node: StateNode
+    kind: str                      # 'capability', 'sensor', 'helper'
+    proposition: str = ''          # activation proposition or sensor name
+    output_mapping: dict | None = None
+
+    @property
+    def capability(self) -> str:
+        return self.proposition[:-len(ACTIVATION_SUFFIX)] if self.kind == 'capability' else ''
+
+
+class StateMapping:
+    """State class + parameter values (or behavior class) -> ``flexbe.states`` entry."""
+
+    def __init__(self, system: str, config_dir: str | Path | None = None):
+        from respec.systems import load_section
+        from sm_generation.config import load_flexbe_config
+
+        self.flexbe = load_flexbe_config(system, config_dir)
+        abstraction = load_section(system, 'abstraction', config_dir)
+        self.control_modes = list(abstraction.get('control_modes') or {})
+        self.sensors = list(abstraction.get('sensors') or [])
+        self._by_key: dict[tuple, Any] = {}
+        for state in self.flexbe.states.values():
+            self._by_key.setdefault(self._key(state.state_class, state.behavior_class, state.parameter_values),
+                                    []).append(state)
+
+    @staticmethod
+    def _key(state_class, behavior_class, parameter_values) -> tuple:
+        if state_class == BEHAVIOR:
+            return (BEHAVIOR, behavior_class)
+        return (state_class, tuple(parameter_values))
+
+    def part(self, node: StateNode) -> Part:
+        if node.state_class in (LOG_STATE, DECISION_STATE):
+            return Part(node, 'helper')
+        matches = self._by_key.get(self._key(node.state_class, node.behavior_class, node.parameter_values), [])
+        if len(matches) > 1:  # same class and parameters: the state's name ('stand_2') says which
+            label = re.sub(r'_\d+$', '', node.name)
+            matches = [s for s in matches if s.label in (node.name, label)] or matches[:1]
+        if not matches:
+            what = node.behavior_class if node.state_class == BEHAVIOR else \
+                f'{node.state_class}({", ".join(node.parameter_values)})'
+            raise UnmappedStateError(f'state {node.path!r} ({what}) matches no entry of flexbe.states of '
+                                     f'{self.flexbe.system!r}', item=node.path)
+        config = matches[0]
+        kind = 'capability' if config.proposition.endswith(ACTIVATION_SUFFIX) else 'sensor'
+        return Part(node, kind, config.proposition, dict(config.output_mapping))
+
+    def sm_outcome_propositions(self) -> dict[str, str]:
+        """SM outcome -> its proposition (inverse of ``flexbe.sm_outcomes``)."""
+        return {outcome: prop for prop, outcome in self.flexbe.sm_outcomes.items()}
+
+
+# --- running ------------------------------------------------------------------------------------
+
+@dataclass
+class ExecutionResult:
+    outcome: str
+    trace: Trace
+    robot_time: float            # robot clock at the end
+    min_pelvis_height: float
+    fallen: bool
+    ticks: int
+    robot_started_at: float = 0.0  # robot clock at the start
+
+    @property
+    def duration(self) -> float:
+        """Robot time the run took."""
+        return self.robot_time - self.robot_started_at
+
+    def to_dict(self) -> dict:
+        return {'outcome': self.outcome, 'trace': self.trace.to_dict(), 'robot_time': round(self.robot_time, 4),
+                'robot_started_at': round(self.robot_started_at, 4),
+                'min_pelvis_height': round(self.min_pelvis_height, 4), 'fallen': self.fallen,
+                'ticks': self.ticks}
+
+
+@dataclass
+class _Running:
+    """A started request of the robot and what has been seen of it."""
+
+    capability: str
+    handle: Any
+    result: CapabilityResult | None = None
+    abandoned: bool = False
+
+
+class Executive:
+    """Runs one state machine on one robot; see :func:`execute_state_machine`."""
+
+    def __init__(self, states, robot: Robot, mapping: StateMapping, max_robot_time: float = 600.0,
+                 max_states: int = 500, max_wall_time: float | None = None,
+                 decide: Callable[[str, list[str]], str] | None = None,
+                 on_tick: Callable[[Robot], None] | None = None):
+        self.root = load_machine(states)
+        self.robot, self.mapping = robot, mapping
+        self.max_robot_time, self.max_states = max_robot_time, max_states
+        self.wall_deadline = None if max_wall_time is None else time.monotonic() + max_wall_time
+        self.decide = decide or (lambda path, outcomes: outcomes[0])
+        self.on_tick = on_tick
+        self.parts = {node.path: mapping.part(node) for state in self.root.children
+                      for node in (state.children or [state])}
+        self.trace = Trace(sm_outcome_propositions=mapping.sm_outcome_propositions())
+        self.running: dict[str, _Running] = {}   # capability -> latest request
+        self.abandoned: list[_Running] = []
+        self.ticks = 0
+        snapshot = robot.snapshot()
+        self.start_time = snapshot['time']
+        self.min_pelvis = snapshot.get('pelvis_height', float('nan'))
+        self.fallen = bool(snapshot.get('fallen', False))
+        self.tracker = OutcomeTracker(mapping.control_modes, snapshot['mode'],
+                                      snapshot.get('completed_actions', []), snapshot.get('sensors', {}))
+
+    def run(self) -> ExecutionResult:
+        try:
+            return self._run()
+        except ExecutionError as error:
+            error.trace = error.trace or self.trace  # what ran until then
+            raise
+
+    def _run(self) -> ExecutionResult:
+        states = {child.name: child for child in self.root.children}
+        current = states[self.root.initial_state_name]
+        while True:
+            if len(self.trace.steps) >= self.max_states:
+                raise ExecutionLimitError(f'no SM outcome after {self.max_states} states', item=current.path,
+                                          trace=self.trace)
+            state_outcome = self._run_state(current)
+            target = current.next_target(state_outcome)
+            self.trace.steps[-1].state_outcome, self.trace.steps[-1].transition = state_outcome, target
+            if target in self.root.outcomes:
+                self.trace.outcome = target
+                snapshot = self.robot.snapshot()
+                return ExecutionResult(target, self.trace, snapshot['time'], self.min_pelvis,
+                                       self.fallen or bool(snapshot.get('fallen')), self.ticks, self.start_time)
+            current = states[target]
+
+    # one top-level state ------------------------------------------------------------------------
+
+    def _run_state(self, state: StateNode) -> str:
+        parts = [self.parts[node.path] for node in (state.children or [state])]
+        snapshot = self.robot.snapshot()
+        step = TraceStep(index=len(self.trace.steps), state=state.path, state_class=state.state_class,
+                         activated=sorted(p.proposition for p in parts if p.kind == 'capability'),
+                         capabilities=[p.capability for p in parts if p.kind == 'capability'],
+                         entered_at=snapshot['time'], mode_at_entry=snapshot['mode'],
+                         outcomes_at_entry=self.tracker.true_propositions())
+        self.trace.steps.append(step)
+        self._activate(step.capabilities)
+        sensors_at_entry = dict(self.tracker.sensors)
+        returned: dict[str, str] = {}          # part path -> state outcome returned
+        while True:
+            for part in parts:
+                if part.node.path not in returned:
+                    outcome = self._returned(part, sensors_at_entry)
+                    if outcome is not None:
+                        returned[part.node.path] = outcome
+            outcome = self._state_outcome(state, returned)
+            if outcome is not None:
+                break
+            self._tick(step)
+        snapshot = self.robot.snapshot()
+        step.ended_at, step.mode_at_exit = snapshot['time'], snapshot['mode']
+        step.outcomes_at_exit = self.tracker.true_propositions()
+        return outcome
+
+    def _activate(self, capabilities: list[str]) -> None:
+        """Start the state's capabilities, keeping those still running from the previous state."""
+        still_running = {c for c, r in self.running.items() if r.result is None}
+        for capability in list(self.running):
+            if capability not in capabilities:
+                request = self.running.pop(capability)
+                if request.result is None:  # cannot be cancelled: watch what it still reports
+                    request.abandoned = True
+                    self.abandoned.append(request)
+        fresh = [c for c in capabilities if c not in still_running]
+        self.tracker.activate(fresh)
+        for capability, handle in zip(fresh, self.robot.start_concurrently(fresh) if fresh else []):
+            self.running[capability] = _Running(capability, handle)
+        self._collect_results(self.trace.steps[-1])  # refusals finish at once
+
+    def _returned(self, part: Part, sensors_at_entry: dict) -> str | None:
+        if part.kind == 'helper':
+            if part.node.state_class == DECISION_STATE:
+                return self.decide(part.node.path, list(part.node.outcomes))
+            return part.node.outcomes[0] if part.node.outcomes else None
+        if part.kind == 'sensor':  # sensors are events: the reading turns true
+            if self.tracker.sensors.get(part.proposition) and not sensors_at_entry.get(part.proposition):
+                return part.output_mapping[part.proposition][0]
+            return None
+        result = self.running[part.capability].result
+        if result is None:
+            return None
+        proposition = outcome_proposition(part.capability, result.outcome)
+        outcomes = part.output_mapping.get(proposition)
+        if not outcomes:
+            raise UndeclaredOutcomeError(f'state {part.node.path!r} has no outcome for {proposition!r} in '
+                                         'flexbe.states', item=part.node.path, trace=self.trace)
+        if outcomes[0] not in part.node.outcomes:
+            raise UndeclaredOutcomeError(
+                f'state {part.node.path!r} returned {outcomes[0]!r} ({proposition}: {result.reason}), which '
+                f'is not one of its outcomes {part.node.outcomes}', item=part.node.path, trace=self.trace)
+        return outcomes[0]
+
+    @staticmethod
+    def _state_outcome(state: StateNode, returned: dict[str, str]) -> str | None:
+        if state.state_class != CONCURRENCY:
+            return returned.get(state.path)
+        by_name = {path.rsplit('/', 1)[-1]: outcome for path, outcome in returned.items()}
+        for outcome, condition in state.conditions:  # FlexBE returns the first that holds
+            if all(by_name.get(name) == wanted for name, wanted in condition):
+                return outcome
+        return None
+
+    def _tick(self, step: TraceStep) -> None:
+        self.robot.step()
+        self.ticks += 1
+        snapshot = self.robot.snapshot()
+        self.min_pelvis = min(self.min_pelvis, snapshot.get('pelvis_height', self.min_pelvis))
+        self.fallen |= bool(snapshot.get('fallen', False))
+        self.tracker.read_sensors(snapshot.get('sensors', {}))
+        self._collect_results(step)
+        if self.on_tick:
+            self.on_tick(self.robot)
+        if snapshot['time'] - self.start_time > self.max_robot_time:
+            raise ExecutionLimitError(f'no SM outcome after {self.max_robot_time:g} s of robot time '
+                                      f'(state {step.state!r} still running)', item=step.state, trace=self.trace)
+        if self.wall_deadline is not None and time.monotonic() > self.wall_deadline:
+            raise ExecutionLimitError(f'no SM outcome within the wall-clock limit (state {step.state!r} still '
+                                      'running; is the robot alive?)', item=step.state, trace=self.trace)
+
+    def _collect_results(self, step: TraceStep) -> None:
+        for request in [*self.running.values(), *self.abandoned]:
+            if request.result is not None:
+                continue
+            request.result = self.robot.result(request.handle)
+            if request.result is not None:
+                self.tracker.report(request.capability, request.result.outcome)
+                step.results.append({'capability': request.capability, 'outcome': request.result.outcome,
+                                     'reason': request.result.reason, 'time': request.result.time,
+                                     'abandoned': request.abandoned})
+        self.abandoned = [r for r in self.abandoned if r.result is None]
+
+
+def execute_state_machine(states, robot: Robot, system: str = 'atlas', config_dir: str | Path | None = None,
+                          **options) -> ExecutionResult:
+    """Run ``states`` on ``robot`` until an SM outcome; returns the outcome and the trace.
+
+    ``options``: ``max_robot_time`` (s, default 600), ``max_states`` (default 500),
+    ``max_wall_time`` (s, default none),
+    ``decide(path, outcomes) -> outcome`` for operator decisions, ``on_tick(robot)``.
+    Raises :class:`ExecutionError` subclasses (with ``item`` and the partial ``trace``).
+    """
+    return Executive(states, robot, StateMapping(system, config_dir), **options).run()
+
+
+__all__ = ['Robot', 'SimulatedRobot', 'CapabilityResult', 'make_simulator', 'parse_faults',
+           'execute_state_machine', 'Executive', 'ExecutionResult', 'StateMapping', 'load_machine',
+           'ExecutionError', 'MachineInvalidError', 'UnmappedStateError', 'UndeclaredOutcomeError',
+           'ExecutionLimitError', 'InitialConditionError', 'FaultSpecError']

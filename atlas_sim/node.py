@@ -1,0 +1,212 @@
+"""ROS 2 node ``atlas_sim``: the simulated ATLAS behind an action server and a state topic.
+
+* action server ``atlas_sim/execute`` (synthesis_msgs/action/ExecuteCapability): the goal
+  names one capability (control mode or action); the result is ``completed``/``failed``,
+  the simulator's reason and the sim time it ended. Goals may overlap, as concurrency
+  containers need: goals arriving within ``batch_window`` wall seconds of each other start
+  in the same sim instant (``AtlasSimulator.start_concurrently``). Requests cannot be
+  cancelled (the simulator has no way to), so cancel requests are rejected.
+* topic ``atlas_sim/state`` (synthesis_msgs/msg/RobotState) at ``state_rate`` Hz.
+* physics runs in the node's own thread at ``speed`` sim seconds per wall second
+  (0: as fast as possible; the default 10 is faster than real time), also between
+  requests, as a real robot keeps balancing.
+
+Parameters: ``system`` (atlas), ``config_dir`` ('' = config/), ``initial_conditions``,
+``fail`` (capabilities that always fail), ``fail_first`` ('capability:k'), ``seed``
+(-1: the config's), ``speed``, ``state_rate``, ``batch_window``. List parameters take a
+string array or a comma-separated string. Run it with ``atlas-sim-node`` (DDS stays on
+loopback) or in-process: ``AtlasSimNode(context=...)`` like the suite's nodes.
+"""
+
+from __future__ import annotations
+
+import threading
+import time
+
+from rcl_interfaces.msg import ParameterDescriptor
+from rclpy.action import ActionServer, CancelResponse, GoalResponse
+from rclpy.callback_groups import ReentrantCallbackGroup
+from rclpy.node import Node
+
+from atlas_sim.executor import make_simulator, parse_faults
+from synthesis_msgs.action import ExecuteCapability
+from synthesis_msgs.msg import RobotState
+
+NODE_NAME = 'atlas_sim'
+ACTION_NAME = 'atlas_sim/execute'
+STATE_TOPIC = 'atlas_sim/state'
+
+
+def names_of(value) -> list[str]:
+    """A list parameter given as a string array or a comma-separated string."""
+    if isinstance(value, str):
+        return [n.strip() for n in value.split(',') if n.strip()]
+    return [str(n).strip() for n in (value or []) if str(n).strip()]
+
+
+def robot_state_message(snapshot: dict) -> RobotState:
+    return RobotState(stamp=float(snapshot['time']), mode=snapshot['mode'],
+                      pending_mode=snapshot['pending_mode'] or '',
+                      completed_actions=list(snapshot['completed_actions']), running=list(snapshot['running']),
+                      head_tilt=float(snapshot['head_tilt']),
+                      base_xy=[float(v) for v in snapshot['base_xy']],
+                      pelvis_height=float(snapshot['pelvis_height']),
+                      holding_object=bool(snapshot['holding_object']), fallen=bool(snapshot['fallen']))
+
+
+class _Job:
+    """A goal waiting for its request to be started and finished by the physics thread."""
+
+    def __init__(self, capability: str):
+        self.capability = capability
+        self.request = None
+        self.finished = threading.Event()
+
+
+class AtlasSimNode(Node):
+    """See the module docstring. ``simulator`` replaces the one built from the parameters."""
+
+    def __init__(self, simulator=None, **kwargs):
+        super().__init__(NODE_NAME, **kwargs)
+        flexible = ParameterDescriptor(dynamic_typing=True)
+        self.declare_parameter('system', 'atlas')
+        self.declare_parameter('config_dir', '')
+        self.declare_parameter('initial_conditions', '', flexible)
+        self.declare_parameter('fail', '', flexible)
+        self.declare_parameter('fail_first', '', flexible)
+        self.declare_parameter('seed', -1)
+        self.declare_parameter('speed', 10.0)
+        self.declare_parameter('state_rate', 10.0)
+        self.declare_parameter('batch_window', 0.02)
+        value = lambda name: self.get_parameter(name).value  # noqa: E731
+        if simulator is None:
+            seed = int(value('seed'))
+            simulator = make_simulator(
+                value('system'), value('config_dir') or None, names_of(value('initial_conditions')),
+                faults=parse_faults(names_of(value('fail')), names_of(value('fail_first'))),
+                seed=None if seed < 0 else seed)
+        self.simulator = simulator
+        self.speed = float(value('speed'))
+        self.batch_window = float(value('batch_window'))
+        self.lock = threading.Lock()  # guards the simulator and the job lists (render under it too)
+        self._pending: list[_Job] = []
+        self._last_arrival = 0.0
+        self._running: list[_Job] = []
+        self._stop = threading.Event()
+        group = ReentrantCallbackGroup()
+        self.state_publisher = self.create_publisher(RobotState, STATE_TOPIC, 10)
+        self.state_timer = self.create_timer(1.0 / float(value('state_rate')), self.publish_state,
+                                             callback_group=group)
+        self.action_server = ActionServer(
+            self, ExecuteCapability, ACTION_NAME, self.execute,
+            goal_callback=self.accept_goal, cancel_callback=lambda _: CancelResponse.REJECT,
+            callback_group=group)
+        self._physics = threading.Thread(target=self._physics_loop, name='atlas-sim-physics', daemon=True)
+        self._physics.start()
+
+    def destroy_node(self):
+        self.destroy_timer(self.state_timer)  # no more publishing while the node goes away
+        self._stop.set()
+        self._physics.join(timeout=5.0)
+        for job in self._pending + self._running:
+            job.finished.set()
+        self.action_server.destroy()
+        super().destroy_node()
+
+    # --- ROS side ------------------------------------------------------------------------------
+
+    def accept_goal(self, goal_request) -> GoalResponse:
+        known = self.simulator.abstraction.is_capability(goal_request.capability)
+        if not known:
+            self.get_logger().warning(f'rejecting unknown capability {goal_request.capability!r}')
+        return GoalResponse.ACCEPT if known else GoalResponse.REJECT
+
+    def execute(self, goal_handle):
+        job = _Job(goal_handle.request.capability)
+        with self.lock:
+            self._pending.append(job)
+            self._last_arrival = time.monotonic()
+        goal_handle.publish_feedback(ExecuteCapability.Feedback(status=f'{job.capability} requested'))
+        while not job.finished.wait(0.05):
+            if self._stop.is_set():
+                break
+        result = ExecuteCapability.Result()
+        if job.request is None or job.request.result is None:
+            goal_handle.abort()
+            result.outcome, result.reason = 'failed', 'simulator shut down'
+            return result
+        goal_handle.succeed()
+        done = job.request.result
+        result.outcome, result.reason, result.stamp = done.outcome, done.reason, float(done.finished_at)
+        return result
+
+    def publish_state(self):
+        with self.lock:
+            snapshot = self.simulator.snapshot()
+        self.state_publisher.publish(robot_state_message(snapshot))
+
+    # --- physics thread --------------------------------------------------------------------------
+
+    def _physics_loop(self):
+        try:
+            self._run_physics()
+        except Exception as error:  # a dead physics thread must not leave goals waiting forever
+            self.get_logger().error(f'physics stopped: {error!r}')
+            self._stop.set()
+            with self.lock:
+                for job in self._pending + self._running:
+                    job.finished.set()
+
+    def _run_physics(self):
+        anchor = None  # (wall, sim) pair for pacing
+        while not self._stop.is_set():
+            with self.lock:
+                started = self._start_pending()
+                self.simulator.step()
+                self._finish_jobs()
+                now = self.simulator.time
+            if started or anchor is None:
+                anchor = (time.monotonic(), now)
+            if self.speed > 0:  # pace: sim time runs at speed x wall time
+                delay = anchor[0] + (now - anchor[1]) / self.speed - time.monotonic()
+                if delay > 0:
+                    time.sleep(delay)
+            else:
+                time.sleep(0)  # let the executor threads in
+
+    def _start_pending(self) -> bool:
+        """Start the goals that arrived together (none arrived for ``batch_window``)."""
+        if not self._pending:
+            return False
+        while time.monotonic() - self._last_arrival < self.batch_window:
+            self.lock.release()   # let late goals of the same batch arrive; sim time stands still
+            time.sleep(self.batch_window / 4)
+            self.lock.acquire()
+        jobs, self._pending = self._pending, []
+        names = [job.capability for job in jobs]
+        duplicates = {n for n in names if names.count(n) > 1}
+        unique = [job for job in jobs if job.capability not in duplicates]
+        requests = self.simulator.start_concurrently([job.capability for job in unique])
+        for job, request in zip(unique, requests):
+            job.request = request
+        for job in jobs:  # the same capability twice at once: one runs, the others are refused
+            if job.capability in duplicates:
+                job.request = self.simulator.start(job.capability)
+        self._running.extend(jobs)
+        self._finish_jobs()
+        return True
+
+    def _finish_jobs(self):
+        for job in [j for j in self._running if j.request.result is not None]:
+            self._running.remove(job)
+            job.finished.set()
+
+
+def main():
+    from synthesis_manager.node_main import node_main
+
+    node_main(AtlasSimNode, NODE_NAME)
+
+
+if __name__ == '__main__':
+    main()

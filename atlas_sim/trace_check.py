@@ -1,0 +1,507 @@
+"""Execution traces and their check against the synthesized GR(1) specification (ROS-free).
+
+A **trace** records one executed run of a state machine: one :class:`TraceStep` per
+executed top-level state, with the activation propositions ``<p>_a`` of the state, the
+outcome propositions true when the state was entered and when it ended, the state name,
+the robot's control mode and the robot clock. JSON shape (``Trace.to_dict``)::
+
+    {"outcome": "finished",                       # SM outcome, or null if the run broke off
+     "sm_outcome_propositions": {"finished": "finished", "failed": "failed"},
+     "steps": [{"index": 0, "state": "/look_down", "state_class": "TiltHeadState",
+                "activated": ["look_down_a"], "capabilities": ["look_down"],
+                "entered_at": 1.8, "ended_at": 2.68, "mode_at_entry": "stand", "mode_at_exit": "stand",
+                "outcomes_at_entry": ["object_template_c", "stand_c"],
+                "outcomes_at_exit": ["look_down_c", "object_template_c", "stand_c"],
+                "results": [{"capability": "look_down", "outcome": "completed", "reason": "...",
+                             "time": 2.68, "abandoned": false}],
+                "state_outcome": "done", "transition": "manipulate"}, ...]}
+
+**Environment valuations** come from what the robot reported, with the paper's
+activation–outcome semantics (:class:`OutcomeTracker`): an outcome proposition
+``<p>_<o>`` becomes true when capability ``p`` reports outcome ``o`` and stays true until
+``p`` is activated again (eqs. (5), (6), (12)); for control modes ``<m>_c`` is true for
+the current mode (eq. (10)). Sensors are true while the robot reads them true.
+
+**The check** (:func:`check_trace`) walks the positions of the run::
+
+    start: (outcomes at entry of step 0, nothing activated)       -- the automaton's initial state
+    step k: (outcomes at entry of step k, activations of step k)
+    end:   (outcomes at exit of the last step, activations unknown, SM outcome proposition true)
+
+(A run that broke off after a state ended gets an end position with no SM outcome; one
+that broke off inside a state ends with that state.) The system valuation of a position
+is its activations; the other system propositions (goal memory ``<g>_m``) are hidden, so
+the checker tracks the *set* of hidden valuations consistent with SYS_INIT and SYS_TRANS
+so far (a subset construction, exact because there are few of them). The end position's
+activations are hidden too: the machine stops before activating anything there.
+SM-outcome propositions are false while the machine runs and at the end exactly the
+reached outcome's is true. Each step must satisfy SYS_TRANS (ENV_TRANS) from one position
+to the next, and each position the formulas without ``next`` (so the end is checked too).
+Between two positions the automaton may pass silently through states that activate
+nothing (the state machine generator skips them), so such idle positions are allowed in
+between. Reported:
+
+* ``env_init`` / ``env_trans``: the robot broke an assumption (formula and step);
+* ``sys_init`` / ``sys_trans``: the state machine broke a guarantee (formula and step);
+* ``goal_order``: with ordered goals each goal counts only once the previous one counted
+  (eq. (20)); a run ending in ``finished`` must have counted every goal.
+Liveness is not checked (a finite run ending in an SM outcome satisfies eq. (19)).
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass, field
+
+from respec.ltl import And, Const, Formula, Iff, Implies, Next, Not, Or, Var, mentions_next, to_infix
+from respec.spec import GR1Specification
+
+ACTIVATION_SUFFIX = '_a'
+MEMORY_SUFFIX = '_m'
+DEFAULT_SM_OUTCOME_PROPOSITIONS = {'finished': 'finished', 'failed': 'failed'}
+
+
+class TraceError(ValueError):
+    """A trace that cannot be checked (malformed); ``item`` names the offending entry."""
+
+    code = 'INVALID_REQUEST'
+
+    def __init__(self, message: str, item: str):
+        super().__init__(message)
+        self.item = item
+
+
+def outcome_proposition(capability: str, outcome: str) -> str:
+    """``<p>_<first letter of outcome>``, e.g. ('stand', 'completed') -> 'stand_c'."""
+    return f'{capability}_{outcome[0]}'
+
+
+# --- traces -------------------------------------------------------------------------------
+
+@dataclass
+class TraceStep:
+    """One executed top-level state (see the module docstring for the fields)."""
+
+    index: int
+    state: str
+    state_class: str = ''
+    activated: list[str] = field(default_factory=list)
+    capabilities: list[str] = field(default_factory=list)
+    entered_at: float = 0.0
+    ended_at: float = 0.0
+    mode_at_entry: str = ''
+    mode_at_exit: str = ''
+    outcomes_at_entry: list[str] = field(default_factory=list)
+    outcomes_at_exit: list[str] = field(default_factory=list)
+    results: list[dict] = field(default_factory=list)
+    state_outcome: str = ''
+    transition: str = ''
+
+    @classmethod
+    def from_dict(cls, data: dict) -> TraceStep:
+        return cls(**data)
+
+
+@dataclass
+class Trace:
+    """A run: its steps and the SM outcome it ended in (None if it broke off)."""
+
+    steps: list[TraceStep] = field(default_factory=list)
+    outcome: str | None = None
+    sm_outcome_propositions: dict[str, str] = field(
+        default_factory=lambda: dict(DEFAULT_SM_OUTCOME_PROPOSITIONS))
+
+    def to_dict(self) -> dict:
+        return {'outcome': self.outcome, 'sm_outcome_propositions': dict(self.sm_outcome_propositions),
+                'steps': [asdict(step) for step in self.steps]}
+
+    @classmethod
+    def from_dict(cls, data: dict) -> Trace:
+        return cls(steps=[TraceStep.from_dict(s) for s in data.get('steps', [])],
+                   outcome=data.get('outcome'),
+                   sm_outcome_propositions=dict(data.get('sm_outcome_propositions')
+                                                or DEFAULT_SM_OUTCOME_PROPOSITIONS))
+
+
+class OutcomeTracker:
+    """Outcome propositions from activations and reports (activation–outcome semantics)."""
+
+    def __init__(self, control_modes, initial_mode: str, completed_actions=(), sensors=None):
+        self.control_modes = set(control_modes)
+        self.mode = initial_mode
+        # capability -> its last reported outcome, cleared by a new activation (eqs. (5), (6))
+        self.reported = {action: 'completed' for action in completed_actions}
+        self.sensors = dict(sensors or {})
+
+    def activate(self, capabilities) -> None:
+        for capability in capabilities:
+            self.reported.pop(capability, None)
+
+    def report(self, capability: str, outcome: str) -> None:
+        self.reported[capability] = outcome
+        if capability in self.control_modes and outcome == 'completed':
+            self.mode = capability
+
+    def read_sensors(self, sensors: dict) -> None:
+        self.sensors.update(sensors)
+
+    def true_propositions(self) -> list[str]:
+        """The outcome propositions (and sensors) that are true now, sorted."""
+        true = {outcome_proposition(self.mode, 'completed')}  # eq. (10): the current mode
+        for capability, outcome in self.reported.items():
+            if capability in self.control_modes and outcome == 'completed':
+                continue  # only the current mode's completion is true
+            true.add(outcome_proposition(capability, outcome))
+        true.update(name for name, value in self.sensors.items() if value)
+        return sorted(true)
+
+
+# --- three-valued evaluation ----------------------------------------------------------------
+
+def partial_evaluate(formula: Formula, current: dict, next_step: dict):
+    """Kleene truth value of ``formula`` on a step: True, False, or None if it depends on
+    variables missing from the valuations (strong Kleene logic, so partial assignments can
+    already refute a formula)."""
+    if isinstance(formula, Const):
+        return formula.value
+    if isinstance(formula, Var):
+        return current.get(formula.name)
+    if isinstance(formula, Next):
+        return partial_evaluate(formula.arg, next_step, {})
+    if isinstance(formula, Not):
+        value = partial_evaluate(formula.arg, current, next_step)
+        return None if value is None else not value
+    if isinstance(formula, (And, Or)):
+        absorbing = isinstance(formula, Or)  # True absorbs a disjunction, False a conjunction
+        unknown = False
+        for arg in formula.args:
+            value = partial_evaluate(arg, current, next_step)
+            if value is absorbing:
+                return absorbing
+            unknown |= value is None
+        return None if unknown else not absorbing
+    if isinstance(formula, Implies):
+        return partial_evaluate(Or((Not(formula.left), formula.right)), current, next_step)
+    if isinstance(formula, Iff):
+        left = partial_evaluate(formula.left, current, next_step)
+        right = partial_evaluate(formula.right, current, next_step)
+        return None if left is None or right is None else left == right
+    raise TypeError(f'not a formula: {formula!r}')
+
+
+def least_violating_assignments(formulas, current: dict, next_known: dict, unknown: list[str],
+                                first_only: bool = False):
+    """Assignments of the ``unknown`` next-step variables violating the fewest ``formulas``.
+
+    Branch and bound over the unknown variables with three-valued evaluation, so a
+    refuted partial assignment is pruned at once. Returns (cost, assignments) where cost
+    is the number of violated formulas (0: the assignments satisfy all of them);
+    ``first_only`` stops at the first satisfying assignment (when existence is enough).
+    """
+    best_cost, best = len(formulas) + 1, []
+
+    def search(depth: int, assignment: dict):
+        nonlocal best_cost, best
+        if first_only and best_cost == 0:
+            return
+        step = {**next_known, **assignment}
+        cost = sum(partial_evaluate(f, current, step) is False for f in formulas)
+        if cost > best_cost:
+            return
+        if depth == len(unknown):
+            if cost < best_cost:
+                best_cost, best = cost, []
+            best.append(dict(assignment))
+            return
+        for value in (False, True):
+            assignment[unknown[depth]] = value
+            search(depth + 1, assignment)
+        del assignment[unknown[depth]]
+
+    search(0, {})
+    return best_cost, best
+
+
+# --- the check -------------------------------------------------------------------------------
+
+@dataclass
+class Violation:
+    kind: str              # env_init, sys_init, env_trans, sys_trans, goal_order
+    step: int | None       # trace step during which it happened (None: before the first)
+    transition: str        # 'start -> /look_down', '/look_down -> /manipulate', '/x -> finished'
+    formulas: list[str]    # the violated formulas (infix)
+    message: str
+
+
+@dataclass
+class TraceCheckReport:
+    ok: bool
+    outcome: str | None
+    violations: list[Violation]
+    goals: list[str]
+    goals_completed_at: dict[str, int | None]
+    positions: int
+
+    def to_dict(self) -> dict:
+        return {'ok': self.ok, 'outcome': self.outcome, 'positions': self.positions,
+                'goals': list(self.goals), 'goals_completed_at': dict(self.goals_completed_at),
+                'violations': [asdict(v) for v in self.violations]}
+
+    def summary(self) -> str:
+        if self.ok:
+            return f'trace check: ok ({self.positions} positions, goals {self.goals_completed_at})'
+        lines = [f'trace check: {len(self.violations)} violation(s)']
+        for v in self.violations:
+            lines.append(f'  {v.kind} at step {v.step} ({v.transition}): {v.message}')
+            lines.extend(f'    {formula}' for formula in v.formulas)
+        return '\n'.join(lines)
+
+
+@dataclass
+class _Position:
+    label: str
+    step: int | None
+    env: dict[str, bool]
+    visible_sys: dict[str, bool]   # activations (unless hidden) and SM outcomes
+
+
+def check_trace(trace: Trace, spec: GR1Specification, goals: list[str] | None = None,
+                ordered: bool = True) -> TraceCheckReport:
+    """Check ``trace`` against ``spec`` (see the module docstring).
+
+    ``goals`` default to the goal-memory propositions ``<g>_m`` of the specification, in
+    declared order; ``ordered`` says whether the goals had a strict order (eq. (20)).
+    """
+    checker = _Checker(trace, spec)
+    violations = checker.run()
+    goals = list(goals) if goals is not None else [
+        p[:-len(MEMORY_SUFFIX)] for p in spec.sys_props if p.endswith(MEMORY_SUFFIX)]
+    completed_at, goal_violations = check_goal_order(trace, goals, ordered)
+    violations.extend(goal_violations)
+    return TraceCheckReport(ok=not violations, outcome=trace.outcome, violations=violations,
+                            goals=goals, goals_completed_at=completed_at,
+                            positions=len(checker.positions))
+
+
+def check_goal_order(trace: Trace, goals: list[str], ordered: bool = True):
+    """When each goal counted: its capability, activated in a step, reported ``completed``.
+
+    With ``ordered`` goals a completion counts only once the previous goal has counted in
+    an earlier step (eq. (20), where the memory of g_(i-1) must already be true). Returns
+    (step of counting per goal, violations): a run ending in ``finished`` must have counted
+    every goal.
+    """
+    completed_at: dict[str, int | None] = {goal: None for goal in goals}
+    for step in trace.steps:
+        completions = {r['capability'] for r in step.results
+                       if r.get('outcome') == 'completed' and not r.get('abandoned')
+                       and r['capability'] in step.capabilities}
+        counted_before = dict(completed_at)
+        for index, goal in enumerate(goals):
+            if completed_at[goal] is not None or goal not in completions:
+                continue
+            previous = goals[index - 1] if ordered and index > 0 else None
+            if previous is None or counted_before[previous] is not None:
+                completed_at[goal] = step.index
+    violations = []
+    finished_prop = trace.sm_outcome_propositions.get(trace.outcome or '', '')
+    if trace.outcome is not None and finished_prop == 'finished':
+        missing = [g for g in goals if completed_at[g] is None]
+        if missing:
+            order = ' in order' if ordered else ''
+            violations.append(Violation(
+                'goal_order', trace.steps[-1].index if trace.steps else None,
+                f'{trace.steps[-1].state if trace.steps else "start"} -> {trace.outcome}', [],
+                f'the run ended in {trace.outcome!r} but goal(s) {", ".join(missing)} were never '
+                f'completed{order}'))
+    return completed_at, violations
+
+
+class _Checker:
+    def __init__(self, trace: Trace, spec: GR1Specification):
+        self.trace, self.spec = trace, spec
+        self.sm_props = {prop for prop in trace.sm_outcome_propositions.values() if prop in spec.sys_props}
+        self.activation_props = [p for p in spec.sys_props if p.endswith(ACTIVATION_SUFFIX)]
+        self.memory_props = [p for p in spec.sys_props
+                             if p not in self.sm_props and p not in self.activation_props]
+        self.positions = self._positions()
+        # Each position must satisfy the formulas without next() itself (the last one too), so
+        # they are also checked on the target of every step, as next-step formulas.
+        self.sys_checks = _with_invariants(spec.sys_trans)
+        self.env_checks = _with_invariants(spec.env_trans)
+
+    # positions of the run -----------------------------------------------------------------
+
+    def _env(self, true_props: list[str]) -> dict[str, bool]:
+        true = set(true_props)
+        return {p: p in true for p in self.spec.env_props}
+
+    def _sys(self, activated, outcome_prop: str | None = None) -> dict[str, bool]:
+        values = {p: False for p in self.sm_props}
+        if outcome_prop is not None:
+            values[outcome_prop] = True
+        if activated is not None:
+            active = set(activated)
+            values.update({p: p in active for p in self.activation_props})
+        return values
+
+    def _positions(self) -> list[_Position]:
+        steps = self.trace.steps
+        if not steps:
+            return []
+        for before, after in zip(steps, steps[1:]):
+            if sorted(before.outcomes_at_exit) != sorted(after.outcomes_at_entry):
+                raise TraceError(f'step {after.index} was entered with outcomes {after.outcomes_at_entry} '
+                                 f'but step {before.index} ended with {before.outcomes_at_exit}',
+                                 item=after.state)
+            if before.index + 1 != after.index:
+                raise TraceError(f'step {after.index} follows step {before.index}', item=after.state)
+        for step in steps:
+            unknown = [p for p in step.activated if p not in self.spec.sys_props]
+            if unknown:
+                raise TraceError(f'step {step.index} activates {unknown[0]!r}, which is not a system '
+                                 'proposition of the specification', item=unknown[0])
+        positions = [_Position('start', None, self._env(steps[0].outcomes_at_entry), self._sys([]))]
+        positions += [_Position(s.state, s.index, self._env(s.outcomes_at_entry), self._sys(s.activated))
+                      for s in steps]
+        last = steps[-1]
+        if self.trace.outcome is not None:
+            prop = self.trace.sm_outcome_propositions.get(self.trace.outcome, self.trace.outcome)
+            if prop not in self.sm_props:
+                raise TraceError(f'the run ended in {self.trace.outcome!r}, whose proposition {prop!r} '
+                                 'is not a system proposition of the specification', item=self.trace.outcome)
+            positions.append(_Position(self.trace.outcome, last.index, self._env(last.outcomes_at_exit),
+                                       self._sys(None, prop)))
+        elif last.transition:  # broke off after the last state ended: its outcomes are still known
+            positions.append(_Position(last.transition, last.index, self._env(last.outcomes_at_exit),
+                                       self._sys(None)))
+        return positions
+
+    def _hidden(self, position: _Position) -> list[str]:
+        return [p for p in self.spec.sys_props if p not in position.visible_sys]
+
+    # the walk ------------------------------------------------------------------------------
+
+    def run(self) -> list[Violation]:
+        if not self.positions:
+            return []
+        violations = []
+        first = self.positions[0]
+        current = {**first.env, **first.visible_sys}
+        false_env = [f for f in self.spec.env_init if partial_evaluate(f, current, {}) is False]
+        if false_env:
+            violations.append(self._violation('env_init', first, first, false_env,
+                                              'the robot did not start as the specification assumes'))
+        # The hidden variables are current-step ones here: evaluate SYS_INIT as a next step.
+        cost, assignments = least_violating_assignments(
+            [Next(f) for f in self.spec.sys_init], {}, current, self._hidden(first))
+        if cost:
+            starts = [({**current, **a}, {}) for a in assignments]
+            blamed = self._blame([(f, f) for f in self.spec.sys_init], starts)
+            violations.append(self._violation('sys_init', first, first, blamed,
+                                              'the state machine did not start as the specification requires'))
+        hidden = [{**current, **a} for a in assignments]  # full valuations of the current position
+        for source, target in zip(self.positions, self.positions[1:]):
+            violations.extend(self._env_violations(source, target, hidden))
+            hidden, violation = self._advance(source, target, hidden, last=target is self.positions[-1])
+            if violation:
+                violations.append(violation)
+        return violations
+
+    def _env_violations(self, source, target, valuations) -> list[Violation]:
+        false_everywhere = None
+        for valuation in valuations:
+            false = {shown for checked, shown in self.env_checks
+                     if partial_evaluate(checked, valuation, target.env) is False}
+            false_everywhere = false if false_everywhere is None else false_everywhere & false
+        if not false_everywhere:
+            return []
+        formulas = [f for f in self.spec.env_trans if f in false_everywhere]
+        return [self._violation('env_trans', source, target, formulas,
+                                'the robot broke an assumption of the specification')]
+
+    def _successors(self, valuations, target: _Position, first_only: bool = False):
+        """Cost and full valuations of ``target`` reachable from ``valuations`` under SYS_TRANS."""
+        known = {**target.env, **target.visible_sys}
+        unknown = self._hidden(target)
+        checks = [checked for checked, _ in self.sys_checks]
+        best_cost, found = len(checks) + 1, {}
+        for valuation in valuations:
+            cost, assignments = least_violating_assignments(checks, valuation, known, unknown, first_only)
+            if cost < best_cost:
+                best_cost, found = cost, {}
+            if cost == best_cost:
+                for assignment in assignments:
+                    full = {**known, **assignment}
+                    found.setdefault(tuple(sorted(full.items())), full)
+        return best_cost, list(found.values())
+
+    def _advance(self, source: _Position, target: _Position, valuations, last: bool):
+        # After the last position only existence matters: no need to collect every valuation.
+        cost, reached = self._successors(valuations, target, first_only=last)
+        if cost == 0:
+            if not last:
+                reached = self._merge(reached, self._via_idle(valuations, target))
+            return reached, None
+        via_idle = self._via_idle(valuations, target)
+        if via_idle:
+            return via_idle, None
+        pairs = [(v, r) for v in valuations for r in reached]
+        blamed = self._blame(self.sys_checks, pairs)
+        return reached, self._violation('sys_trans', source, target, blamed,
+                                        'the state machine broke a guarantee of the specification')
+
+    def _via_idle(self, valuations, target: _Position):
+        """Valuations of ``target`` reached through idle positions (nothing activated)."""
+        idle = _Position('idle', target.step, target.env, self._sys([]))
+        frontier, seen = valuations, {}
+        for _ in range(len(self.memory_props) + 2):  # the hidden part can change that often at most
+            cost, reached = self._successors(frontier, idle)
+            fresh = [r for r in reached if tuple(sorted(r.items())) not in seen] if cost == 0 else []
+            if not fresh:
+                break
+            seen.update((tuple(sorted(r.items())), r) for r in fresh)
+            frontier = fresh
+        if not seen:
+            return []
+        cost, reached = self._successors(list(seen.values()), target)
+        return reached if cost == 0 else []
+
+    @staticmethod
+    def _merge(first, second):
+        merged = {tuple(sorted(v.items())): v for v in first}
+        for v in second:
+            merged.setdefault(tuple(sorted(v.items())), v)
+        return list(merged.values())
+
+    @staticmethod
+    def _blame(checks, pairs) -> list[Formula]:
+        """The formulas violated on the least violating (current, next) pair."""
+        best = None
+        for current, next_step in pairs:
+            false = [shown for checked, shown in checks if partial_evaluate(checked, current, next_step) is False]
+            if best is None or len(false) < len(best):
+                best = false
+        return list(dict.fromkeys(best or []))
+
+    @staticmethod
+    def _violation(kind, source: _Position, target: _Position, formulas, message) -> Violation:
+        transition = source.label if source is target else f'{source.label} -> {target.label}'
+        step = target.step if kind.endswith('init') else (source.step if source.step is not None else target.step)
+        return Violation(kind, step, transition, [to_infix(f) for f in formulas], message)
+
+
+def _with_invariants(formulas) -> list[tuple[Formula, Formula]]:
+    """(formula to evaluate, formula to report): each formula, plus next(f) for those without next."""
+    checks = [(f, f) for f in formulas]
+    checks += [(Next(f), f) for f in formulas if not mentions_next(f)]
+    return checks
+
+
+def valuations_of_trace(trace: Trace, spec: GR1Specification) -> list[dict[str, bool]]:
+    """The observable valuation of each position (for display and tests)."""
+    return [{**p.env, **p.visible_sys} for p in _Checker(trace, spec).positions]
+
+
+__all__ = ['Trace', 'TraceStep', 'OutcomeTracker', 'TraceError', 'TraceCheckReport', 'Violation',
+           'check_trace', 'check_goal_order', 'partial_evaluate', 'least_violating_assignments',
+           'outcome_proposition', 'valuations_of_trace']

@@ -1,0 +1,276 @@
+"""The executive on hand-made state machines: FlexBE semantics, the robot protocol, errors."""
+
+import pytest
+
+from atlas_sim.executor import (CapabilityResult, ExecutionLimitError, FaultSpecError, InitialConditionError,
+                                MachineInvalidError, SimulatedRobot, UndeclaredOutcomeError,
+                                UnmappedStateError, execute_state_machine, load_machine, make_simulator,
+                                parse_faults)
+from atlas_sim.trace_check import check_trace
+from ltl_specification import compile_task
+from sm_generation import StateInstantiation
+from sm_generation.config import load_flexbe_config
+
+FLEXBE = load_flexbe_config('atlas')
+MODES = ['stand_prep', 'stand', 'manipulate', 'step', 'walk']
+
+
+def root(initial, outcomes=('finished', 'failed')):
+    return {'state_path': '/', 'state_class': ':STATEMACHINE', 'initial_state_name': initial,
+            'outcomes': list(outcomes), 'transitions': list(outcomes)}
+
+
+def state(path, proposition, **transitions):
+    """A state configured for ``proposition`` (class and parameters from config/atlas.yaml);
+    ``transitions`` map its outcomes to the next state or machine outcome."""
+    config = FLEXBE.states[proposition]
+    return {'state_path': path, 'state_class': config.state_class, 'behavior_class': config.behavior_class,
+            'parameter_names': list(config.parameter_names), 'parameter_values': list(config.parameter_values),
+            'outcomes': list(transitions), 'transitions': list(transitions.values())}
+
+
+def container(path, conditions, **transitions):
+    """conditions: (container outcome, {child: outcome}) in FlexBE's order."""
+    return {'state_path': path, 'state_class': ':CONCURRENCY', 'outcomes': list(transitions),
+            'transitions': list(transitions.values()), 'cond_outcome': [o for o, _ in conditions],
+            'cond_transition': [{'state_name': list(c), 'state_outcome': list(c.values())}
+                                for _, c in conditions]}
+
+
+PICKUP_TAIL = [state('/look_down', 'look_down_a', done='manipulate', failed='failed'),
+               state('/manipulate', 'manipulate_a', changed='pickup_object', failed='failed'),
+               state('/pickup_object', 'pickup_object_a', finished='finished', failed='failed')]
+
+
+class ScriptedRobot:
+    """A robot without physics: each capability ends after a scripted number of ticks."""
+
+    def __init__(self, script, mode='stand_prep', sensors_at=None):
+        # capability -> (ticks, outcome), or a list of them, one per attempt; missing: never ends
+        self.script = {c: list(v) if isinstance(v, list) else [v] for c, v in script.items()}
+        self.mode, self.tick = mode, 0
+        self.sensors_at = sensors_at or {}  # sensor -> tick from which it reads true
+        self.started = []
+        self.control_modes = MODES
+
+    def start_concurrently(self, capabilities):
+        handles = []
+        for capability in capabilities:
+            attempts = self.script.get(capability, [(None, None)])
+            ticks, outcome = attempts.pop(0) if len(attempts) > 1 else attempts[0]
+            handles.append({'capability': capability, 'ends': None if ticks is None else self.tick + ticks,
+                            'outcome': outcome, 'applied': False})
+            self.started.append((self.tick, capability))
+        self.handles = getattr(self, 'handles', []) + handles
+        return handles
+
+    def step(self):
+        self.tick += 1
+        for handle in self.handles:
+            if handle['ends'] == self.tick and handle['capability'] in MODES and handle['outcome'] == 'completed':
+                self.mode = handle['capability']
+
+    def result(self, handle):
+        if handle['ends'] is None or self.tick < handle['ends']:
+            return None
+        return CapabilityResult(handle['capability'], handle['outcome'], 'scripted', handle['ends'] / 10)
+
+    def snapshot(self):
+        return {'time': self.tick / 10, 'mode': self.mode, 'completed_actions': [], 'pelvis_height': 0.8,
+                'fallen': False, 'sensors': {s: self.tick >= t for s, t in self.sensors_at.items()}}
+
+
+@pytest.fixture(scope='module')
+def pickup_spec():
+    return compile_task('atlas', ['stand_prep'], ['look_down', 'pickup_object'])
+
+
+# --- FlexBE semantics on the simulator ---------------------------------------------------------------
+
+def concurrent_start(conditions, **transitions):
+    return [container('/object_template_and_stand', conditions, **transitions),
+            state('/object_template_and_stand/object_template', 'object_template_a',
+                  received='template_done', aborted='failed_inside'),
+            state('/object_template_and_stand/stand', 'stand_a', changed='both_done', failed='failed_inside')]
+
+
+def test_a_container_returns_on_its_first_holding_condition_and_running_states_carry_over(pickup_spec):
+    machine = [root('object_template_and_stand'),
+               *concurrent_start([('both_done', {'object_template': 'received', 'stand': 'changed'}),
+                                  ('template_done', {'object_template': 'received'}),
+                                  ('failed_inside', {'stand': 'failed'})],
+                                 both_done='look_down', template_done='stand', failed_inside='failed'),
+               state('/stand', 'stand_a', changed='look_down', failed='failed'), *PICKUP_TAIL]
+    simulator = make_simulator('atlas', initial_conditions=['stand_prep'])
+    run = execute_state_machine(machine, SimulatedRobot(simulator))
+    assert run.outcome == 'finished'
+    first, second = run.trace.steps[:2]
+    assert first.activated == ['object_template_a', 'stand_a'] and first.state_outcome == 'template_done'
+    assert [r['capability'] for r in first.results] == ['object_template']
+    # /stand keeps the stand transition started by the container instead of starting another
+    assert second.state == '/stand' and second.results[0]['capability'] == 'stand'
+    assert [r.name for r in simulator.history].count('stand') == 1
+    assert [s.state for s in run.trace.steps] == ['/object_template_and_stand', '/stand', '/look_down',
+                                                   '/manipulate', '/pickup_object']
+    report = check_trace(run.trace, pickup_spec)
+    assert report.ok, report.summary()
+
+
+def test_a_container_waits_until_a_condition_holds(pickup_spec):
+    machine = [root('object_template_and_stand'),
+               *concurrent_start([('both_done', {'object_template': 'received', 'stand': 'changed'}),
+                                  ('failed_inside', {'stand': 'failed'})],
+                                 both_done='look_down', failed_inside='failed'),
+               *PICKUP_TAIL]
+    machine[1]['outcomes'], machine[1]['transitions'] = ['both_done', 'failed_inside'], ['look_down', 'failed']
+    machine[2]['outcomes'], machine[2]['transitions'] = ['received'], ['both_done']
+    run = execute_state_machine(machine, SimulatedRobot(make_simulator('atlas')))
+    first = run.trace.steps[0]
+    assert first.state_outcome == 'both_done' and first.ended_at >= 1.5  # stand takes 1.5 s
+    assert sorted(first.outcomes_at_exit) == ['obj_detected', 'object_template_c', 'stand_c']
+    assert run.outcome == 'finished' and check_trace(run.trace, pickup_spec).ok
+
+
+def test_dataclasses_and_dicts_run_the_same():
+    machine = [root('stand'), state('/stand', 'stand_a', changed='walk', failed='failed'),
+               state('/walk', 'walk_a', changed='finished', failed='failed')]
+    from_dicts = execute_state_machine(machine, SimulatedRobot(make_simulator('atlas')))
+    objects = [StateInstantiation.from_dict(entry) for entry in machine]
+    from_objects = execute_state_machine(objects, SimulatedRobot(make_simulator('atlas')))
+    assert from_dicts.trace.to_dict() == from_objects.trace.to_dict()
+    assert from_dicts.outcome == 'finished' and from_dicts.trace.steps[-1].mode_at_exit == 'walk'
+
+
+def test_a_failing_capability_takes_the_failure_transition():
+    machine = [root('stand'), state('/stand', 'stand_a', changed='walk', failed='failed'),
+               state('/walk', 'walk_a', changed='finished', failed='failed')]
+    simulator = make_simulator('atlas', faults=parse_faults(fail=['walk']))
+    run = execute_state_machine(machine, SimulatedRobot(simulator))
+    assert run.outcome == 'failed'
+    assert run.trace.steps[-1].results[0]['reason'].startswith('injected fault')
+    assert 'walk_f' in run.trace.steps[-1].outcomes_at_exit
+
+
+# --- with a scripted robot --------------------------------------------------------------------------
+
+def test_an_abandoned_request_is_recorded_and_the_check_blames_the_robot(pickup_spec):
+    machine = [root('object_template_and_stand'),
+               *concurrent_start([('template_done', {'object_template': 'received'})],
+                                 template_done='object_template'),
+               state('/object_template', 'object_template_a', received='failed', aborted='failed')]
+    machine[2]['outcomes'], machine[2]['transitions'] = ['received'], ['template_done']
+    robot = ScriptedRobot({'object_template': [(1, 'completed'), (5, 'completed')], 'stand': (3, 'completed')})
+    run = execute_state_machine(machine, robot)
+    second = run.trace.steps[1]
+    assert second.results[0] == {'capability': 'stand', 'outcome': 'completed', 'reason': 'scripted',
+                                 'time': 0.3, 'abandoned': True}
+    assert 'stand_c' in second.outcomes_at_exit and 'stand_prep_c' not in second.outcomes_at_exit
+    report = check_trace(run.trace, pickup_spec)
+    # the mode changed while no state activated it: an assumption of the spec (eq. (12)) broke
+    violation = next(v for v in report.violations if v.kind == 'env_trans')
+    assert violation.step == 1
+    assert 'stand_prep_c & !stand_prep_a & !stand_a & !manipulate_a -> next(stand_prep_c)' in violation.formulas
+
+
+def test_sensor_states_return_when_the_sensor_turns_true():
+    machine = [root('look_down_and_obj_detected'),
+               container('/look_down_and_obj_detected', [('seen', {'obj_detected': 'found'}),
+                                                         ('looked', {'look_down': 'done'})],
+                         seen='finished', looked='failed'),
+               state('/look_down_and_obj_detected/look_down', 'look_down_a', done='looked'),
+               state('/look_down_and_obj_detected/obj_detected', 'obj_detected', found='seen')]
+    robot = ScriptedRobot({'look_down': (10, 'completed')}, mode='stand', sensors_at={'obj_detected': 4})
+    run = execute_state_machine(machine, robot)
+    assert run.outcome == 'finished' and robot.tick == 4
+    assert run.trace.steps[0].activated == ['look_down_a']  # sensors are not activated
+    assert 'obj_detected' in run.trace.steps[0].outcomes_at_exit
+
+
+def test_helper_states_take_no_robot_time_and_decisions_use_the_hook():
+    machine = [root('choose_initial_state'),
+               {'state_path': '/choose_initial_state', 'state_class': 'OperatorDecisionState',
+                'outcomes': ['stand', 'nothing_to_do'], 'transitions': ['stand', 'nothing_to_do']},
+               {'state_path': '/nothing_to_do', 'state_class': 'LogState', 'outcomes': ['done'],
+                'transitions': ['finished']},
+               state('/stand', 'stand_a', changed='finished', failed='failed')]
+    robot = ScriptedRobot({'stand': (2, 'completed')})
+    run = execute_state_machine(machine, robot)  # default: the first outcome
+    assert run.outcome == 'finished' and robot.started == [(0, 'stand')]
+    robot = ScriptedRobot({})
+    asked = []
+    run = execute_state_machine(machine, robot, decide=lambda path, outcomes: asked.append(path) or outcomes[1])
+    assert run.outcome == 'finished' and robot.tick == 0 and asked == ['/choose_initial_state']
+    assert [s.state for s in run.trace.steps] == ['/choose_initial_state', '/nothing_to_do']
+
+
+# --- errors ---------------------------------------------------------------------------------------
+
+def test_a_run_without_outcome_hits_the_robot_time_limit():
+    machine = [root('stand'), state('/stand', 'stand_a', changed='finished', failed='failed')]
+    with pytest.raises(ExecutionLimitError) as error:
+        execute_state_machine(machine, ScriptedRobot({}), max_robot_time=2.0)
+    assert error.value.item == '/stand' and error.value.code == 'TIMEOUT'
+    assert len(error.value.trace.steps) == 1 and 'robot time' in str(error.value)
+
+
+def test_an_undeclared_outcome_names_the_state():
+    machine = [root('stand'), state('/stand', 'stand_a', changed='finished')]  # no 'failed' outcome
+    with pytest.raises(UndeclaredOutcomeError) as error:
+        execute_state_machine(machine, ScriptedRobot({'stand': (1, 'failed')}))
+    assert error.value.item == '/stand' and "'failed'" in str(error.value)
+
+
+def test_an_unmapped_state_names_the_state():
+    machine = [root('dance'), {'state_path': '/dance', 'state_class': 'DanceState', 'outcomes': ['done'],
+                               'transitions': ['finished']}]
+    with pytest.raises(UnmappedStateError) as error:
+        execute_state_machine(machine, ScriptedRobot({}))
+    assert error.value.item == '/dance' and 'DanceState' in str(error.value)
+    wrong_parameter = state('/stand', 'stand_a', changed='finished', failed='failed')
+    wrong_parameter['parameter_values'] = ['ChangeControlModeActionState.FLY']
+    with pytest.raises(UnmappedStateError) as error:
+        execute_state_machine([root('stand'), wrong_parameter], ScriptedRobot({}))
+    assert error.value.item == '/stand'
+
+
+@pytest.mark.parametrize('machine, item', [
+    ([state('/stand', 'stand_a', changed='finished')], '/'),
+    ([root('walk'), state('/stand', 'stand_a', changed='finished')], 'walk'),
+    ([root('stand'), state('/stand', 'stand_a', changed='nowhere')], '/stand'),
+    ([root('stand'), state('/stand/inner', 'stand_a', changed='x'),
+      state('/stand', 'stand_a', changed='finished')],
+     '/stand/inner'),
+    ([root('c'), container('/c', [('x', {'ghost': 'done'})], x='finished'),
+      state('/c/stand', 'stand_a', changed='x')], '/c'),
+])
+def test_invalid_machines_name_the_offending_entry(machine, item):
+    with pytest.raises(MachineInvalidError) as error:
+        load_machine(machine)
+    assert error.value.item == item
+
+
+# --- simulator set-up -------------------------------------------------------------------------------
+
+def test_make_simulator_starts_in_the_initial_conditions():
+    simulator = make_simulator('atlas', initial_conditions=['manipulate', 'object_template'])
+    assert simulator.mode == 'manipulate' and simulator.completed_actions() == ['object_template']
+    assert simulator.execute('pickup_object').completed  # its preconditions hold from the start
+    assert not simulator.has_fallen()
+
+
+@pytest.mark.parametrize('conditions, item', [(['fly'], 'fly'), (['stand', 'walk'], 'walk')])
+def test_make_simulator_rejects_bad_initial_conditions(conditions, item):
+    with pytest.raises(InitialConditionError) as error:
+        make_simulator('atlas', initial_conditions=conditions)
+    assert error.value.item == item
+
+
+def test_parse_faults():
+    assert parse_faults(['walk'], ['pickup_object:2'], ['stand:0.5']) == {
+        'walk': {'always': True}, 'pickup_object': {'fail_first': 2}, 'stand': {'probability': 0.5}}
+    with pytest.raises(FaultSpecError) as error:
+        parse_faults(fail_first=['pickup_object'])
+    assert error.value.item == 'pickup_object'
+    with pytest.raises(FaultSpecError) as error:
+        make_simulator('atlas', faults=parse_faults(fail=['fly']))
+    assert error.value.item == 'fly'

@@ -1,0 +1,130 @@
+"""The atlas_sim node: ExecuteCapability goals (also overlapping), the state topic, parameters, process."""
+
+import os
+import signal
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+
+import pytest
+from rclpy.action import ActionClient
+from rclpy.node import Node
+from rclpy.parameter import Parameter
+
+from atlas_sim.node import ACTION_NAME, STATE_TOPIC, AtlasSimNode, names_of
+from synthesis_manager.harness import RosHarness, wait_for
+from synthesis_manager.ros_env import prepare_ros_environment
+from synthesis_msgs.action import ExecuteCapability
+from synthesis_msgs.msg import RobotState
+
+
+class Client:
+    """Sends capability goals and collects RobotState messages."""
+
+    def __init__(self, ros, name='sim_client'):
+        self.node = ros.add_node(Node, name)
+        self.action = ActionClient(self.node, ExecuteCapability, ACTION_NAME)
+        assert self.action.wait_for_server(timeout_sec=10.0)
+        self.states = []
+        self.received = threading.Event()
+        self.node.create_subscription(RobotState, STATE_TOPIC, self._on_state, 10)
+
+    def _on_state(self, message):
+        self.states.append(message)
+        self.received.set()
+
+    def wait_for_state(self, condition, timeout=5.0):
+        deadline = time.monotonic() + timeout
+        while time.monotonic() < deadline:
+            found = [m for m in list(self.states) if condition(m)]
+            if found:
+                return found[0]
+            time.sleep(0.01)
+        raise AssertionError('no matching RobotState message')
+
+    def send(self, capability):
+        return self.action.send_goal_async(ExecuteCapability.Goal(capability=capability))
+
+    def results(self, futures, timeout=60.0):
+        handles = [wait_for(f, 10.0) for f in futures]
+        return [wait_for(h.get_result_async(), timeout).result if h.accepted else None for h in handles]
+
+    def execute(self, *capabilities):
+        return self.results([self.send(c) for c in capabilities])
+
+
+def sim_node(ros, **parameters):
+    values = {'speed': 20.0, 'state_rate': 50.0, **parameters}
+    return ros.add_node(AtlasSimNode, parameter_overrides=[Parameter(k, value=v) for k, v in values.items()])
+
+
+def test_goals_run_capabilities_and_overlapping_goals_start_together(ros):
+    node = sim_node(ros)
+    client = Client(ros)
+    (stand,) = client.execute('stand')
+    assert (stand.outcome, stand.reason) == ('completed', 'stand completed') and stand.stamp > 1.5
+    # look_down needs stand; sent together with manipulate, both are checked in the same instant
+    look_down, manipulate = client.execute('look_down', 'manipulate')
+    assert look_down.outcome == 'completed' and manipulate.outcome == 'completed', (look_down, manipulate)
+    assert node.simulator.mode == 'manipulate' and not node.simulator.has_fallen()
+    starts = {r.name: r.started_at for r in node.simulator.history}
+    assert starts['look_down'] == starts['manipulate']
+    latest = client.wait_for_state(lambda m: m.stamp > manipulate.stamp)
+    assert latest.mode == 'manipulate' and 'look_down' not in latest.running and not latest.fallen
+    assert 0.6 < latest.pelvis_height < 1.1
+
+
+def test_refused_capabilities_fail_with_the_reason_and_unknown_ones_are_rejected(ros):
+    sim_node(ros)
+    client = Client(ros)
+    (walk,) = client.execute('walk')
+    assert walk.outcome == 'failed' and 'not allowed' in walk.reason
+    (unknown,) = client.execute('fly')
+    assert unknown is None  # goal rejected
+
+
+def test_parameters_set_initial_conditions_and_faults(ros):
+    node = sim_node(ros, initial_conditions='stand,object_template', fail=['look_down'],
+                    fail_first='manipulate:1', seed=3)
+    assert node.simulator.mode == 'stand' and node.simulator.completed_actions() == ['object_template']
+    client = Client(ros)
+    look_down, = client.execute('look_down')
+    assert look_down.outcome == 'failed' and look_down.reason.startswith('injected fault')
+    first, = client.execute('manipulate')
+    second, = client.execute('manipulate')
+    assert (first.outcome, second.outcome) == ('failed', 'completed')
+    pickup, = client.execute('pickup_object')
+    assert pickup.outcome == 'completed'
+
+
+def test_names_of_accepts_arrays_and_comma_separated_strings():
+    assert names_of('a, b,,c') == ['a', 'b', 'c']
+    assert names_of(['a', ' b ']) == ['a', 'b']
+    assert names_of('') == [] and names_of(None) == []
+
+
+def test_the_node_runs_as_its_own_process():
+    from domain_coordinator import domain_id
+
+    script = Path(sys.executable).parent / 'atlas-sim-node'
+    if not script.exists():
+        pytest.fail(f'{script} is not installed (pip install -e .)')
+    with domain_id() as domain:
+        environment = prepare_ros_environment(domain, environ=dict(os.environ))
+        process = subprocess.Popen([str(script), '--ros-args', '-p', 'speed:=20.0', '-p', 'fail:=look_down'],
+                                   env=environment, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+        try:
+            with RosHarness(domain_id=domain) as ros:
+                client = Client(ros, 'process_client')
+                (stand,) = client.execute('stand')
+                (look_down,) = client.execute('look_down')
+                assert stand.outcome == 'completed'
+                assert look_down.outcome == 'failed' and 'injected fault' in look_down.reason
+                assert client.received.wait(5.0)
+        finally:
+            process.send_signal(signal.SIGTERM)
+            output = process.communicate(timeout=20)[0]
+        assert process.returncode == 0, output
+        assert 'atlas_sim ready' in output

@@ -24,7 +24,15 @@ def run_nodes(*node_factories, argv: list[str] | None = None, ready_message: str
             executor.add_node(node)
         if ready_message:
             print(ready_message, flush=True)
-        executor.spin()
+        # spin_once with a timeout, not spin(): a signal arriving while the executor builds
+        # its first wait set can be missed, and then spin() would wait forever.
+        while context.ok():
+            try:
+                executor.spin_once(timeout_sec=0.25)
+            except Exception:
+                if context.ok():
+                    raise
+                # the context was shut down by a signal in the middle of this spin: done
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
     finally:

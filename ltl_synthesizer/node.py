@@ -64,6 +64,11 @@ class LTLSynthesisNode(Node):
         self.create_service(CancelSynthesis, 'ltl_synthesis/cancel', self.on_cancel_request,
                             callback_group=group)
 
+    def active_requests(self) -> list[str]:
+        """Ids of the requests whose synthesis is running now."""
+        with self._lock:
+            return sorted(self._running)
+
     def parameter(self, name):
         return self.get_parameter(name).value
 

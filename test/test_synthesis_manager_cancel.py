@@ -98,3 +98,24 @@ def test_hanging_service_times_out(ros, tmp_path):
     stand_ins[0].release.set()
     assert outcome.error_name == 'TIMEOUT'
     assert 'sm_generate' in outcome.message
+
+
+# Seven ordered goals: synthesis runs for minutes, so a cancel always lands in its middle.
+LONG_TASK = dict(system='atlas', initial_conditions=['stand_prep'],
+                 goals=['look_down', 'pickup_object', 'grasp_object', 'pregrasp', 'approach_object',
+                        'footstep_execution', 'walk'])
+
+
+def test_cancel_in_the_middle_of_synthesis_really_stops_it(ros, tmp_path):
+    client, _ = start(ros, tmp_path)
+    synthesis_node = next(n for n in ros.nodes if n.get_name() == 'ltl_synthesis')
+    outcome, seconds = cancel_when(client, make_goal(**LONG_TASK), 'Synthesizing')
+    assert outcome.error_name == 'PREEMPTED'
+    # The synthesizer forgets a request only when its work has returned: it really stopped.
+    deadline = time.monotonic() + 5
+    while synthesis_node.active_requests() and time.monotonic() < deadline:
+        time.sleep(0.05)
+    assert synthesis_node.active_requests() == []
+    assert seconds < 10
+    # ...and the server keeps serving.
+    assert client.run(make_goal(**PAPER_TASK), timeout=60).error_name == 'SUCCESS'

@@ -6,7 +6,6 @@ Like the original it writes the byproducts ``<spec_name>.structuredslugs``, ``.s
 
 from __future__ import annotations
 
-import json
 import re
 import tempfile
 import threading
@@ -19,6 +18,7 @@ from rclpy.node import Node
 from ltl_synthesizer import SynthesisCancelled, synthesize
 from respec.parsing import ParseError
 from ltl_synthesizer.automaton import automaton_from_strategy
+from ltl_synthesizer.strategy import strategy_to_json
 from synthesis_manager.conversions import automaton_to_msg, error_code, msg_to_sections
 from synthesis_msgs.srv import CancelSynthesis, SynthesizeAutomaton
 
@@ -143,7 +143,7 @@ class LTLSynthesisNode(Node):
                 'SPEC_UNSYNTHESIZABLE',
                 f'specification {stem.name!r} is unrealizable: {explanation}'.rstrip(': '))
             return
-        stem.with_suffix('.json').write_text(json.dumps(strategy, indent=1))
+        stem.with_suffix(".json").write_text(strategy_to_json(strategy))
         response.automaton = automaton_to_msg(automaton_from_strategy(strategy, spec))
         response.error_code = error_code('SUCCESS')
 

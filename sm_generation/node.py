@@ -21,10 +21,10 @@ class SMGenerationNode(Node):
         super().__init__('sm_generation', **kwargs)
         self.declare_parameter('config_dir', '')
         self.declare_parameter('reduce', False)
-        self.create_service(GenerateFlexBESM, 'sm_generate', self.handle,
+        self.create_service(GenerateFlexBESM, 'sm_generate', self.on_request,
                             callback_group=ReentrantCallbackGroup())
 
-    def handle(self, request, response):
+    def on_request(self, request, response):
         try:
             states = generate_state_machine(
                 msg_to_automaton(request.automaton), request.system,

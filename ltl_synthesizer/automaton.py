@@ -1,0 +1,92 @@
+"""The FSAutomaton message shape, converted from a slugs JSON strategy.
+
+Port of the original ltl_synthesis_server's conversion: state names are the node ids as
+strings, valuations split into inputs and outputs, goal-memory propositions (names ending in
+``_m``) dropped from the outputs.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from respec.spec import GR1Specification
+
+from ltl_synthesizer.errors import SynthesisError
+
+MEMORY_SUFFIX = '_m'
+
+
+class AutomatonError(SynthesisError):
+    code = 'AUTOMATON_INVALID'
+
+
+@dataclass
+class AutomatonState:
+    name: str
+    output_valuation: list[bool]
+    input_valuation: list[bool]
+    transitions: list[str]
+    rank: int
+
+
+@dataclass
+class Automaton:
+    output_variables: list[str] = field(default_factory=list)
+    input_variables: list[str] = field(default_factory=list)
+    states: list[AutomatonState] = field(default_factory=list)
+    initial_states: list[str] = field(default_factory=list)
+
+
+def is_memory_proposition(name: str) -> bool:
+    return name.endswith(MEMORY_SUFFIX)
+
+
+def automaton_from_strategy(strategy: dict, spec: GR1Specification,
+                            drop_memory: bool = True) -> Automaton:
+    """The automaton of a slugs JSON strategy; ``initial_states`` are the nodes whose valuation
+    satisfies ENV_INIT and SYS_INIT (the extraction numbers them first)."""
+    inputs, outputs = list(spec.env_props), list(spec.sys_props)
+    expected = inputs + outputs
+    if list(strategy.get('variables', [])) != expected:
+        raise AutomatonError(
+            f"strategy variables {strategy.get('variables')} do not match the specification's "
+            f'inputs then outputs {expected}', item='variables')
+    kept = [i for i, name in enumerate(outputs) if not (drop_memory and is_memory_proposition(name))]
+    nodes = strategy['nodes']
+    n_inputs = len(inputs)
+    states = []
+    for name in sorted(nodes, key=int):
+        node = nodes[name]
+        valuation = node['state']
+        if len(valuation) != len(expected) or any(v not in (0, 1) for v in valuation):
+            raise AutomatonError(f'node {name} has an invalid valuation {valuation}', item=name)
+        for successor in node['trans']:
+            if str(successor) not in nodes:
+                raise AutomatonError(f'node {name} has an unknown successor {successor}', item=name)
+        output_values = valuation[n_inputs:]
+        states.append(AutomatonState(
+            name=str(name),
+            output_valuation=[bool(output_values[i]) for i in kept],
+            input_valuation=[bool(v) for v in valuation[:n_inputs]],
+            transitions=[str(t) for t in node['trans']],
+            rank=int(node['rank'])))
+    initial = _initial_nodes(strategy, spec)
+    return Automaton(output_variables=[outputs[i] for i in kept], input_variables=inputs,
+                     states=states, initial_states=initial)
+
+
+def _initial_nodes(strategy: dict, spec: GR1Specification) -> list[str]:
+    from respec.ltl import conj
+    from ltl_synthesizer.symbolic import SymbolicGame
+
+    initial_only = GR1Specification(env_props=list(spec.env_props), sys_props=list(spec.sys_props),
+                                    env_init=list(spec.env_init), sys_init=list(spec.sys_init))
+    game = SymbolicGame(initial_only)
+    condition = game.translate(conj(list(spec.env_init) + list(spec.sys_init)), 'env_init')
+    names = list(strategy['variables'])
+    found = []
+    for name in sorted(strategy['nodes'], key=int):
+        values = strategy['nodes'][name]['state']
+        if game.evaluate(condition, {v: bool(x) for v, x in zip(names, values)}):
+            found.append(str(name))
+    return found

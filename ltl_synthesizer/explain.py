@@ -1,0 +1,149 @@
+"""Human-readable reasons why a specification is unrealizable.
+
+The explanation names (a) the initial positions that lose, (b) the system liveness goal the
+environment can block, by index and infix text, (c) a short environment play that
+demonstrates it, and (d) a system deadlock (a reachable position where the environment can
+move so that no output satisfies SYS_TRANS), naming a minimal set of conflicting SYS_TRANS
+formulas.
+"""
+
+from __future__ import annotations
+
+from respec.ltl import to_infix
+
+from ltl_synthesizer.gr1 import EnvironmentSolution, SystemSolution
+from ltl_synthesizer.strategy import enumerate_states, extract_counterstrategy, losing_initial_states
+from ltl_synthesizer.symbolic import SymbolicGame
+
+MAX_LISTED_STATES = 3
+PLAY_LENGTH = 8
+
+
+def _true_set(names, values) -> str:
+    chosen = [name for name, value in zip(names, values) if value]
+    return '{' + ', '.join(chosen) + '}'
+
+
+def _goal_text(game: SymbolicGame, index: int) -> str:
+    goals = game.spec.sys_liveness
+    if not goals:
+        return 'the implicit system goal TRUE'
+    return f"system liveness #{index} '{to_infix(goals[index])}'"
+
+
+def explain_unrealizable(game: SymbolicGame, system: SystemSolution,
+                         environment: EnvironmentSolution, robotics_semantics: bool) -> str:
+    lines = _initial_conditions(game, system, environment, robotics_semantics)
+    play = extract_counterstrategy(game, environment, robotics_semantics, play_length=PLAY_LENGTH)
+    lines += _blocked_goal_and_play(game, play)
+    return '\n'.join(lines)
+
+
+def _initial_conditions(game, system, environment, robotics_semantics) -> list[str]:
+    initial = game.env_init & game.sys_init
+    if game.env_init == game.false:
+        return ['ENV_INIT is unsatisfiable.']
+    if initial == game.false:
+        return ['No initial state satisfies both ENV_INIT and SYS_INIT '
+                '(the system initial conditions contradict the environment ones).']
+    if system.complete and system.winning == game.false:
+        header = 'No position is winning for the system (the environment wins from everywhere).'
+    else:
+        header = None
+    losing = losing_initial_states(game, environment.winning, robotics_semantics)
+    if not losing:
+        # The system solver stopped early; fall back to its own view of the initial positions.
+        losing = enumerate_states(game, initial & ~system.winning, game.variables)
+    lines = [header] if header else []
+    if robotics_semantics:
+        lines.append(f'{len(losing)} initial state(s) allowed by ENV_INIT and SYS_INIT are losing '
+                     '(robotics semantics requires all to be winning); true propositions:')
+        for state in losing[:MAX_LISTED_STATES]:
+            lines.append('  ' + _true_set(game.variables, [state[v] for v in game.variables]))
+    else:
+        inputs = []
+        for state in losing:
+            key = tuple(state[name] for name in game.inputs)
+            if key not in inputs:
+                inputs.append(key)
+        lines.append(f'For {len(inputs)} initial input valuation(s) allowed by ENV_INIT no system '
+                     'initial values allowed by SYS_INIT are winning; true inputs:')
+        for key in inputs[:MAX_LISTED_STATES]:
+            lines.append('  ' + _true_set(game.inputs, key))
+    listed = len(losing) if robotics_semantics else len(inputs)
+    if listed > MAX_LISTED_STATES:
+        lines.append(f'  ... and {listed - MAX_LISTED_STATES} more')
+    return lines
+
+
+def _blocked_goal_and_play(game: SymbolicGame, play: dict) -> list[str]:
+    nodes = play['nodes']
+    if not nodes:
+        return []
+    first = nodes['0']
+    _, blocked = first['rank']
+    lines = []
+    names = game.variables
+    n_inputs = len(game.inputs)
+    steps = []
+    deadlock = None
+    node_name = '0'
+    visited = []
+    while node_name in nodes and node_name not in visited:
+        visited.append(node_name)
+        node = nodes[node_name]
+        steps.append(node)
+        if None in node['state']:
+            deadlock = (steps[-2] if len(steps) > 1 else None, node)
+            break
+        if not node['trans']:
+            break
+        node_name = str(node['trans'][0])
+    if deadlock is None:
+        lines.append(f'The environment can prevent {_goal_text(game, blocked)} from holding '
+                     'infinitely often, while satisfying all of its own assumptions.')
+    lines.append('Environment play (counter-strategy; inputs chosen by the environment, '
+                 'outputs one legal system response):')
+    for step, node in enumerate(steps):
+        inputs = _true_set(names[:n_inputs], node['state'][:n_inputs])
+        if None in node['state']:
+            lines.append(f'  step {step}: inputs {inputs} -> no output satisfies SYS_TRANS (deadlock)')
+            continue
+        outputs = _true_set(names[n_inputs:], node['state'][n_inputs:])
+        alternatives = len(node['trans'])
+        lines.append(f'  step {step}: inputs {inputs} outputs {outputs}'
+                     + (f'  ({alternatives} system responses next)' if alternatives > 1 else ''))
+    if node_name in visited and deadlock is None:
+        lines.append(f'  ... step {len(steps)} repeats step {visited.index(node_name)}: '
+                     'the environment can loop forever.')
+    if deadlock is not None and deadlock[0] is not None:
+        lines += _deadlock(game, deadlock[0], deadlock[1])
+    return lines
+
+
+def _deadlock(game: SymbolicGame, before: dict, dead: dict) -> list[str]:
+    """Name a minimal set of SYS_TRANS formulas that no output can satisfy together."""
+    state = {name: bool(value) for name, value in zip(game.variables, before['state'])}
+    for name, value in zip(game.inputs, dead['state']):
+        state[game.to_next[name]] = bool(value)
+    restricted = [(index, game.bdd.let(state, part)) for index, part in enumerate(game.sys_trans_parts)]
+    conflict = [(index, part) for index, part in restricted if part != game.true]
+    # Deletion-based minimisation: drop each formula that is not needed for the conflict.
+    position = 0
+    while position < len(conflict):
+        rest = conflict[:position] + conflict[position + 1:]
+        together = game.true
+        for _, part in rest:
+            together &= part
+        if together == game.false:
+            conflict = rest
+        else:
+            position += 1
+    lines = ['System deadlock (a safety requirement cannot be met): in state '
+             + _true_set(game.variables, before['state'])
+             + ' the environment can set the inputs to '
+             + _true_set(game.inputs, dead['state'][:len(game.inputs)])
+             + ', and then no outputs satisfy these SYS_TRANS formulas together:']
+    for index, _ in conflict:
+        lines.append(f'  sys_trans #{index}: {to_infix(game.spec.sys_trans[index])}')
+    return lines

@@ -1,0 +1,202 @@
+"""GR(1) game solving: the three nested fixpoints of Piterman, Pnueli and Sa'ar, on transitions.
+
+Liveness goals may mention next-step variables (slugs' extended fragment, needed by the
+paper's fairness formulas (7) and (13)), so goals are sets of *transitions*: the fixpoints
+compute which positions can enforce a transition into a target set of transitions
+(``SymbolicGame.cox``), exactly as slugs' ``computeWinningPositions`` does:
+
+    nu Z. /\\_j mu Y. \\/_i nu X. cox( (G_j & Z') | Y' | (!A_i & X') )
+
+with G_j the system goals (guarantees) and A_i the environment goals (assumptions).
+The counter-game (for unrealizable specifications) is the dual, from the environment's side.
+"""
+
+from __future__ import annotations
+
+import itertools
+from dataclasses import dataclass, field
+
+from ltl_synthesizer.symbolic import SymbolicGame
+
+
+@dataclass
+class AttractorStep:
+    """One inner fixpoint of the last Z iteration: for goal ``goal_index``, the transitions
+    ``(goal & Z') | closer' | (waiting' & !assumption)`` the system may take. Kept as parts
+    and assembled only for strategy extraction (the fixpoints never need them)."""
+
+    goal_index: int
+    goal_transitions: object
+    closer: object
+    waiting: object
+    assumption: object
+    responses: object  # exists y'. sys_trans & transitions: where the step offers a move
+
+    def transitions(self, game: SymbolicGame):
+        return (self.goal_transitions | game.prime(self.closer)
+                | (game.prime(self.waiting) & ~self.assumption))
+
+
+@dataclass
+class SystemSolution:
+    """Winning positions and the attractor steps of the last Z iteration, per goal in the order
+    of increasing distance to the goal (the "mY" ranks): a strategy for goal j takes, at each
+    position, the first step that offers a move."""
+
+    winning: object
+    attractor_steps: list = field(default_factory=list)
+    complete: bool = True  # False when the solver stopped early because the initial check failed
+
+
+def solve_system_game(game: SymbolicGame, stop_when_losing=None) -> SystemSolution:
+    """The system's winning positions (greatest fixpoint Z over all goals).
+
+    ``stop_when_losing(Z)`` may return False to stop early: Z only shrinks, so once the
+    initial positions are not covered they never will be (used to reject quickly).
+    """
+    winning = game.true
+    # Inner fixpoints of the previous Z iteration, by (goal, Y iteration, assumption): upper
+    # bounds for this iteration's (everything is monotone in Z), so X can start from them.
+    previous_waiting: dict = {}
+    while True:
+        attractor_steps = []
+        waiting_sets: dict = {}
+        next_winning = game.true
+        for goal_index, goal in enumerate(game.sys_goals):
+            next_winning &= _attract_to_goal(game, goal_index, goal, winning, attractor_steps,
+                                             previous_waiting, waiting_sets)
+            if next_winning == game.false:
+                break
+        if next_winning == winning:
+            return SystemSolution(winning, attractor_steps)
+        winning = next_winning
+        previous_waiting = waiting_sets
+        if stop_when_losing is not None and not stop_when_losing(winning):
+            return SystemSolution(winning, [], complete=False)
+
+
+def _attract_to_goal(game: SymbolicGame, goal_index: int, goal, winning, attractor_steps,
+                     previous_waiting, waiting_sets):
+    """Middle least fixpoint Y: positions that can force goal ``goal`` (into Z) or keep some
+    environment goal false forever while staying safe."""
+    goal_transitions = goal & game.prime(winning)
+    reach_goal = game.system_can_respond(goal_transitions)
+    closer = game.false
+    for iteration in itertools.count():
+        # exists y'. sys_trans & (A | B) splits into two products; the goal part is shared
+        # by every assumption's inner fixpoint.
+        can_move_towards_goal = reach_goal | game.system_can_move_into(closer)
+        next_closer = closer
+        for assumption_index, assumption in enumerate(game.env_goals):
+            key = (goal_index, iteration, assumption_index)
+            # Beyond the previous iteration count, the previous final X is still an upper bound.
+            start = previous_waiting.get(key, previous_waiting.get((goal_index, -1, assumption_index)))
+            start = winning if start is None else start & winning
+            waiting, responses = _wait_for_assumption(game, can_move_towards_goal, assumption, start)
+            waiting_sets[key] = waiting_sets[(goal_index, -1, assumption_index)] = waiting
+            next_closer |= waiting
+            attractor_steps.append(AttractorStep(
+                goal_index, goal_transitions, closer, waiting, assumption, responses))
+        if next_closer == closer:
+            return closer
+        closer = next_closer
+
+
+def _wait_for_assumption(game: SymbolicGame, can_move_towards_goal, assumption, start):
+    """Inner greatest fixpoint X: positions that can move towards the goal, or else stay in X
+    on transitions that violate environment goal ``assumption``.
+
+    X descends from ``start``, an upper bound of the fixpoint within Z (Z itself, or the
+    previous Z iteration's X): positions outside Z lose anyway, so restricting X to Z leaves
+    the outer fixpoint unchanged, and X := X & cox(...) reaches the greatest fixpoint below
+    any upper bound. Returns X and the system's responses (over current variables and next
+    inputs) that keep to these transitions.
+    """
+    waiting = start
+    system_independent = not game.mentions_next_outputs(assumption)
+    while True:
+        if system_independent:
+            # The assumption constrains no next output, so it factors out of exists y'.
+            responses = can_move_towards_goal | (~assumption & game.system_can_move_into(waiting))
+        else:
+            responses = can_move_towards_goal | game.system_can_respond(
+                game.prime(waiting) & ~assumption)
+        next_waiting = waiting & game.enforce(responses)
+        if next_waiting == waiting:
+            return waiting, responses
+        waiting = next_waiting
+
+
+@dataclass
+class EnvironmentLevel:
+    """One iteration k of the environment's outer least fixpoint.
+
+    ``blocking[j]`` is Y_{k,j}: positions where the environment keeps goal j false or drops to
+    a lower level. ``moves[j][i]`` lists, by increasing X rank, the environment moves (over
+    current variables and next inputs) that work towards its assumption i while doing so.
+    """
+
+    below: object  # Z_{k-1}: positions won at lower levels
+    blocking: list = field(default_factory=list)
+    moves: list = field(default_factory=list)
+
+
+@dataclass
+class EnvironmentSolution:
+    """Positions from which the environment wins, with the levels of its attractor."""
+
+    winning: object
+    levels: list = field(default_factory=list)
+
+
+def solve_environment_game(game: SymbolicGame) -> EnvironmentSolution:
+    """The dual (counter-strategy) game, as slugs' ``--counterStrategy``:
+
+        mu Z. \\/_j nu Y. /\\_i mu X. env_cox( (Z' | !G_j) & Y' & (X' | A_i) )
+    """
+    winning = game.false
+    levels = []
+    while True:
+        level = EnvironmentLevel(below=winning)
+        next_winning = game.false
+        for goal in game.sys_goals:
+            blocking, moves = _block_goal(game, goal, winning)
+            level.blocking.append(blocking)
+            level.moves.append(moves)
+            next_winning |= blocking
+        if next_winning == winning:
+            return EnvironmentSolution(winning, levels)
+        levels.append(level)
+        winning = next_winning
+
+
+def _block_goal(game: SymbolicGame, goal, winning):
+    """Middle greatest fixpoint Y: positions where the environment keeps goal ``goal`` false
+    (or reaches Z) while satisfying every one of its own goals infinitely often."""
+    avoid_goal = ~goal | game.prime(winning)
+    blocking = game.true
+    while True:
+        kept = avoid_goal & game.prime(blocking)
+        next_blocking = blocking
+        moves = []
+        for assumption in game.env_goals:
+            reach, reach_moves = _reach_assumption(game, kept, assumption)
+            next_blocking &= reach
+            moves.append(reach_moves)
+        if next_blocking == blocking:
+            return blocking, moves
+        blocking = next_blocking
+
+
+def _reach_assumption(game: SymbolicGame, kept, assumption):
+    """Inner least fixpoint X: positions from which the environment reaches a transition that
+    satisfies its goal ``assumption`` while keeping within ``kept``."""
+    reach = game.false
+    steps = []
+    while True:
+        moves = game.env_cox(kept & (game.prime(reach) | assumption))
+        steps.append(moves)
+        next_reach = game.exist_next_inputs(moves)
+        if next_reach == reach:
+            return reach, steps
+        reach = next_reach

@@ -1,0 +1,111 @@
+"""The gr1synth command line, run as a subprocess the way tools that wrap slugs run it."""
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+REPOSITORY = Path(__file__).resolve().parent.parent
+
+REALIZABLE = """[INPUT]
+x
+
+[OUTPUT]
+y
+
+[ENV_INIT]
+!x
+
+[SYS_INIT]
+!y
+
+[SYS_TRANS]
+next(y) <-> next(x)
+
+[ENV_LIVENESS]
+x
+
+[SYS_LIVENESS]
+y
+"""
+
+UNREALIZABLE = """[INPUT]
+x
+
+[OUTPUT]
+y
+
+[SYS_LIVENESS]
+x
+"""
+
+
+def gr1synth(*arguments):
+    return subprocess.run([sys.executable, '-m', 'ltl_synthesizer', *map(str, arguments)],
+                          capture_output=True, text=True, cwd=REPOSITORY, timeout=120)
+
+
+def write(tmp_path, name, text):
+    path = tmp_path / name
+    path.write_text(text)
+    return path
+
+
+def test_realizable_writes_the_json_strategy_like_slugs(tmp_path):
+    source = write(tmp_path, 'copy.structuredslugs', REALIZABLE)
+    output = tmp_path / 'copy.json'
+    done = gr1synth('--explicitStrategy', '--jsonOutput', '--sysInitRoboticsSemantics', source, output)
+    assert done.returncode == 0
+    assert done.stderr.splitlines()[0] == 'RESULT: Specification is realizable.'
+    strategy = json.loads(output.read_text())
+    assert strategy['variables'] == ['x', 'y']
+    assert strategy['nodes']['0'] == {'rank': 0, 'state': [0, 0], 'trans': [0, 1]}
+
+
+def test_slugsin_input_and_strategy_on_stdout(tmp_path):
+    source = write(tmp_path, 'copy.structuredslugs', REALIZABLE)
+    converted = tmp_path / 'copy.slugsin'
+    assert gr1synth('--convert', source, converted).returncode == 0
+    assert "! ^ y' x'" in converted.read_text()
+    done = gr1synth('--explicitStrategy', '--jsonOutput', converted)
+    assert done.returncode == 0 and 'RESULT: Specification is realizable.' in done.stderr
+    assert json.loads(done.stdout)['nodes']['1']['state'] == [1, 1]
+    text = gr1synth('--explicitStrategy', converted)
+    assert 'State 0 with rank 0 -> <x:0, y:0>\n\tWith successors : 0, 1' in text.stdout
+
+
+def test_unrealizable_exits_zero_and_explains(tmp_path):
+    source = write(tmp_path, 'block.structuredslugs', UNREALIZABLE)
+    done = gr1synth('--explicitStrategy', '--jsonOutput', source, tmp_path / 'out.json')
+    assert done.returncode == 0
+    assert done.stderr.splitlines()[0] == 'RESULT: Specification is unrealizable.'
+    assert "system liveness #0 'x'" in done.stderr
+    assert not (tmp_path / 'out.json').exists()
+
+
+def test_counterstrategy_output(tmp_path):
+    source = write(tmp_path, 'block.structuredslugs', UNREALIZABLE)
+    done = gr1synth('--counterStrategy', '--jsonOutput', source)
+    counter = json.loads(done.stdout)
+    assert counter['nodes']['0']['rank'] == [0, 0]
+
+
+@pytest.mark.parametrize('name, text, location', [
+    ('bad.structuredslugs', '[INPUT]\nx\n[OUTPUT]\ny\n[SYS_TRANS]\nnext(y) & | x\n', ':6:11:'),
+    ('bad.slugsin', '[INPUT]\nx\n[OUTPUT]\ny\n[SYS_TRANS]\n& x\n', ':6:'),
+    ('unknown.structuredslugs', '[INPUT]\nx\n[OUTPUT]\ny\n[SYS_LIVENESS]\nz\n', ':6:1:'),
+])
+def test_malformed_file_names_the_place_and_token(tmp_path, name, text, location):
+    source = write(tmp_path, name, text)
+    done = gr1synth(source)
+    assert done.returncode == 2
+    assert done.stderr.startswith('gr1synth: error: ') and str(source) + location in done.stderr
+    assert 'RESULT' not in done.stderr
+
+
+def test_missing_file_and_unknown_extension(tmp_path):
+    assert gr1synth(tmp_path / 'nothing.slugsin').returncode == 2
+    done = gr1synth(write(tmp_path, 'spec.txt', REALIZABLE))
+    assert done.returncode == 2 and 'expected .slugsin or .structuredslugs' in done.stderr

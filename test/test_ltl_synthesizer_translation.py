@@ -1,0 +1,110 @@
+"""Translation of respec.ltl formulas into BDDs over current and next-step copies."""
+
+import itertools
+
+import pytest
+
+from ltl_synthesizer import InvalidFormulaError, UnknownPropositionError
+from ltl_synthesizer.symbolic import SymbolicGame, primed
+from respec.ltl import FALSE, TRUE, conj, disj, iff, implies, neg, next_, var
+from respec.spec import GR1Specification
+
+a, b, c = var('a'), var('b'), var('c')
+
+
+def game(**sections):
+    return SymbolicGame(GR1Specification(env_props=['a'], sys_props=['b', 'c'], **sections))
+
+
+def truth_table(g, u, names):
+    return [g.evaluate(u, dict(zip(names, values)))
+            for values in itertools.product([False, True], repeat=len(names))]
+
+
+def test_variables_are_interleaved_current_and_next():
+    g = game(sys_trans=[implies(b, next_(c))])
+    order = sorted(g.bdd.vars, key=g.bdd.level_of_var)
+    # 'affinity' order: propositions in order of first use in the safety formulas.
+    assert order == ['b', "b'", 'c', "c'", 'a', "a'"]
+    for name in ('a', 'b', 'c'):
+        assert g.bdd.level_of_var(primed(name)) == g.bdd.level_of_var(name) + 1
+
+
+@pytest.mark.parametrize('formula, expected', [
+    (conj([a, b]), lambda a, b, c: a and b),
+    (disj([a, neg(c)]), lambda a, b, c: a or not c),
+    (implies(a, b), lambda a, b, c: (not a) or b),
+    (iff(a, conj([b, c])), lambda a, b, c: a == (b and c)),
+    (TRUE, lambda a, b, c: True),
+    (FALSE, lambda a, b, c: False),
+])
+def test_boolean_connectives(formula, expected):
+    g = game()
+    u = g.translate(formula, 'sys_trans')
+    names = ['a', 'b', 'c']
+    assert truth_table(g, u, names) == [expected(*v) for v in itertools.product([False, True], repeat=3)]
+
+
+def test_next_maps_to_the_primed_copy_and_distributes():
+    g = game()
+    u = g.translate(next_(conj([a, neg(b)])), 'sys_trans')
+    assert u == g.bdd.var("a'") & ~g.bdd.var("b'")
+    assert g.bdd.support(u) == {"a'", "b'"}
+
+
+def test_prime_and_unprime_are_inverse():
+    g = game()
+    u = g.translate(disj([a, conj([b, neg(c)])]), 'sys_trans')
+    assert g.bdd.support(g.prime(u)) == {"a'", "b'", "c'"}
+    assert g.unprime(g.prime(u)) == u
+
+
+def test_unknown_proposition_is_named():
+    with pytest.raises(UnknownPropositionError) as raised:
+        game(sys_liveness=[var('ghost')])
+    assert raised.value.item == 'ghost' and raised.value.code == 'UNKNOWN_PROPOSITION'
+    assert "sys_liveness: unknown proposition 'ghost'" in str(raised.value)
+
+
+def test_nested_next_and_next_in_init_are_rejected():
+    with pytest.raises(InvalidFormulaError) as raised:
+        game(sys_trans=[next_(next_(a))])
+    assert raised.value.code == 'INVALID_FORMULA' and 'nested next' in str(raised.value)
+    with pytest.raises(InvalidFormulaError) as raised:
+        game(sys_init=[next_(b)])
+    assert 'initial conditions' in str(raised.value) and raised.value.item == 'next(b)'
+
+
+def test_environment_cannot_constrain_the_next_output():
+    with pytest.raises(InvalidFormulaError) as raised:
+        game(env_trans=[implies(a, next_(b))])
+    assert raised.value.item == 'b'
+
+
+def test_duplicate_declaration_is_named():
+    with pytest.raises(UnknownPropositionError) as raised:
+        SymbolicGame(GR1Specification(env_props=['a'], sys_props=['a']))
+    assert raised.value.item == 'a'
+
+
+def test_enforceable_predecessor():
+    # The system copies a' into b'; the environment may only raise a when b holds.
+    g = game(env_trans=[implies(neg(b), neg(next_(a)))])
+    target = g.translate(iff(next_(b), next_(a)), 'sys_trans')
+    assert g.cox(target) == g.true
+    # Forcing b' & a' needs the environment's cooperation: never enforceable.
+    assert g.cox(g.translate(conj([next_(a), next_(b)]), 'sys_trans')) == g.false
+    # Forcing !a' is enforceable exactly where the environment must keep a low.
+    assert g.cox(g.translate(neg(next_(a)), 'sys_trans')) == ~g.bdd.var('b')
+
+
+@pytest.mark.parametrize('cluster_limit', [0, 50, 10**9])
+def test_partitioned_product_equals_monolithic(cluster_limit):
+    from ltl_synthesizer.symbolic import Options
+    sections = dict(env_trans=[implies(b, next_(a)), implies(c, neg(next_(a)))],
+                    sys_trans=[iff(next_(b), a), implies(next_(c), next_(b)), implies(a, next_(c))])
+    g = SymbolicGame(GR1Specification(env_props=['a'], sys_props=['b', 'c'], **sections),
+                     options=Options(cluster_limit=cluster_limit))
+    target = g.translate(disj([next_(c), conj([a, neg(next_(b))])]), 'sys_trans')
+    monolithic = ~g.bdd.exist(["a'"], g.env_trans() & ~g.bdd.exist(["b'", "c'"], g.sys_trans() & target))
+    assert g.cox(target) == monolithic

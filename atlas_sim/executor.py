@@ -41,6 +41,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable, Protocol, Sequence
 
+from respec.errors import CodedError
 from atlas_sim.trace_check import OutcomeTracker, Trace, TraceStep, outcome_proposition
 
 ROOT_PATH = '/'
@@ -56,14 +57,13 @@ DECISION_STATE = 'OperatorDecisionState'
 
 # --- errors -----------------------------------------------------------------------------------
 
-class ExecutionError(Exception):
+class ExecutionError(CodedError):
     """The run could not go on; ``item`` names the offending state, ``trace`` holds what ran."""
 
     code = 'BEHAVIOR_SYNTHESIS_FAILED'
 
     def __init__(self, message: str, item: str, trace: Trace | None = None):
-        super().__init__(message)
-        self.item = item
+        super().__init__(message, item)
         self.trace = trace
 
 
@@ -91,24 +91,16 @@ class ExecutionLimitError(ExecutionError):
     code = 'TIMEOUT'
 
 
-class InitialConditionError(ValueError):
+class InitialConditionError(CodedError, ValueError):
     """An initial condition the simulator cannot start in; ``item`` names it."""
 
     code = 'INVALID_INITIAL_CONDITIONS'
 
-    def __init__(self, message: str, item: str):
-        super().__init__(message)
-        self.item = item
 
-
-class FaultSpecError(ValueError):
+class FaultSpecError(CodedError, ValueError):
     """A malformed fault ('capability:k') or one naming an unknown capability; ``item`` names it."""
 
     code = 'INVALID_REQUEST'
-
-    def __init__(self, message: str, item: str):
-        super().__init__(message)
-        self.item = item
 
 
 # --- the robot ---------------------------------------------------------------------------------

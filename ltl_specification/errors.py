@@ -7,15 +7,13 @@ constant that reports it.
 
 from __future__ import annotations
 
+from respec.errors import CodedError
 
-class SpecificationError(Exception):
+
+class SpecificationError(CodedError):
     """Compiling a task specification failed; ``item`` names what was wrong."""
 
     code = 'LTL_SPEC_COMPILATION_FAILED'
-
-    def __init__(self, message: str, item: str = ''):
-        super().__init__(message)
-        self.item = item
 
 
 class UnknownSystemError(SpecificationError):

@@ -2,15 +2,13 @@
 
 from __future__ import annotations
 
+from respec.errors import CodedError
 
-class SynthesisError(Exception):
+
+class SynthesisError(CodedError):
     """Base class: ``code`` names a SynthesisErrorCodes constant, ``item`` is the offending item."""
 
     code = 'SYNTHESIS_FAILED'
-
-    def __init__(self, message: str, item=None):
-        super().__init__(message)
-        self.item = item
 
 
 class UnknownPropositionError(SynthesisError):

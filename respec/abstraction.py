@@ -39,6 +39,8 @@ _RESERVED_OUTCOME_LETTERS = ('a', 'm')
 class AbstractionConfigError(SystemConfigError):
     """The ``abstraction:`` section is invalid; ``item`` names the offending entry."""
 
+    code = 'ABSTRACTION_CONFIG_INVALID'
+
 
 @dataclass(frozen=True)
 class RobotAbstraction:

@@ -14,22 +14,24 @@ from pathlib import Path
 
 import yaml
 
+from respec.errors import CodedError
+
 CONFIG_DIR_ENV = 'BEHAVIOR_SYNTHESIS_CONFIG_DIR'
 _SYSTEM_NAME = re.compile(r'^[A-Za-z][A-Za-z0-9_]*$')
 # libyaml's safe loader when PyYAML was built with it (5x faster), else the pure-Python one.
 _SAFE_LOADER = getattr(yaml, 'CSafeLoader', yaml.SafeLoader)
 
 
-class SystemConfigError(Exception):
+class SystemConfigError(CodedError):
     """A system configuration problem; ``item`` names the offending system, file or key."""
 
-    def __init__(self, message: str, item: str = ''):
-        super().__init__(message)
-        self.item = item
+    code = 'CONFIG_FILE_INVALID'
 
 
 class UnknownSystemError(SystemConfigError):
     """No configuration file exists for the requested system."""
+
+    code = 'UNKNOWN_SYSTEM'
 
 
 class ConfigFileInvalidError(SystemConfigError):

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from respec.errors import CodedError
+
 # The SynthesisErrorCodes constants this package reports (name -> value, for reference).
 ERROR_CODES = {
     'SM_GENERATION_FAILED': -30,
@@ -20,7 +22,7 @@ ERROR_CODES = {
 }
 
 
-class SMGenerationError(Exception):
+class SMGenerationError(CodedError):
     """State-machine generation failed.
 
     ``code`` is the name of a synthesis_msgs/SynthesisErrorCodes constant and ``item``
@@ -30,10 +32,9 @@ class SMGenerationError(Exception):
     def __init__(self, code: str, message: str, item: str = ''):
         if code not in ERROR_CODES:
             raise ValueError(f'unknown error code {code!r}')
-        super().__init__(message)
+        super().__init__(message, item)
         self.code = code
         self.message = message
-        self.item = item
 
     @property
     def value(self) -> int:

@@ -147,59 +147,6 @@ def _sub_specifications(abstraction: RobotAbstraction, pertinence: Pertinence, i
     ]
 
 
-def explain(self) -> str:
-        return explain(self)
-
-
-def compile_task(system: str, initial_conditions: Sequence[str] | str, goals: Sequence[str] | str,
-                 sm_outcomes: Sequence[str] = (FINISHED, FAILED), strict_order: bool = True,
-                 custom_ltl: Mapping[str, Sequence[str]] | None = None,
-                 config_dir: str | Path | None = None) -> CompiledSpecification:
-    """Compile the GR(1) specification of reaching ``goals`` from ``initial_conditions``.
-
-    Goals and initial conditions are action or control-mode names (a list, or one
-    comma-separated string). At most one initial condition may be a control mode; without
-    one, the system's ``initial_mode`` is used. ``strict_order`` selects (20) over (17).
-    ``custom_ltl`` maps LTLSpecification section names to infix formulas (or, for
-    env_props / sys_props, new proposition names) that are conjoined to the result.
-    Raises a ``SpecificationError`` subclass naming the offending item.
-    """
-    abstraction = _load_abstraction(system, config_dir)
-    sm_outcomes = _check_sm_outcomes(sm_outcomes)
-    goals = _check_goals(abstraction, goals)
-    initial_conditions = _check_initial_conditions(abstraction, initial_conditions)
-    initial_mode = _initial_mode(abstraction, initial_conditions)
-    custom_formulas = _parse_custom_ltl(custom_ltl)
-    mentioned, sensors = _items_mentioned(abstraction, custom_formulas)
-
-    pertinence = infer_pertinence(abstraction, initial_mode, initial_conditions, goals, mentioned)
-    retry = FAILED not in sm_outcomes
-    outcomes = abstraction.outcomes
-    adjacency = {m: (m, *(t for t in abstraction.control_modes[m] if t in pertinence.modes))
-                 for m in pertinence.modes}
-    items = [*pertinence.modes, *pertinence.actions]
-    # The default initial mode holds initially just as if it had been named.
-    initially_completed = [i for i in [*initial_conditions, initial_mode] if i in items]
-    failures = [outcome_proposition(item, o) for item in items for o in abstraction.failure_outcomes]
-    try:
-        spec = merge_specifications([
-            control_mode_specification(adjacency, outcomes, retry),
-            action_specification({a: abstraction.actions[a] for a in pertinence.actions}, outcomes, retry),
-            initial_conditions_specification(items, initially_completed, outcomes),
-            goal_specification(goals, sm_outcomes, strict_order, failures, abstraction.success_outcome),
-            GR1Specification(env_props=list(sensors)),
-            _custom_specification(custom_ltl, custom_formulas),
-        ])
-    except PropositionConflictError as error:
-        raise InvalidFormulaError(
-            f'custom LTL declares {error.item!r} with the wrong kind: {error}', item=error.item) from error
-    _check_custom_scopes(spec, custom_ltl)
-    provenance = Provenance(system, tuple(initial_conditions), tuple(goals), sm_outcomes, strict_order,
-                            pertinence, tuple(s for s in SECTIONS if custom_ltl and custom_ltl.get(s)))
-    return CompiledSpecification(**{f.name: getattr(spec, f.name) for f in fields(GR1Specification)},
-                                 provenance=provenance)
-
-
 def explain(spec: CompiledSpecification) -> str:
     """A short human-readable account of what the specification contains and why."""
     p = spec.provenance

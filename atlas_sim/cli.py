@@ -31,7 +31,7 @@ import time
 from pathlib import Path
 
 from synthesis_manager.send_goal import ProgressBar, add_goal_arguments, goal_from_args, print_summary
-from synthesis_manager.suite import add_suite_arguments, suite_node_factories
+from synthesis_manager.suite import SuiteUnavailable, add_suite_arguments, in_process_suite
 
 EXIT_OK, EXIT_OTHER_OUTCOME, EXIT_USAGE, EXIT_SYNTHESIS, EXIT_VIOLATIONS, EXIT_EXECUTION = 0, 1, 2, 3, 4, 5
 
@@ -100,38 +100,35 @@ def run(args) -> int:
 
 
 def _synthesize_and_execute(args, simulator, goals, report, log) -> int:
-    from rclpy.node import Node
+    try:
+        with in_process_suite(args, 'execute_client') as (ros, client):
+            return _run_in_suite(args, ros, client, simulator, goals, report, log)
+    except SuiteUnavailable as error:
+        print(f'execute: {error}', file=sys.stderr)
+        return EXIT_SYNTHESIS
 
-    from synthesis_manager.client import SynthesisClient
-    from synthesis_manager.harness import RosHarness
 
-    with RosHarness() as ros:
-        for factory in suite_node_factories(args):
-            ros.add_node(factory)
-        client = SynthesisClient(ros.add_node(Node, 'execute_client'))
-        if not client.wait_for_server(timeout=10.0):
-            print('execute: the /behavior_synthesis action server did not come up', file=sys.stderr)
-            return EXIT_SYNTHESIS
-        progress = None if args.json else ProgressBar()
-        outcome = client.run(goal_from_args(args), feedback=progress)
-        if progress:
-            progress.close()
-        report['synthesis'] = {'error_name': outcome.error_name, 'error_code': outcome.error_code,
-                               'message': outcome.message, 'seconds': round(outcome.seconds, 4),
-                               'states': len(outcome.states)}
-        if not args.json:
-            print_summary(outcome, stream=log)
-        if not outcome.succeeded:
-            print(f'execute: synthesis failed: {outcome.error_name}: {outcome.message}', file=sys.stderr)
-            return EXIT_SYNTHESIS
-        sim_node = None
-        if args.ros_sim:
-            robot, sim_node = _ros_robot(ros, args, simulator)
-        else:
-            from atlas_sim.executor import SimulatedRobot
+def _run_in_suite(args, ros, client, simulator, goals, report, log) -> int:
+    progress = None if args.json else ProgressBar()
+    outcome = client.run(goal_from_args(args), feedback=progress)
+    if progress:
+        progress.close()
+    report['synthesis'] = {'error_name': outcome.error_name, 'error_code': outcome.error_code,
+                           'message': outcome.message, 'seconds': round(outcome.seconds, 4),
+                           'states': len(outcome.states)}
+    if not args.json:
+        print_summary(outcome, stream=log)
+    if not outcome.succeeded:
+        print(f'execute: synthesis failed: {outcome.error_name}: {outcome.message}', file=sys.stderr)
+        return EXIT_SYNTHESIS
+    sim_node = None
+    if args.ros_sim:
+        robot, sim_node = _ros_robot(ros, args, simulator)
+    else:
+        from atlas_sim.executor import SimulatedRobot
 
-            robot = SimulatedRobot(simulator)
-        return _execute(args, outcome, robot, simulator, goals, report, log, sim_node)
+        robot = SimulatedRobot(simulator)
+    return _execute(args, outcome, robot, simulator, goals, report, log, sim_node)
 
 
 def _ros_robot(ros, args, simulator):

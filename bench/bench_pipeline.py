@@ -53,19 +53,11 @@ def measure(client, goals: int) -> dict:
 
 
 def one_process(goals: int, byproducts: str) -> dict:
-    from rclpy.node import Node
-
-    from synthesis_manager.client import SynthesisClient
-    from synthesis_manager.harness import RosHarness
-    from synthesis_manager.suite import suite_node_factories
+    from synthesis_manager.suite import in_process_suite
 
     args = Namespace(config_dir='', byproducts_dir=byproducts, backend='builtin', slugs_executable='slugs',
                      synthesis_timeout=60.0, service_timeout=5.0)
-    with RosHarness() as ros:
-        for factory in suite_node_factories(args):
-            ros.add_node(factory)
-        client = SynthesisClient(ros.add_node(Node, 'bench_client'))
-        assert client.wait_for_server(10.0)
+    with in_process_suite(args, 'bench_client') as (_, client):
         return measure(client, goals)
 
 

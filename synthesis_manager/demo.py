@@ -11,7 +11,7 @@ import sys
 from pathlib import Path
 
 from synthesis_manager.send_goal import ProgressBar, add_goal_arguments, goal_from_args, print_summary
-from synthesis_manager.suite import add_suite_arguments, suite_node_factories
+from synthesis_manager.suite import SuiteUnavailable, add_suite_arguments, in_process_suite
 
 
 def add_arguments(parser):
@@ -44,26 +44,18 @@ def write_artifacts(outcome, directory: Path) -> list[Path]:
 
 
 def run(args) -> int:
-    from rclpy.node import Node
-
-    from synthesis_manager.client import SynthesisClient
-    from synthesis_manager.harness import RosHarness
-
     directory = Path(args.output_dir).resolve()
     directory.mkdir(parents=True, exist_ok=True)
     args.byproducts_dir = str(directory)
     print(f'Task: from {args.initial_conditions}: {args.goals} (system {args.system})')
     try:
-        with RosHarness() as ros:
-            for factory in suite_node_factories(args):
-                ros.add_node(factory)
-            client = SynthesisClient(ros.add_node(Node, 'demo_client'))
-            if not client.wait_for_server(timeout=10.0):
-                print('demo: the action server did not come up', file=sys.stderr)
-                return 1
+        with in_process_suite(args, 'demo_client') as (_, client):
             progress = ProgressBar()
             outcome = client.run(goal_from_args(args), feedback=progress)
             progress.close()
+    except SuiteUnavailable as error:
+        print(f'demo: {error}', file=sys.stderr)
+        return 1
     except KeyboardInterrupt:
         print('\ndemo: interrupted', file=sys.stderr)
         return 130

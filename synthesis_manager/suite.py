@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import functools
 
 SUITE_NODE_NAMES = ('ltl_compilation', 'ltl_synthesis', 'sm_generation', 'behavior_synthesis_server')
@@ -47,3 +48,27 @@ def suite_node_factories(args=None, names=SUITE_NODE_NAMES):
     }
     return [functools.partial(settings[name][0], parameter_overrides=settings[name][1])
             for name in names]
+
+
+class SuiteUnavailable(RuntimeError):
+    """The in-process suite's action server did not come up."""
+
+
+@contextlib.contextmanager
+def in_process_suite(args=None, client_name: str = 'suite_client'):
+    """The four suite nodes plus a client node in this process, on a private ROS domain.
+
+    Yields ``(harness, client)``; ``client`` is a SynthesisClient whose server is up.
+    """
+    from rclpy.node import Node
+
+    from synthesis_manager.client import SynthesisClient
+    from synthesis_manager.harness import RosHarness
+
+    with RosHarness() as ros:
+        for factory in suite_node_factories(args):
+            ros.add_node(factory)
+        client = SynthesisClient(ros.add_node(Node, client_name))
+        if not client.wait_for_server(timeout=10.0):
+            raise SuiteUnavailable('the /behavior_synthesis action server did not come up')
+        yield ros, client

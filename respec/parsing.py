@@ -30,6 +30,7 @@ import itertools
 import re
 from dataclasses import dataclass, field
 
+from respec.errors import CodedError
 from respec.ltl import (
     FALSE, TRUE, Formula, Var, conj, disj, iff, implies, neg, next_, var,
 )
@@ -47,7 +48,7 @@ _INTEGER_DECLARATION = re.compile(r"^([A-Za-z_][A-Za-z0-9_]*)\s*:\s*(-?[0-9]+)\s
 _KEYWORDS = {'TRUE', 'FALSE', 'next'}
 
 
-class ParseError(Exception):
+class ParseError(CodedError):
     """A syntax or naming error at ``filename:line:column``; ``item`` is the offending token."""
 
     code = 'INVALID_FORMULA'
@@ -59,8 +60,7 @@ class ParseError(Exception):
         self.line = line
         self.column = column
         self.token = token
-        self.item = token
-        super().__init__(f'{filename}:{line}:{column}: {problem} near {token!r}')
+        super().__init__(f'{filename}:{line}:{column}: {problem} near {token!r}', item=token)
 
 
 class UnknownVariableError(ParseError):

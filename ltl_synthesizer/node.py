@@ -10,6 +10,7 @@ import re
 import tempfile
 import threading
 import time
+import uuid
 from pathlib import Path
 
 from rclpy.callback_groups import ReentrantCallbackGroup
@@ -64,6 +65,12 @@ class LTLSynthesisNode(Node):
         self.create_service(CancelSynthesis, 'ltl_synthesis/cancel', self.on_cancel_request,
                             callback_group=group)
 
+    def stop_work(self):
+        """Stop every running synthesis (at shutdown, so the process exits promptly)."""
+        with self._lock:
+            for event in self._running.values():
+                event.set()
+
     def active_requests(self) -> list[str]:
         """Ids of the requests whose synthesis is running now."""
         with self._lock:
@@ -82,10 +89,10 @@ class LTLSynthesisNode(Node):
 
     def on_request(self, request, response):
         cancel = threading.Event()
-        request_id = request.request_id
-        if request_id:
-            with self._lock:
-                self._running[request_id] = cancel
+        # Anonymous requests are tracked too, so that stop_work() reaches them.
+        request_id = request.request_id or f'anonymous-{uuid.uuid4().hex}'
+        with self._lock:
+            self._running[request_id] = cancel
         try:
             self._synthesize(request, response, cancel)
         except ParseError as error:  # the original's code for a malformed specification
@@ -96,9 +103,8 @@ class LTLSynthesisNode(Node):
             response.synthesizable = False
             response.error_code = error_code(code, f'synthesis failed: {error}')
         finally:
-            if request_id:
-                with self._lock:
-                    self._running.pop(request_id, None)
+            with self._lock:
+                self._running.pop(request_id, None)
         if response.error_code.message:
             self.get_logger().warning(response.error_code.message)
         return response

@@ -40,8 +40,13 @@ class RosHarness:
         import rclpy
         from rclpy.executors import MultiThreadedExecutor
 
+        from rclpy.signals import SignalHandlerOptions
+
         self.context = rclpy.Context()
-        rclpy.init(context=self.context, domain_id=self.domain_id)
+        # No rclpy signal handlers: Ctrl-C stays a KeyboardInterrupt for the code using the
+        # harness (a client cancels its goal, then leaves the block).
+        rclpy.init(context=self.context, domain_id=self.domain_id,
+                   signal_handler_options=SignalHandlerOptions.NO)
         self.executor = MultiThreadedExecutor(num_threads=self._num_threads, context=self.context)
         self._thread = threading.Thread(target=self._spin, name='ros-harness-executor', daemon=True)
         self._thread.start()
@@ -61,7 +66,10 @@ class RosHarness:
         return node
 
     def __exit__(self, *exc_info):
+        from synthesis_manager.node_main import stop_work
+
         try:
+            stop_work(self.nodes)
             self.executor.shutdown(timeout_sec=5.0)
             for node in reversed(self.nodes):
                 node.destroy_node()

@@ -36,11 +36,19 @@ def run_nodes(*node_factories, argv: list[str] | None = None, ready_message: str
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
     finally:
+        stop_work(nodes)
         executor.shutdown(timeout_sec=5.0)
         for node in reversed(nodes):
             node.destroy_node()
         context.try_shutdown()
     return 0
+
+
+def stop_work(nodes):
+    """Ask nodes with long-running callbacks (``stop_work()``) to end them before shutdown."""
+    for node in nodes:
+        if hasattr(node, 'stop_work'):
+            node.stop_work()
 
 
 def node_main(node_factory, name: str):

@@ -112,20 +112,30 @@ def run(args) -> int:
         progress = None if args.json else ProgressBar()
         cancel = threading.Event()
         outcome_box = {}
-        worker = threading.Thread(target=lambda: outcome_box.update(
-            outcome=client.run(goal, feedback=progress, cancel=cancel, timeout=args.timeout + 30)))
-        worker.start()
+        finished = threading.Event()
+
+        def wait_for_outcome():
+            try:
+                outcome_box['outcome'] = client.run(goal, feedback=progress, cancel=cancel,
+                                                    timeout=args.timeout + 30)
+            except Exception as error:
+                outcome_box['error'] = error
+            finally:
+                finished.set()
+
+        # Wait on an Event, not Thread.join: an interrupted join can lose track of the thread.
+        threading.Thread(target=wait_for_outcome, daemon=True).start()
         try:
-            while worker.is_alive():
-                worker.join(0.1)
+            while not finished.wait(0.1):
+                pass
         except KeyboardInterrupt:  # Ctrl-C cancels the goal, then we wait for its result
             cancel.set()
-            worker.join()
+            finished.wait(30)
         if progress:
             progress.close()
     outcome = outcome_box.get('outcome')
     if outcome is None:
-        print('send-goal: no result', file=sys.stderr)
+        print(f"send-goal: no result: {outcome_box.get('error', 'interrupted')}", file=sys.stderr)
         return 1
     if args.output:
         Path(args.output).write_text(json.dumps(outcome.to_dict(), indent=1))

@@ -54,6 +54,7 @@ class BehaviorSynthesisServer(Node):
         self.declare_parameter('compilation_timeout', 30.0)
         self.declare_parameter('synthesis_timeout', 120.0)
         self.declare_parameter('generation_timeout', 30.0)
+        self._stopping = threading.Event()
         group = ReentrantCallbackGroup()
         self.compiler = self.create_client(GenerateLTLSpecification, 'ltl_compilation', callback_group=group)
         self.synthesizer = self.create_client(SynthesizeAutomaton, 'ltl_synthesis', callback_group=group)
@@ -63,6 +64,10 @@ class BehaviorSynthesisServer(Node):
             self, BehaviorSynthesis, 'behavior_synthesis', self.execute,
             goal_callback=lambda _: GoalResponse.ACCEPT,
             cancel_callback=lambda _: CancelResponse.ACCEPT, callback_group=group)
+
+    def stop_work(self):
+        """Make goals that are waiting on a stage give up (at shutdown)."""
+        self._stopping.set()
 
     def destroy_node(self):
         self.action_server.destroy()
@@ -163,6 +168,8 @@ class BehaviorSynthesisServer(Node):
         future.add_done_callback(lambda _: done.set())
         deadline = time.monotonic() + timeout
         while not done.wait(0.02):
+            if self._stopping.is_set():
+                raise StageFailed('BEHAVIOR_SYNTHESIS_FAILED', f'{stage}: the server is shutting down')
             if goal_handle.is_cancel_requested:
                 if on_cancel:
                     on_cancel()

@@ -1,0 +1,113 @@
+"""The command line: serve, send-goal (JSON, errors, Ctrl-C cancels), demo and goal parsing."""
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+from types import SimpleNamespace
+
+import pytest
+
+from synthesis_manager.requests import InvalidRequest, parse_names, selected_option
+from synthesis_manager.ros_env import prepare_ros_environment
+
+CLI = [str(Path(sys.executable).parent / 'behavior-synthesis')]
+LONG_GOALS = 'look_down,pickup_object,grasp_object,pregrasp,approach_object,footstep_execution,walk'
+
+
+@pytest.mark.parametrize('text, names', [
+    ('look_down, pickup_object', ['look_down', 'pickup_object']),
+    ('look_down,pickup_object', ['look_down', 'pickup_object']),
+    ("['look_down', 'pickup_object']", ['look_down', 'pickup_object']),
+    ('look_down pickup_object', ['look_down', 'pickup_object']),
+    (['stand_prep'], ['stand_prep']),
+    ('', []),
+])
+def test_goal_strings_are_parsed_like_the_original_and_the_webui(text, names):
+    assert parse_names(text) == names
+
+
+def test_synthesis_options_are_mutually_exclusive():
+    options = SimpleNamespace(ltl_compilation_only=False, ltl_synthesis_only=False, ltl_steps_only=True)
+    assert selected_option(options) == 'ltl_steps_only'
+    options.ltl_compilation_only = True
+    with pytest.raises(InvalidRequest, match='mutually exclusive'):
+        selected_option(options)
+
+
+@pytest.fixture
+def served(tmp_path):
+    """`behavior-synthesis serve` in its own process on a reserved domain; yields its environment."""
+    from domain_coordinator import domain_id
+
+    with domain_id() as domain:
+        environment = prepare_ros_environment(domain, environ=dict(os.environ))
+        server = subprocess.Popen(CLI + ['serve', '--byproducts-dir', str(tmp_path)], env=environment,
+                                  stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+        assert 'suite up' in server.stdout.readline()
+        yield environment
+        server.send_signal(signal.SIGINT)
+        assert server.wait(20) == 0
+
+
+def send_goal(environment, *arguments, timeout=120):
+    return subprocess.run(CLI + ['send-goal', *arguments], env=environment, capture_output=True,
+                          text=True, timeout=timeout)
+
+
+def test_send_goal_prints_one_json_object(served):
+    result = send_goal(served, '--system', 'atlas', '--initial-conditions', 'stand_prep',
+                       '--goals', 'look_down,pickup_object', '--json')
+    assert result.returncode == 0, result.stderr
+    outcome = json.loads(result.stdout)
+    assert outcome['error_code'] == 1 and outcome['error_name'] == 'SUCCESS'
+    assert outcome['states'] and all(len(state) == 16 for state in outcome['states'])
+
+
+def test_send_goal_shows_progress_and_a_readable_summary(served):
+    result = send_goal(served, '--initial-conditions', 'manipulate', '--goals', 'footstep_execution')
+    assert result.returncode == 0, result.stderr
+    assert '100%' in result.stderr
+    assert 'result: SUCCESS' in result.stdout and 'footstep_execution' in result.stdout
+
+
+def test_send_goal_fails_with_the_code_and_message(served):
+    result = send_goal(served, '--goals', 'look_down,levitate', '--json')
+    assert result.returncode == 1
+    outcome = json.loads(result.stdout)
+    assert outcome['error_name'] == 'UNKNOWN_PROPOSITION' and 'levitate' in outcome['message']
+
+
+def test_ctrl_c_cancels_the_goal(served):
+    process = subprocess.Popen(CLI + ['send-goal', '--goals', LONG_GOALS, '--json'], env=served,
+                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    time.sleep(3.0)  # connected and synthesizing
+    process.send_signal(signal.SIGINT)
+    stdout, stderr = process.communicate(timeout=30)
+    assert process.returncode == 1, stderr
+    assert json.loads(stdout)['error_name'] == 'PREEMPTED'
+
+
+def test_send_goal_without_a_server_says_so():
+    from domain_coordinator import domain_id
+
+    with domain_id() as domain:
+        environment = prepare_ros_environment(domain, environ=dict(os.environ))
+        result = subprocess.run(CLI + ['send-goal'], env=environment, capture_output=True, text=True,
+                                timeout=60)
+    assert result.returncode == 1
+    assert 'no /behavior_synthesis action server' in result.stderr
+
+
+def test_demo_writes_every_artifact(tmp_path):
+    result = subprocess.run(CLI + ['demo', '--output-dir', str(tmp_path)], capture_output=True, text=True,
+                            timeout=120)
+    assert result.returncode == 0, result.stderr
+    assert 'realizable: yes' in result.stdout and 'specification: 12 inputs' in result.stdout
+    for name in ('demo.structuredslugs', 'demo.slugsin', 'demo.json', 'state_machine.yaml',
+                 'state_machine.json', 'state_machine.dot', 'state_machine.svg', 'state_machine.png'):
+        assert (tmp_path / name).stat().st_size > 0, name
+    assert json.loads((tmp_path / 'demo.json').read_text())['nodes']

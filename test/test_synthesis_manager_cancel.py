@@ -119,3 +119,51 @@ def test_cancel_in_the_middle_of_synthesis_really_stops_it(ros, tmp_path):
     assert seconds < 10
     # ...and the server keeps serving.
     assert client.run(make_goal(**PAPER_TASK), timeout=60).error_name == 'SUCCESS'
+
+
+def test_synthesis_time_limit_gives_synthesis_timeout_and_the_server_keeps_serving(ros, tmp_path):
+    client, _ = start(ros, tmp_path)
+    started = time.monotonic()
+    outcome = client.run(make_goal(**LONG_TASK, timeout=0.5), timeout=60)
+    assert outcome.error_name == 'SYNTHESIS_TIMEOUT'
+    assert '0.5' in outcome.message
+    assert time.monotonic() - started < 10
+    assert client.run(make_goal(**PAPER_TASK), timeout=60).error_name == 'SUCCESS'
+
+
+def test_slugs_backend_calls_an_external_slugs_compatible_executable(ros, tmp_path):
+    """The 'slugs' backend, exercised with our own gr1synth as the executable (slugs is not here)."""
+    import sys
+    from pathlib import Path
+
+    from synthesis_manager.suite import suite_node_factories
+    from synthesis_manager.server_node import BehaviorSynthesisServer
+
+    gr1synth = str(Path(sys.executable).parent / 'gr1synth')
+    args = Namespace(config_dir='', byproducts_dir=str(tmp_path), backend='slugs',
+                     slugs_executable=gr1synth, synthesis_timeout=60.0, service_timeout=1.0)
+    for factory in suite_node_factories(args, ['ltl_compilation', 'ltl_synthesis', 'sm_generation']):
+        ros.add_node(factory)
+    ros.add_node(BehaviorSynthesisServer)
+    client = SynthesisClient(ros.add_node(Node, 'slugs_client'))
+    assert client.wait_for_server(timeout=10.0)
+    outcome = client.run(make_goal(**PAPER_TASK, name='external'), timeout=60)
+    assert outcome.error_name == 'SUCCESS', outcome.message
+    assert outcome.states
+    assert (tmp_path / 'external.json').read_text().startswith('{')
+
+    missing = Namespace(**{**vars(args), 'slugs_executable': str(tmp_path / 'no-such-slugs')})
+    ros.add_node(suite_node_factories(missing, ['ltl_synthesis'])[0], namespace='broken')
+    broken = ros.nodes[-1]
+    from synthesis_msgs.srv import SynthesizeAutomaton
+    from synthesis_manager.conversions import sections_to_msg
+    from synthesis_manager.harness import wait_for
+
+    caller = ros.add_node(Node, 'direct_caller')
+    service = caller.create_client(SynthesizeAutomaton, '/broken/ltl_synthesis')
+    assert service.wait_for_service(timeout_sec=10.0)
+    response = wait_for(service.call_async(SynthesizeAutomaton.Request(
+        ltl_specification=sections_to_msg(outcome.ltl_specification), spec_name='x')))
+    assert broken.get_namespace() == '/broken'
+    assert response.error_code.value == response.error_code.SYNTHESIZER_BACKEND_FAILED
+    assert 'no-such-slugs' in response.error_code.message

@@ -184,7 +184,7 @@ def plot(chain_rows) -> None:
 
 
 COMPARISONS = {
-    'default (affinity order, clusters 2500, no reordering)': {},
+    'default (affinity order, clusters 1000, no reordering)': {},
     'declared variable order': {'variable_order': 'declared'},
     'no clustering (one BDD per conjunct)': {'cluster_limit': 0},
     'monolithic transition relations': {'cluster_limit': 10**9},

@@ -23,7 +23,7 @@ from ltl_synthesizer.symbolic import SymbolicGame
 class AttractorStep:
     """One inner fixpoint of the last Z iteration: for goal ``goal_index``, the transitions
     ``(goal & Z') | closer' | (waiting' & !assumption)`` the system may take. Kept as parts
-    and assembled only for strategy extraction (the fixpoints never need them)."""
+    (the fixpoints never need the whole, and strategy extraction only a few moves of it)."""
 
     goal_index: int
     goal_transitions: object
@@ -32,9 +32,17 @@ class AttractorStep:
     assumption: object
     responses: object  # exists y'. sys_trans & transitions: where the step offers a move
 
-    def transitions(self, game: SymbolicGame):
-        return (self.goal_transitions | game.prime(self.closer)
-                | (game.prime(self.waiting) & ~self.assumption))
+    def transitions_among(self, game: SymbolicGame, moves):
+        """The ``moves`` (a small set of transitions) that are transitions of this step.
+
+        The moves are renamed so that their targets become positions, intersected with the
+        step's position sets there, and renamed back: swapping the variables of a small set
+        is cheap, priming the large position sets is not.
+        """
+        swapped = game.swap_steps(moves)  # the moves' targets are now current variables
+        into_closer = game.swap_steps(swapped & self.closer)
+        into_waiting = game.swap_steps(swapped & self.waiting) & ~self.assumption
+        return (moves & self.goal_transitions) | into_closer | into_waiting
 
 
 @dataclass
@@ -54,11 +62,18 @@ def solve_system_game(game: SymbolicGame, stop_when_losing=None) -> SystemSoluti
     ``stop_when_losing(Z)`` may return False to stop early: Z only shrinks, so once the
     initial positions are not covered they never will be (used to reject quickly).
     """
-    winning = game.true
+    # Z may start from any upper bound of the winning positions (the iterates still descend
+    # to the same greatest fixpoint). The safety game's winning positions are one, and cheap;
+    # on typical specifications they are exactly the winning positions, so the first Z
+    # iteration is already the confirming one (instead of two or three full iterations).
+    winning = _safe_positions(game)
+    if stop_when_losing is not None and not stop_when_losing(winning):
+        return SystemSolution(winning, [], complete=False)
     # Inner fixpoints of the previous Z iteration, by (goal, Y iteration, assumption): upper
     # bounds for this iteration's (everything is monotone in Z), so X can start from them.
     previous_waiting: dict = {}
     while True:
+        game.start_outer_iteration()
         attractor_steps = []
         waiting_sets: dict = {}
         next_winning = game.true
@@ -73,6 +88,17 @@ def solve_system_game(game: SymbolicGame, stop_when_losing=None) -> SystemSoluti
         previous_waiting = waiting_sets
         if stop_when_losing is not None and not stop_when_losing(winning):
             return SystemSolution(winning, [], complete=False)
+
+
+def _safe_positions(game: SymbolicGame):
+    """``nu Z. cox(Z')``: positions from which the system can keep both safety sections
+    forever. Every winning position is one (a winning strategy stays among them)."""
+    safe = game.true
+    while True:
+        next_safe = safe & game.enforce(game.system_can_move_into(safe))
+        if next_safe == safe:
+            return safe
+        safe = next_safe
 
 
 def _attract_to_goal(game: SymbolicGame, goal_index: int, goal, winning, attractor_steps,
@@ -92,17 +118,22 @@ def _attract_to_goal(game: SymbolicGame, goal_index: int, goal, winning, attract
             # Beyond the previous iteration count, the previous final X is still an upper bound.
             start = previous_waiting.get(key, previous_waiting.get((goal_index, -1, assumption_index)))
             start = winning if start is None else start & winning
-            waiting, responses = _wait_for_assumption(game, can_move_towards_goal, assumption, start)
+            waiting, responses = _wait_for_assumption(
+                game, can_move_towards_goal, assumption, start,
+                game.env_goal_ignores_outputs[assumption_index])
             waiting_sets[key] = waiting_sets[(goal_index, -1, assumption_index)] = waiting
             next_closer |= waiting
             attractor_steps.append(AttractorStep(
                 goal_index, goal_transitions, closer, waiting, assumption, responses))
-        if next_closer == closer:
-            return closer
+        # Y never leaves Z (every X starts inside it): once Y is Z, the next iteration could
+        # only confirm it, at the price of all the inner fixpoints.
+        if next_closer == closer or next_closer == winning:
+            return next_closer
         closer = next_closer
 
 
-def _wait_for_assumption(game: SymbolicGame, can_move_towards_goal, assumption, start):
+def _wait_for_assumption(game: SymbolicGame, can_move_towards_goal, assumption, start,
+                         system_independent: bool):
     """Inner greatest fixpoint X: positions that can move towards the goal, or else stay in X
     on transitions that violate environment goal ``assumption``.
 
@@ -113,7 +144,6 @@ def _wait_for_assumption(game: SymbolicGame, can_move_towards_goal, assumption, 
     inputs) that keep to these transitions.
     """
     waiting = start
-    system_independent = not game.mentions_next_outputs(assumption)
     while True:
         if system_independent:
             # The assumption constrains no next output, so it factors out of exists y'.

@@ -21,25 +21,38 @@ FORMAT_VERSION = 0
 SLUGS_VERSION = '0.0.1'
 
 
-def goal_strategies(game: SymbolicGame, solution: SystemSolution) -> list:
-    """Per system goal, the positional strategy: at each (position, next input), the moves of
-    the first attractor step (lowest rank) that offers a legal response."""
-    strategies = []
-    for goal_index in range(len(game.sys_goals)):
-        covered = game.false
-        strategy = game.false
-        seen = set()
-        for step in solution.attractor_steps:
-            if step.goal_index != goal_index or int(step.responses) in seen:
-                continue  # a repeated response set offers nothing new
-            seen.add(int(step.responses))
-            new_cases = step.responses & ~covered
-            if new_cases == game.false:
-                continue
-            strategy |= new_cases & step.transitions(game)
-            covered |= new_cases
-        strategies.append(strategy)
-    return strategies
+def goal_steps(game: SymbolicGame, solution: SystemSolution) -> list:
+    """Per system goal, its attractor steps by increasing rank."""
+    steps = [[] for _ in game.sys_goals]
+    for step in solution.attractor_steps:
+        steps[step.goal_index].append(step)
+    return steps
+
+
+def goal_moves(game: SymbolicGame, steps, env_moves, legal):
+    """The positional strategy of one goal at one position: each environment move is
+    answered with the moves of the first attractor step (lowest rank) that offers a response.
+
+    ``env_moves`` (the position's state cube conjoined with env_trans) and ``legal`` (with
+    sys_trans too) are small, and every operation here is conjoined with them, so a step
+    costs little. Building the strategy relation over all positions costs far more than the
+    few positions a strategy visits (seconds on multi-goal tasks), and so does the union of
+    the steps' responses that bisecting for the answering steps would need. Conjoining
+    rather than cofactoring by the state (``let``) saves a Python-level pass over all
+    variables per step. The scan ends at the latest at the first step whose waiting set
+    holds the position: that step answers every environment move.
+    """
+    moves = answered = game.false
+    for step in steps:
+        offered = step.responses & env_moves
+        new_cases = offered & ~answered
+        if new_cases == game.false:
+            continue
+        moves |= step.transitions_among(game, new_cases & legal)
+        answered |= offered
+        if answered == env_moves:
+            break  # every environment move is answered
+    return moves
 
 
 def enumerate_states(game: SymbolicGame, states, names):
@@ -62,16 +75,21 @@ def _successor_goal(game: SymbolicGame, goals, rank: int, transition: dict[str, 
     return goal
 
 
-def _restricted_relation(game: SymbolicGame, clusters, state: dict[str, bool]):
-    result = game.true
-    for cluster in clusters:
-        result &= game.bdd.let(state, cluster)
-    return result
+def _moves_from(game: SymbolicGame, state: dict[str, bool]):
+    """The moves from one position allowed by env_trans, and those allowed by both safety
+    sections, each as the position's state cube conjoined with the relation."""
+    env_moves = game.cube(state)
+    for cluster in game.env_partition.clusters:
+        env_moves &= cluster
+    legal = env_moves
+    for cluster in game.sys_partition.clusters:
+        legal &= cluster
+    return env_moves, legal
 
 
 def extract_strategy(game: SymbolicGame, solution: SystemSolution) -> dict:
     """The explicit strategy as slugs' JSON object (``nodes`` keyed by decimal strings)."""
-    strategies = goal_strategies(game, solution)
+    steps = goal_steps(game, solution)
     variables = game.variables
     next_names = game.next_inputs + game.next_outputs
     index: dict[tuple, int] = {}
@@ -93,9 +111,9 @@ def extract_strategy(game: SymbolicGame, solution: SystemSolution) -> dict:
         values, rank = queue.popleft()
         game.interrupt.check()
         state = dict(zip(variables, values))
-        moves = game.bdd.let(state, strategies[rank])
-        moves &= _restricted_relation(game, game.env_partition.clusters, state)
-        moves &= _restricted_relation(game, game.sys_partition.clusters, state)
+        env_moves, legal = _moves_from(game, state)
+        # Without the state cube, the picks below work on smaller BDDs.
+        moves = game.bdd.exist(variables, goal_moves(game, steps[rank], env_moves, legal))
         successors = []
         while moves != game.false:
             choice, _ = game.pick(moves, next_names)

@@ -11,7 +11,7 @@ from synthesis_manager.gui import ros_backend
 from synthesis_manager.webapp import create_app
 
 PAPER_TASK = {'system': 'atlas', 'initial_conditions': ['stand_prep'], 'goals': ['look_down', 'pickup_object']}
-# Seven ordered goals: its synthesis runs for minutes, so a cancel always lands in the middle.
+# Seven ordered goals: its synthesis takes about 40 s, so a cancel lands in the middle.
 SLOW_TASK = {'system': 'atlas', 'initial_conditions': ['stand_prep'],
              'goals': ['look_down', 'pickup_object', 'grasp_object', 'pregrasp', 'approach_object',
                        'footstep_execution', 'walk']}

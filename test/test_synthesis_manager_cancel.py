@@ -100,7 +100,7 @@ def test_hanging_service_times_out(ros, tmp_path):
     assert 'sm_generate' in outcome.message
 
 
-# Seven ordered goals: synthesis runs for minutes, so a cancel always lands in its middle.
+# Seven ordered goals: synthesis takes about 40 s, so a cancel after a few seconds lands in its middle.
 LONG_TASK = dict(system='atlas', initial_conditions=['stand_prep'],
                  goals=['look_down', 'pickup_object', 'grasp_object', 'pregrasp', 'approach_object',
                         'footstep_execution', 'walk'])

@@ -13,34 +13,17 @@ import gr1_oracle
 from ltl_synthesizer import Options, SynthesisCancelled, synthesize
 from ltl_synthesizer.automaton import automaton_from_strategy
 from ltl_synthesizer.strategy import strategy_to_json
-from respec.ltl import (And, Const, Iff, Implies, Next, Not, Or, TRUE, Var, conj, disj, iff,
+from respec.ltl import (TRUE, conj, disj, evaluate, iff,
                         implies, neg, next_, var)
 from respec.spec import GR1Specification
 
 x, y, r, g = var('x'), var('y'), var('r'), var('g')
 
 
-# --- an independent explicit evaluator and strategy checker --------------------------------
+# --- explicit checks ---------------------------------------------------------------------
 
-def holds(formula, current: dict, following: dict | None = None) -> bool:
-    """Truth of a formula on a transition (``following`` is the next valuation)."""
-    if isinstance(formula, Const):
-        return formula.value
-    if isinstance(formula, Var):
-        return current[formula.name]
-    if isinstance(formula, Next):
-        return holds(formula.arg, following, None)
-    if isinstance(formula, Not):
-        return not holds(formula.arg, current, following)
-    if isinstance(formula, And):
-        return all(holds(a, current, following) for a in formula.args)
-    if isinstance(formula, Or):
-        return any(holds(a, current, following) for a in formula.args)
-    if isinstance(formula, Implies):
-        return not holds(formula.left, current, following) or holds(formula.right, current, following)
-    if isinstance(formula, Iff):
-        return holds(formula.left, current, following) == holds(formula.right, current, following)
-    raise TypeError(formula)
+# The product's evaluator: formulas on a (current, next) valuation pair.
+holds = evaluate
 
 
 def check_strategy(spec: GR1Specification, strategy: dict, robotics_semantics: bool) -> None:

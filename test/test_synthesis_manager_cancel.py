@@ -66,18 +66,13 @@ def cancel_when(client, goal, status_prefix):
     return outcome, time.monotonic() - started
 
 
-def test_cancel_during_compilation(ros, tmp_path):
-    client, _ = start(ros, tmp_path, replace={
-        'ltl_compilation': make_slow_service(GenerateLTLSpecification, 'ltl_compilation', 30)})
-    outcome, seconds = cancel_when(client, make_goal(**PAPER_TASK), 'Compiling')
-    assert outcome.error_name == 'PREEMPTED'
-    assert seconds < 10
-
-
-def test_cancel_during_generation(ros, tmp_path):
-    client, _ = start(ros, tmp_path, replace={
-        'sm_generation': make_slow_service(GenerateFlexBESM, 'sm_generate', 30)})
-    outcome, seconds = cancel_when(client, make_goal(**PAPER_TASK), 'Generating')
+@pytest.mark.parametrize('node, service_type, service, status', [
+    ('ltl_compilation', GenerateLTLSpecification, 'ltl_compilation', 'Compiling'),
+    ('sm_generation', GenerateFlexBESM, 'sm_generate', 'Generating'),
+])
+def test_cancel_while_a_stage_is_running(ros, tmp_path, node, service_type, service, status):
+    client, _ = start(ros, tmp_path, replace={node: make_slow_service(service_type, service, 30)})
+    outcome, seconds = cancel_when(client, make_goal(**PAPER_TASK), status)
     assert outcome.error_name == 'PREEMPTED'
     assert seconds < 10
 

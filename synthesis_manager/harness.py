@@ -66,11 +66,10 @@ class RosHarness:
         return node
 
     def __exit__(self, *exc_info):
-        from synthesis_manager.node_main import stop_work
+        from synthesis_manager.node_main import stop_executor
 
         try:
-            stop_work(self.nodes)
-            self.executor.shutdown(timeout_sec=5.0)
+            stop_executor(self.executor, self.nodes)
             for node in reversed(self.nodes):
                 node.destroy_node()
             self.context.try_shutdown()

@@ -36,19 +36,27 @@ def run_nodes(*node_factories, argv: list[str] | None = None, ready_message: str
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
     finally:
-        stop_work(nodes)
-        executor.shutdown(timeout_sec=5.0)
+        stop_executor(executor, nodes)
         for node in reversed(nodes):
             node.destroy_node()
         context.try_shutdown()
     return 0
 
 
-def stop_work(nodes):
-    """Ask nodes with long-running callbacks (``stop_work()``) to end them before shutdown."""
+def stop_executor(executor, nodes, timeout: float = 5.0):
+    """End running callbacks, then shut the executor down; the nodes can be destroyed after.
+
+    Nodes with long-running callbacks offer ``stop_work()``. We wait for the callbacks
+    ourselves because Executor.shutdown() in rclpy (Jazzy) returns without waiting, and a
+    callback finishing after its node is destroyed fails to send its response.
+    """
     for node in nodes:
         if hasattr(node, 'stop_work'):
             node.stop_work()
+    work_tracker = getattr(executor, '_work_tracker', None)
+    if work_tracker is not None:
+        work_tracker.wait(timeout)
+    executor.shutdown(timeout_sec=timeout)
 
 
 def node_main(node_factory, name: str):

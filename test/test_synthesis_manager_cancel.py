@@ -24,6 +24,7 @@ def make_slow_service(service_type, name, seconds):
         node = Node(f'slow_{name}', context=context)
         release = threading.Event()
         node.release = release
+        node.stop_work = release.set  # the harness ends running callbacks before teardown
 
         def handle(request, response):
             release.wait(seconds)

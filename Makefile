@@ -47,7 +47,7 @@ $(VENV)/.msgs-installed: $(MSGS_SOURCES) $(VENV)/.project-installed
 	  cmake --build . -j2 > cmake-build.log && cmake --install . > cmake-install.log
 	touch $@
 
-# Graphviz draws state machines; Chromium runs the browser tests. Installed from Debian
+# Graphviz draws state machines; Chromium runs the browser tests (MuJoCo renders with EGL). Installed from Debian
 # when missing and we may (root); otherwise tell the user what to install.
 system-packages:
 	@missing=""; command -v dot >/dev/null || missing="$$missing graphviz"; \

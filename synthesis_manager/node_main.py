@@ -9,11 +9,10 @@ from synthesis_manager.ros_env import init_ros
 
 def run_nodes(*node_factories, argv: list[str] | None = None, ready_message: str = '') -> int:
     """Create each node in one process, spin them on a MultiThreadedExecutor, shut down cleanly."""
-    import rclpy
     from rclpy.executors import ExternalShutdownException, MultiThreadedExecutor
 
     # rclpy's own signal handlers (installed by init) turn SIGINT and SIGTERM into a
-    # context shutdown, which wakes the executor: spin() then raises ExternalShutdownException.
+    # context shutdown, which ends the spin loop below.
     context = init_ros(args=argv)
     executor = MultiThreadedExecutor(num_threads=16, context=context)
     nodes = []

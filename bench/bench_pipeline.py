@@ -62,7 +62,7 @@ def one_process(goals: int, byproducts: str) -> dict:
 
 
 def four_processes(goals: int, byproducts: str) -> dict:
-    from domain_coordinator import domain_id
+    from synthesis_manager.harness import reserve_domain_id
     from rclpy.node import Node
 
     from synthesis_manager.client import SynthesisClient
@@ -70,7 +70,7 @@ def four_processes(goals: int, byproducts: str) -> dict:
     from synthesis_manager.ros_env import prepare_ros_environment
 
     bin_dir = Path(sys.executable).parent
-    with domain_id() as domain:
+    with reserve_domain_id() as domain:
         environment = prepare_ros_environment(domain, environ=dict(os.environ))
         commands = [[str(bin_dir / script)] for script in NODE_SCRIPTS]
         commands[1] += ['--ros-args', '-p', f'byproducts_dir:={byproducts}']

@@ -32,10 +32,8 @@ class RosHarness:
         self._thread = None
 
     def __enter__(self) -> 'RosHarness':
-        from domain_coordinator import domain_id
-
         if self.domain_id is None:
-            self.domain_id = self._stack.enter_context(domain_id())
+            self.domain_id = self._stack.enter_context(reserve_domain_id())
         prepare_ros_environment(self.domain_id)
         import rclpy
         from rclpy.executors import MultiThreadedExecutor
@@ -93,3 +91,31 @@ def environment_domain_id() -> int:
     import os
 
     return int(os.environ.get('ROS_DOMAIN_ID') or 0)
+
+
+class _RotatingDomainSelector:
+    """Domain ids 1..100, continuing where the last reservation of this process stopped.
+
+    domain_coordinator's default selector starts at 1 every time, so consecutive harnesses
+    in one process would reuse one domain and could meet entities the previous one left in
+    discovery; rotating (from a per-process offset) keeps consecutive users apart.
+    """
+
+    def __init__(self):
+        import os
+
+        self._next = os.getpid() % 100
+
+    def __call__(self) -> int:
+        self._next = self._next % 100 + 1
+        return self._next
+
+
+_domain_selector = _RotatingDomainSelector()
+
+
+def reserve_domain_id():
+    """Context manager reserving a ROS_DOMAIN_ID no other process on this machine uses."""
+    from domain_coordinator import domain_id
+
+    return domain_id(selector=_domain_selector)

@@ -106,12 +106,12 @@ def test_names_of_accepts_arrays_and_comma_separated_strings():
 
 
 def test_the_node_runs_as_its_own_process():
-    from domain_coordinator import domain_id
+    from synthesis_manager.harness import reserve_domain_id
 
     script = Path(sys.executable).parent / 'atlas-sim-node'
     if not script.exists():
         pytest.fail(f'{script} is not installed (pip install -e .)')
-    with domain_id() as domain:
+    with reserve_domain_id() as domain:
         environment = prepare_ros_environment(domain, environ=dict(os.environ))
         process = subprocess.Popen([str(script), '--ros-args', '-p', 'speed:=20.0', '-p', 'fail:=look_down'],
                                    env=environment, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)

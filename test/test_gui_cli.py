@@ -82,9 +82,9 @@ def test_gui_reports_a_port_in_use():
 
 @pytest.fixture
 def reserved_domain():
-    from domain_coordinator import domain_id
+    from synthesis_manager.harness import reserve_domain_id
 
-    with domain_id() as domain:
+    with reserve_domain_id() as domain:
         yield domain
 
 

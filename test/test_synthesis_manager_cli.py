@@ -41,9 +41,9 @@ def test_synthesis_options_are_mutually_exclusive():
 @pytest.fixture
 def served(tmp_path):
     """`behavior-synthesis serve` in its own process on a reserved domain; yields its environment."""
-    from domain_coordinator import domain_id
+    from synthesis_manager.harness import reserve_domain_id
 
-    with domain_id() as domain:
+    with reserve_domain_id() as domain:
         environment = prepare_ros_environment(domain, environ=dict(os.environ))
         server = subprocess.Popen(CLI + ['serve', '--byproducts-dir', str(tmp_path)], env=environment,
                                   stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
@@ -92,9 +92,9 @@ def test_ctrl_c_cancels_the_goal(served):
 
 
 def test_send_goal_without_a_server_says_so():
-    from domain_coordinator import domain_id
+    from synthesis_manager.harness import reserve_domain_id
 
-    with domain_id() as domain:
+    with reserve_domain_id() as domain:
         environment = prepare_ros_environment(domain, environ=dict(os.environ))
         result = subprocess.run(CLI + ['send-goal'], env=environment, capture_output=True, text=True,
                                 timeout=60)

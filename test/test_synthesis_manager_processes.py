@@ -15,11 +15,11 @@ NODE_SCRIPTS = ('ltl-compilation-node', 'ltl-synthesis-node', 'sm-generation-nod
 
 
 def test_four_node_processes_serve_a_goal_and_stop_cleanly(tmp_path):
-    from domain_coordinator import domain_id
+    from synthesis_manager.harness import reserve_domain_id
     from rclpy.node import Node
 
     bin_dir = Path(sys.executable).parent
-    with domain_id() as domain:
+    with reserve_domain_id() as domain:
         environment = prepare_ros_environment(domain, environ=dict(os.environ))
         processes = [subprocess.Popen([str(bin_dir / script), '--ros-args', '-p',
                                        f'byproducts_dir:={tmp_path}'] if script == 'ltl-synthesis-node'

@@ -2,10 +2,8 @@
 
 Two sections matter here:
 
-``abstraction``  the discrete model shared with the specification compiler:
-                 ``control_modes`` (mode -> adjacent modes, self-loops implied),
-                 ``actions`` (action -> capabilities that must have completed),
-                 ``outcomes`` and ``sensors``.
+``abstraction``  the discrete model shared with the specification compiler, read and
+                 validated by ``respec.abstraction`` (``RobotAbstraction``).
 ``simulation``   how atlas_sim emulates the system (all keys optional)::
 
     simulation:
@@ -44,32 +42,11 @@ from typing import Any, Dict, Mapping, Optional, Tuple
 
 import yaml
 
+from respec.abstraction import AbstractionConfigError, RobotAbstraction, abstraction_from_dict
+
 #: config/ next to the atlas_sim package (the repository layout).
 CONFIG_DIR = Path(__file__).resolve().parent.parent / "config"
 DEFAULT_CONFIG = CONFIG_DIR / "atlas.yaml"
-
-
-@dataclass(frozen=True)
-class AbstractionConfig:
-    """The ``abstraction:`` section: the discrete model of the robot system."""
-
-    control_modes: Dict[str, Tuple[str, ...]]
-    actions: Dict[str, Tuple[str, ...]]
-    outcomes: Tuple[str, ...] = ("completed", "failed")
-    sensors: Tuple[str, ...] = ()
-    initial_mode: Optional[str] = None
-
-    @classmethod
-    def from_dict(cls, section: Mapping[str, Any]) -> "AbstractionConfig":
-        modes = {str(m): tuple(adj or ()) for m, adj in (section.get("control_modes") or {}).items()}
-        actions = {str(a): tuple(pre or ()) for a, pre in (section.get("actions") or {}).items()}
-        return cls(
-            control_modes=modes,
-            actions=actions,
-            outcomes=tuple(section.get("outcomes") or ("completed", "failed")),
-            sensors=tuple(section.get("sensors") or ()),
-            initial_mode=section.get("initial_mode"),
-        )
 
 
 @dataclass(frozen=True)
@@ -150,16 +127,17 @@ class SystemConfig:
     """A robot system: its name, discrete abstraction and simulation settings."""
 
     system: str
-    abstraction: AbstractionConfig
+    abstraction: RobotAbstraction
     simulation: SimulationConfig
 
     @classmethod
     def from_dict(cls, document: Mapping[str, Any]) -> "SystemConfig":
+        system = str(document.get("system", "unnamed"))
         if "abstraction" not in document:
-            raise ValueError("robot config has no 'abstraction' section")
+            raise AbstractionConfigError(f"{system}.yaml has no abstraction: section", item="abstraction")
         return cls(
-            system=str(document.get("system", "unnamed")),
-            abstraction=AbstractionConfig.from_dict(document["abstraction"]),
+            system=system,
+            abstraction=abstraction_from_dict(document["abstraction"], system),
             simulation=SimulationConfig.from_dict(document.get("simulation")),
         )
 

@@ -30,27 +30,21 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Dict, Iterable, List, Mapping, Optional, Set, Tuple
 
-from .config import AbstractionConfig
+from respec.abstraction import RobotAbstraction
+from respec.naming import COMPLETED, FAILED
 
-COMPLETED = "completed"
-FAILED = "failed"
 
 
 class Abstraction:
     """Read-only view of control modes, actions and their relations."""
 
-    def __init__(self, config: AbstractionConfig) -> None:
+    def __init__(self, config: RobotAbstraction) -> None:
+        # ``config`` is validated (respec.abstraction): no name is both a mode and an
+        # action, and every precondition is a capability.
         self.control_modes: Dict[str, Tuple[str, ...]] = dict(config.control_modes)
         self.actions: Dict[str, Tuple[str, ...]] = dict(config.actions)
         self.outcomes = tuple(config.outcomes)
         self.sensors = tuple(config.sensors)
-        overlap = set(self.control_modes) & set(self.actions)
-        if overlap:
-            raise ValueError(f"names used both as control mode and action: {sorted(overlap)}")
-        for name, preconditions in self.actions.items():
-            unknown = [p for p in preconditions if not self.is_capability(p)]
-            if unknown:
-                raise ValueError(f"action {name!r} has unknown preconditions {unknown}")
 
     def is_mode(self, name: str) -> bool:
         return name in self.control_modes

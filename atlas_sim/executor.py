@@ -25,7 +25,7 @@ that the next state does not activate is abandoned (the robot cannot cancel it) 
 whatever it still reports is recorded, so the trace check sees it.
 
 The robot is anything with the :class:`Robot` protocol: :class:`SimulatedRobot` drives an
-``AtlasSimulator`` directly; ``atlas_sim.ros_robot.RosRobot`` drives the simulator node.
+``AtlasSimulator`` directly; ``synthesis_manager.nodes.atlas_sim_robot.RosRobot`` drives the simulator node.
 
     sim = make_simulator('atlas', initial_conditions=['stand_prep'])
     run = execute_state_machine(states, SimulatedRobot(sim), system='atlas')
@@ -41,15 +41,16 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable, Protocol, Sequence
 
+from respec.abstraction import load_abstraction
 from respec.errors import CodedError
-from atlas_sim.trace_check import OutcomeTracker, Trace, TraceStep, outcome_proposition
+from atlas_sim.trace_check import OutcomeTracker, Trace, TraceStep
+from respec.naming import ACTIVATION_SUFFIX, outcome_proposition
 
 ROOT_PATH = '/'
 STATEMACHINE = ':STATEMACHINE'
 CONCURRENCY = ':CONCURRENCY'
 BEHAVIOR = ':BEHAVIOR'
 OUTCOME = ':OUTCOME'
-ACTIVATION_SUFFIX = '_a'
 # The generator's helper states (flexbe_states) and how they return.
 LOG_STATE = 'LogState'
 DECISION_STATE = 'OperatorDecisionState'
@@ -331,13 +332,12 @@ class StateMapping:
     """State class + parameter values (or behavior class) -> ``flexbe.states`` entry."""
 
     def __init__(self, system: str, config_dir: str | Path | None = None):
-        from respec.systems import load_section
         from sm_generation.config import load_flexbe_config
 
         self.flexbe = load_flexbe_config(system, config_dir)
-        abstraction = load_section(system, 'abstraction', config_dir)
-        self.control_modes = list(abstraction.get('control_modes') or {})
-        self.sensors = list(abstraction.get('sensors') or [])
+        abstraction = load_abstraction(system, config_dir)
+        self.control_modes = list(abstraction.control_modes)
+        self.sensors = list(abstraction.sensors)
         self._by_key: dict[tuple, Any] = {}
         for state in self.flexbe.states.values():
             self._by_key.setdefault(self._key(state.state_class, state.behavior_class, state.parameter_values),

@@ -53,11 +53,11 @@ from __future__ import annotations
 from dataclasses import asdict, dataclass, field
 
 from respec.ltl import And, Const, Formula, Iff, Implies, Next, Not, Or, Var, mentions_next, to_infix
+from respec.naming import ACTIVATION_SUFFIX, COMPLETED, DEFAULT_SM_OUTCOMES, MEMORY_SUFFIX, outcome_proposition
 from respec.spec import GR1Specification
 
-ACTIVATION_SUFFIX = '_a'
-MEMORY_SUFFIX = '_m'
-DEFAULT_SM_OUTCOME_PROPOSITIONS = {'finished': 'finished', 'failed': 'failed'}
+# Each SM outcome is the system proposition of the same name.
+DEFAULT_SM_OUTCOME_PROPOSITIONS = {outcome: outcome for outcome in DEFAULT_SM_OUTCOMES}
 
 
 class TraceError(ValueError):
@@ -68,11 +68,6 @@ class TraceError(ValueError):
     def __init__(self, message: str, item: str):
         super().__init__(message)
         self.item = item
-
-
-def outcome_proposition(capability: str, outcome: str) -> str:
-    """``<p>_<first letter of outcome>``, e.g. ('stand', 'completed') -> 'stand_c'."""
-    return f'{capability}_{outcome[0]}'
 
 
 # --- traces -------------------------------------------------------------------------------
@@ -146,7 +141,7 @@ class OutcomeTracker:
 
     def true_propositions(self) -> list[str]:
         """The outcome propositions (and sensors) that are true now, sorted."""
-        true = {outcome_proposition(self.mode, 'completed')}  # eq. (10): the current mode
+        true = {outcome_proposition(self.mode, COMPLETED)}  # eq. (10): the current mode
         for capability, outcome in self.reported.items():
             if capability in self.control_modes and outcome == 'completed':
                 continue  # only the current mode's completion is true
@@ -504,4 +499,4 @@ def valuations_of_trace(trace: Trace, spec: GR1Specification) -> list[dict[str, 
 
 __all__ = ['Trace', 'TraceStep', 'OutcomeTracker', 'TraceError', 'TraceCheckReport', 'Violation',
            'check_trace', 'check_goal_order', 'partial_evaluate', 'least_violating_assignments',
-           'outcome_proposition', 'valuations_of_trace']
+           'valuations_of_trace']

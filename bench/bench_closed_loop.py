@@ -27,7 +27,7 @@ def synthesized_machine(initial_conditions, goals, sm_outcomes):
     """The specification and the state machine for a task, through the ROS-free cores."""
     from ltl_specification import compile_task
     from ltl_synthesizer import synthesize
-    from ltl_synthesizer.automaton import automaton_from_strategy
+    from respec.automaton import automaton_from_strategy
     from sm_generation import generate_state_machine
 
     spec = compile_task('atlas', initial_conditions, goals, sm_outcomes=sm_outcomes)
@@ -49,9 +49,9 @@ def run_over_ros(states, initial_conditions, faults, speed):
     from rclpy.parameter import Parameter
 
     from atlas_sim.executor import execute_state_machine, make_simulator, parse_faults
-    from atlas_sim.node import AtlasSimNode
-    from atlas_sim.ros_robot import RosRobot
-    from synthesis_manager.harness import RosHarness
+    from synthesis_manager.nodes.atlas_sim_node import AtlasSimNode
+    from synthesis_manager.nodes.atlas_sim_robot import RosRobot
+    from synthesis_manager.ros.harness import RosHarness
 
     with RosHarness() as ros:
         simulator = make_simulator('atlas', initial_conditions=initial_conditions,

@@ -62,12 +62,12 @@ def one_process(goals: int, byproducts: str) -> dict:
 
 
 def four_processes(goals: int, byproducts: str) -> dict:
-    from synthesis_manager.harness import reserve_domain_id
+    from synthesis_manager.ros.harness import reserve_domain_id
     from rclpy.node import Node
 
     from synthesis_manager.client import SynthesisClient
-    from synthesis_manager.harness import RosHarness
-    from synthesis_manager.ros_env import prepare_ros_environment
+    from synthesis_manager.ros.harness import RosHarness
+    from synthesis_manager.ros.env import prepare_ros_environment
 
     bin_dir = Path(sys.executable).parent
     with reserve_domain_id() as domain:

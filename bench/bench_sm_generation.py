@@ -75,7 +75,7 @@ def main() -> None:
     try:
         from ltl_specification import compile_task
         from ltl_synthesizer import synthesize
-        from ltl_synthesizer.automaton import automaton_from_strategy
+        from respec.automaton import automaton_from_strategy
     except ImportError as error:
         print(f'(paper tasks skipped: {error})')
     else:

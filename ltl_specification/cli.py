@@ -19,6 +19,7 @@ import yaml
 
 from ltl_specification.compiler import compile_task, explain
 from ltl_specification.errors import InvalidFormulaError, SpecificationError
+from respec.naming import parse_names
 
 FORMATS = ('structuredslugs', 'slugsin', 'json')
 
@@ -46,7 +47,7 @@ def run(args: argparse.Namespace) -> int:
     try:
         custom_ltl = _read_custom_ltl(args.custom_ltl)
         spec = compile_task(args.system, args.initial_conditions, args.goals,
-                            sm_outcomes=_split(args.sm_outcomes), strict_order=not args.unordered,
+                            sm_outcomes=parse_names(args.sm_outcomes), strict_order=not args.unordered,
                             custom_ltl=custom_ltl, config_dir=args.config_dir)
     except SpecificationError as error:
         message = ' '.join(str(error).split())
@@ -71,10 +72,6 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog='behavior-synthesis compile', description=__doc__.split('\n')[0])
     add_arguments(parser)
     return run(parser.parse_args(argv))
-
-
-def _split(text: str) -> list[str]:
-    return [part.strip() for part in text.split(',') if part.strip()]
 
 
 def _read_custom_ltl(path: str | None):

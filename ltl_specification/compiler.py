@@ -45,12 +45,12 @@ from pathlib import Path
 from typing import Mapping, Sequence
 
 from respec.abstraction import AbstractionConfigError, RobotAbstraction, load_abstraction
-from respec.activation_outcomes import activation, outcome_proposition
 from respec.components import (
     action_specification, control_mode_specification, goal_specification,
     initial_conditions_specification,
 )
 from respec.ltl import variables
+from respec.naming import DEFAULT_SM_OUTCOMES, FAILED, FINISHED, activation, outcome_proposition, parse_names
 from respec.parsing import ParseError, UnknownVariableError, parse_formula, spec_from_text_sections
 from respec.spec import (
     FORMULA_SECTIONS, PROPOSITION_SECTIONS, SECTIONS, GR1Specification, PropositionConflictError,
@@ -64,8 +64,7 @@ from ltl_specification.errors import (
 )
 from ltl_specification.pertinence import Pertinence, infer_pertinence
 
-FINISHED, FAILED = 'finished', 'failed'
-SUPPORTED_SM_OUTCOMES = ((FINISHED, FAILED), (FINISHED,))
+SUPPORTED_SM_OUTCOMES = (DEFAULT_SM_OUTCOMES, (FINISHED,))
 
 
 @dataclass
@@ -92,7 +91,7 @@ class CompiledSpecification(GR1Specification):
 
 
 def compile_task(system: str, initial_conditions: Sequence[str] | str, goals: Sequence[str] | str,
-                 sm_outcomes: Sequence[str] = (FINISHED, FAILED), strict_order: bool = True,
+                 sm_outcomes: Sequence[str] = DEFAULT_SM_OUTCOMES, strict_order: bool = True,
                  custom_ltl: Mapping[str, Sequence[str]] | None = None,
                  config_dir: str | Path | None = None) -> CompiledSpecification:
     """Compile the GR(1) specification of reaching ``goals`` from ``initial_conditions``.
@@ -184,7 +183,7 @@ def _names(value: Sequence[str] | str | None, what: str, error) -> list[str]:
     if value is None:
         return []
     if isinstance(value, str):
-        value = [v for v in (part.strip() for part in value.split(',')) if v]
+        value = parse_names(value)
     if not isinstance(value, (list, tuple)):
         raise error(f'{what} must be a list of names, got {value!r}', item=repr(value))
     names = list(value)

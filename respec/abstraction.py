@@ -24,12 +24,11 @@ import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from respec.activation_outcomes import activation, memory, outcome_proposition
+from respec.naming import DEFAULT_SM_OUTCOMES, activation, memory, outcome_proposition
 from respec.systems import SystemConfigError, load_system_file
 
 _NAME = re.compile(r'^[A-Za-z][A-Za-z0-9_]*$')
 DEFAULT_OUTCOMES = ('completed', 'failed')
-SM_OUTCOMES = ('finished', 'failed')
 _SECTION_KEYS = ('outcomes', 'initial_mode', 'control_modes', 'actions', 'sensors')
 # An outcome starting with 'a' or 'm' would name the same proposition as an activation
 # (<p>_a) or a goal memory (<g>_m).
@@ -205,7 +204,7 @@ def _reject_proposition_clashes(abstraction: RobotAbstraction, where: str) -> No
                 f'and {owner}', item=proposition)
         owners[proposition] = owner
 
-    for outcome in SM_OUTCOMES:
+    for outcome in DEFAULT_SM_OUTCOMES:
         claim(outcome, 'the state-machine outcomes')
     for item in abstraction.items():
         owner = f'{abstraction.kind_of(item).replace("_", " ")} {item!r}'

@@ -15,25 +15,8 @@ from __future__ import annotations
 from typing import Iterable, Mapping, Sequence
 
 from respec.ltl import FALSE, TRUE, Formula, conj, disj, iff, implies, neg, next_, var
+from respec.naming import COMPLETED, activation, memory, outcome_proposition
 
-COMPLETED = 'completed'
-
-
-# --- proposition names -------------------------------------------------------------------
-
-def activation(item: str) -> str:
-    """The activation proposition π_p of an action or control mode."""
-    return f'{item}_a'
-
-
-def outcome_proposition(item: str, outcome: str) -> str:
-    """The outcome proposition π_p^o, suffixed with the outcome's first letter."""
-    return f'{item}_{outcome[0]}'
-
-
-def memory(goal: str) -> str:
-    """The memory proposition μ_g of having achieved goal g."""
-    return f'{goal}_m'
 
 
 def _unique(formulas: Iterable[Formula]) -> list[Formula]:

@@ -17,9 +17,9 @@ from pathlib import Path
 
 import yaml
 
+from respec.automaton import Automaton, AutomatonState, automaton_from_strategy
+from respec.parsing import ParseError, parse_structuredslugs
 from sm_generation.errors import SMGenerationError
-
-from ltl_synthesizer.automaton import Automaton, AutomatonState
 
 
 def automaton_from_dict(data: dict, source: str = '<dict>') -> Automaton:
@@ -88,12 +88,6 @@ def _automaton_from_strategy_file(strategy: dict, path: Path, spec_path) -> Auto
     if spec_path is None:
         raise SMGenerationError('AUTOMATON_INVALID', f'{path} is a slugs strategy: give the '
                                 '.structuredslugs specification it was synthesized from', str(path))
-    try:
-        from ltl_synthesizer.automaton import automaton_from_strategy
-        from respec.parsing import ParseError, parse_structuredslugs
-    except ImportError as error:
-        raise SMGenerationError('AUTOMATON_INVALID', f'reading slugs strategies needs {error.name}',
-                                str(path)) from error
     spec_path = Path(spec_path)
     try:
         spec = parse_structuredslugs(spec_path.read_text(), filename=str(spec_path))

@@ -13,6 +13,7 @@ import argparse
 import sys
 from pathlib import Path
 
+from respec.naming import parse_names
 from sm_generation.automaton_io import load_automaton
 from sm_generation.errors import SMGenerationError
 from sm_generation.export import RENDER_FORMATS, RenderError, render, to_dot, to_json, to_yaml
@@ -42,7 +43,7 @@ def run(args: argparse.Namespace) -> int:
         return 2
     initial_conditions = None
     if args.initial_conditions is not None:
-        initial_conditions = [c.strip() for c in args.initial_conditions.split(',') if c.strip()]
+        initial_conditions = parse_names(args.initial_conditions)
     try:
         automaton = load_automaton(args.automaton, args.spec)
         states = generate_state_machine(automaton, args.system, args.config_dir, initial_conditions, args.reduce)

@@ -25,11 +25,11 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
+from respec.naming import ACTIVATION_SUFFIX
 from respec.systems import ConfigFileInvalidError, UnknownSystemError, load_section
 from sm_generation.errors import SMGenerationError
 
 BEHAVIOR_CLASS = ':BEHAVIOR'
-ACTIVATION_SUFFIX = '_a'
 # FlexBE autonomy levels: Off/Inherit 0, Low 1, High 2, Full 3.
 AUTONOMY_LEVELS = range(0, 4)
 

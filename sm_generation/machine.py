@@ -29,11 +29,10 @@ from __future__ import annotations
 from collections import deque
 from dataclasses import dataclass, field
 
+from respec.naming import ACTIVATION_SUFFIX, MEMORY_SUFFIX
 from sm_generation.config import FlexBEConfig, StateConfig
 from sm_generation.errors import SMGenerationError
 
-MEMORY_SUFFIX = '_m'
-ACTIVATION_SUFFIX = '_a'
 
 # An observation: sorted pairs (proposition of a part, outcome proposition seen).
 Observation = tuple[tuple[str, str], ...]

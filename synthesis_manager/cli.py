@@ -18,7 +18,7 @@ SUBCOMMANDS = {
     'send-goal': ('synthesis_manager.send_goal', 'send a goal to /behavior_synthesis and show the result'),
     'compile': ('ltl_specification.cli', 'compile a task into a GR(1) specification (no ROS)'),
     'generate-sm': ('sm_generation.cli', 'turn an automaton into a FlexBE state machine (no ROS)'),
-    'execute': ('atlas_sim.cli', 'synthesize a behavior and run it on the simulated ATLAS'),
+    'execute': ('synthesis_manager.execute', 'synthesize a behavior and run it on the simulated ATLAS'),
     'gui': ('synthesis_manager.gui', 'serve the synthesis web GUI on 127.0.0.1'),
 }
 

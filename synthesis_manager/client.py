@@ -6,8 +6,9 @@ import threading
 import time
 from dataclasses import dataclass, field
 
-from synthesis_manager.conversions import error_name, msg_to_sections, msg_to_state_dict
-from synthesis_manager.harness import wait_for
+from respec.naming import DEFAULT_SM_OUTCOMES
+from synthesis_manager.ros.conversions import error_name, msg_to_sections, msg_to_state_dict
+from synthesis_manager.ros.harness import wait_for
 from synthesis_msgs.action import BehaviorSynthesis
 from synthesis_msgs.msg import BehaviorSynthesisRequest, LTLSpecification, SynthesisOptions
 
@@ -37,7 +38,7 @@ class SynthesisOutcome:
                 'seconds': round(self.seconds, 4)}
 
 
-def make_goal(system: str, initial_conditions, goals, sm_outcomes=('finished', 'failed'),
+def make_goal(system: str, initial_conditions, goals, sm_outcomes=DEFAULT_SM_OUTCOMES,
               option: str | None = None, name: str = '', ltl_specification: dict | None = None,
               unordered: bool = False, timeout: float = 0.0) -> BehaviorSynthesis.Goal:
     """Build a goal; list arguments are joined the original way (comma-separated)."""

@@ -3,7 +3,7 @@
 By default the four suite nodes run in this process on a private ROS domain, next to the
 GUI's action client; ``--connect`` instead joins a suite already running on the
 environment's ROS_DOMAIN_ID (e.g. ``behavior-synthesis serve``). The page and its API are
-``synthesis_manager.webapp``; this module only wires them to ROS and runs uvicorn.
+``synthesis_manager.web``; this module only wires them to ROS and runs uvicorn.
 """
 
 from __future__ import annotations
@@ -14,7 +14,14 @@ import sys
 import threading
 import time
 
-from synthesis_manager.suite import add_suite_arguments
+import uvicorn
+from rclpy.node import Node
+
+from synthesis_manager.client import SynthesisClient, SynthesisOutcome, make_goal
+from synthesis_manager.ros.harness import RosHarness, environment_domain_id
+from synthesis_manager.suite import add_suite_arguments, suite_node_factories
+from synthesis_manager.web.backend import SynthesisBackend
+from synthesis_manager.web.routes import create_app
 
 DEFAULT_PORT = 8080
 LOOPBACK_HOSTS = ('127.0.0.1', 'localhost', '::1')
@@ -41,8 +48,6 @@ class RosGoalRunner:
         self.goal_timeout = goal_timeout
 
     def __call__(self, request, feedback, cancel) -> dict:
-        from synthesis_manager.client import SynthesisOutcome, make_goal
-
         if not self.client.wait_for_server(timeout=self.server_timeout):
             return SynthesisOutcome(
                 -3, 'SERVICE_UNAVAILABLE', 'no /behavior_synthesis action server answered within '
@@ -55,13 +60,6 @@ class RosGoalRunner:
 @contextlib.contextmanager
 def ros_backend(args=None, connect: bool = False):
     """A SynthesisBackend sending jobs over ROS: to an in-process suite, or (connect) a running one."""
-    from rclpy.node import Node
-
-    from synthesis_manager.client import SynthesisClient
-    from synthesis_manager.harness import RosHarness, environment_domain_id
-    from synthesis_manager.suite import suite_node_factories
-    from synthesis_manager.webapp import SynthesisBackend
-
     with RosHarness(domain_id=environment_domain_id() if connect else None) as ros:
         if not connect:
             for factory in suite_node_factories(args):
@@ -86,8 +84,6 @@ def listening_socket(host: str, port: int) -> socket.socket:
 
 def make_server(app, sock: socket.socket):
     """A uvicorn server for ``app`` on an already bound socket (call ``.run(sockets=[sock])``)."""
-    import uvicorn
-
     host, port = sock.getsockname()[:2]
     return uvicorn.Server(uvicorn.Config(app, host=host, port=port, log_level='warning',
                                          timeout_graceful_shutdown=2, ws='none'))
@@ -117,8 +113,6 @@ def run(args) -> int:
     import os
 
     os.environ.setdefault('MUJOCO_GL', 'egl')  # the simulation renders frames off-screen
-    from synthesis_manager.webapp import create_app
-
     if args.host not in LOOPBACK_HOSTS:
         print(f'gui: warning: listening on {args.host}: other machines can reach the page and '
               'start synthesis jobs', file=sys.stderr)

@@ -2,24 +2,12 @@
 
 from __future__ import annotations
 
-import re
 
-# The original takes comma-separated names; the FlexBE WebUI may also send a list-like text
-# ("['look_down', 'pickup_object']") or space-separated names. Accept all of them.
-_SEPARATORS = re.compile(r'[\s,;]+')
-_DECORATION = re.compile(r'[\[\]()"\']')
 OPTION_NAMES = ('ltl_compilation_only', 'ltl_synthesis_only', 'ltl_steps_only')
 
 
 class InvalidRequest(ValueError):
     code = 'INVALID_REQUEST'
-
-
-def parse_names(text) -> list[str]:
-    """``'look_down, pickup_object'`` (or a list of names) -> ``['look_down', 'pickup_object']``."""
-    if isinstance(text, (list, tuple)):
-        text = ','.join(text)
-    return [name for name in _SEPARATORS.split(_DECORATION.sub(' ', text or '')) if name]
 
 
 def selected_option(options) -> str | None:

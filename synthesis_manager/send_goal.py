@@ -7,7 +7,7 @@ import sys
 import threading
 from pathlib import Path
 
-from synthesis_manager.requests import parse_names
+from respec.naming import parse_names
 from synthesis_manager.summary import spec_size, state_machine_tree
 
 
@@ -94,7 +94,7 @@ def print_summary(outcome, stream=sys.stdout):
 
 def run(args) -> int:
     from synthesis_manager.client import SynthesisClient
-    from synthesis_manager.harness import RosHarness, environment_domain_id
+    from synthesis_manager.ros.harness import RosHarness, environment_domain_id
 
     try:
         goal = goal_from_args(args)

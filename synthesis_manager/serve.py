@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from synthesis_manager.ros.node_main import run_nodes
 from synthesis_manager.suite import SUITE_NODE_NAMES, add_suite_arguments, suite_node_factories
 
 
@@ -12,8 +13,6 @@ def add_arguments(parser):
 
 
 def run(args) -> int:
-    from synthesis_manager.node_main import run_nodes
-
     names = [name for name in args.nodes.split(',') if name]
     unknown = sorted(set(names) - set(SUITE_NODE_NAMES))
     if unknown:

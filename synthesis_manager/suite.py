@@ -5,6 +5,16 @@ from __future__ import annotations
 import contextlib
 import functools
 
+from rclpy.node import Node
+from rclpy.parameter import Parameter
+
+from synthesis_manager.client import SynthesisClient
+from synthesis_manager.nodes.ltl_compilation_node import LTLCompilationNode
+from synthesis_manager.nodes.ltl_synthesis_node import LTLSynthesisNode
+from synthesis_manager.nodes.server_node import BehaviorSynthesisServer
+from synthesis_manager.nodes.sm_generation_node import SMGenerationNode
+from synthesis_manager.ros.harness import RosHarness
+
 SUITE_NODE_NAMES = ('ltl_compilation', 'ltl_synthesis', 'sm_generation', 'behavior_synthesis_server')
 
 
@@ -23,13 +33,6 @@ def add_suite_arguments(parser):
 
 def suite_node_factories(args=None, names=SUITE_NODE_NAMES):
     """Factories (taking ``context=``) for the suite's nodes, parametrised from ``args``."""
-    from rclpy.parameter import Parameter
-
-    from ltl_specification.node import LTLCompilationNode
-    from ltl_synthesizer.node import LTLSynthesisNode
-    from sm_generation.node import SMGenerationNode
-    from synthesis_manager.server_node import BehaviorSynthesisServer
-
     def overrides(**values):
         return [Parameter(name, value=value) for name, value in values.items()
                 if value not in ('', None)]
@@ -60,11 +63,6 @@ def in_process_suite(args=None, client_name: str = 'suite_client'):
 
     Yields ``(harness, client)``; ``client`` is a SynthesisClient whose server is up.
     """
-    from rclpy.node import Node
-
-    from synthesis_manager.client import SynthesisClient
-    from synthesis_manager.harness import RosHarness
-
     with RosHarness() as ros:
         for factory in suite_node_factories(args):
             ros.add_node(factory)

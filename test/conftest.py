@@ -4,7 +4,7 @@ import os
 
 import pytest
 
-from synthesis_manager.ros_env import prepare_ros_environment
+from synthesis_manager.ros.env import prepare_ros_environment
 
 # Every test process keeps DDS on loopback, whether or not it starts ROS itself.
 prepare_ros_environment()
@@ -13,7 +13,7 @@ os.environ.setdefault('MUJOCO_GL', 'egl')
 
 @pytest.fixture
 def ros():
-    from synthesis_manager.harness import RosHarness
+    from synthesis_manager.ros.harness import RosHarness
 
     with RosHarness() as harness:
         yield harness

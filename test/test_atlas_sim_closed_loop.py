@@ -13,7 +13,7 @@ from atlas_sim.executor import SimulatedRobot, execute_state_machine, make_simul
 from atlas_sim.trace_check import check_trace
 from ltl_specification import compile_task
 from ltl_synthesizer import synthesize
-from ltl_synthesizer.automaton import automaton_from_strategy
+from respec.automaton import automaton_from_strategy
 from sm_generation import generate_state_machine, validate_state_machine
 
 STAND_HEIGHT_RANGE = (0.6, 1.1)  # pelvis height (m): crouched stand_prep is ~0.67, standing ~0.85

@@ -10,8 +10,8 @@ from rclpy.node import Node
 from rclpy.parameter import Parameter
 
 from atlas_sim.executor import execute_state_machine
-from atlas_sim.node import AtlasSimNode
-from atlas_sim.ros_robot import RosRobot
+from synthesis_manager.nodes.atlas_sim_node import AtlasSimNode
+from synthesis_manager.nodes.atlas_sim_robot import RosRobot
 from atlas_sim.trace_check import check_trace
 from respec.parsing import spec_from_text_sections
 from synthesis_manager.cli import main as cli_main

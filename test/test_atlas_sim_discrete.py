@@ -7,7 +7,8 @@ from pathlib import Path
 
 import pytest
 
-from atlas_sim.config import DEFAULT_CONFIG, AbstractionConfig, load_system_config
+from atlas_sim.config import DEFAULT_CONFIG, SystemConfig, load_system_config
+from respec.abstraction import AbstractionConfigError
 from atlas_sim.discrete import COMPLETED, FAILED, Abstraction, DiscreteSemantics
 from atlas_sim.faults import FaultInjector, FaultSpec
 from atlas_sim.kinematics import LegGeometry, POSTURES, sagittal_leg_ik
@@ -145,9 +146,8 @@ def test_configured_invalidation_consumes_the_footstep_plan(semantics):
 def test_unknown_names_are_refused_or_rejected(semantics):
     state = semantics.initial_state("stand")
     assert "unknown capability" in semantics.refusal(state, "fly")
-    bad = AbstractionConfig(control_modes={"a": ()}, actions={"x": ("nope",)})
-    with pytest.raises(ValueError, match="unknown preconditions"):
-        Abstraction(bad)
+    with pytest.raises(AbstractionConfigError, match="unknown precondition"):
+        SystemConfig.from_dict({"abstraction": {"control_modes": {"a": []}, "actions": {"x": ["nope"]}}})
 
 
 # ----------------------------------------------------------------- faults

@@ -13,9 +13,10 @@ from rclpy.action import ActionClient
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 
-from atlas_sim.node import ACTION_NAME, STATE_TOPIC, AtlasSimNode, names_of
-from synthesis_manager.harness import RosHarness, wait_for
-from synthesis_manager.ros_env import prepare_ros_environment
+from respec.naming import parse_names
+from synthesis_manager.nodes.atlas_sim_node import ACTION_NAME, STATE_TOPIC, AtlasSimNode
+from synthesis_manager.ros.harness import RosHarness, wait_for
+from synthesis_manager.ros.env import prepare_ros_environment
 from synthesis_msgs.action import ExecuteCapability
 from synthesis_msgs.msg import RobotState
 
@@ -99,14 +100,14 @@ def test_parameters_set_initial_conditions_and_faults(ros):
     assert pickup.outcome == 'completed'
 
 
-def test_names_of_accepts_arrays_and_comma_separated_strings():
-    assert names_of('a, b,,c') == ['a', 'b', 'c']
-    assert names_of(['a', ' b ']) == ['a', 'b']
-    assert names_of('') == [] and names_of(None) == []
+def test_list_parameters_accept_arrays_and_comma_separated_strings():
+    assert parse_names('a, b,,c') == ['a', 'b', 'c']
+    assert parse_names(['a', ' b ']) == ['a', 'b']
+    assert parse_names('') == [] and parse_names(None) == []
 
 
 def test_the_node_runs_as_its_own_process():
-    from synthesis_manager.harness import reserve_domain_id
+    from synthesis_manager.ros.harness import reserve_domain_id
 
     script = Path(sys.executable).parent / 'atlas-sim-node'
     if not script.exists():

@@ -10,7 +10,7 @@ from synthesis_msgs.msg import (AutomatonState, BehaviorSynthesisRequest, FSAuto
                                 LTLSpecification, OutcomeCondition, StateInstantiation,
                                 SynthesisErrorCodes, SynthesisOptions)
 from synthesis_msgs.srv import GenerateFlexBESM, GenerateLTLSpecification, SynthesizeAutomaton
-from synthesis_manager.harness import wait_for
+from synthesis_manager.ros.harness import wait_for
 
 FLEXBE_STATE_INSTANTIATION = {
     'state_path': 'string', 'state_class': 'string', 'initial_state_name': 'string',

@@ -4,7 +4,7 @@ import os
 import subprocess
 import sys
 
-from synthesis_manager.ros_env import prepare_ros_environment
+from synthesis_manager.ros.env import prepare_ros_environment
 
 
 def test_prepare_sets_loopback_and_drops_conflicting_settings():
@@ -33,11 +33,11 @@ def test_command_line_help_lists_subcommands():
 
 PACKAGES = ('respec', 'ltl_specification', 'ltl_synthesizer', 'sm_generation', 'synthesis_manager',
             'atlas_sim')
-ROS_INIT_OWNERS = {'synthesis_manager/ros_env.py', 'synthesis_manager/harness.py'}
+ROS_INIT_OWNERS = {'synthesis_manager/ros/env.py', 'synthesis_manager/ros/harness.py'}
 
 
 def test_rclpy_is_initialised_only_by_the_loopback_helpers():
-    """Every entry point reaches rclpy.init() through ros_env.init_ros or RosHarness."""
+    """Every entry point reaches rclpy.init() through ros.env.init_ros or RosHarness."""
     import re
     from pathlib import Path
 
@@ -47,7 +47,7 @@ def test_rclpy_is_initialised_only_by_the_loopback_helpers():
                  for path in (root / package).rglob('*.py')
                  if call.search(path.read_text())
                  and str(path.relative_to(root)) not in ROS_INIT_OWNERS]
-    assert ROS_INIT_OWNERS <= {str(p.relative_to(root)) for p in (root / 'synthesis_manager').glob('*.py')
+    assert ROS_INIT_OWNERS <= {str(p.relative_to(root)) for p in (root / 'synthesis_manager').rglob('*.py')
                                if call.search(p.read_text())}
     assert offenders == []
 
@@ -68,7 +68,7 @@ def capture_environment_at_init(monkeypatch):
 def test_init_ros_applies_loopback_before_rclpy_init(monkeypatch):
     import pytest
 
-    from synthesis_manager.ros_env import init_ros
+    from synthesis_manager.ros.env import init_ros
 
     monkeypatch.setenv('ROS_AUTOMATIC_DISCOVERY_RANGE', 'SUBNET')
     monkeypatch.setenv('ROS_STATIC_PEERS', '192.0.2.1')
@@ -82,7 +82,7 @@ def test_init_ros_applies_loopback_before_rclpy_init(monkeypatch):
 def test_harness_applies_loopback_before_rclpy_init(monkeypatch):
     import pytest
 
-    from synthesis_manager.harness import RosHarness
+    from synthesis_manager.ros.harness import RosHarness
 
     monkeypatch.setenv('ROS_AUTOMATIC_DISCOVERY_RANGE', 'SUBNET')
     seen = capture_environment_at_init(monkeypatch)

@@ -8,7 +8,7 @@ from fastapi.testclient import TestClient
 
 from synthesis_manager.cli import build_parser
 from synthesis_manager.gui import ros_backend
-from synthesis_manager.webapp import create_app
+from synthesis_manager.web.routes import create_app
 
 PAPER_TASK = {'system': 'atlas', 'initial_conditions': ['stand_prep'], 'goals': ['look_down', 'pickup_object']}
 # Seven ordered goals: its synthesis takes about 40 s, so a cancel lands in the middle.

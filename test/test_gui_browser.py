@@ -14,7 +14,7 @@ import yaml
 
 from synthesis_manager.cli import build_parser
 from synthesis_manager.gui import background_server, ros_backend
-from synthesis_manager.webapp import create_app
+from synthesis_manager.web.routes import create_app
 
 CHROMIUM = '/usr/bin/chromium'
 CHROMIUM_ARGS = ['--headless', '--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run',

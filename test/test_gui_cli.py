@@ -10,7 +10,7 @@ import time
 import httpx
 import pytest
 
-from synthesis_manager.ros_env import prepare_ros_environment
+from synthesis_manager.ros.env import prepare_ros_environment
 
 URL_LINE = re.compile(r'behavior synthesis GUI: (http://\S+/)')
 
@@ -82,7 +82,7 @@ def test_gui_reports_a_port_in_use():
 
 @pytest.fixture
 def reserved_domain():
-    from synthesis_manager.harness import reserve_domain_id
+    from synthesis_manager.ros.harness import reserve_domain_id
 
     with reserve_domain_id() as domain:
         yield domain

@@ -11,7 +11,7 @@ import pytest
 import gr1_oracle
 
 from ltl_synthesizer import Options, SynthesisCancelled, synthesize
-from ltl_synthesizer.automaton import automaton_from_strategy
+from respec.automaton import automaton_from_strategy
 from ltl_synthesizer.strategy import strategy_to_json
 from respec.ltl import (TRUE, conj, disj, evaluate, iff,
                         implies, neg, next_, var)
@@ -341,7 +341,7 @@ def test_automaton_drops_memory_and_names_initial_states():
 
 
 def test_automaton_rejects_a_strategy_of_another_specification():
-    from ltl_synthesizer.automaton import AutomatonError
+    from respec.automaton import AutomatonError
     strategy = synthesize(copy_game()).strategy
     other = spec(env_props=['y'], sys_props=['x'])
     with pytest.raises(AutomatonError) as raised:

@@ -6,7 +6,7 @@ import pytest
 
 from ltl_specification.compiler import compile_task
 from ltl_synthesizer import synthesize
-from ltl_synthesizer.automaton import automaton_from_strategy
+from respec.automaton import automaton_from_strategy
 from sm_generation import generate_state_machine, validate_state_machine
 from sm_generation.cli import main
 from sm_generation.export import from_text, to_yaml

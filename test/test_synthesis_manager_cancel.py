@@ -9,7 +9,7 @@ from rclpy.node import Node
 from rclpy.parameter import Parameter
 
 from synthesis_manager.client import SynthesisClient, make_goal
-from synthesis_manager.server_node import BehaviorSynthesisServer
+from synthesis_manager.nodes.server_node import BehaviorSynthesisServer
 from synthesis_manager.suite import suite_node_factories
 from synthesis_msgs.srv import GenerateFlexBESM, GenerateLTLSpecification
 
@@ -133,7 +133,7 @@ def test_slugs_backend_calls_an_external_slugs_compatible_executable(ros, tmp_pa
     from pathlib import Path
 
     from synthesis_manager.suite import suite_node_factories
-    from synthesis_manager.server_node import BehaviorSynthesisServer
+    from synthesis_manager.nodes.server_node import BehaviorSynthesisServer
 
     gr1synth = str(Path(sys.executable).parent / 'gr1synth')
     args = Namespace(config_dir='', byproducts_dir=str(tmp_path), backend='slugs',
@@ -152,8 +152,8 @@ def test_slugs_backend_calls_an_external_slugs_compatible_executable(ros, tmp_pa
     ros.add_node(suite_node_factories(missing, ['ltl_synthesis'])[0], namespace='broken')
     broken = ros.nodes[-1]
     from synthesis_msgs.srv import SynthesizeAutomaton
-    from synthesis_manager.conversions import sections_to_msg
-    from synthesis_manager.harness import wait_for
+    from synthesis_manager.ros.conversions import sections_to_msg
+    from synthesis_manager.ros.harness import wait_for
 
     caller = ros.add_node(Node, 'direct_caller')
     service = caller.create_client(SynthesizeAutomaton, '/broken/ltl_synthesis')

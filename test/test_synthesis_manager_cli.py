@@ -11,8 +11,9 @@ from types import SimpleNamespace
 
 import pytest
 
-from synthesis_manager.requests import InvalidRequest, parse_names, selected_option
-from synthesis_manager.ros_env import prepare_ros_environment
+from respec.naming import parse_names
+from synthesis_manager.requests import InvalidRequest, selected_option
+from synthesis_manager.ros.env import prepare_ros_environment
 
 CLI = [str(Path(sys.executable).parent / 'behavior-synthesis')]
 LONG_GOALS = 'look_down,pickup_object,grasp_object,pregrasp,approach_object,footstep_execution,walk'
@@ -41,7 +42,7 @@ def test_synthesis_options_are_mutually_exclusive():
 @pytest.fixture
 def served(tmp_path):
     """`behavior-synthesis serve` in its own process on a reserved domain; yields its environment."""
-    from synthesis_manager.harness import reserve_domain_id
+    from synthesis_manager.ros.harness import reserve_domain_id
 
     with reserve_domain_id() as domain:
         environment = prepare_ros_environment(domain, environ=dict(os.environ))
@@ -92,7 +93,7 @@ def test_ctrl_c_cancels_the_goal(served):
 
 
 def test_send_goal_without_a_server_says_so():
-    from synthesis_manager.harness import reserve_domain_id
+    from synthesis_manager.ros.harness import reserve_domain_id
 
     with reserve_domain_id() as domain:
         environment = prepare_ros_environment(domain, environ=dict(os.environ))

@@ -7,15 +7,15 @@ import sys
 from pathlib import Path
 
 from synthesis_manager.client import SynthesisClient, make_goal
-from synthesis_manager.harness import RosHarness
-from synthesis_manager.ros_env import prepare_ros_environment
+from synthesis_manager.ros.harness import RosHarness
+from synthesis_manager.ros.env import prepare_ros_environment
 
 NODE_SCRIPTS = ('ltl-compilation-node', 'ltl-synthesis-node', 'sm-generation-node',
                 'behavior-synthesis-server')
 
 
 def test_four_node_processes_serve_a_goal_and_stop_cleanly(tmp_path):
-    from synthesis_manager.harness import reserve_domain_id
+    from synthesis_manager.ros.harness import reserve_domain_id
     from rclpy.node import Node
 
     bin_dir = Path(sys.executable).parent

@@ -29,19 +29,14 @@ from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.node import Node
 
 from atlas_sim.executor import make_simulator, parse_faults
+from respec.naming import parse_names
+from synthesis_manager.ros.node_main import node_main
 from synthesis_msgs.action import ExecuteCapability
 from synthesis_msgs.msg import RobotState
 
 NODE_NAME = 'atlas_sim'
 ACTION_NAME = 'atlas_sim/execute'
 STATE_TOPIC = 'atlas_sim/state'
-
-
-def names_of(value) -> list[str]:
-    """A list parameter given as a string array or a comma-separated string."""
-    if isinstance(value, str):
-        return [n.strip() for n in value.split(',') if n.strip()]
-    return [str(n).strip() for n in (value or []) if str(n).strip()]
 
 
 def robot_state_message(snapshot: dict) -> RobotState:
@@ -82,8 +77,8 @@ class AtlasSimNode(Node):
         if simulator is None:
             seed = int(value('seed'))
             simulator = make_simulator(
-                value('system'), value('config_dir') or None, names_of(value('initial_conditions')),
-                faults=parse_faults(names_of(value('fail')), names_of(value('fail_first'))),
+                value('system'), value('config_dir') or None, parse_names(value('initial_conditions')),
+                faults=parse_faults(parse_names(value('fail')), parse_names(value('fail_first'))),
                 seed=None if seed < 0 else seed)
         self.simulator = simulator
         self.speed = float(value('speed'))
@@ -203,8 +198,6 @@ class AtlasSimNode(Node):
 
 
 def main():
-    from synthesis_manager.node_main import node_main
-
     node_main(AtlasSimNode, NODE_NAME)
 
 

@@ -15,13 +15,13 @@ from rclpy.action import ActionServer, CancelResponse, GoalResponse
 from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.node import Node
 
-from synthesis_manager.conversions import error_code, error_name, is_empty_spec
-from synthesis_manager.requests import InvalidRequest, parse_names, selected_option
+from respec.naming import DEFAULT_SM_OUTCOMES, parse_names
+from synthesis_manager.requests import InvalidRequest, selected_option
+from synthesis_manager.ros.conversions import error_code, error_name, is_empty_spec
+from synthesis_manager.ros.node_main import node_main
 from synthesis_msgs.action import BehaviorSynthesis
 from synthesis_msgs.srv import (CancelSynthesis, GenerateFlexBESM, GenerateLTLSpecification,
                                 SynthesizeAutomaton)
-
-DEFAULT_SM_OUTCOMES = ('finished', 'failed')
 
 
 class StageFailed(Exception):
@@ -190,6 +190,4 @@ class BehaviorSynthesisServer(Node):
 
 
 def main():
-    from synthesis_manager.node_main import node_main
-
     node_main(BehaviorSynthesisServer, 'behavior_synthesis_server')

@@ -15,7 +15,8 @@ from __future__ import annotations
 import contextlib
 import threading
 
-from synthesis_manager.ros_env import prepare_ros_environment
+from synthesis_manager.ros.env import prepare_ros_environment
+from synthesis_manager.ros.node_main import stop_executor
 
 
 class RosHarness:
@@ -64,8 +65,6 @@ class RosHarness:
         return node
 
     def __exit__(self, *exc_info):
-        from synthesis_manager.node_main import stop_executor
-
         try:
             stop_executor(self.executor, self.nodes)
             for node in reversed(self.nodes):

@@ -17,10 +17,12 @@ from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.node import Node
 
 from ltl_synthesizer import SynthesisCancelled, synthesize
-from respec.parsing import ParseError
-from ltl_synthesizer.automaton import automaton_from_strategy
+from ltl_synthesizer.external import run_external_synthesizer
 from ltl_synthesizer.strategy import strategy_to_json
-from synthesis_manager.conversions import automaton_to_msg, error_code, msg_to_sections
+from respec.automaton import automaton_from_strategy
+from respec.parsing import ParseError, spec_from_text_sections
+from synthesis_manager.ros.conversions import automaton_to_msg, error_code, msg_to_sections
+from synthesis_manager.ros.node_main import node_main
 from synthesis_msgs.srv import CancelSynthesis, SynthesizeAutomaton
 
 SPEC_NAME = re.compile(r'^[A-Za-z0-9][A-Za-z0-9_.-]{0,99}$')
@@ -110,8 +112,6 @@ class LTLSynthesisNode(Node):
         return response
 
     def _synthesize(self, request, response, cancel):
-        from respec.parsing import spec_from_text_sections
-
         directory = Path(self.parameter('byproducts_dir'))
         stem = byproduct_stem(directory, request.spec_name)
         spec = spec_from_text_sections(msg_to_sections(request.ltl_specification))
@@ -133,8 +133,6 @@ class LTLSynthesisNode(Node):
                 return
             realizable, strategy, explanation = result.realizable, result.strategy, result.explanation
         elif backend == 'slugs':
-            from ltl_synthesizer.external import run_external_synthesizer
-
             realizable, strategy, stderr = run_external_synthesizer(
                 self.parameter('slugs_executable'), slugsin_path, stem.with_suffix('.json'),
                 robotics_semantics=robotics, timeout=timeout, cancel=cancel)
@@ -155,6 +153,4 @@ class LTLSynthesisNode(Node):
 
 
 def main():
-    from synthesis_manager.node_main import node_main
-
     node_main(LTLSynthesisNode, 'ltl_synthesis')

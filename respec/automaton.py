@@ -1,4 +1,5 @@
-"""The FSAutomaton message shape, converted from a slugs JSON strategy.
+"""The synthesized automaton (the FSAutomaton message shape), and its reading from a slugs
+JSON strategy. Shared by the synthesizer (which produces it) and sm_generation (which reads it).
 
 Port of the original ltl_synthesis_server's conversion: state names are the node ids as
 strings, valuations split into inputs and outputs, goal-memory propositions (names ending in
@@ -9,14 +10,13 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+from respec.errors import CodedError
+from respec.ltl import conj, evaluate
+from respec.naming import MEMORY_SUFFIX
 from respec.spec import GR1Specification
 
-from ltl_synthesizer.errors import SynthesisError
 
-MEMORY_SUFFIX = '_m'
-
-
-class AutomatonError(SynthesisError):
+class AutomatonError(CodedError):
     code = 'AUTOMATON_INVALID'
 
 
@@ -76,17 +76,11 @@ def automaton_from_strategy(strategy: dict, spec: GR1Specification,
 
 
 def _initial_nodes(strategy: dict, spec: GR1Specification) -> list[str]:
-    from respec.ltl import conj
-    from ltl_synthesizer.symbolic import SymbolicGame
-
-    initial_only = GR1Specification(env_props=list(spec.env_props), sys_props=list(spec.sys_props),
-                                    env_init=list(spec.env_init), sys_init=list(spec.sys_init))
-    game = SymbolicGame(initial_only)
-    condition = game.translate(conj(list(spec.env_init) + list(spec.sys_init)), 'env_init')
+    condition = conj(list(spec.env_init) + list(spec.sys_init))
     names = list(strategy['variables'])
-    found = []
-    for name in sorted(strategy['nodes'], key=int):
-        values = strategy['nodes'][name]['state']
-        if game.evaluate(condition, {v: bool(x) for v, x in zip(names, values)}):
-            found.append(str(name))
-    return found
+    try:
+        return [str(name) for name in sorted(strategy['nodes'], key=int)
+                if evaluate(condition, {v: bool(x) for v, x in zip(names, strategy['nodes'][name]['state'])})]
+    except KeyError as unknown:
+        raise AutomatonError(f'an initial condition mentions {unknown.args[0]!r}, which is not a '
+                             'variable of the strategy', item=unknown.args[0]) from None

@@ -6,7 +6,9 @@ from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.node import Node
 
 from ltl_specification import compile_task
-from synthesis_manager.conversions import error_code, msg_to_sections, spec_to_msg
+from respec.naming import DEFAULT_SM_OUTCOMES
+from synthesis_manager.ros.conversions import error_code, msg_to_sections, spec_to_msg
+from synthesis_manager.ros.node_main import node_main
 from synthesis_msgs.srv import GenerateLTLSpecification
 
 
@@ -26,7 +28,7 @@ class LTLCompilationNode(Node):
         try:
             spec = compile_task(
                 request.system, list(request.initial_conditions), list(request.goals),
-                sm_outcomes=tuple(request.sm_outcomes) or ('finished', 'failed'),
+                sm_outcomes=tuple(request.sm_outcomes) or DEFAULT_SM_OUTCOMES,
                 strict_order=not request.unordered_goals,
                 custom_ltl=msg_to_sections(request.custom_ltl) or None,
                 config_dir=self.get_parameter('config_dir').value or None)
@@ -41,6 +43,4 @@ class LTLCompilationNode(Node):
 
 
 def main():
-    from synthesis_manager.node_main import node_main
-
     node_main(LTLCompilationNode, 'ltl_compilation')

@@ -21,7 +21,7 @@ import time
 from rclpy.action import ActionClient
 
 from atlas_sim.executor import CapabilityResult
-from atlas_sim.node import ACTION_NAME, STATE_TOPIC
+from synthesis_manager.nodes.atlas_sim_node import ACTION_NAME, STATE_TOPIC
 from synthesis_msgs.action import ExecuteCapability
 from synthesis_msgs.msg import RobotState
 

@@ -66,21 +66,17 @@ def add_arguments(parser):
                        help='save PNG frames of key moments and timeline.png in DIR')
 
 
-def _split(values) -> list[str]:
-    return [name.strip() for value in values for name in value.split(',') if name.strip()]
-
-
 def run(args) -> int:
     from atlas_sim.executor import FaultSpecError, InitialConditionError, make_simulator, parse_faults
     from respec.systems import SystemConfigError
-    from synthesis_manager.requests import parse_names
+    from respec.naming import parse_names
 
     if args.record:
         os.environ.setdefault('MUJOCO_GL', 'egl')  # before anything imports mujoco
     initial_conditions = parse_names(args.initial_conditions)
     goals = parse_names(args.goals)
     try:  # the simulator first: a bad fault or start is a usage error, found before synthesis
-        faults = parse_faults(_split(args.fail), _split(args.fail_first))
+        faults = parse_faults(parse_names(args.fail), parse_names(args.fail_first))
         simulator = make_simulator(args.system, args.config_dir or None, initial_conditions, faults, args.seed)
     except (FaultSpecError, InitialConditionError, SystemConfigError) as error:
         print(f'execute: {error}', file=sys.stderr)
@@ -136,8 +132,8 @@ def _ros_robot(ros, args, simulator):
     from rclpy.node import Node
     from rclpy.parameter import Parameter
 
-    from atlas_sim.node import AtlasSimNode
-    from atlas_sim.ros_robot import RosRobot
+    from synthesis_manager.nodes.atlas_sim_node import AtlasSimNode
+    from synthesis_manager.nodes.atlas_sim_robot import RosRobot
 
     node = ros.add_node(AtlasSimNode, simulator=simulator,
                         parameter_overrides=[Parameter('speed', value=float(args.speed)),

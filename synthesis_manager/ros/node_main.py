@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import sys
 
-from synthesis_manager.ros_env import init_ros
+from synthesis_manager.ros.env import init_ros
 
 
 def run_nodes(*node_factories, argv: list[str] | None = None, ready_message: str = '') -> int:

@@ -5,6 +5,7 @@ Nodes stay thin: they call a core function and use these helpers on the way in a
 
 from __future__ import annotations
 
+from respec.automaton import Automaton, AutomatonState as CoreState
 from synthesis_msgs.msg import (AutomatonState, FSAutomaton, LTLSpecification, OutcomeCondition,
                                 StateInstantiation, SynthesisErrorCodes)
 
@@ -44,8 +45,8 @@ def is_empty_spec(message: LTLSpecification) -> bool:
     return not any(getattr(message, name) for name in LTL_SECTIONS)
 
 
-def automaton_to_msg(automaton) -> FSAutomaton:
-    """ltl_synthesizer Automaton -> FSAutomaton."""
+def automaton_to_msg(automaton: Automaton) -> FSAutomaton:
+    """respec Automaton -> FSAutomaton."""
     return FSAutomaton(
         output_variables=list(automaton.output_variables),
         input_variables=list(automaton.input_variables),
@@ -56,10 +57,8 @@ def automaton_to_msg(automaton) -> FSAutomaton:
         initial_states=list(automaton.initial_states))
 
 
-def msg_to_automaton(message: FSAutomaton):
-    """FSAutomaton -> ltl_synthesizer Automaton."""
-    from ltl_synthesizer.automaton import Automaton, AutomatonState as CoreState
-
+def msg_to_automaton(message: FSAutomaton) -> Automaton:
+    """FSAutomaton -> respec Automaton."""
     return Automaton(
         output_variables=list(message.output_variables),
         input_variables=list(message.input_variables),

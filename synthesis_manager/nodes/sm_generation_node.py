@@ -6,7 +6,8 @@ from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.node import Node
 
 from sm_generation import generate_state_machine
-from synthesis_manager.conversions import error_code, msg_to_automaton, state_to_msg
+from synthesis_manager.ros.conversions import error_code, msg_to_automaton, state_to_msg
+from synthesis_manager.ros.node_main import node_main
 from synthesis_msgs.srv import GenerateFlexBESM
 
 
@@ -42,6 +43,4 @@ class SMGenerationNode(Node):
 
 
 def main():
-    from synthesis_manager.node_main import node_main
-
     node_main(SMGenerationNode, 'sm_generation')

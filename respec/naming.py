@@ -1,0 +1,45 @@
+"""The naming rules shared by every package: proposition names, SM outcomes, name lists.
+
+Every action or control mode ``p`` has a system proposition ``p_a`` (p is being activated)
+and one environment proposition per outcome, ``p_<first letter>`` (``p_c`` completed,
+``p_f`` failed); goal memories ``g_m`` are system propositions, and so are the state
+machine's outcomes (by default ``finished`` and ``failed``).
+"""
+
+from __future__ import annotations
+
+import re
+
+ACTIVATION_SUFFIX = '_a'
+MEMORY_SUFFIX = '_m'
+COMPLETED = 'completed'
+FINISHED, FAILED = 'finished', 'failed'
+#: The state machine's outcomes when a request names none.
+DEFAULT_SM_OUTCOMES = (FINISHED, FAILED)
+
+# The original takes comma-separated names; the FlexBE WebUI may also send a list-like text
+# ("['look_down', 'pickup_object']") or space-separated names. Accept all of them.
+_SEPARATORS = re.compile(r'[\s,;]+')
+_DECORATION = re.compile(r'[\[\]()"\']')
+
+
+def activation(item: str) -> str:
+    """The activation proposition π_p of an action or control mode."""
+    return f'{item}{ACTIVATION_SUFFIX}'
+
+
+def outcome_proposition(item: str, outcome: str) -> str:
+    """The outcome proposition π_p^o, suffixed with the outcome's first letter ('stand_c')."""
+    return f'{item}_{outcome[0]}'
+
+
+def memory(goal: str) -> str:
+    """The memory proposition μ_g of having achieved goal g."""
+    return f'{goal}{MEMORY_SUFFIX}'
+
+
+def parse_names(text) -> list[str]:
+    """``'look_down, pickup_object'`` (or a list of such texts) -> ``['look_down', 'pickup_object']``."""
+    if isinstance(text, (list, tuple)):
+        text = ','.join(text)
+    return [name for name in _SEPARATORS.split(_DECORATION.sub(' ', text or '')) if name]

@@ -1,0 +1,274 @@
+"""``SynthesisBackend``: the GUI's jobs, simulations and downloads, behind the routes."""
+
+from __future__ import annotations
+
+import dataclasses
+import itertools
+import tempfile
+import threading
+import time
+import uuid
+from collections import OrderedDict
+from pathlib import Path
+from typing import Callable
+
+from respec.abstraction import load_abstraction
+from respec.naming import DEFAULT_SM_OUTCOMES, FINISHED
+from respec.systems import SystemConfigError, available_systems, load_section
+from synthesis_manager.web.artifacts import ARTIFACTS, Artifact
+from synthesis_manager.web.errors import (ArtifactFailedError, InvalidJobRequestError, NotAvailableError,
+                                          NotFoundError)
+from synthesis_manager.web.jobs import JOB_OPTIONS, Job, JobRequest, local_outcome, names_field
+from synthesis_manager.web.simulations import Simulation, simulation_available
+
+
+GoalRunner = Callable[[JobRequest, Callable[[str, float], None], threading.Event], dict]
+
+
+class SynthesisBackend:
+    """Jobs run by ``run_goal(request, feedback, cancel) -> outcome dict`` in worker threads.
+
+    ``run_goal`` calls ``feedback(status, progress)`` as the pipeline advances and stops
+    (returning a PREEMPTED outcome) once ``cancel`` is set.
+
+    Test hook: ``job_gate`` is a set Event; while a test clears it, new jobs wait in the
+    ``queued`` state before anything is sent, which makes cancelling them deterministic.
+    """
+
+    def __init__(self, run_goal: GoalRunner, config_dir: str | Path | None = None,
+                 max_jobs: int = 100, description: str = ''):
+        self.run_goal = run_goal
+        self.config_dir = config_dir or None
+        self.max_jobs = max_jobs
+        self.description = description
+        self.job_gate = threading.Event()
+        self.job_gate.set()
+        self._jobs: OrderedDict[str, Job] = OrderedDict()
+        self._lock = threading.Lock()
+        self._artifacts: dict[tuple[str, str], Artifact] = {}
+        self._counter = itertools.count(1)
+        self._simulations: dict[str, Simulation] = {}
+        self._simulation_dir = tempfile.TemporaryDirectory(prefix='behavior-synthesis-gui-')
+        self.can_simulate = simulation_available()
+
+    # systems ---------------------------------------------------------------------------
+
+    def systems(self) -> list[str]:
+        return available_systems(self.config_dir)
+
+    def choices(self, system: str) -> dict:
+        """The control modes and actions of ``system``, in file order, with their relations."""
+        if system not in self.systems():
+            raise NotFoundError(f'unknown system {system!r} (known systems: {", ".join(self.systems())})',
+                                system)
+        try:
+            abstraction = load_abstraction(system, self.config_dir)
+        except SystemConfigError as error:
+            raise NotAvailableError(str(error), error.item or system) from error
+        modes, actions = abstraction.control_modes, abstraction.actions
+        return {
+            'system': system,
+            'control_modes': [{'name': m, 'next': list(n)} for m, n in modes.items()],
+            'actions': [{'name': a, 'preconditions': list(p)} for a, p in actions.items()],
+            'default_initial_conditions': list(modes)[:1],
+            'sm_outcome_choices': [list(DEFAULT_SM_OUTCOMES), [FINISHED]],
+            'options': list(JOB_OPTIONS),
+        }
+
+    # jobs ------------------------------------------------------------------------------
+
+    def start_job(self, body) -> dict:
+        request = JobRequest.from_json(body, self.systems())
+        job = Job(id=f'{next(self._counter)}-{uuid.uuid4().hex[:8]}', request=request)
+        with self._lock:
+            self._jobs[job.id] = job
+            self._forget_old_jobs()
+        threading.Thread(target=self._work, args=(job,), name=f'gui-job-{job.id}', daemon=True).start()
+        return job.to_dict()
+
+    def cancel_job(self, job_id: str) -> dict:
+        job = self._job(job_id)
+        if job.finished:
+            raise NotAvailableError(f'job {job_id!r} has already finished '
+                                    f'({job.outcome["error_name"]})', job_id)
+        job.cancel_requested.set()
+        self._update(job, status='cancelling')
+        return job.to_dict()
+
+    def job_status(self, job_id: str) -> dict:
+        return self._job(job_id).to_dict()
+
+    def job_revision(self, job_id: str) -> int:
+        return self._job(job_id).revision
+
+    def artifact(self, job_id: str, name: str) -> Artifact:
+        job = self._job(job_id)
+        if name not in ARTIFACTS:
+            raise NotFoundError(f'unknown artifact {name!r} (artifacts: {", ".join(ARTIFACTS)})', name)
+        if not job.finished:
+            raise NotAvailableError(f'job {job_id!r} has not finished yet', job_id)
+        media_type, present, build = ARTIFACTS[name]
+        if not present(job.outcome):
+            raise NotAvailableError(
+                f'job {job_id!r} ({job.outcome["error_name"]}) has no {name}', name)
+        key = (job_id, name)
+        if key not in self._artifacts:
+            try:
+                content = build(job.outcome)
+            except Exception as error:  # e.g. RenderError when Graphviz is missing
+                raise ArtifactFailedError(f'cannot make {name}: {error}',
+                                          getattr(error, 'item', '') or name) from error
+            self._artifacts[key] = Artifact(content, media_type, f'{job.request.name or "behavior"}_{name}')
+        return self._artifacts[key]
+
+    # simulations ------------------------------------------------------------------------
+
+    def start_simulation(self, job_id: str, body) -> dict:
+        """Run the state machine of a finished job on atlas_sim's simulated robot."""
+        job = self._job(job_id)
+        body = {} if body is None else body
+        if not isinstance(body, dict):
+            raise InvalidJobRequestError('the request body must be a JSON object', 'body')
+        unknown = sorted(set(body) - {'fail_first'})
+        if unknown:
+            raise InvalidJobRequestError(f'unknown field {unknown[0]!r} (fields: fail_first)', unknown[0])
+        fail_first = names_field(body, 'fail_first')
+        if not self.can_simulate:
+            raise NotAvailableError('simulation needs atlas_sim and MuJoCo, which are not installed',
+                                    'atlas_sim')
+        if not (job.finished and job.outcome.get('states')):
+            raise NotAvailableError(f'job {job_id!r} has no state machine to simulate', job_id)
+        try:
+            load_section(job.request.system, 'simulation', self.config_dir)
+        except SystemConfigError as error:
+            raise NotAvailableError(f'system {job.request.system!r} cannot be simulated: {error}',
+                                    job.request.system) from error
+        simulation = Simulation(id=f'{job_id}-sim{next(self._counter)}', job_id=job_id, fail_first=fail_first)
+        with self._lock:
+            self._simulations[simulation.id] = simulation
+        threading.Thread(target=self._simulate, args=(simulation, job), name=f'gui-{simulation.id}',
+                         daemon=True).start()
+        return simulation.to_dict()
+
+    def simulation_status(self, simulation_id: str) -> dict:
+        return self._simulation(simulation_id).to_dict()
+
+    def simulation_revision(self, simulation_id: str) -> int:
+        return self._simulation(simulation_id).revision
+
+    def simulation_frame(self, simulation_id: str, index: int) -> Artifact:
+        simulation = self._simulation(simulation_id)
+        if not 0 <= index < len(simulation.frames):
+            raise NotFoundError(f'simulation {simulation_id!r} has no frame {index}', str(index))
+        path = simulation.frames[index]
+        return Artifact(path.read_bytes(), 'image/png', path.name)
+
+    def simulation_timeline(self, simulation_id: str) -> Artifact:
+        simulation = self._simulation(simulation_id)
+        if simulation.timeline_png is None:
+            raise NotAvailableError(f'simulation {simulation_id!r} has no timeline yet', simulation_id)
+        return Artifact(simulation.timeline_png.read_bytes(), 'image/png', f'{simulation_id}_timeline.png')
+
+    def _simulation(self, simulation_id: str) -> Simulation:
+        with self._lock:
+            simulation = self._simulations.get(simulation_id)
+        if simulation is None:
+            raise NotFoundError(f'unknown simulation {simulation_id!r}', simulation_id)
+        return simulation
+
+    def _simulate(self, simulation: Simulation, job: Job):
+        import os
+
+        os.environ.setdefault('MUJOCO_GL', 'egl')  # off-screen rendering, before mujoco loads
+        from atlas_sim.executor import Executive, SimulatedRobot, StateMapping, make_simulator, parse_faults
+        from atlas_sim.rendering import KeyFrameRecorder
+        from atlas_sim.timeline import plot_timeline
+        from atlas_sim.trace_check import check_trace
+        from respec.parsing import spec_from_text_sections
+
+        request, started = job.request, time.monotonic()
+        directory = Path(self._simulation_dir.name) / simulation.id
+        recorder = executive = None
+
+        def watch(_robot):  # every control tick: publish only when a step or frame was added
+            simulation.robot_time = simulator.time
+            steps = executive.trace.steps
+            if len(steps) != len(simulation.steps) or len(recorder.paths) != len(simulation.frames):
+                self._update(simulation, steps=[dataclasses.asdict(step) for step in steps],
+                             frames=list(recorder.paths))
+
+        try:
+            simulator = make_simulator(request.system, self.config_dir, request.initial_conditions,
+                                       faults=parse_faults(fail_first=[f'{c}:1' for c in simulation.fail_first]))
+            recorder = KeyFrameRecorder(simulator, directory / 'frames', width=480, height=360)
+            recorder.capture('start')
+            executive = Executive(job.outcome['states'], SimulatedRobot(simulator),
+                                  StateMapping(request.system, self.config_dir),
+                                  max_robot_time=300.0, max_wall_time=300.0, on_tick=watch)
+            run = executive.run()
+            recorder.capture('end')
+            check = check_trace(run.trace, spec_from_text_sections(job.outcome['ltl_specification']),
+                                goals=list(request.goals), ordered=not request.unordered)
+            timeline = plot_timeline(run.trace, directory / 'timeline.png',
+                                     f'{", ".join(request.goals)}: {run.outcome}')
+            self._update(simulation, outcome=run.outcome, check=check.to_dict(), timeline_png=timeline,
+                         steps=[dataclasses.asdict(step) for step in run.trace.steps])
+        except Exception as error:  # ExecutionError, bad faults, rendering: report, keep serving
+            trace = getattr(error, 'trace', None)
+            self._update(simulation, error={
+                'code': getattr(error, 'code', type(error).__name__), 'item': getattr(error, 'item', ''),
+                'message': str(error)},
+                steps=[dataclasses.asdict(step) for step in trace.steps] if trace else simulation.steps)
+        finally:
+            if recorder is not None:
+                recorder.close()
+                self._update(simulation, frames=list(recorder.paths))
+            self._update(simulation, state='finished', wall_seconds=time.monotonic() - started)
+
+    def _job(self, job_id: str) -> Job:
+        with self._lock:
+            job = self._jobs.get(job_id)
+        if job is None:
+            raise NotFoundError(f'unknown job {job_id!r}', job_id)
+        return job
+
+    def _forget_old_jobs(self):
+        finished = [job_id for job_id, job in self._jobs.items() if job.finished]
+        for job_id in finished[:max(0, len(self._jobs) - self.max_jobs)]:
+            del self._jobs[job_id]
+            for key in [k for k in self._artifacts if k[0] == job_id]:
+                del self._artifacts[key]
+            for run_id in [r for r, run in self._simulations.items() if run.job_id == job_id]:
+                del self._simulations[run_id]
+
+    def _update(self, record, **changes):
+        """Change a Job or Simulation and bump its revision (what the event streams watch)."""
+        with self._lock:
+            for name, value in changes.items():
+                setattr(record, name, value)
+            record.revision += 1
+
+    def _work(self, job: Job):
+        while not self.job_gate.wait(0.05):
+            if job.cancel_requested.is_set():
+                break
+        if job.cancel_requested.is_set():  # never sent: nothing to cancel downstream
+            self._finish(job, local_outcome('PREEMPTED', 'cancelled before it was sent', job))
+            return
+        self._update(job, state='running', status='sending the goal')
+
+        def feedback(status: str, progress: float):
+            entry = {'seconds': round(time.monotonic() - job.created, 4), 'status': status,
+                     'progress': round(float(progress), 4)}
+            self._update(job, status=status, progress=float(progress), timeline=job.timeline + [entry])
+
+        try:
+            outcome = self.run_goal(job.request, feedback, job.cancel_requested)
+        except Exception as error:  # the GUI keeps serving whatever the runner does
+            outcome = local_outcome('FAILURE', f'the GUI could not run the goal: {error}', job)
+        self._finish(job, outcome)
+
+    def _finish(self, job: Job, outcome: dict):
+        self._update(job, state='finished', outcome=outcome, status=outcome['error_name'],
+                     finished_after=round(time.monotonic() - job.created, 4),
+                     progress=1.0 if outcome['error_name'] == 'SUCCESS' else job.progress)

@@ -1,0 +1,166 @@
+"""Synthesis jobs of the GUI: what the page asks for, what happened to it, its summary."""
+
+from __future__ import annotations
+
+import re
+import threading
+import time
+from dataclasses import asdict, dataclass, field
+
+from respec.naming import DEFAULT_SM_OUTCOMES, parse_names
+from synthesis_manager.web.artifacts import available_artifacts
+from synthesis_manager.web.errors import InvalidJobRequestError, NotFoundError
+
+# The stop-early options the page offers (ltl_synthesis_only needs a whole specification).
+JOB_OPTIONS = ('ltl_compilation_only', 'ltl_steps_only')
+REQUEST_FIELDS = ('system', 'initial_conditions', 'goals', 'sm_outcomes', 'option', 'unordered', 'name')
+_NAME = re.compile(r'^[A-Za-z][A-Za-z0-9_]*$')
+
+
+
+@dataclass(frozen=True)
+class JobRequest:
+    """What the page asks for; ``goals`` in the order they must be achieved."""
+
+    system: str
+    initial_conditions: tuple[str, ...]
+    goals: tuple[str, ...]
+    sm_outcomes: tuple[str, ...] = DEFAULT_SM_OUTCOMES
+    option: str | None = None
+    unordered: bool = False
+    name: str = ''
+
+    @classmethod
+    def from_json(cls, body, systems: list[str]) -> 'JobRequest':
+        """Validate a decoded JSON body; names may be lists or comma/space-separated text.
+
+        Goal and initial-condition names are not checked against the system here: the
+        pipeline does that and explains unknown names itself (UNKNOWN_PROPOSITION).
+        """
+        if not isinstance(body, dict):
+            raise InvalidJobRequestError('the request body must be a JSON object', 'body')
+        unknown = sorted(set(body) - set(REQUEST_FIELDS))
+        if unknown:
+            raise InvalidJobRequestError(
+                f'unknown field {unknown[0]!r} (fields: {", ".join(REQUEST_FIELDS)})', unknown[0])
+        system = body.get('system')
+        if not isinstance(system, str) or not system:
+            raise InvalidJobRequestError('field "system" must name a system', 'system')
+        if system not in systems:
+            raise NotFoundError(f'unknown system {system!r} (known systems: {", ".join(systems)})', system)
+        goals = names_field(body, 'goals')
+        if not goals:
+            raise InvalidJobRequestError('field "goals" must name at least one goal', 'goals')
+        sm_outcomes = names_field(body, 'sm_outcomes') or DEFAULT_SM_OUTCOMES
+        option = body.get('option') or None
+        if option is not None and option not in JOB_OPTIONS:
+            raise InvalidJobRequestError(
+                f'unknown option {option!r} (options: {", ".join(JOB_OPTIONS)})', str(option))
+        unordered = body.get('unordered', False)
+        if not isinstance(unordered, bool):
+            raise InvalidJobRequestError('field "unordered" must be true or false', 'unordered')
+        name = body.get('name') or ''
+        if not isinstance(name, str) or (name and not _NAME.match(name)):
+            raise InvalidJobRequestError(
+                f'behavior name {name!r} must start with a letter and contain only letters, '
+                'digits and underscores', str(name))
+        return cls(system=system, initial_conditions=names_field(body, 'initial_conditions'), goals=goals,
+                   sm_outcomes=sm_outcomes, option=option, unordered=unordered, name=name)
+
+
+def names_field(body: dict, key: str) -> tuple[str, ...]:
+    value = body.get(key) or []
+    if isinstance(value, list) and not all(isinstance(v, str) for v in value):
+        raise InvalidJobRequestError(f'field {key!r} must be a list of names', key)
+    if not isinstance(value, (str, list)):
+        raise InvalidJobRequestError(f'field {key!r} must be a list of names or comma-separated text', key)
+    names = tuple(parse_names(value))
+    for name in names:
+        if not _NAME.match(name):
+            raise InvalidJobRequestError(f'{key}: {name!r} is not a proposition name', name)
+    return names
+
+
+# --- jobs ---------------------------------------------------------------------------------
+
+@dataclass
+class Job:
+    """One synthesis request and everything that happened to it."""
+
+    id: str
+    request: JobRequest
+    state: str = 'queued'              # queued -> running -> finished
+    status: str = 'waiting to be sent'
+    progress: float = 0.0
+    timeline: list[dict] = field(default_factory=list)  # {'seconds', 'status', 'progress'}
+    outcome: dict | None = None        # SynthesisOutcome.to_dict() once finished
+    cancel_requested: threading.Event = field(default_factory=threading.Event, repr=False)
+    created: float = field(default_factory=time.monotonic, repr=False)
+    revision: int = 0                  # bumped on every change, so streams send only news
+    finished_after: float = 0.0        # seconds from creation to the result
+
+    @property
+    def finished(self) -> bool:
+        return self.state == 'finished'
+
+    def to_dict(self) -> dict:
+        return {'id': self.id, 'state': self.state, 'status': self.status,
+                'progress': round(self.progress, 4), 'request': asdict(self.request),
+                'cancel_requested': self.cancel_requested.is_set(),
+                'timeline': list(self.timeline), 'outcome': self.outcome,
+                'summary': result_summary(self.outcome) if self.outcome else None,
+                'stages': stage_timings(self.timeline, self.finished_after) if self.outcome else [],
+                'artifacts': available_artifacts(self.outcome) if self.outcome else []}
+
+
+# Values of synthesis_msgs/SynthesisErrorCodes for the outcomes the GUI makes itself.
+LOCAL_ERROR_CODES = {'PREEMPTED': -9, 'FAILURE': 99999}
+
+
+def local_outcome(error_name: str, message: str, job: Job) -> dict:
+    """An outcome (SynthesisOutcome.to_dict() shape) for a job that never got a result."""
+    return {'error_code': LOCAL_ERROR_CODES[error_name], 'error_name': error_name, 'message': message,
+            'states': [], 'ltl_specification': {}, 'automaton': {},
+            'seconds': round(time.monotonic() - job.created, 4)}
+
+
+def result_summary(outcome: dict) -> dict:
+    """Realizability and sizes of a finished job, as the result page shows them."""
+    sections = outcome.get('ltl_specification') or {}
+    automaton_states = len((outcome.get('automaton') or {}).get('states') or [])
+    states = outcome.get('states') or []
+    if outcome.get('error_name') == 'SPEC_UNSYNTHESIZABLE':
+        realizable = False
+    elif automaton_states:
+        realizable = True
+    else:
+        realizable = None  # synthesis did not run (compile only, or an earlier failure)
+    return {
+        'succeeded': outcome.get('error_name') == 'SUCCESS',
+        'realizable': realizable,
+        'input_propositions': len(sections.get('env_props', [])),
+        'output_propositions': len(sections.get('sys_props', [])),
+        'formulas': sum(len(lines) for name, lines in sections.items() if not name.endswith('_props')),
+        'automaton_states': automaton_states,
+        # the root entry '/' is the machine itself, not one of its states
+        'state_machine_states': sum(1 for s in states if s['state_path'] != '/'),
+        'state_instantiations': len(states),
+        'concurrency_containers': sum(1 for s in states if s['state_class'] == ':CONCURRENCY'),
+        'seconds': outcome.get('seconds', 0.0),
+    }
+
+
+def stage_timings(timeline: list[dict], total_seconds: float) -> list[dict]:
+    """How long each pipeline stage took, from the feedback timeline.
+
+    A stage starts with a status whose first word is a gerund ("Compiling ...",
+    "Synthesizing ...") and lasts until the next status (or the end of the job).
+    """
+    stages = []
+    for index, entry in enumerate(timeline):
+        first_word = entry['status'].split(' ', 1)[0]
+        if not first_word.endswith('ing'):
+            continue
+        end = timeline[index + 1]['seconds'] if index + 1 < len(timeline) else total_seconds
+        stages.append({'stage': entry['status'], 'seconds': round(max(0.0, end - entry['seconds']), 4)})
+    return stages

@@ -1,0 +1,147 @@
+"""The synthesis web GUI's routes as a FastAPI app (ROS-free): page, JSON API, progress streams, downloads.
+
+``create_app(backend)`` serves ``static/`` and these routes::
+
+    GET  /                                   the page (static/index.html; app.js, style.css under /static)
+    GET  /api/systems                        {"systems": [...]}
+    GET  /api/systems/{system}               what a request may name: control modes, actions
+    POST /api/jobs                           start a synthesis job -> 202 {"id": ..., ...}
+    GET  /api/jobs/{id}                      its status, progress timeline, result and summary
+    GET  /api/jobs/{id}/events               the same as server-sent events until the job ends
+    POST /api/jobs/{id}/cancel               cancel it (the result becomes PREEMPTED)
+    GET  /api/jobs/{id}/artifacts/{name}     a download (see ARTIFACTS); ?inline=1 to display it
+    POST /api/jobs/{id}/simulations          run the job's state machine on the simulated robot
+    GET  /api/simulations/{id}               its trace so far, frames, outcome and trace check
+    GET  /api/simulations/{id}/events        the same as server-sent events until the run ends
+    GET  /api/simulations/{id}/frames/{n}    key frame n (PNG); .../timeline.png the timeline plot
+
+Bad input is answered with a 4xx JSON body ``{"error", "item", "message"}`` whose ``item``
+names the offending system, field, job or artifact; the server keeps serving.
+
+The backend does the work: :class:`synthesis_manager.web.backend.SynthesisBackend` keeps
+the jobs, validates requests and builds the downloads; the synthesis itself is a
+``run_goal`` callable given to it (``gui.RosGoalRunner`` sends the goal to
+``/behavior_synthesis``).
+"""
+
+from __future__ import annotations
+
+import asyncio
+import json
+from pathlib import Path
+from typing import Callable
+
+from fastapi import Body, FastAPI, Request
+from fastapi.exceptions import RequestValidationError
+from fastapi.responses import FileResponse, JSONResponse, Response, StreamingResponse
+from fastapi.staticfiles import StaticFiles
+
+from synthesis_manager.web.artifacts import Artifact
+from synthesis_manager.web.errors import GuiRequestError, InvalidJobRequestError
+
+STATIC_DIR = Path(__file__).with_name('static')
+
+
+def create_app(backend) -> FastAPI:
+    """The GUI's FastAPI app around ``backend`` (a SynthesisBackend or the same methods)."""
+    # No Swagger/ReDoc pages: they load third-party code from a CDN. The schema stays available.
+    app = FastAPI(title='Behavior synthesis', docs_url=None, redoc_url=None, openapi_url='/api/openapi.json')
+    app.mount('/static', StaticFiles(directory=STATIC_DIR), name='static')
+
+    @app.exception_handler(GuiRequestError)
+    async def gui_error(_request, error: GuiRequestError):
+        return JSONResponse(error.to_dict(), status_code=error.status)
+
+    @app.exception_handler(RequestValidationError)
+    async def malformed(_request, error: RequestValidationError):
+        problem = error.errors()[0] if error.errors() else {'loc': ['body'], 'msg': 'malformed request'}
+        item = '.'.join(str(part) for part in problem.get('loc', ['body']))
+        return JSONResponse(InvalidJobRequestError(f'{item}: {problem.get("msg")}', item).to_dict(),
+                            status_code=422)
+
+    @app.get('/', include_in_schema=False)
+    def index():
+        return FileResponse(STATIC_DIR / 'index.html', media_type='text/html')
+
+    @app.get('/api/info')
+    def info():
+        return {'description': getattr(backend, 'description', ''),
+                'simulation': bool(getattr(backend, 'can_simulate', False))}
+
+    @app.get('/api/systems')
+    def systems():
+        return {'systems': backend.systems()}
+
+    @app.get('/api/systems/{system}')
+    def choices(system: str):
+        return backend.choices(system)
+
+    @app.post('/api/jobs', status_code=202)
+    def start_job(body=Body(None)):
+        return backend.start_job(body)
+
+    @app.get('/api/jobs/{job_id}')
+    def job_status(job_id: str):
+        return backend.job_status(job_id)
+
+    @app.post('/api/jobs/{job_id}/cancel', status_code=202)
+    def cancel_job(job_id: str):
+        return backend.cancel_job(job_id)
+
+    @app.get('/api/jobs/{job_id}/events')
+    async def job_events(job_id: str, request: Request):
+        backend.job_status(job_id)  # unknown job: 404 now rather than an empty stream
+        return _event_stream(request, lambda: backend.job_revision(job_id),
+                             lambda: backend.job_status(job_id))
+
+    @app.get('/api/jobs/{job_id}/artifacts/{name}')
+    def artifact(job_id: str, name: str, inline: bool = False):
+        return _file_response(backend.artifact(job_id, name), inline)
+
+    @app.post('/api/jobs/{job_id}/simulations', status_code=202)
+    def start_simulation(job_id: str, body=Body(None)):
+        return backend.start_simulation(job_id, body)
+
+    @app.get('/api/simulations/{simulation_id}')
+    def simulation_status(simulation_id: str):
+        return backend.simulation_status(simulation_id)
+
+    @app.get('/api/simulations/{simulation_id}/events')
+    async def simulation_events(simulation_id: str, request: Request):
+        backend.simulation_status(simulation_id)
+        return _event_stream(request, lambda: backend.simulation_revision(simulation_id),
+                             lambda: backend.simulation_status(simulation_id))
+
+    @app.get('/api/simulations/{simulation_id}/frames/{index}')
+    def simulation_frame(simulation_id: str, index: int):
+        return _file_response(backend.simulation_frame(simulation_id, index), inline=True)
+
+    @app.get('/api/simulations/{simulation_id}/timeline.png')
+    def simulation_timeline(simulation_id: str):
+        return _file_response(backend.simulation_timeline(simulation_id), inline=True)
+
+    return app
+
+
+def _file_response(found: Artifact, inline: bool) -> Response:
+    disposition = 'inline' if inline else 'attachment'
+    return Response(found.content, media_type=found.media_type,
+                    headers={'Content-Disposition': f'{disposition}; filename="{found.filename}"'})
+
+
+def _event_stream(request: Request, revision: Callable[[], int], snapshot: Callable[[], dict]):
+    """Server-sent events: ``progress`` with each new snapshot, then one ``finished``."""
+    async def events():
+        sent = -1
+        while not await request.is_disconnected():
+            current = revision()
+            if current != sent:
+                sent = current
+                data = snapshot()
+                kind = 'finished' if data['state'] == 'finished' else 'progress'
+                yield f'event: {kind}\ndata: {json.dumps(data)}\n\n'
+                if kind == 'finished':
+                    return
+            await asyncio.sleep(0.05)
+
+    return StreamingResponse(events(), media_type='text/event-stream', headers={'Cache-Control': 'no-cache'})

@@ -1,0 +1,186 @@
+"""Imports point one way: the ROS-free cores never import the shell, and packages form a DAG.
+
+Read with ``ast`` (nothing is imported), so a forbidden import is found even inside a
+function or behind a try. Every import counts, function-local ones included: a cycle cannot
+be hidden by importing late.
+
+A ROS package folder (a directory with a ``package.xml``, e.g. a FlexBE state package inside
+``atlas_sim/``) is its own package: it may import flexbe_core and rclpy, and the core modules
+around it must not import it.
+"""
+
+from __future__ import annotations
+
+import ast
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+CORES = ('respec', 'ltl_specification', 'ltl_synthesizer', 'sm_generation', 'atlas_sim')
+SHELL = 'synthesis_manager'
+PACKAGES = (*CORES, SHELL)
+# What no core may import: the shell, ROS, the interface package, the web stack, FlexBE.
+SHELL_ONLY = ('synthesis_manager', 'rclpy', 'rcl_interfaces', 'action_msgs', 'synthesis_msgs',
+              'domain_coordinator', 'fastapi', 'starlette', 'uvicorn', 'flexbe_core')
+
+
+def ros_package_folders(root: Path = ROOT) -> list[Path]:
+    """Directories with a package.xml inside the Python packages (not the repository's own)."""
+    return sorted(path.parent for package in PACKAGES for path in (root / package).rglob('package.xml'))
+
+
+def owner(path: Path, root: Path, ros_folders: list[Path]) -> str:
+    """The package a source file belongs to: a ROS package folder, else its top-level package."""
+    for folder in ros_folders:
+        if folder in path.parents:
+            return folder.relative_to(root).as_posix()
+    return path.relative_to(root).parts[0]
+
+
+def imported_modules(path: Path, root: Path) -> list[tuple[str, int]]:
+    """Every module ``path`` imports (relative imports resolved), with its line number."""
+    tree = ast.parse(path.read_text(), filename=str(path))
+    here = list(path.relative_to(root).with_suffix('').parts)
+    if here[-1] == '__init__':
+        here.pop()
+    else:
+        here = here[:-1]  # the package containing the module
+    found = []
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            found += [(alias.name, node.lineno) for alias in node.names]
+        elif isinstance(node, ast.ImportFrom):
+            if node.level:
+                base = here[:len(here) - (node.level - 1)]
+                module = '.'.join(base + ([node.module] if node.module else []))
+            else:
+                module = node.module or ''
+            found.append((module, node.lineno))
+    return found
+
+
+def ros_python_names(folder: Path) -> set[str]:
+    """The top-level Python package names a ROS package folder provides."""
+    return {child.name for child in folder.iterdir() if (child / '__init__.py').exists()}
+
+
+def import_graph(root: Path = ROOT):
+    """(package -> {imported project package: first 'file:line'}, forbidden imports of the cores)."""
+    ros_folders = ros_package_folders(root)
+    ros_names = {name: folder.relative_to(root).as_posix()
+                 for folder in ros_folders for name in ros_python_names(folder)}
+    graph: dict[str, dict[str, str]] = {}
+    forbidden = []
+    for package in PACKAGES:
+        for path in sorted((root / package).rglob('*.py')):
+            source = owner(path, root, ros_folders)
+            edges = graph.setdefault(source, {})
+            for module, line in imported_modules(path, root):
+                where = f'{path.relative_to(root).as_posix()}:{line}'
+                target = _target(module, ros_folders, ros_names, root)
+                if target is not None and target != source:
+                    edges.setdefault(target, where)
+                into_ros_folder = target is not None and target not in PACKAGES
+                if source in CORES and (module.split('.')[0] in SHELL_ONLY or into_ros_folder):
+                    forbidden.append(f'{where}: {source} imports {module}')
+    return graph, forbidden
+
+
+def _target(module: str, ros_folders, ros_names: dict[str, str], root: Path) -> str | None:
+    """The project package ``module`` belongs to, or None for third-party modules."""
+    parts = module.split('.')
+    if parts[0] in ros_names:
+        return ros_names[parts[0]]
+    for folder in ros_folders:  # imported by its path inside the package, e.g. atlas_sim.flexbe_x
+        dotted = folder.relative_to(root).as_posix().replace('/', '.')
+        if module == dotted or module.startswith(dotted + '.'):
+            return folder.relative_to(root).as_posix()
+    return parts[0] if parts[0] in PACKAGES else None
+
+
+def find_cycle(graph: dict[str, dict[str, str]]) -> list[str]:
+    """One cycle of the package graph as [a, b, ..., a], or [] when it is a DAG."""
+    state: dict[str, str] = {}
+
+    def visit(package: str, path: list[str]) -> list[str]:
+        state[package] = 'open'
+        for successor in sorted(graph.get(package, {})):
+            if state.get(successor) == 'open':  # on the current path: a cycle
+                return path[path.index(successor):] + [successor]
+            if successor not in state:
+                cycle = visit(successor, path + [successor])
+                if cycle:
+                    return cycle
+        state[package] = 'done'
+        return []
+
+    for package in sorted(graph):
+        if package not in state:
+            cycle = visit(package, [package])
+            if cycle:
+                return cycle
+    return []
+
+
+def test_cores_import_neither_the_shell_nor_ros_nor_the_web_stack():
+    _graph, forbidden = import_graph()
+    assert forbidden == []
+
+
+def test_packages_import_each_other_without_cycles():
+    graph, _forbidden = import_graph()
+    cycle = find_cycle(graph)
+    assert cycle == [], ' -> '.join(cycle) + ': ' + ', '.join(
+        graph[a][b] for a, b in zip(cycle, cycle[1:]))
+
+
+def test_the_cores_sit_below_the_shell():
+    graph, _forbidden = import_graph()
+    assert set(graph[SHELL]) >= {'ltl_specification', 'ltl_synthesizer', 'sm_generation', 'atlas_sim'}
+    assert set(graph['respec']) == set()
+    assert SHELL not in {target for core in CORES for target in graph[core]}
+
+
+# --- the checker itself, on small made-up trees ------------------------------------------
+
+def _write(root: Path, files: dict[str, str]) -> Path:
+    for name, text in files.items():
+        path = root / name
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_text(text)
+    return root
+
+
+def test_checker_finds_a_cycle_hidden_in_a_function(tmp_path):
+    root = _write(tmp_path, {
+        'respec/__init__.py': '',
+        'sm_generation/__init__.py': 'from respec import x\n',
+        'respec/late.py': 'def f():\n    from sm_generation import y\n',
+    })
+    graph, _ = import_graph(root)
+    assert find_cycle(graph) in (['respec', 'sm_generation', 'respec'], ['sm_generation', 'respec', 'sm_generation'])
+
+
+def test_checker_reports_a_core_importing_rclpy_or_the_shell(tmp_path):
+    root = _write(tmp_path, {
+        'atlas_sim/__init__.py': '',
+        'atlas_sim/node.py': 'import rclpy\n',
+        'ltl_synthesizer/cli.py': 'try:\n    from synthesis_manager.ros import env\nexcept ImportError:\n    pass\n',
+        'synthesis_manager/__init__.py': 'import rclpy\nimport fastapi\n',
+    })
+    _, forbidden = import_graph(root)
+    assert sorted(forbidden) == ['atlas_sim/node.py:1: atlas_sim imports rclpy',
+                         'ltl_synthesizer/cli.py:2: ltl_synthesizer imports synthesis_manager.ros']
+
+
+def test_checker_lets_a_ros_package_folder_import_flexbe_but_not_the_cores_import_it(tmp_path):
+    root = _write(tmp_path, {
+        'atlas_sim/__init__.py': '',
+        'atlas_sim/flexbe_states/package.xml': '<package/>',
+        'atlas_sim/flexbe_states/flexbe_states/__init__.py': '',
+        'atlas_sim/flexbe_states/flexbe_states/mode_state.py':
+            'from flexbe_core import EventState\nimport rclpy\nfrom atlas_sim import executor\n',
+        'atlas_sim/executor.py': 'from flexbe_states.mode_state import ModeState\n',
+    })
+    graph, forbidden = import_graph(root)
+    assert forbidden == ['atlas_sim/executor.py:1: atlas_sim imports flexbe_states.mode_state']
+    assert graph['atlas_sim/flexbe_states'] == {'atlas_sim': 'atlas_sim/flexbe_states/flexbe_states/mode_state.py:3'}

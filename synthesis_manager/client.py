@@ -6,13 +6,19 @@ import threading
 import time
 from dataclasses import dataclass, field
 
+import yaml
+
 from respec.naming import DEFAULT_SM_OUTCOMES
-from synthesis_manager.ros.conversions import error_name, msg_to_sections, msg_to_state_dict
+from synthesis_manager.ros.conversions import error_name, flexbe_error_name, msg_to_sections, msg_to_state_dict
 from synthesis_manager.ros.harness import wait_for
-from synthesis_msgs.action import BehaviorSynthesis
-from synthesis_msgs.msg import BehaviorSynthesisRequest, LTLSpecification, SynthesisOptions
+from synthesis_msgs.action import BehaviorSynthesis, FlexBESynthesis
+from synthesis_msgs.msg import (BehaviorSynthesisRequest, FlexBESynthesisRequest, LTLSpecification,
+                                SynthesisOptions)
 
 ACTION_NAME = 'behavior_synthesis'
+# The two action interfaces of the server: name -> action type.
+ACTIONS = {'behavior_synthesis': BehaviorSynthesis, 'flexbe_synthesis': FlexBESynthesis}
+GOAL_STATUS_NAMES = {4: 'SUCCEEDED', 5: 'CANCELED', 6: 'ABORTED'}
 
 
 @dataclass
@@ -26,6 +32,7 @@ class SynthesisOutcome:
     ltl_specification: dict = field(default_factory=dict)
     automaton: dict = field(default_factory=dict)
     seconds: float = 0.0
+    goal_status: str = ''
 
     @property
     def succeeded(self) -> bool:
@@ -35,7 +42,7 @@ class SynthesisOutcome:
         return {'error_code': self.error_code, 'error_name': self.error_name,
                 'message': self.message, 'states': self.states,
                 'ltl_specification': self.ltl_specification, 'automaton': self.automaton,
-                'seconds': round(self.seconds, 4)}
+                'seconds': round(self.seconds, 4), 'goal_status': self.goal_status}
 
 
 def make_goal(system: str, initial_conditions, goals, sm_outcomes=DEFAULT_SM_OUTCOMES,
@@ -53,6 +60,20 @@ def make_goal(system: str, initial_conditions, goals, sm_outcomes=DEFAULT_SM_OUT
     return BehaviorSynthesis.Goal(request=request, synthesis_options=options)
 
 
+def make_flexbe_goal(system: str, initial_conditions, goals, sm_outcomes=DEFAULT_SM_OUTCOMES,
+                     option: str | None = None, name: str = '', timeout: float = 0.0,
+                     unordered: bool = False) -> FlexBESynthesis.Goal:
+    """A FlexBESynthesis goal (CNU's interface): the options travel as YAML."""
+    as_list = lambda names: [names] if isinstance(names, str) else list(names)  # noqa: E731
+    options = {name: True for name in (option,) if name}
+    if unordered:
+        options['unordered_goals'] = True
+    request = FlexBESynthesisRequest(
+        system_name=system, initial_conditions=as_list(initial_conditions), goals=as_list(goals),
+        sm_outcomes=list(sm_outcomes), spec_name=name, synthesis_timeout_s=float(timeout))
+    return FlexBESynthesis.Goal(request=request, synthesis_options=yaml.safe_dump(options) if options else '')
+
+
 def automaton_to_dict(automaton) -> dict:
     return {'output_variables': list(automaton.output_variables),
             'input_variables': list(automaton.input_variables),
@@ -64,9 +85,15 @@ def automaton_to_dict(automaton) -> dict:
 
 
 def outcome_from_result(result, seconds: float) -> SynthesisOutcome:
+    """A result of either action; FlexBESynthesis results carry CNU's codes and `messages`."""
+    states = [msg_to_state_dict(s) for s in result.states]
+    if isinstance(result, FlexBESynthesis.Result):
+        return SynthesisOutcome(
+            error_code=result.error_code.value, error_name=flexbe_error_name(result.error_code.value),
+            message='\n'.join(result.messages), states=states, seconds=seconds)
     return SynthesisOutcome(
         error_code=result.error_code.value, error_name=error_name(result.error_code.value),
-        message=result.error_code.message, states=[msg_to_state_dict(s) for s in result.states],
+        message=result.error_code.message, states=states,
         ltl_specification=msg_to_sections(result.ltl_specification),
         automaton=automaton_to_dict(result.automaton), seconds=seconds)
 
@@ -75,10 +102,11 @@ class SynthesisClient:
     """Sends goals from a (spinning) node and waits for them in the calling thread."""
 
     def __init__(self, node, action_name: str = ACTION_NAME):
+        """``action_name``: one of ACTIONS (its type), or any name served with BehaviorSynthesis."""
         from rclpy.action import ActionClient
 
         self.node = node
-        self.action_client = ActionClient(node, BehaviorSynthesis, action_name)
+        self.action_client = ActionClient(node, ACTIONS.get(action_name, BehaviorSynthesis), action_name)
 
     def wait_for_server(self, timeout: float = 10.0) -> bool:
         return self.action_client.wait_for_server(timeout_sec=timeout)
@@ -103,4 +131,7 @@ class SynthesisClient:
             if time.monotonic() - started > timeout:
                 handle.cancel_goal_async()
                 raise TimeoutError(f'no result within {timeout:g} s')
-        return outcome_from_result(result_future.result().result, time.monotonic() - started)
+        response = result_future.result()
+        outcome = outcome_from_result(response.result, time.monotonic() - started)
+        outcome.goal_status = GOAL_STATUS_NAMES.get(response.status, str(response.status))
+        return outcome

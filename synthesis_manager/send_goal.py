@@ -31,13 +31,16 @@ def add_goal_arguments(parser, with_options: bool = True):
 
 def add_arguments(parser):
     add_goal_arguments(parser)
+    parser.add_argument('--action', choices=('behavior_synthesis', 'flexbe_synthesis'),
+                        default='behavior_synthesis',
+                        help="the server's interface: the original BehaviorSynthesis or CNU's FlexBESynthesis")
     parser.add_argument('--timeout', type=float, default=120.0, help='seconds to wait for the result')
     parser.add_argument('--json', action='store_true', help='print the result as one JSON object')
     parser.add_argument('-o', '--output', help='also write the JSON result to this file')
 
 
 def goal_from_args(args):
-    from synthesis_manager.client import make_goal
+    from synthesis_manager.client import make_flexbe_goal, make_goal
 
     option, spec = None, None
     if getattr(args, 'compile_only', False):
@@ -46,6 +49,13 @@ def goal_from_args(args):
         option = 'ltl_steps_only'
     elif getattr(args, 'synthesis_only', None):
         option, spec = 'ltl_synthesis_only', read_spec_file(args.synthesis_only)
+    if getattr(args, 'action', '') == 'flexbe_synthesis':
+        if spec is not None:
+            raise ValueError('--synthesis-only needs --action behavior_synthesis (FlexBESynthesis '
+                             'goals carry no specification)')
+        return make_flexbe_goal(args.system, parse_names(args.initial_conditions), parse_names(args.goals),
+                                parse_names(args.sm_outcomes), option=option, name=args.name,
+                                timeout=getattr(args, 'timeout', 0.0), unordered=args.unordered)
     return make_goal(args.system, parse_names(args.initial_conditions), parse_names(args.goals),
                      parse_names(args.sm_outcomes), option=option, name=args.name,
                      ltl_specification=spec, unordered=args.unordered,
@@ -104,9 +114,9 @@ def run(args) -> int:
     from rclpy.node import Node
 
     with RosHarness(domain_id=environment_domain_id()) as ros:
-        client = SynthesisClient(ros.add_node(Node, 'behavior_synthesis_client'))
+        client = SynthesisClient(ros.add_node(Node, 'behavior_synthesis_client'), args.action)
         if not client.wait_for_server(timeout=10.0):
-            print('send-goal: no /behavior_synthesis action server (start one with '
+            print(f'send-goal: no /{args.action} action server (start one with '
                   '`behavior-synthesis serve`)', file=sys.stderr)
             return 1
         progress = None if args.json else ProgressBar()

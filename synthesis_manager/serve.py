@@ -20,4 +20,4 @@ def run(args) -> int:
         return 2
     return run_nodes(*suite_node_factories(args, names),
                      ready_message=f'behavior synthesis suite up: {", ".join(names)} '
-                                   '(action /behavior_synthesis); Ctrl-C to stop')
+                                   '(actions /behavior_synthesis and /flexbe_synthesis); Ctrl-C to stop')

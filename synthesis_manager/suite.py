@@ -29,6 +29,8 @@ def add_suite_arguments(parser):
     group.add_argument('--synthesis-timeout', type=float, default=120.0, help='seconds per synthesis')
     group.add_argument('--service-timeout', type=float, default=5.0,
                        help='seconds to wait for a pipeline service to appear')
+    group.add_argument('--default-system', default='',
+                       help='system for requests naming none or "system_wide" (default: atlas)')
 
 
 def suite_node_factories(args=None, names=SUITE_NODE_NAMES):
@@ -47,7 +49,8 @@ def suite_node_factories(args=None, names=SUITE_NODE_NAMES):
         'sm_generation': (SMGenerationNode, overrides(config_dir=getattr(args, 'config_dir', ''))),
         'behavior_synthesis_server': (BehaviorSynthesisServer, overrides(
             synthesis_timeout=getattr(args, 'synthesis_timeout', None),
-            service_timeout=getattr(args, 'service_timeout', None))),
+            service_timeout=getattr(args, 'service_timeout', None),
+            default_system=getattr(args, 'default_system', ''))),
     }
     return [functools.partial(settings[name][0], parameter_overrides=settings[name][1])
             for name in names]

@@ -112,3 +112,15 @@ def test_demo_writes_every_artifact(tmp_path):
                  'state_machine.json', 'state_machine.dot', 'state_machine.svg', 'state_machine.png'):
         assert (tmp_path / name).stat().st_size > 0, name
     assert json.loads((tmp_path / 'demo.json').read_text())['nodes']
+
+
+@pytest.mark.parametrize('action', ['behavior_synthesis', 'flexbe_synthesis'])
+def test_send_goal_shows_the_error_name_and_message_of_either_interface(served, action):
+    result = send_goal(served, '--action', action, '--system', 'system_wide', '--goals', 'look_down,levitate')
+    assert result.returncode == 1
+    assert 'UNKNOWN_PROPOSITION' in result.stderr.splitlines()[-1]  # the last feedback, in the progress line
+    summary = result.stdout.splitlines()
+    assert any('UNKNOWN_PROPOSITION' in line for line in summary[:2]), result.stdout
+    assert any(line.startswith('message: ') and 'levitate' in line for line in summary), result.stdout
+    success = send_goal(served, '--action', action, '--system', 'system_wide', '--json')
+    assert json.loads(success.stdout)['error_name'] == 'SUCCESS', success.stdout

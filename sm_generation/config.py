@@ -6,6 +6,10 @@
       sm_outcomes:              # SM-outcome proposition -> outcome of the generated machine
         finished: finished
         failed: failed
+      packages:                 # optional: FlexBE packages implementing the classes below
+        states: atlas_sim_flexbe_states          # state classes (module: class name in snake_case)
+        state_classes: {InputState: flexbe_states}   # classes from another package
+        behaviors: atlas_sim_flexbe_behaviors    # the :BEHAVIOR behaviors
       states:                   # activation proposition <p>_a (or sensor) -> FlexBE state
         look_down_a:
           class_decl: {name: TiltHeadState, param_names: [desired_tilt], param_values: [TiltHeadState.DOWN_45]}
@@ -22,7 +26,7 @@ is the dotted key of the offending entry (e.g. ``flexbe.states.look_down_a.auton
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 from respec.naming import ACTIVATION_SUFFIX
@@ -71,6 +75,13 @@ class FlexBEConfig:
     system: str
     sm_outcomes: dict[str, str]          # SM-outcome proposition -> machine outcome
     states: dict[str, StateConfig]       # proposition -> state configuration
+    states_package: str = ''             # FlexBE package of the state classes ('' unknown)
+    state_class_packages: dict[str, str] = field(default_factory=dict)  # exceptions: class -> package
+    behavior_package: str = ''           # FlexBE package of the :BEHAVIOR behaviors
+
+    def state_package(self, state_class: str) -> str:
+        """The FlexBE package implementing ``state_class`` ('' when the config names none)."""
+        return self.state_class_packages.get(state_class, self.states_package)
 
     def owner_of_outcome(self, outcome_proposition: str) -> StateConfig | None:
         """The state whose ``output_mapping`` contains ``outcome_proposition``."""
@@ -116,7 +127,29 @@ def parse_flexbe_config(section: dict, system: str = '') -> FlexBEConfig:
                                     f'flexbe.states.{proposition}')
         states[proposition] = _state_config(proposition, entry)
     _check_unique_outcome_owners(states)
-    return FlexBEConfig(system=system, sm_outcomes=sm_outcomes, states=states)
+    packages = _packages(section.get('packages'))
+    return FlexBEConfig(system=system, sm_outcomes=sm_outcomes, states=states,
+                        states_package=packages.get('states', ''),
+                        state_class_packages=dict(packages.get('state_classes', {})),
+                        behavior_package=packages.get('behaviors', ''))
+
+
+def _packages(raw) -> dict:
+    key = 'flexbe.packages'
+    if raw is None:
+        return {}
+    if not isinstance(raw, dict) or set(raw) - {'states', 'state_classes', 'behaviors'}:
+        raise SMGenerationError('CONFIG_FILE_INVALID', f'{key} may only name states, state_classes and '
+                                f'behaviors, got {raw!r}', key)
+    for name in ('states', 'behaviors'):
+        if name in raw and (not isinstance(raw[name], str) or not raw[name]):
+            raise SMGenerationError('CONFIG_FILE_INVALID', f'{key}.{name} must be a package name', f'{key}.{name}')
+    classes = raw.get('state_classes', {})
+    if not isinstance(classes, dict) or not all(isinstance(k, str) and isinstance(v, str) and v
+                                                for k, v in classes.items()):
+        raise SMGenerationError('CONFIG_FILE_INVALID', f'{key}.state_classes must map class names to packages',
+                                f'{key}.state_classes')
+    return raw
 
 
 def _sm_outcomes(raw) -> dict[str, str]:

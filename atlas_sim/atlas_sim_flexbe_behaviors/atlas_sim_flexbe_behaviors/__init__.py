@@ -1,0 +1,1 @@
+"""FlexBE behaviors for atlas_sim robots (see package.xml)."""

@@ -1,0 +1,1 @@
+"""FlexBE states driving the atlas_sim simulator node (see package.xml)."""

@@ -1,0 +1,63 @@
+"""One capability run on the simulator node, through FlexBE's ProxyActionClient.
+
+The simulator node (atlas_sim) serves one ExecuteCapability action per capability under
+``atlas_sim/capabilities/<capability>``: FlexBE's proxy keeps one goal per action name, and
+states running concurrently (a ConcurrencyContainer) each need their own. Nothing here
+blocks in ``execute``: the goal is sent on enter, the result is polled.
+"""
+
+from flexbe_core import Logger
+from flexbe_core.proxy import ProxyActionClient
+
+from synthesis_msgs.action import ExecuteCapability
+
+# Must match the simulator node's CAPABILITY_ACTION_PREFIX (checked by the project's tests).
+CAPABILITY_ACTION_PREFIX = 'atlas_sim/capabilities/'
+COMPLETED = 'completed'  # ExecuteCapability result outcome meaning success
+# How long on_enter waits for the simulator's action server the first time (discovery).
+SERVER_WAIT = 5.0
+
+
+class CapabilityRequest:
+    """Runs ``capability`` (None: the state's parameters name nothing the simulator can do)."""
+
+    def __init__(self, capability, state_name):
+        self.capability = capability
+        self.state_name = state_name
+        self.result = None  # the ExecuteCapability result once it arrived
+        self._failure = None
+        self._topic = CAPABILITY_ACTION_PREFIX + capability if capability else None
+
+    def start(self, unsupported_reason=''):
+        """Send the goal (on_enter)."""
+        self.result, self._failure = None, None
+        if not self._topic:
+            self._failure = unsupported_reason or f'{self.state_name}: nothing the simulator can do'
+            Logger.logwarn(self._failure)
+            return
+        try:
+            # Registered on first use, where waiting for discovery is expected (a client made
+            # while the behavior is built would report the not yet discovered server as an error).
+            ProxyActionClient.setupClient(self._topic, ExecuteCapability, wait_duration=SERVER_WAIT)
+            ProxyActionClient.send_goal(self._topic, ExecuteCapability.Goal(capability=self.capability),
+                                        wait_duration=SERVER_WAIT)
+        except Exception as error:  # pylint: disable=broad-except  (no server, wrong type)
+            self._failure = f'{self.state_name}: could not request {self.capability}: {error}'
+            Logger.logwarn(self._failure)
+
+    def outcome(self, completed, failed):
+        """``completed``/``failed`` once the robot answered, None while it runs (execute)."""
+        if self._failure:
+            return failed
+        if not ProxyActionClient.has_result(self._topic):
+            return None
+        self.result = ProxyActionClient.get_result(self._topic)
+        ProxyActionClient.remove_result(self._topic)
+        if self.result.outcome == COMPLETED:
+            return completed
+        Logger.logwarn(f'{self.state_name}: {self.capability} failed: {self.result.reason}')
+        return failed
+
+    def report(self):
+        """What the simulator reported, for output userdata (it computes no poses or plans)."""
+        return {'capability': self.capability, 'outcome': self.result.outcome, 'stamp': self.result.stamp}

@@ -1,0 +1,26 @@
+"""CreateStepGoalState: Team ViGIR's footstep goal creation, on the simulator."""
+
+from flexbe_core import EventState
+
+from atlas_sim_flexbe_states.capability_request import CapabilityRequest
+
+
+class CreateStepGoalState(EventState):
+    """
+    Creates the goal for footstep planning from the target pose (the simulator's footstep_goal capability).
+
+    -- pose_is_pelvis  bool  Whether the target pose is the pelvis pose (else the feet center).
+
+    <= done                  The step goal was created.
+    <= failed                It could not be created.
+    """
+
+    def __init__(self, pose_is_pelvis=False):
+        super().__init__(outcomes=['done', 'failed'])
+        self._run = CapabilityRequest('footstep_goal', type(self).__name__)
+
+    def on_enter(self, userdata):
+        self._run.start()
+
+    def execute(self, userdata):
+        return self._run.outcome('done', 'failed')

@@ -1,0 +1,75 @@
+"""The FlexBE classes the system configs name exist, on the real flexbe_core (FLEXBE_SOURCES).
+
+Every primitive state of config/atlas.yaml and config/mobile_manipulator.yaml imports from
+the package ``flexbe.packages`` names, is an EventState, takes the configured parameters
+(whose values evaluate in the behavior's namespace) and declares exactly the configured
+outcomes and userdata keys; every :BEHAVIOR is a behavior of the behavior package whose
+state machine has the configured outcomes.
+"""
+
+import importlib
+import inspect
+
+import pytest
+from rclpy.node import Node
+
+from sm_generation.config import load_flexbe_config
+from sm_generation.flexbe_behavior import behavior_class_name, behavior_module_name, state_module_name
+
+pytestmark = pytest.mark.usefixtures('flexbe')
+
+SYSTEMS = ('atlas', 'mobile_manipulator')
+CONFIGS = {system: load_flexbe_config(system) for system in SYSTEMS}
+PRIMITIVES = [(system, s) for system, c in CONFIGS.items() for s in c.states.values() if not s.is_behavior()]
+BEHAVIORS = [(system, s) for system, c in CONFIGS.items() for s in c.states.values() if s.is_behavior()]
+
+
+def label(entry):
+    system, state = entry
+    return f'{system}:{state.proposition}'
+
+
+@pytest.fixture
+def flexbe_node(ros):
+    """flexbe_core's proxies and states bound to a node (as a behavior's __init__ does)."""
+    from flexbe_core import set_node
+
+    node = ros.add_node(Node, 'flexbe_states_test')
+    set_node(node)
+    return node
+
+
+def state_class(system, state):
+    package = CONFIGS[system].state_package(state.state_class)
+    module = importlib.import_module(f'{package}.{state_module_name(state.state_class)}')
+    return getattr(module, state.state_class)
+
+
+@pytest.mark.parametrize('entry', PRIMITIVES, ids=label)
+def test_configured_state_class_has_the_configured_interface(flexbe_node, entry):
+    from flexbe_core import EventState
+
+    system, state = entry
+    cls = state_class(system, state)
+    assert issubclass(cls, EventState)
+    signature = inspect.signature(cls.__init__)
+    required = [n for n, p in signature.parameters.items() if n != 'self' and p.default is inspect.Parameter.empty]
+    assert set(required) <= set(state.parameter_names) <= set(signature.parameters)
+    # Parameter values are source text the behavior evaluates with the class imported.
+    arguments = {name: eval(value, {state.state_class: cls})  # noqa: S307 - our own config
+                 for name, value in zip(state.parameter_names, state.parameter_values)}
+    instance = cls(**arguments)
+    assert list(instance.outcomes) == list(state.outcomes)
+    assert set(instance.input_keys) | set(instance.output_keys) == set(state.userdata_keys)
+
+
+@pytest.mark.parametrize('entry', BEHAVIORS, ids=label)
+def test_configured_behavior_exists_with_the_configured_outcomes(flexbe_node, entry):
+    system, state = entry
+    package = CONFIGS[system].behavior_package
+    module = importlib.import_module(f'{package}.{behavior_module_name(state.behavior_class)}')
+    behavior = getattr(module, behavior_class_name(state.behavior_class))(flexbe_node)
+    assert behavior.name == state.behavior_class
+    machine = behavior.create()
+    assert list(machine.outcomes) == list(state.outcomes)
+    assert set(machine.input_keys) == set(state.userdata_keys)

@@ -39,3 +39,8 @@ def layered_positions(edges: dict[str, list[str]], initial: str, outcomes: list[
 def inner_positions(count: int) -> list[list[float]]:
     """Positions of the states inside a container, side by side."""
     return [[INNER_MARGIN + INNER_SPACING * index, INNER_MARGIN] for index in range(count)]
+
+
+def container_outcome_positions(count: int) -> list[list[float]]:
+    """Positions of a container's outcomes, in a row below its states."""
+    return [[INNER_MARGIN + INNER_SPACING * index, INNER_MARGIN + LAYER_SPACING] for index in range(count)]

@@ -2,6 +2,8 @@
 
     >>> spec = compile_task('atlas', ['stand_prep'], ['look_down', 'pickup_object'])
     >>> print(spec.to_structuredslugs())     # or to_slugsin(), to_text_sections()
+
+``ltl_specification.diagnosis`` says in plain words why a task cannot be done.
 """
 
 from ltl_specification.compiler import CompiledSpecification, Provenance, compile_task, explain

@@ -3,7 +3,7 @@
     behavior-synthesis compile --system atlas --initial-conditions stand_prep \\
         --goals look_down,pickup_object [--sm-outcomes finished,failed] [--unordered] \\
         [--format structuredslugs|slugsin|json] [-o FILE] [--config-dir DIR] \\
-        [--custom-ltl FILE] [--explain]
+        [--custom-ltl FILE] [--explain] [--diagnose]
 
 Bad input exits with status 2 and one line on stderr naming the error code and the item.
 """
@@ -40,6 +40,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument('--custom-ltl', metavar='FILE',
                         help='YAML/JSON mapping of LTLSpecification sections to extra formulas')
     parser.add_argument('--explain', action='store_true', help='also print why each item is included (stderr)')
+    parser.add_argument('--diagnose', action='store_true',
+                        help='also check realizability; if the task cannot be done, say why on stderr '
+                             '(pre-check, unrealizable core, environment play) and exit with status 1')
 
 
 def run(args: argparse.Namespace) -> int:
@@ -65,6 +68,13 @@ def run(args: argparse.Namespace) -> int:
         sys.stdout.write(text)
     if args.explain:
         print(explain(spec), file=sys.stderr)
+    if args.diagnose:
+        from ltl_specification.diagnosis import diagnose
+
+        diagnosis = diagnose(spec, config_dir=args.config_dir)
+        if diagnosis is not None:
+            print(f'SPEC_UNSYNTHESIZABLE: {diagnosis.message()}', file=sys.stderr)
+            return 1
     return 0
 
 

@@ -46,7 +46,8 @@ from typing import Mapping, Sequence
 
 from respec.abstraction import AbstractionConfigError, RobotAbstraction, load_abstraction
 from respec.components import (
-    action_specification, control_mode_specification, goal_specification,
+    SOURCE_CUSTOM, FormulaGroup, action_groups, action_specification, control_mode_groups,
+    control_mode_specification, goal_groups, goal_specification, initial_conditions_groups,
     initial_conditions_specification,
 )
 from respec.ltl import variables
@@ -78,6 +79,8 @@ class Provenance:
     strict_order: bool
     pertinence: Pertinence
     custom_sections: tuple[str, ...] = ()
+    # Every formula's origin: paper equation, item and config section or request field.
+    groups: tuple[FormulaGroup, ...] = ()
 
 
 @dataclass
@@ -103,7 +106,7 @@ def compile_task(system: str, initial_conditions: Sequence[str] | str, goals: Se
     env_props / sys_props, new proposition names) that are conjoined to the result.
     Raises a ``SpecificationError`` subclass naming the offending item.
     """
-    abstraction = _load_abstraction(system, config_dir)
+    abstraction = load_task_abstraction(system, config_dir)
     sm_outcomes = _check_sm_outcomes(sm_outcomes)
     goals = _check_goals(abstraction, goals)
     initial_conditions = _check_initial_conditions(abstraction, initial_conditions)
@@ -112,7 +115,9 @@ def compile_task(system: str, initial_conditions: Sequence[str] | str, goals: Se
     mentioned, sensors = _items_mentioned(abstraction, custom_formulas)
 
     pertinence = infer_pertinence(abstraction, initial_mode, initial_conditions, goals, mentioned)
-    parts = _sub_specifications(abstraction, pertinence, initial_conditions, goals, sm_outcomes, strict_order)
+    parts, groups = _sub_specifications(abstraction, pertinence, initial_conditions, goals, sm_outcomes,
+                                        strict_order)
+    groups += _custom_groups(custom_formulas)
     parts.append(GR1Specification(env_props=sensors))
     parts.append(_custom_specification(custom_ltl, custom_formulas))
     try:
@@ -122,14 +127,17 @@ def compile_task(system: str, initial_conditions: Sequence[str] | str, goals: Se
             f'custom LTL declares {error.item!r} with the wrong kind: {error}', item=error.item) from error
     _check_custom_scopes(spec, custom_ltl)
     provenance = Provenance(system, tuple(initial_conditions), tuple(goals), sm_outcomes, strict_order,
-                            pertinence, tuple(s for s in SECTIONS if custom_ltl and custom_ltl.get(s)))
+                            pertinence, tuple(s for s in SECTIONS if custom_ltl and custom_ltl.get(s)),
+                            tuple(groups))
     return CompiledSpecification(**{f.name: getattr(spec, f.name) for f in fields(GR1Specification)},
                                  provenance=provenance)
 
 
 def _sub_specifications(abstraction: RobotAbstraction, pertinence: Pertinence, initial_conditions: list[str],
-                        goals: list[str], sm_outcomes: tuple[str, ...], strict_order: bool) -> list[GR1Specification]:
-    """The generated parts of the task specification, in merge order (modes, actions, init, goals)."""
+                        goals: list[str], sm_outcomes: tuple[str, ...], strict_order: bool
+                        ) -> tuple[list[GR1Specification], list[FormulaGroup]]:
+    """The generated parts of the task specification, in merge order (modes, actions, init, goals),
+    and the formula groups they are made of (their provenance)."""
     retry = FAILED not in sm_outcomes
     outcomes = abstraction.outcomes
     adjacency = {m: (m, *(t for t in abstraction.control_modes[m] if t in pertinence.modes))
@@ -138,12 +146,23 @@ def _sub_specifications(abstraction: RobotAbstraction, pertinence: Pertinence, i
     # The default initial mode holds initially just as if it had been named.
     initially_completed = [i for i in [*initial_conditions, pertinence.initial_mode] if i in items]
     failures = [outcome_proposition(item, o) for item in items for o in abstraction.failure_outcomes]
-    return [
+    actions = {a: abstraction.actions[a] for a in pertinence.actions}
+    goal_arguments = (goals, sm_outcomes, strict_order, failures, abstraction.success_outcome)
+    parts = [
         control_mode_specification(adjacency, outcomes, retry),
-        action_specification({a: abstraction.actions[a] for a in pertinence.actions}, outcomes, retry),
+        action_specification(actions, outcomes, retry),
         initial_conditions_specification(items, initially_completed, outcomes),
-        goal_specification(goals, sm_outcomes, strict_order, failures, abstraction.success_outcome),
+        goal_specification(*goal_arguments),
     ]
+    groups = [*control_mode_groups(adjacency, outcomes, retry), *action_groups(actions, outcomes, retry),
+              *initial_conditions_groups(items, initially_completed, outcomes), *goal_groups(*goal_arguments)]
+    return parts, groups
+
+
+def _custom_groups(custom_formulas: dict[str, list]) -> list[FormulaGroup]:
+    """One group per custom formula, named by its section and index (as the request gave it)."""
+    return [FormulaGroup(section, 'custom', 'custom LTL', f'{section}[{index}]', SOURCE_CUSTOM, (formula,))
+            for section in FORMULA_SECTIONS for index, formula in enumerate(custom_formulas.get(section, []))]
 
 
 def explain(spec: CompiledSpecification) -> str:
@@ -170,7 +189,7 @@ def explain(spec: CompiledSpecification) -> str:
 
 # --- request validation ---------------------------------------------------------------------
 
-def _load_abstraction(system: str, config_dir) -> RobotAbstraction:
+def load_task_abstraction(system: str, config_dir) -> RobotAbstraction:
     try:
         return load_abstraction(system, config_dir)
     except UnknownSystemConfig as error:

@@ -72,7 +72,7 @@ def infer_pertinence(abstraction: RobotAbstraction, initial_mode: str | None,
     modes = set()  # membership only; the result follows configuration order
     if initial_mode is not None:
         modes.add(initial_mode)
-        reachable = _distances(abstraction.control_modes, initial_mode)
+        reachable = mode_distances(abstraction.control_modes, initial_mode)
         for target in needed_modes:
             if target not in reachable:
                 raise InvalidGoalsError(
@@ -95,7 +95,7 @@ def infer_pertinence(abstraction: RobotAbstraction, initial_mode: str | None,
         left_out=left_out)
 
 
-def _distances(graph: dict[str, Sequence[str]], source: str) -> dict[str, int]:
+def mode_distances(graph: dict[str, Sequence[str]], source: str) -> dict[str, int]:
     """Breadth-first distances from ``source``."""
     distance = {source: 0}
     queue = deque([source])
@@ -110,11 +110,11 @@ def _distances(graph: dict[str, Sequence[str]], source: str) -> dict[str, int]:
 
 def _on_shortest_paths(graph: dict[str, Sequence[str]], source: str, target: str) -> list[str]:
     """Nodes v on some shortest source->target path: d(source, v) + d(v, target) = d(source, target)."""
-    from_source = _distances(graph, source)
+    from_source = mode_distances(graph, source)
     if target not in from_source:
         return []
     reverse = {node: [p for p in graph if node in graph[p]] for node in graph}
-    to_target = _distances(reverse, target)
+    to_target = mode_distances(reverse, target)
     length = from_source[target]
     return [v for v in graph
             if v in from_source and v in to_target and from_source[v] + to_target[v] == length]

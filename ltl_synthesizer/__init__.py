@@ -5,8 +5,9 @@
     result.realizable, result.strategy   # slugs --explicitStrategy --jsonOutput shape
 
 Modules: symbolic (formulas to BDDs, enforceable predecessors), gr1 (fixpoints), strategy
-(explicit strategies, counter-strategies, slugs JSON), explain (why unrealizable), automaton
-(FSAutomaton shape), cli (``gr1synth``).
+(explicit strategies, counter-strategies, slugs JSON), explain (why unrealizable), unrealizable_core
+(minimal unrealizable subsets of guarantees, by delta debugging), automaton (FSAutomaton shape),
+cli (``gr1synth``).
 """
 
 from ltl_synthesizer.errors import (InvalidFormulaError, SynthesisCancelled, SynthesisError,

@@ -7,5 +7,6 @@ Modules:
     systems              locating and loading robot system configuration files (config/<system>.yaml)
     abstraction          a robot's discrete abstraction (the ``abstraction:`` section), validated
     activation_outcomes  the paper's formula families, one function per equation (3)-(20)
-    components           sub-specifications (control modes, actions, initial conditions, goals)
+    components           sub-specifications (control modes, actions, initial conditions, goals),
+                         made of FormulaGroups (the provenance of every formula)
 """

@@ -82,3 +82,12 @@ def test_add_arguments_and_run_in_process(tmp_path, capsys):
     assert target.read_text() == compile_task('atlas', [], ['walk']).to_slugsin()
     assert run(parser.parse_args(['--system', 'atlas', '--goals', ''])) == 2
     assert 'INVALID_GOALS' in capsys.readouterr().err
+
+
+def test_diagnose_says_why_a_task_cannot_be_done():
+    impossible = cli('--system', 'atlas', '--goals', 'look_down,stand_prep', '--diagnose')
+    assert impossible.returncode == 1 and impossible.stdout.startswith('[INPUT]')
+    assert impossible.stderr.startswith('SPEC_UNSYNTHESIZABLE: Goal 2 (stand_prep) can never be achieved')
+    assert 'stand -> stand_prep is not a transition in config/atlas.yaml' in impossible.stderr.splitlines()[0]
+    possible = cli(*DEMO, '--diagnose')
+    assert possible.returncode == 0 and possible.stderr == ''

@@ -140,3 +140,16 @@ def test_same_request_gives_identical_results(suite):
     assert first.ltl_specification == second.ltl_specification
     assert first.automaton == second.automaton
     assert first.states == second.states
+
+
+def test_impossible_goal_order_is_explained_in_plain_words_first(suite):
+    feedback = []
+    outcome = suite.client.run(make_goal(system='atlas', initial_conditions=[], goals=['look_down', 'stand_prep']),
+                               feedback=lambda s, p: feedback.append(s), timeout=120)
+    assert outcome.error_name == 'SPEC_UNSYNTHESIZABLE'
+    first_line = outcome.message.splitlines()[0]
+    assert first_line.startswith('Goal 2 (stand_prep) can never be achieved')
+    assert 'stand -> stand_prep is not a transition in config/atlas.yaml' in first_line
+    assert 'eq. (9) control-mode topology for stand' in outcome.message
+    assert 'Details from the synthesizer:' in outcome.message  # the synthesizer's own account stays
+    assert 'Diagnosing why the task cannot be done' in feedback

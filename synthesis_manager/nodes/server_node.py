@@ -20,9 +20,11 @@ from rclpy.action import ActionServer, CancelResponse, GoalResponse
 from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.node import Node
 
+from ltl_specification.diagnosis import explain_unsynthesizable
 from synthesis_manager.requests import (InvalidRequest, SynthesisTask, task_from_behavior_synthesis,
                                         task_from_flexbe_synthesis)
-from synthesis_manager.ros.conversions import error_code, error_name, flexbe_error_code, is_empty_spec
+from synthesis_manager.ros.conversions import (error_code, error_name, flexbe_error_code, is_empty_spec,
+                                               msg_to_sections)
 from synthesis_manager.ros.node_main import node_main
 from synthesis_msgs.action import BehaviorSynthesis, FlexBESynthesis
 from synthesis_msgs.msg import FSAutomaton, LTLSpecification
@@ -130,7 +132,8 @@ class BehaviorSynthesisServer(Node):
     Parameters: ``default_system`` (for requests naming none or ``system_wide``),
     ``flexbe_log_topic`` (FlexBE's operator log; '' disables it), ``service_timeout`` (seconds
     to wait for a service to appear), ``compilation_timeout``, ``synthesis_timeout`` and
-    ``generation_timeout`` (seconds per stage).
+    ``generation_timeout`` (seconds per stage), ``diagnosis_timeout`` (seconds to find why an
+    unrealizable task cannot be done).
     """
 
     def __init__(self, **kwargs):
@@ -140,6 +143,7 @@ class BehaviorSynthesisServer(Node):
         self.declare_parameter('compilation_timeout', 30.0)
         self.declare_parameter('synthesis_timeout', 120.0)
         self.declare_parameter('generation_timeout', 30.0)
+        self.declare_parameter('diagnosis_timeout', 20.0)
         self.declare_parameter('flexbe_log_topic', 'flexbe/log')
         self._stopping = threading.Event()
         self.log_to_flexbe = flexbe_log_publisher(self, self.parameter('flexbe_log_topic'))
@@ -224,6 +228,13 @@ class BehaviorSynthesisServer(Node):
             ltl_specification=outcome.ltl_specification, spec_name=spec_name,
             timeout=float(timeout), request_id=goal_id),
             'LTL synthesis', timeout + 5.0, on_cancel=lambda: self.cancel_synthesis(goal_id))
+        if task.option != 'ltl_synthesis_only' and error_name(synthesized.error_code.value) == 'SPEC_UNSYNTHESIZABLE':
+            feedback('Diagnosing why the task cannot be done', 0.6)
+            custom_ltl = msg_to_sections(task.custom_ltl) if task.custom_ltl is not None else None
+            synthesized.error_code.message = explain_unsynthesizable(
+                synthesized.error_code.message, task.system, task.initial_conditions, task.goals,
+                task.sm_outcomes, not task.unordered_goals, custom_ltl or None,
+                deadline=time.monotonic() + self.parameter('diagnosis_timeout'))
         self.check(synthesized.error_code)
         outcome.automaton = synthesized.automaton
         feedback(f'Synthesized an automaton with {len(outcome.automaton.automaton)} states', 2 / 3)

@@ -1,0 +1,369 @@
+"""Why a task cannot be done, in plain words: a pre-check and unrealizable cores.
+
+Before synthesis, ``precheck`` looks at the robot abstraction and the request and names
+impossible requests directly:
+
+* a goal whose control mode cannot be reached from where the previous goal leaves the robot
+  (with goals in strict order), naming the missing transition of ``config/<system>.yaml``;
+* a precondition that can never complete because custom LTL forbids activating it;
+* custom LTL that contradicts itself or the initial conditions.
+
+After synthesis reports an unrealizable specification, ``diagnose`` adds a minimal
+unrealizable core (``ltl_synthesizer.unrealizable_core``) over the specification's formula
+groups, each mapped to its paper equation and the configuration entry or request field that
+produced it, and a short environment play told in words. ``Diagnosis.message`` leads with one
+plain sentence; the details follow.
+"""
+
+from __future__ import annotations
+
+import itertools
+import threading
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+
+from respec.abstraction import RobotAbstraction
+from respec.activation_outcomes import activation, memory, outcome_proposition
+from respec.components import (SOURCE_ACTIONS, SOURCE_CONTROL_MODES, SOURCE_CUSTOM, SOURCE_GOALS,
+                               SOURCE_INITIAL_CONDITIONS, SOURCE_SM_OUTCOMES, FormulaGroup)
+from respec.ltl import Formula, evaluate, mentions_next, to_infix, variables
+from respec.systems import system_config_path
+from ltl_synthesizer.errors import SynthesisCancelled
+from ltl_synthesizer.unrealizable_core import environment_play, unrealizable_core
+
+from ltl_specification.compiler import CompiledSpecification, compile_task, load_task_abstraction
+from ltl_specification.pertinence import mode_distances
+
+PLAY_LENGTH = 8
+# Custom formulas are checked by enumerating their variables' values: at most this many.
+MAX_ENUMERATED_VARIABLES = 14
+
+
+@dataclass(frozen=True)
+class Finding:
+    """One impossible part of a request, found before synthesis."""
+
+    sentence: str
+    equation: str      # the paper equation whose formulas make it impossible
+    config_item: str   # the configuration entry or request field to change
+    item: str          # the goal, mode, action or custom formula concerned
+
+
+@dataclass
+class CoreEntry:
+    """One formula group of an unrealizable core, told as equation, origin and formulas."""
+
+    equation: str
+    title: str
+    item: str
+    origin: str
+    formulas: list[str]
+
+    def line(self) -> str:
+        return f'{self.name()} ({self.origin}): ' + '; '.join(self.formulas)
+
+    def name(self) -> str:
+        if self.equation == 'custom':
+            return f'custom LTL {self.item}'
+        return f'eq. {self.equation} {self.title}' + (f' for {self.item}' if self.item else '')
+
+
+@dataclass
+class Diagnosis:
+    """Why a specification is unrealizable: a plain ``sentence`` first, then the evidence."""
+
+    sentence: str
+    findings: list[Finding] = field(default_factory=list)
+    core: list[CoreEntry] = field(default_factory=list)
+    play: list[str] = field(default_factory=list)
+    note: str = ''     # e.g. that the core search ran out of time
+
+    def message(self) -> str:
+        """The sentence, then the core and the environment play (one text, for error messages)."""
+        lines = [self.sentence]
+        for finding in self.findings[1:]:
+            lines.append(f'Also: {finding.sentence}')
+        if self.core:
+            lines.append('')
+            lines.append('Unrealizable core (these requirements together cannot be met; '
+                         'dropping any one of them would make the task possible):')
+            lines += [f'  - {entry.line()}' for entry in self.core]
+        if self.play:
+            lines.append('')
+            lines.append('How the environment wins (the robot does its best):')
+            lines += [f'  {number}. {step}' for number, step in enumerate(self.play, start=1)]
+        if self.note:
+            lines += ['', self.note]
+        return '\n'.join(lines)
+
+    def to_dict(self) -> dict:
+        return asdict(self)
+
+
+# --- pre-check -------------------------------------------------------------------------------
+
+def config_file(system: str, config_dir=None) -> str:
+    """The configuration file as users know it, e.g. 'config/atlas.yaml'."""
+    path = Path(system_config_path(system, config_dir))
+    return f'{path.parent.name}/{path.name}'
+
+
+def precheck(spec: CompiledSpecification, config_dir=None) -> list[Finding]:
+    """Impossible requests that the abstraction and the request alone reveal (see module doc)."""
+    provenance = spec.provenance
+    abstraction = load_task_abstraction(provenance.system, config_dir)
+    where = config_file(provenance.system, config_dir)
+    findings = []
+    if provenance.pertinence.initial_mode is not None:
+        findings += _unreachable_goal_modes(abstraction, provenance.goals, provenance.pertinence.initial_mode,
+                                            provenance.strict_order, where)
+    custom = [g for g in provenance.groups if g.source == SOURCE_CUSTOM]
+    findings += _forbidden_activations(custom, provenance)
+    findings += _contradictory_custom_ltl(custom, provenance.groups)
+    return findings
+
+
+def modes_needed_by(abstraction: RobotAbstraction, item: str) -> list[str]:
+    """The control modes the robot must be in to achieve ``item``: the mode itself, or the
+    action's mode preconditions (action preconditions persist once completed, modes do not)."""
+    if abstraction.kind_of(item) == 'control_mode':
+        return [item]
+    return [p for p in abstraction.actions.get(item, ()) if abstraction.kind_of(p) == 'control_mode']
+
+
+def goal_findings(system: str, initial_conditions, goals, strict_order: bool = True,
+                  config_dir=None) -> list[Finding]:
+    """The goal part of the pre-check, without compiling (cheap enough to run as a form changes).
+
+    Names that are not actions or modes of ``system`` are skipped (compilation reports them).
+    """
+    abstraction = load_task_abstraction(system, config_dir)
+    modes = [i for i in initial_conditions if abstraction.kind_of(i) == 'control_mode']
+    initial_mode = modes[0] if modes else abstraction.initial_mode
+    if initial_mode is None:
+        return []
+    known = [g for g in goals if abstraction.kind_of(g) is not None]
+    return _unreachable_goal_modes(abstraction, known, initial_mode, strict_order, config_file(system, config_dir))
+
+
+def impossible_next_goals(system: str, initial_conditions, goals, strict_order: bool = True,
+                          config_dir=None) -> dict[str, str]:
+    """For every action or mode that is not a goal yet: why it cannot be the next goal (if so)."""
+    abstraction = load_task_abstraction(system, config_dir)
+    impossible = {}
+    for candidate in abstraction.items():
+        if candidate in goals:
+            continue
+        findings = goal_findings(system, initial_conditions, [*goals, candidate], strict_order, config_dir)
+        last = [f for f in findings if f.item == candidate]
+        if last:
+            impossible[candidate] = last[0].sentence
+    return impossible
+
+
+def _unreachable_goal_modes(abstraction: RobotAbstraction, goals, initial_mode: str, strict_order: bool,
+                            where: str) -> list[Finding]:
+    """Eq. (9) only allows the configured mode changes, so every goal's mode must be reachable
+    from the initial mode; with eq. (20) goal i counts only after goal i-1, so it must be
+    reachable from the mode the previous goal left the robot in."""
+    findings = []
+    mode, reason = initial_mode, f'the robot starts in {initial_mode}'
+    for number, goal in enumerate(goals, start=1):
+        for needed in modes_needed_by(abstraction, goal):
+            if needed not in mode_distances(abstraction.control_modes, mode):
+                findings.append(Finding(
+                    _unreachable_sentence(abstraction, number, goal, needed, mode, reason, where),
+                    '(9)', f'control_modes.{mode} in {where}', goal))
+            if not strict_order:
+                continue
+            mode = needed
+            reason = (f'after goal {number} ({goal}) the robot is in {needed}' if needed == goal else
+                      f'goal {number} ({goal}) needs the robot in {needed}')
+    return findings
+
+
+def _unreachable_sentence(abstraction: RobotAbstraction, number: int, goal: str, needed: str, mode: str,
+                          reason: str, where: str) -> str:
+    what = f'goal {number} ({goal})' + ('' if needed == goal else f', which needs the robot in {needed},')
+    adjacent = ', '.join(abstraction.control_modes[mode]) or 'no other mode'
+    reachable = [m for m in mode_distances(abstraction.control_modes, mode) if m != mode]
+    beyond = ('' if set(reachable) <= {*abstraction.control_modes[mode]} else
+              f'; no mode reachable from {mode} ({", ".join(reachable)}) changes to {needed} either')
+    return (f'{what[0].upper()}{what[1:]} can never be achieved: {reason}, and {mode} -> {needed} '
+            f'is not a transition in {where} (from {mode} the robot can only change to {adjacent}{beyond}).')
+
+
+def _forbidden_activations(custom: list[FormulaGroup], provenance) -> list[Finding]:
+    """A needed item whose activation a custom guarantee forbids at every step."""
+    findings = []
+    needed = {**provenance.pertinence.reasons}
+    for group in custom:
+        if group.section not in ('sys_trans', 'sys_init'):
+            continue
+        formula = group.formulas[0]
+        for item, reason in needed.items():
+            if item == provenance.pertinence.initial_mode and reason == 'initial mode':
+                continue
+            if _forces_false(formula, activation(item)):
+                findings.append(Finding(
+                    f'{item} ({reason}) can never complete: custom LTL {group.item} '
+                    f"'{to_infix(formula)}' forbids ever activating it.",
+                    'custom', f'custom LTL {group.item}', item))
+    return findings
+
+
+def _contradictory_custom_ltl(custom: list[FormulaGroup], groups) -> list[Finding]:
+    """Custom formulas that cannot hold together with their section (custom and generated
+    initial conditions; custom formulas of one safety section among themselves)."""
+    findings = []
+    for section in ('env_init', 'sys_init', 'env_trans', 'sys_trans'):
+        own = [g.formulas[0] for g in custom if g.section == section]
+        if not own:
+            continue
+        context = [f for g in groups if g.section == section and g.source != SOURCE_CUSTOM
+                   for f in g.formulas] if section.endswith('init') else []
+        relevant = set().union(*(variables(f) for f in own))
+        formulas = own + [f for f in context if variables(f) & relevant]
+        if _satisfiable(formulas) is False:
+            texts = ', '.join(f"'{to_infix(f)}'" for f in own)
+            against = ' and the generated initial conditions' if len(formulas) > len(own) else ''
+            findings.append(Finding(f'The custom {section} formulas {texts}{against} contradict each other.',
+                                    'custom', f'custom LTL {section}', section))
+    return findings
+
+
+def _forces_false(formula: Formula, name: str) -> bool:
+    """Whether ``formula`` holds only when ``name`` is false now (or next, for a next-formula)."""
+    def with_name_true(current: dict, next_step: dict) -> bool:
+        if mentions_next(formula):
+            return evaluate(formula, current, {**next_step, name: True})
+        return evaluate(formula, {**current, name: True}, next_step)
+    return name in variables(formula) and _satisfiable([formula]) is not False and \
+        _exists(variables(formula), with_name_true) is False
+
+
+def _satisfiable(formulas: list[Formula]) -> bool | None:
+    """Propositional satisfiability (current and next values free); None when too large."""
+    names = set().union(*(variables(f) for f in formulas))
+    return _exists(names, lambda current, next_step: all(evaluate(f, current, next_step) for f in formulas))
+
+
+def _exists(names: set[str], holds) -> bool | None:
+    ordered = sorted(names)
+    if 2 * len(ordered) > MAX_ENUMERATED_VARIABLES:
+        return None
+    for values in itertools.product((False, True), repeat=2 * len(ordered)):
+        current = dict(zip(ordered, values[:len(ordered)]))
+        next_step = dict(zip(ordered, values[len(ordered):]))
+        if holds(current, next_step):
+            return True
+    return False
+
+
+# --- after synthesis: core and play ----------------------------------------------------------
+
+def origin_of(group: FormulaGroup, provenance, abstraction: RobotAbstraction, where: str) -> str:
+    """The configuration entry or request field that produced ``group``, in words."""
+    if group.source == SOURCE_CONTROL_MODES:
+        if group.item:
+            targets = ', '.join(abstraction.control_modes.get(group.item, ())) or 'nothing'
+            return f'control_modes.{group.item} in {where}: {group.item} -> {targets}'
+        return f'control_modes in {where}'
+    if group.source == SOURCE_ACTIONS:
+        preconditions = ', '.join(abstraction.actions.get(group.item, ())) or 'none'
+        return f'actions.{group.item} in {where}: preconditions {preconditions}'
+    if group.source == SOURCE_GOALS:
+        order = 'in this order' if provenance.strict_order else 'in any order'
+        return f'request goals: {", ".join(provenance.goals)} ({order})'
+    if group.source == SOURCE_INITIAL_CONDITIONS:
+        named = ', '.join(provenance.initial_conditions) or f'initial_mode {provenance.pertinence.initial_mode}'
+        return f'request initial conditions: {named}'
+    if group.source == SOURCE_SM_OUTCOMES:
+        return f'request state-machine outcomes: {", ".join(provenance.sm_outcomes)}'
+    return 'request custom LTL'
+
+
+def diagnose(spec: CompiledSpecification, robotics_semantics: bool = True, config_dir=None,
+             cancel: threading.Event | None = None, deadline: float | None = None) -> Diagnosis | None:
+    """Why ``spec`` (compiled with provenance) is unrealizable; None if it is realizable.
+
+    When the deadline passes during the core search, the pre-check's findings are still
+    returned and the note says the core was not computed.
+    """
+    provenance = spec.provenance
+    abstraction = load_task_abstraction(provenance.system, config_dir)
+    where = config_file(provenance.system, config_dir)
+    findings = precheck(spec, config_dir)
+    diagnosis = Diagnosis(sentence=findings[0].sentence if findings else '', findings=findings)
+    try:
+        core = unrealizable_core(spec, provenance.groups, robotics_semantics, cancel, deadline)
+        if core is None:
+            return None
+        diagnosis.core = [CoreEntry(g.equation, g.title, g.item, origin_of(g, provenance, abstraction, where),
+                                    [to_infix(f) for f in g.formulas]) for g in core.groups]
+        steps = environment_play(spec, robotics_semantics, PLAY_LENGTH, cancel, deadline)
+        diagnosis.play = play_in_words(steps, provenance, abstraction)
+    except SynthesisCancelled as stopped:
+        diagnosis.note = f'(The unrealizable core was not computed: {stopped.reason}.)'
+    if not diagnosis.sentence:
+        diagnosis.sentence = _core_sentence(diagnosis.core)
+    return diagnosis
+
+
+def _core_sentence(core: list[CoreEntry]) -> str:
+    """The plain sentence when the pre-check found nothing: the core's configurable causes."""
+    if not core:
+        return 'The task cannot be done: the specification is unrealizable.'
+    causes = [e for e in core if e.equation in ('(8)', '(9)', 'custom')] or core
+    named = '; '.join(f'{e.name()} ({e.origin})' for e in causes[:3])
+    return f'The task cannot be done as requested; these requirements are what makes it impossible: {named}.'
+
+
+def play_in_words(steps: list[dict], provenance, abstraction: RobotAbstraction) -> list[str]:
+    """Each step of an environment play as a sentence about what changed."""
+    meaning = {}
+    for item in [*provenance.pertinence.modes, *provenance.pertinence.actions]:
+        is_mode = item in provenance.pertinence.modes
+        meaning[activation(item)] = f'the robot starts {"changing to " if is_mode else ""}{item}'
+        for outcome in abstraction.outcomes:
+            meaning[outcome_proposition(item, outcome)] = (
+                f'now in {item}' if is_mode and outcome == abstraction.success_outcome else f'{item} {outcome}')
+    for goal in provenance.goals:
+        meaning[memory(goal)] = f'goal {goal} achieved'
+    for outcome in provenance.sm_outcomes:
+        meaning[outcome] = f'the state machine ends {outcome}'
+    words = []
+    previous: dict = {}
+    for index, step in enumerate(steps):
+        if any(value is None for value in step.values()):
+            words.append('the environment answers so that no allowed move remains (deadlock)')
+            break
+        turned_on = [meaning.get(name, name) for name, value in step.items() if value and not previous.get(name)]
+        if index == 0:
+            words.append('start: ' + (', '.join(turned_on) or 'nothing holds'))
+        else:
+            words.append(', '.join(turned_on) or 'no outcome yet (the environment waits)')
+        previous = step
+    if words:
+        words.append('from here no move the robot may make leads to an outcome of the state machine, '
+                     'and the environment never has to report a failure')
+    return words
+
+
+# --- for the pipeline -------------------------------------------------------------------------
+
+def explain_unsynthesizable(details: str, system: str, initial_conditions, goals, sm_outcomes=('finished', 'failed'),
+                            strict_order: bool = True, custom_ltl=None, robotics_semantics: bool = True,
+                            config_dir=None, deadline: float | None = None,
+                            cancel: threading.Event | None = None) -> str:
+    """The SPEC_UNSYNTHESIZABLE message for a task: the diagnosis first, then ``details``
+    (the synthesizer's own explanation). Never raises: if the task cannot be diagnosed
+    (e.g. it does not compile here), ``details`` are returned unchanged."""
+    try:
+        spec = compile_task(system, initial_conditions, goals, sm_outcomes, strict_order, custom_ltl, config_dir)
+        diagnosis = diagnose(spec, robotics_semantics, config_dir, cancel, deadline)
+    except Exception:  # the diagnosis is a help; the synthesizer's verdict stands without it
+        return details
+    if diagnosis is None:
+        return details
+    return f'{diagnosis.message()}\n\nDetails from the synthesizer:\n{details}'

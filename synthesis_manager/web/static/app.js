@@ -93,9 +93,14 @@ async function loadChoices() {
     ...items.map((item) => element('option', { value: item.name, title: hint(item), text: item.name })));
   $('goal-choice').replaceChildren(
     group('Actions', choices.actions, (a) => `needs: ${a.preconditions.join(', ') || 'nothing'}`),
-    group('Control modes', choices.control_modes, (m) => `reached from: ${m.name}`));
+    group('Control modes', choices.control_modes, (m) => `reached from: ${predecessors(m.name).join(', ') || 'no other mode'}`));
   $('goals').replaceChildren();
   updateGoalsHint();
+}
+
+// The control modes that can change to ``mode`` (its own self-loop aside).
+function predecessors(mode) {
+  return choices.control_modes.filter((m) => m.name !== mode && m.next.includes(mode)).map((m) => m.name);
 }
 
 function goalItem(name) {
@@ -216,11 +221,17 @@ function resetResult() {
   $('progress').value = 0;
 }
 
+// A message's first line is its plain sentence; the rest (e.g. the unrealizable core and the
+// synthesizer's own account) goes into a collapsed "Details".
 function showBanner(code, message, good) {
   $('result').hidden = false;
   $('result-banner').className = `banner ${good ? 'good' : 'bad'}`;
   $('result-code').textContent = code;
-  $('result-message').textContent = message;
+  const [sentence, ...rest] = (message || '').split('\n');
+  $('result-message').textContent = sentence;
+  const details = rest.join('\n').trim();
+  $('result-details').hidden = !details;
+  $('result-details-text').textContent = details;
   const top = $('result-banner').getBoundingClientRect().top;
   if (top < 0 || top > window.innerHeight) $('result-banner').scrollIntoView({ block: 'start' });
 }

@@ -80,10 +80,11 @@ def run_one(kind: str, argument: str, options: dict) -> dict:
     else:
         initial, goals = json.loads(argument)
         spec = paper_spec(initial, goals)
-    compiled = time.perf_counter()
+    compiled, compiled_cpu = time.perf_counter(), time.process_time()
     result = synthesize(spec, options=Options(**options))
-    done = time.perf_counter()
+    done, done_cpu = time.perf_counter(), time.process_time()
     return {'realizable': result.realizable, 'seconds': done - compiled,
+            'cpu_seconds': done_cpu - compiled_cpu,
             'process_seconds': _seconds_since_spawn(),
             'nodes': len(result.strategy['nodes']) if result.strategy else 0,
             'variables': result.stats['variables'], 'peak_bdd_nodes': result.stats['peak_bdd_nodes'],

@@ -56,8 +56,39 @@ class SystemSolution:
     complete: bool = True  # False when the solver stopped early because the initial check failed
 
 
+class WarmStarts:
+    """Upper bounds for the inner fixpoints X, from the previous Z iteration.
+
+    Everything is monotone in Z, and Z only shrinks, so the X computed at the same place
+    (goal, sweep, assumption) of the previous Z iteration bounds this iteration's X from
+    above; beyond the previous iteration's sweeps, its last X for (goal, assumption) does.
+    """
+
+    def __init__(self):
+        self._previous: dict = {}
+        self._previous_last: dict = {}
+        self._current: dict = {}
+        self._current_last: dict = {}
+
+    def upper_bound(self, goal_index: int, sweep: int, assumption_index: int, winning):
+        """The best known upper bound of this X, within ``winning`` (Z)."""
+        bound = self._previous.get((goal_index, sweep, assumption_index),
+                                   self._previous_last.get((goal_index, assumption_index)))
+        return winning if bound is None else bound & winning
+
+    def record(self, goal_index: int, sweep: int, assumption_index: int, waiting) -> None:
+        self._current[(goal_index, sweep, assumption_index)] = waiting
+        self._current_last[(goal_index, assumption_index)] = waiting
+
+    def next_outer_iteration(self) -> None:
+        self._previous, self._previous_last = self._current, self._current_last
+        self._current, self._current_last = {}, {}
+
+
 def solve_system_game(game: SymbolicGame, stop_when_losing=None) -> SystemSolution:
-    """The system's winning positions (greatest fixpoint Z over all goals).
+    """The system's winning positions: the greatest fixpoint Z over all goals,
+
+        nu Z. /\\_j mu Y. \\/_i nu X. cox( (G_j & Z') | Y' | (!A_i & X') ).
 
     ``stop_when_losing(Z)`` may return False to stop early: Z only shrinks, so once the
     initial positions are not covered they never will be (used to reject quickly).
@@ -66,70 +97,75 @@ def solve_system_game(game: SymbolicGame, stop_when_losing=None) -> SystemSoluti
     # to the same greatest fixpoint). The safety game's winning positions are one, and cheap;
     # on typical specifications they are exactly the winning positions, so the first Z
     # iteration is already the confirming one (instead of two or three full iterations).
-    winning = _safe_positions(game)
-    if stop_when_losing is not None and not stop_when_losing(winning):
-        return SystemSolution(winning, [], complete=False)
-    # Inner fixpoints of the previous Z iteration, by (goal, Y iteration, assumption): upper
-    # bounds for this iteration's (everything is monotone in Z), so X can start from them.
-    previous_waiting: dict = {}
+    Z = safe = _safe_positions(game, game.relevant_positions())
+    if stop_when_losing is not None and not stop_when_losing(safe):
+        return SystemSolution(safe, [], complete=False)
+    warm_starts = WarmStarts()
     while True:
         game.start_outer_iteration()
         attractor_steps = []
-        waiting_sets: dict = {}
-        next_winning = game.true
+        next_Z = game.true
         for goal_index, goal in enumerate(game.sys_goals):
-            next_winning &= _attract_to_goal(game, goal_index, goal, winning, attractor_steps,
-                                             previous_waiting, waiting_sets)
-            if next_winning == game.false:
+            attracted, steps = _attract_to_goal(game, goal_index, goal, Z, warm_starts)
+            attractor_steps += steps
+            next_Z &= attracted
+            if next_Z == game.false:
                 break
-        if next_winning == winning:
-            return SystemSolution(winning, attractor_steps)
-        winning = next_winning
-        previous_waiting = waiting_sets
-        if stop_when_losing is not None and not stop_when_losing(winning):
-            return SystemSolution(winning, [], complete=False)
+        if next_Z == Z:
+            return SystemSolution(Z, attractor_steps)
+        Z = next_Z
+        warm_starts.next_outer_iteration()
+        if stop_when_losing is not None and not stop_when_losing(Z):
+            return SystemSolution(Z, [], complete=False)
 
 
-def _safe_positions(game: SymbolicGame):
-    """``nu Z. cox(Z')``: positions from which the system can keep both safety sections
-    forever. Every winning position is one (a winning strategy stays among them)."""
-    safe = game.true
+def _safe_positions(game: SymbolicGame, within):
+    """``nu Z. within & cox(Z')``: positions (among ``within``) from which the system can keep
+    both safety sections forever. Every winning position is one (a winning strategy stays
+    among them)."""
+    Z = within
     while True:
-        next_safe = safe & game.enforce(game.system_can_move_into(safe))
-        if next_safe == safe:
-            return safe
-        safe = next_safe
+        next_Z = Z & game.enforce(game.system_can_move_into(Z))
+        if next_Z == Z:
+            return Z
+        Z = next_Z
 
 
-def _attract_to_goal(game: SymbolicGame, goal_index: int, goal, winning, attractor_steps,
-                     previous_waiting, waiting_sets):
-    """Middle least fixpoint Y: positions that can force goal ``goal`` (into Z) or keep some
-    environment goal false forever while staying safe."""
+def _attract_to_goal(game: SymbolicGame, goal_index: int, goal, winning, warm_starts: WarmStarts):
+    """Middle least fixpoint Y: positions that can force goal ``goal`` (into Z = ``winning``)
+    or keep some environment goal false forever while staying safe.
+
+    Returns Y and its attractor steps by increasing rank. With ``chained_sweeps`` each inner
+    fixpoint already uses the positions the previous ones of the same sweep added (a
+    Gauss-Seidel iteration: the same least fixpoint, reached in far fewer sweeps, and each
+    step's ``closer`` set still only holds positions of lower rank).
+    """
+    chained = game.options.chained_sweeps
     goal_transitions = goal & game.prime(winning)
     reach_goal = game.system_can_respond(goal_transitions)
-    closer = game.false
-    for iteration in itertools.count():
-        # exists y'. sys_trans & (A | B) splits into two products; the goal part is shared
-        # by every assumption's inner fixpoint.
+    Y = game.false
+    steps = []
+    for sweep in itertools.count():
+        Y_before_sweep = Y
+        closer = Y
         can_move_towards_goal = reach_goal | game.system_can_move_into(closer)
-        next_closer = closer
         for assumption_index, assumption in enumerate(game.env_goals):
-            key = (goal_index, iteration, assumption_index)
-            # Beyond the previous iteration count, the previous final X is still an upper bound.
-            start = previous_waiting.get(key, previous_waiting.get((goal_index, -1, assumption_index)))
-            start = winning if start is None else start & winning
-            waiting, responses = _wait_for_assumption(
+            if chained and closer != Y:
+                closer = Y
+                can_move_towards_goal = reach_goal | game.system_can_move_into(closer)
+            start = warm_starts.upper_bound(goal_index, sweep, assumption_index, winning)
+            X, responses = _wait_for_assumption(
                 game, can_move_towards_goal, assumption, start,
                 game.env_goal_ignores_outputs[assumption_index])
-            waiting_sets[key] = waiting_sets[(goal_index, -1, assumption_index)] = waiting
-            next_closer |= waiting
-            attractor_steps.append(AttractorStep(
-                goal_index, goal_transitions, closer, waiting, assumption, responses))
-        # Y never leaves Z (every X starts inside it): once Y is Z, the next iteration could
+            warm_starts.record(goal_index, sweep, assumption_index, X)
+            if not chained or X & ~Y != game.false:  # else every position has a lower rank
+                steps.append(AttractorStep(
+                    goal_index, goal_transitions, closer, X, assumption, responses))
+            Y |= X
+        # Y never leaves Z (every X starts inside it): once Y is Z, the next sweep could
         # only confirm it, at the price of all the inner fixpoints.
-        if next_closer == closer or next_closer == winning:
-            return next_closer
-        closer = next_closer
+        if Y == Y_before_sweep or Y == winning:
+            return Y, steps
 
 
 def _wait_for_assumption(game: SymbolicGame, can_move_towards_goal, assumption, start,
@@ -143,18 +179,17 @@ def _wait_for_assumption(game: SymbolicGame, can_move_towards_goal, assumption, 
     any upper bound. Returns X and the system's responses (over current variables and next
     inputs) that keep to these transitions.
     """
-    waiting = start
+    X = start
     while True:
         if system_independent:
             # The assumption constrains no next output, so it factors out of exists y'.
-            responses = can_move_towards_goal | (~assumption & game.system_can_move_into(waiting))
+            responses = can_move_towards_goal | (~assumption & game.system_can_move_into(X))
         else:
-            responses = can_move_towards_goal | game.system_can_respond(
-                game.prime(waiting) & ~assumption)
-        next_waiting = waiting & game.enforce(responses)
-        if next_waiting == waiting:
-            return waiting, responses
-        waiting = next_waiting
+            responses = can_move_towards_goal | game.system_can_respond(game.prime(X) & ~assumption)
+        next_X = X & game.enforce(responses)
+        if next_X == X:
+            return X, responses
+        X = next_X
 
 
 @dataclass

@@ -42,6 +42,9 @@ class Options:
     reordering: bool = False
     cluster_limit: int = DEFAULT_CLUSTER_LIMIT
     variable_order: str = 'affinity'  # 'affinity' (co-occurrence) or 'declared'
+    reachable_only: bool = False  # solve only on positions reachable from the initial ones
+    chained_sweeps: bool = True  # Gauss-Seidel Y sweeps (see gr1._attract_to_goal)
+    responses_within_env_trans: bool = False  # see SymbolicGame.system_can_respond
 
 
 class Interrupt:
@@ -104,6 +107,14 @@ class SymbolicGame:
                                          for goal in self.env_goals]
         self.env_partition = self._partition(self.env_trans_parts, set(self.next_inputs))
         self.sys_partition = self._partition(self.sys_trans_parts, set(self.next_outputs))
+        # The system's responses matter only to environment moves allowed by env_trans (the
+        # enforceable predecessor quantifies over those alone); conjoining env_trans first
+        # keeps the intermediate BDDs of the relational product small.
+        self.response_partition = self._partition(
+            self.env_trans_parts + self.sys_trans_parts, set(self.next_outputs)) \
+            if self.options.responses_within_env_trans else self.sys_partition
+        self.image_partition = self._partition(self.env_trans_parts + self.sys_trans_parts,
+                                               set(self.variables))
         if self.options.reordering:
             self.bdd.configure(reordering=True)
 
@@ -207,7 +218,7 @@ class SymbolicGame:
 
     def system_can_respond(self, target):
         """``exists y'. sys_trans & target``: the system has a legal move into ``target``."""
-        return self._relational_product(target, self.sys_partition)
+        return self._relational_product(target, self.response_partition)
 
     def system_can_move_into(self, positions):
         """``exists y'. sys_trans & positions'``, memoized: the assumptions' inner fixpoints
@@ -239,6 +250,21 @@ class SymbolicGame:
         ``forall x'. env_trans -> exists y'. sys_trans & target``.
         """
         return self.enforce(self.system_can_respond(target))
+
+    def successors(self, positions):
+        return self.unprime(self._relational_product(positions, self.image_partition))
+
+    def relevant_positions(self):
+        """The positions the solver must decide: all, or those reachable from the initial ones."""
+        return self.reachable_positions() if self.options.reachable_only else self.true
+
+    def reachable_positions(self):
+        reached = frontier = self.env_init & self.sys_init
+        while frontier != self.false:
+            self.interrupt.check()
+            frontier = self.successors(frontier) & ~reached
+            reached |= frontier
+        return reached
 
     def mentions_next_outputs(self, u) -> bool:
         return bool(self.bdd.support(u) & set(self.next_outputs))

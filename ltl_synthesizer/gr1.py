@@ -144,28 +144,31 @@ def _attract_to_goal(game: SymbolicGame, goal_index: int, goal, winning, warm_st
     goal_transitions = goal & game.prime(winning)
     reach_goal = game.system_can_respond(goal_transitions)
     Y = game.false
+    can_move_towards_goal = reach_goal  # moves into the goal, or into Y
     steps = []
     for sweep in itertools.count():
         Y_before_sweep = Y
-        closer = Y
-        can_move_towards_goal = reach_goal | game.system_can_move_into(closer)
         for assumption_index, assumption in enumerate(game.env_goals):
-            if chained and closer != Y:
-                closer = Y
-                can_move_towards_goal = reach_goal | game.system_can_move_into(closer)
             start = warm_starts.upper_bound(goal_index, sweep, assumption_index, winning)
             X, responses = _wait_for_assumption(
                 game, can_move_towards_goal, assumption, start,
                 game.env_goal_ignores_outputs[assumption_index])
             warm_starts.record(goal_index, sweep, assumption_index, X)
-            if not chained or X & ~Y != game.false:  # else every position has a lower rank
+            closer = Y if chained else Y_before_sweep
+            new_positions = X & ~Y != game.false
+            if new_positions or not chained:  # else every position of X has a lower rank
                 steps.append(AttractorStep(
                     goal_index, goal_transitions, closer, X, assumption, responses))
             Y |= X
+            if chained and new_positions:
+                # The product distributes over the union, and X's own product is memoized.
+                can_move_towards_goal |= game.system_can_move_into(X)
         # Y never leaves Z (every X starts inside it): once Y is Z, the next sweep could
         # only confirm it, at the price of all the inner fixpoints.
         if Y == Y_before_sweep or Y == winning:
             return Y, steps
+        if not chained:
+            can_move_towards_goal = reach_goal | game.system_can_move_into(Y)
 
 
 def _wait_for_assumption(game: SymbolicGame, can_move_towards_goal, assumption, start,

@@ -13,6 +13,7 @@ import threading
 import time
 import warnings
 from dataclasses import dataclass, field
+from functools import cached_property
 
 from dd import cudd
 
@@ -39,12 +40,12 @@ def primed(name: str) -> str:
 class Options:
     """Tuning switches of the symbolic engine (defaults are the measured best; see bench/)."""
 
-    reordering: bool = False
+    reordering: bool = False  # dynamic reordering throughout (CUDD's automatic sifting)
+    sift_once: bool = True  # one sifting pass after the relations are built (see SymbolicGame)
     cluster_limit: int = DEFAULT_CLUSTER_LIMIT
     variable_order: str = 'affinity'  # 'affinity' (co-occurrence) or 'declared'
-    reachable_only: bool = False  # solve only on positions reachable from the initial ones
+    reachable_only: bool = True  # solve only on positions reachable from the initial ones
     chained_sweeps: bool = True  # Gauss-Seidel Y sweeps (see gr1._attract_to_goal)
-    responses_within_env_trans: bool = False  # see SymbolicGame.system_can_respond
 
 
 class Interrupt:
@@ -86,6 +87,7 @@ class SymbolicGame:
         self.bdd.configure(reordering=False)
         for name in _variable_order(spec, self.options.variable_order):
             self.bdd.declare(name, primed(name))
+            self.bdd.group({name: 2})  # reordering keeps each pair adjacent (cheap renaming)
         self.to_next = {name: primed(name) for name in self.variables}
         self.to_current = {primed(name): name for name in self.variables}
         self.next_inputs = [primed(name) for name in self.inputs]
@@ -107,16 +109,15 @@ class SymbolicGame:
                                          for goal in self.env_goals]
         self.env_partition = self._partition(self.env_trans_parts, set(self.next_inputs))
         self.sys_partition = self._partition(self.sys_trans_parts, set(self.next_outputs))
-        # The system's responses matter only to environment moves allowed by env_trans (the
-        # enforceable predecessor quantifies over those alone); conjoining env_trans first
-        # keeps the intermediate BDDs of the relational product small.
-        self.response_partition = self._partition(
-            self.env_trans_parts + self.sys_trans_parts, set(self.next_outputs)) \
-            if self.options.responses_within_env_trans else self.sys_partition
-        self.image_partition = self._partition(self.env_trans_parts + self.sys_trans_parts,
-                                               set(self.variables))
+        if self.options.sift_once:
+            # The static order cannot know that e.g. a memory proposition belongs next to its
+            # action's activation and outcomes; one sifting pass on the relations finds such
+            # placements (3x faster multi-goal solving) for a few milliseconds.
+            self.bdd.reorder()
         if self.options.reordering:
             self.bdd.configure(reordering=True)
+        # Positions outside this set never matter (see relevant_positions); set by the solver.
+        self.care = self.true
 
     # --- translation ----------------------------------------------------------------------
 
@@ -218,7 +219,7 @@ class SymbolicGame:
 
     def system_can_respond(self, target):
         """``exists y'. sys_trans & target``: the system has a legal move into ``target``."""
-        return self._relational_product(target, self.response_partition)
+        return self._relational_product(target, self.sys_partition)
 
     def system_can_move_into(self, positions):
         """``exists y'. sys_trans & positions'``, memoized: the assumptions' inner fixpoints
@@ -227,7 +228,10 @@ class SymbolicGame:
         key = int(positions)
         found = self._moves_into.get(key) or self._previous_moves_into.get(key)
         if found is None or found[0] != positions:
-            found = (positions, self.system_can_respond(self.prime(positions)))
+            # Only moves from relevant positions matter, and they lead to relevant positions:
+            # the target may take any values elsewhere, so take CUDD's simplest such BDD.
+            target = positions if self.care == self.true else cudd.restrict(positions, self.care)
+            found = (positions, self.system_can_respond(self.prime(target)))
         self._moves_into[key] = found
         return found[1]
 
@@ -251,14 +255,31 @@ class SymbolicGame:
         """
         return self.enforce(self.system_can_respond(target))
 
+    @cached_property
+    def legal_moves(self):
+        """env_trans & sys_trans as one BDD (built on first use, after the sifting pass)."""
+        return _conjoin(self.env_trans(), self.sys_partition.clusters)
+
     def successors(self, positions):
-        return self.unprime(self._relational_product(positions, self.image_partition))
+        """The positions one legal move away from ``positions``."""
+        # The whole relation at once: measured 2x faster than its clusters with early
+        # quantification here, where every current variable is quantified.
+        return self.unprime(cudd.and_exists(positions, self.legal_moves, self.variables))
 
     def relevant_positions(self):
-        """The positions the solver must decide: all, or those reachable from the initial ones."""
-        return self.reachable_positions() if self.options.reachable_only else self.true
+        """The positions the solver must decide: all, or those reachable from the initial ones.
+
+        Every legal move (env_trans and sys_trans) from a reachable position leads to a
+        reachable one, so the game restricted to them has the same winner there; the
+        solver's sets then stay within them, and targets are simplified outside them.
+        """
+        if self.options.reachable_only:
+            self.care = self.reachable_positions()
+        return self.care
 
     def reachable_positions(self):
+        """Positions reachable from the initial ones (env_init & sys_init, either semantics)
+        by moves allowed by both safety sections: a breadth-first search on frontiers."""
         reached = frontier = self.env_init & self.sys_init
         while frontier != self.false:
             self.interrupt.check()
@@ -303,7 +324,9 @@ class SymbolicGame:
         return assignment, u
 
     def evaluate(self, u, assignment: dict[str, bool]) -> bool:
-        value = self.bdd.let(assignment, u)
+        # Substituting only the variables u depends on is much cheaper for small u.
+        support = self.bdd.support(u)
+        value = self.bdd.let({name: assignment[name] for name in support}, u) if support else u
         if value == self.true:
             return True
         if value == self.false:

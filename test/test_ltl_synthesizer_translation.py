@@ -4,7 +4,7 @@ import itertools
 
 import pytest
 
-from ltl_synthesizer import InvalidFormulaError, UnknownPropositionError
+from ltl_synthesizer import InvalidFormulaError, Options, UnknownPropositionError
 from ltl_synthesizer.symbolic import SymbolicGame, primed
 from respec.ltl import FALSE, TRUE, conj, disj, iff, implies, neg, next_, var
 from respec.spec import GR1Specification
@@ -12,8 +12,8 @@ from respec.spec import GR1Specification
 a, b, c = var('a'), var('b'), var('c')
 
 
-def game(**sections):
-    return SymbolicGame(GR1Specification(env_props=['a'], sys_props=['b', 'c'], **sections))
+def game(options=None, **sections):
+    return SymbolicGame(GR1Specification(env_props=['a'], sys_props=['b', 'c'], **sections), options)
 
 
 def truth_table(g, u, names):
@@ -22,12 +22,18 @@ def truth_table(g, u, names):
 
 
 def test_variables_are_interleaved_current_and_next():
-    g = game(sys_trans=[implies(b, next_(c))])
+    g = game(Options(sift_once=False), sys_trans=[implies(b, next_(c))])
     order = sorted(g.bdd.vars, key=g.bdd.level_of_var)
     # 'affinity' order: propositions in order of first use in the safety formulas.
     assert order == ['b', "b'", 'c', "c'", 'a', "a'"]
     for name in ('a', 'b', 'c'):
         assert g.bdd.level_of_var(primed(name)) == g.bdd.level_of_var(name) + 1
+
+
+def test_sifting_keeps_each_current_and_next_pair_adjacent():
+    g = game(sys_trans=[implies(b, next_(c)), iff(next_(a), conj([b, neg(c)]))])
+    for name in ('a', 'b', 'c'):
+        assert abs(g.bdd.level_of_var(primed(name)) - g.bdd.level_of_var(name)) == 1
 
 
 @pytest.mark.parametrize('formula, expected', [

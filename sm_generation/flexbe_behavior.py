@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass
+from pathlib import Path
 
 from sm_generation.config import FlexBEConfig
 from sm_generation.errors import SMGenerationError
@@ -52,6 +53,15 @@ class BehaviorPackage:
     class_name: str
     module: str
     files: dict[str, str]
+
+    def write(self, directory: str | Path) -> Path:
+        """Write the package folder into ``directory``; returns the folder."""
+        folder = Path(directory) / self.package
+        for relative, text in self.files.items():
+            path = folder / relative
+            path.parent.mkdir(parents=True, exist_ok=True)
+            path.write_text(text)
+        return folder
 
 
 # --- names (the editor's rules) ---------------------------------------------------------------

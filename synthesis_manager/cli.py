@@ -19,6 +19,8 @@ SUBCOMMANDS = {
     'compile': ('ltl_specification.cli', 'compile a task into a GR(1) specification (no ROS)'),
     'generate-sm': ('sm_generation.cli', 'turn an automaton into a FlexBE state machine (no ROS)'),
     'execute': ('synthesis_manager.execute', 'synthesize a behavior and run it on the simulated ATLAS'),
+    'export-behavior': ('synthesis_manager.export_behavior', 'synthesize a behavior and write it as a FlexBE '
+                        'behavior package'),
     'gui': ('synthesis_manager.gui', 'serve the synthesis web GUI on 127.0.0.1'),
 }
 

@@ -9,6 +9,11 @@ executed trace is checked against the returned specification.
     behavior-synthesis execute --goals pickup_object --fail pickup_object --expect failed
     behavior-synthesis execute --goals pickup_object --sm-outcomes finished --fail-first pickup_object:2
     behavior-synthesis execute --json --record out/run      # PNG key frames + timeline.png
+    behavior-synthesis execute --engine flexbe --goals look_down,pickup_object   # on flexbe_core
+
+With ``--engine flexbe`` the machine is exported as a FlexBE behavior and run by the real
+FlexBE engine (``synthesis_manager.ros.flexbe_engine``), its states driving the simulator
+node over ROS; the report is the same.
 
 Exit status:
   0  the run ended in the expected SM outcome (``--expect``, default ``finished``), the
@@ -55,6 +60,9 @@ def add_arguments(parser):
     group.add_argument('--seed', type=int, default=None, help='seed of probabilistic faults')
     group.add_argument('--expect', default='finished', metavar='OUTCOME',
                        help='the SM outcome the run should end in (default: finished)')
+    group.add_argument('--engine', choices=('ours', 'flexbe'), default='ours',
+                       help='who runs the state machine: our fast executive (default) or the real FlexBE '
+                            'engine (flexbe_core, e.g. from `make flexbe`; implies --ros-sim)')
     group.add_argument('--ros-sim', action='store_true',
                        help='run the simulator as the atlas_sim node and drive it over ROS')
     group.add_argument('--speed', type=float, default=10.0,
@@ -71,6 +79,11 @@ def run(args) -> int:
     from respec.systems import SystemConfigError
     from respec.naming import parse_names
 
+    if args.engine == 'flexbe':
+        problem = _flexbe_usage_problem(args)
+        if problem:
+            print(f'execute: {problem}', file=sys.stderr)
+            return EXIT_USAGE
     if args.record:
         os.environ.setdefault('MUJOCO_GL', 'egl')  # before anything imports mujoco
     initial_conditions = parse_names(args.initial_conditions)
@@ -93,6 +106,17 @@ def run(args) -> int:
     if args.json:
         print(json.dumps(report))
     return code
+
+
+def _flexbe_usage_problem(args) -> str:
+    if args.record:
+        return '--record is not available with --engine flexbe'
+    try:
+        import flexbe_core  # noqa: F401
+    except ImportError as error:
+        return (f'the FlexBE engine is not installed ({error}): run `make flexbe` (FlexBE sources in '
+                'FLEXBE_SOURCES) or source a ROS 2 workspace with FlexBE')
+    return ''
 
 
 def _synthesize_and_execute(args, simulator, goals, report, log) -> int:
@@ -118,13 +142,13 @@ def _run_in_suite(args, ros, client, simulator, goals, report, log) -> int:
         print(f'execute: synthesis failed: {outcome.error_name}: {outcome.message}', file=sys.stderr)
         return EXIT_SYNTHESIS
     sim_node = None
-    if args.ros_sim:
+    if args.ros_sim or args.engine == 'flexbe':
         robot, sim_node = _ros_robot(ros, args, simulator)
     else:
         from atlas_sim.executor import SimulatedRobot
 
         robot = SimulatedRobot(simulator)
-    return _execute(args, outcome, robot, simulator, goals, report, log, sim_node)
+    return _execute(args, outcome, robot, simulator, goals, report, log, sim_node, ros.domain_id)
 
 
 def _ros_robot(ros, args, simulator):
@@ -143,7 +167,7 @@ def _ros_robot(ros, args, simulator):
     return robot, node
 
 
-def _execute(args, outcome, robot, simulator, goals, report, log, sim_node=None) -> int:
+def _execute(args, outcome, robot, simulator, goals, report, log, sim_node=None, domain_id=None) -> int:
     from atlas_sim.executor import ExecutionError, execute_state_machine
     from atlas_sim.trace_check import check_trace
     from respec.parsing import spec_from_text_sections
@@ -161,9 +185,15 @@ def _execute(args, outcome, robot, simulator, goals, report, log, sim_node=None)
             on_tick = lambda robot: view.replay()  # noqa: E731
     started = time.monotonic()
     try:
-        run = execute_state_machine(outcome.states, robot, args.system, args.config_dir or None,
-                                    max_robot_time=args.max_robot_time,
-                                    max_wall_time=args.max_robot_time * 10 + 60, on_tick=on_tick)
+        if args.engine == 'flexbe':
+            from synthesis_manager.ros.flexbe_engine import run_on_flexbe
+
+            run = run_on_flexbe(outcome.states, simulator, sim_node.lock, domain_id, args.system,
+                                args.config_dir or None, max_wall_time=args.max_robot_time * 10 + 60)
+        else:
+            run = execute_state_machine(outcome.states, robot, args.system, args.config_dir or None,
+                                        max_robot_time=args.max_robot_time,
+                                        max_wall_time=args.max_robot_time * 10 + 60, on_tick=on_tick)
     except ExecutionError as error:
         report.update(outcome=None, error={'code': error.code, 'item': error.item, 'message': str(error)},
                       trace=error.trace.to_dict() if error.trace else None, fallen=simulator.has_fallen())

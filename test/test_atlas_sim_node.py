@@ -14,7 +14,7 @@ from rclpy.node import Node
 from rclpy.parameter import Parameter
 
 from respec.naming import parse_names
-from synthesis_manager.nodes.atlas_sim_node import ACTION_NAME, STATE_TOPIC, AtlasSimNode
+from synthesis_manager.nodes.atlas_sim_node import ACTION_NAME, CAPABILITY_ACTION_PREFIX, STATE_TOPIC, AtlasSimNode
 from synthesis_manager.ros.harness import RosHarness, wait_for
 from synthesis_manager.ros.env import prepare_ros_environment
 from synthesis_msgs.action import ExecuteCapability
@@ -98,6 +98,35 @@ def test_parameters_set_initial_conditions_and_faults(ros):
     assert (first.outcome, second.outcome) == ('failed', 'completed')
     pickup, = client.execute('pickup_object')
     assert pickup.outcome == 'completed'
+
+
+def test_per_capability_servers_join_running_requests_and_wait_for_sensors(ros):
+    node = sim_node(ros, speed=1.0, initial_conditions='stand')
+    client_node = ros.add_node(Node, 'capability_client')
+    clients = {name: ActionClient(client_node, ExecuteCapability, CAPABILITY_ACTION_PREFIX + name)
+               for name in ('look_down', 'obj_detected')}
+    assert all(c.wait_for_server(timeout_sec=10.0) for c in clients.values())
+    goal = ExecuteCapability.Goal()  # the server names the capability
+    first = wait_for(clients['look_down'].send_goal_async(goal))
+    deadline = time.monotonic() + 5.0
+    while 'look_down' not in node.simulator.snapshot()['running']:
+        assert time.monotonic() < deadline
+        time.sleep(0.01)
+    second = wait_for(clients['look_down'].send_goal_async(goal))  # activated again while running
+    results = [wait_for(h.get_result_async(), 30.0).result for h in (first, second)]
+    assert [r.outcome for r in results] == ['completed', 'completed'] and results[0].stamp == results[1].stamp
+    assert [r.name for r in node.simulator.history].count('look_down') == 1
+
+    with node.lock:
+        node.simulator.set_sensor('obj_detected', False)
+    reading = wait_for(clients['obj_detected'].send_goal_async(goal)).get_result_async()
+    time.sleep(0.3)
+    assert not reading.done()
+    with node.lock:
+        node.simulator.set_sensor('obj_detected', True)
+    assert wait_for(reading, 10.0).result.outcome == 'completed'
+    wrong = wait_for(clients['look_down'].send_goal_async(ExecuteCapability.Goal(capability='stand')))
+    assert not wrong.accepted
 
 
 def test_list_parameters_accept_arrays_and_comma_separated_strings():

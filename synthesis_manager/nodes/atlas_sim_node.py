@@ -6,6 +6,12 @@
   containers need: goals arriving within ``batch_window`` wall seconds of each other start
   in the same sim instant (``AtlasSimulator.start_concurrently``). Requests cannot be
   cancelled (the simulator has no way to), so cancel requests are rejected.
+* one such action server per capability, ``atlas_sim/capabilities/<capability>`` (the goal's
+  ``capability`` may be empty): FlexBE's proxy action client keeps one goal per action
+  name, so states running at once (a concurrency container) each need their own. A goal
+  for a capability whose request is still running joins that request (activating a running
+  capability again keeps it running, the activation–outcome semantics). Per sensor,
+  ``atlas_sim/capabilities/<sensor>`` completes once the sensor reads true.
 * topic ``atlas_sim/state`` (synthesis_msgs/msg/RobotState) at ``state_rate`` Hz.
 * physics runs in the node's own thread at ``speed`` sim seconds per wall second
   (0: as fast as possible; the default 10 is faster than real time), also between
@@ -20,6 +26,7 @@ loopback) or in-process: ``AtlasSimNode(context=...)`` like the suite's nodes.
 
 from __future__ import annotations
 
+import functools
 import threading
 import time
 
@@ -36,6 +43,7 @@ from synthesis_msgs.msg import RobotState
 
 NODE_NAME = 'atlas_sim'
 ACTION_NAME = 'atlas_sim/execute'
+CAPABILITY_ACTION_PREFIX = 'atlas_sim/capabilities/'
 STATE_TOPIC = 'atlas_sim/state'
 
 
@@ -52,10 +60,15 @@ def robot_state_message(snapshot: dict) -> RobotState:
 class _Job:
     """A goal waiting for its request to be started and finished by the physics thread."""
 
-    def __init__(self, capability: str):
+    def __init__(self, capability: str, sensor: bool = False):
         self.capability = capability
+        self.sensor = sensor      # wait until the sensor reads true (no request)
         self.request = None
         self.finished = threading.Event()
+
+    @property
+    def done(self) -> bool:
+        return self.request is not None and self.request.result is not None
 
 
 class AtlasSimNode(Node):
@@ -96,6 +109,13 @@ class AtlasSimNode(Node):
             self, ExecuteCapability, ACTION_NAME, self.execute,
             goal_callback=self.accept_goal, cancel_callback=lambda _: CancelResponse.REJECT,
             callback_group=group)
+        abstraction = self.simulator.abstraction
+        self.capability_servers = [
+            ActionServer(self, ExecuteCapability, CAPABILITY_ACTION_PREFIX + name,
+                         functools.partial(self.execute, name=name, sensor=name in abstraction.sensors),
+                         goal_callback=functools.partial(self.accept_named_goal, name),
+                         cancel_callback=lambda _: CancelResponse.REJECT, callback_group=group)
+            for name in (*abstraction.capabilities, *abstraction.sensors)]
         self._physics = threading.Thread(target=self._physics_loop, name='atlas-sim-physics', daemon=True)
         self._physics.start()
 
@@ -106,6 +126,8 @@ class AtlasSimNode(Node):
         for job in self._pending + self._running:
             job.finished.set()
         self.action_server.destroy()
+        for server in self.capability_servers:
+            server.destroy()
         super().destroy_node()
 
     # --- ROS side ------------------------------------------------------------------------------
@@ -116,8 +138,15 @@ class AtlasSimNode(Node):
             self.get_logger().warning(f'rejecting unknown capability {goal_request.capability!r}')
         return GoalResponse.ACCEPT if known else GoalResponse.REJECT
 
-    def execute(self, goal_handle):
-        job = _Job(goal_handle.request.capability)
+    def accept_named_goal(self, name: str, goal_request) -> GoalResponse:
+        """A per-capability server: the goal may repeat its capability's name or leave it empty."""
+        if goal_request.capability not in ('', name):
+            self.get_logger().warning(f'rejecting {goal_request.capability!r} sent to the {name!r} server')
+            return GoalResponse.REJECT
+        return GoalResponse.ACCEPT
+
+    def execute(self, goal_handle, name: str | None = None, sensor: bool = False):
+        job = _Job(name or goal_handle.request.capability, sensor)
         with self.lock:
             self._pending.append(job)
             self._last_arrival = time.monotonic()
@@ -126,7 +155,12 @@ class AtlasSimNode(Node):
             if self._stop.is_set():
                 break
         result = ExecuteCapability.Result()
-        if job.request is None or job.request.result is None:
+        if job.sensor and job.finished.is_set() and not self._stop.is_set():
+            goal_handle.succeed()
+            result.outcome, result.reason = 'completed', f'{job.capability} reads true'
+            result.stamp = float(self.simulator.time)
+            return result
+        if not job.done:
             goal_handle.abort()
             result.outcome, result.reason = 'failed', 'simulator shut down'
             return result
@@ -178,6 +212,12 @@ class AtlasSimNode(Node):
             time.sleep(self.batch_window / 4)
             self.lock.acquire()
         jobs, self._pending = self._pending, []
+        waiting_for_sensors = [job for job in jobs if job.sensor]
+        joining = [job for job in jobs if not job.sensor and job.capability in self._running_requests()]
+        for job in joining:  # activated again while running: the running request answers both
+            job.request = self._running_requests()[job.capability]
+        jobs = [job for job in jobs if job not in waiting_for_sensors and job not in joining]
+        self._running.extend(waiting_for_sensors + joining)
         names = [job.capability for job in jobs]
         duplicates = {n for n in names if names.count(n) > 1}
         unique = [job for job in jobs if job.capability not in duplicates]
@@ -191,10 +231,20 @@ class AtlasSimNode(Node):
         self._finish_jobs()
         return True
 
+    def _running_requests(self) -> dict:
+        """Capability -> its running request."""
+        return {job.capability: job.request for job in self._running
+                if not job.sensor and job.request.result is None}
+
     def _finish_jobs(self):
-        for job in [j for j in self._running if j.request.result is not None]:
+        for job in [j for j in self._running if self._job_finished(j)]:
             self._running.remove(job)
             job.finished.set()
+
+    def _job_finished(self, job: _Job) -> bool:
+        if job.sensor:
+            return bool(self.simulator.sensors.get(job.capability))
+        return job.request.result is not None
 
 
 def main():

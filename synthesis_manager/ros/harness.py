@@ -22,10 +22,15 @@ from synthesis_manager.ros.node_main import stop_executor
 class RosHarness:
     """Context manager: reserved domain, own rclpy context, executor thread, clean teardown."""
 
-    def __init__(self, num_threads: int = 8, domain_id: int | None = None):
-        """``domain_id=None`` reserves a free domain; give one to join an existing system."""
+    def __init__(self, num_threads: int = 8, domain_id: int | None = None, default_context: bool = False):
+        """``domain_id=None`` reserves a free domain; give one to join an existing system.
+
+        ``default_context``: use rclpy's global context (code such as flexbe_core checks
+        ``rclpy.ok()`` without a context); it is shut down and renewed on exit.
+        """
         self._num_threads = num_threads
         self.domain_id = domain_id
+        self._default_context = default_context
         self._stack = contextlib.ExitStack()
         self.nodes = []
         self.context = None
@@ -41,7 +46,7 @@ class RosHarness:
 
         from rclpy.signals import SignalHandlerOptions
 
-        self.context = rclpy.Context()
+        self.context = rclpy.utilities.get_default_context() if self._default_context else rclpy.Context()
         # No rclpy signal handlers: Ctrl-C stays a KeyboardInterrupt for the code using the
         # harness (a client cancels its goal, then leaves the block).
         rclpy.init(context=self.context, domain_id=self.domain_id,
@@ -69,7 +74,12 @@ class RosHarness:
             stop_executor(self.executor, self.nodes)
             for node in reversed(self.nodes):
                 node.destroy_node()
-            self.context.try_shutdown()
+            if self._default_context:  # renews the global context for the next user
+                import rclpy
+
+                rclpy.try_shutdown()
+            else:
+                self.context.try_shutdown()
             self._thread.join(timeout=5.0)
         finally:
             self._stack.close()

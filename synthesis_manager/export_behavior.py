@@ -1,0 +1,81 @@
+"""``behavior-synthesis export-behavior``: a synthesized behavior as a FlexBE behavior package.
+
+    behavior-synthesis export-behavior --system atlas --initial-conditions stand_prep \\
+        --goals look_down,pickup_object [--name NAME] [--package PKG] -o DIR
+
+The task goes through the ``/behavior_synthesis`` action with the suite's nodes running
+in-process (as ``execute`` does); the returned state machine is written to ``DIR/PKG``
+(default package ``synthesized_flexbe_behaviors``) as FlexBE's editor saves a behavior: the
+behavior module and its manifest, plus package.xml/setup.py for colcon
+(``sm_generation.flexbe_behavior``). ``--name`` names the behavior (default: from the goals,
+e.g. "Look Down Pickup Object").
+
+Exit status: 0 written; 2 bad name, package or configuration; 3 synthesis failed.
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+from pathlib import Path
+
+from synthesis_manager.send_goal import ProgressBar, add_goal_arguments, goal_from_args
+from synthesis_manager.suite import SuiteUnavailable, add_suite_arguments, in_process_suite
+
+EXIT_OK, EXIT_USAGE, EXIT_SYNTHESIS = 0, 2, 3
+
+
+def add_arguments(parser):
+    from sm_generation.flexbe_behavior import DEFAULT_PACKAGE
+
+    add_goal_arguments(parser, with_options=False)
+    add_suite_arguments(parser)
+    parser.add_argument('--package', default=DEFAULT_PACKAGE, help=f'ROS package name (default {DEFAULT_PACKAGE})')
+    parser.add_argument('--description', default='', help="the behavior's description")
+    parser.add_argument('-o', '--output', required=True, metavar='DIR', help='write the package folder into DIR')
+
+
+def default_behavior_name(goals: list[str]) -> str:
+    """'look_down', 'pickup_object' -> 'Look Down Pickup Object'."""
+    return ' '.join(word.capitalize() for goal in goals for word in goal.split('_') if word)
+
+
+def run(args) -> int:
+    from respec.naming import parse_names
+    from sm_generation import SMGenerationError, StateInstantiation
+    from sm_generation.config import load_flexbe_config
+    from sm_generation.flexbe_behavior import behavior_package, check_behavior_name, check_package_name
+
+    initial_conditions, goals = parse_names(args.initial_conditions), parse_names(args.goals)
+    behavior_name = args.name or default_behavior_name(goals)
+    try:  # bad names and configurations are usage errors, found before synthesis
+        check_behavior_name(behavior_name)
+        check_package_name(args.package)
+        config = load_flexbe_config(args.system, args.config_dir or None)
+    except SMGenerationError as error:
+        print(f'export-behavior: {error.code}: {error}', file=sys.stderr)
+        return EXIT_USAGE
+    progress = ProgressBar(stream=sys.stderr)  # the stream of now (the default is the one at import)
+    try:
+        with in_process_suite(args, 'export_behavior_client') as (_, client):
+            outcome = client.run(goal_from_args(args), feedback=progress)
+    except SuiteUnavailable as error:
+        print(f'export-behavior: {error}', file=sys.stderr)
+        return EXIT_SYNTHESIS
+    finally:
+        progress.close()
+    if not outcome.succeeded:
+        print(f'export-behavior: synthesis failed: {outcome.error_name}: {outcome.message}', file=sys.stderr)
+        return EXIT_SYNTHESIS
+    states = [StateInstantiation.from_dict(s) for s in outcome.states]
+    description = (args.description or f'Synthesized for {args.system}: from {", ".join(initial_conditions)}, '
+                   f'achieve {", ".join(goals)}.')
+    try:
+        package = behavior_package(states, config, behavior_name, args.package, description=description,
+                                   date=time.strftime('%a %b %d %Y'))
+    except SMGenerationError as error:
+        print(f'export-behavior: {error.code}: {error}', file=sys.stderr)
+        return EXIT_USAGE
+    folder = package.write(Path(args.output))
+    print(f'wrote behavior "{behavior_name}" ({package.class_name}) as package {package.package}: {folder}')
+    return EXIT_OK

@@ -1,0 +1,209 @@
+"""A synthesized behavior on the real FlexBE engine against the simulator node (ROS shell).
+
+``run_on_flexbe`` exports the machine as a behavior package (sm_generation.flexbe_behavior),
+loads its module as flexbe_onboard loads a behavior and runs it the same way: ``set_up``
+(autonomy Full unless told otherwise: no operator confirms transitions),
+``prepare_for_execution``, ``confirm``, ``execute``. The behavior's states drive the
+``atlas_sim`` node over ROS 2 (atlas_sim_flexbe_states: one ExecuteCapability action per
+capability); :class:`SimulatedOperator` answers InputState's ``flexbe/behavior_input``
+requests by running the operator-input capability the request stands for on the simulator.
+
+The trace for the specification check comes from
+:class:`atlas_sim.engine_trace.EngineTraceRecorder`: the top-level states of the running
+machine are observed by wrapping their ``execute`` (the engine itself is not changed), the
+robot's reports come from the simulator's events.
+
+flexbe_core checks ``rclpy.ok()`` on rclpy's global context, so the engine's nodes live
+there, on the same ROS domain as the simulator node.
+"""
+
+from __future__ import annotations
+
+import ast
+import contextlib
+import importlib.util
+import pickle
+import sys
+import tempfile
+import threading
+import time
+import zlib
+from pathlib import Path
+
+from atlas_sim.engine_trace import EngineTraceRecorder
+from atlas_sim.executor import ExecutionLimitError
+from sm_generation.config import load_flexbe_config
+from sm_generation.flexbe_behavior import behavior_package
+from sm_generation.instantiation import StateInstantiation
+
+FULL_AUTONOMY = 3
+INPUT_STATE = 'InputState'
+BEHAVIOR_INPUT_ACTION = 'flexbe/behavior_input'
+# What the simulated operator answers, by BehaviorInput request type (flexbe_msgs): the id
+# of the one object template in the simulated scene, a target pose (x, y, yaw).
+OPERATOR_ANSWERS = {0: 1, 3: [0.6, 0.0, 0.0]}
+PREEMPTED = 'preempted'
+
+
+def input_request_capabilities(config) -> dict[int, str]:
+    """BehaviorInput request type -> operator-input capability, from the InputStates of the config."""
+    capabilities = {}
+    for state in config.states.values():
+        if state.state_class == INPUT_STATE and 'request' in state.parameter_names:
+            value = state.parameter_values[state.parameter_names.index('request')]
+            capabilities[int(ast.literal_eval(value))] = state.label
+    return capabilities
+
+
+class SimulatedOperator:
+    """The operator behind ``flexbe/behavior_input`` (what FlexBE's UI serves for InputState)."""
+
+    def __init__(self, node, request_capabilities: dict[int, str]):
+        from flexbe_msgs.action import BehaviorInput
+        from rclpy.action import ActionClient, ActionServer
+        from rclpy.callback_groups import ReentrantCallbackGroup
+
+        from synthesis_manager.nodes.atlas_sim_node import CAPABILITY_ACTION_PREFIX
+        from synthesis_msgs.action import ExecuteCapability
+
+        self._types = (BehaviorInput, ExecuteCapability)
+        group = ReentrantCallbackGroup()
+        self.request_capabilities = dict(request_capabilities)
+        self.clients = {capability: ActionClient(node, ExecuteCapability, CAPABILITY_ACTION_PREFIX + capability,
+                                                 callback_group=group)
+                        for capability in set(self.request_capabilities.values())}
+        self.server = ActionServer(node, BehaviorInput, BEHAVIOR_INPUT_ACTION, self.answer, callback_group=group)
+
+    def answer(self, goal_handle):
+        behavior_input, execute_capability = self._types
+        result = behavior_input.Result(result_code=behavior_input.Result.RESULT_ABORTED)
+        capability = self.request_capabilities.get(goal_handle.request.request_type)
+        if capability is None or goal_handle.request.request_type not in OPERATOR_ANSWERS:
+            result.data = f'the simulated operator has no answer for request type {goal_handle.request.request_type}'
+            goal_handle.abort()
+            return result
+        client = self.clients[capability]
+        done = threading.Event()
+        outcome = {}
+        if client.wait_for_server(timeout_sec=5.0):
+            future = client.send_goal_async(execute_capability.Goal(capability=capability))
+            future.add_done_callback(lambda f: self._on_accepted(f, done, outcome))
+            done.wait(120.0)
+        if outcome.get('outcome') == 'completed':
+            answer = OPERATOR_ANSWERS[goal_handle.request.request_type]
+            result.result_code, result.data = behavior_input.Result.RESULT_OK, str(pickle.dumps(answer))
+        else:
+            result.data = outcome.get('reason', f'no answer from the simulator for {capability}')
+        goal_handle.succeed()
+        return result
+
+    @staticmethod
+    def _on_accepted(future, done, outcome):
+        handle = future.result()
+        if not handle.accepted:
+            outcome['reason'] = 'the simulator rejected the request'
+            done.set()
+            return
+
+        def on_result(result_future):
+            result = result_future.result().result
+            outcome.update(outcome=result.outcome, reason=result.reason)
+            done.set()
+        handle.get_result_async().add_done_callback(on_result)
+
+
+def load_behavior_class(package, directory: Path):
+    """Write the package under ``directory`` and load its behavior class (as flexbe_onboard does)."""
+    source = package.write(directory) / package.package / f'{package.module}.py'
+    module_name = f'{package.package}_{package.module}_{id(package):x}'  # fresh per run, like onboard's tmp_<id>
+    spec = importlib.util.spec_from_file_location(module_name, source)
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[module_name] = module
+    spec.loader.exec_module(module)
+    checksum = zlib.adler32(source.read_bytes()) & 0x7fffffff  # flexbe_onboard's behavior id
+    return getattr(module, package.class_name), checksum
+
+
+def observe_top_level_states(machine, recorder: EngineTraceRecorder) -> None:
+    """Report the top-level states' starts and outcomes to ``recorder``.
+
+    The engine calls ``execute`` of the current state once per tick; a state starts with its
+    first call after an outcome (or ever) and ends with the call returning an outcome.
+    """
+    for state in machine._states:  # noqa: SLF001 - flexbe_core keeps no public list
+        original = state.execute
+        running = {'now': False}
+
+        def observed(*args, _state=state, _original=original, _running=running, **kwargs):
+            if not _running['now']:
+                _running['now'] = True
+                recorder.entered(_state.name)
+            outcome = _original(*args, **kwargs)
+            if outcome is not None and outcome != PREEMPTED:
+                _running['now'] = False
+                recorder.returned(_state.name, outcome)
+            return outcome
+        state.execute = observed
+
+
+def reset_flexbe_proxies() -> None:
+    """flexbe_core keeps its proxies in class attributes; forget them so the next run starts clean."""
+    from flexbe_core.proxy import (ProxyActionClient, ProxyPublisher, ProxyServiceCaller,
+                                   ProxySubscriberCached, shutdown_proxies)
+
+    shutdown_proxies()
+    for proxy in (ProxyActionClient, ProxyPublisher, ProxyServiceCaller, ProxySubscriberCached):
+        for name in ('_clients', '_topics', '_services'):
+            registry = getattr(proxy, name, None)
+            if isinstance(registry, dict):
+                registry.clear()
+
+
+def run_on_flexbe(states, simulator, simulator_lock, domain_id: int, system: str = 'atlas', config_dir=None,
+                  behavior_name: str = 'Synthesized Behavior', autonomy: int = FULL_AUTONOMY,
+                  max_wall_time: float = 600.0):
+    """Run ``states`` (StateInstantiation objects or dicts) on FlexBE; returns an ExecutionResult.
+
+    The simulator node must be running on ``domain_id`` around ``simulator``. Raises
+    ExecutionLimitError (with the partial trace) if no outcome came within ``max_wall_time``.
+    """
+    from rclpy.node import Node
+
+    from synthesis_manager.ros.harness import RosHarness
+
+    states = [s if isinstance(s, StateInstantiation) else StateInstantiation.from_dict(s) for s in states]
+    config = load_flexbe_config(system, config_dir)
+    package = behavior_package(states, config, behavior_name, date=time.strftime('%a %b %d %Y'))
+    recorder = EngineTraceRecorder(states, simulator, system, config_dir, simulator_lock)
+    try:  # flexbe_core prints progress notes: keep them off stdout, which is the command's output
+        with contextlib.redirect_stdout(sys.stderr), tempfile.TemporaryDirectory(prefix='flexbe_behavior_') as directory, \
+                RosHarness(domain_id=domain_id, default_context=True) as ros:
+            behavior_class, checksum = load_behavior_class(package, Path(directory))
+            SimulatedOperator(ros.add_node(Node, 'simulated_operator'), input_request_capabilities(config))
+            node = ros.add_node(Node, 'flexbe_onboard')
+            try:
+                outcome = _execute(behavior_class(node), checksum, autonomy, recorder, max_wall_time)
+            finally:
+                reset_flexbe_proxies()
+    finally:
+        recorder.close()
+    result = recorder.result()
+    if outcome == PREEMPTED or result.outcome is None:
+        raise ExecutionLimitError(f'no SM outcome within {max_wall_time:g} s on the FlexBE engine '
+                                  f'(engine returned {outcome!r})', item=behavior_name, trace=result.trace)
+    return result
+
+
+def _execute(behavior, checksum: int, autonomy: int, recorder: EngineTraceRecorder, max_wall_time: float):
+    """flexbe_onboard's sequence: set_up, prepare_for_execution, confirm, execute."""
+    behavior.set_up(beh_id=checksum, autonomy_level=autonomy, debug=False)
+    behavior.prepare_for_execution({})
+    observe_top_level_states(behavior._state_machine, recorder)  # noqa: SLF001
+    behavior.confirm()
+    watchdog = threading.Timer(max_wall_time, behavior.preempt)
+    watchdog.daemon = True
+    watchdog.start()
+    try:
+        return behavior.execute()
+    finally:
+        watchdog.cancel()

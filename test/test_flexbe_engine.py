@@ -1,0 +1,144 @@
+"""Synthesized behaviors on the real FlexBE engine (FLEXBE_SOURCES) against the simulated ATLAS.
+
+The exported behavior package loads in flexbe_core and its ``create()`` builds the machine;
+closed loops (the paper's two tasks, a failure, a retry) run on the engine the way
+flexbe_onboard runs a behavior, its states driving the atlas_sim node over ROS 2, and the
+trace checks clean against the specification.
+"""
+
+import pytest
+from rclpy.node import Node
+from rclpy.parameter import Parameter
+
+from atlas_sim.executor import make_simulator, parse_faults
+from synthesis_manager.nodes.atlas_sim_node import AtlasSimNode
+from atlas_sim.trace_check import check_trace
+from ltl_specification import compile_task
+from ltl_synthesizer import synthesize
+from respec.automaton import automaton_from_strategy
+from sm_generation import generate_state_machine
+from sm_generation.config import load_flexbe_config
+from sm_generation.flexbe_behavior import behavior_package
+
+pytestmark = pytest.mark.usefixtures('flexbe')
+
+PICKUP = (['stand_prep'], ['look_down', 'pickup_object'])
+FOOTSTEPS = (['manipulate'], ['footstep_execution'])
+
+
+def synthesized(initial_conditions, goals, sm_outcomes=('finished', 'failed')):
+    spec = compile_task('atlas', initial_conditions, goals, sm_outcomes=sm_outcomes)
+    automaton = automaton_from_strategy(synthesize(spec).strategy, spec)
+    return spec, generate_state_machine(automaton, 'atlas', initial_conditions=initial_conditions)
+
+
+def test_exported_behavior_loads_in_flexbe_core_and_create_builds_the_machine(ros, tmp_path):
+    from flexbe_core import ConcurrencyContainer, OperatableStateMachine, set_node
+
+    from synthesis_manager.ros.flexbe_engine import load_behavior_class, reset_flexbe_proxies
+
+    _, states = synthesized(*PICKUP)
+    package = behavior_package(states, load_flexbe_config('atlas'), 'Look Down And Pickup')
+    behavior_class, _ = load_behavior_class(package, tmp_path)
+    node = ros.add_node(Node, 'flexbe_create_test')
+    set_node(node)
+    try:
+        behavior = behavior_class(node)
+        machine = behavior.create()
+    finally:
+        reset_flexbe_proxies()
+    assert isinstance(machine, OperatableStateMachine)
+    root = states[0]
+    assert list(machine.outcomes) == root.outcomes
+    top = {s.name: s for s in states if s.parent_path == '/' and s.state_class != ':OUTCOME'}
+    assert {s.name for s in machine._states} == set(top)
+    assert machine._states[0].name == root.initial_state_name  # the first state added starts
+    for state in machine._states:
+        entry = top[state.name]
+        assert list(state.outcomes) == entry.outcomes
+        transitions = {o: t for o, t in machine._transitions[state.name].items() if o != 'preempted'}  # FlexBE's own
+        assert transitions == dict(zip(entry.outcomes, entry.transitions))
+        assert isinstance(state, ConcurrencyContainer) == (entry.state_class == ':CONCURRENCY')
+    pickup = next(s for s in machine._states if s.name == 'pickup_object')
+    assert 'template_id' in pickup.input_keys
+
+
+def run_task(ros, initial_conditions, goals, sm_outcomes=('finished', 'failed'), faults=None):
+    from synthesis_manager.ros.flexbe_engine import run_on_flexbe
+
+    spec, states = synthesized(initial_conditions, goals, sm_outcomes)
+    simulator = make_simulator('atlas', initial_conditions=initial_conditions, faults=faults)
+    node = ros.add_node(AtlasSimNode, simulator=simulator, parameter_overrides=[
+        Parameter('speed', value=20.0), Parameter('state_rate', value=50.0)])
+    run = run_on_flexbe(states, simulator, node.lock, ros.domain_id, max_wall_time=120.0)
+    report = check_trace(run.trace, spec, goals=goals)
+    assert report.ok, report.summary()
+    assert not run.fallen
+    return run, simulator
+
+
+@pytest.mark.parametrize('task', [PICKUP, FOOTSTEPS], ids=['pickup', 'footsteps'])
+def test_paper_tasks_finish_on_the_flexbe_engine(ros, task):
+    run, simulator = run_task(ros, *task)
+    assert run.outcome == 'finished'
+    assert run.trace.steps[-1].state_outcome and run.trace.steps[-1].transition == 'finished'
+    if 'pickup_object' in task[1]:
+        assert simulator.snapshot()['holding_object']
+
+
+def test_a_failing_pickup_ends_failed_on_the_flexbe_engine(ros):
+    run, simulator = run_task(ros, *PICKUP, faults=parse_faults(fail=['pickup_object']))
+    assert run.outcome == 'failed'
+    assert [s.state for s in run.trace.steps][-1] == '/pickup_object'
+    assert not simulator.snapshot()['holding_object']
+
+
+def test_retry_until_finished_on_the_flexbe_engine(ros):
+    run, simulator = run_task(ros, *PICKUP, sm_outcomes=('finished',),
+                              faults=parse_faults(fail_first=['pickup_object:2']))
+    assert run.outcome == 'finished'
+    attempts = [r for s in run.trace.steps for r in s.results if r['capability'] == 'pickup_object']
+    assert [r['outcome'] for r in attempts] == ['failed', 'failed', 'completed']
+    assert simulator.snapshot()['holding_object']
+
+
+def run_cli(capsys, *arguments):
+    from synthesis_manager.cli import main
+
+    code = main(list(arguments))
+    return code, capsys.readouterr()
+
+
+@pytest.mark.parametrize('arguments, code, outcome', [
+    ((), 0, 'finished'),
+    (('--fail', 'pickup_object'), 1, 'failed'),
+    (('--sm-outcomes', 'finished', '--fail-first', 'pickup_object:2'), 0, 'finished')],
+    ids=['finished', 'failed', 'retry'])
+def test_execute_on_the_flexbe_engine_prints_the_usual_report(capsys, arguments, code, outcome):
+    import json
+
+    exit_code, output = run_cli(capsys, 'execute', '--engine', 'flexbe', '--json', '--speed', '20',
+                                '--initial-conditions', 'stand_prep', '--goals', 'look_down,pickup_object',
+                                *arguments)
+    report = json.loads(output.out)
+    assert exit_code == code, output.err[-2000:]
+    assert report['outcome'] == outcome and report['fallen'] is False
+    assert report['trace_check']['ok'] and report['trace']['steps'][-1]['state'].startswith('/pickup_object')
+
+
+def test_export_behavior_writes_the_package_the_editor_would(capsys, tmp_path):
+    import xml.etree.ElementTree as ET
+
+    code, output = run_cli(capsys, 'export-behavior', '--system', 'atlas', '--initial-conditions', 'stand_prep',
+                           '--goals', 'look_down,pickup_object', '-o', str(tmp_path))
+    assert code == 0, output.err
+    folder = tmp_path / 'synthesized_flexbe_behaviors'
+    manifest = ET.parse(folder / 'manifest' / 'look_down_pickup_object.xml').getroot()
+    assert manifest.get('name') == 'Look Down Pickup Object'
+    executable = manifest.find('executable')
+    module = executable.get('package_path').split('.')
+    assert (folder / module[0] / f'{module[1]}.py').is_file() and executable.get('class') == 'LookDownPickupObjectSM'
+    assert [c.get('name') for c in manifest.findall('contains')] == ['Pickup Object']
+    assert '<flexbe_behaviors />' in (folder / 'package.xml').read_text()
+    code, output = run_cli(capsys, 'export-behavior', '--name', '9 lives', '-o', str(tmp_path))
+    assert code == 2 and "'9 lives'" in output.err

@@ -29,7 +29,7 @@ from __future__ import annotations
 import contextlib
 import threading
 
-from atlas_sim.executor import ExecutionResult, StateMapping, load_machine
+from atlas_sim.executor import ExecutionResult, StateMapping, entered_step, load_machine
 from atlas_sim.trace_check import OutcomeTracker, Trace, TraceStep
 
 
@@ -68,18 +68,10 @@ class EngineTraceRecorder:
 
     def entered(self, name: str) -> None:
         """Top-level state ``name`` starts (before it requests anything)."""
-        state = self.states[name]
-        parts = self.parts[name]
         snapshot = self._snapshot()
         with self._lock:
             self._observe(snapshot)
-            step = TraceStep(index=len(self.trace.steps), state=state.path, state_class=state.state_class,
-                             activated=sorted(p.proposition for p in parts if p.kind == 'capability'),
-                             capabilities=[p.capability for p in parts if p.kind == 'capability'],
-                             entered_at=snapshot['time'], mode_at_entry=snapshot['mode'],
-                             outcomes_at_entry=self.tracker.true_propositions())
-            self.trace.steps.append(step)
-            self._current = step
+            self._current = entered_step(self.trace, self.states[name], self.parts[name], snapshot, self.tracker)
 
     def returned(self, name: str, outcome: str) -> None:
         """Top-level state ``name`` returned ``outcome``."""

@@ -394,6 +394,18 @@ class ExecutionResult:
                 'ticks': self.ticks}
 
 
+def entered_step(trace: Trace, state: StateNode, parts: list[Part], snapshot: dict,
+                 tracker: OutcomeTracker) -> TraceStep:
+    """Append the step of top-level ``state`` (run as ``parts``) entered now to ``trace``."""
+    step = TraceStep(index=len(trace.steps), state=state.path, state_class=state.state_class,
+                     activated=sorted(p.proposition for p in parts if p.kind == 'capability'),
+                     capabilities=[p.capability for p in parts if p.kind == 'capability'],
+                     entered_at=snapshot['time'], mode_at_entry=snapshot['mode'],
+                     outcomes_at_entry=tracker.true_propositions())
+    trace.steps.append(step)
+    return step
+
+
 @dataclass
 class _Running:
     """A started request of the robot and what has been seen of it."""
@@ -458,13 +470,7 @@ class Executive:
 
     def _run_state(self, state: StateNode) -> str:
         parts = [self.parts[node.path] for node in (state.children or [state])]
-        snapshot = self.robot.snapshot()
-        step = TraceStep(index=len(self.trace.steps), state=state.path, state_class=state.state_class,
-                         activated=sorted(p.proposition for p in parts if p.kind == 'capability'),
-                         capabilities=[p.capability for p in parts if p.kind == 'capability'],
-                         entered_at=snapshot['time'], mode_at_entry=snapshot['mode'],
-                         outcomes_at_entry=self.tracker.true_propositions())
-        self.trace.steps.append(step)
+        step = entered_step(self.trace, state, parts, self.robot.snapshot(), self.tracker)
         self._activate(step.capabilities)
         sensors_at_entry = dict(self.tracker.sensors)
         returned: dict[str, str] = {}          # part path -> state outcome returned

@@ -23,7 +23,9 @@ packages do); the generator's helper states come from flexbe_states.
 
 from __future__ import annotations
 
+import io
 import re
+import zipfile
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -37,6 +39,7 @@ FLEXBE_STATES_PACKAGE = 'flexbe_states'
 HELPER_STATE_CLASSES = (DECISION_CLASS, NOTHING_CLASS)  # the generator's, from flexbe_states
 AUTONOMY_NAMES = {0: 'Autonomy.Off', 1: 'Autonomy.Low', 2: 'Autonomy.High', 3: 'Autonomy.Full'}
 DEFAULT_PACKAGE = 'synthesized_flexbe_behaviors'
+ZIP_DATE = (2020, 1, 1, 0, 0, 0)  # same machine, same archive bytes
 INDENT = '    '
 STATE_INDENT = INDENT * 3
 ADD_CALL = 'OperatableStateMachine.add('
@@ -63,6 +66,14 @@ class BehaviorPackage:
             path.write_text(text)
         return folder
 
+    def zip_bytes(self) -> bytes:
+        """The package folder as a zip archive (entries under ``<package>/``, fixed dates)."""
+        buffer = io.BytesIO()
+        with zipfile.ZipFile(buffer, 'w', zipfile.ZIP_DEFLATED) as archive:
+            for relative, text in sorted(self.files.items()):
+                archive.writestr(zipfile.ZipInfo(f'{self.package}/{relative}', date_time=ZIP_DATE), text)
+        return buffer.getvalue()
+
 
 # --- names (the editor's rules) ---------------------------------------------------------------
 
@@ -74,6 +85,11 @@ def behavior_class_name(behavior_name: str) -> str:
 def behavior_module_name(behavior_name: str) -> str:
     """'Pickup Object' -> 'pickup_object_sm' (its manifest: pickup_object.xml)."""
     return re.sub(r'[^\w]', '_', behavior_name.lower()) + '_sm'
+
+
+def default_behavior_name(goals) -> str:
+    """A behavior name from the goals: 'look_down', 'pickup_object' -> 'Look Down Pickup Object'."""
+    return ' '.join(word.capitalize() for goal in goals for word in goal.split('_') if word) or 'Synthesized'
 
 
 def state_module_name(state_class: str) -> str:

@@ -251,8 +251,10 @@ def _helper_entry(state: MachineState, name: str, target_name) -> StateInstantia
         return StateInstantiation(
             state_path=f'/{name}', state_class=DECISION_CLASS,
             parameter_names=['outcomes', 'hint', 'suggestion'],
+            # The first start is suggested: FlexBE takes it in full autonomy (as our executive
+            # does), below that the operator confirms or picks another.
             parameter_values=[repr(targets), '"Several initial states are possible: choose where to start"',
-                              'None'],
+                              repr(targets[0])],
             outcomes=list(targets), transitions=list(targets), autonomy=[DECISION_AUTONOMY] * len(targets))
     if state.helper == NOTHING_TO_DO:
         return StateInstantiation(

@@ -35,16 +35,12 @@ def add_arguments(parser):
     parser.add_argument('-o', '--output', required=True, metavar='DIR', help='write the package folder into DIR')
 
 
-def default_behavior_name(goals: list[str]) -> str:
-    """'look_down', 'pickup_object' -> 'Look Down Pickup Object'."""
-    return ' '.join(word.capitalize() for goal in goals for word in goal.split('_') if word)
-
-
 def run(args) -> int:
     from respec.naming import parse_names
     from sm_generation import SMGenerationError, StateInstantiation
     from sm_generation.config import load_flexbe_config
-    from sm_generation.flexbe_behavior import behavior_package, check_behavior_name, check_package_name
+    from sm_generation.flexbe_behavior import (behavior_package, check_behavior_name, check_package_name,
+                                               default_behavior_name)
 
     initial_conditions, goals = parse_names(args.initial_conditions), parse_names(args.goals)
     behavior_name = args.name or default_behavior_name(goals)

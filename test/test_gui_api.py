@@ -117,6 +117,15 @@ def test_paper_task_succeeds_with_progress_states_and_downloads(client):
     assert all(name in svg.text for name in ('look_down', 'pickup_object', 'finished', 'failed'))
     assert client.get(f'{base}/state_machine.png').content.startswith(b'\x89PNG')
 
+    import io
+    import zipfile
+
+    behavior = zipfile.ZipFile(io.BytesIO(client.get(f'{base}/flexbe_behavior.zip').content))
+    names = behavior.namelist()  # the package export-behavior writes, behavior named after the goals
+    assert 'synthesized_flexbe_behaviors/manifest/look_down_pickup_object.xml' in names
+    code = behavior.read('synthesized_flexbe_behaviors/synthesized_flexbe_behaviors/look_down_pickup_object_sm.py')
+    assert b'class LookDownPickupObjectSM(Behavior):' in code and b'ConcurrencyContainer(' in code
+
 
 def test_same_request_gives_byte_identical_downloads(client):
     first = run_job(client, PAPER_TASK)[1]

@@ -149,7 +149,9 @@ def test_several_initial_states_with_different_behaviours_ask_the_operator():
     assert states['/'].initial_state_name == 'choose_initial_state'
     assert decision.state_class == 'OperatorDecisionState'
     assert edges(decision) == {'stand': 'stand', 'look_down': 'look_down'}
-    assert dict(zip(decision.parameter_names, decision.parameter_values))['outcomes'] == "['stand', 'look_down']"
+    parameters = dict(zip(decision.parameter_names, decision.parameter_values))
+    assert parameters['outcomes'] == "['stand', 'look_down']"
+    assert parameters['suggestion'] == "'stand'"  # FlexBE takes it in full autonomy, like our executive
 
 
 def test_initial_state_that_already_exits():

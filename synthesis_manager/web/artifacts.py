@@ -1,15 +1,18 @@
-"""The downloads of a finished job, built on demand from its outcome."""
+"""The downloads of a finished job, built on demand from its outcome (and request, config dir)."""
 
 from __future__ import annotations
 
 import json
 import tempfile
+import time
 from dataclasses import dataclass
 from pathlib import Path
 
 from respec.parsing import spec_from_text_sections
-from sm_generation import StateInstantiation, export
+from sm_generation import SMGenerationError, StateInstantiation, export
+from sm_generation.config import load_flexbe_config
 from sm_generation.export import render, to_dot
+from sm_generation.flexbe_behavior import behavior_package, check_behavior_name, default_behavior_name
 
 
 @dataclass(frozen=True)
@@ -24,13 +27,13 @@ def _state_list(outcome):
 
 
 def _export(kind):
-    def build(outcome) -> bytes:
+    def build(outcome, *_) -> bytes:
         return getattr(export, kind)(_state_list(outcome)).encode()
     return build
 
 
 def _picture(fmt):
-    def build(outcome) -> bytes:
+    def build(outcome, *_) -> bytes:
         with tempfile.TemporaryDirectory(prefix='behavior-synthesis-gui-') as directory:
             path = render(to_dot(_state_list(outcome)), Path(directory) / f'state_machine.{fmt}')
             return path.read_bytes()
@@ -38,9 +41,26 @@ def _picture(fmt):
 
 
 def _specification(method):
-    def build(outcome) -> bytes:
+    def build(outcome, *_) -> bytes:
         return getattr(spec_from_text_sections(outcome['ltl_specification']), method)().encode()
     return build
+
+
+def _flexbe_behavior(outcome, request, config_dir) -> bytes:
+    """The behavior package FlexBE's editor would save (as ``behavior-synthesis export-behavior``)."""
+    name = request.name if request.name and check_name(request.name) else default_behavior_name(request.goals)
+    package = behavior_package(_state_list(outcome), load_flexbe_config(request.system, config_dir), name,
+                               date=time.strftime('%a %b %d %Y'))
+    return package.zip_bytes()
+
+
+def check_name(name: str) -> bool:
+    """Whether a request's name can name a behavior (container paths such as '/Container' cannot)."""
+    try:
+        check_behavior_name(name)
+    except SMGenerationError:
+        return False
+    return True
 
 
 def _has_states(outcome):
@@ -65,9 +85,10 @@ ARTIFACTS = {
     'specification.structuredslugs': ('text/plain', _has_specification, _specification('to_structuredslugs')),
     'specification.slugsin': ('text/plain', _has_specification, _specification('to_slugsin')),
     'automaton.json': ('application/json', _has_automaton,
-                       lambda outcome: (json.dumps(outcome['automaton'], indent=1) + '\n').encode()),
+                       lambda outcome, *_: (json.dumps(outcome['automaton'], indent=1) + '\n').encode()),
     'result.json': ('application/json', lambda outcome: True,
-                    lambda outcome: (json.dumps(outcome, indent=1) + '\n').encode()),
+                    lambda outcome, *_: (json.dumps(outcome, indent=1) + '\n').encode()),
+    'flexbe_behavior.zip': ('application/zip', _has_states, _flexbe_behavior),
 }
 
 

@@ -114,7 +114,7 @@ class SynthesisBackend:
         key = (job_id, name)
         if key not in self._artifacts:
             try:
-                content = build(job.outcome)
+                content = build(job.outcome, job.request, self.config_dir)
             except Exception as error:  # e.g. RenderError when Graphviz is missing
                 raise ArtifactFailedError(f'cannot make {name}: {error}',
                                           getattr(error, 'item', '') or name) from error

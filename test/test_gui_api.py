@@ -124,7 +124,8 @@ def test_paper_task_succeeds_with_progress_states_and_downloads(client):
     names = behavior.namelist()  # the package export-behavior writes, behavior named after the goals
     assert 'synthesized_flexbe_behaviors/manifest/look_down_pickup_object.xml' in names
     code = behavior.read('synthesized_flexbe_behaviors/synthesized_flexbe_behaviors/look_down_pickup_object_sm.py')
-    assert b'class LookDownPickupObjectSM(Behavior):' in code and b'ConcurrencyContainer(' in code
+    assert b'class LookDownPickupObjectSM(Behavior):' in code
+    assert b"self.use_behavior(PickupObjectSM, 'pickup_object')" in code
 
 
 def test_same_request_gives_byte_identical_downloads(client):

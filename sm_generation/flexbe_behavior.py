@@ -356,7 +356,7 @@ def _package_xml(package: str, machine: _Machine, config: FlexBEConfig, descript
         'schematypens="http://www.w3.org/2001/XMLSchema"?>',
         '<package format="3">', f'  <name>{package}</name>', '  <version>0.0.0</version>',
         f'  <description>{_xml_text(description)}</description>',
-        '  <maintainer email="user@localhost">user</maintainer>', '  <license>BSD-3-Clause</license>', '',
+        '  <maintainer email="user@example.org">user</maintainer>', '  <license>BSD-3-Clause</license>', '',
         *(f'  <exec_depend>{name}</exec_depend>' for name in depends), '',
         '  <export>', '    <build_type>ament_python</build_type>', '    <flexbe_behaviors />', '  </export>',
         '</package>', ''])

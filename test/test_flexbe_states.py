@@ -73,3 +73,18 @@ def test_configured_behavior_exists_with_the_configured_outcomes(flexbe_node, en
     machine = behavior.create()
     assert list(machine.outcomes) == list(state.outcomes)
     assert set(machine.input_keys) == set(state.userdata_keys)
+
+
+def test_flexbe_onboard_finds_the_configured_behaviors_through_the_ament_index(flexbe, flexbe_node, monkeypatch):
+    """flexbe_core's BehaviorLibrary (what flexbe_onboard starts behaviors from) resolves our behaviors."""
+    from flexbe_core import BehaviorLibrary
+
+    monkeypatch.setenv('AMENT_PREFIX_PATH', str(flexbe))
+    library = BehaviorLibrary(flexbe_node)
+    for system, state in BEHAVIORS:
+        package = CONFIGS[system].behavior_package
+        key, entry = library.find_behavior(f'{package}/{state.behavior_class}')
+        assert entry is not None, state.behavior_class
+        assert entry['class'] == behavior_class_name(state.behavior_class)
+        source = library.get_sourcecode_filepath(key)
+        assert source.endswith(f'{behavior_module_name(state.behavior_class)}.py')

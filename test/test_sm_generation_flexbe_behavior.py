@@ -13,7 +13,8 @@ from sm_generation.config import load_flexbe_config, parse_flexbe_config
 from sm_generation.flexbe_behavior import (behavior_class_name, behavior_module_name, behavior_package,
                                            state_module_name)
 
-AUTOMATA = Path(__file__).resolve().parent / 'automata'
+ROOT = Path(__file__).resolve().parent.parent
+AUTOMATA = ROOT / 'test' / 'automata'
 DATE = 'Sun Nov 22 2026'
 
 
@@ -131,3 +132,17 @@ def test_a_class_without_a_package_names_the_state():
     with pytest.raises(SMGenerationError) as error:
         behavior_package(states, bare, 'No Packages')
     assert error.value.code == 'CONFIG_VARIABLE_CONFIG_INVALID' and error.value.item.startswith('/')
+
+
+def test_package_manifests_are_valid_for_colcon():
+    """catkin_pkg (what colcon and flexbe_onboard parse package.xml with) accepts the exported and our own."""
+    from catkin_pkg.package import parse_package_string
+
+    _, package = export()
+    manifests = [package.files['package.xml']] + [
+        (ROOT / 'atlas_sim' / name / 'package.xml').read_text()
+        for name in ('atlas_sim_flexbe_states', 'atlas_sim_flexbe_behaviors')]
+    for text in manifests:
+        parsed = parse_package_string(text)
+        parsed.validate()
+        assert any(tag.tagname in ('flexbe_states', 'flexbe_behaviors') for tag in parsed.exports)

@@ -21,8 +21,8 @@ setup(
     ],
     install_requires=['setuptools'],
     zip_safe=True,
-    maintainer='behavior-synthesis maintainers',
-    maintainer_email='behavior-synthesis@localhost',
+    maintainer='Behavior synthesis maintainers',
+    maintainer_email='behavior-synthesis@example.org',
     description='FlexBE behaviors for atlas_sim robots',
     license='BSD-3-Clause',
 )

@@ -14,8 +14,8 @@ setup(
     ],
     install_requires=['setuptools'],
     zip_safe=True,
-    maintainer='behavior-synthesis maintainers',
-    maintainer_email='behavior-synthesis@localhost',
+    maintainer='Behavior synthesis maintainers',
+    maintainer_email='behavior-synthesis@example.org',
     description='FlexBE states driving the atlas_sim simulator node',
     license='BSD-3-Clause',
 )

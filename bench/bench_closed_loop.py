@@ -1,7 +1,8 @@
 """Closed-loop runs on the simulated ATLAS: robot (sim) time against wall time.
 
 Runs the closed-loop tasks directly on the simulator and through the simulator node over ROS
-(at two pacing speeds), checks every trace, and prints one table row per run.
+(at two pacing speeds), with the real FlexBE engine too when flexbe_core is importable
+(`make flexbe`), checks every trace, and prints one table row per run.
 
     .venv/bin/python bench/bench_closed_loop.py
 """
@@ -65,19 +66,49 @@ def run_over_ros(states, initial_conditions, faults, speed):
         return run, run.duration, time.perf_counter() - started
 
 
+def run_on_flexbe_engine(states, initial_conditions, faults, speed):
+    """The real FlexBE engine (flexbe_core from `make flexbe`) drives the simulator node."""
+    from rclpy.parameter import Parameter
+
+    from atlas_sim.executor import make_simulator, parse_faults
+    from synthesis_manager.nodes.atlas_sim_node import AtlasSimNode
+    from synthesis_manager.ros.flexbe_engine import run_on_flexbe
+    from synthesis_manager.ros.harness import RosHarness
+
+    with RosHarness() as ros:
+        simulator = make_simulator('atlas', initial_conditions=initial_conditions,
+                                   faults=parse_faults(**faults))
+        node = ros.add_node(AtlasSimNode, simulator=simulator, parameter_overrides=[
+            Parameter('speed', value=speed), Parameter('state_rate', value=50.0)])
+        started = time.perf_counter()
+        run = run_on_flexbe(states, simulator, node.lock, ros.domain_id, max_wall_time=300)
+        return run, run.duration, time.perf_counter() - started
+
+
+def flexbe_available() -> bool:
+    try:
+        import flexbe_core  # noqa: F401
+    except ImportError:
+        return False
+    return True
+
+
 def main() -> int:
     from atlas_sim.trace_check import check_trace
 
-    print(f"{'task':<14}{'path':<10}{'robot s':>9}{'wall s':>9}{'x real':>8}  outcome, trace check")
+    print(f"{'task':<14}{'path':<12}{'robot s':>9}{'wall s':>9}{'x real':>8}  outcome, trace check")
     for name, initial, goals, sm_outcomes, faults in TASKS:
         spec, states = synthesized_machine(initial, goals, sm_outcomes)
         runs = [('direct', lambda: run_direct(states, initial, faults))]
         runs += [(f'ros x{speed:g}', lambda speed=speed: run_over_ros(states, initial, faults, speed))
                  for speed in ROS_SPEEDS]
+        if flexbe_available():  # the real FlexBE engine instead of our executive
+            runs += [(f'flexbe x{speed:g}', lambda speed=speed: run_on_flexbe_engine(states, initial, faults, speed))
+                     for speed in ROS_SPEEDS]
         for path, runner in runs:
             run, robot_seconds, wall_seconds = runner()
             verdict = 'ok' if check_trace(run.trace, spec, goals=goals).ok else 'VIOLATIONS'
-            print(f'{name:<14}{path:<10}{robot_seconds:9.2f}{wall_seconds:9.2f}'
+            print(f'{name:<14}{path:<12}{robot_seconds:9.2f}{wall_seconds:9.2f}'
                   f'{robot_seconds / wall_seconds:8.1f}  {run.outcome}, {verdict}')
     return 0
 

@@ -142,3 +142,20 @@ def test_export_behavior_writes_the_package_the_editor_would(capsys, tmp_path):
     assert '<flexbe_behaviors />' in (folder / 'package.xml').read_text()
     code, output = run_cli(capsys, 'export-behavior', '--name', '9 lives', '-o', str(tmp_path))
     assert code == 2 and "'9 lives'" in output.err
+
+
+@pytest.mark.parametrize('goals', [['dock'], ['place']])
+def test_mobile_manipulator_tasks_on_the_flexbe_engine(ros, goals):
+    """The other configured system: its states, the Dock At Charger behavior, userdata through the root."""
+    from synthesis_manager.ros.flexbe_engine import run_on_flexbe
+
+    spec = compile_task('mobile_manipulator', ['parked'], goals)
+    automaton = automaton_from_strategy(synthesize(spec).strategy, spec)
+    states = generate_state_machine(automaton, 'mobile_manipulator', initial_conditions=['parked'])
+    simulator = make_simulator('mobile_manipulator', initial_conditions=['parked'])
+    node = ros.add_node(AtlasSimNode, simulator=simulator, parameter_overrides=[
+        Parameter('speed', value=20.0), Parameter('state_rate', value=50.0)])
+    run = run_on_flexbe(states, simulator, node.lock, ros.domain_id, system='mobile_manipulator',
+                        max_wall_time=120.0)
+    assert run.outcome == 'finished' and run.trace.steps[-1].state == f'/{goals[-1]}'
+    assert check_trace(run.trace, spec, goals=goals).ok

@@ -102,6 +102,10 @@ def test_paper_task_shows_progress_draws_the_machine_and_downloads_yaml(page, tm
     states = yaml.safe_load(Path(download.path()).read_text())
     assert {s['state_path'] for s in states} >= {'/', '/look_down', '/pickup_object'}
     assert all(len(s) == 16 for s in states)
+    with page.expect_download() as download_info:  # the behavior as FlexBE's editor saves it
+        page.click('a[data-artifact="flexbe_behavior.zip"]')
+    assert download_info.value.suggested_filename.endswith('flexbe_behavior.zip')
+    assert 'FlexBE behavior package' in page.inner_text('a[data-artifact="flexbe_behavior.zip"]')
 
     picture = tmp_path / 'gui-result.png'
     page.screenshot(path=str(picture), full_page=True)

@@ -25,6 +25,7 @@ const DOWNLOAD_LABELS = {
   'specification.slugsin': 'Specification (.slugsin)',
   'automaton.json': 'Automaton (JSON)',
   'result.json': 'Whole result (JSON)',
+  'flexbe_behavior.zip': 'FlexBE behavior package (.zip, as export-behavior writes it)',
 };
 
 let currentJob = null;   // id of the job being followed

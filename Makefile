@@ -18,6 +18,9 @@ SYSTEM_PACKAGES := graphviz chromium
 FLEXBE_SOURCES ?= $(if $(wildcard ../shared/third_party/flexbe_behavior_engine),$(abspath ../shared/third_party))
 FLEXBE_ENGINE = $(FLEXBE_SOURCES)/flexbe_behavior_engine
 FLEXBE_MSGS_BUILD := build/flexbe_msgs
+# The FlexBE WebUI needs an older web stack than our GUI (starlette<0.47): installed into a
+# folder of its own that only the WebUI's process (test/test_flexbe_webui.py) puts on its path.
+WEBUI_SITE := build/flexbe_webui_site
 # Our FlexBE packages (colcon packages; here used from source through the venv's path).
 FLEXBE_PACKAGES := atlas_sim/atlas_sim_flexbe_states atlas_sim/atlas_sim_flexbe_behaviors
 # The ament prefix in which the WebUI and flexbe_core's BehaviorLibrary find FlexBE packages
@@ -65,7 +68,7 @@ $(VENV)/.msgs-installed: $(MSGS_SOURCES) $(VENV)/.project-installed
 # FlexBE packages importable through a .pth file, a tf2_ros stand-in last on the path (only
 # found when no real tf2_ros is installed), and the FlexBE packages registered in an ament
 # index under $(FLEXBE_PREFIX).
-flexbe: setup $(VENV)/.flexbe-msgs-installed
+flexbe: setup $(VENV)/.flexbe-msgs-installed $(WEBUI_SITE)/.installed
 	@site=$$($(BIN)/python -c 'import sysconfig; print(sysconfig.get_path("purelib"))'); \
 	  printf '%s\n' $(addprefix $(abspath $(FLEXBE_ENGINE))/,flexbe_core flexbe_states flexbe_onboard) \
 	    $(abspath $(FLEXBE_PACKAGES)) $(abspath test/flexbe_env/python) > $$site/flexbe.pth
@@ -97,6 +100,12 @@ $(VENV)/.flexbe-msgs-installed: test/flexbe_env/flexbe_msgs/CMakeLists.txt $(VEN
 	    -DBUILD_TESTING=OFF > cmake-configure.log && \
 	  AMENT_PREFIX_PATH=$(abspath $(VENV)) PATH=$(abspath $(BIN)):$$PATH \
 	  cmake --build . -j2 > cmake-build.log && cmake --install . > cmake-install.log
+	touch $@
+
+$(WEBUI_SITE)/.installed: | $(BIN)/python
+	rm -rf $(WEBUI_SITE)
+	$(BIN)/python -m pip install --quiet --no-deps --target $(WEBUI_SITE) \
+	  'fastapi>=0.115,<0.116' 'starlette>=0.40,<0.47'
 	touch $@
 
 # Graphviz draws state machines; Chromium runs the browser tests (MuJoCo renders with EGL). Installed from Debian

@@ -154,6 +154,9 @@ def task_from_flexbe_synthesis(goal, default_system: str) -> SynthesisTask:
         raise InvalidRequest(f'specification_file_name {request.specification_file_name!r}: this server '
                              'compiles specifications itself; leave it empty')
     options = parse_synthesis_options(goal.synthesis_options)
+    if options['option'] == 'ltl_synthesis_only':
+        raise InvalidRequest('synthesis option ltl_synthesis_only needs a complete specification, '
+                             'which FlexBESynthesis goals cannot carry; send it with BehaviorSynthesis')
     return make_task(system=request.system_name, initial_conditions=list(request.initial_conditions),
                      goals=list(request.goals), sm_outcomes=request.sm_outcomes, name=request.spec_name,
                      default_system=default_system, option=options['option'],

@@ -1,13 +1,15 @@
 """Reading requests of both action interfaces into one task (ROS-free parts)."""
 
 from pathlib import Path
+from types import SimpleNamespace
 
 import pytest
 from hypothesis import given, settings, strategies as st
 
 from synthesis_manager.nodes.ltl_synthesis_node import InvalidSpecName, byproduct_stem
 from synthesis_manager.requests import (InvalidRequest, behavior_name, byproduct_file_stem,
-                                        parse_synthesis_options, resolve_system)
+                                        parse_synthesis_options, resolve_system,
+                                        task_from_behavior_synthesis, task_from_flexbe_synthesis)
 
 
 def test_container_paths_name_the_behavior():
@@ -90,3 +92,43 @@ def test_the_synthesizer_still_refuses_names_that_leave_its_directory():
     for name in ('../escape', 'a/b', '.hidden', 'a..b'):
         with pytest.raises(InvalidSpecName, match='invalid spec_name'):
             byproduct_stem(Path('/byproducts'), name)
+
+
+def flexbe_goal(**request_fields):
+    request = dict(initial_conditions=['stand_prep'], goals=['look_down, pickup_object'], sm_outcomes=[],
+                   system_name='system_wide', spec_name='/Container', specification_file_name='',
+                   synthesis_timeout_s=0.0)
+    request.update(request_fields)
+    return SimpleNamespace(request=SimpleNamespace(**request), synthesis_options='')
+
+
+def test_both_interfaces_read_into_the_same_task():
+    legacy = SimpleNamespace(
+        request=SimpleNamespace(system='system_wide', initial_condition='stand_prep',
+                                goal='look_down pickup_object', sm_outcomes=[], name='/Container',
+                                timeout=0.0, unordered_goals=False, ltl_specification=None),
+        synthesis_options=SimpleNamespace(ltl_compilation_only=False, ltl_synthesis_only=False,
+                                          ltl_steps_only=False))
+    assert task_from_behavior_synthesis(legacy, 'atlas') == task_from_flexbe_synthesis(flexbe_goal(), 'atlas')
+    task = task_from_flexbe_synthesis(flexbe_goal(), 'atlas')
+    assert (task.system, task.goals, task.sm_outcomes, task.byproduct_stem) == (
+        'atlas', ['look_down', 'pickup_object'], ['finished', 'failed'], 'Container')
+
+
+def test_flexbe_timeout_field_wins_over_the_options_timeout():
+    goal = flexbe_goal(synthesis_timeout_s=12.5)
+    goal.synthesis_options = 'timeout: 30'
+    assert task_from_flexbe_synthesis(goal, 'atlas').timeout == 12.5
+    goal.request.synthesis_timeout_s = 0.0
+    assert task_from_flexbe_synthesis(goal, 'atlas').timeout == 30.0
+
+
+@pytest.mark.parametrize('fields, options, named', [
+    ({'specification_file_name': 'mine.yaml'}, '', 'mine.yaml'),
+    ({}, 'ltl_synthesis_only', 'ltl_synthesis_only'),
+])
+def test_flexbe_requests_this_server_cannot_serve_are_invalid(fields, options, named):
+    goal = flexbe_goal(**fields)
+    goal.synthesis_options = options
+    with pytest.raises(InvalidRequest, match=named):
+        task_from_flexbe_synthesis(goal, 'atlas')

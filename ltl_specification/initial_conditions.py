@@ -38,7 +38,7 @@ def asks_for_robot_state(initial_conditions: Sequence[str]) -> bool:
     if others:
         raise InvalidInitialConditionsError(
             f"initial condition {CURRENT!r} stands for the robot's whole state and cannot be combined "
-            f"with {', '.join(others)}", item=others[0])
+            f"with {', '.join(map(repr, others))}", item=others[0])
     return True
 
 

@@ -8,7 +8,7 @@ from ltl_specification.initial_conditions import (CURRENT, asks_for_robot_state,
                                                   initial_conditions_from_robot_state,
                                                   initial_conditions_in_status)
 from ltl_synthesizer import synthesize
-from ltl_synthesizer.automaton import automaton_from_strategy
+from respec.automaton import automaton_from_strategy
 from sm_generation import generate_state_machine
 
 # Where the paper's first task (stand_prep -> look_down, pickup_object) leaves ATLAS.
@@ -25,7 +25,7 @@ def test_current_cannot_be_combined_with_named_initial_conditions():
     with pytest.raises(InvalidInitialConditionsError) as raised:
         asks_for_robot_state(['stand', CURRENT, 'look_down'])
     assert raised.value.item == 'stand' and raised.value.code == 'INVALID_INITIAL_CONDITIONS'
-    assert 'stand, look_down' in str(raised.value)
+    assert "'stand', 'look_down'" in str(raised.value)
 
 
 def test_robot_state_gives_its_mode_then_its_completed_actions():

@@ -9,6 +9,19 @@ executed trace is checked against the returned specification.
     behavior-synthesis execute --goals pickup_object --fail pickup_object --expect failed
     behavior-synthesis execute --goals pickup_object --sm-outcomes finished --fail-first pickup_object:2
     behavior-synthesis execute --json --record out/run      # PNG key frames + timeline.png
+
+Mission mode: ``--then GOALS`` (repeatable) adds goal batches, run one after another on the
+same simulated robot; each is synthesized from where the previous one left the robot (also
+after a failure), i.e. with the initial condition ``current``: with ``--ros-sim`` the server
+reads them from the ``atlas_sim/state`` topic, otherwise they are read from the simulator.
+``--initial-conditions current`` does the same for the first batch. The paper's second demo,
+on the fly::
+
+    behavior-synthesis execute --ros-sim --goals look_down,pickup_object --then footstep_execution
+
+With ``--json`` a mission prints ``{"batches": [...], "exit_code"}``, one entry per batch
+with its goals, initial conditions, synthesis time, outcome and trace check.
+
     behavior-synthesis execute --engine flexbe --goals look_down,pickup_object   # on flexbe_core
 
 With ``--engine flexbe`` the machine is exported as a FlexBE behavior and run by the real
@@ -23,6 +36,8 @@ Exit status:
   3  synthesis failed (the action's error code is printed);
   4  the trace check found violations, or the robot fell;
   5  the run could not finish (robot-time limit, a state the executive cannot run, ...).
+A mission stops at the first batch with status 3, 4 or 5 and exits with it; otherwise it
+exits with the status of its last batch (earlier batches may end in any SM outcome).
 """
 
 from __future__ import annotations
@@ -58,8 +73,12 @@ def add_arguments(parser):
     group.add_argument('--fail-first', action='append', default=[], metavar='ACTION:K',
                        help='the first K attempts of ACTION fail (repeatable, comma-separated)')
     group.add_argument('--seed', type=int, default=None, help='seed of probabilistic faults')
+    group.add_argument('--then', action='append', default=[], metavar='GOAL[,GOAL]',
+                       help='another goal batch, synthesized from where the previous batch left the '
+                            'robot (repeatable: a mission)')
     group.add_argument('--expect', default='finished', metavar='OUTCOME',
-                       help='the SM outcome the run should end in (default: finished)')
+                       help='the SM outcome the run (a mission: its last batch) should end in '
+                            '(default: finished)')
     group.add_argument('--engine', choices=('ours', 'flexbe'), default='ours',
                        help='who runs the state machine: our fast executive (default) or the real FlexBE '
                             'engine (flexbe_core, e.g. from `make flexbe`; implies --ros-sim)')
@@ -76,6 +95,8 @@ def add_arguments(parser):
 
 def run(args) -> int:
     from atlas_sim.executor import FaultSpecError, InitialConditionError, make_simulator, parse_faults
+    from ltl_specification.errors import InvalidInitialConditionsError
+    from ltl_specification.initial_conditions import asks_for_robot_state
     from respec.systems import SystemConfigError
     from respec.naming import parse_names
 
@@ -87,18 +108,18 @@ def run(args) -> int:
     if args.record:
         os.environ.setdefault('MUJOCO_GL', 'egl')  # before anything imports mujoco
     initial_conditions = parse_names(args.initial_conditions)
-    goals = parse_names(args.goals)
+    batches = [parse_names(args.goals), *(parse_names(goals) for goals in args.then)]
     try:  # the simulator first: a bad fault or start is a usage error, found before synthesis
         faults = parse_faults(parse_names(args.fail), parse_names(args.fail_first))
-        simulator = make_simulator(args.system, args.config_dir or None, initial_conditions, faults, args.seed)
-    except (FaultSpecError, InitialConditionError, SystemConfigError) as error:
+        start = [] if asks_for_robot_state(initial_conditions) else initial_conditions
+        simulator = make_simulator(args.system, args.config_dir or None, start, faults, args.seed)
+    except (FaultSpecError, InitialConditionError, InvalidInitialConditionsError, SystemConfigError) as error:
         print(f'execute: {error}', file=sys.stderr)
         return EXIT_USAGE
     log = sys.stderr if args.json else sys.stdout
-    report = {'system': args.system, 'initial_conditions': initial_conditions, 'goals': goals,
-              'faults': faults}
+    report = {'system': args.system, 'faults': faults}
     try:
-        code = _synthesize_and_execute(args, simulator, goals, report, log)
+        code = _synthesize_and_execute(args, simulator, initial_conditions, batches, report, log)
     except KeyboardInterrupt:
         print('\nexecute: interrupted', file=sys.stderr)
         return 130
@@ -119,36 +140,109 @@ def _flexbe_usage_problem(args) -> str:
     return ''
 
 
-def _synthesize_and_execute(args, simulator, goals, report, log) -> int:
+def _synthesize_and_execute(args, simulator, initial_conditions, batches, report, log) -> int:
     try:
         with in_process_suite(args, 'execute_client') as (ros, client):
-            return _run_in_suite(args, ros, client, simulator, goals, report, log)
+            session = _Session(args, ros, client, simulator, log)
+            if len(batches) == 1:
+                report.update(goals=batches[0])
+                return session.run_batch(initial_conditions, batches[0], report, args.record, args.expect)
+            return session.run_mission(initial_conditions, batches, report)
     except SuiteUnavailable as error:
         print(f'execute: {error}', file=sys.stderr)
         return EXIT_SYNTHESIS
 
 
-def _run_in_suite(args, ros, client, simulator, goals, report, log) -> int:
-    progress = None if args.json else ProgressBar()
-    outcome = client.run(goal_from_args(args), feedback=progress)
-    if progress:
-        progress.close()
-    report['synthesis'] = {'error_name': outcome.error_name, 'error_code': outcome.error_code,
-                           'message': outcome.message, 'seconds': round(outcome.seconds, 4),
-                           'states': len(outcome.states)}
-    if not args.json:
-        print_summary(outcome, stream=log)
-    if not outcome.succeeded:
-        print(f'execute: synthesis failed: {outcome.error_name}: {outcome.message}', file=sys.stderr)
-        return EXIT_SYNTHESIS
-    sim_node = None
-    if args.ros_sim or args.engine == 'flexbe':
-        robot, sim_node = _ros_robot(ros, args, simulator)
-    else:
-        from atlas_sim.executor import SimulatedRobot
+class _Session:
+    """Synthesis and execution of goal batches on one simulated robot."""
 
-        robot = SimulatedRobot(simulator)
-    return _execute(args, outcome, robot, simulator, goals, report, log, sim_node, ros.domain_id)
+    def __init__(self, args, ros, client, simulator, log):
+        self.args, self.ros, self.client, self.simulator, self.log = args, ros, client, simulator, log
+        self._robot = None
+        self.uses_ros_sim = args.ros_sim or args.engine == 'flexbe'  # FlexBE drives the node
+
+    def robot(self):
+        """The robot (and the simulator node with ``--ros-sim``), made once and kept for every batch."""
+        if self._robot is None:
+            if self.uses_ros_sim:
+                self._robot = _ros_robot(self.ros, self.args, self.simulator)
+            else:
+                from atlas_sim.executor import SimulatedRobot
+
+                self._robot = SimulatedRobot(self.simulator), None
+        return self._robot
+
+    def run_mission(self, initial_conditions, batches, report) -> int:
+        """Each batch from where the previous one left the robot; stops at 3, 4 or 5 (see Exit status)."""
+        from ltl_specification.initial_conditions import CURRENT
+
+        report['batches'] = []
+        for index, goals in enumerate(batches):
+            batch = {'goals': goals}
+            report['batches'].append(batch)
+            last = index == len(batches) - 1
+            print(f'=== batch {index + 1}/{len(batches)}: {", ".join(goals)}', file=self.log)
+            record = str(Path(self.args.record) / f'batch{index + 1}') if self.args.record else None
+            code = self.run_batch(initial_conditions if index == 0 else [CURRENT], goals, batch, record,
+                                  self.args.expect if last else 'finished')
+            batch['exit_code'] = code
+            if code in (EXIT_SYNTHESIS, EXIT_VIOLATIONS, EXIT_EXECUTION):
+                break
+        return code
+
+    def run_batch(self, initial_conditions, goals, report, record, expect) -> int:
+        """Synthesize ``goals`` from ``initial_conditions`` (or the robot's), run and check them."""
+        from argparse import Namespace
+
+        from ltl_specification.initial_conditions import initial_conditions_in_status
+
+        requested, source = self.initial_conditions_for(initial_conditions)
+        goal = goal_from_args(Namespace(**{**vars(self.args), 'initial_conditions': requested, 'goals': goals}))
+        progress = None if self.args.json else ProgressBar()
+        statuses = []
+
+        def on_feedback(status, fraction):
+            statuses.append(status)
+            if progress:
+                progress(status, fraction)
+
+        outcome = self.client.run(goal, feedback=on_feedback)
+        if progress:
+            progress.close()
+        detected = next(filter(None, map(initial_conditions_in_status, statuses)), None)
+        if detected is not None:  # the server read them from the robot state topic
+            source, requested = detected
+        report.update(initial_conditions=requested, initial_conditions_source=source)
+        report['synthesis'] = {'error_name': outcome.error_name, 'error_code': outcome.error_code,
+                               'message': outcome.message, 'seconds': round(outcome.seconds, 4),
+                               'states': len(outcome.states)}
+        if not self.args.json:
+            print(f'initial conditions ({source}): {", ".join(requested)}', file=self.log)
+            print_summary(outcome, stream=self.log)
+        if not outcome.succeeded:
+            print(f'execute: synthesis failed: {outcome.error_name}: {outcome.message}', file=sys.stderr)
+            return EXIT_SYNTHESIS
+        robot, sim_node = self.robot()
+        return _execute(self.args, outcome, robot, self.simulator, goals, report, self.log, sim_node,
+                        record, expect, self.ros.domain_id)
+
+    def initial_conditions_for(self, initial_conditions) -> tuple[list[str], str]:
+        """What to request, and where it comes from: 'request', 'simulator' or the server's topic.
+
+        With ``--ros-sim`` the server reads the robot's state itself (the simulator node
+        publishes it); the in-process simulator publishes nothing, so it is read here.
+        """
+        from ltl_specification.initial_conditions import (CURRENT, asks_for_robot_state,
+                                                          initial_conditions_from_robot_state)
+
+        if not asks_for_robot_state(initial_conditions):
+            return list(initial_conditions), 'request'
+        if self.uses_ros_sim:
+            self.robot()  # the simulator node must be up and publishing before the server asks
+            return [CURRENT], 'server'
+        snapshot = self.simulator.snapshot()
+        return initial_conditions_from_robot_state(snapshot['mode'], snapshot['completed_actions'],
+                                                   source='the simulator'), 'simulator'
 
 
 def _ros_robot(ros, args, simulator):
@@ -167,21 +261,22 @@ def _ros_robot(ros, args, simulator):
     return robot, node
 
 
-def _execute(args, outcome, robot, simulator, goals, report, log, sim_node=None, domain_id=None) -> int:
+def _execute(args, outcome, robot, simulator, goals, report, log, sim_node, record, expect,
+             domain_id=None) -> int:
     from atlas_sim.executor import ExecutionError, execute_state_machine
     from atlas_sim.trace_check import check_trace
     from respec.parsing import spec_from_text_sections
 
     spec = spec_from_text_sections(outcome.ltl_specification)
     recorder, on_tick = None, None
-    if args.record:
+    if record:
         from atlas_sim.rendering import KeyFrameRecorder
 
         if sim_node is None:
-            recorder = KeyFrameRecorder(simulator, Path(args.record) / 'frames', width=480, height=360)
+            recorder = KeyFrameRecorder(simulator, Path(record) / 'frames', width=480, height=360)
         else:  # the node steps physics in its own thread: render here, under its lock
             view = DeferredEvents(simulator, sim_node.lock)
-            recorder = KeyFrameRecorder(view, Path(args.record) / 'frames', width=480, height=360)
+            recorder = KeyFrameRecorder(view, Path(record) / 'frames', width=480, height=360)
             on_tick = lambda robot: view.replay()  # noqa: E731
     started = time.monotonic()
     try:
@@ -212,19 +307,19 @@ def _execute(args, outcome, robot, simulator, goals, report, log, sim_node=None,
     report.update(outcome=run.outcome, trace=run.trace.to_dict(), trace_check=check.to_dict(), fallen=fallen,
                   robot_time=round(run.duration, 3), wall_time=round(wall, 3),
                   min_pelvis_height=round(run.min_pelvis_height, 3))
-    if args.record:
+    if record:
         from atlas_sim.timeline import plot_timeline
 
         title = f'{", ".join(goals)}: {run.outcome}'
-        report['timeline'] = str(plot_timeline(run.trace, Path(args.record) / 'timeline.png', title))
+        report['timeline'] = str(plot_timeline(run.trace, Path(record) / 'timeline.png', title))
         report['frames'] = [str(p) for p in recorder.paths]
     if not args.json:
         print_run(run, check, fallen, wall, stream=log)
-        if args.record:
+        if record:
             print(f'recorded {len(recorder.paths)} frames and {report["timeline"]}', file=log)
     if check.violations or fallen:
         return EXIT_VIOLATIONS
-    return EXIT_OK if run.outcome == args.expect else EXIT_OTHER_OUTCOME
+    return EXIT_OK if run.outcome == expect else EXIT_OTHER_OUTCOME
 
 
 class DeferredEvents:

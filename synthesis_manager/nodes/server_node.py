@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import threading
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Callable
 
 from rclpy.action import ActionServer, CancelResponse, GoalResponse
@@ -21,11 +21,17 @@ from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.node import Node
 
 from ltl_specification.diagnosis import explain_unsynthesizable
+from ltl_specification.errors import InvalidInitialConditionsError
+from ltl_specification.initial_conditions import (asks_for_robot_state, detected_status,
+                                                  initial_conditions_from_robot_state)
+from respec.errors import CodedError
+from synthesis_manager.nodes.atlas_sim_node import STATE_TOPIC
 from synthesis_manager.requests import (InvalidRequest, SynthesisTask, task_from_behavior_synthesis,
                                         task_from_flexbe_synthesis)
 from synthesis_manager.ros.conversions import (error_code, error_name, flexbe_error_code, is_empty_spec,
                                                msg_to_sections)
 from synthesis_manager.ros.node_main import node_main
+from synthesis_manager.ros.robot_state import RobotStateListener
 from synthesis_msgs.action import BehaviorSynthesis, FlexBESynthesis
 from synthesis_msgs.msg import FSAutomaton, LTLSpecification
 from synthesis_msgs.srv import (CancelSynthesis, GenerateFlexBESM, GenerateLTLSpecification,
@@ -58,6 +64,7 @@ class PipelineOutcome:
     ltl_specification: LTLSpecification = field(default_factory=LTLSpecification)
     automaton: FSAutomaton = field(default_factory=FSAutomaton)
     states: list = field(default_factory=list)
+    notes: list = field(default_factory=list)  # what the result should tell, e.g. detected initial conditions
 
     @property
     def succeeded(self) -> bool:
@@ -86,7 +93,7 @@ def behavior_synthesis_result(outcome: PipelineOutcome):
 def flexbe_synthesis_result(outcome: PipelineOutcome):
     return FlexBESynthesis.Result(
         error_code=flexbe_error_code(outcome.error_name), states=outcome.states,
-        messages=[] if outcome.succeeded else [f'{outcome.error_name}: {outcome.message}'])
+        messages=outcome.notes + ([] if outcome.succeeded else [f'{outcome.error_name}: {outcome.message}']))
 
 
 INTERFACES = (
@@ -133,7 +140,9 @@ class BehaviorSynthesisServer(Node):
     ``flexbe_log_topic`` (FlexBE's operator log; '' disables it), ``service_timeout`` (seconds
     to wait for a service to appear), ``compilation_timeout``, ``synthesis_timeout`` and
     ``generation_timeout`` (seconds per stage), ``diagnosis_timeout`` (seconds to find why an
-    unrealizable task cannot be done).
+    unrealizable task cannot be done), ``robot_state_topic`` (synthesis_msgs/RobotState, default
+    the simulator's ``atlas_sim/state``) and ``robot_state_timeout`` (seconds to wait for a state
+    when a request names no initial conditions, or ``current``: synthesis on the fly).
     """
 
     def __init__(self, **kwargs):
@@ -144,6 +153,8 @@ class BehaviorSynthesisServer(Node):
         self.declare_parameter('synthesis_timeout', 120.0)
         self.declare_parameter('generation_timeout', 30.0)
         self.declare_parameter('diagnosis_timeout', 20.0)
+        self.declare_parameter('robot_state_topic', STATE_TOPIC)
+        self.declare_parameter('robot_state_timeout', 2.0)
         self.declare_parameter('flexbe_log_topic', 'flexbe/log')
         self._stopping = threading.Event()
         self.log_to_flexbe = flexbe_log_publisher(self, self.parameter('flexbe_log_topic'))
@@ -152,6 +163,7 @@ class BehaviorSynthesisServer(Node):
         self.synthesizer = self.create_client(SynthesizeAutomaton, 'ltl_synthesis', callback_group=group)
         self.synthesis_cancel = self.create_client(CancelSynthesis, 'ltl_synthesis/cancel', callback_group=group)
         self.generator = self.create_client(GenerateFlexBESM, 'sm_generate', callback_group=group)
+        self.robot_state = RobotStateListener(self, self.parameter('robot_state_topic'), callback_group=group)
         self.action_servers = [
             ActionServer(self, interface.action_type, interface.action_name,
                          lambda goal_handle, interface=interface: self.execute(goal_handle, interface),
@@ -183,7 +195,7 @@ class BehaviorSynthesisServer(Node):
             outcome.fail('PREEMPTED', 'cancelled by the client')
             goal_handle.canceled()
             return interface.make_result(outcome)
-        except (StageFailed, InvalidRequest) as failure:
+        except (StageFailed, InvalidRequest, CodedError) as failure:
             outcome.fail(failure.code, str(failure))
         except Exception as error:  # the server keeps serving whatever happens
             self.get_logger().error(f'behavior synthesis failed: {error!r}')
@@ -210,6 +222,7 @@ class BehaviorSynthesisServer(Node):
                                      'in request.ltl_specification')
             outcome.ltl_specification = task.custom_ltl
         else:
+            task = self.with_initial_conditions(goal_handle, task, outcome, feedback)
             feedback('Compiling the LTL specification', 0.05)
             compiled = self.call(goal_handle, self.compiler, GenerateLTLSpecification.Request(
                 system=task.system, goals=task.goals, initial_conditions=task.initial_conditions,
@@ -250,6 +263,28 @@ class BehaviorSynthesisServer(Node):
         outcome.states = list(generated.state_definition)
         states = [s for s in outcome.states if s.state_path != '/' and s.state_class != s.CLASS_OUTCOME]
         feedback(f'Generated a state machine with {len(states)} states', 1.0)
+
+    def with_initial_conditions(self, goal_handle, task: SynthesisTask, outcome: PipelineOutcome,
+                                feedback) -> SynthesisTask:
+        """``task``, with the robot's initial conditions when it names none or ``current``."""
+        if not asks_for_robot_state(task.initial_conditions):
+            return task
+        topic, timeout = self.robot_state.topic, self.parameter('robot_state_timeout')
+        feedback(f'Reading the initial conditions from {topic}', 0.02)
+        state = self.robot_state.next_state(
+            timeout, should_stop=lambda: goal_handle.is_cancel_requested or self._stopping.is_set())
+        if goal_handle.is_cancel_requested:
+            raise Preempted()
+        if self._stopping.is_set():
+            raise StageFailed('BEHAVIOR_SYNTHESIS_FAILED', 'reading the robot state: the server is shutting down')
+        if state is None:
+            raise InvalidInitialConditionsError(
+                f'no initial conditions given and no robot state on {topic!r} within {timeout:g} s: '
+                'name the initial conditions, or start the robot (e.g. atlas-sim-node)', item=topic)
+        names = initial_conditions_from_robot_state(state.mode, state.completed_actions, source=topic)
+        outcome.notes.append(detected_status(names, topic))
+        feedback(outcome.notes[-1], 0.04)
+        return replace(task, initial_conditions=names)
 
     @staticmethod
     def check(code):

@@ -4,4 +4,5 @@
     node_main     runs nodes in a process until SIGINT/SIGTERM
     conversions   synthesis_msgs messages <-> the ROS-free cores' types
     harness       in-process ROS (private domain, executor thread) for tests and tools
+    robot_state   the latest synthesis_msgs/RobotState of a robot (synthesis on the fly)
 """

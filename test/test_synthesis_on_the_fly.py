@@ -5,6 +5,8 @@ The suite's nodes, the simulator node and the clients run in one harness (or in 
 """
 
 import json
+import threading
+import time
 from argparse import Namespace
 
 import pytest
@@ -88,6 +90,20 @@ def test_no_robot_state_is_a_clear_error_naming_the_topic(ros, tmp_path, initial
     assert "'robot/state'" in outcome.message
     # the server keeps serving, and named initial conditions need no robot
     assert synthesize(client, ['stand_prep'], ['look_down'])[0].succeeded
+
+
+def test_cancel_while_waiting_for_the_robot_state(ros, tmp_path):
+    client = start_suite(ros, tmp_path, robot_state_timeout=60.0)
+    cancel = threading.Event()
+
+    def on_feedback(status, _):
+        if status.startswith('Reading the initial conditions from atlas_sim/state'):
+            cancel.set()
+
+    started = time.monotonic()
+    outcome = client.run(make_goal('atlas', 'current', ['look_down']), feedback=on_feedback,
+                         cancel=cancel, timeout=30.0)
+    assert outcome.error_name == 'PREEMPTED' and time.monotonic() - started < 10.0
 
 
 def test_current_beside_named_initial_conditions_is_rejected(ros, tmp_path):

@@ -20,7 +20,7 @@ from atlas_sim.trace_check import check_trace
 from ltl_specification.initial_conditions import initial_conditions_in_status
 from respec.parsing import spec_from_text_sections
 from synthesis_manager.cli import main as cli_main
-from synthesis_manager.client import SynthesisClient, make_goal
+from synthesis_manager.client import SynthesisClient, make_flexbe_goal, make_goal
 from synthesis_manager.suite import suite_node_factories
 
 TASK_1 = ['look_down', 'pickup_object']
@@ -38,6 +38,13 @@ def start_suite(ros, tmp_path, **server):
         *factories[-1].keywords['parameter_overrides'],
         *(Parameter(name, value=value) for name, value in server.items())])
     client = SynthesisClient(ros.add_node(Node, 'on_the_fly_client'))
+    assert client.wait_for_server(timeout=10.0)
+    return client
+
+
+def cnu_client(ros):
+    """A client of CNU's FlexBESynthesis interface, served by the same server."""
+    client = SynthesisClient(ros.add_node(Node, 'on_the_fly_cnu_client'), 'flexbe_synthesis')
     assert client.wait_for_server(timeout=10.0)
     return client
 
@@ -70,7 +77,14 @@ def test_paper_second_demo_on_the_fly(ros, tmp_path):
     assert first.succeeded and detected is None  # named initial conditions are used as they are
     assert execute(first, robot, TASK_1).outcome == 'finished'
 
+    # CNU's interface with empty initial_conditions: the result's messages say what was used
+    cnu = cnu_client(ros).run(make_flexbe_goal('atlas', [], ['footstep_execution']), timeout=120.0)
+    assert cnu.succeeded, cnu.message
+    source, initial_conditions = initial_conditions_in_status(cnu.message)
+    assert source == 'atlas_sim/state' and sorted(initial_conditions) == sorted(AFTER_TASK_1)
+
     second, detected = synthesize(client, [], ['footstep_execution'])
+    assert second.states == cnu.states  # the same robot state, the same behavior
     assert second.succeeded, second.message
     source, initial_conditions = detected
     assert source == 'atlas_sim/state'
@@ -88,6 +102,9 @@ def test_no_robot_state_is_a_clear_error_naming_the_topic(ros, tmp_path, initial
     outcome, _ = synthesize(client, initial_conditions, ['look_down'])
     assert outcome.error_name == 'INVALID_INITIAL_CONDITIONS'
     assert "'robot/state'" in outcome.message
+    cnu = cnu_client(ros).run(make_flexbe_goal('atlas', initial_conditions, ['look_down']), timeout=30.0)
+    assert not cnu.succeeded
+    assert 'INVALID_INITIAL_CONDITIONS' in cnu.message and "'robot/state'" in cnu.message
     # the server keeps serving, and named initial conditions need no robot
     assert synthesize(client, ['stand_prep'], ['look_down'])[0].succeeded
 

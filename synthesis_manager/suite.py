@@ -31,6 +31,11 @@ def add_suite_arguments(parser):
                        help='seconds to wait for a pipeline service to appear')
     group.add_argument('--default-system', default='',
                        help='system for requests naming none or "system_wide" (default: atlas)')
+    group.add_argument('--robot-state-topic', default='',
+                       help='where requests naming no initial conditions (or "current") read them '
+                            '(synthesis_msgs/RobotState; default: atlas_sim/state)')
+    group.add_argument('--robot-state-timeout', type=float, default=None,
+                       help='seconds to wait for a robot state (default: 2)')
 
 
 def suite_node_factories(args=None, names=SUITE_NODE_NAMES):
@@ -50,7 +55,9 @@ def suite_node_factories(args=None, names=SUITE_NODE_NAMES):
         'behavior_synthesis_server': (BehaviorSynthesisServer, overrides(
             synthesis_timeout=getattr(args, 'synthesis_timeout', None),
             service_timeout=getattr(args, 'service_timeout', None),
-            default_system=getattr(args, 'default_system', ''))),
+            default_system=getattr(args, 'default_system', ''),
+            robot_state_topic=getattr(args, 'robot_state_topic', ''),
+            robot_state_timeout=getattr(args, 'robot_state_timeout', None))),
     }
     return [functools.partial(settings[name][0], parameter_overrides=settings[name][1])
             for name in names]

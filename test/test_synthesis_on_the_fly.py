@@ -27,16 +27,12 @@ TASK_1 = ['look_down', 'pickup_object']
 AFTER_TASK_1 = ['manipulate', 'look_down', 'object_template', 'pickup_object']  # in any action order
 
 
-def start_suite(ros, tmp_path, **server):
-    """The suite's nodes (server parameters overridden by ``server``) and a client."""
+def start_suite(ros, tmp_path, **settings):
+    """The suite's nodes (with ``settings`` as the command line would give them) and a client."""
     args = Namespace(config_dir='', byproducts_dir=str(tmp_path), backend='builtin',
-                     slugs_executable='slugs', synthesis_timeout=60.0, service_timeout=2.0)
-    factories = suite_node_factories(args)
-    for factory in factories[:-1]:
+                     slugs_executable='slugs', synthesis_timeout=60.0, service_timeout=2.0, **settings)
+    for factory in suite_node_factories(args):
         ros.add_node(factory)
-    ros.add_node(factories[-1].func, parameter_overrides=[
-        *factories[-1].keywords['parameter_overrides'],
-        *(Parameter(name, value=value) for name, value in server.items())])
     client = SynthesisClient(ros.add_node(Node, 'on_the_fly_client'))
     assert client.wait_for_server(timeout=10.0)
     return client

@@ -144,7 +144,7 @@ def test_same_request_gives_identical_results(suite):
 
 def test_impossible_goal_order_is_explained_in_plain_words_first(suite):
     feedback = []
-    outcome = suite.client.run(make_goal(system='atlas', initial_conditions=[], goals=['look_down', 'stand_prep']),
+    outcome = suite.client.run(make_goal(system='atlas', initial_conditions=['stand_prep'], goals=['look_down', 'stand_prep']),
                                feedback=lambda s, p: feedback.append(s), timeout=120)
     assert outcome.error_name == 'SPEC_UNSYNTHESIZABLE'
     first_line = outcome.message.splitlines()[0]

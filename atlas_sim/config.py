@@ -28,6 +28,8 @@ Two sections matter here:
         sensors: {obj_detected: true}
       faults:                       # capability -> fault (see atlas_sim.faults)
         pickup_object: {fail_first: 1}
+      stand_in: "..."               # set when the humanoid does not model this robot but only
+                                    # stands in for it (says how); the GUI then offers no simulation
 
 Capabilities without a motion entry get a default: control modes take the
 ``stand`` posture, actions are short computations (they always complete
@@ -84,6 +86,7 @@ class SimulationConfig:
     invalidations: Dict[str, Tuple[str, ...]] = field(default_factory=dict)
     scenario: ScenarioConfig = ScenarioConfig()
     faults: Dict[str, Dict[str, Any]] = field(default_factory=dict)
+    stand_in: Optional[str] = None
 
     @classmethod
     def from_dict(cls, section: Optional[Mapping[str, Any]]) -> "SimulationConfig":
@@ -113,12 +116,13 @@ class SimulationConfig:
             invalidations={str(k): tuple(v or ()) for k, v in (section.get("invalidations") or {}).items()},
             scenario=scenario,
             faults={str(k): dict(v or {}) for k, v in (section.get("faults") or {}).items()},
+            stand_in=str(section["stand_in"]) if section.get("stand_in") else None,
         )
 
 
 _SIMULATION_KEYS = {
     "initial_mode", "timestep", "control_period", "real_time_factor", "seed", "fault_delay",
-    "settle", "fall", "modes", "actions", "invalidations", "scenario", "faults",
+    "settle", "fall", "modes", "actions", "invalidations", "scenario", "faults", "stand_in",
 }
 
 

@@ -56,6 +56,8 @@ class HumanoidPhysics:
         self._pelvis = self._body_id("pelvis")
         self._torso = self._body_id("torso")
         self._mocap = self.model.body_mocapid[self._body_id("pelvis_target")]
+        self._object_mocap = self.model.body_mocapid[self._body_id("pickup_object")]
+        self._hands = (self._body_id("left_hand"), self._body_id("right_hand"))
         self._weld = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_EQUALITY, "balance_assist")
 
     # ----------------------------------------------------------- model lookup
@@ -138,6 +140,15 @@ class HumanoidPhysics:
         self.data.mocap_pos[self._mocap] = position
         if quaternion is not None:
             self.data.mocap_quat[self._mocap] = quaternion
+
+    def carry_object(self) -> None:
+        """Put the object to pick up just below the hands (it is held)."""
+        between = (self.data.xpos[self._hands[0]] + self.data.xpos[self._hands[1]]) / 2
+        self.data.mocap_pos[self._object_mocap] = between + np.array([0.0, 0.0, -0.12])
+        mujoco.mj_kinematics(self.model, self.data)  # so that a frame drawn now shows it there
+
+    def object_position(self) -> np.ndarray:
+        return self.data.mocap_pos[self._object_mocap].copy()
 
     def set_external_force(self, body: str, force) -> None:
         """Apply a constant world-frame force (N) at a body's origin until changed."""

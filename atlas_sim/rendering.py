@@ -57,11 +57,12 @@ def save_png(path: PathLike, image: np.ndarray) -> Path:
 class FrameRenderer:
     """Renders the current frame of a simulator (or ``HumanoidPhysics``).
 
-    ``camera`` is a camera name of the model: ``overview`` (follows the pelvis
-    from the front-right) or ``head_camera`` (what the robot sees).
+    ``camera`` is a camera name of the model: ``follow`` (rides with the pelvis
+    from the front-right, so the robot stays centred), ``overview`` (fixed, turns
+    to the pelvis) or ``head_camera`` (what the robot sees).
     """
 
-    def __init__(self, simulator, width: int = 640, height: int = 480, camera: str = "overview"):
+    def __init__(self, simulator, width: int = 640, height: int = 480, camera: str = "follow"):
         import mujoco  # local: only rendering users need a GL context
 
         self.physics = getattr(simulator, "physics", simulator)
@@ -95,7 +96,7 @@ class KeyFrameRecorder:
     """
 
     def __init__(self, simulator, directory: PathLike, width: int = 640, height: int = 480,
-                 camera: str = "overview"):
+                 camera: str = "follow"):
         self.simulator = simulator
         self.directory = Path(directory)
         self.directory.mkdir(parents=True, exist_ok=True)

@@ -307,6 +307,8 @@ class AtlasSimulator:
                 result = self._check_settled(request)
                 if result:
                     finished.append(result)
+        if self.outputs["holding_object"]:  # after the results: a pickup that just completed holds it
+            self.physics.carry_object()
         self._pace()
         return finished
 

@@ -21,8 +21,8 @@ Modules:
 from sm_generation.automaton_io import Automaton, AutomatonState, load_automaton
 from sm_generation.errors import SMGenerationError
 from sm_generation.generator import generate_state_machine
-from sm_generation.instantiation import OutcomeCondition, StateInstantiation
+from sm_generation.instantiation import OutcomeCondition, StateInstantiation, count_states
 from sm_generation.validation import validate_state_machine
 
-__all__ = ['Automaton', 'AutomatonState', 'OutcomeCondition', 'SMGenerationError', 'StateInstantiation',
+__all__ = ['Automaton', 'AutomatonState', 'OutcomeCondition', 'count_states', 'SMGenerationError', 'StateInstantiation',
            'generate_state_machine', 'load_automaton', 'validate_state_machine']

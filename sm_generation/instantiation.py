@@ -106,3 +106,17 @@ class StateInstantiation:
 
 
 FIELD_NAMES = tuple(f.name for f in fields(StateInstantiation))
+
+
+def count_states(entries) -> int:
+    """How many states a machine has: every entry but the machine itself ('/') and its outcomes.
+
+    States inside containers count, and so do the containers. ``entries`` are
+    StateInstantiations, their dicts or messages. Every report of a machine's size (progress,
+    result summary, command line) uses this one count.
+    """
+    def field(entry, name):
+        return entry[name] if isinstance(entry, dict) else getattr(entry, name)
+
+    return sum(1 for entry in entries
+               if field(entry, 'state_path') != '/' and field(entry, 'state_class') != StateInstantiation.CLASS_OUTCOME)

@@ -8,6 +8,7 @@ import threading
 from pathlib import Path
 
 from respec.naming import parse_names
+from sm_generation.instantiation import count_states
 from synthesis_manager.summary import spec_size, state_machine_tree
 
 
@@ -98,7 +99,8 @@ def print_summary(outcome, stream=sys.stdout):
     if outcome.automaton.get('states'):
         print(f"automaton: {len(outcome.automaton['states'])} states", file=stream)
     if outcome.states:
-        print(f'state machine ({len(outcome.states)} state instantiations):', file=stream)
+        print(f'state machine: {count_states(outcome.states)} states '
+              f'({len(outcome.states)} StateInstantiation entries):', file=stream)
         print(state_machine_tree(outcome.states), file=stream)
 
 

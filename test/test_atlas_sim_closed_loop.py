@@ -50,6 +50,15 @@ def test_look_down_then_pickup_object_finishes():
     snapshot = simulator.snapshot()
     assert snapshot['mode'] == 'manipulate' and snapshot['holding_object']
     assert math.degrees(snapshot['head_tilt']) == pytest.approx(45, abs=8)
+    # the object left the table (top at 0.68 m) and hangs just below the hands
+    hands = (simulator.physics.body_position('left_hand') + simulator.physics.body_position('right_hand')) / 2
+    assert simulator.physics.object_position()[2] > 0.85
+    assert simulator.physics.object_position() == pytest.approx(hands + [0, 0, -0.12], abs=0.01)
+
+
+def test_the_object_waits_on_the_table_until_picked_up():
+    _, _, simulator = run_task(['stand_prep'], ['look_down', 'pickup_object'], fail=['pickup_object'])
+    assert simulator.physics.object_position() == pytest.approx([0.55, -0.08, 0.72])
 
 
 def test_pickup_object_failing_ends_in_failed():

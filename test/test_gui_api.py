@@ -92,7 +92,10 @@ def test_paper_task_succeeds_with_progress_states_and_downloads(client):
     assert summary['input_propositions'] == len(job['outcome']['ltl_specification']['env_props'])
     names = {s['state_path'].rsplit('/', 1)[-1] for s in job['outcome']['states']}
     assert {'look_down', 'pickup_object', 'stand', 'manipulate'} <= names
-    assert summary['state_machine_states'] == len(job['outcome']['states']) - 1  # without the root
+    # one count everywhere: without the root and the machine's outcomes, as the timeline says
+    states = [s for s in job['outcome']['states'] if s['state_path'] != '/' and s['state_class'] != ':OUTCOME']
+    assert summary['state_machine_states'] == len(states)
+    assert job['timeline'][-1]['status'] == f'Generated a state machine with {len(states)} states'
 
     base = f"/api/jobs/{job['id']}/artifacts"
     listing = yaml.safe_load(client.get(f'{base}/state_machine.yaml').text)
@@ -198,7 +201,8 @@ def test_cancel_a_job_before_it_is_sent(client, backend):
     finally:
         backend.job_gate.set()
     assert final['outcome']['error_name'] == 'PREEMPTED'
-    assert final['timeline'] == []  # nothing reached the pipeline
+    # nothing reached the pipeline: the timeline holds only the cancel
+    assert [entry['status'] for entry in final['timeline']] == ['Cancel requested', 'Cancelled']
 
 
 def test_cancel_a_running_synthesis(client):
@@ -252,3 +256,27 @@ def test_bad_simulation_requests_name_the_item(client):
     assert client.post('/api/jobs/no-such-job/simulations', json={}).status_code == 404
     unknown = client.get('/api/simulations/no-such-run')
     assert unknown.status_code == 404 and unknown.json()['item'] == 'no-such-run'
+
+
+def test_goal_check_names_impossible_goals_and_refuses_bad_input(client):
+    check = client.post('/api/goal-check', json={'system': 'atlas', 'initial_conditions': [],
+                                                 'goals': ['look_down', 'stand_prep']}).json()
+    assert [f['item'] for f in check['findings']] == ['stand_prep']
+    assert 'stand -> stand_prep is not a transition in config/atlas.yaml' in check['findings'][0]['sentence']
+    assert check['impossible_next'] == {}  # every other item can still come next
+    unknown = client.post('/api/goal-check', json={'system': 'r2d2', 'goals': []})
+    assert unknown.status_code == 404 and unknown.json()['item'] == 'r2d2'
+    assert client.post('/api/goal-check', json=['atlas']).status_code == 422
+
+
+def test_choices_say_whether_the_humanoid_can_simulate_the_system(client):
+    assert client.get('/api/systems/atlas').json()['simulation']['available'] is True
+    mobile = client.get('/api/systems/mobile_manipulator').json()['simulation']
+    assert mobile['available'] is False and 'does not model the mobile manipulator' in mobile['note']
+
+
+def test_a_forgotten_download_is_json_for_programs_and_a_page_for_browsers(client):
+    url = '/api/jobs/1-0000dead/artifacts/state_machine.yaml'
+    assert client.get(url).json()['error'] == 'NOT_FOUND'
+    page = client.get(url, headers={'accept': 'text/html,application/xhtml+xml'})
+    assert page.status_code == 404 and 'This download is no longer available' in page.text

@@ -7,6 +7,7 @@ picture used by the documentation.
 import os
 import shutil
 import tempfile
+from contextlib import contextmanager
 from pathlib import Path
 
 import pytest
@@ -24,14 +25,35 @@ SLOW_GOALS = ['look_down', 'pickup_object', 'grasp_object', 'pregrasp', 'approac
 SCREENSHOT_ENV = 'BEHAVIOR_SYNTHESIS_GUI_SCREENSHOT'
 
 
-@pytest.fixture(scope='module')
-def gui(tmp_path_factory):
+@contextmanager
+def gui_server(byproducts_dir, synthesis_timeout=60, goal_timeout=120):
     """The GUI served over HTTP on 127.0.0.1, the suite in-process; yields (url, backend)."""
     args = build_parser(only='gui').parse_args(
-        ['gui', '--byproducts-dir', str(tmp_path_factory.mktemp('gui-browser')),
-         '--synthesis-timeout', '60', '--goal-timeout', '120'])
+        ['gui', '--byproducts-dir', str(byproducts_dir),
+         '--synthesis-timeout', str(synthesis_timeout), '--goal-timeout', str(goal_timeout)])
     with ros_backend(args) as backend, background_server(create_app(backend)) as url:
         yield url, backend
+
+
+@contextmanager
+def open_page(browser_context, url, viewport=None):
+    """A fresh tab on the page, once it is ready; JavaScript errors fail the test."""
+    page = browser_context.new_page()
+    if viewport:
+        page.set_viewport_size(viewport)
+    errors = []
+    page.on('pageerror', lambda error: errors.append(str(error)))
+    page.goto(url)
+    page.wait_for_selector('body.ready')
+    yield page
+    page.close()
+    assert errors == []
+
+
+@pytest.fixture(scope='module')
+def gui(tmp_path_factory):
+    with gui_server(tmp_path_factory.mktemp('gui-browser')) as served:
+        yield served
 
 
 @pytest.fixture(scope='module')
@@ -48,15 +70,8 @@ def browser_context():
 
 @pytest.fixture
 def page(gui, browser_context):
-    url, _ = gui
-    page = browser_context.new_page()
-    errors = []
-    page.on('pageerror', lambda error: errors.append(str(error)))
-    page.goto(url)
-    page.wait_for_selector('body.ready')
-    yield page
-    page.close()
-    assert errors == []
+    with open_page(browser_context, gui[0]) as page:
+        yield page
 
 
 def choose_task(page, goals, initial_conditions=('stand_prep',)):
@@ -87,9 +102,11 @@ def test_paper_task_shows_progress_draws_the_machine_and_downloads_yaml(page, tm
 
     page.wait_for_selector('#graph svg g.node')
     node_labels = page.locator('#graph svg g.node text').all_text_contents()
-    assert {'look_down', 'pickup_object', 'stand', 'manipulate', 'finished', 'failed'} <= set(node_labels)
+    # FlexBE-like boxes: the state's name and its outcomes (along the bottom) are in the node
+    assert {'look_down', 'pickup_object', 'stand', 'manipulate', 'finished', 'failed', 'done', 'changed'} <= set(
+        node_labels)
     edge_labels = page.locator('#graph svg g.edge text').all_text_contents()
-    assert {'initial', 'done', 'changed'} <= set(edge_labels)
+    assert [label.strip() for label in edge_labels] == ['initial']
     assert 'Realizable\tyes' in page.inner_text('#summary')
     assert page.is_visible('#simulate') and page.is_hidden('#simulation-view')  # offered, not run
     page.click('details[data-section="sys_liveness"] summary')
@@ -152,10 +169,13 @@ def test_cancel_a_queued_job(page, gui):
         page.wait_for_selector('#cancel:enabled')
         assert page.inner_text('#status') == 'waiting to be sent'
         page.click('#cancel')
-        assert result_code(page) == 'PREEMPTED'
+        assert result_code(page) == 'CANCELLED'  # neutral, not an error
     finally:
         backend.job_gate.set()
     assert 'cancelled' in page.inner_text('#result-message')
+    assert page.locator('#result-banner.neutral').count() == 1
+    timeline = page.inner_text('#timeline')
+    assert 'Cancel requested' in timeline and 'Cancelled' in timeline
     assert page.is_enabled('#synthesize') and page.is_disabled('#cancel')
 
 
@@ -165,8 +185,9 @@ def test_cancel_a_running_synthesis(page):
     page.wait_for_function("document.getElementById('status').textContent.startsWith('Synthesizing')",
                            timeout=60_000)
     page.click('#cancel')
-    assert result_code(page, timeout=30_000) == 'PREEMPTED'
-    assert page.locator('#result-banner.bad').count() == 1
+    assert result_code(page, timeout=30_000) == 'CANCELLED'
+    assert page.locator('#result-banner.neutral').count() == 1
+    assert page.inner_text('#timeline').rstrip().endswith('Cancelled')
 
 
 def test_simulate_with_a_fault_shows_steps_frames_and_timeline(page):
@@ -178,6 +199,7 @@ def test_simulate_with_a_fault_shows_steps_frames_and_timeline(page):
     page.wait_for_selector('#simulation-steps tr[data-state]', timeout=60_000)  # live, while running
     assert page.is_visible('#simulation-view')
     page.wait_for_selector('#simulation-timeline:not([hidden])', timeout=120_000)
+    page.wait_for_function("document.getElementById('simulation-status').textContent.startsWith('Outcome')")
     assert page.inner_text('#simulation-status').startswith('Outcome: failed')
     rows = page.locator('#simulation-steps tr[data-state]')
     assert rows.last.get_attribute('data-state') == '/pickup_object'

@@ -29,12 +29,24 @@ def test_yaml_and_json_round_trip(concurrent):
 def test_dot_draws_states_containers_outcomes_and_start(concurrent):
     dot = to_dot(concurrent)
     assert dot.startswith('digraph state_machine {') and dot.rstrip().endswith('}')
-    assert '"outcome:finished" [label="finished", shape=doublecircle];' in dot
-    assert 'subgraph "cluster_0"' in dot and 'object_template_and_stand (concurrent)' in dot
-    assert '"start" -> "state:object_template_and_stand/object_template" [label="initial", lhead="cluster_0"];' in dot
-    assert ('"state:pregrasp_pose" -> "outcome:failed" [label="not_available"];') in dot
-    assert '[label="stand_c", ltail="cluster_0"]' in dot
+    assert '"outcome:finished" [id="outcome:finished", class="outcome", label="finished"' in dot
+    container = next(line for line in dot.splitlines() if line.startswith('  "state:object_template_and_stand"'))
+    # the container box holds its states and shows its own outcomes along the bottom
+    assert '(concurrency container)' in container and '<B>object_template</B>' in container
+    assert 'PORT="o0"' in container and '>object_template_c__stand_c<' in container
+    assert '"start" -> "state:object_template_and_stand":n [id="edge:start", label=" initial"];' in dot
     assert to_dot(concurrent) == dot
+
+
+def test_dot_merges_parallel_transitions_into_one_outcome_cell_and_arrow(concurrent):
+    dot = to_dot(concurrent)
+    pregrasp_pose = next(s for s in concurrent if s.name == 'pregrasp_pose')
+    assert pregrasp_pose.transitions.count('failed') == 2  # 'failed' and 'not_available'
+    assert '>failed, not_available<' in dot
+    arrows = [line for line in dot.splitlines() if line.startswith('  "state:pregrasp_pose":')]
+    assert arrows == ['  "state:pregrasp_pose":o0:s -> "outcome:finished" [id="edge:pregrasp_pose->finished"];',
+                      '  "state:pregrasp_pose":o1:s -> "outcome:failed" [id="edge:pregrasp_pose->failed", '
+                      'color="#c62828", style=dashed];']
 
 
 def test_dot_labels_behaviours_and_escapes_quotes():
@@ -43,7 +55,7 @@ def test_dot_labels_behaviours_and_escapes_quotes():
     states[1].transitions = ['say "hi"', 'failed']
     dot = to_dot(states)
     assert '[Grasp Object]' in dot
-    assert '"state:say \\"hi\\""' in dot
+    assert '"state:say \\"hi\\""' in dot and '<B>say &quot;hi&quot;</B>' in dot
 
 
 @pytest.mark.parametrize('fmt, magic', [('svg', b'<svg'), ('png', b'\x89PNG')])

@@ -25,6 +25,7 @@ from ltl_specification.errors import InvalidInitialConditionsError
 from ltl_specification.initial_conditions import (asks_for_robot_state, detected_status,
                                                   initial_conditions_from_robot_state)
 from respec.errors import CodedError
+from sm_generation.instantiation import count_states
 from synthesis_manager.nodes.atlas_sim_node import STATE_TOPIC
 from synthesis_manager.requests import (InvalidRequest, SynthesisTask, task_from_behavior_synthesis,
                                         task_from_flexbe_synthesis)
@@ -261,8 +262,7 @@ class BehaviorSynthesisServer(Node):
             'state machine generation', self.parameter('generation_timeout'))
         self.check(generated.error_code)
         outcome.states = list(generated.state_definition)
-        states = [s for s in outcome.states if s.state_path != '/' and s.state_class != s.CLASS_OUTCOME]
-        feedback(f'Generated a state machine with {len(states)} states', 1.0)
+        feedback(f'Generated a state machine with {count_states(outcome.states)} states', 1.0)
 
     def with_initial_conditions(self, goal_handle, task: SynthesisTask, outcome: PipelineOutcome,
                                 feedback) -> SynthesisTask:

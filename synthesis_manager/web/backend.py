@@ -12,7 +12,9 @@ from collections import OrderedDict
 from pathlib import Path
 from typing import Callable
 
+from ltl_specification.diagnosis import goal_findings, impossible_next_goals
 from respec.abstraction import load_abstraction
+from respec.errors import CodedError
 from respec.naming import DEFAULT_SM_OUTCOMES, FINISHED
 from respec.systems import SystemConfigError, available_systems, load_section
 from synthesis_manager.web.artifacts import ARTIFACTS, Artifact
@@ -73,7 +75,38 @@ class SynthesisBackend:
             'default_initial_conditions': list(modes)[:1],
             'sm_outcome_choices': [list(DEFAULT_SM_OUTCOMES), [FINISHED]],
             'options': list(JOB_OPTIONS),
+            'simulation': self.simulation_support(system),
         }
+
+    def simulation_support(self, system: str) -> dict:
+        """Whether atlas_sim can run ``system``'s machines, and if not, why (in plain words)."""
+        if not self.can_simulate:
+            return {'available': False, 'note': 'Simulation needs atlas_sim and MuJoCo, which are not installed.'}
+        try:
+            section = load_section(system, 'simulation', self.config_dir)
+        except SystemConfigError:
+            return {'available': False, 'note': f'{system} has no simulation section: atlas_sim cannot run it.'}
+        if section.get('stand_in'):
+            return {'available': False, 'note': f'No simulation for {system}: {" ".join(str(section["stand_in"]).split())}'}
+        return {'available': True, 'note': ''}
+
+    def goal_check(self, body) -> dict:
+        """The request form's live check: chosen goals that can never be achieved, and why each
+        other action or mode cannot be the next goal (ltl_specification.diagnosis)."""
+        if not isinstance(body, dict):
+            raise InvalidJobRequestError('the request body must be a JSON object', 'body')
+        system = body.get('system')
+        if system not in self.systems():
+            raise NotFoundError(f'unknown system {system!r}', str(system))
+        initial_conditions = names_field(body, 'initial_conditions')
+        goals = names_field(body, 'goals')
+        strict_order = not body.get('unordered', False)
+        try:
+            findings = goal_findings(system, initial_conditions, goals, strict_order, self.config_dir)
+            impossible = impossible_next_goals(system, initial_conditions, goals, strict_order, self.config_dir)
+        except CodedError as error:  # e.g. an invalid abstraction: the synthesis will say it
+            raise NotAvailableError(str(error), error.item or system) from error
+        return {'findings': [dataclasses.asdict(f) for f in findings], 'impossible_next': impossible}
 
     # jobs ------------------------------------------------------------------------------
 
@@ -92,7 +125,7 @@ class SynthesisBackend:
             raise NotAvailableError(f'job {job_id!r} has already finished '
                                     f'({job.outcome["error_name"]})', job_id)
         job.cancel_requested.set()
-        self._update(job, status='cancelling')
+        self._note(job, 'Cancel requested', job.progress)
         return job.to_dict()
 
     def job_status(self, job_id: str) -> dict:
@@ -138,11 +171,9 @@ class SynthesisBackend:
                                     'atlas_sim')
         if not (job.finished and job.outcome.get('states')):
             raise NotAvailableError(f'job {job_id!r} has no state machine to simulate', job_id)
-        try:
-            load_section(job.request.system, 'simulation', self.config_dir)
-        except SystemConfigError as error:
-            raise NotAvailableError(f'system {job.request.system!r} cannot be simulated: {error}',
-                                    job.request.system) from error
+        support = self.simulation_support(job.request.system)
+        if not support['available']:
+            raise NotAvailableError(support['note'], job.request.system)
         simulation = Simulation(id=f'{job_id}-sim{next(self._counter)}', job_id=job_id, fail_first=fail_first)
         with self._lock:
             self._simulations[simulation.id] = simulation
@@ -257,18 +288,22 @@ class SynthesisBackend:
             return
         self._update(job, state='running', status='sending the goal')
 
-        def feedback(status: str, progress: float):
-            entry = {'seconds': round(time.monotonic() - job.created, 4), 'status': status,
-                     'progress': round(float(progress), 4)}
-            self._update(job, status=status, progress=float(progress), timeline=job.timeline + [entry])
-
         try:
-            outcome = self.run_goal(job.request, feedback, job.cancel_requested)
+            outcome = self.run_goal(job.request, lambda status, progress: self._note(job, status, progress),
+                                    job.cancel_requested)
         except Exception as error:  # the GUI keeps serving whatever the runner does
             outcome = local_outcome('FAILURE', f'the GUI could not run the goal: {error}', job)
         self._finish(job, outcome)
 
+    def _note(self, job: Job, status: str, progress: float):
+        """A new status of ``job``: shown now and kept in its timeline."""
+        entry = {'seconds': round(time.monotonic() - job.created, 4), 'status': status,
+                 'progress': round(float(progress), 4)}
+        self._update(job, status=status, progress=float(progress), timeline=job.timeline + [entry])
+
     def _finish(self, job: Job, outcome: dict):
+        if outcome['error_name'] == 'PREEMPTED':
+            self._note(job, 'Cancelled', job.progress)
         self._update(job, state='finished', outcome=outcome, status=outcome['error_name'],
                      finished_after=round(time.monotonic() - job.created, 4),
                      progress=1.0 if outcome['error_name'] == 'SUCCESS' else job.progress)

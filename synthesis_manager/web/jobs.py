@@ -8,6 +8,7 @@ import time
 from dataclasses import asdict, dataclass, field
 
 from respec.naming import DEFAULT_SM_OUTCOMES, parse_names
+from sm_generation.instantiation import count_states
 from synthesis_manager.web.artifacts import available_artifacts
 from synthesis_manager.web.errors import InvalidJobRequestError, NotFoundError
 
@@ -142,8 +143,7 @@ def result_summary(outcome: dict) -> dict:
         'output_propositions': len(sections.get('sys_props', [])),
         'formulas': sum(len(lines) for name, lines in sections.items() if not name.endswith('_props')),
         'automaton_states': automaton_states,
-        # the root entry '/' is the machine itself, not one of its states
-        'state_machine_states': sum(1 for s in states if s['state_path'] != '/'),
+        'state_machine_states': count_states(states),
         'state_instantiations': len(states),
         'concurrency_containers': sum(1 for s in states if s['state_class'] == ':CONCURRENCY'),
         'seconds': outcome.get('seconds', 0.0),

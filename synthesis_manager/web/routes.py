@@ -10,6 +10,8 @@
     GET  /api/jobs/{id}/events               the same as server-sent events until the job ends
     POST /api/jobs/{id}/cancel               cancel it (the result becomes PREEMPTED)
     GET  /api/jobs/{id}/artifacts/{name}     a download (see ARTIFACTS); ?inline=1 to display it
+                                             (a browser asking for a forgotten one gets a page saying so)
+    POST /api/goal-check                     goals that cannot be achieved / cannot come next, and why
     POST /api/jobs/{id}/simulations          run the job's state machine on the simulated robot
     GET  /api/simulations/{id}               its trace so far, frames, outcome and trace check
     GET  /api/simulations/{id}/events        the same as server-sent events until the run ends
@@ -27,17 +29,18 @@ the jobs, validates requests and builds the downloads; the synthesis itself is a
 from __future__ import annotations
 
 import asyncio
+import html
 import json
 from pathlib import Path
 from typing import Callable
 
 from fastapi import Body, FastAPI, Request
 from fastapi.exceptions import RequestValidationError
-from fastapi.responses import FileResponse, JSONResponse, Response, StreamingResponse
+from fastapi.responses import FileResponse, HTMLResponse, JSONResponse, Response, StreamingResponse
 from fastapi.staticfiles import StaticFiles
 
 from synthesis_manager.web.artifacts import Artifact
-from synthesis_manager.web.errors import GuiRequestError, InvalidJobRequestError
+from synthesis_manager.web.errors import GuiRequestError, InvalidJobRequestError, NotFoundError
 
 STATIC_DIR = Path(__file__).with_name('static')
 
@@ -95,8 +98,17 @@ def create_app(backend) -> FastAPI:
                              lambda: backend.job_status(job_id))
 
     @app.get('/api/jobs/{job_id}/artifacts/{name}')
-    def artifact(job_id: str, name: str, inline: bool = False):
-        return _file_response(backend.artifact(job_id, name), inline)
+    def artifact(job_id: str, name: str, request: Request, inline: bool = False):
+        try:
+            return _file_response(backend.artifact(job_id, name), inline)
+        except NotFoundError as error:
+            if 'text/html' not in request.headers.get('accept', ''):
+                raise
+            return HTMLResponse(_download_gone_page(name, error), status_code=404)
+
+    @app.post('/api/goal-check')
+    def goal_check(body=Body(None)):
+        return backend.goal_check(body)
 
     @app.post('/api/jobs/{job_id}/simulations', status_code=202)
     def start_simulation(job_id: str, body=Body(None)):
@@ -121,6 +133,19 @@ def create_app(backend) -> FastAPI:
         return _file_response(backend.simulation_timeline(simulation_id), inline=True)
 
     return app
+
+
+def _download_gone_page(name: str, error: NotFoundError) -> str:
+    """What a browser shows for a download the server no longer has (old link, restarted server)."""
+    return f'''<!DOCTYPE html>
+<html lang="en"><head><meta charset="utf-8"><title>Download no longer available</title>
+<link rel="stylesheet" href="/static/style.css"></head>
+<body><main class="gone"><h1>This download is no longer available</h1>
+<p>The server keeps results only while it runs, and only the most recent ones: {html.escape(name)}
+belonged to a job it no longer has ({html.escape(str(error))}). The server was probably restarted.</p>
+<p><a href="/">Open the synthesis page</a> and run the synthesis again to get a fresh download.</p>
+</main></body></html>
+'''
 
 
 def _file_response(found: Artifact, inline: bool) -> Response:

@@ -24,6 +24,7 @@ const DOWNLOAD_LABELS = {
   'specification.structuredslugs': 'Specification (.structuredslugs)',
   'specification.slugsin': 'Specification (.slugsin)',
   'automaton.json': 'Automaton (JSON)',
+  'flexbe_behavior.zip': 'FlexBE behavior package (zip: behavior code, manifest, package.xml)',
   'result.json': 'Whole result (JSON)',
   'flexbe_behavior.zip': 'FlexBE behavior package (.zip, as export-behavior writes it)',
 };
@@ -34,6 +35,8 @@ let shownJob = null;     // the job whose result is on the page
 let choices = null;      // the current system's control modes and actions
 let canSimulate = false; // the server can run atlas_sim
 let simulationEvents = null;
+let startedAt = 0;         // performance.now() when the followed job was started
+let elapsedTimer = null;
 
 function element(tag, attributes = {}, ...children) {
   const node = document.createElement(tag);
@@ -99,6 +102,31 @@ async function loadChoices() {
   updateGoalsHint();
 }
 
+// Ask the server which goals cannot come next (and which chosen goals can never be
+// achieved) and say so in the picker and the list, before anything is synthesized.
+async function checkGoals() {
+  const request = currentRequest();
+  let check;
+  try {
+    check = await api('POST', '/api/goal-check', { system: request.system, initial_conditions: request.initial_conditions,
+      goals: request.goals, unordered: request.unordered });
+  } catch (error) {
+    return;  // the synthesis itself will report what is wrong
+  }
+  for (const option of $('goal-choice').options) {
+    const why = check.impossible_next[option.value];
+    option.textContent = why ? `${option.value} (impossible here)` : option.value;
+    option.classList.toggle('impossible', Boolean(why));
+    option.dataset.impossible = why || '';
+    if (why) option.title = why;
+  }
+  for (const item of $('goals').children) {
+    const finding = check.findings.find((f) => f.item === item.dataset.goal);
+    item.classList.toggle('impossible', Boolean(finding));
+    item.querySelector('.goal-warning').textContent = finding ? finding.sentence : '';
+  }
+}
+
 // The control modes that can change to ``mode`` (its own self-loop aside).
 function predecessors(mode) {
   return choices.control_modes.filter((m) => m.name !== mode && m.next.includes(mode)).map((m) => m.name);
@@ -112,9 +140,10 @@ function goalItem(name) {
   };
   const item = element('li', { 'data-goal': name }, element('span', { className: 'goal-name', text: name }));
   item.append(
-    button('↑', 'move up', () => { if (item.previousElementSibling) item.previousElementSibling.before(item); }),
-    button('↓', 'move down', () => { if (item.nextElementSibling) item.nextElementSibling.after(item); }),
-    button('×', 'remove', () => { item.remove(); updateGoalsHint(); }));
+    button('↑', 'move up', () => { if (item.previousElementSibling) item.previousElementSibling.before(item); updateGoalsHint(); }),
+    button('↓', 'move down', () => { if (item.nextElementSibling) item.nextElementSibling.after(item); updateGoalsHint(); }),
+    button('×', 'remove', () => { item.remove(); updateGoalsHint(); }),
+    element('span', { className: 'goal-warning', role: 'note' }));
   return item;
 }
 
@@ -127,6 +156,7 @@ function addGoal() {
 
 function updateGoalsHint() {
   $('goals-empty').hidden = $('goals').children.length > 0;
+  checkGoals();
 }
 
 function currentRequest() {
@@ -156,19 +186,54 @@ async function synthesize(event) {
     return;
   }
   currentJob = job.id;
+  startedAt = performance.now();
   setRunning(true);
   showProgress(job);
-  events = new EventSource(`/api/jobs/${job.id}/events`);
-  events.addEventListener('progress', (message) => showProgress(JSON.parse(message.data)));
+  follow(job.id);
+}
+
+// Follow a job's events. When the stream breaks, say so and keep asking until the server
+// answers: then either resume (same server) or explain that a restart lost the job.
+function follow(jobId) {
+  events = new EventSource(`/api/jobs/${jobId}/events`);
+  events.addEventListener('progress', (message) => { setConnection(''); showProgress(JSON.parse(message.data)); });
   events.addEventListener('finished', (message) => {
     stopFollowing();
+    setConnection('');
     finish(JSON.parse(message.data));
   });
   events.onerror = () => {
-    // The stream broke (e.g. the server restarted): fall back to asking once.
     stopFollowing();
-    api('GET', `/api/jobs/${job.id}`).then(finish, (error) => showRequestError(error));
+    reconnect(jobId, 1);
   };
+}
+
+async function reconnect(jobId, attempt) {
+  if (currentJob !== jobId) return;
+  setConnection(`Connection to the server lost — reconnecting (attempt ${attempt})…`);
+  let job;
+  try {
+    job = await api('GET', `/api/jobs/${jobId}`);
+  } catch (error) {
+    if (error.code === 'NOT_FOUND') {
+      setConnection('');
+      currentJob = null;
+      setRunning(false);
+      $('status').textContent = 'The server restarted, so this job was lost — run it again.';
+      showBanner('CONNECTION LOST', 'The server restarted, so this job was lost — run it again.', null);
+      return;
+    }
+    setTimeout(() => reconnect(jobId, attempt + 1), 1000);
+    return;
+  }
+  setConnection('Connected again.');
+  if (job.state === 'finished') finish(job);
+  else follow(jobId);
+}
+
+function setConnection(text) {
+  $('connection').textContent = text;
+  $('connection').hidden = !text;
 }
 
 async function cancel() {
@@ -190,10 +255,20 @@ function setRunning(running) {
   $('synthesize').disabled = running;
   $('cancel').disabled = !running;
   document.body.classList.toggle('running', running);
+  clearInterval(elapsedTimer);
+  if (running) {
+    $('progress').removeAttribute('value');  // indeterminate: no stage knows how long it takes
+    elapsedTimer = setInterval(showElapsed, 200);
+    showElapsed();
+  }
+}
+
+function showElapsed() {
+  $('elapsed').textContent = `${((performance.now() - startedAt) / 1000).toFixed(1)} s`;
 }
 
 function showProgress(job) {
-  $('progress').value = job.progress;
+  if (job.state === 'finished') $('progress').value = job.progress;
   $('status').textContent = job.status;
   $('timeline').replaceChildren(...job.timeline.map((entry) => element('li', {},
     element('span', { className: 'time', text: formatSeconds(entry.seconds) }),
@@ -204,6 +279,7 @@ function finish(job) {
   setRunning(false);
   showProgress(job);
   if (job.state !== 'finished') return;
+  $('elapsed').textContent = formatSeconds(job.summary.seconds);
   currentJob = null;
   showResult(job);
 }
@@ -218,6 +294,7 @@ function resetResult() {
     $(id).hidden = true;
   }
   $('graph').replaceChildren();
+  StateMachineView.clear();
   $('timeline').replaceChildren();
   $('progress').value = 0;
 }
@@ -226,7 +303,7 @@ function resetResult() {
 // synthesizer's own account) goes into a collapsed "Details".
 function showBanner(code, message, good) {
   $('result').hidden = false;
-  $('result-banner').className = `banner ${good ? 'good' : 'bad'}`;
+  $('result-banner').className = `banner ${good === null ? 'neutral' : good ? 'good' : 'bad'}`;
   $('result-code').textContent = code;
   const [sentence, ...rest] = (message || '').split('\n');
   $('result-message').textContent = sentence;
@@ -247,9 +324,10 @@ function showRequestError(error) {
 function showResult(job) {
   const { outcome, summary } = job;
   const message = outcome.message || (summary.succeeded ? describeSuccess(job) : '');
-  showBanner(outcome.error_name, message, summary.succeeded);
+  const cancelled = outcome.error_name === 'PREEMPTED';
+  showBanner(cancelled ? 'CANCELLED' : outcome.error_name, message, cancelled ? null : summary.succeeded);
   showSummary(summary, job.stages);
-  if (job.artifacts.includes('state_machine.svg')) drawStateMachine(job.id);
+  if (job.artifacts.includes('state_machine.svg')) drawStateMachine(job);
   showDownloads(job);
   showSpecification(outcome.ltl_specification);
   shownJob = job;
@@ -282,23 +360,48 @@ function showSummary(summary, stages) {
     element('tr', { className }, element('th', { text: name }), element('td', { text: String(value) }))));
 }
 
-async function drawStateMachine(jobId) {
-  const response = await fetch(`/api/jobs/${jobId}/artifacts/state_machine.svg?inline=1`);
+async function drawStateMachine(job) {
+  const response = await fetch(`/api/jobs/${job.id}/artifacts/state_machine.svg?inline=1`);
+  $('graph-section').hidden = false;
   if (!response.ok) {
     const data = await response.json().catch(() => ({}));
     $('graph').replaceChildren(element('p', { className: 'bad', text: data.message || 'no picture' }));
-    $('graph-section').hidden = false;
     return;
   }
-  const svg = new DOMParser().parseFromString(await response.text(), 'image/svg+xml').documentElement;
-  svg.removeAttribute('width');   // scale to the column; the viewBox keeps the proportions
-  svg.removeAttribute('height');
-  svg.setAttribute('id', 'state-machine-svg');
-  $('graph').replaceChildren(document.importNode(svg, true));
-  $('graph-section').hidden = false;
+  StateMachineView.show($('graph'), await response.text(), job.outcome.states, showStateDetails);
+  showStateDetails(null);
 }
 
+// What FlexBE's editor shows for a state: class, parameters, userdata, outcomes, autonomy.
+function showStateDetails(state, children = []) {
+  const panel = $('state-details');
+  if (!state) {
+    panel.replaceChildren(element('p', { className: 'muted', text: 'Click a state to see its class, parameters, userdata, outcomes and autonomy.' }));
+    return;
+  }
+  const row = (name, ...values) => element('tr', {}, element('th', { text: name }), element('td', {}, ...values));
+  const className = state.state_class === ':BEHAVIOR' ? `${state.behavior_class} (behavior)`
+    : state.state_class === ':CONCURRENCY' ? 'concurrency container' : state.state_class;
+  const parameters = state.parameter_names.map((n, i) => `${n} = ${state.parameter_values[i]}`);
+  const userdata = state.userdata_keys.map((k, i) => `${k} ← ${state.userdata_remapping[i] || k}`);
+  const outcomes = state.outcomes.map((o, i) => element('li', { text: `${o} → ${state.transitions[i]}` +
+    (state.autonomy.length ? ` (autonomy ${AUTONOMY[state.autonomy[i]] ?? state.autonomy[i]})` : '') }));
+  panel.replaceChildren(
+    element('h3', { text: state.state_path.replace(/^\//, '') }),
+    element('table', { className: 'details' },
+      row('Class', className),
+      row('Parameters', parameters.join(', ') || '—'),
+      row('Userdata', userdata.join(', ') || '—'),
+      row('Outcomes', element('ul', {}, ...outcomes)),
+      ...(children.length ? [row('Contains', children.map((c) => `${c.state_path.split('/').pop()} (${c.state_class})`).join(', '))] : [])));
+}
+
+const AUTONOMY = { 0: 'Off', 1: 'Low', 2: 'High', 3: 'Full' };
+
 function showDownloads(job) {
+  const exportable = job.artifacts.includes('flexbe_behavior.zip');
+  $('export-flexbe').hidden = !exportable;
+  if (exportable) $('export-flexbe').href = `/api/jobs/${job.id}/artifacts/flexbe_behavior.zip`;
   $('downloads').replaceChildren(...job.artifacts.map((name) => element('li', {},
     element('a', { href: `/api/jobs/${job.id}/artifacts/${name}`, download: '', 'data-artifact': name,
       text: DOWNLOAD_LABELS[name] || name }))));
@@ -316,7 +419,15 @@ function showSpecification(sections) {
 // --- the simulation ----------------------------------------------------------------------
 
 function offerSimulation(job) {
-  if (!canSimulate || !job.artifacts.includes('state_machine.yaml')) return;
+  if (!job.artifacts.includes('state_machine.yaml')) return;
+  const support = choices.simulation || { available: canSimulate, note: '' };
+  $('simulation-note').textContent = support.note;
+  $('simulation-note').hidden = support.available;
+  $('simulation-controls').hidden = !support.available;
+  if (!support.available) {
+    $('simulation-section').hidden = false;
+    return;
+  }
   const names = [...choices.actions, ...choices.control_modes].map((c) => c.name);
   $('fail-first').replaceChildren(element('option', { value: '', text: 'nothing (no faults)' }),
     ...names.map((name) => element('option', { value: name, text: name })));
@@ -331,6 +442,10 @@ function resetSimulation() {
   $('simulation-view').hidden = true;
   $('simulation-steps').replaceChildren();
   $('simulation-frames').replaceChildren();
+  frameList = [];
+  $('frame-scrubber').value = '0';
+  $('frame-scrubber').max = '0';
+  StateMachineView.markRun([], false);
   $('simulation-check').textContent = '';
   $('simulation-timeline').hidden = true;
 }
@@ -361,16 +476,24 @@ async function simulate() {
 
 function showSimulation(simulation) {
   const base = `/api/simulations/${simulation.id}`;
+  const running = simulation.state !== 'finished';
   let status = `Running: ${simulation.steps.length} states, robot time ${simulation.robot_time.toFixed(2)} s`;
-  if (simulation.state === 'finished') {
+  let outcomeClass = '';
+  if (!running) {
     status = simulation.error
       ? `Stopped: ${simulation.error.code}: ${simulation.error.message}`
       : `Outcome: ${simulation.outcome} after ${simulation.steps.length} states ` +
         `(robot time ${simulation.robot_time.toFixed(2)} s, wall time ${simulation.wall_seconds.toFixed(2)} s)`;
+    outcomeClass = simulation.error ? 'bad' : `outcome-${simulation.outcome}`;
   }
   $('simulation-status').textContent = status;
-  $('simulation-status').className = `status ${simulation.error ? 'bad' : ''}`;
+  $('simulation-status').className = `status ${outcomeClass}`;
   $('simulation-view').hidden = false;
+  const outcomeCell = (step) => {
+    if (!step.state_outcome) return element('td', { text: '…' });
+    const ends = ['finished', 'failed'].includes(step.transition) ? ` outcome-${step.transition}` : '';
+    return element('td', { className: `outcome${ends}`, text: `${step.state_outcome} → ${step.transition}` });
+  };
   $('simulation-steps').replaceChildren(
     element('tr', {}, ...['#', 'state', 'activated', 'results', 'outcome', 'robot time (s)'].map((h) => element('th', { text: h }))),
     ...simulation.steps.map((step) => element('tr', { 'data-state': step.state },
@@ -378,18 +501,10 @@ function showSimulation(simulation) {
       element('td', { text: step.state.replace(/^\//, '') }),
       element('td', { text: step.capabilities.join(', ') }),
       element('td', { text: step.results.map((r) => `${r.capability} ${r.outcome}`).join(', ') }),
-      element('td', { text: step.state_outcome ? `${step.state_outcome} → ${step.transition}` : '…' }),
+      outcomeCell(step),
       element('td', { text: `${step.entered_at.toFixed(2)}–${step.ended_at.toFixed(2)}` }))));
-  const frames = simulation.frames;
-  if (frames.length) {
-    const latest = frames[frames.length - 1];
-    showFrame(`${base}/frames/${latest.index}`, latest.label);
-    $('simulation-frames').replaceChildren(...frames.map((frame) => {
-      const thumb = element('img', { src: `${base}/frames/${frame.index}`, alt: frame.label, title: frame.label });
-      thumb.addEventListener('click', () => showFrame(thumb.src, frame.label));
-      return thumb;
-    }));
-  }
+  StateMachineView.markRun(simulation.steps, running);
+  showFrames(base, simulation.frames);
   if (simulation.check) {
     const check = simulation.check;
     $('simulation-check').textContent = check.ok
@@ -404,11 +519,38 @@ function showSimulation(simulation) {
   }
 }
 
-function showFrame(src, label) {
-  $('simulation-frame').src = src;
-  // key frame files are named <index>_<sim time>s_<capability>_<event>
+// Key frames: the latest one large with a caption, a scrubber over all of them, and
+// captioned thumbnails.
+let frameList = [];
+function showFrames(base, frames) {
+  if (!frames.length) return;
+  const followLatest = Number($('frame-scrubber').value) >= frameList.length - 1;
+  frameList = frames.map((frame) => ({ src: `${base}/frames/${frame.index}`, caption: frameCaption(frame.label) }));
+  $('frame-scrubber').max = String(frames.length - 1);
+  $('simulation-frames').replaceChildren(...frameList.map((frame, index) => {
+    const figure = element('figure', { 'data-frame': String(index) },
+      element('img', { src: frame.src, alt: frame.caption }), element('figcaption', { text: frame.caption }));
+    figure.addEventListener('click', () => showFrame(index));
+    return figure;
+  }));
+  showFrame(followLatest ? frames.length - 1 : Number($('frame-scrubber').value));
+}
+
+function showFrame(index) {
+  const frame = frameList[index];
+  if (!frame) return;
+  $('frame-scrubber').value = String(index);
+  $('simulation-frame').src = frame.src;
+  $('simulation-frame').alt = frame.caption;
+  $('simulation-frame-label').textContent = `Frame ${index + 1} of ${frameList.length}: ${frame.caption}`;
+  document.querySelectorAll('#simulation-frames figure').forEach((f) =>
+    f.classList.toggle('current', f.dataset.frame === String(index)));
+}
+
+// key frame files are named <index>_<sim time>s_<capability>_<event>
+function frameCaption(label) {
   const match = label.match(/^\d+_0*(\d+\.\d+)s_(.*)$/);
-  $('simulation-frame-label').textContent = match ? `t = ${match[1]} s: ${match[2].replace(/_/g, ' ')}` : label;
+  return match ? `t = ${match[1]} s: ${match[2].replace(/_/g, ' ')}` : label.replace(/_/g, ' ');
 }
 
 function formatSeconds(seconds) {
@@ -423,6 +565,9 @@ document.addEventListener('DOMContentLoaded', () => {
   $('request-form').addEventListener('submit', synthesize);
   $('cancel').addEventListener('click', cancel);
   $('simulate').addEventListener('click', simulate);
+  $('frame-scrubber').addEventListener('input', (event) => showFrame(Number(event.target.value)));
+  $('initial-conditions').addEventListener('change', checkGoals);
+  $('unordered').addEventListener('change', checkGoals);
   loadSystems().then(() => document.body.classList.add('ready'),
     (error) => { $('status').textContent = `Cannot load the systems: ${error.message}`; });
 });

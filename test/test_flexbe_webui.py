@@ -4,7 +4,8 @@ Its backend (FastAPI + a ROS node) runs as its own process with its older web st
 (`make flexbe`), our suite as another, both on a reserved ROS domain on loopback; the
 editor page runs in headless Chromium. The test clicks what a FlexBE user clicks (add a
 container, "Display synthesis", the task, Synthesize) and reads the result from the page's own
-JavaScript model (``Behavior.getStatemachine()``).
+JavaScript model (``Behavior.getStatemachine()``). Our behaviors (the synthesized one as
+`export-behavior` writes it, and atlas_sim's) open through the behavior dashboard's loader.
 """
 
 import contextlib
@@ -118,7 +119,36 @@ def synthesis_server(ros_domain, tmp_path_factory):
 
 
 @pytest.fixture(scope='module')
-def webui(flexbe, flexbe_sources, ros_domain, synthesis_server, tmp_path_factory):
+def exported_behavior(tmp_path_factory):
+    """The paper task as `export-behavior` writes it, registered in an ament prefix of its own
+    (as a colcon install of the package would be): (name, top-level states, prefix, code folder)."""
+    from ltl_specification import compile_task
+    from ltl_synthesizer import synthesize
+    from respec.automaton import automaton_from_strategy
+    from sm_generation import generate_state_machine
+    from sm_generation.config import load_flexbe_config
+    from sm_generation.flexbe_behavior import behavior_package
+
+    initial, goals = ['stand_prep'], ['look_down', 'pickup_object']
+    spec = compile_task('atlas', initial, goals)
+    states = generate_state_machine(automaton_from_strategy(synthesize(spec).strategy, spec), 'atlas',
+                                    initial_conditions=initial)
+    package = behavior_package(states, load_flexbe_config('atlas'), 'Look Down Pickup Object')
+    prefix = tmp_path_factory.mktemp('exported_prefix')
+    folder = package.write(prefix / 'src')
+    index = prefix / 'share' / 'ament_index' / 'resource_index' / 'packages'
+    index.mkdir(parents=True)
+    (index / package.package).touch()
+    (prefix / 'share' / package.package).mkdir()
+    (prefix / 'share' / package.package / 'package.xml').symlink_to(folder / 'package.xml')
+    (prefix / 'lib' / package.package).mkdir(parents=True)
+    (prefix / 'lib' / package.package / 'manifest').symlink_to(folder / 'manifest')
+    top = sorted(s.name for s in states if s.parent_path == '/' and s.state_class != ':OUTCOME')
+    return package.behavior_name, top, prefix, folder
+
+
+@pytest.fixture(scope='module')
+def webui(flexbe, flexbe_sources, ros_domain, synthesis_server, exported_behavior, tmp_path_factory):
     """The WebUI backend process; yields its URL."""
     import json
 
@@ -128,9 +158,10 @@ def webui(flexbe, flexbe_sources, ros_domain, synthesis_server, tmp_path_factory
     (folder / 'webui.json').write_text(json.dumps(WEBUI_SETTINGS))
     environment = prepare_ros_environment(ros_domain, environ=dict(os.environ))
     environment['PYTHONPATH'] = os.pathsep.join(
-        [str(WEBUI_SITE), str(flexbe_sources / 'flexbe_webui'), str(flexbe_sources / 'rosidl_runtime_py')]
+        [str(WEBUI_SITE), str(flexbe_sources / 'flexbe_webui'), str(flexbe_sources / 'rosidl_runtime_py'),
+         str(exported_behavior[3])]
         + [entry for entry in os.environ.get('PYTHONPATH', '').split(os.pathsep) if entry])
-    environment['AMENT_PREFIX_PATH'] = str(flexbe)
+    environment['AMENT_PREFIX_PATH'] = os.pathsep.join([str(exported_behavior[2]), str(flexbe)])
     url = f'http://127.0.0.1:{WEBUI_PORT}/'
 
     def answers():
@@ -227,3 +258,21 @@ def test_a_bad_goal_shows_our_error_name_in_the_webui(editor, goals, error_name,
     assert f'Behavior synthesis failed: {error_name}: ' in log and named in log
     assert "Goal for '/behavior_synthesis' - failed!" in editor.inner_text('#terminal')
     assert editor.evaluate(READ_CONTAINER, '/Container')['states'] == []
+
+
+LOAD_BEHAVIOR = """name => new Promise(resolve => {
+    const entry = WS.Behaviorlib.getByName(name);
+    if (!entry) { resolve({error: `${name} is not in the behavior library`}); return; }
+    IO.BehaviorLoader.loadBehavior(entry.getBehaviorManifest(), error => resolve({
+        error: error === undefined ? null : String(error),
+        states: Behavior.getStatemachine().getStates().map(s => s.getStateName()).sort()}));
+})"""
+
+
+def test_our_behaviors_open_in_the_behavior_dashboard(editor, exported_behavior):
+    """Issue 13: the exported synthesized behavior and the behaviors the configs embed load in the editor."""
+    name, top_states, _, _ = exported_behavior
+    for behavior, states in [(name, top_states), ('Pickup Object', ['Check Template', 'Pick Up']),
+                             ('Grasp Object', ['Check Template', 'Grasp'])]:
+        loaded = editor.evaluate(LOAD_BEHAVIOR, behavior)
+        assert loaded == {'error': None, 'states': states}

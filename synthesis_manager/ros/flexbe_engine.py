@@ -74,42 +74,32 @@ class SimulatedOperator:
                         for capability in set(self.request_capabilities.values())}
         self.server = ActionServer(node, BehaviorInput, BEHAVIOR_INPUT_ACTION, self.answer, callback_group=group)
 
-    def answer(self, goal_handle):
+    async def answer(self, goal_handle):
+        """Run the request's operator-input capability; awaited, so no executor thread waits."""
         behavior_input, execute_capability = self._types
         result = behavior_input.Result(result_code=behavior_input.Result.RESULT_ABORTED)
-        capability = self.request_capabilities.get(goal_handle.request.request_type)
-        if capability is None or goal_handle.request.request_type not in OPERATOR_ANSWERS:
-            result.data = f'the simulated operator has no answer for request type {goal_handle.request.request_type}'
+        request_type = goal_handle.request.request_type
+        capability = self.request_capabilities.get(request_type)
+        if capability is None or request_type not in OPERATOR_ANSWERS:
+            result.data = f'the simulated operator has no answer for request type {request_type}'
             goal_handle.abort()
             return result
         client = self.clients[capability]
-        done = threading.Event()
-        outcome = {}
-        if client.wait_for_server(timeout_sec=5.0):
-            future = client.send_goal_async(execute_capability.Goal(capability=capability))
-            future.add_done_callback(lambda f: self._on_accepted(f, done, outcome))
-            done.wait(120.0)
-        if outcome.get('outcome') == 'completed':
-            answer = OPERATOR_ANSWERS[goal_handle.request.request_type]
-            result.result_code, result.data = behavior_input.Result.RESULT_OK, str(pickle.dumps(answer))
-        else:
-            result.data = outcome.get('reason', f'no answer from the simulator for {capability}')
+        reason = f'no simulator answers {capability}'
+        if client.server_is_ready() or client.wait_for_server(timeout_sec=5.0):  # waits once, at discovery
+            handle = await client.send_goal_async(execute_capability.Goal(capability=capability))
+            if handle.accepted:
+                done = (await handle.get_result_async()).result
+                if done.outcome == 'completed':
+                    result.result_code = behavior_input.Result.RESULT_OK
+                    result.data = str(pickle.dumps(OPERATOR_ANSWERS[request_type]))
+                reason = done.reason
+            else:
+                reason = 'the simulator rejected the request'
+        if result.result_code != behavior_input.Result.RESULT_OK:
+            result.data = reason
         goal_handle.succeed()
         return result
-
-    @staticmethod
-    def _on_accepted(future, done, outcome):
-        handle = future.result()
-        if not handle.accepted:
-            outcome['reason'] = 'the simulator rejected the request'
-            done.set()
-            return
-
-        def on_result(result_future):
-            result = result_future.result().result
-            outcome.update(outcome=result.outcome, reason=result.reason)
-            done.set()
-        handle.get_result_async().add_done_callback(on_result)
 
 
 def load_behavior_class(package, directory: Path):

@@ -24,7 +24,6 @@ const DOWNLOAD_LABELS = {
   'specification.structuredslugs': 'Specification (.structuredslugs)',
   'specification.slugsin': 'Specification (.slugsin)',
   'automaton.json': 'Automaton (JSON)',
-  'flexbe_behavior.zip': 'FlexBE behavior package (zip: behavior code, manifest, package.xml)',
   'result.json': 'Whole result (JSON)',
   'flexbe_behavior.zip': 'FlexBE behavior package (.zip, as export-behavior writes it)',
 };

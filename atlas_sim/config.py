@@ -45,6 +45,13 @@ from typing import Any, Dict, Mapping, Optional, Tuple
 import yaml
 
 from respec.abstraction import AbstractionConfigError, RobotAbstraction, abstraction_from_dict
+from respec.errors import CodedError
+
+class SimulationConfigError(CodedError, ValueError):
+    """The ``simulation:`` section is invalid; ``item`` names the offending key or capability."""
+
+    code = 'CONFIG_FILE_INVALID'
+
 
 #: config/ next to the atlas_sim package (the repository layout).
 CONFIG_DIR = Path(__file__).resolve().parent.parent / "config"
@@ -93,7 +100,8 @@ class SimulationConfig:
         section = dict(section or {})
         unknown = set(section) - _SIMULATION_KEYS
         if unknown:
-            raise ValueError(f"unknown keys in simulation section: {sorted(unknown)}")
+            raise SimulationConfigError(f"unknown keys in simulation section: {sorted(unknown)}",
+                                        item=sorted(unknown)[0])
         settle = SettleConfig(**(section.get("settle") or {}))
         fall = section.get("fall") or {}
         scenario_section = section.get("scenario") or {}

@@ -30,6 +30,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Dict, Iterable, List, Mapping, Optional, Set, Tuple
 
+from .config import SimulationConfigError
 from respec.abstraction import RobotAbstraction
 from respec.naming import COMPLETED, FAILED
 
@@ -105,12 +106,12 @@ class DiscreteSemantics:
         for trigger, victims in self.invalidations.items():
             unknown = [n for n in (trigger, *victims) if not abstraction.is_capability(n)]
             if unknown:
-                raise ValueError(f"invalidations mention unknown capabilities {unknown}")
+                raise SimulationConfigError(f"invalidations mention unknown capabilities {unknown}", item=unknown[0])
 
     def initial_state(self, mode: Optional[str] = None) -> DiscreteState:
         mode = mode or next(iter(self.abstraction.control_modes))
         if not self.abstraction.is_mode(mode):
-            raise ValueError(f"unknown initial mode {mode!r}")
+            raise SimulationConfigError(f"unknown initial mode {mode!r}", item=str(mode))
         return DiscreteState(mode=mode)
 
     # ----------------------------------------------------------------- checks

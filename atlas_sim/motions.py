@@ -32,6 +32,7 @@ from typing import Any, Dict, FrozenSet, List, Mapping, Optional, Sequence, Tupl
 
 import numpy as np
 
+from .config import SimulationConfigError
 from .kinematics import (
     ARM_POSES,
     HIP_HEIGHTS,
@@ -285,7 +286,7 @@ def build_motion(entry: Mapping[str, Any], geometry: LegGeometry) -> Motion:
     kind = entry.pop("motion", "compute")
     builder = _BUILDERS.get(kind)
     if builder is None:
-        raise ValueError(f"unknown motion kind {kind!r}; known: {sorted(_BUILDERS)}")
+        raise SimulationConfigError(f"unknown motion kind {kind!r}; known: {sorted(_BUILDERS)}", item=str(kind))
     return builder(entry, geometry)
 
 
@@ -311,7 +312,8 @@ def _arm_sequence(entry, geometry: LegGeometry) -> Motion:
     keyframes = []
     for frame in entry["keyframes"]:
         if frame["arms"] not in ARM_POSES:
-            raise ValueError(f"unknown arm pose {frame['arms']!r}; known: {sorted(ARM_POSES)}")
+            raise SimulationConfigError(f"unknown arm pose {frame['arms']!r}; known: {sorted(ARM_POSES)}",
+                                        item=str(frame["arms"]))
         targets = arm_targets(frame["arms"])
         targets.update(gripper_targets(frame.get("gripper", "open") == "closed"))
         keyframes.append((float(frame.get("duration", 1.0)), targets))

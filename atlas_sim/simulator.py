@@ -32,7 +32,7 @@ from typing import Any, Callable, Dict, Iterable, List, Optional, Union
 
 import numpy as np
 
-from .config import SystemConfig, load_system_config
+from .config import SimulationConfigError, SystemConfig, load_system_config
 from .discrete import COMPLETED, FAILED, Abstraction, DiscreteSemantics, DiscreteState
 from .faults import FaultInjector, FaultSpec
 from .kinematics import POSTURES
@@ -133,11 +133,13 @@ class AtlasSimulator:
         for section, entries in named.items():
             unknown = [name for name in entries if not self.abstraction.is_capability(name)]
             if unknown:
-                raise ValueError(f"simulation.{section} names unknown capabilities {unknown}")
+                raise SimulationConfigError(f"simulation.{section} names unknown capabilities {unknown}",
+                                            item=unknown[0])
         misplaced = [m for m in settings.modes if not self.abstraction.is_mode(m)]
         misplaced += [a for a in settings.actions if not self.abstraction.is_action(a)]
         if misplaced:
-            raise ValueError(f"modes/actions listed in the wrong simulation section: {misplaced}")
+            raise SimulationConfigError(f"modes/actions listed in the wrong simulation section: {misplaced}",
+                                        item=misplaced[0])
         for name in self.abstraction.capabilities:
             self._motion_for(name)  # raises on unknown motion kinds, poses or parameters
         for entry in settings.faults.values():

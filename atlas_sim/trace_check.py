@@ -52,6 +52,7 @@ from __future__ import annotations
 
 from dataclasses import asdict, dataclass, field
 
+from respec.errors import CodedError
 from respec.ltl import And, Const, Formula, Iff, Implies, Next, Not, Or, Var, mentions_next, to_infix
 from respec.naming import ACTIVATION_SUFFIX, COMPLETED, DEFAULT_SM_OUTCOMES, MEMORY_SUFFIX, outcome_proposition
 from respec.spec import GR1Specification
@@ -60,14 +61,10 @@ from respec.spec import GR1Specification
 DEFAULT_SM_OUTCOME_PROPOSITIONS = {outcome: outcome for outcome in DEFAULT_SM_OUTCOMES}
 
 
-class TraceError(ValueError):
+class TraceError(CodedError):
     """A trace that cannot be checked (malformed); ``item`` names the offending entry."""
 
     code = 'INVALID_REQUEST'
-
-    def __init__(self, message: str, item: str):
-        super().__init__(message)
-        self.item = item
 
 
 # --- traces -------------------------------------------------------------------------------

@@ -24,9 +24,28 @@ class InvalidFormulaError(SynthesisError):
 
 
 class SynthesisCancelled(SynthesisError):
-    """Synthesis was stopped by the cancel flag (``reason='cancelled'``) or the deadline ('timeout')."""
+    """Synthesis was stopped by the cancel flag (``reason='cancelled'``) or the deadline ('timeout').
 
-    def __init__(self, reason: str):
+    ``SynthesisCancelled('timeout')`` makes a :class:`SynthesisTimedOut`, so that each code
+    belongs to a class.
+    """
+
+    code = 'PREEMPTED'
+
+    def __new__(cls, reason: str = 'cancelled'):
+        if cls is SynthesisCancelled and reason == 'timeout':
+            cls = SynthesisTimedOut
+        return super().__new__(cls, reason)
+
+    def __init__(self, reason: str = 'cancelled'):
         super().__init__(f'synthesis {reason}', item=reason)
         self.reason = reason
-        self.code = 'PREEMPTED' if reason == 'cancelled' else 'SYNTHESIS_TIMEOUT'
+
+
+class SynthesisTimedOut(SynthesisCancelled):
+    """Synthesis passed its deadline."""
+
+    code = 'SYNTHESIS_TIMEOUT'
+
+    def __init__(self, reason: str = 'timeout'):
+        super().__init__(reason)

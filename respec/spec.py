@@ -9,6 +9,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field, fields
 from typing import Iterable
 
+from respec.errors import CodedError
 from respec.ltl import Formula, to_infix, to_prefix, variables
 
 PROPOSITION_SECTIONS = ('env_props', 'sys_props')
@@ -89,12 +90,10 @@ class GR1Specification:
         return '\n\n'.join(blocks) + '\n'
 
 
-class PropositionConflictError(ValueError):
+class PropositionConflictError(CodedError, ValueError):
     """A proposition is declared as both an environment and a system proposition."""
 
-    def __init__(self, message: str, item: str):
-        super().__init__(message)
-        self.item = item
+    code = 'INVALID_FORMULA'
 
 
 def merge_specifications(specifications: Iterable[GR1Specification]) -> GR1Specification:

@@ -19,23 +19,23 @@ import yaml
 
 from respec.automaton import Automaton, AutomatonState, automaton_from_strategy
 from respec.parsing import ParseError, parse_structuredslugs
-from sm_generation.errors import SMGenerationError
+from sm_generation.errors import AutomatonInvalidError
 
 
 def automaton_from_dict(data: dict, source: str = '<dict>') -> Automaton:
     """Build an Automaton from our file format (already parsed)."""
     if not isinstance(data, dict):
-        raise SMGenerationError('AUTOMATON_INVALID', f'{source}: expected a mapping', source)
+        raise AutomatonInvalidError(f'{source}: expected a mapping', source)
     states = data.get('automaton', data.get('states'))
     for key, value in (('output_variables', data.get('output_variables')),
                        ('input_variables', data.get('input_variables')),
                        ('automaton', states)):
         if not isinstance(value, list):
-            raise SMGenerationError('AUTOMATON_INVALID', f'{source}: {key!r} must be a list', key)
+            raise AutomatonInvalidError(f'{source}: {key!r} must be a list', key)
     parsed = []
     for index, entry in enumerate(states):
         if not isinstance(entry, dict) or 'name' not in entry:
-            raise SMGenerationError('AUTOMATON_INVALID', f'{source}: state #{index} needs a name',
+            raise AutomatonInvalidError(f'{source}: state #{index} needs a name',
                                     f'automaton[{index}]')
         parsed.append(AutomatonState(
             name=str(entry['name']),
@@ -73,11 +73,11 @@ def load_automaton(path: str | Path, spec_path: str | Path | None = None) -> Aut
     try:
         text = path.read_text()
     except OSError as error:
-        raise SMGenerationError('AUTOMATON_INVALID', f'cannot read {path}: {error}', str(path)) from error
+        raise AutomatonInvalidError(f'cannot read {path}: {error}', str(path)) from error
     try:
         data = json.loads(text) if path.suffix == '.json' else yaml.safe_load(text)
     except (json.JSONDecodeError, yaml.YAMLError) as error:
-        raise SMGenerationError('AUTOMATON_INVALID', f'{path}: not valid YAML/JSON: {error}',
+        raise AutomatonInvalidError(f'{path}: not valid YAML/JSON: {error}',
                                 str(path)) from error
     if isinstance(data, dict) and 'nodes' in data and 'variables' in data:
         return _automaton_from_strategy_file(data, path, spec_path)
@@ -86,16 +86,16 @@ def load_automaton(path: str | Path, spec_path: str | Path | None = None) -> Aut
 
 def _automaton_from_strategy_file(strategy: dict, path: Path, spec_path) -> Automaton:
     if spec_path is None:
-        raise SMGenerationError('AUTOMATON_INVALID', f'{path} is a slugs strategy: give the '
+        raise AutomatonInvalidError(f'{path} is a slugs strategy: give the '
                                 '.structuredslugs specification it was synthesized from', str(path))
     spec_path = Path(spec_path)
     try:
         spec = parse_structuredslugs(spec_path.read_text(), filename=str(spec_path))
     except OSError as error:
-        raise SMGenerationError('AUTOMATON_INVALID', f'cannot read {spec_path}: {error}',
+        raise AutomatonInvalidError(f'cannot read {spec_path}: {error}',
                                 str(spec_path)) from error
     except ParseError as error:
-        raise SMGenerationError('AUTOMATON_INVALID', str(error), error.item) from error
+        raise AutomatonInvalidError(str(error), error.item) from error
     return automaton_from_strategy(strategy, spec)
 
 

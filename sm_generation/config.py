@@ -20,7 +20,7 @@
 
 ``class_decl.name`` is a state class, or ``:BEHAVIOR`` together with ``behavior_class``.
 A state's outcomes are the values of its ``output_mapping`` in file order; a list-valued
-``autonomy`` follows that order. Every problem raises ``SMGenerationError`` whose ``item``
+``autonomy`` follows that order. Every problem raises an ``SMGenerationError`` subclass whose ``item``
 is the dotted key of the offending entry (e.g. ``flexbe.states.look_down_a.autonomy``).
 """
 
@@ -31,7 +31,9 @@ from pathlib import Path
 
 from respec.naming import ACTIVATION_SUFFIX
 from respec.systems import ConfigFileInvalidError, UnknownSystemError, load_section
-from sm_generation.errors import SMGenerationError
+from sm_generation.errors import (AutonomyConfigInvalidError, FlexBEConfigInvalidError, NoSystemConfigError,
+                                  SMGenerationError, StateConfigInvalidError, SystemConfigNotFoundError,
+                                  UserdataConfigInvalidError)
 
 BEHAVIOR_CLASS = ':BEHAVIOR'
 # FlexBE autonomy levels: Off/Inherit 0, Low 1, High 2, Full 3.
@@ -94,36 +96,33 @@ class FlexBEConfig:
 def load_flexbe_config(system: str, config_dir: str | Path | None = None) -> FlexBEConfig:
     """Load and validate the ``flexbe:`` section of ``config/<system>.yaml``."""
     if config_dir is not None and not Path(config_dir).is_dir():
-        raise SMGenerationError('SYSTEM_CONFIG_NOT_FOUND', f'configuration directory {config_dir} does not exist',
+        raise SystemConfigNotFoundError(f'configuration directory {config_dir} does not exist',
                                 str(config_dir))
     try:
         section = load_section(system, 'flexbe', config_dir)
     except UnknownSystemError as error:
-        raise SMGenerationError('NO_SYSTEM_CONFIG', str(error), error.item or system) from error
+        raise NoSystemConfigError(str(error), error.item or system) from error
     except ConfigFileInvalidError as error:
-        raise SMGenerationError('CONFIG_FILE_INVALID', str(error), error.item) from error
+        raise FlexBEConfigInvalidError(str(error), error.item) from error
     return parse_flexbe_config(section, system)
 
 
 def parse_flexbe_config(section: dict, system: str = '') -> FlexBEConfig:
     """Validate an already-parsed ``flexbe:`` mapping."""
     if not isinstance(section, dict):
-        raise SMGenerationError('CONFIG_FILE_INVALID', 'the flexbe section must be a mapping', 'flexbe')
+        raise FlexBEConfigInvalidError('the flexbe section must be a mapping', 'flexbe')
     sm_outcomes = _sm_outcomes(section.get('sm_outcomes'))
     raw_states = section.get('states')
     if not isinstance(raw_states, dict) or not raw_states:
-        raise SMGenerationError('CONFIG_FILE_INVALID',
-                                'flexbe.states must be a non-empty mapping of propositions to states',
+        raise FlexBEConfigInvalidError('flexbe.states must be a non-empty mapping of propositions to states',
                                 'flexbe.states')
     states = {}
     for proposition, entry in raw_states.items():
         if not isinstance(proposition, str) or not proposition:
-            raise SMGenerationError('CONFIG_VARIABLE_CONFIG_INVALID',
-                                    f'flexbe.states: invalid proposition name {proposition!r}',
+            raise StateConfigInvalidError(f'flexbe.states: invalid proposition name {proposition!r}',
                                     f'flexbe.states.{proposition}')
         if proposition in sm_outcomes:
-            raise SMGenerationError('CONFIG_VARIABLE_CONFIG_INVALID',
-                                    f'{proposition!r} is both an SM outcome and a state',
+            raise StateConfigInvalidError(f'{proposition!r} is both an SM outcome and a state',
                                     f'flexbe.states.{proposition}')
         states[proposition] = _state_config(proposition, entry)
     _check_unique_outcome_owners(states)
@@ -155,59 +154,57 @@ def _packages(raw) -> dict:
 def _sm_outcomes(raw) -> dict[str, str]:
     key = 'flexbe.sm_outcomes'
     if not isinstance(raw, dict) or not raw:
-        raise SMGenerationError('CONFIG_FILE_INVALID',
-                                f'{key} must map SM-outcome propositions to outcome names', key)
+        raise FlexBEConfigInvalidError(f'{key} must map SM-outcome propositions to outcome names', key)
     for proposition, outcome in raw.items():
         if not isinstance(proposition, str) or not isinstance(outcome, str) or not outcome:
-            raise SMGenerationError('CONFIG_FILE_INVALID',
-                                    f'{key}.{proposition}: expected a non-empty outcome name, got {outcome!r}',
+            raise FlexBEConfigInvalidError(f'{key}.{proposition}: expected a non-empty outcome name, got {outcome!r}',
                                     f'{key}.{proposition}')
     return dict(raw)
 
 
-def _string_list(value, key: str, code: str) -> tuple[str, ...]:
+def _string_list(value, key: str, error: type[SMGenerationError]) -> tuple[str, ...]:
     if value is None:
         return ()
     if not isinstance(value, list) or any(isinstance(v, (list, dict)) or v is None for v in value):
-        raise SMGenerationError(code, f'{key} must be a list of strings, got {value!r}', key)
+        raise error(f'{key} must be a list of strings, got {value!r}', key)
     # YAML reads False or 3 as bool/int; FlexBE parameters and keys are source text.
     return tuple(str(v) for v in value)
 
 
 def _state_config(proposition: str, entry) -> StateConfig:
     where = f'flexbe.states.{proposition}'
-    invalid = 'CONFIG_VARIABLE_CONFIG_INVALID'
+    invalid = StateConfigInvalidError
     if not isinstance(entry, dict):
-        raise SMGenerationError(invalid, f'{where} must be a mapping', where)
+        raise invalid(f'{where} must be a mapping', where)
     for required in ('class_decl', 'output_mapping'):
         if required not in entry:
-            raise SMGenerationError(invalid, f'{where} lacks {required!r}', f'{where}.{required}')
+            raise invalid(f'{where} lacks {required!r}', f'{where}.{required}')
 
     decl = entry['class_decl']
     if not isinstance(decl, dict) or not isinstance(decl.get('name'), str) or not decl['name']:
-        raise SMGenerationError(invalid, f'{where}.class_decl needs a class name', f'{where}.class_decl.name')
+        raise invalid(f'{where}.class_decl needs a class name', f'{where}.class_decl.name')
     behavior_class = decl.get('behavior_class', '')
     if decl['name'] == BEHAVIOR_CLASS and (not isinstance(behavior_class, str) or not behavior_class):
-        raise SMGenerationError(invalid, f'{where}.class_decl: a {BEHAVIOR_CLASS} needs behavior_class',
+        raise invalid(f'{where}.class_decl: a {BEHAVIOR_CLASS} needs behavior_class',
                                 f'{where}.class_decl.behavior_class')
     names = _string_list(decl.get('param_names'), f'{where}.class_decl.param_names', invalid)
     values = _string_list(decl.get('param_values'), f'{where}.class_decl.param_values', invalid)
     if len(names) != len(values):
-        raise SMGenerationError(invalid, f'{where}.class_decl: {len(names)} param_names but '
+        raise invalid(f'{where}.class_decl: {len(names)} param_names but '
                                 f'{len(values)} param_values', f'{where}.class_decl.param_values')
 
     output_mapping = _output_mapping(entry['output_mapping'], f'{where}.output_mapping')
     outcomes = [o for os in output_mapping.values() for o in os]
     autonomy = _autonomy(entry.get('autonomy', 0), outcomes, f'{where}.autonomy')
 
-    keys = _string_list(entry.get('userdata_keys'), f'{where}.userdata_keys', 'CONFIG_USERDATA_INVALID')
+    keys = _string_list(entry.get('userdata_keys'), f'{where}.userdata_keys', UserdataConfigInvalidError)
     remapping = _string_list(entry.get('userdata_remapping'), f'{where}.userdata_remapping',
-                             'CONFIG_USERDATA_INVALID')
+                             UserdataConfigInvalidError)
     if len(keys) != len(remapping):
-        raise SMGenerationError('CONFIG_USERDATA_INVALID', f'{where}: {len(keys)} userdata_keys but '
+        raise UserdataConfigInvalidError(f'{where}: {len(keys)} userdata_keys but '
                                 f'{len(remapping)} userdata_remapping', f'{where}.userdata_remapping')
     if len(set(keys)) != len(keys):
-        raise SMGenerationError('CONFIG_USERDATA_INVALID', f'{where}.userdata_keys lists a key twice',
+        raise UserdataConfigInvalidError(f'{where}.userdata_keys lists a key twice',
                                 f'{where}.userdata_keys')
     return StateConfig(proposition=proposition, state_class=decl['name'],
                        behavior_class=behavior_class if decl['name'] == BEHAVIOR_CLASS else '',
@@ -217,19 +214,19 @@ def _state_config(proposition: str, entry) -> StateConfig:
 
 
 def _output_mapping(raw, where: str) -> dict[str, tuple[str, ...]]:
-    invalid = 'CONFIG_VARIABLE_CONFIG_INVALID'
+    invalid = StateConfigInvalidError
     if not isinstance(raw, dict) or not raw:
-        raise SMGenerationError(invalid, f'{where} must map outcome propositions to state outcomes', where)
+        raise invalid(f'{where} must map outcome propositions to state outcomes', where)
     mapping, seen = {}, {}
     for proposition, outcomes in raw.items():
         if isinstance(outcomes, str):
             outcomes = [outcomes]
         if not isinstance(outcomes, list) or not outcomes or not all(isinstance(o, str) and o for o in outcomes):
-            raise SMGenerationError(invalid, f'{where}.{proposition}: expected a non-empty list of outcomes',
+            raise invalid(f'{where}.{proposition}: expected a non-empty list of outcomes',
                                     f'{where}.{proposition}')
         for outcome in outcomes:
             if outcome in seen:
-                raise SMGenerationError(invalid, f'{where}: outcome {outcome!r} means both '
+                raise invalid(f'{where}: outcome {outcome!r} means both '
                                         f'{seen[outcome]!r} and {proposition!r}', f'{where}.{proposition}')
             seen[outcome] = proposition
         mapping[str(proposition)] = tuple(outcomes)
@@ -239,13 +236,12 @@ def _output_mapping(raw, where: str) -> dict[str, tuple[str, ...]]:
 def _autonomy(raw, outcomes: list[str], where: str) -> dict[str, int]:
     def level(value) -> int:
         if isinstance(value, bool) or not isinstance(value, int) or value not in AUTONOMY_LEVELS:
-            raise SMGenerationError('CONFIG_AUTONOMY_INVALID',
-                                    f'{where}: autonomy must be an integer 0..3, got {value!r}', where)
+            raise AutonomyConfigInvalidError(f'{where}: autonomy must be an integer 0..3, got {value!r}', where)
         return value
 
     if isinstance(raw, list):
         if len(raw) != len(outcomes):
-            raise SMGenerationError('CONFIG_AUTONOMY_INVALID', f'{where}: {len(raw)} levels for '
+            raise AutonomyConfigInvalidError(f'{where}: {len(raw)} levels for '
                                     f'{len(outcomes)} outcomes {outcomes}', where)
         return {outcome: level(value) for outcome, value in zip(outcomes, raw)}
     return {outcome: level(raw) for outcome in outcomes}
@@ -256,8 +252,7 @@ def _check_unique_outcome_owners(states: dict[str, StateConfig]) -> None:
     for state in states.values():
         for proposition in state.output_mapping:
             if proposition in owners:
-                raise SMGenerationError('CONFIG_VARIABLE_CONFIG_INVALID',
-                                        f'outcome proposition {proposition!r} is mapped by both '
+                raise StateConfigInvalidError(f'outcome proposition {proposition!r} is mapped by both '
                                         f'{owners[proposition]!r} and {state.proposition!r}',
                                         f'flexbe.states.{state.proposition}.output_mapping.{proposition}')
             owners[proposition] = state.proposition

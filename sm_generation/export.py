@@ -16,6 +16,7 @@ from pathlib import Path
 
 import yaml
 
+from respec.errors import CodedError
 from respec.naming import FINISHED
 from sm_generation.instantiation import StateInstantiation
 
@@ -24,12 +25,10 @@ RENDER_FORMATS = ('svg', 'png')
 GOOD_COLOUR, BAD_COLOUR = '#2e7d32', '#c62828'
 
 
-class RenderError(RuntimeError):
+class RenderError(CodedError):
     """Rendering failed; ``item`` names the missing program or the output file."""
 
-    def __init__(self, message: str, item: str):
-        super().__init__(message)
-        self.item = item
+    code = 'SM_GENERATION_FAILED'
 
 
 def to_yaml(states: list[StateInstantiation]) -> str:

@@ -261,4 +261,4 @@ def _helper_entry(state: MachineState, name: str, target_name) -> StateInstantia
             state_path=f'/{name}', state_class=NOTHING_CLASS, parameter_names=['text', 'severity'],
             parameter_values=[f'"Nothing to do: the task ends with {targets[0]}"', 'Logger.REPORT_HINT'],
             outcomes=['done'], transitions=targets[:1], autonomy=[0])
-    raise SMGenerationError('SM_GENERATION_FAILED', f'unknown helper state {state.helper!r}', name)
+    raise SMGenerationError(f'unknown helper state {state.helper!r}', name)

@@ -31,7 +31,9 @@ from dataclasses import dataclass, field
 
 from respec.naming import ACTIVATION_SUFFIX, MEMORY_SUFFIX
 from sm_generation.config import FlexBEConfig, StateConfig
-from sm_generation.errors import SMGenerationError
+from sm_generation.errors import (AutomatonInvalidError, InitialConditionsInvalidError, InputValuationInvalidError,
+                                  NextStateInvalidError, NoInitialStateError, OutputValuationInvalidError,
+                                  StateConfigInvalidError)
 
 
 # An observation: sorted pairs (proposition of a part, outcome proposition seen).
@@ -75,7 +77,7 @@ class AutomatonView:
         self.initial_states = [str(n) for n in (getattr(automaton, 'initial_states', None) or [])]
         for name in self.initial_states:
             if name not in self.states:
-                raise SMGenerationError('AUTOMATON_INVALID', f'initial state {name!r} is not a state', name)
+                raise AutomatonInvalidError(f'initial state {name!r} is not a state', name)
         self._classify_variables()
         self.activations = {name: self._true_activations(state) for name, state in self.states.items()}
         self.exits = {name: self._exit_outcome(state) for name, state in self.states.items()}
@@ -95,9 +97,7 @@ class AutomatonView:
             if prop in config.sm_outcomes or prop in config.states or prop.endswith(MEMORY_SUFFIX):
                 continue
             if any(state.output_valuation[index] for state in self.states.values()):
-                raise SMGenerationError(
-                    'CONFIG_VARIABLE_CONFIG_INVALID',
-                    f'output proposition {prop!r} is activated by the automaton but has no entry '
+                raise StateConfigInvalidError(f'output proposition {prop!r} is activated by the automaton but has no entry '
                     f'in flexbe.states of system {config.system!r}', prop)
         for index, prop in enumerate(self.input_variables):
             if prop in config.states or config.owner_of_outcome(prop) is not None:
@@ -105,9 +105,7 @@ class AutomatonView:
             # Nothing in FlexBE reports it: harmless while it never changes, wrong otherwise.
             if any(state.input_valuation[index] != self.states[successor].input_valuation[index]
                    for state in self.states.values() for successor in state.transitions):
-                raise SMGenerationError(
-                    'CONFIG_VARIABLE_CONFIG_INVALID',
-                    f'input proposition {prop!r} changes in the automaton but no state in flexbe.states '
+                raise StateConfigInvalidError(f'input proposition {prop!r} changes in the automaton but no state in flexbe.states '
                     f'of system {config.system!r} reports it', prop)
 
     def _true_activations(self, state) -> tuple[str, ...]:
@@ -119,7 +117,7 @@ class AutomatonView:
         true = [p for p, value in zip(self.output_variables, state.output_valuation)
                 if value and p in self.config.sm_outcomes]
         if len(true) > 1:
-            raise SMGenerationError('AUTOMATON_INVALID', f'state {state.name!r} sets several SM '
+            raise AutomatonInvalidError(f'state {state.name!r} sets several SM '
                                     f'outcomes at once: {", ".join(true)}', state.name)
         return self.config.sm_outcomes[true[0]] if true else None
 
@@ -140,9 +138,7 @@ class AutomatonView:
         for activation in activations:
             seen = [p for p in self.config.states[activation].output_mapping if now.get(p)]
             if len(seen) > 1:
-                raise SMGenerationError(
-                    'AUTOMATON_INPUT_VALUATION_INVALID',
-                    f'state {target!r} reports several outcomes of {activation!r} at once: '
+                raise InputValuationInvalidError(f'state {target!r} reports several outcomes of {activation!r} at once: '
                     f'{", ".join(seen)}', target)
             pairs.extend((activation, p) for p in seen)
         for sensor in self.sensor_props:
@@ -195,7 +191,7 @@ class AutomatonView:
             return self.resolve(exit_state)
         if self.observed_transitions(name):
             return ('state', name)  # waits for its sensors
-        raise SMGenerationError('AUTOMATON_INVALID', f'state {name!r} activates nothing and no '
+        raise AutomatonInvalidError(f'state {name!r} activates nothing and no '
                                 'outcome or sensor ever leads out of it', name)
 
     def _first_silent_exit(self, name: str) -> str | None:
@@ -234,8 +230,7 @@ class AutomatonView:
             candidates = unentered or candidates
         if not candidates:
             detail = f' with {", ".join(required)} true' if required else ''
-            raise SMGenerationError('AUTOMATON_NO_INITIAL_STATE',
-                                    f'no initial state{detail}: give Automaton.initial_states or a state '
+            raise NoInitialStateError(f'no initial state{detail}: give Automaton.initial_states or a state '
                                     'that activates nothing', ','.join(initial_conditions or []))
         return candidates
 
@@ -254,8 +249,7 @@ class AutomatonView:
                 continue
             state = self.config.states.get(condition + ACTIVATION_SUFFIX) or self.config.states.get(condition)
             if state is None:
-                raise SMGenerationError('INVALID_INITIAL_CONDITIONS',
-                                        f'initial condition {condition!r} is neither a proposition of this '
+                raise InitialConditionsInvalidError(f'initial condition {condition!r} is neither a proposition of this '
                                         f'automaton nor a state of system {self.config.system!r}', condition)
             completion = next(iter(state.output_mapping))
             if completion in self.input_variables:
@@ -266,11 +260,11 @@ class AutomatonView:
 def _variables(automaton, attribute: str) -> list[str]:
     values = getattr(automaton, attribute, None)
     if not isinstance(values, (list, tuple)) or not all(isinstance(v, str) for v in values):
-        raise SMGenerationError('AUTOMATON_INVALID', f'automaton.{attribute} must be a list of names',
+        raise AutomatonInvalidError(f'automaton.{attribute} must be a list of names',
                                 attribute)
     duplicates = sorted({v for v in values if list(values).count(v) > 1})
     if duplicates:
-        raise SMGenerationError('AUTOMATON_INVALID', f'{attribute} lists {duplicates[0]!r} twice',
+        raise AutomatonInvalidError(f'{attribute} lists {duplicates[0]!r} twice',
                                 duplicates[0])
     return list(values)
 
@@ -278,23 +272,21 @@ def _variables(automaton, attribute: str) -> list[str]:
 def _states(automaton, n_outputs: int, n_inputs: int) -> dict:
     states = getattr(automaton, 'states', None)
     if not states:
-        raise SMGenerationError('AUTOMATON_INVALID', 'the automaton has no states', 'states')
+        raise AutomatonInvalidError('the automaton has no states', 'states')
     by_name = {}
     for state in states:
         name = str(state.name)
         if name in by_name:
-            raise SMGenerationError('AUTOMATON_INVALID', f'two states are named {name!r}', name)
-        for valuation, expected, code in ((state.output_valuation, n_outputs, 'AUTOMATON_OUTPUT_VALUATION_INVALID'),
-                                          (state.input_valuation, n_inputs, 'AUTOMATON_INPUT_VALUATION_INVALID')):
+            raise AutomatonInvalidError(f'two states are named {name!r}', name)
+        for valuation, expected, error in ((state.output_valuation, n_outputs, OutputValuationInvalidError),
+                                           (state.input_valuation, n_inputs, InputValuationInvalidError)):
             if len(valuation) != expected or not all(v in (0, 1) for v in valuation):
-                raise SMGenerationError(code, f'state {name!r}: expected {expected} truth values, got '
-                                        f'{list(valuation)!r}', name)
+                raise error(f'state {name!r}: expected {expected} truth values, got {list(valuation)!r}', name)
         by_name[name] = state
     for name, state in by_name.items():
         for successor in state.transitions:
             if str(successor) not in by_name:
-                raise SMGenerationError('AUTOMATON_NEXT_STATE_INVALID',
-                                        f'state {name!r} has a transition to unknown state {successor!r}',
+                raise NextStateInvalidError(f'state {name!r} has a transition to unknown state {successor!r}',
                                         str(successor))
     return {name: _normalized(state, name) for name, state in by_name.items()}
 

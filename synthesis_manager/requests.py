@@ -8,12 +8,15 @@ from dataclasses import dataclass
 from types import SimpleNamespace
 from typing import Any
 
+from respec.errors import CodedError
 from respec.naming import DEFAULT_SM_OUTCOMES, parse_names
 
 OPTION_NAMES = ('ltl_compilation_only', 'ltl_synthesis_only', 'ltl_steps_only')
 
 
-class InvalidRequest(ValueError):
+class InvalidRequest(CodedError):
+    """A request the server cannot run (contradictory or malformed options)."""
+
     code = 'INVALID_REQUEST'
 
 

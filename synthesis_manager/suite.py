@@ -8,6 +8,7 @@ import functools
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 
+from respec.errors import CodedError
 from synthesis_manager.client import SynthesisClient
 from synthesis_manager.nodes.ltl_compilation_node import LTLCompilationNode
 from synthesis_manager.nodes.ltl_synthesis_node import LTLSynthesisNode
@@ -63,8 +64,10 @@ def suite_node_factories(args=None, names=SUITE_NODE_NAMES):
             for name in names]
 
 
-class SuiteUnavailable(RuntimeError):
+class SuiteUnavailable(CodedError):
     """The in-process suite's action server did not come up."""
+
+    code = 'SERVICE_UNAVAILABLE'
 
 
 @contextlib.contextmanager

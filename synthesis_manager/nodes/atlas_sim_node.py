@@ -37,6 +37,7 @@ from rclpy.node import Node
 
 from atlas_sim.executor import make_simulator, parse_faults
 from respec.naming import parse_names
+from synthesis_manager.ros.errors import log_internal_error
 from synthesis_manager.ros.node_main import node_main
 from synthesis_msgs.action import ExecuteCapability
 from synthesis_msgs.msg import RobotState
@@ -180,7 +181,7 @@ class AtlasSimNode(Node):
         try:
             self._run_physics()
         except Exception as error:  # a dead physics thread must not leave goals waiting forever
-            self.get_logger().error(f'physics stopped: {error!r}')
+            log_internal_error(self.get_logger(), 'physics stopped', error)
             self._stop.set()
             with self.lock:
                 for job in self._pending + self._running:

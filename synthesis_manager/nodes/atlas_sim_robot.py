@@ -21,17 +21,16 @@ import time
 from rclpy.action import ActionClient
 
 from atlas_sim.executor import CapabilityResult
+from respec.errors import CodedError
 from synthesis_manager.nodes.atlas_sim_node import ACTION_NAME, STATE_TOPIC
 from synthesis_msgs.action import ExecuteCapability
 from synthesis_msgs.msg import RobotState
 
 
-class RobotUnavailableError(RuntimeError):
-    code = 'SERVICE_UNAVAILABLE'
+class RobotUnavailableError(CodedError):
+    """The atlas_sim node does not answer."""
 
-    def __init__(self, message: str, item: str):
-        super().__init__(message)
-        self.item = item
+    code = 'SERVICE_UNAVAILABLE'
 
 
 class _Goal:

@@ -8,6 +8,7 @@ from rclpy.node import Node
 from ltl_specification import compile_task
 from respec.naming import DEFAULT_SM_OUTCOMES
 from synthesis_manager.ros.conversions import error_code, msg_to_sections, spec_to_msg
+from synthesis_manager.ros.errors import reported_error
 from synthesis_manager.ros.node_main import node_main
 from synthesis_msgs.srv import GenerateLTLSpecification
 
@@ -33,8 +34,7 @@ class LTLCompilationNode(Node):
                 custom_ltl=msg_to_sections(request.custom_ltl) or None,
                 config_dir=self.get_parameter('config_dir').value or None)
         except Exception as error:  # every failure becomes an error code; the node keeps serving
-            code = getattr(error, 'code', 'LTL_SPEC_COMPILATION_FAILED')
-            response.error_code = error_code(code, f'LTL compilation failed: {error}')
+            response.error_code = reported_error(error, self.get_logger(), 'LTL compilation failed')
             self.get_logger().warning(response.error_code.message)
             return response
         response.ltl_specification = spec_to_msg(spec)

@@ -20,8 +20,10 @@ from ltl_synthesizer import SynthesisCancelled, synthesize
 from ltl_synthesizer.external import run_external_synthesizer
 from ltl_synthesizer.strategy import strategy_to_json
 from respec.automaton import automaton_from_strategy
+from respec.errors import CodedError
 from respec.parsing import ParseError, spec_from_text_sections
 from synthesis_manager.ros.conversions import automaton_to_msg, error_code, msg_to_sections
+from synthesis_manager.ros.errors import reported_error
 from synthesis_manager.ros.node_main import node_main
 from synthesis_msgs.srv import CancelSynthesis, SynthesizeAutomaton
 
@@ -30,7 +32,9 @@ DEFAULT_SPEC_NAME = 'synthesized_spec'
 BACKENDS = ('builtin', 'slugs')
 
 
-class InvalidSpecName(ValueError):
+class InvalidSpecName(CodedError):
+    """A spec_name that would leave the byproducts directory."""
+
     code = 'INVALID_SPEC_NAME'
 
 
@@ -101,9 +105,8 @@ class LTLSynthesisNode(Node):
             response.synthesizable = False
             response.error_code = error_code('SYNTHESIS_FAILED', f'malformed specification: {error}')
         except Exception as error:  # every failure becomes an error code; the node keeps serving
-            code = getattr(error, 'code', 'SYNTHESIS_FAILED')
             response.synthesizable = False
-            response.error_code = error_code(code, f'synthesis failed: {error}')
+            response.error_code = reported_error(error, self.get_logger(), 'synthesis failed')
         finally:
             with self._lock:
                 self._running.pop(request_id, None)

@@ -24,13 +24,14 @@ from ltl_specification.diagnosis import explain_unsynthesizable
 from ltl_specification.errors import InvalidInitialConditionsError
 from ltl_specification.initial_conditions import (asks_for_robot_state, detected_status,
                                                   initial_conditions_from_robot_state)
-from respec.errors import CodedError
+from respec.errors import INTERNAL_ERROR, CodedError
 from sm_generation.instantiation import count_states
 from synthesis_manager.nodes.atlas_sim_node import STATE_TOPIC
 from synthesis_manager.requests import (InvalidRequest, SynthesisTask, task_from_behavior_synthesis,
                                         task_from_flexbe_synthesis)
 from synthesis_manager.ros.conversions import (error_code, error_name, flexbe_error_code, is_empty_spec,
                                                msg_to_sections)
+from synthesis_manager.ros.errors import log_internal_error
 from synthesis_manager.ros.node_main import node_main
 from synthesis_manager.ros.robot_state import RobotStateListener
 from synthesis_msgs.action import BehaviorSynthesis, FlexBESynthesis
@@ -40,16 +41,29 @@ from synthesis_msgs.srv import (CancelSynthesis, GenerateFlexBESM, GenerateLTLSp
 
 
 class StageFailed(Exception):
-    """A pipeline stage ended the goal; carries the error code name and message."""
+    """A pipeline service answered with an error: the goal ends with that answer."""
 
-    def __init__(self, code: str, message: str):
-        super().__init__(message)
-        self.code = code
+    def __init__(self, answer):
+        self.error_name = error_name(answer.value)
+        super().__init__(answer.message or self.error_name)
 
-    @classmethod
-    def from_error_code(cls, error_code_msg) -> 'StageFailed':
-        name = error_name(error_code_msg.value)
-        return cls(name, error_code_msg.message or name)
+
+class StageUnavailable(CodedError):
+    """A pipeline service is not there."""
+
+    code = 'SERVICE_UNAVAILABLE'
+
+
+class StageTimedOut(CodedError):
+    """A pipeline service did not answer in time."""
+
+    code = 'TIMEOUT'
+
+
+class ServerStopping(CodedError):
+    """The server shuts down while a goal waits on a stage."""
+
+    code = 'BEHAVIOR_SYNTHESIS_FAILED'
 
 
 class Preempted(Exception):
@@ -196,11 +210,13 @@ class BehaviorSynthesisServer(Node):
             outcome.fail('PREEMPTED', 'cancelled by the client')
             goal_handle.canceled()
             return interface.make_result(outcome)
-        except (StageFailed, InvalidRequest, CodedError) as failure:
-            outcome.fail(failure.code, str(failure))
-        except Exception as error:  # the server keeps serving whatever happens
-            self.get_logger().error(f'behavior synthesis failed: {error!r}')
-            outcome.fail('BEHAVIOR_SYNTHESIS_FAILED', f'internal error: {error}')
+        except StageFailed as failure:
+            outcome.fail(failure.error_name, str(failure))
+        except CodedError as error:
+            outcome.fail(error.code, str(error))
+        except Exception as error:  # a bug: logged with its traceback; the server keeps serving
+            log_internal_error(self.get_logger(), 'behavior synthesis failed', error)
+            outcome.fail(INTERNAL_ERROR, f'internal error: {error!r}')
         if outcome.succeeded:
             goal_handle.succeed()
         else:
@@ -276,7 +292,7 @@ class BehaviorSynthesisServer(Node):
         if goal_handle.is_cancel_requested:
             raise Preempted()
         if self._stopping.is_set():
-            raise StageFailed('BEHAVIOR_SYNTHESIS_FAILED', 'reading the robot state: the server is shutting down')
+            raise ServerStopping('reading the robot state: the server is shutting down', topic)
         if state is None:
             raise InvalidInitialConditionsError(
                 f'no initial conditions given and no robot state on {topic!r} within {timeout:g} s: '
@@ -289,20 +305,19 @@ class BehaviorSynthesisServer(Node):
     @staticmethod
     def check(code):
         if code.value != code.SUCCESS:
-            raise StageFailed.from_error_code(code)
+            raise StageFailed(code)
 
     def call(self, goal_handle, client, request, stage: str, timeout: float, on_cancel=None):
         """Call a service asynchronously; wait while watching for cancel and the time limit."""
         if not client.wait_for_service(timeout_sec=self.parameter('service_timeout')):
-            raise StageFailed('SERVICE_UNAVAILABLE',
-                              f'{stage}: service {client.srv_name!r} is not available')
+            raise StageUnavailable(f'{stage}: service {client.srv_name!r} is not available', client.srv_name)
         future = client.call_async(request)
         done = threading.Event()
         future.add_done_callback(lambda _: done.set())
         deadline = time.monotonic() + timeout
         while not done.wait(0.02):
             if self._stopping.is_set():
-                raise StageFailed('BEHAVIOR_SYNTHESIS_FAILED', f'{stage}: the server is shutting down')
+                raise ServerStopping(f'{stage}: the server is shutting down', stage)
             if goal_handle.is_cancel_requested:
                 if on_cancel:
                     on_cancel()
@@ -312,8 +327,8 @@ class BehaviorSynthesisServer(Node):
                 if on_cancel:
                     on_cancel()
                 client.remove_pending_request(future)
-                raise StageFailed('TIMEOUT', f'{stage}: no answer from {client.srv_name!r} '
-                                  f'within {timeout:g} s')
+                raise StageTimedOut(f'{stage}: no answer from {client.srv_name!r} within {timeout:g} s',
+                                    client.srv_name)
         return future.result()
 
     def cancel_synthesis(self, goal_id: str):

@@ -7,6 +7,7 @@ from rclpy.node import Node
 
 from sm_generation import generate_state_machine
 from synthesis_manager.ros.conversions import error_code, msg_to_automaton, state_to_msg
+from synthesis_manager.ros.errors import reported_error
 from synthesis_manager.ros.node_main import node_main
 from synthesis_msgs.srv import GenerateFlexBESM
 
@@ -33,8 +34,7 @@ class SMGenerationNode(Node):
                 initial_conditions=list(request.initial_conditions) or None,
                 reduce=self.get_parameter('reduce').value)
         except Exception as error:  # every failure becomes an error code; the node keeps serving
-            code = getattr(error, 'code', 'SM_GENERATION_FAILED')
-            response.error_code = error_code(code, f'state machine generation failed: {error}')
+            response.error_code = reported_error(error, self.get_logger(), 'state machine generation failed')
             self.get_logger().warning(response.error_code.message)
             return response
         response.state_definition = [state_to_msg(state) for state in states]

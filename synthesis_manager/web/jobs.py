@@ -11,6 +11,7 @@ from respec.naming import DEFAULT_SM_OUTCOMES, parse_names
 from sm_generation.instantiation import count_states
 from synthesis_manager.web.artifacts import available_artifacts
 from synthesis_manager.web.errors import InvalidJobRequestError, NotFoundError
+from synthesis_msgs.msg import SynthesisErrorCodes
 
 # The stop-early options the page offers (ltl_synthesis_only needs a whole specification).
 JOB_OPTIONS = ('ltl_compilation_only', 'ltl_steps_only')
@@ -114,13 +115,11 @@ class Job:
                 'artifacts': available_artifacts(self.outcome) if self.outcome else []}
 
 
-# Values of synthesis_msgs/SynthesisErrorCodes for the outcomes the GUI makes itself.
-LOCAL_ERROR_CODES = {'PREEMPTED': -9, 'FAILURE': 99999}
 
 
 def local_outcome(error_name: str, message: str, job: Job) -> dict:
     """An outcome (SynthesisOutcome.to_dict() shape) for a job that never got a result."""
-    return {'error_code': LOCAL_ERROR_CODES[error_name], 'error_name': error_name, 'message': message,
+    return {'error_code': getattr(SynthesisErrorCodes, error_name), 'error_name': error_name, 'message': message,
             'states': [], 'ltl_specification': {}, 'automaton': {},
             'seconds': round(time.monotonic() - job.created, 4)}
 

@@ -42,14 +42,14 @@ exits with the status of its last batch (earlier batches may end in any SM outco
 
 from __future__ import annotations
 
-import collections
-import contextlib
 import json
 import os
 import sys
-import time
 from pathlib import Path
 
+from atlas_sim.closed_loop import DeferredEvents, run_and_check
+from atlas_sim.executor import ExecutionError
+from respec.parsing import spec_from_text_sections
 from synthesis_manager.send_goal import ProgressBar, add_goal_arguments, goal_from_args, print_summary
 from synthesis_manager.suite import SuiteUnavailable, add_suite_arguments, in_process_suite
 
@@ -263,98 +263,43 @@ def _ros_robot(ros, args, simulator):
 
 def _execute(args, outcome, robot, simulator, goals, report, log, sim_node, record, expect,
              domain_id=None) -> int:
-    from atlas_sim.executor import ExecutionError, execute_state_machine
-    from atlas_sim.trace_check import check_trace
-    from respec.parsing import spec_from_text_sections
+    view = lock = None
+    if record and sim_node is not None:  # the node steps physics in its own thread: render here
+        view, lock = DeferredEvents(simulator, sim_node.lock), sim_node.lock
+    run_machine = None
+    if args.engine == 'flexbe':
+        # FlexBE is no registry package: imported only when asked for
+        from synthesis_manager.ros.flexbe_engine import run_on_flexbe
 
-    spec = spec_from_text_sections(outcome.ltl_specification)
-    recorder, on_tick = None, None
-    if record:
-        from atlas_sim.rendering import KeyFrameRecorder
-
-        if sim_node is None:
-            recorder = KeyFrameRecorder(simulator, Path(record) / 'frames', width=480, height=360)
-        else:  # the node steps physics in its own thread: render here, under its lock
-            view = DeferredEvents(simulator, sim_node.lock)
-            recorder = KeyFrameRecorder(view, Path(record) / 'frames', width=480, height=360)
-            on_tick = lambda robot: view.replay()  # noqa: E731
-    started = time.monotonic()
+        run_machine = lambda _tick: run_on_flexbe(  # noqa: E731
+            outcome.states, simulator, sim_node.lock, domain_id, args.system, args.config_dir or None,
+            max_wall_time=args.max_robot_time * 10 + 60)
     try:
-        if args.engine == 'flexbe':
-            from synthesis_manager.ros.flexbe_engine import run_on_flexbe
-
-            run = run_on_flexbe(outcome.states, simulator, sim_node.lock, domain_id, args.system,
-                                args.config_dir or None, max_wall_time=args.max_robot_time * 10 + 60)
-        else:
-            run = execute_state_machine(outcome.states, robot, args.system, args.config_dir or None,
-                                        max_robot_time=args.max_robot_time,
-                                        max_wall_time=args.max_robot_time * 10 + 60, on_tick=on_tick)
+        run = run_and_check(outcome.states, robot, simulator, args.system,
+                            spec_from_text_sections(outcome.ltl_specification), goals,
+                            ordered=not args.unordered, config_dir=args.config_dir or None, record_dir=record,
+                            max_robot_time=args.max_robot_time, max_wall_time=args.max_robot_time * 10 + 60,
+                            view=view, lock=lock, run_machine=run_machine)
     except ExecutionError as error:
         report.update(outcome=None, error={'code': error.code, 'item': error.item, 'message': str(error)},
                       trace=error.trace.to_dict() if error.trace else None, fallen=simulator.has_fallen())
         print(f'execute: {error}', file=sys.stderr)
         return EXIT_EXECUTION
-    finally:
-        if recorder:
-            if on_tick:
-                on_tick(robot)
-            with getattr(sim_node, 'lock', contextlib.nullcontext()):
-                recorder.capture('end')
-            recorder.close()
-    wall = time.monotonic() - started
-    check = check_trace(run.trace, spec, goals=goals, ordered=not args.unordered)
-    fallen = run.fallen or simulator.has_fallen()
-    report.update(outcome=run.outcome, trace=run.trace.to_dict(), trace_check=check.to_dict(), fallen=fallen,
-                  robot_time=round(run.duration, 3), wall_time=round(wall, 3),
-                  min_pelvis_height=round(run.min_pelvis_height, 3))
+    result, check = run.result, run.check
+    fallen = result.fallen or simulator.has_fallen()
+    report.update(outcome=result.outcome, trace=result.trace.to_dict(), trace_check=check.to_dict(),
+                  fallen=fallen, robot_time=round(result.duration, 3), wall_time=round(run.wall_seconds, 3),
+                  min_pelvis_height=round(result.min_pelvis_height, 3))
     if record:
-        from atlas_sim.timeline import plot_timeline
-
-        title = f'{", ".join(goals)}: {run.outcome}'
-        report['timeline'] = str(plot_timeline(run.trace, Path(record) / 'timeline.png', title))
-        report['frames'] = [str(p) for p in recorder.paths]
+        report['timeline'] = str(run.timeline)
+        report['frames'] = [str(p) for p in run.frames]
     if not args.json:
-        print_run(run, check, fallen, wall, stream=log)
+        print_run(result, check, fallen, run.wall_seconds, stream=log)
         if record:
-            print(f'recorded {len(recorder.paths)} frames and {report["timeline"]}', file=log)
+            print(f'recorded {len(run.frames)} frames and {report["timeline"]}', file=log)
     if check.violations or fallen:
         return EXIT_VIOLATIONS
-    return EXIT_OK if run.outcome == expect else EXIT_OTHER_OUTCOME
-
-
-class DeferredEvents:
-    """A simulator view for ``KeyFrameRecorder`` when another thread steps the simulator.
-
-    OpenGL contexts belong to the thread that made them, so the simulator's events are
-    queued in the stepping thread and replayed (rendered) in this one under ``lock``; frames
-    show the robot a poll period after the event, named with the event's sim time.
-    """
-
-    def __init__(self, simulator, lock):
-        self.simulator, self.lock = simulator, lock
-        self.physics = simulator.physics
-        self.time = simulator.time
-        self._listeners, self._queue = [], collections.deque()
-        simulator.add_listener(self._enqueue)
-
-    def _enqueue(self, event: str, request) -> None:
-        self._queue.append((event, request, self.simulator.time))
-
-    def add_listener(self, listener) -> None:
-        self._listeners.append(listener)
-
-    def remove_listener(self, listener) -> None:
-        self._listeners.remove(listener)
-        if not self._listeners:
-            self.simulator.remove_listener(self._enqueue)
-
-    def replay(self) -> None:
-        while self._queue:
-            event, request, self.time = self._queue.popleft()
-            with self.lock:
-                for listener in list(self._listeners):
-                    listener(event, request)
-        self.time = self.simulator.time
+    return EXIT_OK if result.outcome == expect else EXIT_OTHER_OUTCOME
 
 
 def print_run(run, check, fallen: bool, wall: float, stream=sys.stdout) -> None:

@@ -9,11 +9,9 @@ from __future__ import annotations
 
 import traceback
 
-from respec.errors import CodedError
+from respec.errors import INTERNAL_ERROR, CodedError
 from synthesis_manager.ros.conversions import error_code
 from synthesis_msgs.msg import SynthesisErrorCodes
-
-INTERNAL_ERROR = 'FAILURE'
 
 
 def reported_error(error: BaseException, logger, what: str) -> SynthesisErrorCodes:

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import dataclasses
 import itertools
+import logging
+import os
 import tempfile
 import threading
 import time
@@ -12,16 +14,21 @@ from collections import OrderedDict
 from pathlib import Path
 from typing import Callable
 
+from atlas_sim.closed_loop import run_and_check
+from atlas_sim.executor import SimulatedRobot, make_simulator, parse_faults
 from ltl_specification.diagnosis import goal_findings, impossible_next_goals
 from respec.abstraction import load_abstraction
-from respec.errors import CodedError
+from respec.errors import INTERNAL_ERROR, CodedError
 from respec.naming import DEFAULT_SM_OUTCOMES, FINISHED
+from respec.parsing import spec_from_text_sections
 from respec.systems import SystemConfigError, available_systems, load_section
 from synthesis_manager.web.artifacts import ARTIFACTS, Artifact
 from synthesis_manager.web.errors import (ArtifactFailedError, InvalidJobRequestError, NotAvailableError,
                                           NotFoundError)
 from synthesis_manager.web.jobs import JOB_OPTIONS, Job, JobRequest, local_outcome, names_field
 from synthesis_manager.web.simulations import Simulation, simulation_available
+
+logger = logging.getLogger(__name__)
 
 
 GoalRunner = Callable[[JobRequest, Callable[[str, float], None], threading.Event], dict]
@@ -208,52 +215,35 @@ class SynthesisBackend:
         return simulation
 
     def _simulate(self, simulation: Simulation, job: Job):
-        import os
-
         os.environ.setdefault('MUJOCO_GL', 'egl')  # off-screen rendering, before mujoco loads
-        from atlas_sim.executor import Executive, SimulatedRobot, StateMapping, make_simulator, parse_faults
-        from atlas_sim.rendering import KeyFrameRecorder
-        from atlas_sim.timeline import plot_timeline
-        from atlas_sim.trace_check import check_trace
-        from respec.parsing import spec_from_text_sections
-
         request, started = job.request, time.monotonic()
-        directory = Path(self._simulation_dir.name) / simulation.id
-        recorder = executive = None
+        simulator = None
 
-        def watch(_robot):  # every control tick: publish only when a step or frame was added
+        def progress(steps, frames):  # every control tick: publish only when a step or frame was added
             simulation.robot_time = simulator.time
-            steps = executive.trace.steps
-            if len(steps) != len(simulation.steps) or len(recorder.paths) != len(simulation.frames):
-                self._update(simulation, steps=[dataclasses.asdict(step) for step in steps],
-                             frames=list(recorder.paths))
+            if len(steps) != len(simulation.steps) or len(frames) != len(simulation.frames):
+                self._update(simulation, steps=[dataclasses.asdict(step) for step in steps], frames=frames)
 
         try:
             simulator = make_simulator(request.system, self.config_dir, request.initial_conditions,
                                        faults=parse_faults(fail_first=[f'{c}:1' for c in simulation.fail_first]))
-            recorder = KeyFrameRecorder(simulator, directory / 'frames', width=480, height=360)
-            recorder.capture('start')
-            executive = Executive(job.outcome['states'], SimulatedRobot(simulator),
-                                  StateMapping(request.system, self.config_dir),
-                                  max_robot_time=300.0, max_wall_time=300.0, on_tick=watch)
-            run = executive.run()
-            recorder.capture('end')
-            check = check_trace(run.trace, spec_from_text_sections(job.outcome['ltl_specification']),
-                                goals=list(request.goals), ordered=not request.unordered)
-            timeline = plot_timeline(run.trace, directory / 'timeline.png',
-                                     f'{", ".join(request.goals)}: {run.outcome}')
-            self._update(simulation, outcome=run.outcome, check=check.to_dict(), timeline_png=timeline,
-                         steps=[dataclasses.asdict(step) for step in run.trace.steps])
+            run = run_and_check(job.outcome['states'], SimulatedRobot(simulator), simulator, request.system,
+                                spec_from_text_sections(job.outcome['ltl_specification']), list(request.goals),
+                                ordered=not request.unordered, config_dir=self.config_dir,
+                                record_dir=Path(self._simulation_dir.name) / simulation.id,
+                                max_robot_time=300.0, max_wall_time=300.0, on_progress=progress)
+            self._update(simulation, outcome=run.result.outcome, check=run.check.to_dict(),
+                         timeline_png=run.timeline, frames=run.frames,
+                         steps=[dataclasses.asdict(step) for step in run.result.trace.steps])
         except Exception as error:  # ExecutionError, bad faults, rendering: report, keep serving
+            if not isinstance(error, CodedError):
+                logger.exception('simulation %s failed', simulation.id)
             trace = getattr(error, 'trace', None)
             self._update(simulation, error={
-                'code': getattr(error, 'code', type(error).__name__), 'item': getattr(error, 'item', ''),
-                'message': str(error)},
+                'code': error.code if isinstance(error, CodedError) else INTERNAL_ERROR,
+                'item': getattr(error, 'item', ''), 'message': str(error)},
                 steps=[dataclasses.asdict(step) for step in trace.steps] if trace else simulation.steps)
         finally:
-            if recorder is not None:
-                recorder.close()
-                self._update(simulation, frames=list(recorder.paths))
             self._update(simulation, state='finished', wall_seconds=time.monotonic() - started)
 
     def _job(self, job_id: str) -> Job:
@@ -292,7 +282,8 @@ class SynthesisBackend:
             outcome = self.run_goal(job.request, lambda status, progress: self._note(job, status, progress),
                                     job.cancel_requested)
         except Exception as error:  # the GUI keeps serving whatever the runner does
-            outcome = local_outcome('FAILURE', f'the GUI could not run the goal: {error}', job)
+            logger.exception('job %s failed', job.id)
+            outcome = local_outcome(INTERNAL_ERROR, f'the GUI could not run the goal: {error}', job)
         self._finish(job, outcome)
 
     def _note(self, job: Job, status: str, progress: float):

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import importlib.util
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -33,9 +34,5 @@ class Simulation:
 
 
 def simulation_available() -> bool:
-    """Whether atlas_sim (MuJoCo) can be imported in this installation."""
-    try:
-        import atlas_sim.executor  # noqa: F401
-    except ImportError:
-        return False
-    return True
+    """Whether MuJoCo, which atlas_sim simulates with, is installed."""
+    return importlib.util.find_spec('mujoco') is not None

@@ -7,6 +7,7 @@ import tempfile
 import time
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Callable
 
 from respec.parsing import spec_from_text_sections
 from sm_generation import SMGenerationError, StateInstantiation, export
@@ -75,22 +76,42 @@ def _has_automaton(outcome):
     return bool((outcome.get('automaton') or {}).get('states'))
 
 
-# name -> (media type, is it there for this outcome?, build bytes from the outcome)
+@dataclass(frozen=True)
+class ArtifactKind:
+    """One download: what the page calls it, its media type, when it exists, how it is built."""
+
+    label: str
+    media_type: str
+    present: Callable[[dict], bool]
+    build: Callable[..., bytes]  # (outcome, job request, config_dir) -> bytes
+
+
 ARTIFACTS = {
-    'state_machine.yaml': ('application/yaml', _has_states, _export('to_yaml')),
-    'state_machine.json': ('application/json', _has_states, _export('to_json')),
-    'state_machine.dot': ('text/vnd.graphviz', _has_states, _export('to_dot')),
-    'state_machine.svg': ('image/svg+xml', _has_states, _picture('svg')),
-    'state_machine.png': ('image/png', _has_states, _picture('png')),
-    'specification.structuredslugs': ('text/plain', _has_specification, _specification('to_structuredslugs')),
-    'specification.slugsin': ('text/plain', _has_specification, _specification('to_slugsin')),
-    'automaton.json': ('application/json', _has_automaton,
-                       lambda outcome, *_: (json.dumps(outcome['automaton'], indent=1) + '\n').encode()),
-    'result.json': ('application/json', lambda outcome: True,
-                    lambda outcome, *_: (json.dumps(outcome, indent=1) + '\n').encode()),
-    'flexbe_behavior.zip': ('application/zip', _has_states, _flexbe_behavior),
+    'state_machine.yaml': ArtifactKind('State machine (StateInstantiation list, YAML)', 'application/yaml',
+                                       _has_states, _export('to_yaml')),
+    'state_machine.json': ArtifactKind('State machine (StateInstantiation list, JSON)', 'application/json',
+                                       _has_states, _export('to_json')),
+    'state_machine.dot': ArtifactKind('Picture source (Graphviz DOT)', 'text/vnd.graphviz',
+                                      _has_states, _export('to_dot')),
+    'state_machine.svg': ArtifactKind('Picture (SVG)', 'image/svg+xml', _has_states, _picture('svg')),
+    'state_machine.png': ArtifactKind('Picture (PNG)', 'image/png', _has_states, _picture('png')),
+    'specification.structuredslugs': ArtifactKind('Specification (.structuredslugs)', 'text/plain',
+                                                  _has_specification, _specification('to_structuredslugs')),
+    'specification.slugsin': ArtifactKind('Specification (.slugsin)', 'text/plain',
+                                          _has_specification, _specification('to_slugsin')),
+    'automaton.json': ArtifactKind('Automaton (JSON)', 'application/json', _has_automaton,
+                                   lambda outcome, *_: (json.dumps(outcome['automaton'], indent=1) + '\n').encode()),
+    'result.json': ArtifactKind('Whole result (JSON)', 'application/json', lambda outcome: True,
+                                lambda outcome, *_: (json.dumps(outcome, indent=1) + '\n').encode()),
+    'flexbe_behavior.zip': ArtifactKind('FlexBE behavior package (.zip, as export-behavior writes it)', 'application/zip',
+                                        _has_states, _flexbe_behavior),
 }
 
 
 def available_artifacts(outcome: dict) -> list[str]:
-    return [name for name, (_, present, _) in ARTIFACTS.items() if present(outcome)]
+    return [name for name, kind in ARTIFACTS.items() if kind.present(outcome)]
+
+
+def download_labels(names: list[str]) -> dict[str, str]:
+    """What the page calls each download."""
+    return {name: ARTIFACTS[name].label for name in names}

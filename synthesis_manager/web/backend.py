@@ -147,18 +147,20 @@ class SynthesisBackend:
             raise NotFoundError(f'unknown artifact {name!r} (artifacts: {", ".join(ARTIFACTS)})', name)
         if not job.finished:
             raise NotAvailableError(f'job {job_id!r} has not finished yet', job_id)
-        media_type, present, build = ARTIFACTS[name]
-        if not present(job.outcome):
+        kind = ARTIFACTS[name]
+        if not kind.present(job.outcome):
             raise NotAvailableError(
                 f'job {job_id!r} ({job.outcome["error_name"]}) has no {name}', name)
         key = (job_id, name)
         if key not in self._artifacts:
             try:
-                content = build(job.outcome, job.request, self.config_dir)
-            except Exception as error:  # e.g. RenderError when Graphviz is missing
+                content = kind.build(job.outcome, job.request, self.config_dir)
+            except Exception as error:  # e.g. RenderError when Graphviz is missing; keep serving
+                if not isinstance(error, CodedError):
+                    logger.exception('building %s of job %s failed', name, job_id)
                 raise ArtifactFailedError(f'cannot make {name}: {error}',
                                           getattr(error, 'item', '') or name) from error
-            self._artifacts[key] = Artifact(content, media_type, f'{job.request.name or "behavior"}_{name}')
+            self._artifacts[key] = Artifact(content, kind.media_type, f'{job.request.name or "behavior"}_{name}')
         return self._artifacts[key]
 
     # simulations ------------------------------------------------------------------------

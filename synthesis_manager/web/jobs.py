@@ -9,7 +9,7 @@ from dataclasses import asdict, dataclass, field
 
 from respec.naming import DEFAULT_SM_OUTCOMES, parse_names
 from sm_generation.instantiation import count_states
-from synthesis_manager.web.artifacts import available_artifacts
+from synthesis_manager.web.artifacts import available_artifacts, download_labels
 from synthesis_manager.web.errors import InvalidJobRequestError, NotFoundError
 from synthesis_msgs.msg import SynthesisErrorCodes
 
@@ -106,15 +106,14 @@ class Job:
         return self.state == 'finished'
 
     def to_dict(self) -> dict:
+        artifacts = available_artifacts(self.outcome) if self.outcome else []
         return {'id': self.id, 'state': self.state, 'status': self.status,
                 'progress': round(self.progress, 4), 'request': asdict(self.request),
                 'cancel_requested': self.cancel_requested.is_set(),
                 'timeline': list(self.timeline), 'outcome': self.outcome,
                 'summary': result_summary(self.outcome) if self.outcome else None,
                 'stages': stage_timings(self.timeline, self.finished_after) if self.outcome else [],
-                'artifacts': available_artifacts(self.outcome) if self.outcome else []}
-
-
+                'artifacts': artifacts, 'download_labels': download_labels(artifacts)}
 
 
 def local_outcome(error_name: str, message: str, job: Job) -> dict:

@@ -15,19 +15,6 @@ const SECTION_TITLES = {
   sys_liveness: 'System liveness',
 };
 
-const DOWNLOAD_LABELS = {
-  'state_machine.yaml': 'State machine (StateInstantiation list, YAML)',
-  'state_machine.json': 'State machine (StateInstantiation list, JSON)',
-  'state_machine.svg': 'Picture (SVG)',
-  'state_machine.png': 'Picture (PNG)',
-  'state_machine.dot': 'Picture source (Graphviz DOT)',
-  'specification.structuredslugs': 'Specification (.structuredslugs)',
-  'specification.slugsin': 'Specification (.slugsin)',
-  'automaton.json': 'Automaton (JSON)',
-  'result.json': 'Whole result (JSON)',
-  'flexbe_behavior.zip': 'FlexBE behavior package (.zip, as export-behavior writes it)',
-};
-
 let currentJob = null;   // id of the job being followed
 let events = null;       // its EventSource
 let shownJob = null;     // the job whose result is on the page
@@ -59,6 +46,7 @@ async function api(method, path, body) {
   if (!response.ok) {
     const error = new Error(data.message || `${response.status} ${response.statusText}`);
     error.code = data.error || String(response.status);
+    error.status = response.status;
     error.item = data.item;
     throw error;
   }
@@ -194,17 +182,11 @@ async function synthesize(event) {
 // Follow a job's events. When the stream breaks, say so and keep asking until the server
 // answers: then either resume (same server) or explain that a restart lost the job.
 function follow(jobId) {
-  events = new EventSource(`/api/jobs/${jobId}/events`);
-  events.addEventListener('progress', (message) => { setConnection(''); showProgress(JSON.parse(message.data)); });
-  events.addEventListener('finished', (message) => {
-    stopFollowing();
-    setConnection('');
-    finish(JSON.parse(message.data));
+  events = streamEvents(`/api/jobs/${jobId}/events`, {
+    progress: (job) => { setConnection(''); showProgress(job); },
+    finished: (job) => { stopFollowing(); setConnection(''); finish(job); },
+    broken: () => { stopFollowing(); reconnect(jobId, 1); },
   });
-  events.onerror = () => {
-    stopFollowing();
-    reconnect(jobId, 1);
-  };
 }
 
 async function reconnect(jobId, attempt) {
@@ -214,7 +196,7 @@ async function reconnect(jobId, attempt) {
   try {
     job = await api('GET', `/api/jobs/${jobId}`);
   } catch (error) {
-    if (error.code === 'NOT_FOUND') {
+    if (error.status === 404) {
       setConnection('');
       currentJob = null;
       setRunning(false);
@@ -403,7 +385,7 @@ function showDownloads(job) {
   if (exportable) $('export-flexbe').href = `/api/jobs/${job.id}/artifacts/flexbe_behavior.zip`;
   $('downloads').replaceChildren(...job.artifacts.map((name) => element('li', {},
     element('a', { href: `/api/jobs/${job.id}/artifacts/${name}`, download: '', 'data-artifact': name,
-      text: DOWNLOAD_LABELS[name] || name }))));
+      text: job.download_labels[name] || name }))));
   $('downloads-section').hidden = job.artifacts.length === 0;
 }
 
@@ -463,14 +445,34 @@ async function simulate() {
     return;
   }
   showSimulation(simulation);
-  simulationEvents = new EventSource(`/api/simulations/${simulation.id}/events`);
-  simulationEvents.addEventListener('progress', (message) => showSimulation(JSON.parse(message.data)));
-  simulationEvents.addEventListener('finished', (message) => {
-    simulationEvents.close();
+  const end = () => {
     simulationEvents = null;
     $('simulate').disabled = false;
-    showSimulation(JSON.parse(message.data));
+  };
+  simulationEvents = streamEvents(`/api/simulations/${simulation.id}/events`, {
+    progress: showSimulation,
+    finished: (last) => { end(); showSimulation(last); },
+    // The stream broke (e.g. the server restarted): show what the server still knows, once.
+    broken: () => api('GET', `/api/simulations/${simulation.id}`).then(
+      (last) => { end(); showSimulation(last); },
+      (error) => { end(); $('simulation-status').textContent = `${error.code}: ${error.message}`; }),
   });
+}
+
+// The one reader of the server-sent events of jobs and simulations: `progress` with each
+// snapshot, `finished` with the last one, `broken` when the stream fails. Returns the EventSource.
+function streamEvents(url, handlers) {
+  const source = new EventSource(url);
+  source.addEventListener('progress', (message) => handlers.progress(JSON.parse(message.data)));
+  source.addEventListener('finished', (message) => {
+    source.close();
+    handlers.finished(JSON.parse(message.data));
+  });
+  source.onerror = () => {
+    source.close();
+    handlers.broken();
+  };
+  return source;
 }
 
 function showSimulation(simulation) {

@@ -44,7 +44,7 @@ from typing import Any, Dict, Mapping, Optional, Tuple
 
 import yaml
 
-from respec.abstraction import AbstractionConfigError, RobotAbstraction, abstraction_from_dict
+from respec.abstraction import RobotAbstraction, abstraction_from_document
 from respec.errors import CodedError
 
 class SimulationConfigError(CodedError, ValueError):
@@ -145,11 +145,9 @@ class SystemConfig:
     @classmethod
     def from_dict(cls, document: Mapping[str, Any]) -> "SystemConfig":
         system = str(document.get("system", "unnamed"))
-        if "abstraction" not in document:
-            raise AbstractionConfigError(f"{system}.yaml has no abstraction: section", item="abstraction")
         return cls(
             system=system,
-            abstraction=abstraction_from_dict(document["abstraction"], system),
+            abstraction=abstraction_from_document(document, system),
             simulation=SimulationConfig.from_dict(document.get("simulation")),
         )
 

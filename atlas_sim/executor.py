@@ -41,10 +41,13 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable, Protocol, Sequence
 
+from atlas_sim.config import load_system_config
+from atlas_sim.trace_check import OutcomeTracker, Trace, TraceStep
 from respec.abstraction import load_abstraction
 from respec.errors import CodedError
-from atlas_sim.trace_check import OutcomeTracker, Trace, TraceStep
 from respec.naming import ACTIVATION_SUFFIX, outcome_proposition
+from respec.systems import system_config_path
+from sm_generation.config import load_flexbe_config
 
 ROOT_PATH = '/'
 STATEMACHINE = ':STATEMACHINE'
@@ -180,9 +183,7 @@ def make_simulator(system: str = 'atlas', config_dir: str | Path | None = None, 
     config's) and actions that have already completed. ``faults`` (capability -> entry of
     ``simulation.faults``) are added to the config's, ``seed`` replaces its seed.
     """
-    from atlas_sim.config import load_system_config
-    from atlas_sim.simulator import AtlasSimulator
-    from respec.systems import system_config_path
+    from atlas_sim.simulator import AtlasSimulator  # here: importing the executor needs no MuJoCo
 
     config = load_system_config(system_config_path(system, config_dir))
     modes = [c for c in initial_conditions if c in config.abstraction.control_modes]
@@ -332,8 +333,6 @@ class StateMapping:
     """State class + parameter values (or behavior class) -> ``flexbe.states`` entry."""
 
     def __init__(self, system: str, config_dir: str | Path | None = None):
-        from sm_generation.config import load_flexbe_config
-
         self.flexbe = load_flexbe_config(system, config_dir)
         abstraction = load_abstraction(system, config_dir)
         self.control_modes = list(abstraction.control_modes)

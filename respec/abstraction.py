@@ -77,7 +77,11 @@ class RobotAbstraction:
 
 def load_abstraction(system: str, config_dir: str | Path | None = None) -> RobotAbstraction:
     """Load and validate the ``abstraction:`` section of ``config/<system>.yaml``."""
-    document = load_system_file(system, config_dir)
+    return abstraction_from_document(load_system_file(system, config_dir), system)
+
+
+def abstraction_from_document(document: dict, system: str) -> RobotAbstraction:
+    """The validated ``abstraction:`` section of a whole (parsed) system file."""
     if 'abstraction' not in document:
         raise AbstractionConfigError(f'{system}.yaml has no abstraction: section', item='abstraction')
     return abstraction_from_dict(document['abstraction'], system)

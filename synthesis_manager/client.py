@@ -7,6 +7,7 @@ import time
 from dataclasses import dataclass, field
 
 import yaml
+from rclpy.action import ActionClient
 
 from respec.naming import DEFAULT_SM_OUTCOMES
 from synthesis_manager.ros.conversions import error_name, flexbe_error_name, msg_to_sections, msg_to_state_dict
@@ -103,8 +104,6 @@ class SynthesisClient:
 
     def __init__(self, node, action_name: str = ACTION_NAME):
         """``action_name``: one of ACTIONS (its type), or any name served with BehaviorSynthesis."""
-        from rclpy.action import ActionClient
-
         self.node = node
         self.action_client = ActionClient(node, ACTIONS.get(action_name, BehaviorSynthesis), action_name)
 

@@ -10,6 +10,8 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
+from sm_generation import StateInstantiation
+from sm_generation.export import render, to_dot, to_json, to_yaml
 from synthesis_manager.send_goal import ProgressBar, add_goal_arguments, goal_from_args, print_summary
 from synthesis_manager.suite import SuiteUnavailable, add_suite_arguments, in_process_suite
 
@@ -23,9 +25,6 @@ def add_arguments(parser):
 
 def write_artifacts(outcome, directory: Path) -> list[Path]:
     """StateInstantiation YAML/JSON and pictures of the state machine (byproducts are already there)."""
-    from sm_generation import StateInstantiation
-    from sm_generation.export import render, to_dot, to_json, to_yaml
-
     states = [StateInstantiation.from_dict(s) for s in outcome.states]
     written = []
     for name, text in (('state_machine.yaml', to_yaml(states)), ('state_machine.json', to_json(states)),

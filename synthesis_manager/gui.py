@@ -9,6 +9,7 @@ environment's ROS_DOMAIN_ID (e.g. ``behavior-synthesis serve``). The page and it
 from __future__ import annotations
 
 import contextlib
+import os
 import socket
 import sys
 import threading
@@ -110,8 +111,6 @@ def background_server(app, host: str = '127.0.0.1', port: int = 0, startup_timeo
 
 
 def run(args) -> int:
-    import os
-
     os.environ.setdefault('MUJOCO_GL', 'egl')  # the simulation renders frames off-screen
     if args.host not in LOOPBACK_HOSTS:
         print(f'gui: warning: listening on {args.host}: other machines can reach the page and '

@@ -7,8 +7,14 @@ import sys
 import threading
 from pathlib import Path
 
+from rclpy.node import Node
+
+from respec.errors import CodedError
 from respec.naming import parse_names
+from respec.parsing import parse_structuredslugs
 from sm_generation.instantiation import count_states
+from synthesis_manager.client import SynthesisClient, make_flexbe_goal, make_goal
+from synthesis_manager.ros.harness import RosHarness, environment_domain_id
 from synthesis_manager.summary import spec_size, state_machine_tree
 
 
@@ -41,8 +47,6 @@ def add_arguments(parser):
 
 
 def goal_from_args(args):
-    from synthesis_manager.client import make_flexbe_goal, make_goal
-
     option, spec = None, None
     if getattr(args, 'compile_only', False):
         option = 'ltl_compilation_only'
@@ -68,8 +72,6 @@ def read_spec_file(path: str) -> dict:
     text = Path(path).read_text()
     if path.endswith('.json'):
         return json.loads(text)
-    from respec.parsing import parse_structuredslugs
-
     return parse_structuredslugs(text, filename=path).to_text_sections()
 
 
@@ -105,15 +107,11 @@ def print_summary(outcome, stream=sys.stdout):
 
 
 def run(args) -> int:
-    from synthesis_manager.client import SynthesisClient
-    from synthesis_manager.ros.harness import RosHarness, environment_domain_id
-
     try:
         goal = goal_from_args(args)
-    except Exception as error:
+    except (OSError, ValueError, CodedError) as error:
         print(f'send-goal: cannot read the request: {error}', file=sys.stderr)
         return 2
-    from rclpy.node import Node
 
     with RosHarness(domain_id=environment_domain_id()) as ros:
         client = SynthesisClient(ros.add_node(Node, 'behavior_synthesis_client'), args.action)

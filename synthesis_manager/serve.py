@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from respec.naming import parse_names
 from synthesis_manager.ros.node_main import run_nodes
 from synthesis_manager.suite import SUITE_NODE_NAMES, add_suite_arguments, suite_node_factories
 
@@ -13,7 +14,7 @@ def add_arguments(parser):
 
 
 def run(args) -> int:
-    names = [name for name in args.nodes.split(',') if name]
+    names = parse_names(args.nodes)
     unknown = sorted(set(names) - set(SUITE_NODE_NAMES))
     if unknown:
         print(f'behavior-synthesis serve: unknown node {unknown[0]!r}')

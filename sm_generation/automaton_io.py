@@ -36,7 +36,7 @@ def automaton_from_dict(data: dict, source: str = '<dict>') -> Automaton:
     for index, entry in enumerate(states):
         if not isinstance(entry, dict) or 'name' not in entry:
             raise AutomatonInvalidError(f'{source}: state #{index} needs a name',
-                                    f'automaton[{index}]')
+                                        f'automaton[{index}]')
         parsed.append(AutomatonState(
             name=str(entry['name']),
             output_valuation=list(entry.get('output_valuation', [])),
@@ -78,7 +78,7 @@ def load_automaton(path: str | Path, spec_path: str | Path | None = None) -> Aut
         data = json.loads(text) if path.suffix == '.json' else yaml.safe_load(text)
     except (json.JSONDecodeError, yaml.YAMLError) as error:
         raise AutomatonInvalidError(f'{path}: not valid YAML/JSON: {error}',
-                                str(path)) from error
+                                    str(path)) from error
     if isinstance(data, dict) and 'nodes' in data and 'variables' in data:
         return _automaton_from_strategy_file(data, path, spec_path)
     return automaton_from_dict(data, str(path))
@@ -87,13 +87,13 @@ def load_automaton(path: str | Path, spec_path: str | Path | None = None) -> Aut
 def _automaton_from_strategy_file(strategy: dict, path: Path, spec_path) -> Automaton:
     if spec_path is None:
         raise AutomatonInvalidError(f'{path} is a slugs strategy: give the '
-                                '.structuredslugs specification it was synthesized from', str(path))
+                                    '.structuredslugs specification it was synthesized from', str(path))
     spec_path = Path(spec_path)
     try:
         spec = parse_structuredslugs(spec_path.read_text(), filename=str(spec_path))
     except OSError as error:
         raise AutomatonInvalidError(f'cannot read {spec_path}: {error}',
-                                str(spec_path)) from error
+                                    str(spec_path)) from error
     except ParseError as error:
         raise AutomatonInvalidError(str(error), error.item) from error
     return automaton_from_strategy(strategy, spec)

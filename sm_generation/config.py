@@ -97,7 +97,7 @@ def load_flexbe_config(system: str, config_dir: str | Path | None = None) -> Fle
     """Load and validate the ``flexbe:`` section of ``config/<system>.yaml``."""
     if config_dir is not None and not Path(config_dir).is_dir():
         raise SystemConfigNotFoundError(f'configuration directory {config_dir} does not exist',
-                                str(config_dir))
+                                        str(config_dir))
     try:
         section = load_section(system, 'flexbe', config_dir)
     except UnknownSystemError as error:
@@ -115,15 +115,15 @@ def parse_flexbe_config(section: dict, system: str = '') -> FlexBEConfig:
     raw_states = section.get('states')
     if not isinstance(raw_states, dict) or not raw_states:
         raise FlexBEConfigInvalidError('flexbe.states must be a non-empty mapping of propositions to states',
-                                'flexbe.states')
+                                       'flexbe.states')
     states = {}
     for proposition, entry in raw_states.items():
         if not isinstance(proposition, str) or not proposition:
             raise StateConfigInvalidError(f'flexbe.states: invalid proposition name {proposition!r}',
-                                    f'flexbe.states.{proposition}')
+                                          f'flexbe.states.{proposition}')
         if proposition in sm_outcomes:
             raise StateConfigInvalidError(f'{proposition!r} is both an SM outcome and a state',
-                                    f'flexbe.states.{proposition}')
+                                          f'flexbe.states.{proposition}')
         states[proposition] = _state_config(proposition, entry)
     _check_unique_outcome_owners(states)
     packages = _packages(section.get('packages'))
@@ -158,7 +158,7 @@ def _sm_outcomes(raw) -> dict[str, str]:
     for proposition, outcome in raw.items():
         if not isinstance(proposition, str) or not isinstance(outcome, str) or not outcome:
             raise FlexBEConfigInvalidError(f'{key}.{proposition}: expected a non-empty outcome name, got {outcome!r}',
-                                    f'{key}.{proposition}')
+                                           f'{key}.{proposition}')
     return dict(raw)
 
 
@@ -186,12 +186,12 @@ def _state_config(proposition: str, entry) -> StateConfig:
     behavior_class = decl.get('behavior_class', '')
     if decl['name'] == BEHAVIOR_CLASS and (not isinstance(behavior_class, str) or not behavior_class):
         raise invalid(f'{where}.class_decl: a {BEHAVIOR_CLASS} needs behavior_class',
-                                f'{where}.class_decl.behavior_class')
+                      f'{where}.class_decl.behavior_class')
     names = _string_list(decl.get('param_names'), f'{where}.class_decl.param_names', invalid)
     values = _string_list(decl.get('param_values'), f'{where}.class_decl.param_values', invalid)
     if len(names) != len(values):
         raise invalid(f'{where}.class_decl: {len(names)} param_names but '
-                                f'{len(values)} param_values', f'{where}.class_decl.param_values')
+                      f'{len(values)} param_values', f'{where}.class_decl.param_values')
 
     output_mapping = _output_mapping(entry['output_mapping'], f'{where}.output_mapping')
     outcomes = [o for os in output_mapping.values() for o in os]
@@ -202,10 +202,10 @@ def _state_config(proposition: str, entry) -> StateConfig:
                              UserdataConfigInvalidError)
     if len(keys) != len(remapping):
         raise UserdataConfigInvalidError(f'{where}: {len(keys)} userdata_keys but '
-                                f'{len(remapping)} userdata_remapping', f'{where}.userdata_remapping')
+                                         f'{len(remapping)} userdata_remapping', f'{where}.userdata_remapping')
     if len(set(keys)) != len(keys):
         raise UserdataConfigInvalidError(f'{where}.userdata_keys lists a key twice',
-                                f'{where}.userdata_keys')
+                                         f'{where}.userdata_keys')
     return StateConfig(proposition=proposition, state_class=decl['name'],
                        behavior_class=behavior_class if decl['name'] == BEHAVIOR_CLASS else '',
                        parameter_names=names, parameter_values=values,
@@ -223,11 +223,11 @@ def _output_mapping(raw, where: str) -> dict[str, tuple[str, ...]]:
             outcomes = [outcomes]
         if not isinstance(outcomes, list) or not outcomes or not all(isinstance(o, str) and o for o in outcomes):
             raise invalid(f'{where}.{proposition}: expected a non-empty list of outcomes',
-                                    f'{where}.{proposition}')
+                          f'{where}.{proposition}')
         for outcome in outcomes:
             if outcome in seen:
                 raise invalid(f'{where}: outcome {outcome!r} means both '
-                                        f'{seen[outcome]!r} and {proposition!r}', f'{where}.{proposition}')
+                              f'{seen[outcome]!r} and {proposition!r}', f'{where}.{proposition}')
             seen[outcome] = proposition
         mapping[str(proposition)] = tuple(outcomes)
     return mapping
@@ -242,7 +242,7 @@ def _autonomy(raw, outcomes: list[str], where: str) -> dict[str, int]:
     if isinstance(raw, list):
         if len(raw) != len(outcomes):
             raise AutonomyConfigInvalidError(f'{where}: {len(raw)} levels for '
-                                    f'{len(outcomes)} outcomes {outcomes}', where)
+                                             f'{len(outcomes)} outcomes {outcomes}', where)
         return {outcome: level(value) for outcome, value in zip(outcomes, raw)}
     return {outcome: level(raw) for outcome in outcomes}
 
@@ -253,6 +253,6 @@ def _check_unique_outcome_owners(states: dict[str, StateConfig]) -> None:
         for proposition in state.output_mapping:
             if proposition in owners:
                 raise StateConfigInvalidError(f'outcome proposition {proposition!r} is mapped by both '
-                                        f'{owners[proposition]!r} and {state.proposition!r}',
-                                        f'flexbe.states.{state.proposition}.output_mapping.{proposition}')
+                                              f'{owners[proposition]!r} and {state.proposition!r}',
+                                              f'flexbe.states.{state.proposition}.output_mapping.{proposition}')
             owners[proposition] = state.proposition

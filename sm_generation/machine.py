@@ -97,16 +97,16 @@ class AutomatonView:
             if prop in config.sm_outcomes or prop in config.states or prop.endswith(MEMORY_SUFFIX):
                 continue
             if any(state.output_valuation[index] for state in self.states.values()):
-                raise StateConfigInvalidError(f'output proposition {prop!r} is activated by the automaton but has no entry '
-                    f'in flexbe.states of system {config.system!r}', prop)
+                raise StateConfigInvalidError(f'output proposition {prop!r} is activated by the automaton but has '
+                                              f'no entry in flexbe.states of system {config.system!r}', prop)
         for index, prop in enumerate(self.input_variables):
             if prop in config.states or config.owner_of_outcome(prop) is not None:
                 continue
             # Nothing in FlexBE reports it: harmless while it never changes, wrong otherwise.
             if any(state.input_valuation[index] != self.states[successor].input_valuation[index]
                    for state in self.states.values() for successor in state.transitions):
-                raise StateConfigInvalidError(f'input proposition {prop!r} changes in the automaton but no state in flexbe.states '
-                    f'of system {config.system!r} reports it', prop)
+                raise StateConfigInvalidError(f'input proposition {prop!r} changes in the automaton but no state in '
+                                              f'flexbe.states of system {config.system!r} reports it', prop)
 
     def _true_activations(self, state) -> tuple[str, ...]:
         true = {v for v, value in zip(self.output_variables, state.output_valuation) if value}
@@ -118,7 +118,7 @@ class AutomatonView:
                 if value and p in self.config.sm_outcomes]
         if len(true) > 1:
             raise AutomatonInvalidError(f'state {state.name!r} sets several SM '
-                                    f'outcomes at once: {", ".join(true)}', state.name)
+                                        f'outcomes at once: {", ".join(true)}', state.name)
         return self.config.sm_outcomes[true[0]] if true else None
 
     def inputs(self, name: str) -> dict[str, bool]:
@@ -138,8 +138,8 @@ class AutomatonView:
         for activation in activations:
             seen = [p for p in self.config.states[activation].output_mapping if now.get(p)]
             if len(seen) > 1:
-                raise InputValuationInvalidError(f'state {target!r} reports several outcomes of {activation!r} at once: '
-                    f'{", ".join(seen)}', target)
+                raise InputValuationInvalidError(f'state {target!r} reports several outcomes of {activation!r} '
+                                                 f'at once: {", ".join(seen)}', target)
             pairs.extend((activation, p) for p in seen)
         for sensor in self.sensor_props:
             if now[sensor] and not before[sensor]:
@@ -192,7 +192,7 @@ class AutomatonView:
         if self.observed_transitions(name):
             return ('state', name)  # waits for its sensors
         raise AutomatonInvalidError(f'state {name!r} activates nothing and no '
-                                'outcome or sensor ever leads out of it', name)
+                                    'outcome or sensor ever leads out of it', name)
 
     def _first_silent_exit(self, name: str) -> str | None:
         queue, seen = deque([name]), {name}
@@ -231,7 +231,7 @@ class AutomatonView:
         if not candidates:
             detail = f' with {", ".join(required)} true' if required else ''
             raise NoInitialStateError(f'no initial state{detail}: give Automaton.initial_states or a state '
-                                    'that activates nothing', ','.join(initial_conditions or []))
+                                      'that activates nothing', ','.join(initial_conditions or []))
         return candidates
 
     def _initial_condition_props(self, initial_conditions: list[str]) -> list[str]:
@@ -249,8 +249,9 @@ class AutomatonView:
                 continue
             state = self.config.states.get(condition + ACTIVATION_SUFFIX) or self.config.states.get(condition)
             if state is None:
-                raise InitialConditionsInvalidError(f'initial condition {condition!r} is neither a proposition of this '
-                                        f'automaton nor a state of system {self.config.system!r}', condition)
+                raise InitialConditionsInvalidError(
+                    f'initial condition {condition!r} is neither a proposition of this automaton nor a state '
+                    f'of system {self.config.system!r}', condition)
             completion = next(iter(state.output_mapping))
             if completion in self.input_variables:
                 props.append(completion)
@@ -261,11 +262,11 @@ def _variables(automaton, attribute: str) -> list[str]:
     values = getattr(automaton, attribute, None)
     if not isinstance(values, (list, tuple)) or not all(isinstance(v, str) for v in values):
         raise AutomatonInvalidError(f'automaton.{attribute} must be a list of names',
-                                attribute)
+                                    attribute)
     duplicates = sorted({v for v in values if list(values).count(v) > 1})
     if duplicates:
         raise AutomatonInvalidError(f'{attribute} lists {duplicates[0]!r} twice',
-                                duplicates[0])
+                                    duplicates[0])
     return list(values)
 
 
@@ -287,7 +288,7 @@ def _states(automaton, n_outputs: int, n_inputs: int) -> dict:
         for successor in state.transitions:
             if str(successor) not in by_name:
                 raise NextStateInvalidError(f'state {name!r} has a transition to unknown state {successor!r}',
-                                        str(successor))
+                                            str(successor))
     return {name: _normalized(state, name) for name, state in by_name.items()}
 
 

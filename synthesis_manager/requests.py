@@ -8,6 +8,8 @@ from dataclasses import dataclass
 from types import SimpleNamespace
 from typing import Any
 
+import yaml
+
 from respec.errors import CodedError
 from respec.naming import DEFAULT_SM_OUTCOMES, parse_names
 
@@ -101,8 +103,6 @@ def parse_synthesis_options(text: str) -> dict:
     mapping of option flags, ``timeout`` (seconds) and ``unordered_goals``. Anything else is an
     InvalidRequest naming the bad item.
     """
-    import yaml
-
     try:
         options = yaml.safe_load(text or '')
     except yaml.YAMLError as error:

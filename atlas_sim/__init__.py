@@ -21,6 +21,9 @@ Modules (MuJoCo is imported only by ``physics``, ``simulator``, ``rendering``)
 ``physics``     ``HumanoidPhysics``: model loading, targets, fall detection.
 ``simulator``   ``AtlasSimulator``, ``Request``, ``RequestResult``.
 ``rendering``   ``FrameRenderer``, ``KeyFrameRecorder``, ``save_png``.
+``executor``    runs a synthesized state machine on a robot (``execute_state_machine``).
+``trace_check`` checks an executed trace against the specification and the goal order.
+``closed_loop`` ``run_and_check``: execute, record key frames, check, draw the timeline.
 
 Typical use
 -----------

@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import ast
 import importlib
-import pkgutil
 import re
 from pathlib import Path
 
@@ -22,15 +21,14 @@ MSG_CONSTANTS = dict(re.findall(r'^int32 ([A-Z_]+) = (-?\d+)', (ROOT / 'synthesi
 
 def project_modules():
     """Every module of the project's packages (ROS package folders inside them excepted)."""
+    ros_folders = [path.parent for package in PACKAGES for path in (ROOT / package).rglob('package.xml')]
     names = []
     for package in PACKAGES:
-        names.append(package)
-        for info in pkgutil.walk_packages([str(ROOT / package)], prefix=f'{package}.'):
-            relative = Path(*info.name.split('.'))
-            if info.name.endswith('__main__') or any(
-                    (ROOT / Path(*relative.parts[:i]) / 'package.xml').exists() for i in range(1, len(relative.parts))):
+        for path in sorted((ROOT / package).rglob('*.py')):
+            if path.stem == '__main__' or any(folder in path.parents for folder in ros_folders):
                 continue
-            names.append(info.name)
+            parts = path.relative_to(ROOT).with_suffix('').parts
+            names.append('.'.join(parts[:-1] if parts[-1] == '__init__' else parts))
     return [importlib.import_module(name) for name in names]
 
 

@@ -138,16 +138,16 @@ def _packages(raw) -> dict:
     if raw is None:
         return {}
     if not isinstance(raw, dict) or set(raw) - {'states', 'state_classes', 'behaviors'}:
-        raise SMGenerationError('CONFIG_FILE_INVALID', f'{key} may only name states, state_classes and '
-                                f'behaviors, got {raw!r}', key)
+        raise FlexBEConfigInvalidError(f'{key} may only name states, state_classes and '
+                                       f'behaviors, got {raw!r}', key)
     for name in ('states', 'behaviors'):
         if name in raw and (not isinstance(raw[name], str) or not raw[name]):
-            raise SMGenerationError('CONFIG_FILE_INVALID', f'{key}.{name} must be a package name', f'{key}.{name}')
+            raise FlexBEConfigInvalidError(f'{key}.{name} must be a package name', f'{key}.{name}')
     classes = raw.get('state_classes', {})
     if not isinstance(classes, dict) or not all(isinstance(k, str) and isinstance(v, str) and v
                                                 for k, v in classes.items()):
-        raise SMGenerationError('CONFIG_FILE_INVALID', f'{key}.state_classes must map class names to packages',
-                                f'{key}.state_classes')
+        raise FlexBEConfigInvalidError(f'{key}.state_classes must map class names to packages',
+                                       f'{key}.state_classes')
     return raw
 
 

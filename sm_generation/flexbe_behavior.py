@@ -30,7 +30,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from sm_generation.config import FlexBEConfig
-from sm_generation.errors import SMGenerationError
+from sm_generation.errors import SMGenerationError, StateConfigInvalidError
 from sm_generation.generator import DECISION_CLASS, NOTHING_CLASS
 from sm_generation.instantiation import StateInstantiation
 from sm_generation.layout import container_outcome_positions
@@ -99,14 +99,14 @@ def state_module_name(state_class: str) -> str:
 
 def check_package_name(package: str) -> str:
     if not re.fullmatch(r'[a-z][a-z0-9_]*', package):
-        raise SMGenerationError('SM_GENERATION_FAILED', f'invalid ROS package name {package!r} '
+        raise SMGenerationError(f'invalid ROS package name {package!r} '
                                 '(lower case letters, digits and underscores, starting with a letter)', package)
     return package
 
 
 def check_behavior_name(name: str) -> str:
     if not re.search(r'[A-Za-z]', name) or not re.fullmatch(r'[\w ]+', name) or name[0].isdigit():
-        raise SMGenerationError('SM_GENERATION_FAILED', f'invalid behavior name {name!r} (letters, digits, '
+        raise SMGenerationError(f'invalid behavior name {name!r} (letters, digits, '
                                 'spaces and underscores, not starting with a digit)', name)
     return name
 
@@ -144,7 +144,7 @@ class _Machine:
     def __init__(self, states: list[StateInstantiation]):
         roots = [s for s in states if s.state_path == '/']
         if len(roots) != 1:
-            raise SMGenerationError('SM_GENERATION_FAILED', 'the state machine needs exactly one root entry '
+            raise SMGenerationError('the state machine needs exactly one root entry '
                                     f"(state_path '/'), found {len(roots)}", '/')
         self.root = roots[0]
         self.children: dict[str, list[StateInstantiation]] = {}
@@ -159,7 +159,7 @@ class _Machine:
         unsupported = [s for s in states if s.state_class in (StateInstantiation.CLASS_STATEMACHINE,
                                                              StateInstantiation.CLASS_PRIORITY) and s is not self.root]
         if unsupported:
-            raise SMGenerationError('SM_GENERATION_FAILED', f'{unsupported[0].state_class} containers inside '
+            raise SMGenerationError(f'{unsupported[0].state_class} containers inside '
                                     'the machine are not exported', unsupported[0].state_path)
 
     def containers(self) -> list[StateInstantiation]:
@@ -192,17 +192,17 @@ def _state_package(state_class: str, config: FlexBEConfig, path: str) -> str:
         return FLEXBE_STATES_PACKAGE
     package = config.state_package(state_class)
     if not package:
-        raise SMGenerationError('CONFIG_VARIABLE_CONFIG_INVALID', f'no FlexBE package for state class '
-                                f'{state_class!r}: name one in flexbe.packages of config/{config.system}.yaml',
-                                path)
+        raise StateConfigInvalidError(f'no FlexBE package for state class '
+                                      f'{state_class!r}: name one in flexbe.packages of config/{config.system}.yaml',
+                                      path)
     return package
 
 
 def _behavior_import(state: StateInstantiation, config: FlexBEConfig) -> str:
     if not config.behavior_package:
-        raise SMGenerationError('CONFIG_VARIABLE_CONFIG_INVALID', f'no FlexBE package for behavior '
-                                f'{state.behavior_class!r}: set flexbe.packages.behaviors of '
-                                f'config/{config.system}.yaml', state.state_path)
+        raise StateConfigInvalidError(f'no FlexBE package for behavior '
+                                      f'{state.behavior_class!r}: set flexbe.packages.behaviors of '
+                                      f'config/{config.system}.yaml', state.state_path)
     return (f'from {config.behavior_package}.{behavior_module_name(state.behavior_class)} '
             f'import {behavior_class_name(state.behavior_class)}')
 
@@ -291,7 +291,7 @@ def _container_definition(container: StateInstantiation, variable: str, machine:
                                                   zip(condition.state_name, condition.state_outcome)) + '])'
                   for outcome, condition in zip(container.cond_outcome, container.cond_transition)]
     if not conditions:
-        raise SMGenerationError('SM_GENERATION_FAILED', 'a concurrency container needs outcome conditions',
+        raise SMGenerationError('a concurrency container needs outcome conditions',
                                 container.state_path)
     outcome_positions = container_outcome_positions(len(container.outcomes))
     lines = [f'{body}# ' + ', '.join(f'x:{round(x)} y:{round(y)}' for x, y in outcome_positions),

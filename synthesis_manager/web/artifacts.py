@@ -103,8 +103,8 @@ ARTIFACTS = {
                                    lambda outcome, *_: (json.dumps(outcome['automaton'], indent=1) + '\n').encode()),
     'result.json': ArtifactKind('Whole result (JSON)', 'application/json', lambda outcome: True,
                                 lambda outcome, *_: (json.dumps(outcome, indent=1) + '\n').encode()),
-    'flexbe_behavior.zip': ArtifactKind('FlexBE behavior package (.zip, as export-behavior writes it)', 'application/zip',
-                                        _has_states, _flexbe_behavior),
+    'flexbe_behavior.zip': ArtifactKind('FlexBE behavior package (.zip, as export-behavior writes it)',
+                                        'application/zip', _has_states, _flexbe_behavior),
 }
 
 

@@ -1,7 +1,8 @@
-"""The GUI's request errors: each answers with an HTTP status and ``{"error", "item", "message"}``.
+"""The GUI's request errors: each answers with an HTTP status and
+``{"error", "code", "item", "message"}``.
 
-``error`` is the SynthesisErrorCodes name (``code``) like everywhere else; the HTTP status
-tells the kinds of bad request apart.
+``error`` names the kind of HTTP failure (``NOT_FOUND``, ...); ``code`` is the
+SynthesisErrorCodes name, as for every user-facing error.
 """
 
 from __future__ import annotations
@@ -13,32 +14,37 @@ class GuiRequestError(CodedError):
     """A request the GUI cannot serve; ``item`` names what was wrong."""
 
     status = 400
+    kind = 'BAD_REQUEST'
     code = 'INVALID_REQUEST'
 
     def to_dict(self) -> dict:
-        return {'error': self.code, 'item': self.item, 'message': str(self)}
+        return {'error': self.kind, 'code': self.code, 'item': self.item, 'message': str(self)}
 
 
 class NotFoundError(GuiRequestError):
     """An unknown system, job or artifact name."""
 
     status = 404
+    kind = 'NOT_FOUND'
 
 
 class InvalidJobRequestError(GuiRequestError):
     """A job request with a missing, mistyped or malformed field."""
 
     status = 422
+    kind = 'INVALID_REQUEST'
 
 
 class NotAvailableError(GuiRequestError):
     """The item exists but not in this state (e.g. no state machine to download yet)."""
 
     status = 409
+    kind = 'NOT_AVAILABLE'
 
 
 class ArtifactFailedError(GuiRequestError):
     """Building a download failed (e.g. Graphviz is not installed)."""
 
     status = 500
+    kind = 'ARTIFACT_FAILED'
     code = 'FAILURE'

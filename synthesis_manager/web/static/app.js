@@ -46,7 +46,6 @@ async function api(method, path, body) {
   if (!response.ok) {
     const error = new Error(data.message || `${response.status} ${response.statusText}`);
     error.code = data.error || String(response.status);
-    error.status = response.status;
     error.item = data.item;
     throw error;
   }
@@ -196,7 +195,7 @@ async function reconnect(jobId, attempt) {
   try {
     job = await api('GET', `/api/jobs/${jobId}`);
   } catch (error) {
-    if (error.status === 404) {
+    if (error.code === 'NOT_FOUND') {
       setConnection('');
       currentJob = null;
       setRunning(false);

@@ -1,0 +1,67 @@
+"""The bounds every entry point enforces on what it is sent (ROS-free).
+
+A request that breaks one is refused as INVALID_REQUEST naming the field, before any work is
+done, and the offending value is never echoed whole (a 50 MB name must not travel back in the
+error message). The ROS nodes check their requests with :func:`check_message`; the web GUI
+refuses larger bodies than :data:`MAX_BODY_BYTES` with 413.
+"""
+
+from __future__ import annotations
+
+import math
+
+from synthesis_manager.requests import InvalidRequest
+
+#: Longest string accepted in any request field, in UTF-8 bytes.
+MAX_STRING_BYTES = 64 * 1024
+#: Largest HTTP request body the web GUI reads.
+MAX_BODY_BYTES = 1024 * 1024
+#: How much of a refused value an error message quotes.
+QUOTED_CHARACTERS = 40
+
+
+def quote_start(text: str, length: int = QUOTED_CHARACTERS) -> str:
+    """``text`` quoted for an error message, cut after ``length`` characters."""
+    return repr(text) if len(text) <= length else repr(text[:length]) + '...'
+
+
+def check_timeout(value, item: str = 'timeout') -> float:
+    """A time limit in seconds: finite and >= 0 (0 means the server's default)."""
+    try:
+        seconds = float(value)
+    except (TypeError, ValueError):
+        raise InvalidRequest(f'{item} must be a number of seconds, got {quote_start(str(value))}') from None
+    if not math.isfinite(seconds) or seconds < 0:
+        raise InvalidRequest(f'{item} must be a finite number of seconds >= 0 (0: the default), '
+                             f'got {value!r}')
+    return seconds
+
+
+def utf8_length(text: str) -> int:
+    return len(text.encode('utf-8', errors='surrogatepass'))
+
+
+def oversized_strings(message, path: str = 'request', limit: int = MAX_STRING_BYTES):
+    """Yield ``(field path, string)`` for every string longer than ``limit`` bytes in a message.
+
+    ``message`` is a ROS message (anything with ``get_fields_and_field_types()``), a string,
+    or a sequence of those; nested messages and arrays are searched too.
+    """
+    if isinstance(message, str):
+        # A character takes at most 4 bytes: shorter strings need no encoding to be checked.
+        if len(message) * 4 > limit and utf8_length(message) > limit:
+            yield path, message
+    elif isinstance(message, (list, tuple)):
+        for index, element in enumerate(message):
+            if isinstance(element, str) or hasattr(element, 'get_fields_and_field_types'):
+                yield from oversized_strings(element, f'{path}[{index}]', limit)
+    elif hasattr(message, 'get_fields_and_field_types'):
+        for name in message.get_fields_and_field_types():
+            yield from oversized_strings(getattr(message, name), f'{path}.{name}', limit)
+
+
+def check_message(message, path: str = 'request', limit: int = MAX_STRING_BYTES):
+    """Refuse a message with an oversized string field, naming the first such field."""
+    for field_path, value in oversized_strings(message, path, limit):
+        raise InvalidRequest(f'{field_path} is {utf8_length(value)} bytes long; the limit is '
+                             f'{limit} bytes (it starts {quote_start(value)})')

@@ -1,0 +1,119 @@
+"""Pipeline service calls awaited from async execute callbacks, watched while they run.
+
+A goal's execute callback is a coroutine: while a stage's service works, it awaits instead
+of holding an executor thread, so any number of goals can wait side by side and the
+executor keeps serving (with blocking waits, 8 waiting goals on an 8-thread executor starved
+the very services they waited for). Each wait ends with the response, or as soon as one of
+these happens (checked at least every WATCH_PERIOD seconds):
+
+- the client cancels the goal              -> Preempted
+- the stage's time limit passes            -> StageFailed TIMEOUT
+- the server shuts down                    -> StageFailed BEHAVIOR_SYNTHESIS_FAILED
+- the node serving the stage goes away     -> StageFailed SERVICE_UNAVAILABLE naming it
+
+How the waiting works: rclpy's executor resumes every pending coroutine each time it wakes,
+and a node-wide watchdog timer wakes it every WATCH_PERIOD seconds; a coroutine waits by
+yielding once (:func:`next_executor_turn`) and then checks its conditions again.
+"""
+
+from __future__ import annotations
+
+import threading
+import time
+from typing import Callable
+
+from rclpy.callback_groups import ReentrantCallbackGroup
+
+WATCH_PERIOD = 0.1
+
+
+class StageFailed(Exception):
+    """A pipeline stage ended the goal; carries the error code name and message."""
+
+    def __init__(self, code: str, message: str):
+        super().__init__(message)
+        self.code = code
+
+
+class Preempted(Exception):
+    """The client cancelled the goal."""
+
+
+class _NextExecutorTurn:
+    def __await__(self):
+        yield
+
+
+def next_executor_turn() -> _NextExecutorTurn:
+    """Awaitable: give the executor back until it next wakes (a response, a timer tick...)."""
+    return _NextExecutorTurn()
+
+
+class StageCaller:
+    """Makes watched service calls for ``node``'s coroutines (see the module docstring)."""
+
+    def __init__(self, node, watch_period: float = WATCH_PERIOD):
+        self.node = node
+        self._stopping = threading.Event()
+        self._providers: dict[str, str] = {}
+        # The timer only wakes the executor; the waiting coroutines do the checking.
+        self._watchdog = node.create_timer(watch_period, lambda: None,
+                                           callback_group=ReentrantCallbackGroup())
+
+    def stop(self):
+        """Make every waiting call give up (at shutdown)."""
+        self._stopping.set()
+
+    async def call(self, client, request, stage: str, timeout: float, service_timeout: float,
+                   cancelled: Callable[[], bool] = lambda: False, on_cancel: Callable[[], None] | None = None):
+        """``client``'s response to ``request``, or one of the exceptions above."""
+        await self._wait_for_service(client, stage, service_timeout, cancelled)
+        provider = self._providers.get(client.srv_name) or self._find_provider(client.srv_name)
+        future = client.call_async(request)
+        deadline = time.monotonic() + timeout
+        while not future.done():
+            failure = None
+            if self._stopping.is_set():
+                failure = StageFailed('BEHAVIOR_SYNTHESIS_FAILED', f'{stage}: the server is shutting down')
+            elif cancelled():
+                failure = Preempted()
+            elif time.monotonic() > deadline:
+                failure = StageFailed('TIMEOUT', f'{stage}: no answer from {client.srv_name!r} '
+                                      f'within {timeout:g} s')
+            elif not client.service_is_ready():
+                self._providers.pop(client.srv_name, None)
+                failure = StageFailed('SERVICE_UNAVAILABLE', f'{stage}: node {provider!r} serving '
+                                      f'{client.srv_name!r} went away before answering')
+            if failure is not None:
+                client.remove_pending_request(future)
+                if on_cancel is not None and (isinstance(failure, Preempted) or failure.code == 'TIMEOUT'):
+                    on_cancel()  # tell the service to stop working for nobody
+                raise failure
+            await next_executor_turn()
+        return future.result()
+
+    async def _wait_for_service(self, client, stage: str, service_timeout: float, cancelled):
+        deadline = time.monotonic() + service_timeout
+        while not client.service_is_ready():
+            if self._stopping.is_set():
+                raise StageFailed('BEHAVIOR_SYNTHESIS_FAILED', f'{stage}: the server is shutting down')
+            if cancelled():
+                raise Preempted()
+            if time.monotonic() > deadline:
+                raise StageFailed('SERVICE_UNAVAILABLE', f'{stage}: service {client.srv_name!r} is not '
+                                  f'available (waited {service_timeout:g} s)')
+            await next_executor_turn()
+
+    def _find_provider(self, service_name: str) -> str:
+        """The full name of the node serving ``service_name`` (remembered until it goes away)."""
+        resolved = self.node.resolve_service_name(service_name)
+        for name, namespace in self.node.get_node_names_and_namespaces():
+            try:
+                services = self.node.get_service_names_and_types_by_node(name, namespace)
+            except Exception:  # the node left the graph meanwhile
+                continue
+            if any(service == resolved for service, _ in services):
+                full_name = f'{namespace.rstrip("/")}/{name}'
+                self._providers[service_name] = full_name
+                return full_name
+        return resolved

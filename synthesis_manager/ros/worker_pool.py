@@ -1,0 +1,79 @@
+"""Blocking work (a synthesis) run off the executor, awaited by async service callbacks.
+
+A service callback that synthesizes for a minute must not hold an executor thread: with a
+handful of them every thread is taken and cancel requests, other services and the action
+server wait. The callback instead hands the work to this pool and awaits it; the pool runs
+at most ``workers`` jobs at once, keeps up to ``max_waiting`` more in arrival order and
+refuses the rest (:class:`PoolFull`, reported as BUSY), so a burst is bounded.
+
+Worker threads are daemons: a synthesis that ignored its cancel event could otherwise keep
+the process alive after SIGTERM.
+"""
+
+from __future__ import annotations
+
+import queue
+import threading
+from concurrent.futures import Future
+
+from synthesis_manager.ros.stage_calls import next_executor_turn
+
+
+class PoolFull(Exception):
+    """Too many jobs are running or waiting."""
+
+    code = 'BUSY'
+
+
+class WorkerPool:
+    def __init__(self, workers: int, max_waiting: int, name: str = 'worker'):
+        if workers < 1 or max_waiting < 0:
+            raise ValueError('a worker pool needs workers >= 1 and max_waiting >= 0')
+        self.workers, self.max_waiting, self.name = workers, max_waiting, name
+        self._jobs: queue.SimpleQueue = queue.SimpleQueue()
+        self._lock = threading.Lock()
+        self._threads: list[threading.Thread] = []
+        self._outstanding = 0  # running + waiting
+
+    @property
+    def outstanding(self) -> int:
+        with self._lock:
+            return self._outstanding
+
+    def submit(self, function, *args) -> Future:
+        """Queue ``function(*args)``; raises PoolFull when the pool is at its limit."""
+        with self._lock:
+            if self._outstanding >= self.workers + self.max_waiting:
+                raise PoolFull(f'{self._outstanding} jobs are running or waiting (limit '
+                               f'{self.workers} running + {self.max_waiting} waiting); try again later')
+            self._outstanding += 1
+            if len(self._threads) < min(self.workers, self._outstanding):
+                thread = threading.Thread(target=self._work, name=f'{self.name}-{len(self._threads)}',
+                                          daemon=True)
+                self._threads.append(thread)
+                thread.start()
+        future: Future = Future()
+        self._jobs.put((future, function, args))
+        return future
+
+    async def run(self, function, *args, wake=None):
+        """Await ``function(*args)`` from a coroutine; ``wake()`` is called when it is done
+        (pass the executor's ``wake`` so the waiting callback resumes at once)."""
+        future = self.submit(function, *args)
+        if wake is not None:
+            future.add_done_callback(lambda _: wake())
+        while not future.done():
+            await next_executor_turn()
+        return future.result()
+
+    def _work(self):
+        while True:
+            future, function, args = self._jobs.get()
+            try:
+                if future.set_running_or_notify_cancel():
+                    future.set_result(function(*args))
+            except BaseException as error:  # handed to the awaiting callback
+                future.set_exception(error)
+            finally:
+                with self._lock:
+                    self._outstanding -= 1

@@ -1,0 +1,92 @@
+"""What the GUI refuses before any route sees a request (plain ASGI middleware, ROS-free).
+
+- A ``Host`` header other than the address the server listens on: 421. A web page from
+  another site that re-points its own name at 127.0.0.1 (DNS rebinding) still sends its own
+  name as Host, so it can no longer read the API. On a loopback address ``localhost`` is
+  accepted too.
+- A body over ``max_body_bytes`` (default 1 MB): 413, whether announced by Content-Length or
+  streamed in chunks; the body is never read further (a 50 MB name once cost 860 MB of RAM).
+"""
+
+from __future__ import annotations
+
+import json
+
+from synthesis_manager.limits import MAX_BODY_BYTES
+
+LOOPBACK_ADDRESSES = ('127.0.0.1', '::1')
+
+
+def accepted_hosts(server_host: str, server_port: int) -> set[str]:
+    """Host header values naming ``server_host:server_port``."""
+    names = {server_host}
+    if server_host in LOOPBACK_ADDRESSES:
+        names |= {'localhost', *LOOPBACK_ADDRESSES}
+    hosts = set()
+    for name in names:
+        shown = f'[{name}]' if ':' in name else name
+        hosts.add(f'{shown}:{server_port}'.lower())
+        if server_port == 80:
+            hosts.add(shown.lower())
+    return hosts
+
+
+class RequestGuard:
+    """ASGI middleware enforcing the Host check and the body size limit."""
+
+    def __init__(self, app, max_body_bytes: int = MAX_BODY_BYTES):
+        self.app = app
+        self.max_body_bytes = max_body_bytes
+
+    async def __call__(self, scope, receive, send):
+        if scope['type'] != 'http':
+            return await self.app(scope, receive, send)
+        headers = {name.decode('latin-1').lower(): value.decode('latin-1') for name, value in scope['headers']}
+        host = headers.get('host', '').lower()
+        server = scope.get('server')
+        if server is not None and host not in accepted_hosts(*server[:2]):
+            return await _refuse(send, 421, 'BAD_HOST', 'host',
+                                 f'this server answers only to {server[0]}:{server[1]}, not to Host '
+                                 f'{host[:100]!r}')
+        declared = headers.get('content-length', '')
+        if declared.isdigit() and int(declared) > self.max_body_bytes:
+            return await _refuse(send, 413, 'TOO_LARGE', 'body', self._too_large())
+        if scope['method'] not in ('POST', 'PUT', 'PATCH'):
+            return await self.app(scope, receive, send)
+        body = bytearray()
+        while True:
+            message = await receive()
+            if message['type'] != 'http.request':
+                return  # the client went away
+            body += message.get('body', b'')
+            if len(body) > self.max_body_bytes:
+                return await _refuse(send, 413, 'TOO_LARGE', 'body', self._too_large())
+            if not message.get('more_body', False):
+                break
+        return await self.app(scope, _replay(bytes(body), receive), send)
+
+    def _too_large(self) -> str:
+        return f'the request body is larger than {self.max_body_bytes} bytes'
+
+
+def _replay(body: bytes, receive):
+    """A ``receive`` that hands the already read body to the app, then the real channel."""
+    sent = False
+
+    async def replayed():
+        nonlocal sent
+        if not sent:
+            sent = True
+            return {'type': 'http.request', 'body': body, 'more_body': False}
+        return await receive()
+    return replayed
+
+
+async def _refuse(send, status: int, error: str, item: str, message: str):
+    """Answer with the GUI's error body ``{"error", "item", "message"}``."""
+    payload = json.dumps({'error': error, 'item': item, 'message': message}).encode()
+    await send({'type': 'http.response.start', 'status': status,
+                'headers': [(b'content-type', b'application/json'),
+                            (b'content-length', str(len(payload)).encode()),
+                            (b'connection', b'close')]})
+    await send({'type': 'http.response.body', 'body': payload})

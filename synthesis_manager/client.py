@@ -7,9 +7,9 @@ import time
 from dataclasses import dataclass, field
 
 import yaml
-from rclpy.action import ActionClient
 
 from respec.naming import DEFAULT_SM_OUTCOMES
+from synthesis_manager.ros.action_client import RaceFreeActionClient
 from synthesis_manager.ros.conversions import error_name, flexbe_error_name, msg_to_sections, msg_to_state_dict
 from synthesis_manager.ros.harness import wait_for
 from synthesis_msgs.action import BehaviorSynthesis, FlexBESynthesis
@@ -99,13 +99,27 @@ def outcome_from_result(result, seconds: float) -> SynthesisOutcome:
         automaton=automaton_to_dict(result.automaton), seconds=seconds)
 
 
+# Goal states after which the server has a result to give.
+_FINISHED_STATES = tuple(GOAL_STATUS_NAMES)
+# Ask for a result again this long after the status said the goal finished (or anyway
+# after RESULT_REQUEST_RETRY): a result request or its response can be lost.
+RESULT_GRACE = 5.0
+RESULT_REQUEST_RETRY = 10.0
+
+
 class SynthesisClient:
-    """Sends goals from a (spinning) node and waits for them in the calling thread."""
+    """Sends goals from a (spinning) node and waits for them in the calling thread.
+
+    Every accepted goal gets its result: the action client registers each request before
+    its response can arrive (rclpy#1123), and the result is asked for again when it is
+    overdue (the server keeps it for its ``result_retention``).
+    """
 
     def __init__(self, node, action_name: str = ACTION_NAME):
         """``action_name``: one of ACTIONS (its type), or any name served with BehaviorSynthesis."""
         self.node = node
-        self.action_client = ActionClient(node, ACTIONS.get(action_name, BehaviorSynthesis), action_name)
+        self.action_client = RaceFreeActionClient(node, ACTIONS.get(action_name, BehaviorSynthesis),
+                                                  action_name)
 
     def wait_for_server(self, timeout: float = 10.0) -> bool:
         return self.action_client.wait_for_server(timeout_sec=timeout)
@@ -119,18 +133,34 @@ class SynthesisClient:
                             timeout)
         if not handle.accepted:
             return SynthesisOutcome(-2, 'INVALID_REQUEST', 'the server rejected the goal')
-        result_future = handle.get_result_async()
         done = threading.Event()
-        result_future.add_done_callback(lambda _: done.set())
+        requests = []
+
+        def request_result():
+            future = self.action_client._get_result_async(handle)
+            future.add_done_callback(lambda _: done.set())
+            requests.append((future, time.monotonic()))
+
+        request_result()
         cancel_sent = False
+        finished_seen = None
         while not done.wait(0.02):
+            now = time.monotonic()
             if cancel is not None and cancel.is_set() and not cancel_sent:
                 handle.cancel_goal_async()
                 cancel_sent = True
-            if time.monotonic() - started > timeout:
+            if now - started > timeout:
                 handle.cancel_goal_async()
                 raise TimeoutError(f'no result within {timeout:g} s')
-        response = result_future.result()
+            if handle.status in _FINISHED_STATES and finished_seen is None:
+                finished_seen = now
+            last_request = requests[-1][1]
+            if ((finished_seen is not None and now - max(finished_seen, last_request) > RESULT_GRACE)
+                    or now - last_request > RESULT_REQUEST_RETRY):
+                request_result()
+        # Requests still pending are left to complete: dropping them would make their late
+        # responses "unexpected".
+        response = next(future.result() for future, _ in requests if future.done())
         outcome = outcome_from_result(response.result, time.monotonic() - started)
         outcome.goal_status = GOAL_STATUS_NAMES.get(response.status, str(response.status))
         return outcome

@@ -8,8 +8,10 @@ from rclpy.node import Node
 from ltl_specification import compile_task
 from respec.naming import DEFAULT_SM_OUTCOMES
 from synthesis_manager.ros.conversions import error_code, msg_to_sections, spec_to_msg
+from synthesis_manager.limits import check_message
 from synthesis_manager.ros.errors import reported_error
 from synthesis_manager.ros.node_main import node_main
+from synthesis_manager.ros.qos import service_qos
 from synthesis_msgs.srv import GenerateLTLSpecification
 
 
@@ -23,10 +25,11 @@ class LTLCompilationNode(Node):
         super().__init__('ltl_compilation', **kwargs)
         self.declare_parameter('config_dir', '')
         self.create_service(GenerateLTLSpecification, 'ltl_compilation', self.on_request,
-                            callback_group=ReentrantCallbackGroup())
+                            callback_group=ReentrantCallbackGroup(), qos_profile=service_qos())
 
     def on_request(self, request, response):
         try:
+            check_message(request)
             spec = compile_task(
                 request.system, list(request.initial_conditions), list(request.goals),
                 sm_outcomes=tuple(request.sm_outcomes) or DEFAULT_SM_OUTCOMES,

@@ -3,14 +3,17 @@ synthesis -> state machine generation.
 
 Both actions (the original BehaviorSynthesis and CNU's FlexBESynthesis, which FlexBE WebUI
 revisions send) are read into one SynthesisTask and run the same pipeline with the same cancel.
-Each stage is an asynchronous call to its service node. Waiting happens in the goal's own
-executor thread (MultiThreadedExecutor), so goals run side by side and the executor keeps
-serving; cancel requests are checked while waiting and forwarded to the synthesizer, which
-stops within about a second.
+Each stage is an asynchronous call to its service node, awaited by the goal's coroutine
+(synthesis_manager.ros.stage_calls): a waiting goal holds no executor thread, so any number
+of goals run side by side and the executor keeps serving. Cancel requests, the stage's time
+limit, shutdown and the stage's node going away end the wait; a cancel is forwarded to the
+synthesizer. Beyond ``max_active_goals`` goals at once, new goals are answered BUSY at once.
 """
 
 from __future__ import annotations
 
+import contextlib
+import functools
 import threading
 import time
 from dataclasses import dataclass, field, replace
@@ -26,6 +29,7 @@ from ltl_specification.initial_conditions import (asks_for_robot_state, detected
                                                   initial_conditions_from_robot_state)
 from respec.errors import INTERNAL_ERROR, CodedError
 from sm_generation.instantiation import count_states
+from synthesis_manager.limits import check_message, check_timeout
 from synthesis_manager.nodes.atlas_sim_node import STATE_TOPIC
 from synthesis_manager.requests import (InvalidRequest, SynthesisTask, task_from_behavior_synthesis,
                                         task_from_flexbe_synthesis)
@@ -33,41 +37,20 @@ from synthesis_manager.ros.conversions import (error_code, error_name, flexbe_er
                                                msg_to_sections)
 from synthesis_manager.ros.errors import log_internal_error
 from synthesis_manager.ros.node_main import node_main
+from synthesis_manager.ros.qos import action_server_qos, service_qos
 from synthesis_manager.ros.robot_state import RobotStateListener
+from synthesis_manager.ros.stage_calls import Preempted, ServerStopping, StageCaller, StageFailed
+from synthesis_manager.ros.worker_pool import WorkerPool
 from synthesis_msgs.action import BehaviorSynthesis, FlexBESynthesis
 from synthesis_msgs.msg import FSAutomaton, LTLSpecification
 from synthesis_msgs.srv import (CancelSynthesis, GenerateFlexBESM, GenerateLTLSpecification,
                                 SynthesizeAutomaton)
 
 
-class StageFailed(Exception):
-    """A pipeline service answered with an error: the goal ends with that answer."""
+class Busy(CodedError):
+    """Too many goals are in progress."""
 
-    def __init__(self, answer):
-        self.error_name = error_name(answer.value)
-        super().__init__(answer.message or self.error_name)
-
-
-class StageUnavailable(CodedError):
-    """A pipeline service is not there."""
-
-    code = 'SERVICE_UNAVAILABLE'
-
-
-class StageTimedOut(CodedError):
-    """A pipeline service did not answer in time."""
-
-    code = 'TIMEOUT'
-
-
-class ServerStopping(CodedError):
-    """The server shuts down while a goal waits on a stage."""
-
-    code = 'BEHAVIOR_SYNTHESIS_FAILED'
-
-
-class Preempted(Exception):
-    """The client cancelled the goal."""
+    code = 'BUSY'
 
 
 @dataclass
@@ -156,8 +139,10 @@ class BehaviorSynthesisServer(Node):
     to wait for a service to appear), ``compilation_timeout``, ``synthesis_timeout`` and
     ``generation_timeout`` (seconds per stage), ``diagnosis_timeout`` (seconds to find why an
     unrealizable task cannot be done), ``robot_state_topic`` (synthesis_msgs/RobotState, default
-    the simulator's ``atlas_sim/state``) and ``robot_state_timeout`` (seconds to wait for a state
-    when a request names no initial conditions, or ``current``: synthesis on the fly).
+    the simulator's ``atlas_sim/state``), ``robot_state_timeout`` (seconds to wait for a state
+    when a request names no initial conditions, or ``current``: synthesis on the fly),
+    ``max_active_goals`` (goals in progress at once, both actions together; more are answered
+    BUSY) and ``result_retention`` (seconds a finished goal's result stays available to its client).
     """
 
     def __init__(self, **kwargs):
@@ -171,24 +156,47 @@ class BehaviorSynthesisServer(Node):
         self.declare_parameter('robot_state_topic', STATE_TOPIC)
         self.declare_parameter('robot_state_timeout', 2.0)
         self.declare_parameter('flexbe_log_topic', 'flexbe/log')
+        self.declare_parameter('max_active_goals', 100)
+        self.declare_parameter('result_retention', 60.0)
         self._stopping = threading.Event()
+        self._active_goals = 0
+        self._lock = threading.Lock()
+        self.stages = StageCaller(self)
+        self.diagnoses = WorkerPool(workers=2, max_waiting=self.parameter('max_active_goals'), name='diagnosis')
         self.log_to_flexbe = flexbe_log_publisher(self, self.parameter('flexbe_log_topic'))
         group = ReentrantCallbackGroup()
-        self.compiler = self.create_client(GenerateLTLSpecification, 'ltl_compilation', callback_group=group)
-        self.synthesizer = self.create_client(SynthesizeAutomaton, 'ltl_synthesis', callback_group=group)
-        self.synthesis_cancel = self.create_client(CancelSynthesis, 'ltl_synthesis/cancel', callback_group=group)
-        self.generator = self.create_client(GenerateFlexBESM, 'sm_generate', callback_group=group)
+
+        def client(service_type, name):
+            return self.create_client(service_type, name, callback_group=group, qos_profile=service_qos())
+        self.compiler = client(GenerateLTLSpecification, 'ltl_compilation')
+        self.synthesizer = client(SynthesizeAutomaton, 'ltl_synthesis')
+        self.synthesis_cancel = client(CancelSynthesis, 'ltl_synthesis/cancel')
+        self.generator = client(GenerateFlexBESM, 'sm_generate')
         self.robot_state = RobotStateListener(self, self.parameter('robot_state_topic'), callback_group=group)
+        # rclpy keeps each result for result_timeout seconds (default 900: ~38 KB per goal).
         self.action_servers = [
             ActionServer(self, interface.action_type, interface.action_name,
-                         lambda goal_handle, interface=interface: self.execute(goal_handle, interface),
+                         self._executor_for(interface),
                          goal_callback=lambda _: GoalResponse.ACCEPT,
-                         cancel_callback=lambda _: CancelResponse.ACCEPT, callback_group=group)
+                         cancel_callback=lambda _: CancelResponse.ACCEPT, callback_group=group,
+                         result_timeout=max(1, round(self.parameter('result_retention'))),
+                         **action_server_qos())
             for interface in INTERFACES]
+
+    def _executor_for(self, interface):
+        """The execute callback of ``interface``'s action server (a coroutine function)."""
+        async def execute(goal_handle):
+            return await self.execute(goal_handle, interface)
+        return execute
 
     def stop_work(self):
         """Make goals that are waiting on a stage give up (at shutdown)."""
         self._stopping.set()
+        self.stages.stop()
+
+    def _wake_executor(self):
+        if self.executor is not None:
+            self.executor.wake()
 
     def destroy_node(self):
         for action_server in self.action_servers:
@@ -200,12 +208,15 @@ class BehaviorSynthesisServer(Node):
 
     # --- goal execution -----------------------------------------------------------------
 
-    def execute(self, goal_handle, interface: ActionInterface):
+    async def execute(self, goal_handle, interface: ActionInterface):
         feedback = FeedbackChannel(goal_handle, interface.action_type.Feedback)
         outcome = PipelineOutcome()
         try:
+            check_message(goal_handle.request, 'goal')
             task = interface.read_goal(goal_handle.request, self.parameter('default_system'))
-            self.run_pipeline(goal_handle, task, outcome, feedback)
+            check_timeout(task.timeout)
+            with self.admitted():
+                await self.run_pipeline(goal_handle, task, outcome, feedback)
         except Preempted:
             outcome.fail('PREEMPTED', 'cancelled by the client')
             goal_handle.canceled()
@@ -229,7 +240,22 @@ class BehaviorSynthesisServer(Node):
             goal_handle.abort()
         return interface.make_result(outcome)
 
-    def run_pipeline(self, goal_handle, task: SynthesisTask, outcome: PipelineOutcome, feedback):
+    @contextlib.contextmanager
+    def admitted(self):
+        """Count a goal in while it runs; raise Busy when max_active_goals are running."""
+        limit = self.parameter('max_active_goals')
+        with self._lock:
+            if self._active_goals >= limit:
+                raise Busy(f'the server is busy: {self._active_goals} goals in progress '
+                           f'(max_active_goals {limit}); try again later')
+            self._active_goals += 1
+        try:
+            yield
+        finally:
+            with self._lock:
+                self._active_goals -= 1
+
+    async def run_pipeline(self, goal_handle, task: SynthesisTask, outcome: PipelineOutcome, feedback):
         goal_id = bytes(goal_handle.goal_id.uuid).hex()
         spec_name = task.byproduct_stem or f'{task.system or "behavior"}_{goal_id[:8]}'
 
@@ -239,9 +265,9 @@ class BehaviorSynthesisServer(Node):
                                      'in request.ltl_specification')
             outcome.ltl_specification = task.custom_ltl
         else:
-            task = self.with_initial_conditions(goal_handle, task, outcome, feedback)
+            task = await self.with_initial_conditions(goal_handle, task, outcome, feedback)
             feedback('Compiling the LTL specification', 0.05)
-            compiled = self.call(goal_handle, self.compiler, GenerateLTLSpecification.Request(
+            compiled = await self.call(goal_handle, self.compiler, GenerateLTLSpecification.Request(
                 system=task.system, goals=task.goals, initial_conditions=task.initial_conditions,
                 sm_outcomes=task.sm_outcomes, custom_ltl=task.custom_ltl or LTLSpecification(),
                 unordered_goals=task.unordered_goals),
@@ -254,17 +280,19 @@ class BehaviorSynthesisServer(Node):
 
         feedback('Synthesizing an automaton', 0.4)
         timeout = task.timeout or self.parameter('synthesis_timeout')
-        synthesized = self.call(goal_handle, self.synthesizer, SynthesizeAutomaton.Request(
+        synthesized = await self.call(goal_handle, self.synthesizer, SynthesizeAutomaton.Request(
             ltl_specification=outcome.ltl_specification, spec_name=spec_name,
             timeout=float(timeout), request_id=goal_id),
             'LTL synthesis', timeout + 5.0, on_cancel=lambda: self.cancel_synthesis(goal_id))
         if task.option != 'ltl_synthesis_only' and error_name(synthesized.error_code.value) == 'SPEC_UNSYNTHESIZABLE':
             feedback('Diagnosing why the task cannot be done', 0.6)
             custom_ltl = msg_to_sections(task.custom_ltl) if task.custom_ltl is not None else None
-            synthesized.error_code.message = explain_unsynthesizable(
-                synthesized.error_code.message, task.system, task.initial_conditions, task.goals,
-                task.sm_outcomes, not task.unordered_goals, custom_ltl or None,
-                deadline=time.monotonic() + self.parameter('diagnosis_timeout'))
+            # CPU work of up to diagnosis_timeout: in a worker, so the executor keeps serving.
+            synthesized.error_code.message = await self.diagnoses.run(functools.partial(
+                explain_unsynthesizable, synthesized.error_code.message, task.system,
+                task.initial_conditions, task.goals, task.sm_outcomes, not task.unordered_goals,
+                custom_ltl or None, deadline=time.monotonic() + self.parameter('diagnosis_timeout')),
+                wake=self._wake_executor)
         self.check(synthesized.error_code)
         outcome.automaton = synthesized.automaton
         feedback(f'Synthesized an automaton with {len(outcome.automaton.automaton)} states', 2 / 3)
@@ -272,7 +300,7 @@ class BehaviorSynthesisServer(Node):
             return
 
         feedback('Generating the state machine', 0.7)
-        generated = self.call(goal_handle, self.generator, GenerateFlexBESM.Request(
+        generated = await self.call(goal_handle, self.generator, GenerateFlexBESM.Request(
             automaton=outcome.automaton, system=task.system,
             initial_conditions=task.initial_conditions),
             'state machine generation', self.parameter('generation_timeout'))
@@ -280,14 +308,14 @@ class BehaviorSynthesisServer(Node):
         outcome.states = list(generated.state_definition)
         feedback(f'Generated a state machine with {count_states(outcome.states)} states', 1.0)
 
-    def with_initial_conditions(self, goal_handle, task: SynthesisTask, outcome: PipelineOutcome,
+    async def with_initial_conditions(self, goal_handle, task: SynthesisTask, outcome: PipelineOutcome,
                                 feedback) -> SynthesisTask:
         """``task``, with the robot's initial conditions when it names none or ``current``."""
         if not asks_for_robot_state(task.initial_conditions):
             return task
         topic, timeout = self.robot_state.topic, self.parameter('robot_state_timeout')
         feedback(f'Reading the initial conditions from {topic}', 0.02)
-        state = self.robot_state.next_state(
+        state = await self.robot_state.next_state_async(
             timeout, should_stop=lambda: goal_handle.is_cancel_requested or self._stopping.is_set())
         if goal_handle.is_cancel_requested:
             raise Preempted()
@@ -307,29 +335,10 @@ class BehaviorSynthesisServer(Node):
         if code.value != code.SUCCESS:
             raise StageFailed(code)
 
-    def call(self, goal_handle, client, request, stage: str, timeout: float, on_cancel=None):
-        """Call a service asynchronously; wait while watching for cancel and the time limit."""
-        if not client.wait_for_service(timeout_sec=self.parameter('service_timeout')):
-            raise StageUnavailable(f'{stage}: service {client.srv_name!r} is not available', client.srv_name)
-        future = client.call_async(request)
-        done = threading.Event()
-        future.add_done_callback(lambda _: done.set())
-        deadline = time.monotonic() + timeout
-        while not done.wait(0.02):
-            if self._stopping.is_set():
-                raise ServerStopping(f'{stage}: the server is shutting down', stage)
-            if goal_handle.is_cancel_requested:
-                if on_cancel:
-                    on_cancel()
-                client.remove_pending_request(future)
-                raise Preempted()
-            if time.monotonic() > deadline:
-                if on_cancel:
-                    on_cancel()
-                client.remove_pending_request(future)
-                raise StageTimedOut(f'{stage}: no answer from {client.srv_name!r} within {timeout:g} s',
-                                    client.srv_name)
-        return future.result()
+    async def call(self, goal_handle, client, request, stage: str, timeout: float, on_cancel=None):
+        """Call a stage's service; wait watching for cancel, time limit, shutdown and the node."""
+        return await self.stages.call(client, request, stage, timeout, self.parameter('service_timeout'),
+                                      cancelled=lambda: goal_handle.is_cancel_requested, on_cancel=on_cancel)
 
     def cancel_synthesis(self, goal_id: str):
         """Tell the synthesizer to stop this goal's synthesis (fire and forget)."""

@@ -7,8 +7,10 @@ from rclpy.node import Node
 
 from sm_generation import generate_state_machine
 from synthesis_manager.ros.conversions import error_code, msg_to_automaton, state_to_msg
+from synthesis_manager.limits import check_message
 from synthesis_manager.ros.errors import reported_error
 from synthesis_manager.ros.node_main import node_main
+from synthesis_manager.ros.qos import service_qos
 from synthesis_msgs.srv import GenerateFlexBESM
 
 
@@ -24,10 +26,11 @@ class SMGenerationNode(Node):
         self.declare_parameter('config_dir', '')
         self.declare_parameter('reduce', False)
         self.create_service(GenerateFlexBESM, 'sm_generate', self.on_request,
-                            callback_group=ReentrantCallbackGroup())
+                            callback_group=ReentrantCallbackGroup(), qos_profile=service_qos())
 
     def on_request(self, request, response):
         try:
+            check_message(request)
             states = generate_state_machine(
                 msg_to_automaton(request.automaton), request.system,
                 config_dir=self.get_parameter('config_dir').value or None,

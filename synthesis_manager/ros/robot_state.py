@@ -11,6 +11,7 @@ from __future__ import annotations
 import threading
 import time
 
+from synthesis_manager.ros.stage_calls import next_executor_turn
 from synthesis_msgs.msg import RobotState
 
 
@@ -42,3 +43,17 @@ class RobotStateListener:
                     return None
                 self._changed.wait(min(remaining, 0.02))
             return self._latest
+
+    async def next_state_async(self, timeout: float, should_stop=lambda: False) -> RobotState | None:
+        """:meth:`next_state` for coroutines (async execute callbacks): checks at each executor
+        turn instead of blocking an executor thread."""
+        deadline = time.monotonic() + timeout
+        with self._changed:
+            seen = self._received
+        while True:
+            with self._changed:
+                if self._received != seen:
+                    return self._latest
+            if time.monotonic() > deadline or should_stop():
+                return None
+            await next_executor_turn()

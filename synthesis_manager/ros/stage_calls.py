@@ -7,9 +7,9 @@ the very services they waited for). Each wait ends with the response, or as soon
 these happens (checked at least every WATCH_PERIOD seconds):
 
 - the client cancels the goal              -> Preempted
-- the stage's time limit passes            -> StageFailed TIMEOUT
-- the server shuts down                    -> StageFailed BEHAVIOR_SYNTHESIS_FAILED
-- the node serving the stage goes away     -> StageFailed SERVICE_UNAVAILABLE naming it
+- the stage's time limit passes            -> StageTimedOut (TIMEOUT)
+- the server shuts down                    -> ServerStopping (BEHAVIOR_SYNTHESIS_FAILED)
+- the node serving the stage goes away     -> StageUnavailable (SERVICE_UNAVAILABLE) naming it
 
 How the waiting works: rclpy's executor resumes every pending coroutine each time it wakes,
 and a node-wide watchdog timer wakes it every WATCH_PERIOD seconds; a coroutine waits by
@@ -24,15 +24,36 @@ from typing import Callable
 
 from rclpy.callback_groups import ReentrantCallbackGroup
 
+from respec.errors import CodedError
+from synthesis_manager.ros.conversions import error_name
+
 WATCH_PERIOD = 0.1
 
 
 class StageFailed(Exception):
-    """A pipeline stage ended the goal; carries the error code name and message."""
+    """A pipeline service answered with an error: the goal ends with that answer."""
 
-    def __init__(self, code: str, message: str):
-        super().__init__(message)
-        self.code = code
+    def __init__(self, answer):
+        self.error_name = error_name(answer.value)
+        super().__init__(answer.message or self.error_name)
+
+
+class StageUnavailable(CodedError):
+    """A pipeline service is not there, or its node went away while working."""
+
+    code = 'SERVICE_UNAVAILABLE'
+
+
+class StageTimedOut(CodedError):
+    """A pipeline service did not answer in time."""
+
+    code = 'TIMEOUT'
+
+
+class ServerStopping(CodedError):
+    """The server shuts down while a goal waits on a stage."""
+
+    code = 'BEHAVIOR_SYNTHESIS_FAILED'
 
 
 class Preempted(Exception):
@@ -74,16 +95,17 @@ class StageCaller:
         while not future.done():
             failure = None
             if self._stopping.is_set():
-                failure = StageFailed('BEHAVIOR_SYNTHESIS_FAILED', f'{stage}: the server is shutting down')
+                failure = ServerStopping(f'{stage}: the server is shutting down', stage)
             elif cancelled():
                 failure = Preempted()
             elif time.monotonic() > deadline:
-                failure = StageFailed('TIMEOUT', f'{stage}: no answer from {client.srv_name!r} '
-                                      f'within {timeout:g} s')
+                failure = StageTimedOut(f'{stage}: no answer from {client.srv_name!r} within {timeout:g} s',
+                                        client.srv_name)
             elif not client.service_is_ready():
                 self._providers.pop(client.srv_name, None)
-                failure = StageFailed('SERVICE_UNAVAILABLE', f'{stage}: node {provider!r} serving '
-                                      f'{client.srv_name!r} went away before answering')
+                failure = StageUnavailable(f'{stage}: node {provider!r} (service '
+                                           f'{self.node.resolve_service_name(client.srv_name)!r}) went '
+                                           'away before answering', provider)
             if failure is not None:
                 client.remove_pending_request(future)
                 if on_cancel is not None and (isinstance(failure, Preempted) or failure.code == 'TIMEOUT'):
@@ -96,12 +118,12 @@ class StageCaller:
         deadline = time.monotonic() + service_timeout
         while not client.service_is_ready():
             if self._stopping.is_set():
-                raise StageFailed('BEHAVIOR_SYNTHESIS_FAILED', f'{stage}: the server is shutting down')
+                raise ServerStopping(f'{stage}: the server is shutting down', stage)
             if cancelled():
                 raise Preempted()
             if time.monotonic() > deadline:
-                raise StageFailed('SERVICE_UNAVAILABLE', f'{stage}: service {client.srv_name!r} is not '
-                                  f'available (waited {service_timeout:g} s)')
+                raise StageUnavailable(f'{stage}: service {client.srv_name!r} is not available '
+                                       f'(waited {service_timeout:g} s)', client.srv_name)
             await next_executor_turn()
 
     def _find_provider(self, service_name: str) -> str:

@@ -16,10 +16,11 @@ import queue
 import threading
 from concurrent.futures import Future
 
+from respec.errors import CodedError
 from synthesis_manager.ros.stage_calls import next_executor_turn
 
 
-class PoolFull(Exception):
+class PoolFull(CodedError):
     """Too many jobs are running or waiting."""
 
     code = 'BUSY'
@@ -45,7 +46,8 @@ class WorkerPool:
         with self._lock:
             if self._outstanding >= self.workers + self.max_waiting:
                 raise PoolFull(f'{self._outstanding} jobs are running or waiting (limit '
-                               f'{self.workers} running + {self.max_waiting} waiting); try again later')
+                               f'{self.workers} running + {self.max_waiting} waiting); try again later',
+                               self.name)
             self._outstanding += 1
             if len(self._threads) < min(self.workers, self._outstanding):
                 thread = threading.Thread(target=self._work, name=f'{self.name}-{len(self._threads)}',

@@ -23,8 +23,8 @@ from respec.naming import DEFAULT_SM_OUTCOMES, FINISHED
 from respec.parsing import spec_from_text_sections
 from respec.systems import SystemConfigError, available_systems, load_section
 from synthesis_manager.web.artifacts import ARTIFACTS, Artifact
-from synthesis_manager.web.errors import (ArtifactFailedError, InvalidJobRequestError, NotAvailableError,
-                                          NotFoundError)
+from synthesis_manager.web.errors import (ArtifactFailedError, BusyError, InvalidJobRequestError,
+                                          NotAvailableError, NotFoundError)
 from synthesis_manager.web.jobs import JOB_OPTIONS, Job, JobRequest, local_outcome, names_field
 from synthesis_manager.web.simulations import Simulation, simulation_available
 
@@ -45,10 +45,11 @@ class SynthesisBackend:
     """
 
     def __init__(self, run_goal: GoalRunner, config_dir: str | Path | None = None,
-                 max_jobs: int = 100, description: str = ''):
+                 max_jobs: int = 100, max_unfinished_jobs: int = 50, description: str = ''):
         self.run_goal = run_goal
         self.config_dir = config_dir or None
         self.max_jobs = max_jobs
+        self.max_unfinished_jobs = max_unfinished_jobs
         self.description = description
         self.job_gate = threading.Event()
         self.job_gate.set()
@@ -121,6 +122,10 @@ class SynthesisBackend:
         request = JobRequest.from_json(body, self.systems())
         job = Job(id=f'{next(self._counter)}-{uuid.uuid4().hex[:8]}', request=request)
         with self._lock:
+            unfinished = sum(1 for other in self._jobs.values() if not other.finished)
+            if unfinished >= self.max_unfinished_jobs:
+                raise BusyError(f'{unfinished} jobs are unfinished (at most {self.max_unfinished_jobs}); '
+                                'try again when one has finished', 'jobs')
             self._jobs[job.id] = job
             self._forget_old_jobs()
         threading.Thread(target=self._work, args=(job,), name=f'gui-job-{job.id}', daemon=True).start()

@@ -48,3 +48,11 @@ class ArtifactFailedError(GuiRequestError):
     status = 500
     kind = 'ARTIFACT_FAILED'
     code = 'FAILURE'
+
+
+class BusyError(GuiRequestError):
+    """Too many jobs are unfinished: the request is refused, try again later."""
+
+    status = 503
+    kind = 'BUSY'
+    code = 'BUSY'

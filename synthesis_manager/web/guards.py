@@ -83,8 +83,8 @@ def _replay(body: bytes, receive):
 
 
 async def _refuse(send, status: int, error: str, item: str, message: str):
-    """Answer with the GUI's error body ``{"error", "item", "message"}``."""
-    payload = json.dumps({'error': error, 'item': item, 'message': message}).encode()
+    """Answer with the GUI's error body ``{"error", "code", "item", "message"}``."""
+    payload = json.dumps({'error': error, 'code': 'INVALID_REQUEST', 'item': item, 'message': message}).encode()
     await send({'type': 'http.response.start', 'status': status,
                 'headers': [(b'content-type', b'application/json'),
                             (b'content-length', str(len(payload)).encode()),

@@ -18,7 +18,9 @@
     GET  /api/simulations/{id}/frames/{n}    key frame n (PNG); .../timeline.png the timeline plot
 
 Bad input is answered with a 4xx JSON body ``{"error", "item", "message"}`` whose ``item``
-names the offending system, field, job or artifact; the server keeps serving.
+names the offending system, field, job or artifact; the server keeps serving. Requests with
+a foreign Host header (421) or a body over 1 MB (413) are refused first (web.guards); a new
+job while too many are unfinished is 503 BUSY.
 
 The backend does the work: :class:`synthesis_manager.web.backend.SynthesisBackend` keeps
 the jobs, validates requests and builds the downloads; the synthesis itself is a
@@ -41,6 +43,7 @@ from fastapi.staticfiles import StaticFiles
 
 from synthesis_manager.web.artifacts import Artifact
 from synthesis_manager.web.errors import GuiRequestError, InvalidJobRequestError, NotFoundError
+from synthesis_manager.web.guards import RequestGuard
 
 STATIC_DIR = Path(__file__).with_name('static')
 
@@ -50,6 +53,7 @@ def create_app(backend) -> FastAPI:
     # No Swagger/ReDoc pages: they load third-party code from a CDN. The schema stays available.
     app = FastAPI(title='Behavior synthesis', docs_url=None, redoc_url=None, openapi_url='/api/openapi.json')
     app.mount('/static', StaticFiles(directory=STATIC_DIR), name='static')
+    app.add_middleware(RequestGuard)  # Host check and the body size limit, before any route
 
     @app.exception_handler(GuiRequestError)
     async def gui_error(_request, error: GuiRequestError):

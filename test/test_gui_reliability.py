@@ -1,0 +1,118 @@
+"""The web GUI under load and against hostile requests (real uvicorn, in-process suite)."""
+
+import http.client
+import json
+import time
+import urllib.parse
+from concurrent.futures import ThreadPoolExecutor
+
+import pytest
+
+from synthesis_manager.cli import build_parser
+from synthesis_manager.gui import background_server, ros_backend
+from synthesis_manager.limits import MAX_BODY_BYTES
+from synthesis_manager.web.routes import create_app
+
+PAPER_TASK = {'system': 'atlas', 'initial_conditions': ['stand_prep'], 'goals': ['look_down', 'pickup_object']}
+
+
+@pytest.fixture(scope='module')
+def gui(tmp_path_factory):
+    """(backend, base URL) of a GUI whose suite runs in this process."""
+    args = build_parser(only='gui').parse_args(
+        ['gui', '--byproducts-dir', str(tmp_path_factory.mktemp('gui-reliability')),
+         '--synthesis-timeout', '60', '--goal-timeout', '120'])
+    with ros_backend(args) as backend:
+        with background_server(create_app(backend)) as url:
+            yield backend, url
+
+
+def request(url, method, path, body=None, headers=None, chunks=None):
+    """One HTTP request; returns (status, decoded JSON or None)."""
+    parts = urllib.parse.urlsplit(url)
+    connection = http.client.HTTPConnection(parts.hostname, parts.port, timeout=60)
+    try:
+        if chunks is not None:
+            connection.putrequest(method, path)
+            for name, value in (headers or {}).items():
+                connection.putheader(name, value)
+            connection.putheader('Transfer-Encoding', 'chunked')
+            connection.putheader('Content-Type', 'application/json')
+            connection.endheaders()
+            try:
+                for chunk in chunks:
+                    connection.send(b'%x\r\n%s\r\n' % (len(chunk), chunk))
+                connection.send(b'0\r\n\r\n')
+            except (BrokenPipeError, ConnectionResetError):
+                pass  # the server answered and closed before reading it all
+        else:
+            data = None if body is None else (body if isinstance(body, bytes) else json.dumps(body).encode())
+            connection.request(method, path, body=data,
+                               headers={'Content-Type': 'application/json', **(headers or {})})
+        response = connection.getresponse()
+        payload = response.read()
+        return response.status, json.loads(payload) if payload.startswith(b'{') else None
+    finally:
+        connection.close()
+
+
+def wait_until_finished(url, job_id, timeout=180.0):
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        status, job = request(url, 'GET', f'/api/jobs/{job_id}')
+        assert status == 200
+        if job['state'] == 'finished':
+            return job
+        time.sleep(0.2)
+    raise AssertionError(f'job {job_id} unfinished after {timeout} s')
+
+
+def test_twenty_jobs_at_once_all_finish(gui):
+    _, url = gui
+    with ThreadPoolExecutor(20) as pool:
+        started = list(pool.map(lambda i: request(url, 'POST', '/api/jobs', {**PAPER_TASK, 'name': f'job{i}'}),
+                                range(20)))
+        assert [status for status, _ in started] == [202] * 20
+        finished = list(pool.map(lambda answer: wait_until_finished(url, answer[1]['id']), started))
+    assert [job['outcome']['error_name'] for job in finished] == ['SUCCESS'] * 20
+    assert all(job['summary']['state_machine_states'] > 0 for job in finished)
+
+
+def test_jobs_beyond_the_limit_are_busy(gui):
+    backend, url = gui
+    backend.job_gate.clear()  # new jobs wait unsent, so they stay unfinished
+    limit = backend.max_unfinished_jobs
+    try:
+        backend.max_unfinished_jobs = 3
+        ids = [request(url, 'POST', '/api/jobs', PAPER_TASK)[1]['id'] for _ in range(3)]
+        status, error = request(url, 'POST', '/api/jobs', PAPER_TASK)
+        assert status == 503
+        assert error['error'] == 'BUSY'
+    finally:
+        backend.max_unfinished_jobs = limit
+        for job_id in ids:
+            request(url, 'POST', f'/api/jobs/{job_id}/cancel')
+        backend.job_gate.set()
+    assert all(wait_until_finished(url, job_id)['outcome']['error_name'] == 'PREEMPTED' for job_id in ids)
+
+
+def test_bodies_over_a_megabyte_are_refused(gui):
+    _, url = gui
+    big = json.dumps({**PAPER_TASK, 'name': 'x' * (MAX_BODY_BYTES + 10)}).encode()
+    status, error = request(url, 'POST', '/api/jobs', big)
+    assert status == 413
+    assert error['error'] == 'TOO_LARGE'
+    status, error = request(url, 'POST', '/api/jobs', chunks=[b'{"name": "' + b'x' * 65536] * 20)
+    assert status == 413
+    assert request(url, 'GET', '/api/systems')[0] == 200  # and it keeps serving
+
+
+def test_a_foreign_host_header_is_refused(gui):
+    _, url = gui
+    port = urllib.parse.urlsplit(url).port
+    for host in (f'evil.example:{port}', 'evil.example', f'127.0.0.1:{port + 1}'):
+        status, error = request(url, 'GET', '/api/systems', headers={'Host': host})
+        assert status == 421, host
+        assert error['error'] == 'BAD_HOST'
+    for host in (f'127.0.0.1:{port}', f'localhost:{port}'):
+        assert request(url, 'GET', '/api/systems', headers={'Host': host})[0] == 200

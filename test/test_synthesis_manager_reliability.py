@@ -1,0 +1,234 @@
+"""Reliability of the ROS suite: bursts, BUSY, fairness, lost goals, killed nodes, bad input, byproducts.
+
+Figures for bigger runs (50 goals to ``serve``, 20 GUI jobs, a 2,000-goal soak with its RSS
+slope) are printed by bench/bench_reliability.py.
+"""
+
+import math
+import os
+import signal
+import subprocess
+import sys
+import threading
+import time
+from argparse import Namespace
+from collections import Counter
+from pathlib import Path
+
+import pytest
+from rclpy.node import Node
+from rclpy.parameter import Parameter
+
+from synthesis_manager.client import SynthesisClient, make_goal
+from synthesis_manager.limits import MAX_STRING_BYTES
+from synthesis_manager.nodes.server_node import BehaviorSynthesisServer
+from synthesis_manager.ros.env import prepare_ros_environment
+from synthesis_manager.ros.harness import RosHarness, reserve_domain_id
+from synthesis_manager.suite import suite_node_factories
+from synthesis_msgs.srv import SynthesizeAutomaton
+
+PAPER_TASK = dict(system='atlas', initial_conditions=['stand_prep'], goals=['look_down', 'pickup_object'])
+# 200 unconstrained outputs: strategy extraction alone would run for hours.
+RUNAWAY_SPEC = {'sys_props': [f'p{i}' for i in range(200)], 'env_props': ['e'], 'sys_liveness': ['p0']}
+
+
+def runaway_goal(timeout=0.0):
+    return make_goal('atlas', [], [], option='ltl_synthesis_only', ltl_specification=RUNAWAY_SPEC,
+                     timeout=timeout)
+
+
+def suite_args(byproducts_dir, **overrides):
+    return Namespace(**{'config_dir': '', 'byproducts_dir': str(byproducts_dir), 'backend': 'builtin',
+                        'slugs_executable': 'slugs', 'synthesis_timeout': 60.0, 'service_timeout': 5.0,
+                        **overrides})
+
+
+def start_suite(ros, tmp_path, names=('ltl_compilation', 'ltl_synthesis', 'sm_generation'),
+                server_parameters=(), synthesis_parameters=()):
+    """The suite in ``ros`` (the synthesis node with extra parameters); returns a client."""
+    from synthesis_manager.nodes.ltl_synthesis_node import LTLSynthesisNode
+
+    for factory in suite_node_factories(suite_args(tmp_path), [n for n in names if n != 'ltl_synthesis']):
+        ros.add_node(factory)
+    if 'ltl_synthesis' in names:
+        ros.add_node(LTLSynthesisNode, parameter_overrides=[
+            Parameter('byproducts_dir', value=str(tmp_path)), *synthesis_parameters])
+    ros.add_node(BehaviorSynthesisServer, parameter_overrides=list(server_parameters))
+    client = SynthesisClient(ros.add_node(Node, 'reliability_client'))
+    assert client.wait_for_server(timeout=10.0)
+    return client
+
+
+def run_all(client, goals, timeout=120.0):
+    """Send every goal at once (one thread each); returns outcomes (or exceptions) in order."""
+    outcomes = [None] * len(goals)
+
+    def run(index):
+        try:
+            outcomes[index] = client.run(goals[index], timeout=timeout)
+        except Exception as error:  # a hang shows up as TimeoutError here
+            outcomes[index] = error
+
+    threads = [threading.Thread(target=run, args=(index,)) for index in range(len(goals))]
+    for thread in threads:
+        thread.start()
+    for thread in threads:
+        thread.join()
+    return outcomes
+
+
+def names(outcomes):
+    return Counter(getattr(outcome, 'error_name', repr(outcome)) for outcome in outcomes)
+
+
+# --- load ---------------------------------------------------------------------------------
+
+def test_fifty_goals_at_once_all_get_their_result(ros, tmp_path):
+    client = start_suite(ros, tmp_path)
+    goals = [make_goal(**PAPER_TASK, name=f'burst{i}',
+                       option='ltl_compilation_only' if i % 5 == 0 else None) for i in range(50)]
+    outcomes = run_all(client, goals)
+    assert names(outcomes) == {'SUCCESS': 50}
+    assert all(outcome.states for i, outcome in enumerate(outcomes) if i % 5)
+
+
+def test_goals_beyond_the_limit_are_answered_busy_at_once(ros, tmp_path):
+    client = start_suite(ros, tmp_path, server_parameters=[Parameter('max_active_goals', value=2)])
+    cancel = threading.Event()
+    runaways = [threading.Thread(target=client.run, args=(runaway_goal(),), kwargs={'cancel': cancel})
+                for _ in range(2)]
+    for thread in runaways:
+        thread.start()
+    time.sleep(2.0)  # both are synthesizing now
+    try:
+        started = time.monotonic()
+        outcome = client.run(make_goal(**PAPER_TASK), timeout=30)
+        assert outcome.error_name == 'BUSY', outcome.message
+        assert 'max_active_goals 2' in outcome.message
+        assert time.monotonic() - started < 5
+    finally:
+        cancel.set()
+        for thread in runaways:
+            thread.join(timeout=60)
+
+
+def test_fast_goals_are_not_starved_by_slow_ones(ros, tmp_path):
+    client = start_suite(ros, tmp_path)
+    cancel = threading.Event()
+    slow = [threading.Thread(target=client.run, args=(runaway_goal(),), kwargs={'cancel': cancel})
+            for _ in range(4)]
+    for thread in slow:
+        thread.start()
+    try:
+        time.sleep(2.0)
+        started = time.monotonic()
+        outcomes = run_all(client, [make_goal(**PAPER_TASK, name=f'fast{i}') for i in range(10)], timeout=60)
+        assert names(outcomes) == {'SUCCESS': 10}
+        assert all(thread.is_alive() for thread in slow)  # the slow ones are still at it
+        assert time.monotonic() - started < 45
+    finally:
+        cancel.set()
+        for thread in slow:
+            thread.join(timeout=60)
+
+
+def test_a_short_soak_loses_no_goal(ros, tmp_path):
+    """300 goals back to back, ten in flight (the 2,000-goal soak is in bench/)."""
+    client = start_suite(ros, tmp_path, synthesis_parameters=[Parameter('keep_byproducts', value=20)])
+    goals = [make_goal(**PAPER_TASK, name=f'soak{i}',
+                       option='ltl_compilation_only' if i % 2 else 'ltl_steps_only') for i in range(300)]
+    outcomes = []
+    for start in range(0, len(goals), 10):
+        outcomes += run_all(client, goals[start:start + 10], timeout=60)
+    assert names(outcomes) == {'SUCCESS': 300}
+    assert len({path.name.split('.')[0] for path in tmp_path.glob('*.json')}) == 20
+
+
+# --- bad input ----------------------------------------------------------------------------
+
+@pytest.mark.parametrize('timeout', [-1.0, math.nan, math.inf])
+def test_bad_goal_time_limits_are_invalid_requests(ros, tmp_path, timeout):
+    client = start_suite(ros, tmp_path)
+    outcome = client.run(make_goal(**PAPER_TASK, timeout=timeout), timeout=30)
+    assert outcome.error_name == 'INVALID_REQUEST'
+    assert 'request.timeout' in outcome.message
+
+
+def test_oversized_strings_are_refused_without_echo(ros, tmp_path):
+    client = start_suite(ros, tmp_path)
+    huge = 'x' * (2 * MAX_STRING_BYTES)
+    for goal in (make_goal(**PAPER_TASK, name=huge),
+                 make_goal(system='atlas', initial_conditions=['stand_prep'], goals=[huge]),
+                 make_goal(**PAPER_TASK, ltl_specification={'sys_trans': [huge]})):
+        outcome = client.run(goal, timeout=30)
+        assert outcome.error_name == 'INVALID_REQUEST', outcome.message
+        assert f'{2 * MAX_STRING_BYTES} bytes' in outcome.message
+        assert len(outcome.message) < 400
+    assert client.run(make_goal(**PAPER_TASK), timeout=60).error_name == 'SUCCESS'
+
+
+def test_the_synthesis_service_refuses_bad_time_limits(ros, tmp_path):
+    start_suite(ros, tmp_path, names=('ltl_synthesis',))
+    node = ros.add_node(Node, 'direct_client')
+    service = node.create_client(SynthesizeAutomaton, 'ltl_synthesis')
+    assert service.wait_for_service(timeout_sec=10)
+    from synthesis_manager.ros.harness import wait_for
+
+    response = wait_for(service.call_async(SynthesizeAutomaton.Request(timeout=-5.0, spec_name='x')), 30)
+    assert response.error_code.value == response.error_code.INVALID_REQUEST
+    assert 'request.timeout' in response.error_code.message
+
+
+# --- byproducts ---------------------------------------------------------------------------
+
+def test_dotted_spec_names_do_not_overwrite_each_other(ros, tmp_path):
+    client = start_suite(ros, tmp_path)
+    for name in ('collide.one', 'collide.two'):
+        assert client.run(make_goal(**PAPER_TASK, name=name, option='ltl_steps_only'),
+                          timeout=60).error_name == 'SUCCESS'
+    assert sorted(path.name for path in tmp_path.iterdir()) == [
+        f'collide.{which}.{extension}' for which in ('one', 'two')
+        for extension in ('json', 'slugsin', 'structuredslugs')]
+
+
+def test_keeping_no_byproducts_leaves_the_directory_empty(ros, tmp_path):
+    client = start_suite(ros, tmp_path / 'byproducts',
+                         synthesis_parameters=[Parameter('keep_byproducts', value=0)])
+    assert client.run(make_goal(**PAPER_TASK), timeout=60).error_name == 'SUCCESS'
+    assert not (tmp_path / 'byproducts').exists() or not list((tmp_path / 'byproducts').iterdir())
+
+
+# --- faults -------------------------------------------------------------------------------
+
+def test_a_killed_node_is_reported_by_name_and_the_suite_recovers(tmp_path):
+    """ltl_synthesis runs in its own process and is killed (SIGKILL) mid-synthesis."""
+    serve = [str(Path(sys.executable).parent / 'behavior-synthesis'), 'serve', '--nodes', 'ltl_synthesis',
+             '--byproducts-dir', str(tmp_path)]
+    with reserve_domain_id() as domain:
+        environment = prepare_ros_environment(domain, environ=dict(os.environ))
+        process = subprocess.Popen(serve, env=environment, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        try:
+            with RosHarness(domain_id=domain) as ros:
+                client = start_suite(ros, tmp_path, names=('ltl_compilation', 'sm_generation'))
+                probe = ros.nodes[-1].create_client(SynthesizeAutomaton, 'ltl_synthesis')
+                assert probe.wait_for_service(timeout_sec=60)
+                killed = []
+
+                def kill_while_synthesizing(status, _progress):
+                    if status.startswith('Synthesizing') and not killed:
+                        threading.Timer(1.0, lambda: (process.kill(), killed.append(time.monotonic()))).start()
+
+                outcome = client.run(runaway_goal(), feedback=kill_while_synthesizing, timeout=60)
+                noticed_after = time.monotonic() - killed[0]
+                assert outcome.error_name == 'SERVICE_UNAVAILABLE', outcome.message
+                assert "node '/ltl_synthesis'" in outcome.message
+                assert noticed_after < 2.0
+                process.wait(timeout=10)
+
+                process = subprocess.Popen(serve, env=environment, stdout=subprocess.DEVNULL,
+                                           stderr=subprocess.DEVNULL)
+                assert probe.wait_for_service(timeout_sec=60)
+                assert client.run(make_goal(**PAPER_TASK), timeout=60).error_name == 'SUCCESS'
+        finally:
+            process.send_signal(signal.SIGTERM)
+            process.wait(timeout=20)

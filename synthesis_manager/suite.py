@@ -24,6 +24,8 @@ def add_suite_arguments(parser):
     group = parser.add_argument_group('suite settings')
     group.add_argument('--config-dir', default='', help='robot system configurations (default: config/)')
     group.add_argument('--byproducts-dir', default='', help='where the synthesizer writes its byproducts')
+    group.add_argument('--keep-byproducts', type=int, default=None, metavar='N',
+                       help="keep the newest N spec names' byproduct files (default 200; 0: none)")
     group.add_argument('--backend', choices=('builtin', 'slugs'), default='builtin',
                        help='synthesizer: our own (builtin) or a slugs executable on PATH')
     group.add_argument('--slugs-executable', default='slugs', help='the executable for --backend slugs')
@@ -49,6 +51,7 @@ def suite_node_factories(args=None, names=SUITE_NODE_NAMES):
         'ltl_compilation': (LTLCompilationNode, overrides(config_dir=getattr(args, 'config_dir', ''))),
         'ltl_synthesis': (LTLSynthesisNode, overrides(
             byproducts_dir=getattr(args, 'byproducts_dir', ''),
+            keep_byproducts=getattr(args, 'keep_byproducts', None),
             backend=getattr(args, 'backend', ''),
             slugs_executable=getattr(args, 'slugs_executable', ''),
             timeout=getattr(args, 'synthesis_timeout', None))),

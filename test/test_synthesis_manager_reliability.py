@@ -4,6 +4,7 @@ Figures for bigger runs (50 goals to ``serve``, 20 GUI jobs, a 2,000-goal soak w
 slope) are printed by bench/bench_reliability.py.
 """
 
+import contextlib
 import math
 import os
 import signal
@@ -77,6 +78,23 @@ def run_all(client, goals, timeout=120.0):
     return outcomes
 
 
+@contextlib.contextmanager
+def runaways_running(client, count):
+    """``count`` runaway syntheses in progress (cancelled on leaving); yields their threads."""
+    cancel = threading.Event()
+    threads = [threading.Thread(target=client.run, args=(runaway_goal(),), kwargs={'cancel': cancel})
+               for _ in range(count)]
+    for thread in threads:
+        thread.start()
+    time.sleep(2.0)  # they are synthesizing now
+    try:
+        yield threads
+    finally:
+        cancel.set()
+        for thread in threads:
+            thread.join(timeout=60)
+
+
 def names(outcomes):
     return Counter(getattr(outcome, 'error_name', repr(outcome)) for outcome in outcomes)
 
@@ -94,42 +112,22 @@ def test_fifty_goals_at_once_all_get_their_result(ros, tmp_path):
 
 def test_goals_beyond_the_limit_are_answered_busy_at_once(ros, tmp_path):
     client = start_suite(ros, tmp_path, server_parameters=[Parameter('max_active_goals', value=2)])
-    cancel = threading.Event()
-    runaways = [threading.Thread(target=client.run, args=(runaway_goal(),), kwargs={'cancel': cancel})
-                for _ in range(2)]
-    for thread in runaways:
-        thread.start()
-    time.sleep(2.0)  # both are synthesizing now
-    try:
+    with runaways_running(client, 2):
         started = time.monotonic()
         outcome = client.run(make_goal(**PAPER_TASK), timeout=30)
         assert outcome.error_name == 'BUSY', outcome.message
         assert 'max_active_goals 2' in outcome.message
         assert time.monotonic() - started < 5
-    finally:
-        cancel.set()
-        for thread in runaways:
-            thread.join(timeout=60)
 
 
 def test_fast_goals_are_not_starved_by_slow_ones(ros, tmp_path):
     client = start_suite(ros, tmp_path)
-    cancel = threading.Event()
-    slow = [threading.Thread(target=client.run, args=(runaway_goal(),), kwargs={'cancel': cancel})
-            for _ in range(4)]
-    for thread in slow:
-        thread.start()
-    try:
-        time.sleep(2.0)
+    with runaways_running(client, 4) as slow:
         started = time.monotonic()
         outcomes = run_all(client, [make_goal(**PAPER_TASK, name=f'fast{i}') for i in range(10)], timeout=60)
         assert names(outcomes) == {'SUCCESS': 10}
         assert all(thread.is_alive() for thread in slow)  # the slow ones are still at it
         assert time.monotonic() - started < 45
-    finally:
-        cancel.set()
-        for thread in slow:
-            thread.join(timeout=60)
 
 
 def test_a_short_soak_loses_no_goal(ros, tmp_path):

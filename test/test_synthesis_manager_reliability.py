@@ -29,6 +29,10 @@ from synthesis_manager.suite import suite_node_factories
 from synthesis_msgs.srv import SynthesizeAutomaton
 
 PAPER_TASK = dict(system='atlas', initial_conditions=['stand_prep'], goals=['look_down', 'pickup_object'])
+# Seven ordered goals: a synthesis of many seconds that stops when cancelled.
+SLOW_TASK = dict(system='atlas', initial_conditions=['stand_prep'],
+                 goals=['look_down', 'pickup_object', 'grasp_object', 'pregrasp', 'approach_object',
+                        'footstep_execution', 'walk'])
 # 200 unconstrained outputs: strategy extraction alone would run for hours.
 RUNAWAY_SPEC = {'sys_props': [f'p{i}' for i in range(200)], 'env_props': ['e'], 'sys_liveness': ['p0']}
 
@@ -79,10 +83,10 @@ def run_all(client, goals, timeout=120.0):
 
 
 @contextlib.contextmanager
-def runaways_running(client, count):
-    """``count`` runaway syntheses in progress (cancelled on leaving); yields their threads."""
+def slow_goals_running(client, count):
+    """``count`` slow goals in progress (cancelled on leaving); yields their threads."""
     cancel = threading.Event()
-    threads = [threading.Thread(target=client.run, args=(runaway_goal(),), kwargs={'cancel': cancel})
+    threads = [threading.Thread(target=client.run, args=(make_goal(**SLOW_TASK),), kwargs={'cancel': cancel})
                for _ in range(count)]
     for thread in threads:
         thread.start()
@@ -112,7 +116,7 @@ def test_fifty_goals_at_once_all_get_their_result(ros, tmp_path):
 
 def test_goals_beyond_the_limit_are_answered_busy_at_once(ros, tmp_path):
     client = start_suite(ros, tmp_path, server_parameters=[Parameter('max_active_goals', value=2)])
-    with runaways_running(client, 2):
+    with slow_goals_running(client, 2):
         started = time.monotonic()
         outcome = client.run(make_goal(**PAPER_TASK), timeout=30)
         assert outcome.error_name == 'BUSY', outcome.message
@@ -122,7 +126,7 @@ def test_goals_beyond_the_limit_are_answered_busy_at_once(ros, tmp_path):
 
 def test_fast_goals_are_not_starved_by_slow_ones(ros, tmp_path):
     client = start_suite(ros, tmp_path)
-    with runaways_running(client, 4) as slow:
+    with slow_goals_running(client, 4) as slow:
         started = time.monotonic()
         outcomes = run_all(client, [make_goal(**PAPER_TASK, name=f'fast{i}') for i in range(10)], timeout=60)
         assert names(outcomes) == {'SUCCESS': 10}

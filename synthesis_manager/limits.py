@@ -45,7 +45,8 @@ def oversized_strings(message, path: str = 'request', limit: int = MAX_STRING_BY
     """Yield ``(field path, string)`` for every string longer than ``limit`` bytes in a message.
 
     ``message`` is a ROS message (anything with ``get_fields_and_field_types()``), a string,
-    or a sequence of those; nested messages and arrays are searched too.
+    or a sequence or (JSON-like) dict of those; nested messages, arrays and dicts are searched
+    too, dict keys included.
     """
     if isinstance(message, str):
         # A character takes at most 4 bytes: shorter strings need no encoding to be checked.
@@ -55,6 +56,12 @@ def oversized_strings(message, path: str = 'request', limit: int = MAX_STRING_BY
         for index, element in enumerate(message):
             if isinstance(element, str) or hasattr(element, 'get_fields_and_field_types'):
                 yield from oversized_strings(element, f'{path}[{index}]', limit)
+    elif isinstance(message, dict):
+        for key, element in message.items():
+            if list(oversized_strings(key, path, limit)):
+                yield f'{path} (a key)', key
+            else:
+                yield from oversized_strings(element, f'{path}.{key}', limit)
     elif hasattr(message, 'get_fields_and_field_types'):
         for name in message.get_fields_and_field_types():
             yield from oversized_strings(getattr(message, name), f'{path}.{name}', limit)
@@ -63,5 +70,10 @@ def oversized_strings(message, path: str = 'request', limit: int = MAX_STRING_BY
 def check_message(message, path: str = 'request', limit: int = MAX_STRING_BYTES):
     """Refuse a message with an oversized string field, naming the first such field."""
     for field_path, value in oversized_strings(message, path, limit):
-        raise InvalidRequest(f'{field_path} is {utf8_length(value)} bytes long; the limit is '
-                             f'{limit} bytes (it starts {quote_start(value)})')
+        raise InvalidRequest(too_long(field_path, value, limit))
+
+
+def too_long(field_path: str, value: str, limit: int = MAX_STRING_BYTES) -> str:
+    """The error message for an oversized string, quoting only its start."""
+    return (f'{field_path} is {utf8_length(value)} bytes long; the limit is {limit} bytes '
+            f'(it starts {quote_start(value)})')

@@ -27,12 +27,21 @@ def gui(tmp_path_factory):
             yield backend, url
 
 
-def request(url, method, path, body=None, headers=None, chunks=None):
-    """One HTTP request; returns (status, decoded JSON or None)."""
+def request(url, method, path, body=None, headers=None, chunks=None, announced=None):
+    """One HTTP request; returns (status, decoded JSON or None).
+
+    ``chunks``: send the body chunked; ``announced``: only announce a body of that many bytes
+    (the server must answer without reading it).
+    """
     parts = urllib.parse.urlsplit(url)
     connection = http.client.HTTPConnection(parts.hostname, parts.port, timeout=60)
     try:
-        if chunks is not None:
+        if announced is not None:
+            connection.putrequest(method, path)
+            connection.putheader('Content-Type', 'application/json')
+            connection.putheader('Content-Length', str(announced))
+            connection.endheaders()
+        elif chunks is not None:
             connection.putrequest(method, path)
             for name, value in (headers or {}).items():
                 connection.putheader(name, value)
@@ -98,12 +107,16 @@ def test_jobs_beyond_the_limit_are_busy(gui):
 
 def test_bodies_over_a_megabyte_are_refused(gui):
     _, url = gui
-    big = json.dumps({**PAPER_TASK, 'name': 'x' * (MAX_BODY_BYTES + 10)}).encode()
-    status, error = request(url, 'POST', '/api/jobs', big)
+    status, error = request(url, 'POST', '/api/jobs', announced=50 * MAX_BODY_BYTES)
     assert status == 413
     assert error['error'] == 'TOO_LARGE'
     status, error = request(url, 'POST', '/api/jobs', chunks=[b'{"name": "' + b'x' * 65536] * 20)
     assert status == 413
+    assert error['error'] == 'TOO_LARGE'
+    body = json.dumps({**PAPER_TASK, 'name': 'x' * (MAX_BODY_BYTES - 200)}).encode()  # just fits
+    status, error = request(url, 'POST', '/api/jobs', body)
+    assert (status, error['error'], error['item']) == (422, 'INVALID_REQUEST', 'body.name')
+    assert len(error['message']) < 300  # the name is not echoed
     assert request(url, 'GET', '/api/systems')[0] == 200  # and it keeps serving
 
 

@@ -38,3 +38,9 @@ def test_multibyte_text_counts_in_bytes():
     text = '\u00e9' * (MAX_STRING_BYTES // 2 + 1)  # fewer characters than the limit, more bytes
     assert [path for path, _ in oversized_strings(text, 'name')] == ['name']
     assert not list(oversized_strings('\u00e9' * (MAX_STRING_BYTES // 2), 'name'))
+
+
+def test_json_bodies_are_searched_keys_included():
+    big = 'k' * (MAX_STRING_BYTES + 1)
+    found = list(oversized_strings({'goals': ['a', big], big: 1}, 'body'))
+    assert [path for path, _ in found] == ['body.goals[1]', 'body (a key)']

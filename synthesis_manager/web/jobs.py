@@ -9,6 +9,7 @@ from dataclasses import asdict, dataclass, field
 
 from respec.naming import DEFAULT_SM_OUTCOMES, parse_names
 from sm_generation.instantiation import count_states
+from synthesis_manager.limits import oversized_strings, too_long
 from synthesis_manager.web.artifacts import available_artifacts, download_labels
 from synthesis_manager.web.errors import InvalidJobRequestError, NotFoundError
 from synthesis_msgs.msg import SynthesisErrorCodes
@@ -41,6 +42,8 @@ class JobRequest:
         """
         if not isinstance(body, dict):
             raise InvalidJobRequestError('the request body must be a JSON object', 'body')
+        for item, value in oversized_strings(body, 'body'):
+            raise InvalidJobRequestError(too_long(item, value), item)
         unknown = sorted(set(body) - set(REQUEST_FIELDS))
         if unknown:
             raise InvalidJobRequestError(

@@ -1,0 +1,218 @@
+"""Reliability under load: bursts to ``serve`` and to the GUI, and a long soak with its RSS slope.
+
+- burst: 50 goals sent at once to ``behavior-synthesis serve`` (10 compile-only "fast" goals
+  among 40 whole pipelines); every goal must get an answer (a result or BUSY).
+- gui: 20 jobs posted at once to ``behavior-synthesis gui``; every job must finish.
+- soak: N goals (default 2,000) to ``serve``, ``--in-flight`` at a time, half whole
+  pipelines and half compile-only; counts goals without a result and samples the server's
+  RSS. The slope is fitted (least squares) over the samples after warm-up (the first
+  ``--warmup`` goals, which also covers the server's 60 s result retention).
+
+The server and GUI run as their real console entry points in separate processes on a
+reserved ROS domain; the clients are in this process. Prints a table and writes
+bench/results/reliability.md.
+
+    .venv/bin/python bench/bench_reliability.py [--goals 2000] [--in-flight 4] [--warmup 600]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import re
+import signal
+import statistics
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+import urllib.request
+from collections import Counter
+from concurrent.futures import ThreadPoolExecutor
+from pathlib import Path
+
+RESULTS = Path(__file__).resolve().parent / 'results' / 'reliability.md'
+BIN = Path(sys.executable).parent
+TASK = ('atlas', ['stand_prep'], ['look_down', 'pickup_object'])
+GUI_TASK = {'system': 'atlas', 'initial_conditions': ['stand_prep'], 'goals': ['look_down', 'pickup_object']}
+
+
+def rss_kib(pid: int) -> int:
+    for line in Path(f'/proc/{pid}/status').read_text().splitlines():
+        if line.startswith('VmRSS:'):
+            return int(line.split()[1])
+    raise RuntimeError(f'no VmRSS for process {pid}')
+
+
+def slope(points: list[tuple[float, float]]) -> float:
+    """Least-squares slope of (x, y) points."""
+    mean_x = statistics.fmean(x for x, _ in points)
+    mean_y = statistics.fmean(y for _, y in points)
+    spread = sum((x - mean_x) ** 2 for x, _ in points)
+    return sum((x - mean_x) * (y - mean_y) for x, y in points) / spread if spread else 0.0
+
+
+def percentile(values, fraction):
+    ordered = sorted(values)
+    return ordered[min(len(ordered) - 1, int(round(fraction * (len(ordered) - 1))))]
+
+
+class Serve:
+    """``behavior-synthesis serve`` in its own process on ``domain``."""
+
+    def __init__(self, domain: int, byproducts: str):
+        from synthesis_manager.ros.env import prepare_ros_environment
+
+        environment = prepare_ros_environment(domain, environ=dict(os.environ))
+        self.process = subprocess.Popen([str(BIN / 'behavior-synthesis'), 'serve', '--byproducts-dir', byproducts],
+                                        env=environment, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+
+    def stop(self):
+        self.process.send_signal(signal.SIGTERM)
+        self.process.wait(timeout=30)
+
+
+def timed_run(client, goal, timeout=300.0):
+    started = time.monotonic()
+    try:
+        outcome = client.run(goal, timeout=timeout)
+        return outcome.error_name, time.monotonic() - started
+    except TimeoutError:
+        return 'NO RESULT', time.monotonic() - started
+
+
+def burst(client, count: int = 50) -> dict:
+    from synthesis_manager.client import make_goal
+
+    goals = [(i % 5 == 0, make_goal(*TASK, name=f'burst{i}',
+                                    option='ltl_compilation_only' if i % 5 == 0 else None))
+             for i in range(count)]
+    started = time.monotonic()
+    with ThreadPoolExecutor(count) as pool:
+        answers = list(pool.map(lambda fast_goal: (fast_goal[0], *timed_run(client, fast_goal[1])), goals))
+    return {'goals': count, 'codes': Counter(code for _, code, _ in answers),
+            'all answered after s': time.monotonic() - started,
+            'fast goals, slowest s': max(seconds for fast, _, seconds in answers if fast),
+            'pipelines, median s': statistics.median(seconds for fast, _, seconds in answers if not fast)}
+
+
+def gui_burst(domain: int, byproducts: str, jobs: int = 20) -> dict:
+    from synthesis_manager.ros.env import prepare_ros_environment
+
+    environment = prepare_ros_environment(domain, environ=dict(os.environ))
+    process = subprocess.Popen([str(BIN / 'behavior-synthesis'), 'gui', '--port', '0',
+                                '--byproducts-dir', byproducts], env=environment,
+                               stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
+    try:
+        url = re.search(r'http://\S+?/', process.stdout.readline()).group(0)
+
+        def post(index):
+            request = urllib.request.Request(url + 'api/jobs', method='POST',
+                                             data=json.dumps({**GUI_TASK, 'name': f'job{index}'}).encode(),
+                                             headers={'Content-Type': 'application/json'})
+            with urllib.request.urlopen(request, timeout=60) as response:
+                return json.load(response)['id']
+
+        def finish(job_id):
+            deadline = time.monotonic() + 300
+            while time.monotonic() < deadline:
+                with urllib.request.urlopen(f'{url}api/jobs/{job_id}', timeout=60) as response:
+                    job = json.load(response)
+                if job['state'] == 'finished':
+                    return job['outcome']['error_name']
+                time.sleep(0.2)
+            return 'UNFINISHED'
+
+        started = time.monotonic()
+        with ThreadPoolExecutor(jobs) as pool:
+            codes = list(pool.map(finish, list(pool.map(post, range(jobs)))))
+        return {'jobs': jobs, 'codes': Counter(codes), 'all finished after s': time.monotonic() - started}
+    finally:
+        process.send_signal(signal.SIGINT)
+        process.wait(timeout=30)
+
+
+def soak(client, server_pid: int, goals: int, in_flight: int, warmup: int) -> dict:
+    from synthesis_manager.client import make_goal
+
+    codes: Counter = Counter()
+    samples = []  # (goals answered, seconds since start, RSS KiB)
+    lock = threading.Lock()
+    answered = 0
+    started_wall, started_cpu = time.monotonic(), time.process_time()
+
+    def one(index):
+        nonlocal answered
+        option = 'ltl_compilation_only' if index % 2 else None
+        code, _ = timed_run(client, make_goal(*TASK, name=f'soak{index % 500}', option=option))
+        with lock:
+            codes[code] += 1
+            answered += 1
+            if answered % 50 == 0:
+                samples.append((answered, time.monotonic() - started_wall, rss_kib(server_pid)))
+                print(f'  {answered} goals, server RSS {samples[-1][2] / 1024:.1f} MiB', flush=True)
+
+    with ThreadPoolExecutor(in_flight) as pool:
+        list(pool.map(one, range(goals)))
+    after_warmup = [sample for sample in samples if sample[0] > warmup] or samples
+    return {'goals': goals, 'in flight': in_flight, 'codes': codes,
+            'goals without a result': codes['NO RESULT'],
+            'wall s': time.monotonic() - started_wall, 'client CPU s': time.process_time() - started_cpu,
+            'RSS after warm-up MiB': after_warmup[0][2] / 1024, 'RSS at end MiB': samples[-1][2] / 1024,
+            'RSS slope KiB per goal': slope([(n, rss) for n, _, rss in after_warmup]),
+            'RSS slope KiB per minute': 60 * slope([(t, rss) for _, t, rss in after_warmup])}
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument('--goals', type=int, default=2000, help='goals in the soak')
+    parser.add_argument('--in-flight', type=int, default=4, help='soak goals in progress at once')
+    parser.add_argument('--warmup', type=int, default=600, help='soak goals before the RSS slope counts')
+    args = parser.parse_args(argv)
+
+    from rclpy.node import Node
+
+    from synthesis_manager.client import SynthesisClient, make_goal
+    from synthesis_manager.ros.harness import RosHarness, reserve_domain_id
+
+    report = {}
+    with tempfile.TemporaryDirectory(prefix='bench-reliability-') as byproducts:
+        with reserve_domain_id() as domain:
+            serve = Serve(domain, byproducts)
+            try:
+                with RosHarness(domain_id=domain) as ros:
+                    client = SynthesisClient(ros.add_node(Node, 'bench_reliability_client'))
+                    assert client.wait_for_server(timeout=60.0), 'serve did not come up'
+                    for _ in range(3):  # warm-up: imports, discovery
+                        timed_run(client, make_goal(*TASK))
+                    print('burst: 50 goals at once to serve', flush=True)
+                    report['burst'] = burst(client)
+                    print(f'soak: {args.goals} goals, {args.in_flight} in flight', flush=True)
+                    report['soak'] = soak(client, serve.process.pid, args.goals, args.in_flight, args.warmup)
+            finally:
+                serve.stop()
+        with reserve_domain_id() as domain:
+            print('gui: 20 jobs at once', flush=True)
+            report['gui'] = gui_burst(domain, byproducts)
+
+    lines = ['# Reliability under load', '',
+             'Measured by `bench/bench_reliability.py` (2-core machine shared with other work; '
+             'wall-clock times are indicative only).', '']
+    for section, figures in report.items():
+        lines += [f'## {section}', '', '| figure | value |', '|---|---|']
+        for name, value in figures.items():
+            shown = (', '.join(f'{code} {count}' for code, count in sorted(value.items()))
+                     if isinstance(value, Counter) else f'{value:.3f}' if isinstance(value, float) else str(value))
+            lines.append(f'| {name} | {shown} |')
+        lines.append('')
+    text = '\n'.join(lines)
+    print(text)
+    RESULTS.parent.mkdir(exist_ok=True)
+    RESULTS.write_text(text)
+    return 0
+
+
+if __name__ == '__main__':
+    sys.exit(main())

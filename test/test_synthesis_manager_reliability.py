@@ -153,7 +153,7 @@ def test_bad_goal_time_limits_are_invalid_requests(ros, tmp_path, timeout):
     client = start_suite(ros, tmp_path)
     outcome = client.run(make_goal(**PAPER_TASK, timeout=timeout), timeout=30)
     assert outcome.error_name == 'INVALID_REQUEST'
-    assert 'request.timeout' in outcome.message
+    assert 'timeout must be a finite number' in outcome.message
 
 
 def test_oversized_strings_are_refused_without_echo(ros, tmp_path):

@@ -108,7 +108,7 @@ class StageCaller:
                                            'away before answering', provider)
             if failure is not None:
                 client.remove_pending_request(future)
-                if on_cancel is not None and (isinstance(failure, Preempted) or failure.code == 'TIMEOUT'):
+                if on_cancel is not None and getattr(failure, 'code', '') != 'SERVICE_UNAVAILABLE':
                     on_cancel()  # tell the service to stop working for nobody
                 raise failure
             await next_executor_turn()

@@ -23,6 +23,7 @@ from rclpy.parameter import Parameter
 from synthesis_manager.client import SynthesisClient, make_goal
 from synthesis_manager.limits import MAX_STRING_BYTES
 from synthesis_manager.nodes.server_node import BehaviorSynthesisServer
+from synthesis_manager.requests import byproduct_file_stem
 from synthesis_manager.ros.env import prepare_ros_environment
 from synthesis_manager.ros.harness import RosHarness, reserve_domain_id
 from synthesis_manager.suite import suite_node_factories
@@ -188,9 +189,9 @@ def test_dotted_spec_names_do_not_overwrite_each_other(ros, tmp_path):
     for name in ('collide.one', 'collide.two'):
         assert client.run(make_goal(**PAPER_TASK, name=name, option='ltl_steps_only'),
                           timeout=60).error_name == 'SUCCESS'
+    stems = [byproduct_file_stem(name) for name in ('collide.one', 'collide.two')]
     assert sorted(path.name for path in tmp_path.iterdir()) == [
-        f'collide.{which}.{extension}' for which in ('one', 'two')
-        for extension in ('json', 'slugsin', 'structuredslugs')]
+        f'{stem}.{extension}' for stem in stems for extension in ('json', 'slugsin', 'structuredslugs')]
 
 
 def test_keeping_no_byproducts_leaves_the_directory_empty(ros, tmp_path):

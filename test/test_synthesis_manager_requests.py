@@ -1,12 +1,11 @@
 """Reading requests of both action interfaces into one task (ROS-free parts)."""
 
-from pathlib import Path
 from types import SimpleNamespace
 
 import pytest
 from hypothesis import given, settings, strategies as st
 
-from synthesis_manager.nodes.ltl_synthesis_node import InvalidSpecName, byproduct_stem
+from synthesis_manager.byproducts import InvalidSpecName, checked_spec_name
 from synthesis_manager.requests import (InvalidRequest, behavior_name, byproduct_file_stem,
                                         parse_synthesis_options, resolve_system,
                                         task_from_behavior_synthesis, task_from_flexbe_synthesis)
@@ -44,7 +43,7 @@ def test_different_names_never_share_a_stem():
 @given(st.text(min_size=1, max_size=160).filter(lambda name: behavior_name(name)))
 def test_every_stem_is_a_valid_spec_name_inside_the_directory(name):
     stem = byproduct_file_stem(name)
-    assert byproduct_stem(Path('/byproducts'), stem) == Path('/byproducts') / stem
+    assert checked_spec_name(stem) == stem
 
 
 @settings(deadline=None)
@@ -91,7 +90,7 @@ def test_bad_synthesis_options_are_invalid_requests(text, named):
 def test_the_synthesizer_still_refuses_names_that_leave_its_directory():
     for name in ('../escape', 'a/b', '.hidden', 'a..b'):
         with pytest.raises(InvalidSpecName, match='invalid spec_name'):
-            byproduct_stem(Path('/byproducts'), name)
+            checked_spec_name(name)
 
 
 def flexbe_goal(**request_fields):

@@ -30,10 +30,6 @@ from synthesis_manager.suite import suite_node_factories
 from synthesis_msgs.srv import SynthesizeAutomaton
 
 PAPER_TASK = dict(system='atlas', initial_conditions=['stand_prep'], goals=['look_down', 'pickup_object'])
-# Seven ordered goals: a synthesis of many seconds that stops when cancelled.
-SLOW_TASK = dict(system='atlas', initial_conditions=['stand_prep'],
-                 goals=['look_down', 'pickup_object', 'grasp_object', 'pregrasp', 'approach_object',
-                        'footstep_execution', 'walk'])
 # 200 unconstrained outputs: strategy extraction alone would run for hours.
 RUNAWAY_SPEC = {'sys_props': [f'p{i}' for i in range(200)], 'env_props': ['e'], 'sys_liveness': ['p0']}
 
@@ -85,9 +81,9 @@ def run_all(client, goals, timeout=120.0):
 
 @contextlib.contextmanager
 def slow_goals_running(client, count):
-    """``count`` slow goals in progress (cancelled on leaving); yields their threads."""
+    """``count`` runaway syntheses in progress (cancelled on leaving); yields their threads."""
     cancel = threading.Event()
-    threads = [threading.Thread(target=client.run, args=(make_goal(**SLOW_TASK),), kwargs={'cancel': cancel})
+    threads = [threading.Thread(target=client.run, args=(runaway_goal(30.0),), kwargs={'cancel': cancel})
                for _ in range(count)]
     for thread in threads:
         thread.start()

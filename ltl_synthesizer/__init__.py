@@ -4,16 +4,40 @@
     result = synthesize(spec)            # spec: respec.spec.GR1Specification
     result.realizable, result.strategy   # slugs --explicitStrategy --jsonOutput shape
 
-Modules: symbolic (formulas to BDDs, enforceable predecessors), gr1 (fixpoints), strategy
-(explicit strategies, counter-strategies, slugs JSON), explain (why unrealizable), unrealizable_core
-(minimal unrealizable subsets of guarantees, by delta debugging), automaton (FSAutomaton shape),
-cli (``gr1synth``).
+Limits (every phase -- parsing, BDD building, solving, extraction, explanation -- checks them
+in each of its loops, so a synthesis stops within a few milliseconds plus one BDD operation)::
+
+    synthesize(spec, deadline=time.monotonic() + 60,   # -> SynthesisCancelled, code SYNTHESIS_TIMEOUT
+               cancel=threading.Event(),               # set() -> SynthesisCancelled, code PREEMPTED
+               memory_limit=2 * 2**30)                 # BDD bytes -> SynthesisMemoryExceeded
+    is_realizable(spec, ...)                           # the verdict only, same limits
+
+``Interrupt(cancel, deadline, memory_limit)`` is the same check as one object: pass it to
+``respec.parsing.parse_structuredslugs(text, check=interrupt)`` to bound parsing too.
+
+Modules: symbolic (formulas to BDDs, enforceable predecessors, the Interrupt), gr1 (fixpoints),
+strategy (explicit strategies, counter-strategies, slugs JSON), explain (why unrealizable),
+unrealizable_core (minimal unrealizable subsets of guarantees, by delta debugging), cli
+(``gr1synth``). Imports are lazy, so ``gr1synth --help`` starts without loading CUDD.
 """
 
-from ltl_synthesizer.errors import (InvalidFormulaError, SynthesisCancelled, SynthesisError,
-                                    UnknownPropositionError)
-from ltl_synthesizer.symbolic import Options
-from ltl_synthesizer.synthesizer import SynthesisResult, synthesize
+import importlib
 
-__all__ = ['synthesize', 'SynthesisResult', 'SynthesisCancelled', 'SynthesisError',
-           'UnknownPropositionError', 'InvalidFormulaError', 'Options']
+_EXPORTS = {
+    'synthesize': 'ltl_synthesizer.synthesizer', 'is_realizable': 'ltl_synthesizer.synthesizer',
+    'SynthesisResult': 'ltl_synthesizer.synthesizer',
+    'DEFAULT_MEMORY_LIMIT': 'ltl_synthesizer.synthesizer',
+    'Options': 'ltl_synthesizer.symbolic', 'Interrupt': 'ltl_synthesizer.symbolic',
+    'SynthesisCancelled': 'ltl_synthesizer.errors', 'SynthesisError': 'ltl_synthesizer.errors',
+    'SynthesisMemoryExceeded': 'ltl_synthesizer.errors',
+    'UnknownPropositionError': 'ltl_synthesizer.errors',
+    'InvalidFormulaError': 'ltl_synthesizer.errors',
+}
+
+__all__ = sorted(_EXPORTS)
+
+
+def __getattr__(name):
+    if name not in _EXPORTS:
+        raise AttributeError(f'module {__name__!r} has no attribute {name!r}')
+    return getattr(importlib.import_module(_EXPORTS[name]), name)

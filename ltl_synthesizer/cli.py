@@ -1,13 +1,17 @@
 """``gr1synth``: a drop-in for the slugs command line (plus a structuredslugs converter).
 
     gr1synth [--explicitStrategy] [--jsonOutput] [--sysInitRoboticsSemantics]
-             [--counterStrategy] INPUT [OUTPUT]
+             [--counterStrategy] [--explain] [--timeout S] [--memory-limit MB] INPUT [OUTPUT]
     gr1synth --convert INPUT.structuredslugs [OUTPUT.slugsin]
 
 INPUT is ``.slugsin`` or ``.structuredslugs`` (chosen by extension). As slugs, it prints
 ``RESULT: Specification is realizable.`` or ``... unrealizable.`` on stderr and exits 0 in
-both cases; the strategy (or counter-strategy) goes to OUTPUT or stdout. A malformed file
-exits with status 2 and a ``file:line:col: ... near 'token'`` message.
+both cases; only with ``--explicitStrategy`` (``--counterStrategy``) is a strategy
+(counter-strategy) computed, and written to OUTPUT or stdout; only with ``--explain`` is the
+reason for unrealizability computed and printed. A malformed or unreadable input exits with
+status 1 (as slugs) and a ``file:line:col: ... near 'token'`` message; the time limit exits
+with 3, the memory limit with 4. Formulas may be nested to any depth. Heavy modules (CUDD)
+load only when a specification is synthesized, so ``--help`` is instant.
 """
 
 from __future__ import annotations
@@ -19,7 +23,13 @@ from pathlib import Path
 
 REALIZABLE_LINE = 'RESULT: Specification is realizable.'
 UNREALIZABLE_LINE = 'RESULT: Specification is unrealizable.'
-EXIT_USAGE = 2
+EXIT_MALFORMED = 1
+EXIT_TIMEOUT = 3
+EXIT_MEMORY = 4
+# Formula trees are walked recursively (parsing, translation, printing): the work runs in a
+# thread whose stack holds formulas nested this deep and more (slugs handles 3,000).
+DEEP_STACK_BYTES = 1 << 30
+DEEP_RECURSION_LIMIT = 1_000_000
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -34,22 +44,25 @@ def _parser() -> argparse.ArgumentParser:
                         help='write a counter-strategy when unrealizable')
     parser.add_argument('--convert', action='store_true',
                         help='only convert INPUT.structuredslugs to slugsin')
+    parser.add_argument('--explain', action='store_true',
+                        help='when unrealizable, say why (losing initial states, blocked goal, a play)')
     parser.add_argument('--timeout', type=float, default=None, metavar='SECONDS',
                         help='give up after this many seconds (exit status 3)')
-    parser.add_argument('--quiet', action='store_true', help='no explanation after RESULT')
+    parser.add_argument('--memory-limit', type=float, default=2048, metavar='MB',
+                        help='give up beyond this much BDD memory (default 2048; exit status 4)')
     parser.add_argument('input', metavar='INPUT')
     parser.add_argument('output', metavar='OUTPUT', nargs='?')
     return parser
 
 
-def read_specification(path: str):
-    """Parse a .slugsin or .structuredslugs file (by extension) into a GR1Specification."""
+def read_specification(path: str, check=None):
+    """Parse a .slugsin or .structuredslugs file (by extension) into a GR1Specification;
+    ``check`` (e.g. an ltl_synthesizer Interrupt) is called regularly while parsing."""
     from respec.parsing import parse_slugsin, parse_structuredslugs
-    text = Path(path).read_text()
     if path.endswith('.structuredslugs'):
-        return parse_structuredslugs(text, filename=path)
+        return parse_structuredslugs(Path(path).read_text(), filename=path, check=check)
     if path.endswith('.slugsin'):
-        return parse_slugsin(text, filename=path)
+        return parse_slugsin(Path(path).read_text(), filename=path, check=check)
     raise ValueError(f"{path}: unknown input format (expected .slugsin or .structuredslugs)")
 
 
@@ -81,38 +94,80 @@ def strategy_to_text(strategy: dict) -> str:
 
 def main(argv=None) -> int:
     args = _parser().parse_args(argv)
-    from respec.parsing import ParseError
-    from ltl_synthesizer import SynthesisCancelled, SynthesisError, synthesize
-    from ltl_synthesizer.strategy import strategy_to_json
+    return run_with_deep_stack(_run, args)
 
+
+def run_with_deep_stack(function, *args):
+    """``function(*args)`` in a thread with a deep stack, so that no formula is too deeply nested."""
+    import threading
+    outcome = {}
+
+    def target():
+        try:
+            outcome['value'] = function(*args)
+        except BaseException as error:  # re-raised in the caller's thread
+            outcome['error'] = error
+
+    previous_stack, previous_limit = threading.stack_size(), sys.getrecursionlimit()
+    threading.stack_size(DEEP_STACK_BYTES)
+    sys.setrecursionlimit(DEEP_RECURSION_LIMIT)
     try:
-        spec = read_specification(args.input)
-    except ParseError as error:
+        worker = threading.Thread(target=target, name='gr1synth', daemon=True)
+        worker.start()
+    finally:
+        threading.stack_size(previous_stack)
+    try:
+        while worker.is_alive():  # a timed join keeps Ctrl-C working in the main thread
+            worker.join(0.1)
+    finally:
+        sys.setrecursionlimit(previous_limit)
+    if 'error' in outcome:
+        raise outcome['error']
+    return outcome['value']
+
+
+def _run(args) -> int:
+    from respec.parsing import ParseError
+    from ltl_synthesizer.errors import (SynthesisCancelled, SynthesisError,
+                                        SynthesisMemoryExceeded)
+    from ltl_synthesizer.symbolic import Interrupt
+
+    deadline = time.monotonic() + args.timeout if args.timeout else None
+    memory_limit = int(args.memory_limit * 2**20) if args.memory_limit > 0 else None
+    interrupt = Interrupt(None, deadline, memory_limit)
+    try:
+        spec = read_specification(args.input, check=interrupt)
+    except SynthesisCancelled as error:
         print(f'gr1synth: error: {error}', file=sys.stderr)
-        return EXIT_USAGE
-    except (OSError, ValueError) as error:
+        return EXIT_TIMEOUT
+    except (ParseError, OSError, ValueError) as error:
         print(f'gr1synth: error: {error}', file=sys.stderr)
-        return EXIT_USAGE
+        return EXIT_MALFORMED
 
     if args.convert:
         _write(spec.to_slugsin(), args.output)
         return 0
 
-    deadline = time.monotonic() + args.timeout if args.timeout else None
+    from ltl_synthesizer.synthesizer import synthesize
     try:
         result = synthesize(spec, robotics_semantics=args.sysInitRoboticsSemantics,
                             deadline=deadline, counterstrategy=args.counterStrategy,
-                            explain=not args.quiet)
+                            explain=args.explain, strategy=args.explicitStrategy,
+                            memory_limit=memory_limit)
     except SynthesisCancelled as error:
         print(f'gr1synth: error: {error}', file=sys.stderr)
-        return 3
+        return EXIT_TIMEOUT
+    except SynthesisMemoryExceeded as error:
+        print(f'gr1synth: error: {error}', file=sys.stderr)
+        return EXIT_MEMORY
     except SynthesisError as error:
         print(f'gr1synth: error: {args.input}: {error}', file=sys.stderr)
-        return EXIT_USAGE
+        return EXIT_MALFORMED
 
     print(REALIZABLE_LINE if result.realizable else UNREALIZABLE_LINE, file=sys.stderr)
-    if not result.realizable and result.explanation and not args.quiet:
+    if not result.realizable and args.explain and result.explanation:
         print(result.explanation, file=sys.stderr)
+    from ltl_synthesizer.strategy import strategy_to_json
     printer = strategy_to_json if args.jsonOutput else strategy_to_text
     if result.realizable and args.explicitStrategy:
         _write(printer(result.strategy), args.output)

@@ -49,3 +49,7 @@ class SynthesisTimedOut(SynthesisCancelled):
 
     def __init__(self, reason: str = 'timeout'):
         super().__init__(reason)
+
+
+class SynthesisMemoryExceeded(SynthesisError):
+    """The synthesis needed more memory than its limit (``item`` is 'memory_limit')."""

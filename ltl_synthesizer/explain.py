@@ -12,7 +12,7 @@ from __future__ import annotations
 from respec.ltl import to_infix
 
 from ltl_synthesizer.gr1 import EnvironmentSolution, SystemSolution
-from ltl_synthesizer.strategy import enumerate_states, extract_counterstrategy, losing_initial_states
+from ltl_synthesizer.strategy import enumerate_states, extract_counterstrategy, losing_initial_positions
 from ltl_synthesizer.symbolic import SymbolicGame
 
 MAX_LISTED_STATES = 3
@@ -47,33 +47,37 @@ def _initial_conditions(game, system, environment, robotics_semantics) -> list[s
         return ['No initial state satisfies both ENV_INIT and SYS_INIT '
                 '(the system initial conditions contradict the environment ones).']
     if system.complete and system.winning == game.false:
-        header = 'No position is winning for the system (the environment wins from everywhere).'
+        where = 'reachable ' if game.options.reachable_only else ''
+        header = f'No {where}position is winning for the system (the environment wins from everywhere).'
     else:
         header = None
-    losing = losing_initial_states(game, environment.winning, robotics_semantics)
-    if not losing:
+    losing = losing_initial_positions(game, environment.winning, robotics_semantics)
+    if losing == game.false:
         # The system solver stopped early; fall back to its own view of the initial positions.
-        losing = enumerate_states(game, initial & ~system.winning, game.variables)
+        losing = initial & ~system.winning
     lines = [header] if header else []
+    # Counted symbolically and listed up to a few: there may be astronomically many.
     if robotics_semantics:
-        lines.append(f'{len(losing)} initial state(s) allowed by ENV_INIT and SYS_INIT are losing '
+        count = _count(game, losing, game.variables)
+        lines.append(f'{count} initial state(s) allowed by ENV_INIT and SYS_INIT are losing '
                      '(robotics semantics requires all to be winning); true propositions:')
-        for state in losing[:MAX_LISTED_STATES]:
+        for state in enumerate_states(game, losing, game.variables, limit=MAX_LISTED_STATES):
             lines.append('  ' + _true_set(game.variables, [state[v] for v in game.variables]))
     else:
-        inputs = []
-        for state in losing:
-            key = tuple(state[name] for name in game.inputs)
-            if key not in inputs:
-                inputs.append(key)
-        lines.append(f'For {len(inputs)} initial input valuation(s) allowed by ENV_INIT no system '
+        losing_inputs = game.bdd.exist(game.outputs, losing)
+        count = _count(game, losing_inputs, game.inputs)
+        lines.append(f'For {count} initial input valuation(s) allowed by ENV_INIT no system '
                      'initial values allowed by SYS_INIT are winning; true inputs:')
-        for key in inputs[:MAX_LISTED_STATES]:
-            lines.append('  ' + _true_set(game.inputs, key))
-    listed = len(losing) if robotics_semantics else len(inputs)
-    if listed > MAX_LISTED_STATES:
-        lines.append(f'  ... and {listed - MAX_LISTED_STATES} more')
+        for state in enumerate_states(game, losing_inputs, game.inputs, limit=MAX_LISTED_STATES):
+            lines.append('  ' + _true_set(game.inputs, [state[v] for v in game.inputs]))
+    if count > MAX_LISTED_STATES:
+        lines.append(f'  ... and {count - MAX_LISTED_STATES} more')
     return lines
+
+
+def _count(game: SymbolicGame, u, names) -> int:
+    """The number of assignments to ``names`` in ``u`` (which depends on no other variable)."""
+    return int(game.bdd.count(u, nvars=len(names))) if names else int(u == game.true)
 
 
 def _blocked_goal_and_play(game: SymbolicGame, play: dict) -> list[str]:
@@ -110,7 +114,7 @@ def _blocked_goal_and_play(game: SymbolicGame, play: dict) -> list[str]:
             lines.append(f'  step {step}: inputs {inputs} -> no output satisfies SYS_TRANS (deadlock)')
             continue
         outputs = _true_set(names[n_inputs:], node['state'][n_inputs:])
-        alternatives = len(node['trans'])
+        alternatives = node.get('responses', len(node['trans']))
         lines.append(f'  step {step}: inputs {inputs} outputs {outputs}'
                      + (f'  ({alternatives} system responses next)' if alternatives > 1 else ''))
     if node_name in visited and deadlock is None:

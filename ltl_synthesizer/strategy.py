@@ -55,10 +55,11 @@ def goal_moves(game: SymbolicGame, steps, env_moves, legal):
     return moves
 
 
-def enumerate_states(game: SymbolicGame, states, names):
-    """All assignments to ``names`` in ``states``, smallest first (``states`` must depend only on names)."""
+def enumerate_states(game: SymbolicGame, states, names, limit: int | None = None):
+    """The assignments to ``names`` in ``states`` (all, or the first ``limit``), smallest first
+    (``states`` must depend only on names)."""
     found = []
-    while states != game.false:
+    while states != game.false and (limit is None or len(found) < limit):
         assignment, single = game.pick(states, names)
         found.append(assignment)
         states &= ~single
@@ -182,9 +183,8 @@ def extract_counterstrategy(game: SymbolicGame, solution: EnvironmentSolution,
             queue.append(key)
         return index[key]
 
-    for state in losing_initial_states(game, solution.winning, robotics_semantics):
-        if play_length is not None and index:
-            break
+    initial = losing_initial_positions(game, solution.winning, robotics_semantics)
+    for state in enumerate_states(game, initial, variables, limit=1 if play_length else None):
         values = tuple(state[name] for name in variables)
         node_id(values, (0, first_blockable_goal(state, level_of(state))))
 
@@ -217,7 +217,11 @@ def extract_counterstrategy(game: SymbolicGame, solution: EnvironmentSolution,
         moves = game.bdd.let(state, strategies[level][goal][assumption])
         chosen_input, input_cube = game.pick(moves, game.next_inputs)
         responses = input_cube & allowed_sys
-        while responses != game.false:
+        if play_length is not None:
+            # One play: its first response is followed; the others are only counted.
+            node['responses'] = int(game.bdd.count(game.bdd.exist(game.next_inputs, responses),
+                                                   nvars=len(game.next_outputs)))
+        while responses != game.false and not (play_length is not None and node['trans']):
             choice, single = game.pick(responses, game.next_outputs)
             transition = dict(state)
             transition.update(chosen_input)
@@ -239,18 +243,23 @@ def extract_counterstrategy(game: SymbolicGame, solution: EnvironmentSolution,
             'nodes': nodes}
 
 
-def losing_initial_states(game: SymbolicGame, environment_wins, robotics_semantics: bool):
-    """Initial positions from which the environment wins, smallest first.
+def losing_initial_positions(game: SymbolicGame, environment_wins, robotics_semantics: bool):
+    """The set of initial positions from which the environment wins.
 
     Robotics semantics: any position allowed by both init sections. Standard semantics: the
     environment picks an initial input for which every system completion loses.
     """
     initial = game.env_init & game.sys_init & environment_wins
     if not robotics_semantics:
-        outputs = game.outputs
-        hopeless_inputs = game.bdd.forall(outputs, ~game.sys_init | environment_wins)
+        hopeless_inputs = game.bdd.forall(game.outputs, ~game.sys_init | environment_wins)
         initial &= hopeless_inputs
-    return enumerate_states(game, initial, game.variables)
+    return initial
+
+
+def losing_initial_states(game: SymbolicGame, environment_wins, robotics_semantics: bool):
+    """The losing initial positions (see losing_initial_positions) as valuations, smallest first."""
+    return enumerate_states(game, losing_initial_positions(game, environment_wins, robotics_semantics),
+                            game.variables)
 
 
 def strategy_to_json(strategy: dict) -> str:

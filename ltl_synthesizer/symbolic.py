@@ -20,7 +20,8 @@ from dd import cudd
 from respec.ltl import And, Const, Formula, Iff, Implies, Next, Not, Or, Var, children, to_infix
 from respec.spec import GR1Specification
 
-from ltl_synthesizer.errors import InvalidFormulaError, SynthesisCancelled, UnknownPropositionError
+from ltl_synthesizer.errors import (InvalidFormulaError, SynthesisCancelled, SynthesisMemoryExceeded,
+                                    UnknownPropositionError)
 
 # Conjuncts are merged into clusters while the cluster's BDD stays below this many nodes: fewer,
 # larger relational products are faster than many tiny ones, up to a point (see bench/): 1000
@@ -49,17 +50,42 @@ class Options:
 
 
 class Interrupt:
-    """Checks a cancel flag and a deadline; called inside every fixpoint step."""
+    """Stops a synthesis on request: a cancel flag, a deadline (a ``time.monotonic()``
+    instant) and a memory limit (bytes of BDD memory). Every long loop of the synthesizer
+    (translation, fixpoints, reachability, extraction, explanation, parsing) calls
+    ``check()``, so a synthesis stops within a few milliseconds of the request, beyond the
+    duration of one BDD operation. The object is also a plain callable (for respec's parser).
+    """
 
-    def __init__(self, cancel: threading.Event | None, deadline: float | None):
+    MEMORY_CHECK_SECONDS = 0.05  # reading CUDD's statistics costs microseconds; not every step
+
+    def __init__(self, cancel: threading.Event | None = None, deadline: float | None = None,
+                 memory_limit: int | None = None):
         self.cancel = cancel
         self.deadline = deadline
+        self.memory_limit = memory_limit
+        self.memory_in_use = None  # a callable returning bytes, set by the game that is watched
+        self._memory_checked_at = 0.0
 
     def check(self) -> None:
         if self.cancel is not None and self.cancel.is_set():
             raise SynthesisCancelled('cancelled')
-        if self.deadline is not None and time.monotonic() >= self.deadline:
+        now = time.monotonic()
+        if self.deadline is not None and now >= self.deadline:
             raise SynthesisCancelled('timeout')
+        if self.memory_limit is not None and self.memory_in_use is not None \
+                and now - self._memory_checked_at >= self.MEMORY_CHECK_SECONDS:
+            self._memory_checked_at = now
+            if self.memory_in_use() > self.memory_limit:
+                raise memory_exceeded(self.memory_limit)
+
+    __call__ = check
+
+
+def memory_exceeded(limit: int) -> SynthesisMemoryExceeded:
+    return SynthesisMemoryExceeded(
+        f'synthesis needs more than its memory limit of {limit / 2**20:.0f} MB '
+        '(memory_limit); simplify the specification or raise the limit', item='memory_limit')
 
 
 @dataclass
@@ -85,6 +111,11 @@ class SymbolicGame:
         self.variables = self.inputs + self.outputs
         self.bdd = cudd.BDD(memory_estimate=MEMORY_ESTIMATE)
         self.bdd.configure(reordering=False)
+        if self.interrupt.memory_limit is not None:
+            # CUDD fails an operation that would go beyond this (synthesize reports it);
+            # the interrupt's own check catches slower growth between operations.
+            self.bdd.configure(max_memory=self.interrupt.memory_limit)
+            self.interrupt.memory_in_use = self.memory_in_use
         for name in _variable_order(spec, self.options.variable_order):
             self.bdd.declare(name, primed(name))
             self.bdd.group({name: 2})  # reordering keeps each pair adjacent (cheap renaming)
@@ -123,6 +154,7 @@ class SymbolicGame:
 
     def translate(self, formula: Formula, section: str) -> cudd.Function:
         """The BDD of a formula over current and next-step variables."""
+        self.interrupt.check()
         if section in ('env_init', 'sys_init') and _mentions_next(formula):
             raise InvalidFormulaError(
                 f'{section}: initial conditions cannot refer to the next step: {to_infix(formula)}',
@@ -198,7 +230,7 @@ class SymbolicGame:
         return _conjoin(self.true, self.sys_partition.clusters)
 
     def _partition(self, parts, quantified: set[str]) -> _Partition:
-        clusters = _cluster(self.bdd, parts, self.options.cluster_limit)
+        clusters = _cluster(self.bdd, parts, self.options.cluster_limit, self.interrupt)
         supports = [self.bdd.support(c) & quantified for c in clusters]
         partition = _Partition(clusters=clusters)
         for index, support in enumerate(supports):
@@ -313,6 +345,7 @@ class SymbolicGame:
         Returns ``(assignment, u restricted to it)``; ``u`` must not be FALSE. Independent of
         the BDD variable order, hence deterministic even with dynamic reordering.
         """
+        self.interrupt.check()
         assignment = {}
         for name in names:
             variable = self.bdd.var(name)
@@ -333,10 +366,17 @@ class SymbolicGame:
             return False
         raise ValueError('assignment does not fix every variable of the function')
 
-    def statistics(self) -> dict:
+    def memory_in_use(self) -> int:
+        """Bytes CUDD holds for this game's BDDs."""
+        return int(self._cudd_statistics()['mem'])
+
+    def _cudd_statistics(self) -> dict:
         with warnings.catch_warnings():  # dd warns that 'mem' is now in bytes; we know
             warnings.simplefilter('ignore')
-            stats = self.bdd.statistics()
+            return self.bdd.statistics()
+
+    def statistics(self) -> dict:
+        stats = self._cudd_statistics()
         return {'bdd_nodes': stats.get('n_nodes'), 'peak_bdd_nodes': stats.get('peak_nodes'),
                 'reorderings': stats.get('n_reorderings'), 'bdd_memory_bytes': stats.get('mem')}
 
@@ -348,11 +388,12 @@ def _conjoin(start, parts):
     return result
 
 
-def _cluster(bdd, parts, limit: int):
+def _cluster(bdd, parts, limit: int, interrupt: Interrupt):
     """Greedily merge consecutive conjuncts while the merged BDD stays under ``limit`` nodes."""
     clusters = []
     current = None
     for part in parts:
+        interrupt.check()
         if part == bdd.true:
             continue
         if current is None:

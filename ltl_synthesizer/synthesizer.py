@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import threading
 import time
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 
 from respec.spec import GR1Specification
@@ -11,7 +12,10 @@ from respec.spec import GR1Specification
 from ltl_synthesizer.explain import explain_unrealizable
 from ltl_synthesizer.gr1 import solve_environment_game, solve_system_game
 from ltl_synthesizer.strategy import extract_counterstrategy, extract_strategy
-from ltl_synthesizer.symbolic import Interrupt, Options, SymbolicGame
+from ltl_synthesizer.symbolic import Interrupt, Options, SymbolicGame, memory_exceeded
+
+# Default memory limit of one synthesis: BDD memory, in bytes.
+DEFAULT_MEMORY_LIMIT = 2 * 2**30
 
 
 @dataclass
@@ -39,15 +43,47 @@ def initial_positions_win(game: SymbolicGame, winning, robotics_semantics: bool)
 def synthesize(spec: GR1Specification, robotics_semantics: bool = True,
                cancel: threading.Event | None = None, deadline: float | None = None,
                counterstrategy: bool = False, explain: bool = True,
-               options: Options | None = None) -> SynthesisResult:
-    """Decide realizability of ``spec`` and extract an explicit strategy (or counter-strategy).
+               options: Options | None = None, strategy: bool = True,
+               memory_limit: int | None = DEFAULT_MEMORY_LIMIT) -> SynthesisResult:
+    """Decide realizability of ``spec``; extract an explicit strategy (``strategy``), or a
+    counter-strategy (``counterstrategy``) and an explanation (``explain``) when unrealizable.
 
-    Raises ``SynthesisCancelled`` when ``cancel`` is set or ``deadline`` (a
-    ``time.monotonic()`` instant) passes; ``UnknownPropositionError`` /
-    ``InvalidFormulaError`` for formulas outside the declared propositions or GR(1).
+    Limits (all optional, checked in every long loop of every phase): ``cancel`` (a
+    threading.Event) raises ``SynthesisCancelled`` (code PREEMPTED), ``deadline`` (a
+    ``time.monotonic()`` instant) raises ``SynthesisCancelled`` (code SYNTHESIS_TIMEOUT),
+    ``memory_limit`` (bytes of BDD memory, default 2 GiB) raises ``SynthesisMemoryExceeded``.
+    ``UnknownPropositionError`` / ``InvalidFormulaError`` for formulas outside the declared
+    propositions or GR(1).
     """
+    interrupt = Interrupt(cancel, deadline, memory_limit)
+    with _memory_failures_reported(memory_limit):
+        return _synthesize(spec, robotics_semantics, interrupt, counterstrategy, explain,
+                           options, strategy)
+
+
+def is_realizable(spec: GR1Specification, robotics_semantics: bool = True,
+                  cancel: threading.Event | None = None, deadline: float | None = None,
+                  memory_limit: int | None = DEFAULT_MEMORY_LIMIT,
+                  options: Options | None = None) -> bool:
+    """Only the verdict (no strategy, no explanation); same limits as ``synthesize``."""
+    return synthesize(spec, robotics_semantics, cancel, deadline, explain=False, options=options,
+                      strategy=False, memory_limit=memory_limit).realizable
+
+
+@contextmanager
+def _memory_failures_reported(memory_limit: int | None):
+    """CUDD fails an operation beyond its memory limit; dd reports that as a NULL node."""
+    try:
+        yield
+    except ValueError as error:
+        if memory_limit is not None and 'NULL' in str(error):
+            raise memory_exceeded(memory_limit) from error
+        raise
+
+
+def _synthesize(spec, robotics_semantics, interrupt, counterstrategy, explain, options,
+                strategy) -> SynthesisResult:
     start = time.perf_counter()
-    interrupt = Interrupt(cancel, deadline)
     interrupt.check()
     game = SymbolicGame(spec, options, interrupt)
     built = time.perf_counter()
@@ -60,7 +96,8 @@ def synthesize(spec: GR1Specification, robotics_semantics: bool = True,
     solved = time.perf_counter()
     result = SynthesisResult(realizable=realizable)
     if realizable:
-        result.strategy = extract_strategy(game, solution)
+        if strategy:
+            result.strategy = extract_strategy(game, solution)
         if game.env_init & game.sys_init == game.false:
             result.stats['warnings'] = ['ENV_INIT and SYS_INIT are contradictory: realizable '
                                         'vacuously, the strategy has no initial state']

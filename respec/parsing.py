@@ -29,6 +29,8 @@ from __future__ import annotations
 import itertools
 import re
 from dataclasses import dataclass, field
+from functools import lru_cache
+from typing import NamedTuple
 
 from respec.errors import CodedError
 from respec.ltl import (
@@ -69,8 +71,7 @@ class UnknownVariableError(ParseError):
     code = 'UNKNOWN_PROPOSITION'
 
 
-@dataclass(frozen=True)
-class _Token:
+class _Token(NamedTuple):
     kind: str       # 'name', 'primed', 'number', 'op', 'TRUE', 'FALSE', 'next', 'end'
     text: str
     line: int
@@ -107,62 +108,55 @@ _ANY = _Scope(None, None, None)
 
 # --- infix (structured slugs) -------------------------------------------------------------
 
-# Longest alternatives first; each maps to a canonical operator.
-_INFIX_OPERATORS = [
-    ('<-->', '<->'), ('<->', '<->'), ('-->', '->'), ('->', '->'), ('&&', '&'), ('||', '|'),
-    ('/\\', '&'), ('\\/', '|'), ('&', '&'), ('|', '|'), ('^', '^'), ('!=', '!='), ('!', '!'),
-    ('~', '!'), ('(', '('), (')', ')'),
+# Each spelling of an operator -> its canonical form.
+_INFIX_OPERATORS = {
+    '<-->': '<->', '<->': '<->', '-->': '->', '->': '->', '&&': '&', '||': '|',
+    '/\\': '&', '\\/': '|', '&': '&', '|': '|', '^': '^', '!=': '!=', '!': '!',
+    '~': '!', '(': '(', ')': ')',
     # Integer comparisons and addition (structured slugs' integer variables).
-    ('<=', '<='), ('>=', '>='), ('<', '<'), ('>', '>'), ('=', '='), ('+', '+'),
-]
+    '<=': '<=', '>=': '>=', '<': '<', '>': '>', '=': '=', '+': '+',
+}
+# One scanner for all tokens (longest operator spellings first); much faster than a
+# character loop on large files.
+_INFIX_TOKEN = re.compile(
+    r"(?P<space>[^\S\n]+)|(?P<newline>\n)|(?P<comment>#[^\n]*)|(?P<number>[0-9]+)"
+    r"|(?P<name>[A-Za-z_][A-Za-z0-9_.@]*)(?P<prime>')?"
+    r"|(?P<op>" + '|'.join(re.escape(spelling) for spelling in
+                           sorted(_INFIX_OPERATORS, key=len, reverse=True)) + r")"
+    r"|(?P<bad>.)")
 _COMPARATORS = {
     '=': lambda a, b: a == b, '!=': lambda a, b: a != b, '<': lambda a, b: a < b,
     '<=': lambda a, b: a <= b, '>': lambda a, b: a > b, '>=': lambda a, b: a >= b,
 }
 _MAX_EXPANSION = 1 << 16   # valuations enumerated to expand one integer comparison
-_BINARY_LEVELS = ['<->', '->', '^', '|', '&']     # loosest first
+# Binary operators by binding strength, loosest first (all left associative).
+_BINARY_LEVEL = {'<->': 0, '->': 1, '^': 2, '|': 3, '&': 4}
 
 
 def _infix_tokens(text: str, source: _Source) -> list[_Token]:
-    tokens, line, line_start, position = [], 1, 0, 0
-    while position < len(text):
-        char = text[position]
-        column = position - line_start + 1
-        if char == '\n':
-            line, line_start, position = line + 1, position + 1, position + 1
+    tokens, line, line_start = [], 1, 0
+    append = tokens.append
+    for match in _INFIX_TOKEN.finditer(text):
+        kind = match.lastgroup
+        if kind == 'space' or kind == 'comment':
             continue
-        if char.isspace():
-            position += 1
+        if kind == 'newline':
+            line, line_start = line + 1, match.end()
             continue
-        if char == '#':      # comment to the end of the line
-            end = text.find('\n', position)
-            position = len(text) if end < 0 else end
-            continue
-        number = _NUMBER.match(text, position)
-        if number:
-            tokens.append(_Token('number', number.group(), line, column))
-            position = number.end()
-            continue
-        match = _NAME.match(text, position)
-        if match:
+        column = match.start() - line_start + 1
+        if kind == 'prime':  # a name followed by a prime: the last group that matched
+            append(_Token('primed', match.group('name'), line, column))
+        elif kind == 'name':
             word = match.group()
-            position = match.end()
-            if word in _KEYWORDS:
-                tokens.append(_Token(word, word, line, column))
-            elif text.startswith("'", position):
-                position += 1
-                tokens.append(_Token('primed', word, line, column))
-            else:
-                tokens.append(_Token('name', word, line, column))
-            continue
-        for spelling, operator in _INFIX_OPERATORS:
-            if text.startswith(spelling, position):
-                tokens.append(_Token('op', operator, line, column))
-                position += len(spelling)
-                break
+            append(_Token(word, word, line, column) if word in _KEYWORDS
+                   else _Token('name', word, line, column))
+        elif kind == 'op':
+            append(_Token('op', _INFIX_OPERATORS[match.group()], line, column))
+        elif kind == 'number':
+            append(_Token('number', match.group(), line, column))
         else:
-            raise source.error('unexpected character', char, line, column)
-    tokens.append(_Token('end', '', line, position - line_start + 1))
+            raise source.error('unexpected character', match.group(), line, column)
+    append(_Token('end', '', line, len(text) - line_start + 1))
     return tokens
 
 
@@ -196,15 +190,17 @@ class _InfixParser:
         return self.source.error(problem, text, token.line, token.column, kind)
 
     def binary(self, level: int, in_next: bool) -> Formula:
-        if level == len(_BINARY_LEVELS):
-            return self.unary(in_next)
-        operator = _BINARY_LEVELS[level]
-        left = self.binary(level + 1, in_next)
-        while self.peek().kind == 'op' and self.peek().text == operator:
-            self.take()
-            right = self.binary(level + 1, in_next)
-            left = _combine(operator, left, right)
-        return left
+        """Operators binding at least as strongly as ``level`` (precedence climbing)."""
+        left = self.unary(in_next)
+        tokens = self.tokens
+        while True:
+            token = tokens[self.position]
+            operator_level = _BINARY_LEVEL.get(token.text) if token.kind == 'op' else None
+            if operator_level is None or operator_level < level:
+                return left
+            self.position += 1
+            right = self.binary(operator_level + 1, in_next)  # left associative
+            left = _combine(token.text, left, right)
 
     def unary(self, in_next: bool) -> Formula:
         token = self.peek()
@@ -296,7 +292,13 @@ class _InfixParser:
         if problem:
             kind = UnknownVariableError if problem.startswith('unknown') else ParseError
             raise self.error(problem, token, kind)
-        return var(token.text)
+        return _var(token.text)
+
+
+@lru_cache(maxsize=1 << 16)
+def _var(name: str) -> Var:
+    """One shared node per proposition name: large specifications mention each many times."""
+    return var(name)
 
 
 def _combine(operator: str, left: Formula, right: Formula) -> Formula:
@@ -460,7 +462,7 @@ class _PrefixParser:
         if problem:
             kind = UnknownVariableError if problem.startswith('unknown') else ParseError
             raise self.error(problem, token, kind)
-        return next_(var(name)) if primed else var(name)
+        return next_(_var(name)) if primed else _var(name)
 
 
 # --- public API ---------------------------------------------------------------------------
@@ -501,21 +503,25 @@ def _scopes(env_props: list[str], sys_props: list[str], integers=None) -> dict[s
     }
 
 
-def parse_structuredslugs(text: str, filename: str = '<string>') -> GR1Specification:
+def parse_structuredslugs(text: str, filename: str = '<string>', check=None) -> GR1Specification:
     """Parse a ``.structuredslugs`` file: one infix conjunct per non-empty line.
 
     Like slugs' structured compiler, a line that is not infix but is a valid slugsin prefix
-    formula is accepted as prefix.
+    formula is accepted as prefix. ``check``, if given, is called every few hundred lines
+    (e.g. a synthesizer's Interrupt, which raises to stop a long parse).
     """
-    return _parse_slugs_file(text, filename, syntax='infix')
+    return _parse_slugs_file(text, filename, 'infix', check)
 
 
-def parse_slugsin(text: str, filename: str = '<string>') -> GR1Specification:
-    """Parse a ``.slugsin`` file: one prefix conjunct per non-empty line."""
-    return _parse_slugs_file(text, filename, syntax='prefix')
+def parse_slugsin(text: str, filename: str = '<string>', check=None) -> GR1Specification:
+    """Parse a ``.slugsin`` file: one prefix conjunct per non-empty line (``check``: as above)."""
+    return _parse_slugs_file(text, filename, 'prefix', check)
 
 
-def _parse_slugs_file(text: str, filename: str, syntax: str) -> GR1Specification:
+_LINES_BETWEEN_CHECKS = 256
+
+
+def _parse_slugs_file(text: str, filename: str, syntax: str, check=None) -> GR1Specification:
     lines_by_section: dict[str, list[tuple[int, int, str]]] = {s: [] for s in PROPOSITION_SECTIONS + FORMULA_SECTIONS}
     section = None
     for number, raw in enumerate(text.splitlines(), start=1):
@@ -557,9 +563,12 @@ def _parse_slugs_file(text: str, filename: str, syntax: str) -> GR1Specification
     scopes = _scopes(declared['env_props'], declared['sys_props'], integers)
     formulas = {}
     for section in FORMULA_SECTIONS:
-        formulas[section] = [
-            _parse_line(line, syntax, scopes[section], _Source(filename, number, column))
-            for number, column, line in lines_by_section[section]]
+        formulas[section] = []
+        for count, (number, column, line) in enumerate(lines_by_section[section]):
+            if check is not None and count % _LINES_BETWEEN_CHECKS == 0:
+                check()
+            formulas[section].append(_parse_line(line, syntax, scopes[section],
+                                                 _Source(filename, number, column)))
     # Like slugs' compiler, keep integers in range: initially and after every step.
     for variable in integers.values():
         owner = 'env' if variable.bits and variable.bits[0] in declared['env_props'] else 'sys'

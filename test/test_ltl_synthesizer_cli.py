@@ -3,6 +3,7 @@
 import json
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import pytest
@@ -76,12 +77,23 @@ def test_slugsin_input_and_strategy_on_stdout(tmp_path):
     assert 'State 0 with rank 0 -> <x:0, y:0>\n\tWith successors : 0, 1' in text.stdout
 
 
-def test_unrealizable_exits_zero_and_explains(tmp_path):
+def test_unrealizable_exits_zero_and_explains_only_when_asked(tmp_path):
     source = write(tmp_path, 'block.structuredslugs', UNREALIZABLE)
-    done = gr1synth('--explicitStrategy', '--jsonOutput', source, tmp_path / 'out.json')
+    done = gr1synth('--explicitStrategy', '--jsonOutput', '--explain', source, tmp_path / 'out.json')
     assert done.returncode == 0
     assert done.stderr.splitlines()[0] == 'RESULT: Specification is unrealizable.'
     assert "system liveness #0 'x'" in done.stderr
+    assert not (tmp_path / 'out.json').exists()
+    # As slugs: without --explain, just the verdict.
+    done = gr1synth('--explicitStrategy', '--jsonOutput', source, tmp_path / 'out.json')
+    assert done.returncode == 0 and done.stderr == 'RESULT: Specification is unrealizable.\n'
+
+
+def test_without_explicit_strategy_only_the_verdict(tmp_path):
+    source = write(tmp_path, 'copy.structuredslugs', REALIZABLE)
+    done = gr1synth(source, tmp_path / 'out.json')
+    assert done.returncode == 0 and done.stdout == ''
+    assert done.stderr == 'RESULT: Specification is realizable.\n'
     assert not (tmp_path / 'out.json').exists()
 
 
@@ -100,12 +112,43 @@ def test_counterstrategy_output(tmp_path):
 def test_malformed_file_names_the_place_and_token(tmp_path, name, text, location):
     source = write(tmp_path, name, text)
     done = gr1synth(source)
-    assert done.returncode == 2
+    assert done.returncode == 1  # as slugs
     assert done.stderr.startswith('gr1synth: error: ') and str(source) + location in done.stderr
     assert 'RESULT' not in done.stderr
 
 
 def test_missing_file_and_unknown_extension(tmp_path):
-    assert gr1synth(tmp_path / 'nothing.slugsin').returncode == 2
+    assert gr1synth(tmp_path / 'nothing.slugsin').returncode == 1
     done = gr1synth(write(tmp_path, 'spec.txt', REALIZABLE))
-    assert done.returncode == 2 and 'expected .slugsin or .structuredslugs' in done.stderr
+    assert done.returncode == 1 and 'expected .slugsin or .structuredslugs' in done.stderr
+
+
+@pytest.mark.parametrize('name, formula', [
+    ('deep.structuredslugs', '(' * 10_000 + 'x' + ')' * 10_000),
+    ('alternating.structuredslugs', '(x & (y | ' * 5_000 + 'x' + '))' * 5_000),
+    ('deep.slugsin', '| x & y ' * 5_000 + 'x'),
+])
+def test_formulas_nested_10000_deep_are_synthesized(tmp_path, name, formula):
+    if name.endswith('.slugsin'):
+        text = f'[INPUT]\nx\n\n[OUTPUT]\ny\n\n[SYS_LIVENESS]\n{formula}\n'
+    else:
+        text = f'[INPUT]\nx\n\n[OUTPUT]\ny\n\n[SYS_TRANS]\n{formula} | TRUE\n'
+    done = gr1synth('--explicitStrategy', write(tmp_path, name, text))
+    assert done.returncode == 0, done.stderr
+    assert done.stderr.startswith('RESULT: Specification is ')
+
+
+# 100 inputs and 100 outputs that nothing constrains: solving is instant, but there are 2**200
+# initial states to enumerate (the reproducer of issue 15: the time limit used to be ignored).
+RUNAWAY = ('[INPUT]\n' + '\n'.join(f'x{i}' for i in range(100)) + '\n\n[OUTPUT]\n'
+           + '\n'.join(f'y{i}' for i in range(100)) + '\n\n[SYS_LIVENESS]\ny0\n')
+
+
+def test_the_time_limit_stops_a_runaway_strategy_extraction(tmp_path):
+    started = time.monotonic()
+    done = gr1synth('--explicitStrategy', '--timeout', '2', write(tmp_path, 'runaway.structuredslugs', RUNAWAY))
+    assert done.returncode == 3 and 'synthesis timeout' in done.stderr
+    assert time.monotonic() - started < 2 + 10  # interpreter start-up on a loaded machine included
+    # Without --explicitStrategy there is nothing to enumerate: the verdict comes at once.
+    done = gr1synth('--timeout', '60', write(tmp_path, 'runaway.structuredslugs', RUNAWAY))
+    assert done.returncode == 0 and 'realizable' in done.stderr

@@ -1,0 +1,80 @@
+"""Every limit of a synthesis is enforced in every phase: time limit, cancel, memory limit."""
+
+import threading
+import time
+
+import pytest
+
+from ltl_synthesizer import (Interrupt, SynthesisCancelled, SynthesisMemoryExceeded, is_realizable,
+                             synthesize)
+from respec.ltl import conj, disj, iff, neg, next_, var
+from respec.parsing import parse_structuredslugs
+from respec.spec import GR1Specification
+
+
+def runaway_spec(size=100):
+    """``size`` inputs and outputs that nothing constrains: solved at once, but 2**(2 size)
+    initial states for the strategy (issue 15's reproducer: the time limit was ignored)."""
+    return GR1Specification(env_props=[f'x{i}' for i in range(size)],
+                            sys_props=[f'y{i}' for i in range(size)], sys_liveness=[var('y0')])
+
+
+def exponential_spec(pairs=20):
+    """next(y_i) <-> x_i for all i, with every x ordered before every y (the first formula
+    mentions them so): the BDD of the conjunction has 2**pairs nodes."""
+    xs, ys = [var(f'x{i}') for i in range(pairs)], [var(f'y{i}') for i in range(pairs)]
+    order = disj(xs + ys + [neg(xs[0])])
+    return GR1Specification(env_props=[x.name for x in xs], sys_props=[y.name for y in ys],
+                            sys_trans=[order, conj([iff(next_(y), x) for x, y in zip(xs, ys)])])
+
+
+@pytest.mark.parametrize('robotics_semantics', [True, False])
+def test_the_deadline_stops_strategy_extraction_within_a_second(robotics_semantics):
+    started = time.monotonic()
+    with pytest.raises(SynthesisCancelled) as raised:
+        synthesize(runaway_spec(), robotics_semantics=robotics_semantics, deadline=started + 1.0)
+    assert raised.value.code == 'SYNTHESIS_TIMEOUT'
+    assert time.monotonic() - started < 2.0
+
+
+def test_cancel_stops_a_runaway_within_a_second():
+    cancel = threading.Event()
+    threading.Timer(0.5, cancel.set).start()
+    started = time.monotonic()
+    with pytest.raises(SynthesisCancelled) as raised:
+        synthesize(runaway_spec(), cancel=cancel)
+    assert raised.value.code == 'PREEMPTED'
+    assert time.monotonic() - started < 1.5
+
+
+def test_the_verdict_alone_of_the_runaway_is_immediate():
+    started = time.monotonic()
+    assert is_realizable(runaway_spec(), deadline=started + 30)
+    assert time.monotonic() - started < 5
+
+
+def test_the_memory_limit_ends_a_blow_up_with_a_clear_error():
+    limit = 48 * 2**20
+    with pytest.raises(SynthesisMemoryExceeded) as raised:
+        synthesize(exponential_spec(), memory_limit=limit)
+    assert raised.value.code == 'SYNTHESIS_FAILED' and raised.value.item == 'memory_limit'
+    assert 'memory limit of 48 MB' in str(raised.value)
+
+
+def test_unrealizable_runaway_explanation_is_bounded_too():
+    # The same free propositions, but a goal the environment blocks: every one of the 2**200
+    # initial states loses. The explanation counts them symbolically instead of listing them.
+    spec = runaway_spec()
+    spec.sys_liveness = [var('x0')]
+    result = synthesize(spec, deadline=time.monotonic() + 30)
+    assert not result.realizable
+    assert f'{2**200} initial state(s)' in result.explanation.replace('.0 initial', ' initial')
+
+
+def test_parsing_checks_the_interrupt():
+    text = '[INPUT]\nx\n\n[OUTPUT]\ny\n\n[SYS_TRANS]\n' + 'x -> next(y)\n' * 5000
+    cancel = threading.Event()
+    cancel.set()
+    with pytest.raises(SynthesisCancelled):
+        parse_structuredslugs(text, check=Interrupt(cancel))
+    assert len(parse_structuredslugs(text, check=Interrupt()).sys_trans) == 5000

@@ -16,7 +16,6 @@ from synthesis_manager.requests import InvalidRequest, selected_option
 from synthesis_manager.ros.env import prepare_ros_environment
 
 CLI = [str(Path(sys.executable).parent / 'behavior-synthesis')]
-LONG_GOALS = 'look_down,pickup_object,grasp_object,pregrasp,approach_object,footstep_execution,walk'
 
 
 @pytest.mark.parametrize('text, names', [
@@ -82,10 +81,14 @@ def test_send_goal_fails_with_the_code_and_message(served):
     assert outcome['error_name'] == 'UNKNOWN_PROPOSITION' and 'levitate' in outcome['message']
 
 
-def test_ctrl_c_cancels_the_goal(served):
-    process = subprocess.Popen(CLI + ['send-goal', '--goals', LONG_GOALS, '--json'], env=served,
-                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    time.sleep(3.0)  # connected and synthesizing
+def test_ctrl_c_cancels_the_goal(served, tmp_path):
+    # A synthesis that never ends by itself: 2**80 initial states for the strategy.
+    runaway = tmp_path / 'runaway.json'
+    runaway.write_text(json.dumps({'env_props': [f'x{i}' for i in range(40)],
+                                   'sys_props': [f'y{i}' for i in range(40)], 'sys_liveness': ['y0']}))
+    process = subprocess.Popen(CLI + ['send-goal', '--synthesis-only', str(runaway), '--json'],
+                               env=served, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    time.sleep(8.0)  # connected and synthesizing (the synthesis never ends by itself)
     process.send_signal(signal.SIGINT)
     stdout, stderr = process.communicate(timeout=30)
     assert process.returncode == 1, stderr

@@ -3,14 +3,18 @@
 On random small specifications (2-5 inputs, 2-5 outputs, next-step operators in safety and
 liveness sections) both must agree on realizability under both initial-state semantics,
 every strategy must pass the oracle's model check and every counter-strategy must be a
-winning environment strategy.
+winning environment strategy; the symbolic winning region must be the oracle's winning states
+(restricted to the reachable ones when the solver is).
 """
 
+import numpy as np
 from hypothesis import HealthCheck, event, given, settings
 from hypothesis import strategies as st
 
 from gr1_oracle import Oracle, formulas
-from ltl_synthesizer import synthesize
+from ltl_synthesizer import Options, synthesize
+from ltl_synthesizer.gr1 import solve_system_game
+from ltl_synthesizer.symbolic import SymbolicGame
 from respec.ltl import implies, neg, next_, var
 from respec.spec import GR1Specification
 
@@ -68,3 +72,29 @@ def test_synthesizer_agrees_with_oracle_and_its_strategies_check(spec):
         else:
             assert result.counterstrategy is not None
             assert oracle.check_counterstrategy(result.counterstrategy, robotics_semantics) == []
+
+
+def explicit_reachable(game) -> np.ndarray:
+    """States reachable from the initial ones by moves allowed by both safety sections."""
+    legal = game.env_trans & game.sys_trans
+    reached = frontier = game.init.copy()
+    while frontier.any():
+        frontier = legal[frontier].any(axis=0) & ~reached
+        reached |= frontier
+    return reached
+
+
+@settings(max_examples=60, deadline=None, database=None, suppress_health_check=[HealthCheck.too_slow])
+@given(specifications(max_inputs=4, max_outputs=4))
+def test_symbolic_winning_region_equals_the_oracles_winning_states(spec):
+    """Not only the verdict: the whole fixpoint, on all positions and on the reachable ones."""
+    oracle = Oracle(spec)
+    explicit = oracle.game
+    for reachable_only in (False, True):
+        game = SymbolicGame(spec, Options(reachable_only=reachable_only))
+        solution = solve_system_game(game)  # no early stop: the whole region
+        symbolic = np.array([game.evaluate(solution.winning, dict(zip(explicit.names, explicit.valuation(s))))
+                             for s in range(explicit.S)])
+        expected = oracle.winning & explicit_reachable(explicit) if reachable_only else oracle.winning
+        assert (symbolic == expected).all(), (f'reachable_only={reachable_only}\n'
+                                              f'{spec.to_structuredslugs()}')

@@ -88,28 +88,40 @@ def _moves_from(game: SymbolicGame, state: dict[str, bool]):
     return env_moves, legal
 
 
+class _Numbering:
+    """Nodes (valuation, rank) numbered in order of discovery, breadth-first: ``queue`` holds
+    the discovered nodes not yet expanded."""
+
+    def __init__(self):
+        self.index: dict[tuple, int] = {}
+        self.queue: deque = deque()
+
+    def number(self, values: tuple, rank) -> int:
+        key = (values, rank)
+        if key not in self.index:
+            self.index[key] = len(self.index)
+            self.queue.append(key)
+        return self.index[key]
+
+
+def _strategy_json(variables, nodes: dict) -> dict:
+    return {'version': FORMAT_VERSION, 'slugs': SLUGS_VERSION, 'variables': list(variables),
+            'nodes': nodes}
+
+
 def extract_strategy(game: SymbolicGame, solution: SystemSolution) -> dict:
     """The explicit strategy as slugs' JSON object (``nodes`` keyed by decimal strings)."""
     steps = goal_steps(game, solution)
     variables = game.variables
     next_names = game.next_inputs + game.next_outputs
-    index: dict[tuple, int] = {}
-    queue: deque = deque()
-
-    def node_id(values: tuple, rank: int) -> int:
-        key = (values, rank)
-        if key not in index:
-            index[key] = len(index)
-            queue.append(key)
-        return index[key]
-
+    numbering = _Numbering()
     initial = solution.winning & game.env_init & game.sys_init
     for state in enumerate_states(game, initial, variables):
-        node_id(tuple(state[name] for name in variables), 0)
+        numbering.number(tuple(state[name] for name in variables), 0)
 
     nodes = {}
-    while queue:
-        values, rank = queue.popleft()
+    while numbering.queue:
+        values, rank = numbering.queue.popleft()
         game.interrupt.check()
         state = dict(zip(variables, values))
         env_moves, legal = _moves_from(game, state)
@@ -122,13 +134,12 @@ def extract_strategy(game: SymbolicGame, solution: SystemSolution) -> dict:
             transition.update(choice)
             next_rank = _successor_goal(game, game.sys_goals, rank, transition)
             next_values = tuple(choice[game.to_next[name]] for name in variables)
-            successors.append(node_id(next_values, next_rank))
+            successors.append(numbering.number(next_values, next_rank))
             # One response per environment move: drop every move with the same next inputs.
             moves &= ~game.cube({name: choice[name] for name in game.next_inputs})
-        nodes[str(index[(values, rank)])] = {
+        nodes[str(numbering.index[(values, rank)])] = {
             'rank': rank, 'state': [int(v) for v in values], 'trans': successors}
-    return {'version': FORMAT_VERSION, 'slugs': SLUGS_VERSION, 'variables': list(variables),
-            'nodes': nodes}
+    return _strategy_json(variables, nodes)
 
 
 def extract_counterstrategy(game: SymbolicGame, solution: EnvironmentSolution,
@@ -136,19 +147,108 @@ def extract_counterstrategy(game: SymbolicGame, solution: EnvironmentSolution,
     """The environment's explicit winning strategy (slugs' ``--counterStrategy`` as JSON).
 
     A node is (valuation, i, j) and its ``rank`` is ``[i, j]``: the environment works towards
-    its assumption i while blocking system goal j. The position's level k (first iteration of
-    the environment's outer fixpoint that contains it) fixes which moves to use; j stays fixed
-    while the play stays on that level and is chosen afresh (the first goal blockable there)
-    when it drops to a lower one, so no play can satisfy every system goal. Each node lists
+    its assumption i while blocking system goal j (see EnvironmentStrategy). Each node lists
     the system responses allowed by sys_trans to the environment's chosen next input. When the
     environment can pick an input to which no output is allowed by sys_trans, the successor
     is a deadlock node whose outputs are ``null`` and which has no successors.
 
     With ``play_length``, only one play is unfolded: from the first initial node, always the
-    first successor, for at most that many nodes (used to explain unrealizability cheaply).
+    first successor, for at most that many nodes (used to explain unrealizability cheaply);
+    its nodes also count the system's responses (``responses``).
     """
-    goals, assumptions = game.sys_goals, game.env_goals
-    # Per level, goal and assumption: the first (lowest X rank) environment moves at each position.
+    environment = EnvironmentStrategy(game, solution)
+    one_play = play_length is not None
+    numbering = _Numbering()
+    initial = losing_initial_positions(game, solution.winning, robotics_semantics)
+    for state in enumerate_states(game, initial, game.variables, limit=1 if one_play else None):
+        numbering.number(tuple(state[name] for name in game.variables),
+                         (0, environment.first_blockable_goal(state)))
+    nodes: dict[str, dict] = {}
+    while numbering.queue and not (one_play and len(nodes) >= play_length):
+        values, rank = numbering.queue.popleft()
+        game.interrupt.check()
+        node = {'rank': list(rank), 'state': [None if v is None else int(v) for v in values],
+                'trans': []}
+        nodes[str(numbering.index[(values, rank)])] = node
+        if None in values:  # a deadlock node: nothing follows
+            continue
+        successors = environment.successors(dict(zip(game.variables, values)), rank, one_play)
+        if one_play:
+            node['responses'] = environment.responses_counted
+        node['trans'] = [numbering.number(*successor) for successor in successors]
+    return _strategy_json(game.variables, nodes)
+
+
+class EnvironmentStrategy:
+    """The environment's winning moves, from the levels of its attractor.
+
+    The position's level k (first iteration of the environment's outer fixpoint that contains
+    it) fixes which moves to use; the blocked goal j stays fixed while the play stays on that
+    level and is chosen afresh (the first goal blockable there) when it drops to a lower one,
+    so no play can satisfy every system goal.
+    """
+
+    def __init__(self, game: SymbolicGame, solution: EnvironmentSolution):
+        self.game = game
+        self.levels = solution.levels
+        self.moves = _first_environment_moves(game, solution)
+        self.env_trans = game.env_trans()
+        self.sys_trans = game.sys_trans()
+        self.responses_counted = 0
+
+    def level_of(self, state) -> int:
+        # Z_k grows with k, so the first level whose blocking sets contain the position.
+        return next(k for k, level in enumerate(self.levels)
+                    if any(self.game.evaluate(blocking, state) for blocking in level.blocking))
+
+    def first_blockable_goal(self, state, level: int | None = None) -> int:
+        level = self.level_of(state) if level is None else level
+        return next(j for j, blocking in enumerate(self.levels[level].blocking)
+                    if self.game.evaluate(blocking, state))
+
+    def successors(self, state: dict, rank: tuple, only_first: bool) -> list[tuple]:
+        """The successor nodes (values, rank) of node (state, rank): a deadlock node when the
+        environment can leave the system no legal output, else one per system response to
+        the environment's chosen input (only the first with ``only_first``)."""
+        game = self.game
+        allowed_sys = game.bdd.let(state, self.sys_trans)
+        deadlock = self._deadlock_input(state, allowed_sys)
+        if deadlock is not None:
+            return [(deadlock, rank)]
+        assumption, goal = rank
+        level = self.level_of(state)
+        moves = game.bdd.let(state, self.moves[level][goal][assumption])
+        chosen_input, input_cube = game.pick(moves, game.next_inputs)
+        responses = input_cube & allowed_sys
+        self.responses_counted = int(game.bdd.count(game.bdd.exist(game.next_inputs, responses),
+                                                    nvars=len(game.next_outputs)))
+        successors = []
+        while responses != game.false and not (only_first and successors):
+            choice, single = game.pick(responses, game.next_outputs)
+            transition = {**state, **chosen_input, **choice}
+            next_state = {name: transition[game.to_next[name]] for name in game.variables}
+            next_assumption = _successor_goal(game, game.env_goals, assumption, transition)
+            next_level = self.level_of(next_state)
+            next_goal = goal if next_level == level else self.first_blockable_goal(next_state, next_level)
+            successors.append((tuple(next_state[name] for name in game.variables),
+                               (next_assumption, next_goal)))
+            responses &= ~single
+        return successors
+
+    def _deadlock_input(self, state: dict, allowed_sys) -> tuple | None:
+        """The values of a deadlock node (chosen inputs, no outputs), if the environment can
+        move so that no output satisfies sys_trans."""
+        game = self.game
+        allowed_env = game.bdd.let(state, self.env_trans)
+        deadlock_inputs = game.bdd.forall(game.next_outputs, allowed_env & ~allowed_sys)
+        if deadlock_inputs == game.false:
+            return None
+        choice, _ = game.pick(deadlock_inputs, game.next_inputs)
+        return tuple(choice[game.to_next[name]] for name in game.inputs) + (None,) * len(game.outputs)
+
+
+def _first_environment_moves(game: SymbolicGame, solution: EnvironmentSolution) -> list:
+    """Per level, goal and assumption: the environment moves of lowest X rank at each position."""
     strategies = []
     for level in solution.levels:
         per_goal = []
@@ -161,86 +261,7 @@ def extract_counterstrategy(game: SymbolicGame, solution: EnvironmentSolution,
                 per_assumption.append(strategy)
             per_goal.append(per_assumption)
         strategies.append(per_goal)
-
-    def level_of(state) -> int:
-        # Z_k grows with k, so the first level whose blocking sets contain the position.
-        return next(k for k, level in enumerate(solution.levels)
-                    if any(game.evaluate(blocking, state) for blocking in level.blocking))
-
-    def first_blockable_goal(state, k) -> int:
-        return next(j for j, blocking in enumerate(solution.levels[k].blocking)
-                    if game.evaluate(blocking, state))
-
-    variables = game.variables
-    index: dict[tuple, int] = {}
-    queue: deque = deque()
-    nodes: dict[str, dict] = {}
-
-    def node_id(values: tuple, rank: tuple) -> int:
-        key = (values, rank)
-        if key not in index:
-            index[key] = len(index)
-            queue.append(key)
-        return index[key]
-
-    initial = losing_initial_positions(game, solution.winning, robotics_semantics)
-    for state in enumerate_states(game, initial, variables, limit=1 if play_length else None):
-        values = tuple(state[name] for name in variables)
-        node_id(values, (0, first_blockable_goal(state, level_of(state))))
-
-    env_trans = game.env_trans()
-    sys_trans = game.sys_trans()
-    while queue:
-        values, rank = queue.popleft()
-        game.interrupt.check()
-        if play_length is not None:
-            if len(nodes) >= play_length:
-                break
-            queue.clear()
-        assumption, goal = rank
-        node = nodes.setdefault(str(index[(values, rank)]), {
-            'rank': list(rank), 'state': [None if v is None else int(v) for v in values],
-            'trans': []})
-        if None in values:  # a deadlock node: nothing follows
-            continue
-        state = dict(zip(variables, values))
-        allowed_env = game.bdd.let(state, env_trans)
-        allowed_sys = game.bdd.let(state, sys_trans)
-        deadlock_inputs = game.bdd.forall(game.next_outputs, allowed_env & ~allowed_sys)
-        if deadlock_inputs != game.false:
-            choice, _ = game.pick(deadlock_inputs, game.next_inputs)
-            dead_values = tuple(choice[game.to_next[name]] for name in game.inputs) \
-                + (None,) * len(game.outputs)
-            node['trans'].append(node_id(dead_values, rank))
-            continue
-        level = level_of(state)
-        moves = game.bdd.let(state, strategies[level][goal][assumption])
-        chosen_input, input_cube = game.pick(moves, game.next_inputs)
-        responses = input_cube & allowed_sys
-        if play_length is not None:
-            # One play: its first response is followed; the others are only counted.
-            node['responses'] = int(game.bdd.count(game.bdd.exist(game.next_inputs, responses),
-                                                   nvars=len(game.next_outputs)))
-        while responses != game.false and not (play_length is not None and node['trans']):
-            choice, single = game.pick(responses, game.next_outputs)
-            transition = dict(state)
-            transition.update(chosen_input)
-            transition.update(choice)
-            next_state = {name: transition[game.to_next[name]] for name in variables}
-            next_assumption = _successor_goal(game, assumptions, assumption, transition)
-            next_level = level_of(next_state)
-            next_goal = goal if next_level == level else first_blockable_goal(next_state, next_level)
-            next_values = tuple(next_state[name] for name in variables)
-            node['trans'].append(node_id(next_values, (next_assumption, next_goal)))
-            responses &= ~single
-        if play_length is not None:
-            queue.clear()
-            first = node['trans'][0] if node['trans'] else None
-            key = next((k for k, v in index.items() if v == first), None)
-            if key is not None and str(first) not in nodes:
-                queue.append(key)
-    return {'version': FORMAT_VERSION, 'slugs': SLUGS_VERSION, 'variables': list(variables),
-            'nodes': nodes}
+    return strategies
 
 
 def losing_initial_positions(game: SymbolicGame, environment_wins, robotics_semantics: bool):
@@ -254,12 +275,6 @@ def losing_initial_positions(game: SymbolicGame, environment_wins, robotics_sema
         hopeless_inputs = game.bdd.forall(game.outputs, ~game.sys_init | environment_wins)
         initial &= hopeless_inputs
     return initial
-
-
-def losing_initial_states(game: SymbolicGame, environment_wins, robotics_semantics: bool):
-    """The losing initial positions (see losing_initial_positions) as valuations, smallest first."""
-    return enumerate_states(game, losing_initial_positions(game, environment_wins, robotics_semantics),
-                            game.variables)
 
 
 def strategy_to_json(strategy: dict) -> str:

@@ -1,6 +1,7 @@
-"""The symbolic game: a GR(1) specification translated into BDDs on CUDD (``dd.cudd``).
+"""The symbolic game: a GR(1) specification as BDDs on CUDD (``dd.cudd``) and its operators.
 
-Every proposition ``p`` has a current copy ``p`` and a next-step copy ``p'``, declared next to
+Formulas become BDDs in translation.py; this module holds the game built from them. Every
+proposition ``p`` has a current copy ``p`` and a next-step copy ``p'``, declared next to
 each other (interleaved order), so that renaming current <-> next is cheap. Safety sections are
 kept as lists of conjunct BDDs ("partitioned transition relations"): the enforceable
 predecessor conjoins them one by one and quantifies each next-step variable as soon as no
@@ -9,6 +10,7 @@ remaining conjunct mentions it (early quantification), which keeps intermediate 
 
 from __future__ import annotations
 
+import os
 import threading
 import time
 import warnings
@@ -17,11 +19,10 @@ from functools import cached_property
 
 from dd import cudd
 
-from respec.ltl import And, Const, Formula, Iff, Implies, Next, Not, Or, Var, children, to_infix
 from respec.spec import GR1Specification
 
-from ltl_synthesizer.errors import (InvalidFormulaError, SynthesisCancelled, SynthesisMemoryExceeded,
-                                    UnknownPropositionError)
+from ltl_synthesizer.errors import SynthesisCancelled, SynthesisMemoryExceeded
+from ltl_synthesizer.translation import Translator, check_declarations, primed, variable_order
 
 # Conjuncts are merged into clusters while the cluster's BDD stays below this many nodes: fewer,
 # larger relational products are faster than many tiny ones, up to a point (see bench/): 1000
@@ -30,11 +31,6 @@ DEFAULT_CLUSTER_LIMIT = 1000
 
 # CUDD's cache and unique tables grow on demand; starting small keeps tiny specs fast.
 MEMORY_ESTIMATE = 64 * 2**20
-
-
-def primed(name: str) -> str:
-    """The name of the next-step copy of a proposition."""
-    return name + "'"
 
 
 @dataclass
@@ -51,21 +47,25 @@ class Options:
 
 class Interrupt:
     """Stops a synthesis on request: a cancel flag, a deadline (a ``time.monotonic()``
-    instant) and a memory limit (bytes of BDD memory). Every long loop of the synthesizer
-    (translation, fixpoints, reachability, extraction, explanation, parsing) calls
-    ``check()``, so a synthesis stops within a few milliseconds of the request, beyond the
-    duration of one BDD operation. The object is also a plain callable (for respec's parser).
+    instant) and a memory limit in bytes. Every long loop of the synthesizer (translation,
+    fixpoints, reachability, extraction, explanation, parsing) calls ``check()``, so a
+    synthesis stops within a few milliseconds of the request, beyond the duration of one BDD
+    operation. The object is also a plain callable (for respec's parser).
+
+    The memory limit bounds the BDDs (CUDD's own limit, set by the game, fails the operation
+    that would exceed it) and the process's growth in resident memory since this object was
+    made (the explicit strategy and the rest), polled every ``MEMORY_CHECK_SECONDS``.
     """
 
-    MEMORY_CHECK_SECONDS = 0.05  # reading CUDD's statistics costs microseconds; not every step
+    MEMORY_CHECK_SECONDS = 0.1
 
     def __init__(self, cancel: threading.Event | None = None, deadline: float | None = None,
                  memory_limit: int | None = None):
         self.cancel = cancel
         self.deadline = deadline
         self.memory_limit = memory_limit
-        self.memory_in_use = None  # a callable returning bytes, set by the game that is watched
-        self._memory_checked_at = 0.0
+        self._baseline_memory = _resident_memory() if memory_limit is not None else 0
+        self._memory_checked_at = time.monotonic()
 
     def check(self) -> None:
         if self.cancel is not None and self.cancel.is_set():
@@ -73,13 +73,25 @@ class Interrupt:
         now = time.monotonic()
         if self.deadline is not None and now >= self.deadline:
             raise SynthesisCancelled('timeout')
-        if self.memory_limit is not None and self.memory_in_use is not None \
-                and now - self._memory_checked_at >= self.MEMORY_CHECK_SECONDS:
+        if self.memory_limit is not None and now - self._memory_checked_at >= self.MEMORY_CHECK_SECONDS:
             self._memory_checked_at = now
-            if self.memory_in_use() > self.memory_limit:
+            if _resident_memory() - self._baseline_memory > self.memory_limit:
                 raise memory_exceeded(self.memory_limit)
 
     __call__ = check
+
+
+def _resident_memory() -> int:
+    """This process's resident memory in bytes (Linux; elsewhere its peak so far)."""
+    try:
+        with open('/proc/self/statm') as statm:
+            return int(statm.read().split()[1]) * _PAGE_SIZE
+    except OSError:
+        import resource
+        return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
+
+
+_PAGE_SIZE = os.sysconf('SC_PAGE_SIZE') if hasattr(os, 'sysconf') else 4096
 
 
 def memory_exceeded(limit: int) -> SynthesisMemoryExceeded:
@@ -107,7 +119,7 @@ class SymbolicGame:
         self.interrupt = interrupt or Interrupt(None, None)
         self.inputs = list(spec.env_props)
         self.outputs = list(spec.sys_props)
-        _check_declarations(spec)
+        check_declarations(spec)
         self.variables = self.inputs + self.outputs
         self.bdd = cudd.BDD(memory_estimate=MEMORY_ESTIMATE)
         self.bdd.configure(reordering=False)
@@ -115,8 +127,7 @@ class SymbolicGame:
             # CUDD fails an operation that would go beyond this (synthesize reports it);
             # the interrupt's own check catches slower growth between operations.
             self.bdd.configure(max_memory=self.interrupt.memory_limit)
-            self.interrupt.memory_in_use = self.memory_in_use
-        for name in _variable_order(spec, self.options.variable_order):
+        for name in variable_order(spec, self.options.variable_order):
             self.bdd.declare(name, primed(name))
             self.bdd.group({name: 2})  # reordering keeps each pair adjacent (cheap renaming)
         self.to_next = {name: primed(name) for name in self.variables}
@@ -128,13 +139,15 @@ class SymbolicGame:
         self._moves_into = {}
         self._previous_moves_into = {}
 
-        self.env_init = self.conjunction(spec.env_init, 'env_init')
-        self.sys_init = self.conjunction(spec.sys_init, 'sys_init')
-        self.env_trans_parts = [self.translate(f, 'env_trans') for f in spec.env_trans]
-        self.sys_trans_parts = [self.translate(f, 'sys_trans') for f in spec.sys_trans]
+        self.translator = Translator(self.bdd, self.inputs, self.outputs, self.interrupt.check)
+        translate = self.translator.translate
+        self.env_init = self.translator.conjunction(spec.env_init, 'env_init')
+        self.sys_init = self.translator.conjunction(spec.sys_init, 'sys_init')
+        self.env_trans_parts = [translate(f, 'env_trans') for f in spec.env_trans]
+        self.sys_trans_parts = [translate(f, 'sys_trans') for f in spec.sys_trans]
         # slugs treats an empty liveness section as the single goal TRUE.
-        self.env_goals = [self.translate(f, 'env_liveness') for f in spec.env_liveness] or [self.true]
-        self.sys_goals = [self.translate(f, 'sys_liveness') for f in spec.sys_liveness] or [self.true]
+        self.env_goals = [translate(f, 'env_liveness') for f in spec.env_liveness] or [self.true]
+        self.sys_goals = [translate(f, 'sys_liveness') for f in spec.sys_liveness] or [self.true]
         # Assumptions that constrain no next output factor out of exists y' (see gr1).
         self.env_goal_ignores_outputs = [not self.mentions_next_outputs(goal)
                                          for goal in self.env_goals]
@@ -150,77 +163,23 @@ class SymbolicGame:
         # Positions outside this set never matter (see relevant_positions); set by the solver.
         self.care = self.true
 
-    # --- translation ----------------------------------------------------------------------
-
-    def translate(self, formula: Formula, section: str) -> cudd.Function:
-        """The BDD of a formula over current and next-step variables."""
-        self.interrupt.check()
-        if section in ('env_init', 'sys_init') and _mentions_next(formula):
-            raise InvalidFormulaError(
-                f'{section}: initial conditions cannot refer to the next step: {to_infix(formula)}',
-                item=to_infix(formula))
-        if section == 'env_trans' and _next_outputs(formula, set(self.outputs)):
-            # slugs rejects this too: the environment moves first and cannot see the system's move.
-            bad = sorted(_next_outputs(formula, set(self.outputs)))[0]
-            raise InvalidFormulaError(
-                f"env_trans: environment assumption refers to the next value of output '{bad}': "
-                f'{to_infix(formula)}', item=bad)
-        return self._translate(formula, primed_context=False, section=section)
-
-    def _translate(self, formula: Formula, primed_context: bool, section: str):
-        if isinstance(formula, Const):
-            return self.true if formula.value else self.false
-        if isinstance(formula, Var):
-            if formula.name not in self.to_next:
-                raise UnknownPropositionError(
-                    f"{section}: unknown proposition '{formula.name}' (declare it as an input or output)",
-                    item=formula.name)
-            return self.bdd.var(primed(formula.name) if primed_context else formula.name)
-        if isinstance(formula, Next):
-            if primed_context:
-                raise InvalidFormulaError(f'{section}: nested next is not GR(1): {to_infix(formula)}',
-                                          item=to_infix(formula))
-            return self._translate(formula.arg, True, section)
-        args = [self._translate(child, primed_context, section) for child in children(formula)]
-        if isinstance(formula, Not):
-            return ~args[0]
-        if isinstance(formula, And):
-            result = self.true
-            for arg in args:
-                result &= arg
-            return result
-        if isinstance(formula, Or):
-            result = self.false
-            for arg in args:
-                result |= arg
-            return result
-        if isinstance(formula, Implies):
-            return ~args[0] | args[1]
-        if isinstance(formula, Iff):
-            return self.bdd.apply('<=>', args[0], args[1])
-        raise InvalidFormulaError(f'{section}: not a formula: {formula!r}', item=repr(formula))
-
-    def conjunction(self, formulas, section: str):
-        result = self.true
-        for formula in formulas:
-            result &= self.translate(formula, section)
-        return result
-
     # --- renaming and quantification ------------------------------------------------------
+
+    def swap_steps(self, u):
+        """``u`` with current and next-step variables exchanged (any set of transitions).
+
+        The one place that uses dd's ``_swap``: swapping each pair is exact for any ``u`` and
+        much cheaper than dd's general renaming, which composes a substitution vector.
+        """
+        return self.bdd._swap(u, self.to_next)
 
     def prime(self, u):
         """The set ``u`` of positions (current variables only) as a condition on the next step."""
-        # Swapping each pair is exact here (u has no next-step variables) and much cheaper
-        # than dd's general renaming, which composes a substitution vector.
-        return self.bdd._swap(u, self.to_next)
+        return self.swap_steps(u)
 
     def unprime(self, u):
         """A condition on next-step variables only, as a set of current positions."""
-        return self.bdd._swap(u, self.to_next)
-
-    def swap_steps(self, u):
-        """``u`` with current and next-step variables exchanged (any set of transitions)."""
-        return self.bdd._swap(u, self.to_next)
+        return self.swap_steps(u)
 
     def env_trans(self):
         """The monolithic environment safety relation (for explicit extraction and explanations)."""
@@ -346,15 +305,19 @@ class SymbolicGame:
         the BDD variable order, hence deterministic even with dynamic reordering.
         """
         self.interrupt.check()
-        assignment = {}
+        support = self.bdd.support(u)
+        assignment, unconstrained = {}, {}
         for name in names:
+            if name not in support:  # u allows both values: the smaller one, without BDD work
+                assignment[name] = unconstrained[name] = False
+                continue
             variable = self.bdd.var(name)
             low = u & ~variable
             if low != self.false:
                 u, assignment[name] = low, False
             else:
                 u, assignment[name] = u & variable, True
-        return assignment, u
+        return assignment, (u & self.bdd.cube(unconstrained) if unconstrained else u)
 
     def evaluate(self, u, assignment: dict[str, bool]) -> bool:
         # Substituting only the variables u depends on is much cheaper for small u.
@@ -366,17 +329,10 @@ class SymbolicGame:
             return False
         raise ValueError('assignment does not fix every variable of the function')
 
-    def memory_in_use(self) -> int:
-        """Bytes CUDD holds for this game's BDDs."""
-        return int(self._cudd_statistics()['mem'])
-
-    def _cudd_statistics(self) -> dict:
+    def statistics(self) -> dict:
         with warnings.catch_warnings():  # dd warns that 'mem' is now in bytes; we know
             warnings.simplefilter('ignore')
-            return self.bdd.statistics()
-
-    def statistics(self) -> dict:
-        stats = self._cudd_statistics()
+            stats = self.bdd.statistics()
         return {'bdd_nodes': stats.get('n_nodes'), 'peak_bdd_nodes': stats.get('peak_nodes'),
                 'reorderings': stats.get('n_reorderings'), 'bdd_memory_bytes': stats.get('mem')}
 
@@ -408,56 +364,3 @@ def _cluster(bdd, parts, limit: int, interrupt: Interrupt):
     if current is not None:
         clusters.append(current)
     return clusters
-
-
-def _check_declarations(spec: GR1Specification) -> None:
-    seen = set()
-    for name in list(spec.env_props) + list(spec.sys_props):
-        if not isinstance(name, str) or not name or name.endswith("'"):
-            raise UnknownPropositionError(f'invalid proposition name {name!r}', item=name)
-        if name in seen:
-            raise UnknownPropositionError(f"proposition '{name}' is declared twice", item=name)
-        seen.add(name)
-
-
-def _mentions_next(formula: Formula) -> bool:
-    return isinstance(formula, Next) or any(_mentions_next(c) for c in children(formula))
-
-
-def _next_outputs(formula: Formula, outputs: set[str], under_next: bool = False) -> set[str]:
-    if isinstance(formula, Var):
-        return {formula.name} if under_next and formula.name in outputs else set()
-    under_next = under_next or isinstance(formula, Next)
-    found = set()
-    for child in children(formula):
-        found |= _next_outputs(child, outputs, under_next)
-    return found
-
-
-def _formula_variables(formula: Formula, found: list[str], seen: set[str]) -> None:
-    if isinstance(formula, Var):
-        if formula.name not in seen:
-            seen.add(formula.name)
-            found.append(formula.name)
-    for child in children(formula):
-        _formula_variables(child, found, seen)
-
-
-def _variable_order(spec: GR1Specification, strategy: str) -> list[str]:
-    """Static variable order: declared, or 'affinity' (first appearance in the safety formulas).
-
-    Propositions used together (an action's activation and its outcomes) then sit together,
-    which keeps the transition relations small.
-    """
-    declared = list(spec.env_props) + list(spec.sys_props)
-    if strategy == 'declared':
-        return declared
-    if strategy != 'affinity':
-        raise ValueError(f'unknown variable order {strategy!r}')
-    found, seen = [], set()
-    known = set(declared)
-    for formula in list(spec.sys_trans) + list(spec.env_trans) + list(spec.sys_liveness) \
-            + list(spec.env_liveness) + list(spec.env_init) + list(spec.sys_init):
-        _formula_variables(formula, found, seen)
-    order = [name for name in found if name in known]
-    return order + [name for name in declared if name not in seen]

@@ -46,21 +46,21 @@ def test_sifting_keeps_each_current_and_next_pair_adjacent():
 ])
 def test_boolean_connectives(formula, expected):
     g = game()
-    u = g.translate(formula, 'sys_trans')
+    u = g.translator.translate(formula, 'sys_trans')
     names = ['a', 'b', 'c']
     assert truth_table(g, u, names) == [expected(*v) for v in itertools.product([False, True], repeat=3)]
 
 
 def test_next_maps_to_the_primed_copy_and_distributes():
     g = game()
-    u = g.translate(next_(conj([a, neg(b)])), 'sys_trans')
+    u = g.translator.translate(next_(conj([a, neg(b)])), 'sys_trans')
     assert u == g.bdd.var("a'") & ~g.bdd.var("b'")
     assert g.bdd.support(u) == {"a'", "b'"}
 
 
 def test_prime_and_unprime_are_inverse():
     g = game()
-    u = g.translate(disj([a, conj([b, neg(c)])]), 'sys_trans')
+    u = g.translator.translate(disj([a, conj([b, neg(c)])]), 'sys_trans')
     assert g.bdd.support(g.prime(u)) == {"a'", "b'", "c'"}
     assert g.unprime(g.prime(u)) == u
 
@@ -96,12 +96,12 @@ def test_duplicate_declaration_is_named():
 def test_enforceable_predecessor():
     # The system copies a' into b'; the environment may only raise a when b holds.
     g = game(env_trans=[implies(neg(b), neg(next_(a)))])
-    target = g.translate(iff(next_(b), next_(a)), 'sys_trans')
+    target = g.translator.translate(iff(next_(b), next_(a)), 'sys_trans')
     assert g.cox(target) == g.true
     # Forcing b' & a' needs the environment's cooperation: never enforceable.
-    assert g.cox(g.translate(conj([next_(a), next_(b)]), 'sys_trans')) == g.false
+    assert g.cox(g.translator.translate(conj([next_(a), next_(b)]), 'sys_trans')) == g.false
     # Forcing !a' is enforceable exactly where the environment must keep a low.
-    assert g.cox(g.translate(neg(next_(a)), 'sys_trans')) == ~g.bdd.var('b')
+    assert g.cox(g.translator.translate(neg(next_(a)), 'sys_trans')) == ~g.bdd.var('b')
 
 
 @pytest.mark.parametrize('cluster_limit', [0, 50, 10**9])
@@ -111,6 +111,6 @@ def test_partitioned_product_equals_monolithic(cluster_limit):
                     sys_trans=[iff(next_(b), a), implies(next_(c), next_(b)), implies(a, next_(c))])
     g = SymbolicGame(GR1Specification(env_props=['a'], sys_props=['b', 'c'], **sections),
                      options=Options(cluster_limit=cluster_limit))
-    target = g.translate(disj([next_(c), conj([a, neg(next_(b))])]), 'sys_trans')
+    target = g.translator.translate(disj([next_(c), conj([a, neg(next_(b))])]), 'sys_trans')
     monolithic = ~g.bdd.exist(["a'"], g.env_trans() & ~g.bdd.exist(["b'", "c'"], g.sys_trans() & target))
     assert g.cox(target) == monolithic

@@ -30,11 +30,13 @@ import itertools
 import re
 from dataclasses import dataclass, field
 from functools import lru_cache
+from operator import itemgetter
 from typing import NamedTuple
 
 from respec.errors import CodedError
 from respec.ltl import (
-    FALSE, TRUE, Formula, Var, conj, disj, iff, implies, neg, next_, var,
+    FALSE, TRUE, And, Const, Formula, Iff, Implies, Next, Not, Or, Var, conj, disj, iff, implies,
+    neg, next_, var,
 )
 from respec.spec import FORMULA_SECTIONS, PROPOSITION_SECTIONS, SLUGS_HEADERS, GR1Specification
 
@@ -301,6 +303,21 @@ def _var(name: str) -> Var:
     return var(name)
 
 
+@lru_cache(maxsize=1 << 16)
+def _not_var(name: str) -> Not:
+    return Not(_var(name))
+
+
+@lru_cache(maxsize=1 << 16)
+def _next_var(name: str) -> Next:
+    return Next(_var(name))
+
+
+@lru_cache(maxsize=1 << 16)
+def _next_not_var(name: str) -> Next:
+    return Next(_not_var(name))
+
+
 def _combine(operator: str, left: Formula, right: Formula) -> Formula:
     if operator == '&':
         return conj([left, right])
@@ -522,33 +539,35 @@ _LINES_BETWEEN_CHECKS = 256
 
 
 def _parse_slugs_file(text: str, filename: str, syntax: str, check=None) -> GR1Specification:
-    lines_by_section: dict[str, list[tuple[int, int, str]]] = {s: [] for s in PROPOSITION_SECTIONS + FORMULA_SECTIONS}
+    lines_by_section: dict[str, list[tuple[int, str, str]]] = {s: [] for s in PROPOSITION_SECTIONS + FORMULA_SECTIONS}
     section = None
+    lines = None
     for number, raw in enumerate(text.splitlines(), start=1):
-        content = raw.split('#', 1)[0]
+        content = raw.partition('#')[0] if '#' in raw else raw
         stripped = content.strip()
         if not stripped:
             continue
-        column = len(content) - len(content.lstrip()) + 1
-        if stripped.startswith('['):
+        if stripped[0] == '[':
             header = stripped[1:-1] if stripped.endswith(']') else None
             if header not in _SECTION_OF_HEADER:
                 raise ParseError('unknown section header (expected one of '
                                  + ', '.join(f'[{h}]' for h in SLUGS_HEADERS.values()) + ')',
-                                 stripped, filename, number, column)
+                                 stripped, filename, number, _column(content))
             section = _SECTION_OF_HEADER[header]
+            lines = lines_by_section[section]
             continue
         if section is None:
-            raise ParseError('text before the first section header', stripped, filename, number, column)
-        lines_by_section[section].append((number, column, stripped))
+            raise ParseError('text before the first section header', stripped, filename, number,
+                             _column(content))
+        lines.append((number, content, stripped))
 
     declared: dict[str, list[str]] = {}
     integers: dict[str, IntegerVariable] = {}
     seen: set[str] = set()
     for section in PROPOSITION_SECTIONS:
         declared[section] = []
-        for number, column, name in lines_by_section[section]:
-            source = _Source(filename, number, column)
+        for number, content, name in lines_by_section[section]:
+            source = _Source(filename, number, _column(content))
             integer = _INTEGER_DECLARATION.match(name) if syntax == 'infix' else None
             if integer:
                 variable = _integer_variable(integer, seen, source)
@@ -563,12 +582,16 @@ def _parse_slugs_file(text: str, filename: str, syntax: str, check=None) -> GR1S
     scopes = _scopes(declared['env_props'], declared['sys_props'], integers)
     formulas = {}
     for section in FORMULA_SECTIONS:
-        formulas[section] = []
-        for count, (number, column, line) in enumerate(lines_by_section[section]):
+        scope, parsed = scopes[section], []
+        shapes_apply = syntax == 'infix' and not scope.integers
+        for count, (number, content, line) in enumerate(lines_by_section[section]):
             if check is not None and count % _LINES_BETWEEN_CHECKS == 0:
                 check()
-            formulas[section].append(_parse_line(line, syntax, scopes[section],
-                                                 _Source(filename, number, column)))
+            formula = _parse_by_shape(line, scope) if shapes_apply else None
+            if formula is None:
+                formula = _parse_line(line, syntax, scope, _Source(filename, number, _column(content)))
+            parsed.append(formula)
+        formulas[section] = parsed
     # Like slugs' compiler, keep integers in range: initially and after every step.
     for variable in integers.values():
         owner = 'env' if variable.bits and variable.bits[0] in declared['env_props'] else 'sys'
@@ -590,6 +613,11 @@ def _integer_variable(declaration: re.Match, seen: set[str], source: _Source) ->
     return variable
 
 
+def _column(content: str) -> int:
+    """The column of a line's first non-blank character."""
+    return len(content) - len(content.lstrip()) + 1
+
+
 def _parse_line(line: str, syntax: str, scope: _Scope, source: _Source) -> Formula:
     try:
         return _parse(line, syntax, scope, source)
@@ -600,6 +628,94 @@ def _parse_line(line: str, syntax: str, scope: _Scope, source: _Source) -> Formu
             return _parse(line, 'prefix', scope, source)
         except ParseError:
             raise infix_error from None
+
+
+# --- infix lines by shape -------------------------------------------------------------------
+#
+# Large specifications repeat a few line shapes with different propositions ("a & next(b) ->
+# !c" ...). A shape is the line with every proposition replaced by a placeholder; it is parsed
+# once, by the parser above, and compiled into a function that builds the formula of any line
+# of that shape. The result is the very tree the parser would build (a proposition never
+# changes how operators group or fold). Lines whose propositions break the section's rules,
+# and unusual lines (very long or deeply nested), go through the parser, which explains errors.
+
+_PROPOSITION = re.compile(
+    r"(?<![A-Za-z0-9_.@])(?!(?:TRUE|FALSE|next)(?![A-Za-z0-9_.@]))[A-Za-z_][A-Za-z0-9_.@]*")
+_PLACEHOLDER = '\x00'
+_MAX_SHAPE_PLACEHOLDERS = 64
+_MAX_SHAPE_NESTING = 32
+_SHAPES: dict[str, object] = {}
+_MAX_SHAPES = 1 << 14
+
+
+def _parse_by_shape(line: str, scope: _Scope) -> Formula | None:
+    """The formula of an infix line, or None when the parser must handle the line."""
+    names = _PROPOSITION.findall(line)
+    if len(names) > _MAX_SHAPE_PLACEHOLDERS or line.count('(') > _MAX_SHAPE_NESTING:
+        return None
+    shape = _PROPOSITION.sub(_PLACEHOLDER, line)
+    compiled = _SHAPES.get(shape)
+    if compiled is None:
+        if len(_SHAPES) >= _MAX_SHAPES:
+            _SHAPES.clear()
+        compiled = _SHAPES[shape] = _compile_shape(shape, len(names))
+    if compiled is False:
+        return None
+    build, current_names, next_names = compiled
+    if scope.names is not None and not (scope.current.issuperset(current_names(names))
+                                        and scope.next_step.issuperset(next_names(names))):
+        return None  # the parser names the problem
+    return build(names)
+
+
+def _compile_shape(shape: str, count: int):
+    """(build(names) -> Formula, names -> those read in the current step, names -> those read
+    in the next step), or False when the shape is not a formula (the parser then reports the
+    line's error)."""
+    pieces = shape.split(_PLACEHOLDER)
+    text = ''.join(piece + (f'_{index}' if index < count else '') for index, piece in enumerate(pieces))
+    try:
+        template = _InfixParser(text, _ANY, _Source()).parse()
+    except ParseError:
+        return False
+    in_next = [False] * count
+    source = _template_source(template, in_next)
+    build = eval(f'lambda names: {source}', {  # noqa: S307 -- our own generated expression
+        'Var': _var, 'NotVar': _not_var, 'NextVar': _next_var, 'NextNotVar': _next_not_var,
+        'Const': Const, 'Not': Not, 'And': And, 'Or': Or, 'Implies': Implies, 'Iff': Iff,
+        'Next': Next})
+    return (build, _picker([i for i in range(count) if not in_next[i]]),
+            _picker([i for i in range(count) if in_next[i]]))
+
+
+def _picker(indices: list[int]):
+    """names -> the names at ``indices`` (as a tuple)."""
+    if not indices:
+        return lambda names: ()
+    if len(indices) == 1:
+        index = indices[0]
+        return lambda names: (names[index],)
+    return itemgetter(*indices)
+
+
+def _template_source(formula: Formula, in_next: list, under_next: bool = False) -> str:
+    """Python source building ``formula`` with placeholder ``_i`` read from ``names[i]``."""
+    if isinstance(formula, Var):
+        index = int(formula.name[1:])
+        in_next[index] = under_next
+        return f'Var(names[{index}])'
+    if isinstance(formula, Const):
+        return f'Const({formula.value})'
+    if isinstance(formula, (Not, Next)):
+        inner = _template_source(formula.arg, in_next, under_next or isinstance(formula, Next))
+        if inner.startswith('Var(') or inner.startswith('NotVar('):  # shared nodes, made once
+            return f'{type(formula).__name__}{inner}'
+        return f'{type(formula).__name__}({inner})'
+    if isinstance(formula, (And, Or)):
+        args = ', '.join(_template_source(arg, in_next, under_next) for arg in formula.args)
+        return f'{type(formula).__name__}(({args},))'
+    return (f'{type(formula).__name__}({_template_source(formula.left, in_next, under_next)}, '
+            f'{_template_source(formula.right, in_next, under_next)})')
 
 
 def _check_proposition_name(name: str, seen: set[str], syntax: str, source: _Source) -> None:

@@ -57,7 +57,7 @@ def specifications(draw, max_inputs=5, max_outputs=5):
         env_liveness=draw(liveness(0)), sys_liveness=draw(liveness(1)))
 
 
-@settings(max_examples=150, deadline=None, database=None, suppress_health_check=[HealthCheck.too_slow])
+@settings(max_examples=100, deadline=None, database=None, suppress_health_check=[HealthCheck.too_slow])
 @given(specifications())
 def test_synthesizer_agrees_with_oracle_and_its_strategies_check(spec):
     oracle = Oracle(spec)

@@ -41,7 +41,8 @@ class LTLSynthesisNode(Node):
     limit); ``backend`` ('builtin' or 'slugs': an external slugs-compatible executable,
     ``slugs_executable``, called the original way); ``timeout`` (seconds, used when a
     request gives none; time spent waiting for a worker counts); ``robotics_semantics``;
-    ``parallel_syntheses`` (run at once) and ``queued_syntheses`` (waiting beyond those;
+    ``memory_limit_mb`` (per synthesis; beyond it the synthesis ends with SYNTHESIS_FAILED
+    naming the limit, not an OOM kill); ``parallel_syntheses`` (run at once) and ``queued_syntheses`` (waiting beyond those;
     further requests are answered BUSY).
 
     Syntheses run in the node's own worker threads, awaited by an async service callback,
@@ -58,6 +59,7 @@ class LTLSynthesisNode(Node):
         self.declare_parameter('slugs_executable', 'slugs')
         self.declare_parameter('timeout', 60.0)
         self.declare_parameter('robotics_semantics', True)
+        self.declare_parameter('memory_limit_mb', 2048)
         self.declare_parameter('parallel_syntheses', 8)
         self.declare_parameter('queued_syntheses', 200)
         self._running: dict[str, threading.Event] = {}
@@ -138,7 +140,8 @@ class LTLSynthesisNode(Node):
             backend = self.parameter('backend')
             if backend == 'builtin':
                 try:
-                    result = synthesize(spec, robotics_semantics=robotics, cancel=cancel, deadline=deadline)
+                    result = synthesize(spec, robotics_semantics=robotics, cancel=cancel, deadline=deadline,
+                                        memory_limit=self.parameter('memory_limit_mb') * 2**20)
                 except SynthesisCancelled as stopped:
                     return self._stopped(response, stopped.reason, timeout)
                 realizable, strategy, explanation = result.realizable, result.strategy, result.explanation

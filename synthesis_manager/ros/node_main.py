@@ -42,12 +42,15 @@ def run_nodes(*node_factories, argv: list[str] | None = None, ready_message: str
     return 0
 
 
-def stop_executor(executor, nodes, timeout: float = 5.0):
+def stop_executor(executor, nodes, timeout: float = 1.0):
     """End running callbacks, then shut the executor down; the nodes can be destroyed after.
 
     Nodes with long-running callbacks offer ``stop_work()``. We wait for the callbacks
     ourselves because Executor.shutdown() in rclpy (Jazzy) returns without waiting, and a
-    callback finishing after its node is destroyed fails to send its response.
+    callback finishing after its node is destroyed fails to send its response. The wait is
+    short: async callbacks suspended on a future cannot resume once the context is shut down
+    (nothing spins any more), and a stopped synthesis ends within a second anyway; the
+    entry points must exit within 3 s of SIGINT/SIGTERM.
     """
     for node in nodes:
         if hasattr(node, 'stop_work'):

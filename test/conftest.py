@@ -68,3 +68,26 @@ def flexbe(flexbe_sources) -> Path:
     if not (FLEXBE_AMENT_PREFIX / 'share' / 'ament_index').is_dir():
         pytest.fail(f'no FlexBE package index at {FLEXBE_AMENT_PREFIX}; run `make flexbe`')
     return FLEXBE_AMENT_PREFIX
+
+
+@pytest.fixture
+def runaway_synthesis(monkeypatch):
+    """Make the in-process synthesis node's next syntheses run until cancelled or out of time.
+
+    Multi-goal tasks synthesize in about a second now, so a GUI cancel test cannot rely on a
+    task being slow. The node still runs the real synthesizer, with its own cancel event and
+    deadline, on a specification whose strategy extraction would take hours (100 inputs and
+    outputs that nothing constrains): cancel and timeouts are exercised end to end.
+    """
+    from ltl_synthesizer import synthesize
+    from respec.ltl import var
+    from respec.spec import GR1Specification
+    from synthesis_manager.nodes import ltl_synthesis_node
+
+    runaway = GR1Specification(env_props=[f'x{i}' for i in range(100)],
+                               sys_props=[f'y{i}' for i in range(100)], sys_liveness=[var('y0')])
+
+    def synthesize_runaway(spec, **limits):
+        return synthesize(runaway, **limits)
+
+    monkeypatch.setattr(ltl_synthesis_node, 'synthesize', synthesize_runaway)

@@ -11,10 +11,6 @@ from synthesis_manager.gui import ros_backend
 from synthesis_manager.web.routes import create_app
 
 PAPER_TASK = {'system': 'atlas', 'initial_conditions': ['stand_prep'], 'goals': ['look_down', 'pickup_object']}
-# Seven ordered goals: its synthesis takes about 40 s, so a cancel lands in the middle.
-SLOW_TASK = {'system': 'atlas', 'initial_conditions': ['stand_prep'],
-             'goals': ['look_down', 'pickup_object', 'grasp_object', 'pregrasp', 'approach_object',
-                       'footstep_execution', 'walk']}
 STATE_FIELDS = {'state_path', 'state_class', 'initial_state_name', 'input_keys', 'output_keys',
                 'cond_outcome', 'cond_transition', 'behavior_class', 'parameter_names',
                 'parameter_values', 'position', 'outcomes', 'transitions', 'autonomy',
@@ -205,8 +201,8 @@ def test_cancel_a_job_before_it_is_sent(client, backend):
     assert [entry['status'] for entry in final['timeline']] == ['Cancel requested', 'Cancelled']
 
 
-def test_cancel_a_running_synthesis(client):
-    job = client.post('/api/jobs', json=SLOW_TASK).json()
+def test_cancel_a_running_synthesis(client, runaway_synthesis):
+    job = client.post('/api/jobs', json=PAPER_TASK).json()
     with client.stream('GET', f"/api/jobs/{job['id']}/events", timeout=120) as response:
         for line in response.iter_lines():
             if line.startswith('data: ') and 'Synthesizing' in json.loads(line[6:])['status']:

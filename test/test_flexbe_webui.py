@@ -256,7 +256,10 @@ def test_a_bad_goal_shows_our_error_name_in_the_webui(editor, goals, error_name,
                                          .includes(name)""", arg=error_name, timeout=60_000)
     log = editor.inner_text('#runtime_feedback_text')
     assert f'Behavior synthesis failed: {error_name}: ' in log and named in log
-    assert "Goal for '/behavior_synthesis' - failed!" in editor.inner_text('#terminal')
+    # Our log line is published just before the goal is aborted, so the terminal's line can
+    # arrive a moment later.
+    editor.wait_for_function("text => document.getElementById('terminal').innerText.includes(text)",
+                             arg="Goal for '/behavior_synthesis' - failed!", timeout=30_000)
     assert editor.evaluate(READ_CONTAINER, '/Container')['states'] == []
 
 

@@ -113,6 +113,7 @@ $(WEBUI_SITE)/.installed: | $(BIN)/python
 system-packages:
 	@missing=""; command -v dot >/dev/null || missing="$$missing graphviz"; \
 	  command -v chromium >/dev/null || missing="$$missing chromium"; \
+	  ldconfig -p | grep -q 'libEGL_mesa.so.0' || missing="$$missing libegl1 libegl-mesa0"; \
 	  if [ -n "$$missing" ]; then \
 	    if [ "$$(id -u)" = 0 ]; then \
 	      (apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq $$missing) >/dev/null; \

@@ -3,7 +3,8 @@
     python bench/bench_synthesizer.py                 # paper tasks + chain N=4..256, stopping
                                                       # at the first N over 5 minutes (+ plot)
     python bench/bench_synthesizer.py --max-n 12      # shorter
-    python bench/bench_synthesizer.py --compare       # option comparison (reordering, partitioning)
+    python bench/bench_synthesizer.py --compare       # option comparison (reordering, partitioning,
+                                                      # sifting and reachability on small games)
 
 Chain family: ATLAS's 5 control modes plus actions act0..act{N-1}, act_i needing control mode
 [stand, manipulate][i % 2] and act_{i-1}; outcomes completed/failed; SM outcomes
@@ -211,6 +212,38 @@ def compare(sizes) -> None:
     print('\n'.join(lines))
 
 
+SMALL_GAME_SWITCHES = {
+    'automatic (default)': {},
+    'sifting + reachability on': {'sift_once': True, 'reachable_only': True},
+    'sifting + reachability off': {'sift_once': False, 'reachable_only': False},
+}
+MULTI_GOAL_TASKS = ['look_down', 'approach_object', 'pregrasp', 'grasp_object', 'pickup_object']
+
+
+def compare_small_games(repeats: int = 3) -> None:
+    """The sifting pass and the reachability search, forced on or off, around the size where
+    the automatic choice switches them on (ltl_synthesizer.symbolic.SMALL_GAME_PROPOSITIONS)."""
+    cases = [(label, 'paper', json.dumps([initial, goals])) for label, initial, goals in PAPER_TASKS]
+    cases += [(f'{n} goals from stand_prep', 'paper', json.dumps([['stand_prep'], MULTI_GOAL_TASKS[:n]]))
+              for n in (3, 4, 5)]
+    cases += [(f'chain N={n}', 'chain', str(n)) for n in (8, 12)]
+    lines = ['# ltl_synthesizer: sifting and reachability on small games', '',
+             f'Synthesis + strategy extraction, in-process ms, best of {repeats} fresh processes.', '',
+             '| task | variables | ' + ' | '.join(SMALL_GAME_SWITCHES) + ' |',
+             '|---|---|' + '---|' * len(SMALL_GAME_SWITCHES)]
+    for label, kind, argument in cases:
+        cells, variables = [], 0
+        for options in SMALL_GAME_SWITCHES.values():
+            runs = [measure(kind, argument, options) for _ in range(repeats)]
+            variables = runs[0]['variables']
+            cells.append(f"{min(r['seconds'] for r in runs) * 1000:.1f}")
+        lines.append(f'| {label} | {variables} | ' + ' | '.join(cells) + ' |')
+        print(lines[-1], flush=True)
+    RESULTS.mkdir(parents=True, exist_ok=True)
+    (RESULTS / 'synthesizer_small_games.md').write_text('\n'.join(lines) + '\n')
+    print('\n'.join(lines))
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument('--child', nargs=3, help=argparse.SUPPRESS)
@@ -225,6 +258,7 @@ def main(argv=None) -> int:
              if n <= args.max_n]
     if args.compare:
         compare([n for n in sizes if n <= 16])
+        compare_small_games()
         return 0
     paper_rows = bench_paper()
     chain_rows = bench_chain(sizes)

@@ -29,8 +29,16 @@ from ltl_synthesizer.translation import Translator, check_declarations, primed, 
 # rather than 2500 makes multi-goal ATLAS tasks 20-40% faster and leaves the chain family as is.
 DEFAULT_CLUSTER_LIMIT = 1000
 
-# CUDD's cache and unique tables grow on demand; starting small keeps tiny specs fast.
+# CUDD's cache and unique tables grow on demand; starting small keeps tiny specs fast (dd's
+# default cache of 262,144 slots alone costs 5-6 ms to set up, a tenth of a paper-size task).
 MEMORY_ESTIMATE = 64 * 2**20
+INITIAL_CACHE_SLOTS = 2**14
+
+# Up to this many propositions a game solves in a few tens of milliseconds, and neither the
+# sifting pass nor the reachability search pays for itself (bench/bench_synthesizer.py
+# --compare: paper tasks 35-45% faster without them, 5-goal ATLAS tasks and 12-action chains
+# 10-45% slower); 'automatic' options switch them on above it.
+SMALL_GAME_PROPOSITIONS = 36
 
 
 @dataclass
@@ -38,10 +46,11 @@ class Options:
     """Tuning switches of the symbolic engine (defaults are the measured best; see bench/)."""
 
     reordering: bool = False  # dynamic reordering throughout (CUDD's automatic sifting)
-    sift_once: bool = True  # one sifting pass after the relations are built (see SymbolicGame)
+    # None = automatic: on for games of more than SMALL_GAME_PROPOSITIONS propositions.
+    sift_once: bool | None = None  # one sifting pass after the relations are built (see SymbolicGame)
     cluster_limit: int = DEFAULT_CLUSTER_LIMIT
     variable_order: str = 'affinity'  # 'affinity' (co-occurrence) or 'declared'
-    reachable_only: bool = True  # solve only on positions reachable from the initial ones
+    reachable_only: bool | None = None  # solve only on positions reachable from the initial ones
     chained_sweeps: bool = True  # Gauss-Seidel Y sweeps (see gr1._attract_to_goal)
 
 
@@ -121,7 +130,10 @@ class SymbolicGame:
         self.outputs = list(spec.sys_props)
         check_declarations(spec)
         self.variables = self.inputs + self.outputs
-        self.bdd = cudd.BDD(memory_estimate=MEMORY_ESTIMATE)
+        large = len(self.variables) > SMALL_GAME_PROPOSITIONS
+        self.sift_once = large if self.options.sift_once is None else self.options.sift_once
+        self.reachable_only = large if self.options.reachable_only is None else self.options.reachable_only
+        self.bdd = cudd.BDD(memory_estimate=MEMORY_ESTIMATE, initial_cache_size=INITIAL_CACHE_SLOTS)
         self.bdd.configure(reordering=False)
         if self.interrupt.memory_limit is not None:
             # CUDD fails an operation that would go beyond this (synthesize reports it);
@@ -153,7 +165,7 @@ class SymbolicGame:
                                          for goal in self.env_goals]
         self.env_partition = self._partition(self.env_trans_parts, set(self.next_inputs))
         self.sys_partition = self._partition(self.sys_trans_parts, set(self.next_outputs))
-        if self.options.sift_once:
+        if self.sift_once:
             # The static order cannot know that e.g. a memory proposition belongs next to its
             # action's activation and outcomes; one sifting pass on the relations finds such
             # placements (3x faster multi-goal solving) for a few milliseconds.
@@ -264,7 +276,7 @@ class SymbolicGame:
         reachable one, so the game restricted to them has the same winner there; the
         solver's sets then stay within them, and targets are simplified outside them.
         """
-        if self.options.reachable_only:
+        if self.reachable_only:
             self.care = self.reachable_positions()
         return self.care
 

@@ -52,15 +52,20 @@ def infer_pertinence(abstraction: RobotAbstraction, initial_mode: str | None,
     needed_actions: list[str] = []
 
     def need(item: str, reason: str) -> None:
-        if item in reasons:
-            return
-        reasons[item] = reason
-        if abstraction.kind_of(item) == 'control_mode':
-            needed_modes.append(item)
-            return
-        needed_actions.append(item)
-        for precondition in abstraction.actions[item]:
-            need(precondition, f'precondition of {item}')
+        """Mark ``item`` and, depth first, its preconditions (a stack, not recursion: a
+        configuration may chain thousands of actions)."""
+        pending = [(item, reason)]
+        while pending:
+            item, reason = pending.pop()
+            if item in reasons:
+                continue
+            reasons[item] = reason
+            if abstraction.kind_of(item) == 'control_mode':
+                needed_modes.append(item)
+                continue
+            needed_actions.append(item)
+            pending.extend((precondition, f'precondition of {item}')
+                           for precondition in reversed(abstraction.actions[item]))
 
     if initial_mode is not None:
         reasons[initial_mode] = 'initial mode'

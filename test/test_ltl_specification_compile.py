@@ -195,6 +195,15 @@ def test_system_without_control_modes(tmp_path):
     assert spec.provenance.pertinence.modes == ()
 
 
+def test_a_chain_of_thousands_of_preconditions_compiles(tmp_path):
+    actions = {f'act{i}': ['on'] if i == 0 else [f'act{i - 1}'] for i in range(3000)}
+    (tmp_path / 'chain.yaml').write_text(yaml.safe_dump({'abstraction': {
+        'control_modes': {'on': []}, 'initial_mode': 'on', 'actions': actions}}, sort_keys=False))
+    spec = compile_task('chain', [], ['act2999'], config_dir=tmp_path)
+    assert spec.provenance.pertinence.actions == tuple(actions)
+    assert spec.provenance.pertinence.reasons['act0'] == 'precondition of act1'
+
+
 # --- determinism --------------------------------------------------------------------------------
 
 def test_same_request_gives_byte_identical_output():

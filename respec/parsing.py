@@ -26,8 +26,10 @@ offending token, e.g. ``spec.structuredslugs:7:12: unknown variable 'foo' near '
 
 from __future__ import annotations
 
+import gc
 import itertools
 import re
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from functools import lru_cache
 from operator import itemgetter
@@ -103,6 +105,11 @@ class _Scope:
     next_step: frozenset[str] | None
     section: str = ''
     integers: dict = field(default_factory=dict)   # name -> IntegerVariable (structured slugs)
+
+    @property
+    def both_steps(self) -> frozenset[str]:
+        """The propositions allowed in the current and in the next step."""
+        return self.current & self.next_step
 
 
 _ANY = _Scope(None, None, None)
@@ -202,7 +209,16 @@ class _InfixParser:
                 return left
             self.position += 1
             right = self.binary(operator_level + 1, in_next)  # left associative
-            left = _combine(token.text, left, right)
+            if token.text in ('&', '|'):
+                # A run of the same associative operator becomes one node at once: combining
+                # pairwise would copy the growing operand list at every step.
+                operands = [left, right]
+                while tokens[self.position].kind == 'op' and tokens[self.position].text == token.text:
+                    self.position += 1
+                    operands.append(self.binary(operator_level + 1, in_next))
+                left = conj(operands) if token.text == '&' else disj(operands)
+            else:
+                left = _combine(token.text, left, right)
 
     def unary(self, in_next: bool) -> Formula:
         token = self.peek()
@@ -450,11 +466,18 @@ class _PrefixParser:
         text = token[0]
         if text == '!':
             return neg(self.formula(memory))
-        if text in ('&', '|', '^'):
+        if text == '^':
             left = self.formula(memory)
-            right = self.formula(memory)
-            return {'&': lambda: conj([left, right]), '|': lambda: disj([left, right]),
-                    '^': lambda: xor(left, right)}[text]()
+            return xor(left, self.formula(memory))
+        if text in ('&', '|'):
+            # "| a | b | c d": the right operands that repeat the operator are gathered into
+            # one node (pairwise, each level would copy the flattened list below it).
+            operands = [self.formula(memory)]
+            while self.position < len(self.tokens) and self.tokens[self.position][0] == text:
+                self.position += 1
+                operands.append(self.formula(memory))
+            operands.append(self.formula(memory))
+            return conj(operands) if text == '&' else disj(operands)
         if text in ('1', '0'):
             return TRUE if text == '1' else FALSE
         if text == '$':
@@ -567,6 +590,11 @@ def _parse_slugs_file(text: str, filename: str, syntax: str, check=None) -> GR1S
     for section in PROPOSITION_SECTIONS:
         declared[section] = []
         for number, content, name in lines_by_section[section]:
+            if (syntax != 'infix' or ':' not in name) and name not in seen \
+                    and name not in _KEYWORDS and _NAME.fullmatch(name):
+                declared[section].append(name)  # the common case, without an error source
+                seen.add(name)
+                continue
             source = _Source(filename, number, _column(content))
             integer = _INTEGER_DECLARATION.match(name) if syntax == 'infix' else None
             if integer:
@@ -581,17 +609,19 @@ def _parse_slugs_file(text: str, filename: str, syntax: str, check=None) -> GR1S
 
     scopes = _scopes(declared['env_props'], declared['sys_props'], integers)
     formulas = {}
-    for section in FORMULA_SECTIONS:
-        scope, parsed = scopes[section], []
-        shapes_apply = syntax == 'infix' and not scope.integers
-        for count, (number, content, line) in enumerate(lines_by_section[section]):
-            if check is not None and count % _LINES_BETWEEN_CHECKS == 0:
-                check()
-            formula = _parse_by_shape(line, scope) if shapes_apply else None
-            if formula is None:
-                formula = _parse_line(line, syntax, scope, _Source(filename, number, _column(content)))
-            parsed.append(formula)
-        formulas[section] = parsed
+    with _collector_paused():
+        for section in FORMULA_SECTIONS:
+            scope, parsed, entries = scopes[section], [], lines_by_section[section]
+            shaped = _shaped_lines([line for _, _, line in entries], scope) if not scope.integers \
+                else itertools.repeat(None)
+            for count, ((number, content, line), shape) in enumerate(zip(entries, shaped)):
+                if check is not None and count % _LINES_BETWEEN_CHECKS == 0:
+                    check()
+                formula = _parse_by_shape(shape, syntax, scope) if shape is not None else None
+                if formula is None:
+                    formula = _parse_line(line, syntax, scope, _Source(filename, number, _column(content)))
+                parsed.append(formula)
+            formulas[section] = parsed
     # Like slugs' compiler, keep integers in range: initially and after every step.
     for variable in integers.values():
         owner = 'env' if variable.bits and variable.bits[0] in declared['env_props'] else 'sys'
@@ -630,10 +660,10 @@ def _parse_line(line: str, syntax: str, scope: _Scope, source: _Source) -> Formu
             raise infix_error from None
 
 
-# --- infix lines by shape -------------------------------------------------------------------
+# --- lines by shape ---------------------------------------------------------------------------
 #
 # Large specifications repeat a few line shapes with different propositions ("a & next(b) ->
-# !c" ...). A shape is the line with every proposition replaced by a placeholder; it is parsed
+# !c", "| ! a | b' c'" ...). A shape is the line with every proposition replaced by a placeholder; it is parsed
 # once, by the parser above, and compiled into a function that builds the formula of any line
 # of that shape. The result is the very tree the parser would build (a proposition never
 # changes how operators group or fold). Lines whose propositions break the section's rules,
@@ -641,41 +671,96 @@ def _parse_line(line: str, syntax: str, scope: _Scope, source: _Source) -> Formu
 
 _PROPOSITION = re.compile(
     r"(?<![A-Za-z0-9_.@])(?!(?:TRUE|FALSE|next)(?![A-Za-z0-9_.@]))[A-Za-z_][A-Za-z0-9_.@]*")
+_WORD = re.compile(r"([A-Za-z_][A-Za-z0-9_.@]*)")
 _PLACEHOLDER = '\x00'
+_NEXT_MARK = '\x01'
 _MAX_SHAPE_PLACEHOLDERS = 64
 _MAX_SHAPE_NESTING = 32
-_SHAPES: dict[str, object] = {}
+_SHAPES: dict[tuple[str, str], object] = {}
+_SHAPES_SEEN_ONCE: set[tuple[str, str]] = set()
 _MAX_SHAPES = 1 << 14
 
 
-def _parse_by_shape(line: str, scope: _Scope) -> Formula | None:
-    """The formula of an infix line, or None when the parser must handle the line."""
-    names = _PROPOSITION.findall(line)
-    if len(names) > _MAX_SHAPE_PLACEHOLDERS or line.count('(') > _MAX_SHAPE_NESTING:
-        return None
-    shape = _PROPOSITION.sub(_PLACEHOLDER, line)
-    compiled = _SHAPES.get(shape)
+def _shaped_lines(lines: list[str], scope: _Scope):
+    """Each line as (shape, its propositions, whether the scope needs checking), found for all
+    lines at once (one regular-expression pass over the joined text instead of two per line);
+    None for lines the shapes do not cover (very long or deeply nested)."""
+    joined = '\n'.join(lines)
+    if _PLACEHOLDER in joined or _NEXT_MARK in joined:
+        yield from itertools.repeat(None, len(lines))
+        return
+    # 'next(' is marked first, so that every word left is a proposition or a keyword;
+    # a rare TRUE / FALSE / spaced 'next (' needs the slower expression that skips keywords.
+    marked = joined.replace('next(', _NEXT_MARK + '(')
+    parts = _WORD.split(marked)
+    names = parts[1::2]
+    if _KEYWORDS.intersection(names):
+        names = _PROPOSITION.findall(marked)
+        shapes = _PROPOSITION.sub(_PLACEHOLDER, marked)
+    else:
+        shapes = _PLACEHOLDER.join(parts[0::2])
+    # Each line is checked against the section's rules unless every proposition of the
+    # section may appear both in the current and in the next step.
+    check = scope.names is not None and not scope.both_steps.issuperset(names)
+    start = 0
+    for shape in shapes.split('\n'):
+        count = shape.count(_PLACEHOLDER)
+        line_names = names[start:start + count]
+        start += count
+        if count > _MAX_SHAPE_PLACEHOLDERS or shape.count('(') > _MAX_SHAPE_NESTING:
+            yield None
+        else:
+            yield shape, line_names, check
+
+
+def _parse_by_shape(shaped: tuple, syntax: str, scope: _Scope) -> Formula | None:
+    """The formula of a line from its (shape, propositions), or None when the parser must
+    handle the line. A shape is compiled the second time it is seen: compiling costs more than
+    parsing one line, and lines of a large file are either alike or all different."""
+    shape, names, check_scope = shaped
+    key = (syntax, shape)
+    compiled = _SHAPES.get(key)
     if compiled is None:
         if len(_SHAPES) >= _MAX_SHAPES:
             _SHAPES.clear()
-        compiled = _SHAPES[shape] = _compile_shape(shape, len(names))
+        if key not in _SHAPES_SEEN_ONCE:
+            if len(_SHAPES_SEEN_ONCE) >= _MAX_SHAPES:
+                _SHAPES_SEEN_ONCE.clear()
+            _SHAPES_SEEN_ONCE.add(key)
+            return None
+        compiled = _SHAPES[key] = _compile_shape(shape, syntax, len(names))
     if compiled is False:
         return None
     build, current_names, next_names = compiled
-    if scope.names is not None and not (scope.current.issuperset(current_names(names))
-                                        and scope.next_step.issuperset(next_names(names))):
+    if check_scope and not (scope.current.issuperset(current_names(names))
+                            and scope.next_step.issuperset(next_names(names))):
         return None  # the parser names the problem
     return build(names)
 
 
-def _compile_shape(shape: str, count: int):
+@contextmanager
+def _collector_paused():
+    """Python's cyclic garbage collector off while a file's formula trees are built: trees
+    have no cycles, and its passes over millions of new nodes cost a third of a large parse."""
+    was_enabled = gc.isenabled()
+    gc.disable()
+    try:
+        yield
+    finally:
+        if was_enabled:
+            gc.enable()
+
+
+def _compile_shape(shape: str, syntax: str, count: int):
     """(build(names) -> Formula, names -> those read in the current step, names -> those read
     in the next step), or False when the shape is not a formula (the parser then reports the
     line's error)."""
-    pieces = shape.split(_PLACEHOLDER)
+    if syntax == 'prefix' and '$' in shape:
+        return False  # memory buffers share subformulas, which a template would copy out
+    pieces = shape.replace(_NEXT_MARK, 'next').split(_PLACEHOLDER)
     text = ''.join(piece + (f'_{index}' if index < count else '') for index, piece in enumerate(pieces))
     try:
-        template = _InfixParser(text, _ANY, _Source()).parse()
+        template = _parse(text, syntax, _ANY, _Source())
     except ParseError:
         return False
     in_next = [False] * count

@@ -171,6 +171,47 @@ def test_prefix_round_trip_is_structural_up_to_normal_form_and_equivalent(formul
                           np.broadcast_to(evaluate(formula, current, following), current['a'].shape))
 
 
+RENAMED = {'a': 'b', 'b': 'x_1', 'c': 'a', 'x_1': 'y.2', 'y.2': 'c'}
+
+
+def renamed(formula):
+    """``formula`` with every proposition renamed (the same line shape, other names)."""
+    if isinstance(formula, Var):
+        return var(RENAMED[formula.name])
+    if isinstance(formula, Const):
+        return formula
+    if isinstance(formula, (Not, Next)):
+        return type(formula)(renamed(formula.arg))
+    if isinstance(formula, (And, Or)):
+        return type(formula)(tuple(renamed(f) for f in formula.args))
+    return type(formula)(renamed(formula.left), renamed(formula.right))
+
+
+@settings(max_examples=150, deadline=None, database=None)
+@given(st.lists(formulas(NAMES), min_size=1, max_size=6))
+def test_files_of_repeated_line_shapes_parse_as_the_parser_parses_each_line(lines):
+    """Large files are parsed by line shape (compiled on the second sighting); every line must
+    still give the parser's own tree, in both syntaxes and under the sections' rules."""
+    lines = [f for line in lines for f in (line, renamed(line), renamed(renamed(line)))]
+    for printer, syntax, parse_file in ((to_infix, 'infix', parse_structuredslugs),
+                                        (to_prefix, 'prefix', parse_slugsin)):
+        texts = [printer(line) for line in lines]
+        text = '\n'.join(['[INPUT]', 'a', 'b', '[OUTPUT]', 'c', 'x_1', 'y.2', '[SYS_TRANS]', *texts])
+        assert parse_file(text).sys_trans == [parse_formula(t, syntax) for t in texts], syntax
+
+
+@pytest.mark.parametrize('parse_file, lines', [
+    (parse_structuredslugs, ['a -> next(b)', 'b -> next(a)', 'a -> next(c)']),
+    (parse_slugsin, ["| ! a b'", "| ! b a'", "| ! a c'"]),
+])
+def test_a_line_breaking_the_section_rules_is_reported_even_when_its_shape_is_known(parse_file, lines):
+    text = '\n'.join(['[INPUT]', 'a', 'b', '[OUTPUT]', 'c', '[ENV_TRANS]', *lines])
+    with pytest.raises(ParseError) as error:
+        parse_file(text)
+    assert error.value.token.startswith('c') and error.value.line == 9
+    assert 'next-step' in str(error.value)
+
+
 @settings(max_examples=150, deadline=None, database=None)
 @given(st.data())
 def test_specification_files_round_trip(data):

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import contextlib
 import os
+import signal
 import socket
 import sys
 import threading
@@ -83,11 +84,45 @@ def listening_socket(host: str, port: int) -> socket.socket:
     return sock
 
 
-def make_server(app, sock: socket.socket):
-    """A uvicorn server for ``app`` on an already bound socket (call ``.run(sockets=[sock])``)."""
+class GuiServer(uvicorn.Server):
+    """uvicorn's server, stopping promptly on SIGINT/SIGTERM and then returning normally.
+
+    ``on_stop`` runs first: the backend cancels its jobs and ends the event streams, which
+    uvicorn's graceful shutdown would otherwise wait for. uvicorn raises the signals it
+    caught again once it has stopped, and a second SIGTERM would kill the process before
+    its ROS side is shut down; here the signal has done its job and is not raised again.
+    """
+
+    def __init__(self, config: uvicorn.Config, on_stop=None):
+        super().__init__(config)
+        self.on_stop = on_stop
+
+    def handle_exit(self, sig, frame):
+        if self.on_stop is not None:
+            self.on_stop()
+        super().handle_exit(sig, frame)
+
+    @contextlib.contextmanager
+    def capture_signals(self):
+        if threading.current_thread() is not threading.main_thread():  # signals reach the main thread only
+            yield
+            return
+        previous = {sig: signal.signal(sig, self.handle_exit) for sig in (signal.SIGINT, signal.SIGTERM)}
+        try:
+            yield
+        finally:
+            for sig, handler in previous.items():
+                signal.signal(sig, handler)
+
+
+def make_server(app, sock: socket.socket, on_stop=None) -> GuiServer:
+    """A server for ``app`` on an already bound socket (call ``.run(sockets=[sock])``).
+
+    Requests still running a second after the server is told to stop are cut short.
+    """
     host, port = sock.getsockname()[:2]
-    return uvicorn.Server(uvicorn.Config(app, host=host, port=port, log_level='warning',
-                                         timeout_graceful_shutdown=2, ws='none'))
+    return GuiServer(uvicorn.Config(app, host=host, port=port, log_level='warning',
+                                    timeout_graceful_shutdown=1, ws='none'), on_stop=on_stop)
 
 
 @contextlib.contextmanager
@@ -123,7 +158,7 @@ def run(args) -> int:
     with sock:
         try:
             with ros_backend(args, connect=args.connect) as backend:
-                server = make_server(create_app(backend), sock)
+                server = make_server(create_app(backend), sock, on_stop=backend.stop)
                 host, port = sock.getsockname()[:2]
                 shown = f'[{host}]' if ':' in host else host
                 print(f'behavior synthesis GUI: http://{shown}:{port}/ ({backend.description}); '

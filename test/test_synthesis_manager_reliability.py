@@ -1,5 +1,7 @@
 """Reliability of the ROS suite: bursts, BUSY, fairness, lost goals, killed nodes, bad input, byproducts.
 
+Shutdown within 3 s of SIGINT/SIGTERM, entry point by entry point: test_entry_point_shutdown.py.
+
 Figures for bigger runs (50 goals to ``serve``, 20 GUI jobs, a 2,000-goal soak with its RSS
 slope) are printed by bench/bench_reliability.py.
 """
@@ -234,50 +236,7 @@ def test_a_killed_node_is_reported_by_name_and_the_suite_recovers(tmp_path):
 
 
 
-# --- shutdown -------------------------------------------------------------------------------
-
-def wait_for_line(process, text, timeout=60.0):
-    """Read ``process``'s stdout until a line containing ``text``; returns that line."""
-    found = []
-    reader = threading.Thread(target=lambda: found.extend(
-        line for line in iter(process.stdout.readline, '') if text in line and not found), daemon=True)
-    reader.start()
-    deadline = time.monotonic() + timeout
-    while not found and time.monotonic() < deadline and process.poll() is None:
-        time.sleep(0.05)
-    assert found, f'no {text!r} from {process.args}'
-    return found[0]
-
-
-@pytest.mark.parametrize('stop_signal', [signal.SIGTERM, signal.SIGINT])
-def test_serve_stops_within_three_seconds_in_the_middle_of_a_runaway_synthesis(tmp_path, stop_signal):
-    with reserve_domain_id() as domain:
-        environment = prepare_ros_environment(domain, environ=dict(os.environ))
-        process = subprocess.Popen([str(Path(sys.executable).parent / 'behavior-synthesis'), 'serve',
-                                    '--byproducts-dir', str(tmp_path)], env=environment,
-                                   stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
-        try:
-            wait_for_line(process, 'suite up')
-            with RosHarness(domain_id=domain) as ros:
-                client = SynthesisClient(ros.add_node(Node, 'shutdown_client'))
-                assert client.wait_for_server(timeout=30)
-                synthesizing = threading.Event()
-                threading.Thread(target=client.run, args=(runaway_goal(),), daemon=True, kwargs={
-                    'feedback': lambda status, _: status.startswith('Synthesizing') and synthesizing.set(),
-                    'timeout': 60}).start()
-                assert synthesizing.wait(30)
-                time.sleep(1.0)  # well into the synthesis
-                signalled = time.monotonic()
-                process.send_signal(stop_signal)
-                process.wait(timeout=30)
-                assert time.monotonic() - signalled < 3.0
-                assert process.returncode == 0
-        finally:
-            if process.poll() is None:
-                process.kill()
-                process.wait()
-
-
+# --- memory ---------------------------------------------------------------------------------
 
 def test_a_synthesis_over_its_memory_limit_ends_with_a_clear_error(ros, tmp_path):
     client = start_suite(ros, tmp_path, synthesis_parameters=[Parameter('memory_limit_mb', value=64)])

@@ -53,6 +53,7 @@ class SynthesisBackend:
         self.description = description
         self.job_gate = threading.Event()
         self.job_gate.set()
+        self.stopping = threading.Event()
         self._jobs: OrderedDict[str, Job] = OrderedDict()
         self._lock = threading.Lock()
         self._artifacts: dict[tuple[str, str], Artifact] = {}
@@ -118,7 +119,17 @@ class SynthesisBackend:
 
     # jobs ------------------------------------------------------------------------------
 
+    def stop(self):
+        """The server is stopping: cancel every unfinished job (its goal too) and end the event streams."""
+        self.stopping.set()
+        with self._lock:
+            unfinished = [job for job in self._jobs.values() if not job.finished]
+        for job in unfinished:
+            job.cancel_requested.set()
+
     def start_job(self, body) -> dict:
+        if self.stopping.is_set():
+            raise BusyError('the server is stopping', 'jobs')
         request = JobRequest.from_json(body, self.systems())
         job = Job(id=f'{next(self._counter)}-{uuid.uuid4().hex[:8]}', request=request)
         with self._lock:

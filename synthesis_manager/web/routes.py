@@ -99,7 +99,7 @@ def create_app(backend) -> FastAPI:
     async def job_events(job_id: str, request: Request):
         backend.job_status(job_id)  # unknown job: 404 now rather than an empty stream
         return _event_stream(request, lambda: backend.job_revision(job_id),
-                             lambda: backend.job_status(job_id))
+                             lambda: backend.job_status(job_id), _stopping(backend))
 
     @app.get('/api/jobs/{job_id}/artifacts/{name}')
     def artifact(job_id: str, name: str, request: Request, inline: bool = False):
@@ -126,7 +126,7 @@ def create_app(backend) -> FastAPI:
     async def simulation_events(simulation_id: str, request: Request):
         backend.simulation_status(simulation_id)
         return _event_stream(request, lambda: backend.simulation_revision(simulation_id),
-                             lambda: backend.simulation_status(simulation_id))
+                             lambda: backend.simulation_status(simulation_id), _stopping(backend))
 
     @app.get('/api/simulations/{simulation_id}/frames/{index}')
     def simulation_frame(simulation_id: str, index: int):
@@ -158,11 +158,22 @@ def _file_response(found: Artifact, inline: bool) -> Response:
                     headers={'Content-Disposition': f'{disposition}; filename="{found.filename}"'})
 
 
-def _event_stream(request: Request, revision: Callable[[], int], snapshot: Callable[[], dict]):
-    """Server-sent events: ``progress`` with each new snapshot, then one ``finished``."""
+def _stopping(backend) -> Callable[[], bool]:
+    """Whether ``backend`` is stopping (a backend without ``stopping`` never is)."""
+    stopping = getattr(backend, 'stopping', None)
+    return stopping.is_set if stopping is not None else (lambda: False)
+
+
+def _event_stream(request: Request, revision: Callable[[], int], snapshot: Callable[[], dict],
+                  stopping: Callable[[], bool]):
+    """Server-sent events: ``progress`` with each new snapshot, then one ``finished``.
+
+    A stream also ends when the server stops: an open stream would otherwise hold the
+    server's shutdown until its grace period runs out.
+    """
     async def events():
         sent = -1
-        while not await request.is_disconnected():
+        while not stopping() and not await request.is_disconnected():
             current = revision()
             if current != sent:
                 sent = current

@@ -1,0 +1,269 @@
+"""SIGINT and SIGTERM stop every long-running entry point within 3 s, even mid-synthesis.
+
+Each test starts the entry point as its own process, waits until it is provably in the
+middle of a synthesis (or, for the simulator, of an action), waits a second more, sends
+the signal and measures how long the process takes to exit. It also checks the exit code
+(0 for servers and nodes; 128 + the signal number for clients and gr1synth, after a
+client has cancelled its goal) and that the process left nothing behind: no child
+process, and no suite still burning CPU on a goal nobody waits for.
+
+The runaway syntheses are real requests: through ROS and gr1synth a specification whose
+strategy extraction would take hours (``RUNAWAY_SPEC``); through the GUI and the
+in-process commands, which take only a robot system and goals, a system whose goal needs
+60 parts assembled at once (``many_parts_config``). Those commands synthesize it with
+gr1synth as the external synthesizer (``--backend slugs``): the builtin synthesizer runs
+in the entry point's own process, and its BDD operations on such a specification hold
+Python's GIL for seconds at a time, delaying any shutdown by as much (README, "Limits,
+load and faults"); the runaway specification above yields the GIL often.
+"""
+
+import contextlib
+import json
+import os
+import re
+import signal
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+
+import httpx
+import pytest
+from rclpy.node import Node
+
+from synthesis_manager.client import SynthesisClient, make_goal
+from synthesis_manager.ros.env import prepare_ros_environment
+from synthesis_manager.ros.harness import RosHarness, reserve_domain_id
+from test_synthesis_manager_reliability import RUNAWAY_SPEC, runaway_goal
+
+BIN = Path(sys.executable).parent
+STOP_WITHIN = 3.0  # seconds from the signal to the process's exit
+STOP_SIGNALS = pytest.mark.parametrize('stop_signal', [signal.SIGINT, signal.SIGTERM], ids=['SIGINT', 'SIGTERM'])
+NODE_SCRIPTS = ('ltl-compilation-node', 'ltl-synthesis-node', 'sm-generation-node', 'behavior-synthesis-server')
+RUNAWAY_PARTS = 60
+EXTERNAL_SYNTHESIZER = ['--backend', 'slugs', '--slugs-executable', BIN / 'gr1synth']
+
+
+# --- processes ------------------------------------------------------------------------------
+
+class Output:
+    """Collects a process's output lines in a thread; ``wait_for`` a line matching a pattern."""
+
+    def __init__(self, process):
+        self.process, self.lines = process, []
+        threading.Thread(target=self._read, daemon=True).start()
+
+    def _read(self):
+        for line in iter(self.process.stdout.readline, ''):
+            self.lines.append(line)
+
+    def wait_for(self, pattern: str, timeout: float = 60.0) -> re.Match:
+        deadline = time.monotonic() + timeout
+        while time.monotonic() < deadline:
+            for line in list(self.lines):
+                match = re.search(pattern, line)
+                if match:
+                    return match
+            if self.process.poll() is not None and not any(re.search(pattern, line) for line in self.lines):
+                break
+            time.sleep(0.05)
+        raise AssertionError(f'no line matching {pattern!r} from {self.process.args}:\n{self.text()}')
+
+    def text(self) -> str:
+        return ''.join(self.lines)
+
+
+@contextlib.contextmanager
+def started(command, env=None, cwd=None):
+    """``command`` running (output collected); killed on leaving if it is still alive."""
+    process = subprocess.Popen([str(part) for part in command], env=env, cwd=cwd, stdout=subprocess.PIPE,
+                               stderr=subprocess.STDOUT, text=True)
+    try:
+        yield process, Output(process)
+    finally:
+        if process.poll() is None:
+            process.kill()
+            process.wait()
+
+
+@contextlib.contextmanager
+def loopback_domain():
+    """A reserved ROS domain and an environment for processes on it (DDS on loopback)."""
+    with reserve_domain_id() as domain:
+        yield domain, prepare_ros_environment(domain, environ=dict(os.environ))
+
+
+def descendants(pid: int) -> set[int]:
+    """Process ids of ``pid``'s children, grandchildren, ... (from /proc)."""
+    parents = {}
+    for entry in Path('/proc').iterdir():
+        if entry.name.isdigit():
+            with contextlib.suppress(OSError):
+                # the command name (field 2) may hold spaces and parentheses: split after it
+                fields = (entry / 'stat').read_text().rsplit(')', 1)[1].split()
+                parents[int(entry.name)] = int(fields[1])
+    found, frontier = set(), {pid}
+    while frontier:
+        frontier = {child for child, parent in parents.items() if parent in frontier} - found
+        found |= frontier
+    return found
+
+
+def cpu_seconds(pid: int) -> float:
+    """User + system CPU time of process ``pid`` so far."""
+    fields = Path(f'/proc/{pid}/stat').read_text().rsplit(')', 1)[1].split()
+    return (int(fields[11]) + int(fields[12])) / os.sysconf('SC_CLK_TCK')
+
+
+def assert_busy(pid: int, within: float = 1.0):
+    """``pid`` is computing: it uses at least a third of a core over ``within`` seconds."""
+    before = cpu_seconds(pid)
+    time.sleep(within)
+    used = cpu_seconds(pid) - before
+    assert used > within / 3, f'process {pid} used only {used:.2f} s CPU in {within} s: not synthesizing'
+
+
+def assert_idle(pid: int, within: float = 1.0):
+    """``pid`` has gone back to idle: under a tenth of a core over ``within`` seconds."""
+    time.sleep(0.5)  # the last moments of a stopped synthesis
+    before = cpu_seconds(pid)
+    time.sleep(within)
+    used = cpu_seconds(pid) - before
+    assert used < within / 10, f'process {pid} still used {used:.2f} s CPU in {within} s'
+
+
+def assert_busy_synthesizing(pid: int):
+    """``pid``'s external synthesizer (gr1synth) has started and is computing."""
+    deadline = time.monotonic() + 30
+    while not (synthesizers := [child for child in descendants(pid) if _runs_gr1synth(child)]):
+        assert time.monotonic() < deadline, f'process {pid} started no gr1synth'
+        time.sleep(0.05)
+    assert_busy(synthesizers[0])
+
+
+def _runs_gr1synth(pid: int) -> bool:
+    try:
+        return b'gr1synth' in Path(f'/proc/{pid}/cmdline').read_bytes()
+    except OSError:
+        return False
+
+
+def stop(process, stop_signal, name: str) -> float:
+    """Send ``stop_signal``; assert exit within STOP_WITHIN leaving no descendant; returns the seconds."""
+    return stop_all({name: process}, stop_signal)[name]
+
+
+def stop_all(processes: dict, stop_signal) -> dict:
+    """``stop`` for several processes signalled at once: {name: seconds to exit}."""
+    children = {name: descendants(process.pid) for name, process in processes.items()}
+    signalled = time.monotonic()
+    for process in processes.values():
+        process.send_signal(stop_signal)
+    seconds = {}
+    while len(seconds) < len(processes) and time.monotonic() - signalled < 30:
+        for name, process in processes.items():
+            if name not in seconds and process.poll() is not None:
+                seconds[name] = time.monotonic() - signalled
+        time.sleep(0.01)
+    for name, process in processes.items():
+        assert name in seconds, f'{name} still running 30 s after {stop_signal.name}'
+        print(f'{name}: {stop_signal.name} -> exit {process.returncode} in {seconds[name]:.2f} s')
+    for name, process in processes.items():
+        left = {pid for pid in children[name] if Path(f'/proc/{pid}').exists()}
+        assert not left, f'{name} left processes {sorted(left)} behind'
+        assert seconds[name] < STOP_WITHIN, f'{name} took {seconds[name]:.2f} s to stop after {stop_signal.name}'
+    return seconds
+
+
+def client_exit_code(stop_signal) -> int:
+    return 128 + stop_signal
+
+
+# --- runaway requests -------------------------------------------------------------------------
+
+def many_parts_config(directory: Path, parts: int = RUNAWAY_PARTS) -> Path:
+    """A robot system whose action ``assemble`` needs ``parts`` other actions completed first.
+
+    Every part may be worked on at once and each may complete or fail at any time, so the
+    specification for the goal ``assemble`` has 2 * (parts + 1) outcome inputs; with 60
+    parts its synthesis runs for minutes (into the memory limit).
+    """
+    names = [f'part{index}' for index in range(parts)]
+    lines = ['system: many_parts', 'abstraction:', '  outcomes: [completed, failed]', '  initial_mode: idle',
+             '  control_modes:', '    idle: []', '  actions:', f'    assemble: [{", ".join(names)}]',
+             *(f'    {name}: []' for name in names)]
+    directory.mkdir(parents=True, exist_ok=True)
+    (directory / 'many_parts.yaml').write_text('\n'.join(lines) + '\n')
+    return directory
+
+
+MANY_PARTS_TASK = ['--system', 'many_parts', '--initial-conditions', 'idle', '--goals', 'assemble']
+
+
+def start_runaway_goal(ros):
+    """Send ``runaway_goal()`` to /behavior_synthesis from a client in ``ros``; return once it synthesizes."""
+    client = SynthesisClient(ros.add_node(Node, 'shutdown_client'))
+    assert client.wait_for_server(timeout=30)
+    synthesizing = threading.Event()
+    threading.Thread(target=client.run, args=(runaway_goal(),), daemon=True, kwargs={
+        'feedback': lambda status, _: status.startswith('Synthesizing') and synthesizing.set(),
+        'timeout': 60}).start()
+    assert synthesizing.wait(30), 'the runaway goal did not reach the synthesis'
+
+
+# --- servers and nodes --------------------------------------------------------------------------
+
+@STOP_SIGNALS
+def test_serve_stops_within_three_seconds_in_the_middle_of_a_runaway_synthesis(tmp_path, stop_signal):
+    with loopback_domain() as (domain, environment):
+        with started([BIN / 'behavior-synthesis', 'serve', '--byproducts-dir', tmp_path], environment) as (
+                process, output):
+            output.wait_for('suite up')
+            with RosHarness(domain_id=domain) as ros:
+                start_runaway_goal(ros)
+                assert_busy(process.pid)  # a second well into the synthesis
+                stop(process, stop_signal, 'serve')
+                assert process.returncode == 0, output.text()
+
+
+@STOP_SIGNALS
+def test_each_node_process_stops_within_three_seconds_in_the_middle_of_a_runaway_synthesis(
+        tmp_path, stop_signal):
+    """The four node scripts as separate processes; all are signalled while one synthesizes."""
+    with loopback_domain() as (domain, environment), contextlib.ExitStack() as stack:
+        nodes = {}
+        for script in NODE_SCRIPTS:
+            arguments = ['--ros-args', '-p', f'byproducts_dir:={tmp_path}'] if script == 'ltl-synthesis-node' else []
+            nodes[script] = stack.enter_context(started([BIN / script, *arguments], environment))
+        for process, output in nodes.values():
+            output.wait_for('ready')
+        with RosHarness(domain_id=domain) as ros:
+            start_runaway_goal(ros)
+            assert_busy(nodes['ltl-synthesis-node'][0].pid)
+            stop_all({script: process for script, (process, _) in nodes.items()}, stop_signal)
+        for script, (process, output) in nodes.items():
+            assert process.returncode == 0, f'{script}:\n{output.text()}'
+
+
+
+@STOP_SIGNALS
+def test_gui_stops_within_three_seconds_in_the_middle_of_a_runaway_job_with_its_page_watching(
+        tmp_path, stop_signal):
+    """The GUI with its in-process suite; the job's event stream (the page) stays open."""
+    config = many_parts_config(tmp_path / 'config')
+    with started([BIN / 'behavior-synthesis', 'gui', '--port', '0', '--config-dir', config,
+                  '--byproducts-dir', tmp_path / 'byproducts', *EXTERNAL_SYNTHESIZER]) as (process, output):
+        url = output.wait_for(r'behavior synthesis GUI: (http://\S+/)').group(1)
+        answer = httpx.post(f'{url}api/jobs', json={'system': 'many_parts', 'initial_conditions': ['idle'],
+                                                    'goals': ['assemble']})
+        assert answer.status_code == 202, answer.text
+        job = answer.json()['id']
+        with httpx.stream('GET', f'{url}api/jobs/{job}/events', timeout=30) as events:
+            for line in events.iter_lines():
+                if line.startswith('data:') and json.loads(line[5:])['status'].startswith('Synthesizing'):
+                    break
+            assert_busy_synthesizing(process.pid)
+            assert httpx.get(f'{url}api/jobs/{job}').json()['state'] == 'running'
+            stop(process, stop_signal, 'gui')
+        assert process.returncode == 0, output.text()

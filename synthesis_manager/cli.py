@@ -3,12 +3,18 @@
 Each subcommand lives in the package that owns it and provides ``add_arguments(parser)``
 and ``run(args) -> int``; modules are imported only when their subcommand is built, so
 ``--help`` stays fast.
+
+SIGTERM stops a command as Ctrl-C (SIGINT) does: a client cancels its goal, an in-process
+suite shuts down, and the command exits with 128 + the signal's number (130, 143).
+Servers (``serve``, ``gui``) handle both signals themselves and exit with 0.
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
 import importlib
+import signal
 import sys
 
 # name -> (module providing add_arguments/run, one-line help)
@@ -48,7 +54,29 @@ def main(argv: list[str] | None = None) -> int:
     if not getattr(args, 'run', None):
         parser.print_help()
         return 0 if not argv or '-h' in argv or '--help' in argv else 2
-    return args.run(args)
+    with stop_signals_interrupt() as received:
+        try:
+            return args.run(args)
+        except KeyboardInterrupt:
+            print(f'\nbehavior-synthesis {args.command}: interrupted', file=sys.stderr)
+            return 128 + (received[-1] if received else signal.SIGINT)
+
+
+@contextlib.contextmanager
+def stop_signals_interrupt():
+    """SIGINT and SIGTERM raise KeyboardInterrupt in the main thread; yields the signals received."""
+    received = []
+
+    def interrupt(signum, _frame):
+        received.append(signum)
+        raise KeyboardInterrupt
+
+    previous = {sig: signal.signal(sig, interrupt) for sig in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        yield received
+    finally:
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
 
 
 if __name__ == '__main__':

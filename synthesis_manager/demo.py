@@ -55,9 +55,6 @@ def run(args) -> int:
     except SuiteUnavailable as error:
         print(f'demo: {error}', file=sys.stderr)
         return 1
-    except KeyboardInterrupt:
-        print('\ndemo: interrupted', file=sys.stderr)
-        return 130
     print_summary(outcome)
     if not outcome.succeeded:
         return 1

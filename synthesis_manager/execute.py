@@ -35,7 +35,8 @@ Exit status:
   2  bad command line (e.g. a malformed ``--fail-first``);
   3  synthesis failed (the action's error code is printed);
   4  the trace check found violations, or the robot fell;
-  5  the run could not finish (robot-time limit, a state the executive cannot run, ...).
+  5  the run could not finish (robot-time limit, a state the executive cannot run, ...);
+  130, 143  stopped by SIGINT (Ctrl-C) or SIGTERM.
 A mission stops at the first batch with status 3, 4 or 5 and exits with it; otherwise it
 exits with the status of its last batch (earlier batches may end in any SM outcome).
 """
@@ -118,11 +119,7 @@ def run(args) -> int:
         return EXIT_USAGE
     log = sys.stderr if args.json else sys.stdout
     report = {'system': args.system, 'faults': faults}
-    try:
-        code = _synthesize_and_execute(args, simulator, initial_conditions, batches, report, log)
-    except KeyboardInterrupt:
-        print('\nexecute: interrupted', file=sys.stderr)
-        return 130
+    code = _synthesize_and_execute(args, simulator, initial_conditions, batches, report, log)
     report['exit_code'] = code
     if args.json:
         print(json.dumps(report))

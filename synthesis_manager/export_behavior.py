@@ -10,7 +10,8 @@ behavior module and its manifest, plus package.xml/setup.py for colcon
 (``sm_generation.flexbe_behavior``). ``--name`` names the behavior (default: from the goals,
 e.g. "Look Down Pickup Object").
 
-Exit status: 0 written; 2 bad name, package or configuration; 3 synthesis failed.
+Exit status: 0 written; 2 bad name, package or configuration; 3 synthesis failed; 130, 143
+stopped by SIGINT (Ctrl-C) or SIGTERM.
 """
 
 from __future__ import annotations

@@ -76,6 +76,10 @@ def read_spec_file(path: str) -> dict:
     return parse_structuredslugs(text, filename=path).to_text_sections()
 
 
+# Seconds an interrupted send-goal waits for its cancelled goal's result (it exits within 3 s).
+CANCEL_GRACE = 2.0
+
+
 class ProgressBar:
     """A one-line progress bar on stderr driven by the action's feedback."""
 
@@ -136,22 +140,28 @@ def run(args) -> int:
 
         # Wait on an Event, not Thread.join: an interrupted join can lose track of the thread.
         threading.Thread(target=wait_for_outcome, daemon=True).start()
+        interrupted = False
         try:
             while not finished.wait(0.1):
                 pass
-        except KeyboardInterrupt:  # Ctrl-C cancels the goal, then we wait for its result
+        except KeyboardInterrupt:  # Ctrl-C/SIGTERM cancel the goal; its result shows the cancel
+            interrupted = True
             cancel.set()
-            finished.wait(30)
+            finished.wait(CANCEL_GRACE)
         if progress:
             progress.close()
     outcome = outcome_box.get('outcome')
     if outcome is None:
         print(f"send-goal: no result: {outcome_box.get('error', 'interrupted')}", file=sys.stderr)
-        return 1
-    if args.output:
-        Path(args.output).write_text(json.dumps(outcome.to_dict(), indent=1))
-    if args.json:
-        print(json.dumps(outcome.to_dict()))
     else:
-        print_summary(outcome)
+        if args.output:
+            Path(args.output).write_text(json.dumps(outcome.to_dict(), indent=1))
+        if args.json:
+            print(json.dumps(outcome.to_dict()))
+        else:
+            print_summary(outcome)
+    if interrupted:
+        raise KeyboardInterrupt  # the command line exits with 128 + the signal's number
+    if outcome is None:
+        return 1
     return 0 if outcome.succeeded else 1

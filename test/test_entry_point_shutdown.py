@@ -48,43 +48,46 @@ EXTERNAL_SYNTHESIZER = ['--backend', 'slugs', '--slugs-executable', BIN / 'gr1sy
 # --- processes ------------------------------------------------------------------------------
 
 class Output:
-    """Collects a process's output lines in a thread; ``wait_for`` a line matching a pattern."""
+    """Collects a process's output in a thread; ``wait_for`` a pattern in it.
+
+    Read in chunks, not lines: progress bars end their updates with a carriage return only.
+    """
 
     def __init__(self, process):
-        self.process, self.lines = process, []
+        self.process, self.chunks = process, []
         threading.Thread(target=self._read, daemon=True).start()
 
     def _read(self):
-        for line in iter(self.process.stdout.readline, ''):
-            self.lines.append(line)
+        while chunk := os.read(self.process.stdout.fileno(), 65536):
+            self.chunks.append(chunk.decode(errors='replace'))
 
     def wait_for(self, pattern: str, timeout: float = 60.0) -> re.Match:
         deadline = time.monotonic() + timeout
         while time.monotonic() < deadline:
-            for line in list(self.lines):
-                match = re.search(pattern, line)
-                if match:
-                    return match
-            if self.process.poll() is not None and not any(re.search(pattern, line) for line in self.lines):
+            exited = self.process.poll() is not None
+            match = re.search(pattern, self.text())
+            if match or exited:
                 break
             time.sleep(0.05)
-        raise AssertionError(f'no line matching {pattern!r} from {self.process.args}:\n{self.text()}')
+        assert match, f'no {pattern!r} from {self.process.args}:\n{self.text()}'
+        return match
 
     def text(self) -> str:
-        return ''.join(self.lines)
+        return ''.join(self.chunks)
 
 
 @contextlib.contextmanager
 def started(command, env=None, cwd=None):
-    """``command`` running (output collected); killed on leaving if it is still alive."""
+    """``command`` running in a session of its own (output collected); on leaving, whatever is
+    still running of it (its process group) is killed."""
     process = subprocess.Popen([str(part) for part in command], env=env, cwd=cwd, stdout=subprocess.PIPE,
-                               stderr=subprocess.STDOUT, text=True)
+                               stderr=subprocess.STDOUT, start_new_session=True)
     try:
         yield process, Output(process)
     finally:
-        if process.poll() is None:
-            process.kill()
-            process.wait()
+        with contextlib.suppress(ProcessLookupError):
+            os.killpg(process.pid, signal.SIGKILL)
+        process.wait()
 
 
 @contextlib.contextmanager
@@ -192,7 +195,12 @@ def many_parts_config(directory: Path, parts: int = RUNAWAY_PARTS) -> Path:
     names = [f'part{index}' for index in range(parts)]
     lines = ['system: many_parts', 'abstraction:', '  outcomes: [completed, failed]', '  initial_mode: idle',
              '  control_modes:', '    idle: []', '  actions:', f'    assemble: [{", ".join(names)}]',
-             *(f'    {name}: []' for name in names)]
+             *(f'    {name}: []' for name in names),
+             'flexbe:', '  sm_outcomes: {finished: finished, failed: failed}',
+             '  packages: {states: many_parts_flexbe_states, behaviors: many_parts_flexbe_behaviors}', '  states:',
+             *(f'    {name}_a: {{class_decl: {{name: RunState, param_names: [], param_values: []}}, '
+               f'output_mapping: {{{name}_c: [done], {name}_f: [failed]}}, autonomy: [1, 0]}}'
+               for name in ['idle', 'assemble', *names])]
     directory.mkdir(parents=True, exist_ok=True)
     (directory / 'many_parts.yaml').write_text('\n'.join(lines) + '\n')
     return directory
@@ -267,3 +275,41 @@ def test_gui_stops_within_three_seconds_in_the_middle_of_a_runaway_job_with_its_
             assert httpx.get(f'{url}api/jobs/{job}').json()['state'] == 'running'
             stop(process, stop_signal, 'gui')
         assert process.returncode == 0, output.text()
+
+
+# --- clients ------------------------------------------------------------------------------------
+
+@STOP_SIGNALS
+def test_send_goal_stops_within_three_seconds_and_cancels_its_runaway_goal(tmp_path, stop_signal):
+    spec = tmp_path / 'runaway.json'
+    spec.write_text(json.dumps(RUNAWAY_SPEC))
+    with loopback_domain() as (_, environment):
+        with started([BIN / 'behavior-synthesis', 'serve', '--byproducts-dir', tmp_path], environment) as (
+                server, server_output):
+            server_output.wait_for('suite up')
+            with started([BIN / 'behavior-synthesis', 'send-goal', '--synthesis-only', spec],
+                         environment) as (client, output):
+                output.wait_for('Synthesizing')
+                assert_busy(server.pid)
+                stop(client, stop_signal, 'send-goal')
+                assert client.returncode == client_exit_code(stop_signal), output.text()
+                assert 'result: PREEMPTED' in output.text()
+            assert_idle(server.pid)  # the goal was cancelled: the suite stopped synthesizing
+            stop(server, signal.SIGINT, 'serve')
+
+
+@pytest.mark.parametrize('command', ['execute', 'demo', 'export-behavior'])
+@STOP_SIGNALS
+def test_in_process_suite_commands_stop_within_three_seconds_in_the_middle_of_a_runaway_synthesis(
+        tmp_path, command, stop_signal):
+    config = many_parts_config(tmp_path / 'config')
+    outputs = {'demo': ['--output-dir', tmp_path / 'out'], 'export-behavior': ['-o', tmp_path / 'out'],
+               'execute': []}[command]
+    with started([BIN / 'behavior-synthesis', command, *MANY_PARTS_TASK, '--config-dir', config,
+                  '--byproducts-dir', tmp_path / 'byproducts', *EXTERNAL_SYNTHESIZER, *outputs],
+                 cwd=tmp_path) as (process, output):
+        output.wait_for('Synthesizing')
+        assert_busy_synthesizing(process.pid)
+        stop(process, stop_signal, command)
+        assert process.returncode == client_exit_code(stop_signal), output.text()
+        assert 'interrupted' in output.text()

@@ -91,7 +91,7 @@ def test_ctrl_c_cancels_the_goal(served, tmp_path):
     time.sleep(8.0)  # connected and synthesizing (the synthesis never ends by itself)
     process.send_signal(signal.SIGINT)
     stdout, stderr = process.communicate(timeout=30)
-    assert process.returncode == 1, stderr
+    assert process.returncode == 130, stderr
     assert json.loads(stdout)['error_name'] == 'PREEMPTED'
 
 

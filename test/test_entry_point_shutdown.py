@@ -32,9 +32,12 @@ import httpx
 import pytest
 from rclpy.node import Node
 
+from respec.parsing import spec_from_text_sections
+
 from synthesis_manager.client import SynthesisClient, make_goal
 from synthesis_manager.ros.env import prepare_ros_environment
 from synthesis_manager.ros.harness import RosHarness, reserve_domain_id
+from test_atlas_sim_node import Client as SimClient
 from test_synthesis_manager_reliability import RUNAWAY_SPEC, runaway_goal
 
 BIN = Path(sys.executable).parent
@@ -277,6 +280,23 @@ def test_gui_stops_within_three_seconds_in_the_middle_of_a_runaway_job_with_its_
         assert process.returncode == 0, output.text()
 
 
+@STOP_SIGNALS
+def test_the_simulator_node_stops_within_three_seconds_in_the_middle_of_an_action(stop_signal):
+    with loopback_domain() as (domain, environment):
+        with started([BIN / 'atlas-sim-node', '--ros-args', '-p', 'speed:=0.5', '-p', 'state_rate:=20.0'],
+                     environment) as (process, output):
+            output.wait_for('atlas_sim ready')
+            with RosHarness(domain_id=domain) as ros:
+                client = SimClient(ros, 'shutdown_sim_client')
+                goal = client.send('stand')
+                client.wait_for_state(lambda state: 'stand' in state.running or state.pending_mode == 'stand',
+                                      timeout=30)
+                time.sleep(1.0)
+                assert 'stand' in client.states[-1].running or client.states[-1].pending_mode == 'stand'
+                stop(process, stop_signal, 'atlas-sim-node')
+                assert process.returncode == 0, output.text()
+
+
 # --- clients ------------------------------------------------------------------------------------
 
 @STOP_SIGNALS
@@ -313,3 +333,17 @@ def test_in_process_suite_commands_stop_within_three_seconds_in_the_middle_of_a_
         stop(process, stop_signal, command)
         assert process.returncode == client_exit_code(stop_signal), output.text()
         assert 'interrupted' in output.text()
+
+
+@STOP_SIGNALS
+def test_gr1synth_stops_within_three_seconds_in_the_middle_of_a_runaway_synthesis(tmp_path, stop_signal):
+    """Killed by the signal, as a command-line tool should be (the shell reports 128 + its number)."""
+    spec = tmp_path / 'runaway.slugsin'
+    spec.write_text(spec_from_text_sections(RUNAWAY_SPEC).to_slugsin())
+    with started([BIN / 'gr1synth', '--explicitStrategy', '--jsonOutput', '--sysInitRoboticsSemantics', spec,
+                  tmp_path / 'strategy.json']) as (process, output):
+        time.sleep(1.0)
+        assert_busy(process.pid)
+        stop(process, stop_signal, 'gr1synth')
+        assert process.returncode in (-stop_signal, client_exit_code(stop_signal)), output.text()
+        assert not (tmp_path / 'strategy.json').exists()

@@ -45,6 +45,7 @@ STOP_WITHIN = 3.0  # seconds from the signal to the process's exit
 STOP_SIGNALS = pytest.mark.parametrize('stop_signal', [signal.SIGINT, signal.SIGTERM], ids=['SIGINT', 'SIGTERM'])
 NODE_SCRIPTS = ('ltl-compilation-node', 'ltl-synthesis-node', 'sm-generation-node', 'behavior-synthesis-server')
 RUNAWAY_PARTS = 60
+GUI_URL = r'behavior synthesis GUI: (http://\S+/)'
 EXTERNAL_SYNTHESIZER = ['--backend', 'slugs', '--slugs-executable', BIN / 'gr1synth']
 
 
@@ -82,12 +83,16 @@ class Output:
 @contextlib.contextmanager
 def started(command, env=None, cwd=None):
     """``command`` running in a session of its own (output collected); on leaving, whatever is
-    still running of it (its process group) is killed."""
+    still running of it (its process group, and descendants in groups of their own, such as
+    an external synthesizer) is killed."""
     process = subprocess.Popen([str(part) for part in command], env=env, cwd=cwd, stdout=subprocess.PIPE,
                                stderr=subprocess.STDOUT, start_new_session=True)
     try:
         yield process, Output(process)
     finally:
+        for pid in descendants(process.pid):
+            with contextlib.suppress(ProcessLookupError):
+                os.kill(pid, signal.SIGKILL)
         with contextlib.suppress(ProcessLookupError):
             os.killpg(process.pid, signal.SIGKILL)
         process.wait()
@@ -258,6 +263,21 @@ def test_each_node_process_stops_within_three_seconds_in_the_middle_of_a_runaway
 
 
 
+@contextlib.contextmanager
+def runaway_gui_job(url: str):
+    """A many_parts job started through the GUI's API, watched by its event stream (as the page
+    does) until it synthesizes; yields the job's id with the stream still open."""
+    answer = httpx.post(f'{url}api/jobs', json={'system': 'many_parts', 'initial_conditions': ['idle'],
+                                                'goals': ['assemble']})
+    assert answer.status_code == 202, answer.text
+    job = answer.json()['id']
+    with httpx.stream('GET', f'{url}api/jobs/{job}/events', timeout=30) as events:
+        for line in events.iter_lines():
+            if line.startswith('data:') and json.loads(line[5:])['status'].startswith('Synthesizing'):
+                break
+        yield job
+
+
 @STOP_SIGNALS
 def test_gui_stops_within_three_seconds_in_the_middle_of_a_runaway_job_with_its_page_watching(
         tmp_path, stop_signal):
@@ -265,19 +285,31 @@ def test_gui_stops_within_three_seconds_in_the_middle_of_a_runaway_job_with_its_
     config = many_parts_config(tmp_path / 'config')
     with started([BIN / 'behavior-synthesis', 'gui', '--port', '0', '--config-dir', config,
                   '--byproducts-dir', tmp_path / 'byproducts', *EXTERNAL_SYNTHESIZER]) as (process, output):
-        url = output.wait_for(r'behavior synthesis GUI: (http://\S+/)').group(1)
-        answer = httpx.post(f'{url}api/jobs', json={'system': 'many_parts', 'initial_conditions': ['idle'],
-                                                    'goals': ['assemble']})
-        assert answer.status_code == 202, answer.text
-        job = answer.json()['id']
-        with httpx.stream('GET', f'{url}api/jobs/{job}/events', timeout=30) as events:
-            for line in events.iter_lines():
-                if line.startswith('data:') and json.loads(line[5:])['status'].startswith('Synthesizing'):
-                    break
+        url = output.wait_for(GUI_URL).group(1)
+        with runaway_gui_job(url) as job:
             assert_busy_synthesizing(process.pid)
             assert httpx.get(f'{url}api/jobs/{job}').json()['state'] == 'running'
             stop(process, stop_signal, 'gui')
         assert process.returncode == 0, output.text()
+
+
+@STOP_SIGNALS
+def test_a_connected_gui_stops_within_three_seconds_and_cancels_its_running_job(tmp_path, stop_signal):
+    """``gui --connect`` to a ``serve`` elsewhere: stopping the GUI cancels its goal there."""
+    config = many_parts_config(tmp_path / 'config')
+    with loopback_domain() as (_, environment):
+        with started([BIN / 'behavior-synthesis', 'serve', '--config-dir', config, '--byproducts-dir', tmp_path,
+                      *EXTERNAL_SYNTHESIZER], environment) as (server, server_output):
+            server_output.wait_for('suite up')
+            with started([BIN / 'behavior-synthesis', 'gui', '--port', '0', '--connect', '--config-dir', config],
+                         environment) as (gui, output):
+                with runaway_gui_job(output.wait_for(GUI_URL).group(1)):
+                    assert_busy_synthesizing(server.pid)
+                    stop(gui, stop_signal, 'gui --connect')
+                assert gui.returncode == 0, output.text()
+            assert_idle(server.pid)
+            assert not [child for child in descendants(server.pid) if _runs_gr1synth(child)]
+            stop(server, signal.SIGINT, 'serve')
 
 
 @STOP_SIGNALS

@@ -93,6 +93,10 @@ def strategy_to_text(strategy: dict) -> str:
 
 
 def main(argv=None) -> int:
+    if argv is None:  # run as a program: Ctrl-C ends it at once, as it ends slugs, even while
+        # one long CUDD operation holds the interpreter (a Python handler would wait for it).
+        import signal
+        signal.signal(signal.SIGINT, signal.SIG_DFL)
     args = _parser().parse_args(argv)
     return run_with_deep_stack(_run, args)
 

@@ -195,10 +195,10 @@ class SymbolicGame:
 
     def env_trans(self):
         """The monolithic environment safety relation (for explicit extraction and explanations)."""
-        return _conjoin(self.true, self.env_partition.clusters)
+        return _conjoin(self.true, self.env_partition.clusters, self.interrupt)
 
     def sys_trans(self):
-        return _conjoin(self.true, self.sys_partition.clusters)
+        return _conjoin(self.true, self.sys_partition.clusters, self.interrupt)
 
     def _partition(self, parts, quantified: set[str]) -> _Partition:
         clusters = _cluster(self.bdd, parts, self.options.cluster_limit, self.interrupt)
@@ -261,7 +261,7 @@ class SymbolicGame:
     @cached_property
     def legal_moves(self):
         """env_trans & sys_trans as one BDD (built on first use, after the sifting pass)."""
-        return _conjoin(self.env_trans(), self.sys_partition.clusters)
+        return _conjoin(self.env_trans(), self.sys_partition.clusters, self.interrupt)
 
     def successors(self, positions):
         """The positions one legal move away from ``positions``."""
@@ -306,7 +306,7 @@ class SymbolicGame:
         """
         self.interrupt.check()
         system_escapes = self._relational_product(~target, self.sys_partition)
-        return _conjoin(~system_escapes, self.env_partition.clusters)
+        return _conjoin(~system_escapes, self.env_partition.clusters, self.interrupt)
 
     def exist_next_inputs(self, u):
         return self.bdd.exist(self.next_inputs, u)
@@ -355,9 +355,10 @@ class SymbolicGame:
                 'reorderings': stats.get('n_reorderings'), 'bdd_memory_bytes': stats.get('mem')}
 
 
-def _conjoin(start, parts):
+def _conjoin(start, parts, interrupt: Interrupt):
     result = start
     for part in parts:
+        interrupt.check()
         result &= part
     return result
 

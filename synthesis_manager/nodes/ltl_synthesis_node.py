@@ -15,8 +15,9 @@ from pathlib import Path
 from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.node import Node
 
-from ltl_synthesizer import SynthesisCancelled, synthesize
+from ltl_synthesizer import SynthesisCancelled
 from ltl_synthesizer.external import run_external_synthesizer
+from ltl_synthesizer.isolated import SynthesisProcesses
 from ltl_synthesizer.strategy import strategy_to_json
 from respec.automaton import automaton_from_strategy
 from respec.errors import CodedError
@@ -46,7 +47,9 @@ class LTLSynthesisNode(Node):
     further requests are answered BUSY).
 
     Syntheses run in the node's own worker threads, awaited by an async service callback,
-    so the executor stays free for cancel requests and the other nodes of the process.
+    so the executor stays free for cancel requests and the other nodes of the process. Each
+    builtin synthesis runs in a child process (ltl_synthesizer.isolated), which a cancel, the
+    time limit or shutdown kills at once, even in the middle of a long CUDD operation.
     """
 
     def __init__(self, **kwargs):
@@ -66,6 +69,9 @@ class LTLSynthesisNode(Node):
         self._lock = threading.Lock()
         self.workers = WorkerPool(self.parameter('parallel_syntheses'), self.parameter('queued_syntheses'),
                                   name='synthesis')
+        self.synthesis_processes = SynthesisProcesses()
+        if self.parameter('backend') == 'builtin':
+            self.synthesis_processes.prepare()
         group = ReentrantCallbackGroup()
         self.create_service(SynthesizeAutomaton, 'ltl_synthesis', self.on_request, callback_group=group,
                             qos_profile=service_qos())
@@ -77,6 +83,11 @@ class LTLSynthesisNode(Node):
         with self._lock:
             for event in self._running.values():
                 event.set()
+        self.synthesis_processes.close()
+
+    def destroy_node(self):
+        self.synthesis_processes.close()
+        return super().destroy_node()
 
     def active_requests(self) -> list[str]:
         """Ids of the requests whose synthesis is running or waiting now."""
@@ -140,8 +151,9 @@ class LTLSynthesisNode(Node):
             backend = self.parameter('backend')
             if backend == 'builtin':
                 try:
-                    result = synthesize(spec, robotics_semantics=robotics, cancel=cancel, deadline=deadline,
-                                        memory_limit=self.parameter('memory_limit_mb') * 2**20)
+                    result = self.synthesis_processes.synthesize(
+                        spec, robotics_semantics=robotics, cancel=cancel, deadline=deadline,
+                        memory_limit=self.parameter('memory_limit_mb') * 2**20)
                 except SynthesisCancelled as stopped:
                     return self._stopped(response, stopped.reason, timeout)
                 realizable, strategy, explanation = result.realizable, result.strategy, result.explanation

@@ -1,0 +1,124 @@
+"""ltl_synthesizer.isolated: syntheses in child processes, stopped by killing the child."""
+
+import os
+import signal
+import threading
+import time
+
+import pytest
+
+from ltl_specification import compile_task
+from ltl_synthesizer import SynthesisCancelled, synthesize
+from ltl_synthesizer.errors import SynthesisMemoryExceeded, UnknownPropositionError
+from ltl_synthesizer.isolated import SynthesisProcessDied, SynthesisProcesses
+from respec.ltl import var
+from respec.spec import GR1Specification
+
+# Strategy extraction over 2**100 initial states: runs until stopped.
+RUNAWAY = GR1Specification(env_props=[f'x{i}' for i in range(100)],
+                           sys_props=[f'y{i}' for i in range(100)], sys_liveness=[var('y0')])
+
+
+@pytest.fixture
+def processes():
+    pool = SynthesisProcesses()
+    yield pool
+    pool.close()
+
+
+def children_of_this_process() -> set[int]:
+    """The synthesis processes (multiprocessing's resource tracker aside)."""
+    with open(f'/proc/{os.getpid()}/task/{os.getpid()}/children') as children:
+        pids = {int(pid) for pid in children.read().split()}
+    found = set()
+    for pid in pids:
+        try:
+            with open(f'/proc/{pid}/cmdline') as cmdline:
+                if b'ltl_synthesizer.isolated' in cmdline.read().encode():
+                    found.add(pid)
+        except FileNotFoundError:  # ended meanwhile
+            pass
+    return found
+
+
+def test_results_equal_the_in_process_synthesizer_and_children_are_reused(processes):
+    spec = compile_task('atlas', ['stand_prep'], ['pregrasp', 'grasp_object'])
+    first = processes.synthesize(spec)
+    children = children_of_this_process()
+    second = processes.synthesize(spec)
+    assert first.realizable and first.strategy == synthesize(spec).strategy == second.strategy
+    assert children_of_this_process() == children  # the same child served both
+
+
+def test_unrealizable_specs_come_back_with_their_explanation(processes):
+    spec = compile_task('atlas', ['stand_prep'], ['look_down', 'stand_prep'])
+    result = processes.synthesize(spec)
+    assert not result.realizable and result.explanation == synthesize(spec).explanation
+
+
+def test_errors_come_back_as_the_synthesizers_own(processes):
+    bad = GR1Specification(sys_props=['a'], sys_trans=[var('nowhere')])
+    with pytest.raises(UnknownPropositionError) as error:
+        processes.synthesize(bad)
+    assert error.value.item == 'nowhere' and error.value.code == 'UNKNOWN_PROPOSITION'
+    with pytest.raises(SynthesisMemoryExceeded) as error:
+        processes.synthesize(RUNAWAY, memory_limit=16 * 2**20, deadline=time.monotonic() + 120)
+    assert error.value.item == 'memory_limit'
+
+
+def test_a_cancel_kills_the_child_at_once_and_the_next_synthesis_works(processes):
+    cancel = threading.Event()
+    threading.Timer(1.0, cancel.set).start()
+    with pytest.raises(SynthesisCancelled) as error:
+        processes.synthesize(RUNAWAY, cancel=cancel)
+    stopped = time.monotonic()
+    assert error.value.code == 'PREEMPTED'
+    running = children_of_this_process()
+    assert len(running) == 1  # only the replacement, started idle
+    assert processes.synthesize(compile_task('atlas', ['stand_prep'], ['look_down'])).realizable
+    assert time.monotonic() - stopped < 30
+
+
+def test_the_deadline_stops_the_synthesis_within_a_poll(processes):
+    started = time.monotonic()
+    with pytest.raises(SynthesisCancelled) as error:
+        processes.synthesize(RUNAWAY, deadline=started + 1.0)
+    assert error.value.code == 'SYNTHESIS_TIMEOUT'
+    assert time.monotonic() - started < 1.5
+
+
+def test_a_child_killed_from_outside_is_reported_and_replaced(processes):
+    processes.prepare()
+    outcome = {}
+
+    def run():
+        try:
+            processes.synthesize(RUNAWAY, deadline=time.monotonic() + 60)
+        except Exception as error:  # noqa: BLE001 -- inspected below
+            outcome['error'] = error
+
+    worker = threading.Thread(target=run)
+    worker.start()
+    time.sleep(1.0)
+    for pid in children_of_this_process():
+        os.kill(pid, signal.SIGKILL)
+    worker.join(timeout=10)
+    assert isinstance(outcome.get('error'), SynthesisProcessDied)
+    assert outcome['error'].code == 'SYNTHESIS_FAILED'
+    assert processes.synthesize(compile_task('atlas', ['stand_prep'], ['look_down'])).realizable
+
+
+def test_close_kills_busy_and_idle_children():
+    processes = SynthesisProcesses()
+    processes.prepare(2)
+    worker = threading.Thread(target=lambda: pytest.raises(SynthesisCancelled, processes.synthesize, RUNAWAY))
+    worker.start()
+    time.sleep(1.0)
+    assert len(children_of_this_process()) >= 2
+    processes.close()
+    worker.join(timeout=5)
+    assert not worker.is_alive()
+    deadline = time.monotonic() + 5
+    while children_of_this_process() and time.monotonic() < deadline:
+        time.sleep(0.05)
+    assert children_of_this_process() == set()

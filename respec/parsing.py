@@ -611,16 +611,13 @@ def _parse_slugs_file(text: str, filename: str, syntax: str, check=None) -> GR1S
     formulas = {}
     with _collector_paused():
         for section in FORMULA_SECTIONS:
-            scope, parsed, entries = scopes[section], [], lines_by_section[section]
-            shaped = _shaped_lines([line for _, _, line in entries], scope) if not scope.integers \
-                else itertools.repeat(None)
-            for count, ((number, content, line), shape) in enumerate(zip(entries, shaped)):
-                if check is not None and count % _LINES_BETWEEN_CHECKS == 0:
-                    check()
-                formula = _parse_by_shape(shape, syntax, scope) if shape is not None else None
+            scope, entries = scopes[section], lines_by_section[section]
+            parsed = _parse_section_by_shapes([line for _, _, line in entries], syntax, scope, check) \
+                if not scope.integers else [None] * len(entries)
+            for index, formula in enumerate(parsed):
                 if formula is None:
-                    formula = _parse_line(line, syntax, scope, _Source(filename, number, _column(content)))
-                parsed.append(formula)
+                    number, content, line = entries[index]
+                    parsed[index] = _parse_line(line, syntax, scope, _Source(filename, number, _column(content)))
             formulas[section] = parsed
     # Like slugs' compiler, keep integers in range: initially and after every step.
     for variable in integers.values():
@@ -676,19 +673,22 @@ _PLACEHOLDER = '\x00'
 _NEXT_MARK = '\x01'
 _MAX_SHAPE_PLACEHOLDERS = 64
 _MAX_SHAPE_NESTING = 32
-_SHAPES: dict[tuple[str, str], object] = {}
+_SHAPES: dict[str, dict[str, object]] = {}  # syntax -> shape -> compiled (or False)
 _SHAPES_SEEN_ONCE: set[tuple[str, str]] = set()
 _MAX_SHAPES = 1 << 14
 
 
-def _shaped_lines(lines: list[str], scope: _Scope):
-    """Each line as (shape, its propositions, whether the scope needs checking), found for all
-    lines at once (one regular-expression pass over the joined text instead of two per line);
-    None for lines the shapes do not cover (very long or deeply nested)."""
+def _parse_section_by_shapes(lines: list[str], syntax: str, scope: _Scope, check=None) -> list:
+    """The formula of each line, or None where the parser must handle the line.
+
+    The shapes and propositions of all lines are found at once (one regular-expression pass
+    over the joined text, not two per line). A shape is compiled the second time it is seen:
+    compiling costs more than parsing one line, and the lines of a large file are either
+    alike or all different.
+    """
     joined = '\n'.join(lines)
-    if _PLACEHOLDER in joined or _NEXT_MARK in joined:
-        yield from itertools.repeat(None, len(lines))
-        return
+    if not lines or _PLACEHOLDER in joined or _NEXT_MARK in joined:
+        return [None] * len(lines)
     # 'next(' is marked first, so that every word left is a proposition or a keyword;
     # a rare TRUE / FALSE / spaced 'next (' needs the slower expression that skips keywords.
     marked = joined.replace('next(', _NEXT_MARK + '(')
@@ -701,41 +701,47 @@ def _shaped_lines(lines: list[str], scope: _Scope):
         shapes = _PLACEHOLDER.join(parts[0::2])
     # Each line is checked against the section's rules unless every proposition of the
     # section may appear both in the current and in the next step.
-    check = scope.names is not None and not scope.both_steps.issuperset(names)
+    check_scope = scope.names is not None and not scope.both_steps.issuperset(names)
+    compiled_shapes = _SHAPES.setdefault(syntax, {})
+    formulas = []
+    append = formulas.append
     start = 0
     for shape in shapes.split('\n'):
         count = shape.count(_PLACEHOLDER)
         line_names = names[start:start + count]
         start += count
-        if count > _MAX_SHAPE_PLACEHOLDERS or shape.count('(') > _MAX_SHAPE_NESTING:
-            yield None
-        else:
-            yield shape, line_names, check
+        if check is not None and len(formulas) % _LINES_BETWEEN_CHECKS == 0:
+            check()
+        compiled = compiled_shapes.get(shape)
+        if compiled is None:
+            compiled = _first_sightings(compiled_shapes, shape, syntax, count)
+        if compiled is False:
+            append(None)
+            continue
+        build, current_names, next_names = compiled
+        if check_scope and not (scope.current.issuperset(current_names(line_names))
+                                and scope.next_step.issuperset(next_names(line_names))):
+            append(None)  # the parser names the problem
+            continue
+        append(build(line_names))
+    return formulas
 
 
-def _parse_by_shape(shaped: tuple, syntax: str, scope: _Scope) -> Formula | None:
-    """The formula of a line from its (shape, propositions), or None when the parser must
-    handle the line. A shape is compiled the second time it is seen: compiling costs more than
-    parsing one line, and lines of a large file are either alike or all different."""
-    shape, names, check_scope = shaped
+def _first_sightings(compiled_shapes: dict, shape: str, syntax: str, count: int):
+    """A shape not compiled yet: False the first time (the parser handles that line) and for
+    unusual lines (very long or deeply nested), else its compiled form, kept."""
+    if count > _MAX_SHAPE_PLACEHOLDERS or shape.count('(') > _MAX_SHAPE_NESTING:
+        return False
     key = (syntax, shape)
-    compiled = _SHAPES.get(key)
-    if compiled is None:
-        if len(_SHAPES) >= _MAX_SHAPES:
-            _SHAPES.clear()
-        if key not in _SHAPES_SEEN_ONCE:
-            if len(_SHAPES_SEEN_ONCE) >= _MAX_SHAPES:
-                _SHAPES_SEEN_ONCE.clear()
-            _SHAPES_SEEN_ONCE.add(key)
-            return None
-        compiled = _SHAPES[key] = _compile_shape(shape, syntax, len(names))
-    if compiled is False:
-        return None
-    build, current_names, next_names = compiled
-    if check_scope and not (scope.current.issuperset(current_names(names))
-                            and scope.next_step.issuperset(next_names(names))):
-        return None  # the parser names the problem
-    return build(names)
+    if key not in _SHAPES_SEEN_ONCE:
+        if len(_SHAPES_SEEN_ONCE) >= _MAX_SHAPES:
+            _SHAPES_SEEN_ONCE.clear()
+        _SHAPES_SEEN_ONCE.add(key)
+        return False
+    if len(compiled_shapes) >= _MAX_SHAPES:
+        compiled_shapes.clear()
+    compiled = compiled_shapes[shape] = _compile_shape(shape, syntax, count)
+    return compiled
 
 
 @contextmanager

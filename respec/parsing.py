@@ -334,6 +334,11 @@ def _next_not_var(name: str) -> Next:
     return Next(_not_var(name))
 
 
+@lru_cache(maxsize=1 << 16)
+def _not_next_var(name: str) -> Not:
+    return Not(_next_var(name))
+
+
 def _combine(operator: str, left: Formula, right: Formula) -> Formula:
     if operator == '&':
         return conj([left, right])
@@ -773,6 +778,7 @@ def _compile_shape(shape: str, syntax: str, count: int):
     source = _template_source(template, in_next)
     build = eval(f'lambda names: {source}', {  # noqa: S307 -- our own generated expression
         'Var': _var, 'NotVar': _not_var, 'NextVar': _next_var, 'NextNotVar': _next_not_var,
+        'NotNextVar': _not_next_var,
         'Const': Const, 'Not': Not, 'And': And, 'Or': Or, 'Implies': Implies, 'Iff': Iff,
         'Next': Next})
     return (build, _picker([i for i in range(count) if not in_next[i]]),
@@ -799,7 +805,8 @@ def _template_source(formula: Formula, in_next: list, under_next: bool = False) 
         return f'Const({formula.value})'
     if isinstance(formula, (Not, Next)):
         inner = _template_source(formula.arg, in_next, under_next or isinstance(formula, Next))
-        if inner.startswith('Var(') or inner.startswith('NotVar('):  # shared nodes, made once
+        if inner.startswith(('Var(', 'NotVar(')) or (isinstance(formula, Not) and inner.startswith('NextVar(')):
+            # shared nodes, made once (the parser never builds Not(Not) or Next(Next))
             return f'{type(formula).__name__}{inner}'
         return f'{type(formula).__name__}({inner})'
     if isinstance(formula, (And, Or)):

@@ -4,9 +4,10 @@
   among 40 whole pipelines); every goal must get an answer (a result or BUSY).
 - gui: 20 jobs posted at once to ``behavior-synthesis gui``; every job must finish.
 - soak: N goals (default 2,000) to ``serve``, ``--in-flight`` at a time, half whole
-  pipelines and half compile-only; counts goals without a result and samples the server's
-  RSS. The slope is fitted (least squares) over the samples after warm-up (the first
-  ``--warmup`` goals, which also covers the server's 60 s result retention).
+  pipelines and half compile-only; counts goals without a result and samples the RSS of the
+  server with its synthesis child processes. The slope is fitted (least squares) over the
+  samples after warm-up (the first ``--warmup`` goals, which also covers the server's 60 s
+  result retention).
 
 The server and GUI run as their real console entry points in separate processes on a
 reserved ROS domain; the clients are in this process. Prints a table and writes
@@ -40,10 +41,22 @@ GUI_TASK = {'system': 'atlas', 'initial_conditions': ['stand_prep'], 'goals': ['
 
 
 def rss_kib(pid: int) -> int:
-    for line in Path(f'/proc/{pid}/status').read_text().splitlines():
-        if line.startswith('VmRSS:'):
-            return int(line.split()[1])
-    raise RuntimeError(f'no VmRSS for process {pid}')
+    """Resident memory of ``pid`` and its child processes (the synthesis processes)."""
+    total = 0
+    for process in [pid, *_children(pid)]:
+        try:
+            status = Path(f'/proc/{process}/status').read_text()
+        except OSError:  # ended meanwhile
+            continue
+        total += next((int(line.split()[1]) for line in status.splitlines() if line.startswith('VmRSS:')), 0)
+    return total
+
+
+def _children(pid: int) -> list[int]:
+    try:
+        return [int(child) for child in Path(f'/proc/{pid}/task/{pid}/children').read_text().split()]
+    except OSError:
+        return []
 
 
 def slope(points: list[tuple[float, float]]) -> float:
@@ -152,7 +165,7 @@ def soak(client, server_pid: int, goals: int, in_flight: int, warmup: int) -> di
             answered += 1
             if answered % 50 == 0:
                 samples.append((answered, time.monotonic() - started_wall, rss_kib(server_pid)))
-                print(f'  {answered} goals, server RSS {samples[-1][2] / 1024:.1f} MiB', flush=True)
+                print(f'  {answered} goals, server RSS (with its synthesis processes) {samples[-1][2] / 1024:.1f} MiB', flush=True)
 
     with ThreadPoolExecutor(in_flight) as pool:
         list(pool.map(one, range(goals)))

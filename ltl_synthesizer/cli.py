@@ -152,7 +152,14 @@ def _run(args) -> int:
         _write(spec.to_slugsin(), args.output)
         return 0
 
-    from ltl_synthesizer.synthesizer import synthesize
+    if deadline is None:
+        from ltl_synthesizer.synthesizer import synthesize
+    else:
+        # With a time limit the synthesis runs in a child process, killed at the deadline even
+        # in the middle of a long CUDD operation (checks between operations could be late).
+        from ltl_synthesizer.isolated import SynthesisProcesses
+        processes = SynthesisProcesses()
+        synthesize = processes.synthesize
     try:
         result = synthesize(spec, robotics_semantics=args.sysInitRoboticsSemantics,
                             deadline=deadline, counterstrategy=args.counterStrategy,
@@ -167,7 +174,9 @@ def _run(args) -> int:
     except SynthesisError as error:
         print(f'gr1synth: error: {args.input}: {error}', file=sys.stderr)
         return EXIT_MALFORMED
-
+    finally:
+        if deadline is not None:
+            processes.close()
     print(REALIZABLE_LINE if result.realizable else UNREALIZABLE_LINE, file=sys.stderr)
     if not result.realizable and args.explain and result.explanation:
         print(result.explanation, file=sys.stderr)

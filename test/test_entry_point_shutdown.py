@@ -395,3 +395,25 @@ def test_gr1synth_stops_within_three_seconds_in_the_middle_of_a_runaway_synthesi
         stop(process, stop_signal, 'gr1synth')
         assert process.returncode in (-stop_signal, client_exit_code(stop_signal)), output.text()
         assert not (tmp_path / 'strategy.json').exists()
+
+
+def test_gr1synth_time_limit_ends_a_synthesis_in_the_middle_of_long_bdd_operations(tmp_path):
+    """The many-parts specification spends seconds inside single CUDD operations; --timeout
+    still ends gr1synth on time, with its exit code 3 and no process left behind."""
+    from ltl_specification import compile_task
+    spec = tmp_path / 'many_parts.slugsin'
+    spec.write_text(compile_task('many_parts', ['idle'], ['assemble'],
+                                 config_dir=many_parts_config(tmp_path / 'config')).to_slugsin())
+    began = time.monotonic()
+    with subprocess.Popen([BIN / 'gr1synth', '--timeout', '2', spec], stdout=subprocess.PIPE,
+                          stderr=subprocess.PIPE, text=True) as process:
+        children_seen = set()
+        while process.poll() is None and time.monotonic() - began < 30:
+            children_seen |= descendants(process.pid)
+            time.sleep(0.05)
+        _, errors = process.communicate(timeout=30)
+    assert process.returncode == 3, errors
+    assert 'timeout' in errors
+    assert time.monotonic() - began < 2 + 2.0  # the limit, plus start-up and parsing
+    assert children_seen  # the synthesis ran in a child process ...
+    assert not {pid for pid in children_seen if Path(f'/proc/{pid}').exists()}  # ... that is gone

@@ -172,8 +172,9 @@ def test_cancel_a_queued_job(page, gui):
         backend.job_gate.set()
     assert 'cancelled' in page.inner_text('#result-message')
     assert page.locator('#result-banner.neutral').count() == 1
-    timeline = page.inner_text('#timeline')
-    assert 'Cancel requested' in timeline and 'Cancelled' in timeline
+    # The job's last event may reach the timeline a moment after the result banner.
+    page.wait_for_function("document.querySelector('#timeline').innerText.includes('Cancelled')", timeout=10_000)
+    assert 'Cancel requested' in page.inner_text('#timeline')
     assert page.is_enabled('#synthesize') and page.is_disabled('#cancel')
 
 
@@ -185,7 +186,8 @@ def test_cancel_a_running_synthesis(page, runaway_synthesis):
     page.click('#cancel')
     assert result_code(page, timeout=30_000) == 'CANCELLED'
     assert page.locator('#result-banner.neutral').count() == 1
-    assert page.inner_text('#timeline').rstrip().endswith('Cancelled')
+    page.wait_for_function("document.querySelector('#timeline').innerText.trimEnd().endsWith('Cancelled')",
+                           timeout=10_000)
 
 
 def test_simulate_with_a_fault_shows_steps_frames_and_timeline(page):

@@ -313,30 +313,17 @@ class _InfixParser:
         return _var(token.text)
 
 
-@lru_cache(maxsize=1 << 16)
-def _var(name: str) -> Var:
-    """One shared node per proposition name: large specifications mention each many times."""
-    return var(name)
+def _shared(wrapper, inner):
+    """name -> ``wrapper(inner(name))``, one shared node per name: large specifications mention
+    each proposition many times."""
+    return lru_cache(maxsize=1 << 16)(lambda name: wrapper(inner(name)))
 
 
-@lru_cache(maxsize=1 << 16)
-def _not_var(name: str) -> Not:
-    return Not(_var(name))
-
-
-@lru_cache(maxsize=1 << 16)
-def _next_var(name: str) -> Next:
-    return Next(_var(name))
-
-
-@lru_cache(maxsize=1 << 16)
-def _next_not_var(name: str) -> Next:
-    return Next(_not_var(name))
-
-
-@lru_cache(maxsize=1 << 16)
-def _not_next_var(name: str) -> Not:
-    return Not(_next_var(name))
+_var = lru_cache(maxsize=1 << 16)(var)
+_not_var = _shared(Not, _var)
+_next_var = _shared(Next, _var)
+_next_not_var = _shared(Next, _not_var)
+_not_next_var = _shared(Not, _next_var)
 
 
 def _combine(operator: str, left: Formula, right: Formula) -> Formula:

@@ -26,6 +26,8 @@ from synthesis_manager.client import SynthesisClient, make_goal
 from synthesis_manager.ros.harness import RosHarness, reserve_domain_id
 from synthesis_manager.ros.env import prepare_ros_environment
 
+import headless_chromium
+
 pytestmark = pytest.mark.usefixtures('flexbe')
 
 REPOSITORY = Path(__file__).resolve().parents[1]
@@ -34,9 +36,6 @@ WEBUI_SITE = REPOSITORY / 'build' / 'flexbe_webui_site'
 # The WebUI 4.0.3 page opens its topic subscriptions at ws://localhost:8000 whatever port it is
 # served from, so it only fully works on 8000; runs on one machine take turns (a lock file).
 WEBUI_PORT = 8000
-CHROMIUM = '/usr/bin/chromium'
-CHROMIUM_ARGS = ['--headless', '--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run',
-                 '--disable-background-networking', '--disable-component-update', '--disable-sync']
 # The WebUI's settings for our legacy interface (what README tells FlexBE users to set).
 WEBUI_SETTINGS = {'synthesis_enabled': True, 'synthesis_topic': '/behavior_synthesis',
                   'synthesis_type': 'synthesis_msgs/BehaviorSynthesisAction',
@@ -178,14 +177,8 @@ def webui(flexbe, flexbe_sources, ros_domain, synthesis_server, exported_behavio
 
 @pytest.fixture(scope='module')
 def browser():
-    from playwright.sync_api import sync_playwright
-
-    with sync_playwright() as playwright, tempfile.TemporaryDirectory() as profile:
-        context = playwright.chromium.launch_persistent_context(
-            profile, executable_path=CHROMIUM, args=CHROMIUM_ARGS, headless=True,
-            viewport={'width': 1600, 'height': 1000})
+    with headless_chromium.browser_context(viewport={'width': 1600, 'height': 1000}) as context:
         yield context
-        context.close()
 
 
 @pytest.fixture

@@ -18,10 +18,10 @@ from sm_generation.config import load_flexbe_config
 from sm_generation.flexbe_behavior import AUTONOMY_NAMES, behavior_package
 
 from test_sm_generation_flexbe_behavior import AUTOMATA, ROOT
+import headless_chromium
 
 pytestmark = pytest.mark.usefixtures('flexbe')
 
-CHROMIUM = '/usr/bin/chromium'
 PARSER_SCRIPTS = ('prototype.js', 'io/io.js', 'io/io_codeparser.js')
 # The page's terminal, as the parser uses it; warnings are collected.
 TERMINAL = "window.warnings = []; window.T = {logInfo() {}, logWarn(m) { warnings.push(m); }, " \
@@ -37,8 +37,8 @@ def parser(flexbe_sources):
 
     app = flexbe_sources / 'flexbe_webui' / 'flexbe_webui' / 'app'
     with sync_playwright() as playwright:
-        browser = playwright.chromium.launch(executable_path=CHROMIUM, headless=True,
-                                             args=['--no-sandbox', '--disable-gpu'])
+        browser = playwright.chromium.launch(executable_path=headless_chromium.EXECUTABLE, headless=True,
+                                             args=headless_chromium.ARGUMENTS)
         page = browser.new_page()
         errors = []
         page.on('pageerror', lambda error: errors.append(str(error)))

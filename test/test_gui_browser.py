@@ -6,7 +6,6 @@ picture used by the documentation.
 
 import os
 import shutil
-import tempfile
 from contextlib import contextmanager
 from pathlib import Path
 
@@ -17,9 +16,8 @@ from synthesis_manager.cli import build_parser
 from synthesis_manager.gui import background_server, ros_backend
 from synthesis_manager.web.routes import create_app
 
-CHROMIUM = '/usr/bin/chromium'
-CHROMIUM_ARGS = ['--headless', '--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run',
-                 '--disable-background-networking', '--disable-component-update', '--disable-sync']
+import headless_chromium
+
 SCREENSHOT_ENV = 'BEHAVIOR_SYNTHESIS_GUI_SCREENSHOT'
 
 
@@ -56,14 +54,8 @@ def gui(tmp_path_factory):
 
 @pytest.fixture(scope='module')
 def browser_context():
-    from playwright.sync_api import sync_playwright
-
-    with sync_playwright() as playwright, tempfile.TemporaryDirectory() as profile:
-        context = playwright.chromium.launch_persistent_context(
-            profile, executable_path=CHROMIUM, args=CHROMIUM_ARGS, headless=True,
-            accept_downloads=True, viewport={'width': 1400, 'height': 1000})
+    with headless_chromium.browser_context(accept_downloads=True, viewport={'width': 1400, 'height': 1000}) as context:
         yield context
-        context.close()
 
 
 @pytest.fixture

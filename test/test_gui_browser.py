@@ -170,6 +170,31 @@ def test_cancel_a_queued_job(page, gui):
     assert page.is_enabled('#synthesize') and page.is_disabled('#cancel')
 
 
+def test_a_cancel_reply_arriving_after_the_result_does_not_roll_the_timeline_back(page, gui):
+    """The cancel request's reply is held until the job's last event is on the page."""
+    _, backend = gui
+    held = []
+    page.route('**/api/jobs/*/cancel', lambda route: held.append((route, route.fetch())))
+    backend.job_gate.clear()
+    try:
+        choose_task(page, ['look_down'])
+        page.click('#synthesize')
+        page.wait_for_selector('#cancel:enabled')
+        page.click('#cancel')
+        page.wait_for_function("document.querySelector('#timeline').innerText.includes('Cancelled')",
+                               timeout=10_000)
+    finally:
+        backend.job_gate.set()
+    assert len(held) == 1
+    route, stale_reply = held[0]
+    assert stale_reply.json()['state'] != 'finished'  # the reply really is older than the page
+    route.fulfill(response=stale_reply)
+    page.wait_for_timeout(300)
+    assert 'Cancelled' in page.inner_text('#timeline')
+    assert result_code(page) == 'CANCELLED'
+    page.unroute('**/api/jobs/*/cancel')
+
+
 def test_cancel_a_running_synthesis(page, runaway_synthesis):
     choose_task(page, ['look_down', 'pickup_object'])
     page.click('#synthesize')

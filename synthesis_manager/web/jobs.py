@@ -110,7 +110,7 @@ class Job:
 
     def to_dict(self) -> dict:
         artifacts = available_artifacts(self.outcome) if self.outcome else []
-        return {'id': self.id, 'state': self.state, 'status': self.status,
+        return {'id': self.id, 'revision': self.revision, 'state': self.state, 'status': self.status,
                 'progress': round(self.progress, 4), 'request': asdict(self.request),
                 'cancel_requested': self.cancel_requested.is_set(),
                 'timeline': list(self.timeline), 'outcome': self.outcome,

@@ -17,6 +17,7 @@ const SECTION_TITLES = {
 
 let currentJob = null;   // id of the job being followed
 let events = null;       // its EventSource
+let shownProgress = { id: null, revision: -1 };  // newest job snapshot shown: replies can overtake
 let shownJob = null;     // the job whose result is on the page
 let choices = null;      // the current system's control modes and actions
 let canSimulate = false; // the server can run atlas_sim
@@ -248,6 +249,8 @@ function showElapsed() {
 }
 
 function showProgress(job) {
+  if (job.id === shownProgress.id && job.revision < shownProgress.revision) return;
+  shownProgress = { id: job.id, revision: job.revision };
   if (job.state === 'finished') $('progress').value = job.progress;
   $('status').textContent = job.status;
   $('timeline').replaceChildren(...job.timeline.map((entry) => element('li', {},

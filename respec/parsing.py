@@ -28,17 +28,20 @@ from __future__ import annotations
 
 import gc
 import itertools
+from bisect import bisect_right
 import re
+import string
+from collections import deque
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from functools import lru_cache
-from operator import itemgetter
+from operator import add
 from typing import NamedTuple
 
 from respec.errors import CodedError
 from respec.ltl import (
     FALSE, TRUE, And, Const, Formula, Iff, Implies, Next, Not, Or, Var, conj, disj, iff, implies,
-    neg, next_, var,
+    neg, next_, var, variables,
 )
 from respec.spec import FORMULA_SECTIONS, PROPOSITION_SECTIONS, SLUGS_HEADERS, GR1Specification
 
@@ -105,11 +108,6 @@ class _Scope:
     next_step: frozenset[str] | None
     section: str = ''
     integers: dict = field(default_factory=dict)   # name -> IntegerVariable (structured slugs)
-
-    @property
-    def both_steps(self) -> frozenset[str]:
-        """The propositions allowed in the current and in the next step."""
-        return self.current & self.next_step
 
 
 _ANY = _Scope(None, None, None)
@@ -313,17 +311,8 @@ class _InfixParser:
         return _var(token.text)
 
 
-def _shared(wrapper, inner):
-    """name -> ``wrapper(inner(name))``, one shared node per name: large specifications mention
-    each proposition many times."""
-    return lru_cache(maxsize=1 << 16)(lambda name: wrapper(inner(name)))
-
-
+# One node per proposition: large specifications mention each proposition many times.
 _var = lru_cache(maxsize=1 << 16)(var)
-_not_var = _shared(Not, _var)
-_next_var = _shared(Next, _var)
-_next_not_var = _shared(Next, _not_var)
-_not_next_var = _shared(Not, _next_var)
 
 
 def _combine(operator: str, left: Formula, right: Formula) -> Formula:
@@ -550,44 +539,98 @@ def parse_slugsin(text: str, filename: str = '<string>', check=None) -> GR1Speci
     return _parse_slugs_file(text, filename, 'prefix', check)
 
 
-_LINES_BETWEEN_CHECKS = 256
+_LINES_BETWEEN_CHECKS = 1024
+
+
+class _SectionText:
+    """A section's non-blank lines (comments and surrounding blanks removed), and where each
+    one is in the file (worked out only for the lines that need a position: errors)."""
+
+    def __init__(self):
+        self.lines: list[str] = []
+        self._parts: list[tuple[int, int, list[str], list[int] | None]] = []
+
+    def add(self, first_line: int, contents: list[str]) -> None:
+        """The lines after one header; ``first_line``: the file line of ``contents[0]``."""
+        stripped = list(map(str.strip, contents))
+        while stripped and not stripped[-1]:  # the blank lines before the next header
+            stripped.pop()
+        kept = [index for index, line in enumerate(stripped) if line] if '' in stripped else None
+        self._parts.append((len(self.lines), first_line, contents, kept))
+        self.lines.extend(stripped if kept is None else [stripped[index] for index in kept])
+
+    def source(self, index: int, filename: str) -> _Source:
+        start, first_line, contents, kept = self._parts[bisect_right(self._parts, (index, 1 << 62)) - 1]
+        position = index - start if kept is None else kept[index - start]
+        return _Source(filename, first_line + position, _column(contents[position]))
+
+
+# Line breaks other than '\n' that str.splitlines() also honours.
+_OTHER_LINE_BREAKS = '\r\x0b\x0c\x1c\x1d\x1e\x85\u2028\u2029'
+
+
+def _sections_of(text: str, filename: str) -> dict[str, _SectionText]:
+    """Each section's lines: the file is cut at its header lines, not walked line by line."""
+    if any(mark in text for mark in _OTHER_LINE_BREAKS):
+        text = '\n'.join(text.splitlines())
+    sections = {section: _SectionText() for section in PROPOSITION_SECTIONS + FORMULA_SECTIONS}
+    section, line, position = None, 1, 0
+    for header in itertools.chain(_header_lines(text), [None]):
+        chunk = text[position:header[0] if header else len(text)]
+        body = chunk.split('\n')
+        if not body[-1]:
+            body.pop()  # what follows the chunk's last line break
+        if '#' in chunk:
+            body = [raw.partition('#')[0] for raw in body]
+        if section is not None:
+            sections[section].add(line, body)
+        else:
+            for offset, content in enumerate(body):
+                if content.strip():
+                    raise ParseError('text before the first section header', content.strip(), filename,
+                                     line + offset, _column(content))
+        if header is None:
+            break
+        line += chunk.count('\n')
+        content = text[header[0]:header[1]].partition('#')[0]
+        stripped = content.strip()
+        name = stripped[1:-1] if stripped.endswith(']') else None
+        if name not in _SECTION_OF_HEADER:
+            raise ParseError('unknown section header (expected one of '
+                             + ', '.join(f'[{h}]' for h in SLUGS_HEADERS.values()) + ')',
+                             stripped, filename, line, _column(content))
+        section, line, position = _SECTION_OF_HEADER[name], line + 1, header[1] + 1
+    return sections
+
+
+def _header_lines(text: str):
+    """(start, end) of each line whose first non-blank character is '[' (formulas have no '[')."""
+    at = text.find('[')
+    while at != -1:
+        start = text.rfind('\n', 0, at) + 1
+        if text[start:at].isspace() or start == at:
+            end = text.find('\n', at)
+            end = len(text) if end == -1 else end
+            yield start, end
+            at = text.find('[', end)
+        else:
+            at = text.find('[', at + 1)
 
 
 def _parse_slugs_file(text: str, filename: str, syntax: str, check=None) -> GR1Specification:
-    lines_by_section: dict[str, list[tuple[int, str, str]]] = {s: [] for s in PROPOSITION_SECTIONS + FORMULA_SECTIONS}
-    section = None
-    lines = None
-    for number, raw in enumerate(text.splitlines(), start=1):
-        content = raw.partition('#')[0] if '#' in raw else raw
-        stripped = content.strip()
-        if not stripped:
-            continue
-        if stripped[0] == '[':
-            header = stripped[1:-1] if stripped.endswith(']') else None
-            if header not in _SECTION_OF_HEADER:
-                raise ParseError('unknown section header (expected one of '
-                                 + ', '.join(f'[{h}]' for h in SLUGS_HEADERS.values()) + ')',
-                                 stripped, filename, number, _column(content))
-            section = _SECTION_OF_HEADER[header]
-            lines = lines_by_section[section]
-            continue
-        if section is None:
-            raise ParseError('text before the first section header', stripped, filename, number,
-                             _column(content))
-        lines.append((number, content, stripped))
-
+    sections = _sections_of(text, filename)
     declared: dict[str, list[str]] = {}
     integers: dict[str, IntegerVariable] = {}
     seen: set[str] = set()
     for section in PROPOSITION_SECTIONS:
         declared[section] = []
-        for number, content, name in lines_by_section[section]:
+        for index, name in enumerate(sections[section].lines):
             if (syntax != 'infix' or ':' not in name) and name not in seen \
                     and name not in _KEYWORDS and _NAME.fullmatch(name):
                 declared[section].append(name)  # the common case, without an error source
                 seen.add(name)
                 continue
-            source = _Source(filename, number, _column(content))
+            source = sections[section].source(index, filename)
             integer = _INTEGER_DECLARATION.match(name) if syntax == 'infix' else None
             if integer:
                 variable = _integer_variable(integer, seen, source)
@@ -601,15 +644,15 @@ def _parse_slugs_file(text: str, filename: str, syntax: str, check=None) -> GR1S
 
     scopes = _scopes(declared['env_props'], declared['sys_props'], integers)
     formulas = {}
+    leaves = _LeafNodes()
     with _collector_paused():
         for section in FORMULA_SECTIONS:
-            scope, entries = scopes[section], lines_by_section[section]
-            parsed = _parse_section_by_shapes([line for _, _, line in entries], syntax, scope, check) \
-                if not scope.integers else [None] * len(entries)
+            scope, lines = scopes[section], sections[section].lines
+            parsed = _parse_section_by_shapes(lines, syntax, scope, leaves, check) \
+                if not scope.integers else [None] * len(lines)
             for index, formula in enumerate(parsed):
                 if formula is None:
-                    number, content, line = entries[index]
-                    parsed[index] = _parse_line(line, syntax, scope, _Source(filename, number, _column(content)))
+                    parsed[index] = _parse_line(lines[index], syntax, scope, sections[section].source(index, filename))
             formulas[section] = parsed
     # Like slugs' compiler, keep integers in range: initially and after every step.
     for variable in integers.values():
@@ -663,72 +706,135 @@ _PROPOSITION = re.compile(
 _WORD = re.compile(r"([A-Za-z_][A-Za-z0-9_.@]*)")
 _PLACEHOLDER = '\x00'
 _NEXT_MARK = '\x01'
+# Outlines (see _shapes_by_translation): each character of a word becomes one of these.
+_DIGIT_MARK, _DOT_MARK = '\x02', '\x03'
+_MARKS = (_PLACEHOLDER, _NEXT_MARK, _DIGIT_MARK, _DOT_MARK)
+_NAME_START = string.ascii_letters + '_'
+_OUTLINE = str.maketrans({**dict.fromkeys(_NAME_START, _PLACEHOLDER), **dict.fromkeys(string.digits, _DIGIT_MARK),
+                          '.': _DOT_MARK, '@': _DOT_MARK})
+_WORDS_ONLY = str.maketrans({chr(code): ' ' for code in range(128)
+                             if chr(code) not in _NAME_START + string.digits + '.@'})
+_OUTLINE_WORD = re.compile('[\x00\x02\x03]+')
+_OUTLINE_NON_NAME = re.compile('(?<![\x00\x02\x03])[\x02\x03]')  # a number, or a word starting with . or @
 _MAX_SHAPE_PLACEHOLDERS = 64
 _MAX_SHAPE_NESTING = 32
 _SHAPES: dict[str, dict[str, object]] = {}  # syntax -> shape -> compiled (or False)
-_SHAPES_SEEN_ONCE: set[tuple[str, str]] = set()
 _MAX_SHAPES = 1 << 14
 
 
-def _parse_section_by_shapes(lines: list[str], syntax: str, scope: _Scope, check=None) -> list:
+def _parse_section_by_shapes(lines: list[str], syntax: str, scope: _Scope, leaves: _LeafNodes,
+                             check=None) -> list:
     """The formula of each line, or None where the parser must handle the line.
 
     The shapes and propositions of all lines are found at once (one regular-expression pass
-    over the joined text, not two per line). A shape is compiled the second time it is seen:
-    compiling costs more than parsing one line, and the lines of a large file are either
-    alike or all different.
+    over the joined text, not two per line), and the lines of each shape are built together.
+    A shape seen on one line only is left to the parser: compiling costs more than parsing
+    one line, and the lines of a large file are either alike or all different.
     """
     joined = '\n'.join(lines)
-    if not lines or _PLACEHOLDER in joined or _NEXT_MARK in joined:
+    if not lines or any(mark in joined for mark in _MARKS):
         return [None] * len(lines)
-    # 'next(' is marked first, so that every word left is a proposition or a keyword;
-    # a rare TRUE / FALSE / spaced 'next (' needs the slower expression that skips keywords.
+    # 'next(' is marked first, so that every word left is a proposition or a keyword.
     marked = joined.replace('next(', _NEXT_MARK + '(')
+    names, starts, lines_of_shape = _shapes_by_translation(marked) or _shapes_by_expression(marked)
+    # Lines are checked against the section's rules, for each step only if some proposition
+    # of the section may not appear in it.
+    check_now = scope.names is not None and not scope.current.issuperset(names)
+    check_next = scope.names is not None and not scope.next_step.issuperset(names)
+    compiled_shapes = _SHAPES.setdefault(syntax, {})
+    formulas = [None] * len(lines)
+    for shape, indices in lines_of_shape.items():
+        compiled = compiled_shapes.get(shape)
+        if compiled is None:
+            if len(indices) == 1:
+                continue
+            compiled = _compiled_shape(compiled_shapes, shape, syntax, starts[indices[0] + 1] - starts[indices[0]])
+        if compiled is False:
+            continue
+        build, read_now, read_next = compiled
+        count = len(read_now) + len(read_next)
+        read_now, read_next = read_now if check_now else (), read_next if check_next else ()
+        for first in range(0, len(indices), _LINES_BETWEEN_CHECKS):
+            if check is not None:
+                check()
+            chosen = indices[first:first + _LINES_BETWEEN_CHECKS]
+            columns = _columns(names, [starts[index] for index in chosen], count)
+            if (read_now or read_next) and not _within(scope, columns, read_now, read_next):
+                # Some line breaks the rules: the parser names the problem.
+                keep = [row for row in range(len(chosen))
+                        if _within(scope, [[column[row]] for column in columns], read_now, read_next)]
+                chosen = [chosen[row] for row in keep]
+                columns = [[column[row] for row in keep] for column in columns]
+            for index, formula in zip(chosen, build(columns, len(chosen), leaves)):
+                formulas[index] = formula
+    return formulas
+
+
+def _shapes_by_translation(marked: str):
+    """(names, starts, lines_of_shape): every proposition in order, where each line's
+    propositions start in it, and the lines of each shape. Found with str.translate (a few
+    times faster than a regular expression); None when the text needs the expression
+    (non-ASCII text, numbers, TRUE / FALSE or a spaced 'next (')."""
+    if not marked.isascii():
+        return None
+    names = marked.translate(_WORDS_ONLY).split()
+    if _KEYWORDS.intersection(names):
+        return None
+    # In a line's outline each word is a run of marks as long as the word; lines are grouped
+    # by outline, then outlines by shape (one placeholder per word).
+    outline_of_line = marked.translate(_OUTLINE).split('\n')
+    word_counts, lines_of_shape = {}, {}
+    for outline, indices in _positions(outline_of_line).items():
+        if _OUTLINE_NON_NAME.search(outline):
+            return None
+        shape = _OUTLINE_WORD.sub(_PLACEHOLDER, outline)
+        word_counts[outline] = shape.count(_PLACEHOLDER)
+        lines_of_shape.setdefault(shape, []).extend(indices)
+    return names, list(itertools.accumulate(map(word_counts.__getitem__, outline_of_line), initial=0)), lines_of_shape
+
+
+def _shapes_by_expression(marked: str):
+    """What _shapes_by_translation finds, for any text."""
     parts = _WORD.split(marked)
     names = parts[1::2]
-    if _KEYWORDS.intersection(names):
+    if _KEYWORDS.intersection(names):  # the slower expression that skips keywords
         names = _PROPOSITION.findall(marked)
         shapes = _PROPOSITION.sub(_PLACEHOLDER, marked)
     else:
         shapes = _PLACEHOLDER.join(parts[0::2])
-    # Each line is checked against the section's rules unless every proposition of the
-    # section may appear both in the current and in the next step.
-    check_scope = scope.names is not None and not scope.both_steps.issuperset(names)
-    compiled_shapes = _SHAPES.setdefault(syntax, {})
-    formulas = []
-    append = formulas.append
-    start = 0
-    for shape in shapes.split('\n'):
-        count = shape.count(_PLACEHOLDER)
-        line_names = names[start:start + count]
-        start += count
-        if check is not None and len(formulas) % _LINES_BETWEEN_CHECKS == 0:
-            check()
-        compiled = compiled_shapes.get(shape)
-        if compiled is None:
-            compiled = _first_sightings(compiled_shapes, shape, syntax, count)
-        if compiled is False:
-            append(None)
-            continue
-        build, current_names, next_names = compiled
-        if check_scope and not (scope.current.issuperset(current_names(line_names))
-                                and scope.next_step.issuperset(next_names(line_names))):
-            append(None)  # the parser names the problem
-            continue
-        append(build(line_names))
-    return formulas
+    shape_of_line = shapes.split('\n')
+    starts = list(itertools.accumulate(map(str.count, shape_of_line, itertools.repeat(_PLACEHOLDER)), initial=0))
+    return names, starts, _positions(shape_of_line)
 
 
-def _first_sightings(compiled_shapes: dict, shape: str, syntax: str, count: int):
-    """A shape not compiled yet: False the first time (the parser handles that line) and for
-    unusual lines (very long or deeply nested), else its compiled form, kept."""
+def _positions(items: list[str]) -> dict[str, list[int]]:
+    """Each distinct item -> the indices where it occurs."""
+    positions: dict[str, list[int]] = {}
+    for index, item in enumerate(items):
+        found = positions.get(item)
+        if found is None:
+            positions[item] = [index]
+        else:
+            found.append(index)
+    return positions
+
+
+def _columns(names: list[str], line_starts: list[int], count: int) -> list[list[str]]:
+    """Column i: the i-th proposition of each line (its propositions start at ``line_starts``)."""
+    return [list(map(names.__getitem__, map(add, line_starts, itertools.repeat(offset)))) for offset in range(count)]
+
+
+def _within(scope: _Scope, columns: list[list[str]], read_now: tuple, read_next: tuple) -> bool:
+    """Whether lines read only what the section allows (``read_now``, ``read_next``: the
+    columns read in the current and in the next step)."""
+    return (scope.current.issuperset(itertools.chain.from_iterable(columns[i] for i in read_now))
+            and scope.next_step.issuperset(itertools.chain.from_iterable(columns[i] for i in read_next)))
+
+
+def _compiled_shape(compiled_shapes: dict, shape: str, syntax: str, count: int):
+    """A shape's compiled form (see _compile_shape), kept; False for unusual lines (very long
+    or deeply nested), which the parser handles."""
     if count > _MAX_SHAPE_PLACEHOLDERS or shape.count('(') > _MAX_SHAPE_NESTING:
-        return False
-    key = (syntax, shape)
-    if key not in _SHAPES_SEEN_ONCE:
-        if len(_SHAPES_SEEN_ONCE) >= _MAX_SHAPES:
-            _SHAPES_SEEN_ONCE.clear()
-        _SHAPES_SEEN_ONCE.add(key)
         return False
     if len(compiled_shapes) >= _MAX_SHAPES:
         compiled_shapes.clear()
@@ -750,9 +856,10 @@ def _collector_paused():
 
 
 def _compile_shape(shape: str, syntax: str, count: int):
-    """(build(names) -> Formula, names -> those read in the current step, names -> those read
-    in the next step), or False when the shape is not a formula (the parser then reports the
-    line's error)."""
+    """(build, read_now, read_next), or False when the shape is not a formula (the parser then
+    reports the line's error). ``build(columns, n)`` makes the formulas of n lines of the shape,
+    where ``columns[i]`` holds each line's i-th proposition; ``read_now`` / ``read_next`` are the
+    columns read in the current / in the next step."""
     if syntax == 'prefix' and '$' in shape:
         return False  # memory buffers share subformulas, which a template would copy out
     pieces = shape.replace(_NEXT_MARK, 'next').split(_PLACEHOLDER)
@@ -761,66 +868,111 @@ def _compile_shape(shape: str, syntax: str, count: int):
         template = _parse(text, syntax, _ANY, _Source())
     except ParseError:
         return False
+    if variables(template) != {f'_{index}' for index in range(count)}:
+        return False  # folded away (e.g. '& 0 a'): the parser still checks the proposition
     in_next = [False] * count
     namespace = dict(_BUILDER_NAMES)
     exec(_builder_source(template, in_next), namespace)  # noqa: S102 -- our own generated code
-    return (namespace['build'], _picker([i for i in range(count) if not in_next[i]]),
-            _picker([i for i in range(count) if in_next[i]]))
+    return (namespace['build'], tuple(i for i in range(count) if not in_next[i]),
+            tuple(i for i in range(count) if in_next[i]))
 
 
-def _picker(indices: list[int]):
-    """names -> the names at ``indices`` (as a tuple)."""
-    if not indices:
-        return lambda names: ()
-    if len(indices) == 1:
-        index = indices[0]
-        return lambda names: (names[index],)
-    return itemgetter(*indices)
+_consume = deque(maxlen=0).extend  # runs an iterator to its end
+
+
+class _LeafNodes:
+    """The leaf nodes of one file's compiled lines: one node per proposition for each of a,
+    !a, next(a), next(!a) and !next(a), made a column at a time."""
+
+    def __init__(self):
+        self._made: dict[str, dict[str, Formula]] = {factory: {} for factory in _LEAF_PARTS}
+
+    def __call__(self, factory: str, names: list[str]) -> list[Formula]:
+        """The ``factory`` leaf ('Var', 'NotVar', ...) of each of ``names``."""
+        made = self._made[factory]
+        try:
+            return list(map(made.__getitem__, names))
+        except KeyError:  # some are new
+            pass
+        missing = list(set(names).difference(made))
+        kind, inner = _LEAF_PARTS[factory]
+        nodes = list(map(object.__new__, itertools.repeat(kind, len(missing))))
+        if inner is None:
+            _consume(map(Var.name.__set__, nodes, missing))
+        else:
+            _consume(map(kind.arg.__set__, nodes, self(inner, missing)))
+        made.update(zip(missing, nodes))
+        return list(map(made.__getitem__, names))
+
+
+# Each leaf factory: the node's class, and the leaf factory of its argument.
+_LEAF_PARTS = {'Var': (Var, None), 'NotVar': (Not, 'Var'), 'NextVar': (Next, 'Var'),
+               'NextNotVar': (Next, 'NotVar'), 'NotNextVar': (Not, 'NextVar')}
 
 
 # What a compiled shape's code may use: the shared leaf nodes, and for every other node the
-# allocation and the field setters (about twice as fast as the dataclass's __init__, which
-# matters for the millions of nodes of a large file; the nodes are the same).
+# allocation and the field setters, applied a column at a time with map() (no Python code
+# runs per line: about five times faster than calling the dataclass's __init__ per node,
+# which matters for the millions of nodes of a large file; the nodes are the same).
 _BUILDER_NAMES = {
-    'Var': _var, 'NotVar': _not_var, 'NextVar': _next_var, 'NextNotVar': _next_not_var,
-    'NotNextVar': _not_next_var, 'TRUE': TRUE, 'FALSE': FALSE, 'new': object.__new__,
+    'TRUE': TRUE, 'FALSE': FALSE, 'new': object.__new__, 'repeat': itertools.repeat, 'consume': _consume,
     **{f'{kind.__name__}_{name}': getattr(kind, name).__set__
        for kind in (Not, Next, And, Or, Implies, Iff) for name in kind.__dataclass_fields__},
     **{kind.__name__: kind for kind in (Not, Next, And, Or, Implies, Iff)},
 }
 
 
+def _leaf(formula: Formula) -> tuple[str, Var] | None:
+    """(the shared-leaf factory, its variable) if ``formula`` is a leaf the parser shares."""
+    match formula:
+        case Var():
+            return 'Var', formula
+        case Not(arg=Var() as variable):
+            return 'NotVar', variable
+        case Next(arg=Var() as variable):
+            return 'NextVar', variable
+        case Next(arg=Not(arg=Var() as variable)):
+            return 'NextNotVar', variable
+        case Not(arg=Next(arg=Var() as variable)):
+            return 'NotNextVar', variable
+    return None
+
+
 def _builder_source(template: Formula, in_next: list) -> str:
-    """Python source of ``build(names)``, which makes ``template`` with each placeholder ``_i``
-    replaced by the proposition ``names[i]`` (``in_next[i]`` is set if it is read in the next step)."""
+    """Python source of ``build(columns, n, leaves)``: ``template`` for n lines, its placeholder
+    ``_i`` replaced by the propositions of ``columns[i]`` (their leaf nodes from ``leaves``, a
+    _LeafNodes), one node column (a list over the lines) at a time (``in_next[i]`` is set if
+    ``_i`` is read in the next step)."""
     statements = []
 
-    def node(formula: Formula, under_next: bool) -> str:
-        """An expression for ``formula``'s node, after the statements that make its parts."""
-        if isinstance(formula, Var):
-            index = int(formula.name[1:])
-            in_next[index] = under_next
-            return f'Var(names[{index}])'
+    def column(formula: Formula, under_next: bool) -> str:
+        """The name of a list holding ``formula``'s node for each line, after the statements making it."""
+        leaf = _leaf(formula)
+        if leaf is not None:
+            factory, variable = leaf
+            index = int(variable.name[1:])
+            in_next[index] = under_next or factory.startswith('Next') or factory == 'NotNextVar'
+            return new_column(f'leaves({factory!r}, columns[{index}])')
         if isinstance(formula, Const):
-            return 'TRUE' if formula.value else 'FALSE'
+            return new_column('[TRUE] * n' if formula.value else '[FALSE] * n')
+        kind = type(formula).__name__
         if isinstance(formula, (Not, Next)):
-            inner = node(formula.arg, under_next or isinstance(formula, Next))
-            # Shared leaf nodes, made once (the parser never builds Not(Not) or Next(Next)).
-            if inner.startswith(('Var(', 'NotVar(')) or (isinstance(formula, Not) and inner.startswith('NextVar(')):
-                return f'{type(formula).__name__}{inner}'
-            return made(formula, {'arg': inner})
-        if isinstance(formula, (And, Or)):
-            return made(formula, {'args': '(' + ''.join(f'{node(arg, under_next)}, ' for arg in formula.args) + ')'})
-        return made(formula, {'left': node(formula.left, under_next), 'right': node(formula.right, under_next)})
+            fields = {'arg': column(formula.arg, under_next or isinstance(formula, Next))}
+        elif isinstance(formula, (And, Or)):
+            fields = {'args': 'zip(' + ', '.join(column(arg, under_next) for arg in formula.args) + ')'}
+        else:
+            fields = {'left': column(formula.left, under_next), 'right': column(formula.right, under_next)}
+        nodes = new_column(f'list(map(new, repeat({kind}, n)))')
+        statements.extend(f'consume(map({kind}_{field}, {nodes}, {values}))' for field, values in fields.items())
+        return nodes
 
-    def made(formula: Formula, fields: dict) -> str:
-        kind, name = type(formula).__name__, f'n{len(statements)}'
-        statements.append(f'{name} = new({kind})')
-        statements.extend(f'{kind}_{field}({name}, {value})' for field, value in fields.items())
+    def new_column(expression: str) -> str:
+        name = f'c{len(statements)}'
+        statements.append(f'{name} = {expression}')
         return name
 
-    result = node(template, False)
-    return '\n'.join(['def build(names):', *(f'    {line}' for line in statements), f'    return {result}'])
+    result = column(template, False)
+    return '\n'.join(['def build(columns, n, leaves):', *(f'    {line}' for line in statements), f'    return {result}'])
 
 
 def _check_proposition_name(name: str, seen: set[str], syntax: str, source: _Source) -> None:

@@ -10,14 +10,18 @@ one costs the start of a Python interpreter, a fraction of a second).
 
     processes = SynthesisProcesses()
     result = processes.synthesize(spec, cancel=event, deadline=time.monotonic() + 60)
+    explanation = processes.call('ltl_specification.diagnosis:explain_unsynthesizable', args,
+                                 cancel=event, deadline=deadline)  # other solver work, the same way
     processes.close()
 
-Same arguments, results and exceptions as :func:`ltl_synthesizer.synthesize`; a child that
-dies (killed from outside, crashed) raises :class:`SynthesisProcessDied`.
+``synthesize`` has the arguments, results and exceptions of :func:`ltl_synthesizer.synthesize`;
+``call`` runs any importable function. A child that dies (killed from outside, crashed) raises
+:class:`SynthesisProcessDied`; a cancel or the deadline raises SynthesisCancelled.
 """
 
 from __future__ import annotations
 
+import importlib
 import os
 import pickle
 import select
@@ -38,10 +42,13 @@ class SynthesisProcessDied(SynthesisError):
     """The process running the synthesis ended without an answer."""
 
 
+SYNTHESIZE = 'ltl_synthesizer.synthesizer:synthesize'
+
+
 class _Child:
     """One child process (``python -m ltl_synthesizer.isolated``), spoken to through its stdin
-    and stdout: length-prefixed pickles, a request (spec, deadline, arguments) in, an answer
-    ('result', SynthesisResult) or ('error', exception) out."""
+    and stdout: length-prefixed pickles, a request ('module:function', args, kwargs) in, an
+    answer ('result', value) or ('error', exception) out."""
 
     def __init__(self):
         self.process = subprocess.Popen([sys.executable, '-m', 'ltl_synthesizer.isolated', str(os.getpid())],
@@ -98,10 +105,16 @@ class SynthesisProcesses:
     def synthesize(self, spec, cancel: threading.Event | None = None, deadline: float | None = None,
                    **arguments):
         """``ltl_synthesizer.synthesize(spec, cancel=..., deadline=..., **arguments)`` in a child."""
+        return self.call(SYNTHESIZE, (spec,), dict(arguments, deadline=deadline), cancel=cancel, deadline=deadline)
+
+    def call(self, target: str, args=(), kwargs=None, cancel: threading.Event | None = None,
+             deadline: float | None = None):
+        """``function(*args, **kwargs)`` in a child, where ``target`` is 'module:function'.
+        The child is killed once ``cancel`` is set or at ``deadline`` (time.monotonic())."""
         child = self._take()
         answer = None
         try:
-            child.send((spec, deadline, arguments))
+            child.send((target, tuple(args), dict(kwargs or {})))
             while not child.answered(POLL_SECONDS):
                 if cancel is not None and cancel.is_set():
                     raise SynthesisCancelled('cancelled')
@@ -161,20 +174,20 @@ class SynthesisProcesses:
 
 
 def _serve(parent_pid: int) -> None:
-    """The child: answer synthesis requests until stdin closes or the parent is gone."""
+    """The child: answer requests until stdin closes or the parent is gone."""
     _die_with_parent(parent_pid)
     requests = sys.stdin.buffer
     answers = os.fdopen(os.dup(sys.stdout.fileno()), 'wb')
     sys.stdout = sys.stderr  # stray prints must not corrupt the answers
-    from ltl_synthesizer.synthesizer import synthesize
+    _function(SYNTHESIZE)  # imported now: the first synthesis need not wait for it
     while True:
         try:
-            spec, deadline, arguments = pickle.loads(_read_exactly(requests, int.from_bytes(
+            target, args, kwargs = pickle.loads(_read_exactly(requests, int.from_bytes(
                 _read_exactly(requests, _LENGTH_BYTES), 'little')))
         except EOFError:
             return
         try:
-            answer = ('result', synthesize(spec, deadline=deadline, **arguments))
+            answer = ('result', _function(target)(*args, **kwargs))
         except Exception as error:  # noqa: BLE001 -- every failure goes back to the caller
             error.add_note(f'in the synthesis process:\n{traceback.format_exc()}')
             answer = ('error', error)
@@ -184,6 +197,11 @@ def _serve(parent_pid: int) -> None:
             data = pickle.dumps(('error', SynthesisError(f'synthesis process: {error!r}')))
         answers.write(len(data).to_bytes(_LENGTH_BYTES, 'little') + data)
         answers.flush()
+
+
+def _function(target: str):
+    module, _, name = target.partition(':')
+    return getattr(importlib.import_module(module), name)
 
 
 def _die_with_parent(parent_pid: int) -> None:

@@ -1,8 +1,10 @@
 """The /behavior_synthesis action server end to end, all nodes in-process (launch-free)."""
 
+import os
 import threading
 import time
 from argparse import Namespace
+from pathlib import Path
 
 import pytest
 
@@ -153,3 +155,71 @@ def test_impossible_goal_order_is_explained_in_plain_words_first(suite):
     assert 'eq. (9) control-mode topology for stand' in outcome.message
     assert 'Details from the synthesizer:' in outcome.message  # the synthesizer's own account stays
     assert 'Diagnosing why the task cannot be done' in feedback
+
+
+# --- the diagnosis of unrealizable tasks: a cancel and the time limit end it at once ---------
+
+IMPOSSIBLE_TASK = dict(system='atlas', initial_conditions=['stand_prep'], goals=['look_down', 'stand_prep'])
+
+
+@pytest.fixture
+def endless_diagnosis(suite, monkeypatch, tmp_path):
+    """The suite's server diagnoses with test/endless_diagnosis.py; yields its pid file."""
+    from synthesis_manager.nodes import server_node
+
+    test_dir = str(Path(__file__).resolve().parent)
+    monkeypatch.setenv('PYTHONPATH', os.pathsep.join(filter(None, [test_dir, os.environ.get('PYTHONPATH')])))
+    pid_file = tmp_path / 'diagnosis.pid'
+    monkeypatch.setenv('ENDLESS_DIAGNOSIS_PID_FILE', str(pid_file))
+    monkeypatch.setattr(server_node, 'DIAGNOSIS', 'endless_diagnosis:endless_diagnosis')
+    return pid_file
+
+
+def server_of(suite):
+    from synthesis_manager.nodes.server_node import BehaviorSynthesisServer
+
+    return next(node for node in suite.nodes if isinstance(node, BehaviorSynthesisServer))
+
+
+def process_gone(pid: int, within: float) -> bool:
+    deadline = time.monotonic() + within
+    while time.monotonic() < deadline:
+        try:
+            with open(f'/proc/{pid}/stat') as stat:
+                if stat.read().rsplit(')', 1)[1].split()[0] == 'Z':  # ended, not yet reaped
+                    return True
+        except FileNotFoundError:
+            return True
+        time.sleep(0.02)
+    return False
+
+
+def test_a_cancel_ends_the_diagnosis_at_once(suite, endless_diagnosis):
+    cancel, cancelled_at = threading.Event(), []
+
+    def on_feedback(status, _):
+        if status.startswith('Diagnosing') and not cancel.is_set():
+            time.sleep(0.5)  # the diagnosis process is busy by now
+            cancelled_at.append(time.monotonic())
+            cancel.set()
+
+    outcome = suite.client.run(make_goal(**IMPOSSIBLE_TASK), feedback=on_feedback, cancel=cancel, timeout=60)
+    assert outcome.error_name == 'PREEMPTED', outcome.message
+    assert time.monotonic() - cancelled_at[0] < 1.0
+    assert process_gone(int(endless_diagnosis.read_text()), within=1.0)
+    assert run(suite, **PAPER_TASK).error_name == 'SUCCESS'  # the server keeps serving
+
+
+def test_the_diagnosis_time_limit_keeps_the_synthesizers_verdict(suite, endless_diagnosis):
+    from rclpy.parameter import Parameter
+    from synthesis_manager.nodes.server_node import DIAGNOSIS_GRACE
+
+    server_of(suite).set_parameters([Parameter('diagnosis_timeout', value=1.0)])
+    started = []
+    outcome = suite.client.run(make_goal(**IMPOSSIBLE_TASK), timeout=60, feedback=lambda status, _: (
+        status.startswith('Diagnosing') and started.append(time.monotonic())))
+    assert outcome.error_name == 'SPEC_UNSYNTHESIZABLE'
+    assert 'Details from the synthesizer' not in outcome.message  # no diagnosis: the synthesizer's account
+    assert outcome.message.strip()
+    assert time.monotonic() - started[0] < 1.0 + DIAGNOSIS_GRACE + 1.0
+    assert process_gone(int(endless_diagnosis.read_text()), within=1.0)

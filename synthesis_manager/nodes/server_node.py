@@ -13,7 +13,6 @@ synthesizer. Beyond ``max_active_goals`` goals at once, new goals are answered B
 from __future__ import annotations
 
 import contextlib
-import functools
 import threading
 import time
 from dataclasses import dataclass, field, replace
@@ -23,10 +22,11 @@ from rclpy.action import ActionServer, CancelResponse, GoalResponse
 from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.node import Node
 
-from ltl_specification.diagnosis import explain_unsynthesizable
 from ltl_specification.errors import InvalidInitialConditionsError
 from ltl_specification.initial_conditions import (asks_for_robot_state, detected_status,
                                                   initial_conditions_from_robot_state)
+from ltl_synthesizer.errors import SynthesisError
+from ltl_synthesizer.isolated import SynthesisProcesses
 from respec.errors import INTERNAL_ERROR, CodedError
 from sm_generation.instantiation import count_states
 from synthesis_manager.limits import check_message, check_timeout
@@ -39,12 +39,19 @@ from synthesis_manager.ros.errors import log_internal_error
 from synthesis_manager.ros.node_main import node_main
 from synthesis_manager.ros.qos import action_server_qos, service_qos
 from synthesis_manager.ros.robot_state import RobotStateListener
-from synthesis_manager.ros.stage_calls import Preempted, ServerStopping, StageCaller, StageFailed
+from synthesis_manager.ros.stage_calls import (Preempted, ServerStopping, StageCaller, StageFailed,
+                                               next_executor_turn)
 from synthesis_manager.ros.worker_pool import WorkerPool
 from synthesis_msgs.action import BehaviorSynthesis, FlexBESynthesis
 from synthesis_msgs.msg import FSAutomaton, LTLSpecification
 from synthesis_msgs.srv import (CancelSynthesis, GenerateFlexBESM, GenerateLTLSpecification,
                                 SynthesizeAutomaton)
+
+
+# What explains an unrealizable task (run in a child process; a module-level name so that
+# tests can put a stand-in there).
+DIAGNOSIS = 'ltl_specification.diagnosis:explain_unsynthesizable'
+DIAGNOSIS_GRACE = 1.0  # seconds past diagnosis_timeout before the diagnosis process is killed
 
 
 class Busy(CodedError):
@@ -163,6 +170,9 @@ class BehaviorSynthesisServer(Node):
         self._lock = threading.Lock()
         self.stages = StageCaller(self)
         self.diagnoses = WorkerPool(workers=2, max_waiting=self.parameter('max_active_goals'), name='diagnosis')
+        # Diagnoses run syntheses too: in child processes that a cancel, the time limit or
+        # shutdown ends at once (one CUDD operation can hold the GIL for seconds).
+        self.diagnosis_processes = SynthesisProcesses()
         self.log_to_flexbe = flexbe_log_publisher(self, self.parameter('flexbe_log_topic'))
         group = ReentrantCallbackGroup()
 
@@ -193,6 +203,7 @@ class BehaviorSynthesisServer(Node):
         """Make goals that are waiting on a stage give up (at shutdown)."""
         self._stopping.set()
         self.stages.stop()
+        self.diagnosis_processes.close()
 
     def _wake_executor(self):
         if self.executor is not None:
@@ -201,6 +212,7 @@ class BehaviorSynthesisServer(Node):
     def destroy_node(self):
         for action_server in self.action_servers:
             action_server.destroy()
+        self.diagnosis_processes.close()
         super().destroy_node()
 
     def parameter(self, name):
@@ -286,13 +298,7 @@ class BehaviorSynthesisServer(Node):
             'LTL synthesis', timeout + 5.0, on_cancel=lambda: self.cancel_synthesis(goal_id))
         if task.option != 'ltl_synthesis_only' and error_name(synthesized.error_code.value) == 'SPEC_UNSYNTHESIZABLE':
             feedback('Diagnosing why the task cannot be done', 0.6)
-            custom_ltl = msg_to_sections(task.custom_ltl) if task.custom_ltl is not None else None
-            # CPU work of up to diagnosis_timeout: in a worker, so the executor keeps serving.
-            synthesized.error_code.message = await self.diagnoses.run(functools.partial(
-                explain_unsynthesizable, synthesized.error_code.message, task.system,
-                task.initial_conditions, task.goals, task.sm_outcomes, not task.unordered_goals,
-                custom_ltl or None, deadline=time.monotonic() + self.parameter('diagnosis_timeout')),
-                wake=self._wake_executor)
+            synthesized.error_code.message = await self.diagnose(goal_handle, task, synthesized.error_code.message)
         self.check(synthesized.error_code)
         outcome.automaton = synthesized.automaton
         feedback(f'Synthesized an automaton with {len(outcome.automaton.automaton)} states', 2 / 3)
@@ -339,6 +345,36 @@ class BehaviorSynthesisServer(Node):
         """Call a stage's service; wait watching for cancel, time limit, shutdown and the node."""
         return await self.stages.call(client, request, stage, timeout, self.parameter('service_timeout'),
                                       cancelled=lambda: goal_handle.is_cancel_requested, on_cancel=on_cancel)
+
+    async def diagnose(self, goal_handle, task: SynthesisTask, details: str) -> str:
+        """Why ``task`` cannot be done, in plain words ahead of the synthesizer's ``details``
+        (``details`` alone when there is no diagnosis within diagnosis_timeout). A cancel or
+        shutdown ends the diagnosis at once."""
+        custom_ltl = msg_to_sections(task.custom_ltl) if task.custom_ltl is not None else None
+        arguments = (details, task.system, task.initial_conditions, task.goals, task.sm_outcomes,
+                     not task.unordered_goals, custom_ltl or None)
+        deadline = time.monotonic() + self.parameter('diagnosis_timeout')
+        stop = threading.Event()
+        # The worker only waits on the child process; the executor keeps serving.
+        diagnosis = self.diagnoses.submit(self._diagnosis, arguments, deadline, stop, details)
+        diagnosis.add_done_callback(lambda _: self._wake_executor())
+        while not diagnosis.done():
+            if goal_handle.is_cancel_requested or self._stopping.is_set():
+                stop.set()
+            await next_executor_turn()
+        if goal_handle.is_cancel_requested:
+            raise Preempted()
+        if self._stopping.is_set():
+            raise ServerStopping('diagnosis: the server is shutting down', 'diagnosis')
+        return diagnosis.result()
+
+    def _diagnosis(self, arguments: tuple, deadline: float, stop: threading.Event, details: str) -> str:
+        try:
+            # The diagnosis keeps its own deadline; the child is killed only if it overruns.
+            return self.diagnosis_processes.call(DIAGNOSIS, arguments, {'deadline': deadline}, cancel=stop,
+                                                 deadline=deadline + DIAGNOSIS_GRACE)
+        except SynthesisError:  # stopped, out of time, or its process died: the verdict stands without it
+            return details
 
     def cancel_synthesis(self, goal_id: str):
         """Tell the synthesizer to stop this goal's synthesis (fire and forget)."""

@@ -695,11 +695,13 @@ def _parse_line(line: str, syntax: str, scope: _Scope, source: _Source) -> Formu
 # --- lines by shape ---------------------------------------------------------------------------
 #
 # Large specifications repeat a few line shapes with different propositions ("a & next(b) ->
-# !c", "| ! a | b' c'" ...). A shape is the line with every proposition replaced by a placeholder; it is parsed
-# once, by the parser above, and compiled into a function that builds the formula of any line
-# of that shape. The result is the very tree the parser would build (a proposition never
-# changes how operators group or fold). Lines whose propositions break the section's rules,
-# and unusual lines (very long or deeply nested), go through the parser, which explains errors.
+# !c", "| ! a | b' c'" ...). A shape is the line with every proposition replaced by a
+# placeholder; it is parsed once, by the parser above, and compiled into a function that builds
+# the formulas of all lines of that shape together, a node column at a time. The result is the
+# very tree the parser would build (a proposition never changes how operators group or fold).
+# Lines whose propositions break the section's rules, and unusual lines (very long or deeply
+# nested, or whose template folds a proposition away), go through the parser, which explains
+# errors.
 
 _PROPOSITION = re.compile(
     r"(?<![A-Za-z0-9_.@])(?!(?:TRUE|FALSE|next)(?![A-Za-z0-9_.@]))[A-Za-z_][A-Za-z0-9_.@]*")
@@ -726,8 +728,8 @@ def _parse_section_by_shapes(lines: list[str], syntax: str, scope: _Scope, leave
                              check=None) -> list:
     """The formula of each line, or None where the parser must handle the line.
 
-    The shapes and propositions of all lines are found at once (one regular-expression pass
-    over the joined text, not two per line), and the lines of each shape are built together.
+    The shapes and propositions of all lines are found at once (a few passes of str.translate
+    over the joined text, not a scan per line), and the lines of each shape are built together.
     A shape seen on one line only is left to the parser: compiling costs more than parsing
     one line, and the lines of a large file are either alike or all different.
     """

@@ -70,18 +70,33 @@ class Next(Formula):
 TRUE = Const(True)
 FALSE = Const(False)
 
+# The constructors below make nodes without the dataclass __init__, which (frozen) sets each
+# field through object.__setattr__: allocating the node and calling its slots' setters costs
+# half as much, and large specifications build millions of nodes. The nodes are the same.
+FIELD_SETTERS = {kind: {name: getattr(kind, name).__set__ for name in kind.__dataclass_fields__}
+                 for kind in (Const, Var, Not, And, Or, Implies, Iff, Next)}
+_new = object.__new__
+_set_name = FIELD_SETTERS[Var]['name']
+_set_not_arg, _set_next_arg = FIELD_SETTERS[Not]['arg'], FIELD_SETTERS[Next]['arg']
+_set_args = {And: FIELD_SETTERS[And]['args'], Or: FIELD_SETTERS[Or]['args']}
+_set_sides = {kind: (FIELD_SETTERS[kind]['left'], FIELD_SETTERS[kind]['right']) for kind in (Implies, Iff)}
+
 
 def var(name: str) -> Var:
-    return Var(name)
+    node = _new(Var)
+    _set_name(node, name)
+    return node
 
 
 def neg(arg: Formula) -> Formula:
     """Negation; folds constants and double negation."""
     if isinstance(arg, Const):
-        return Const(not arg.value)
+        return FALSE if arg.value else TRUE
     if isinstance(arg, Not):
         return arg.arg
-    return Not(arg)
+    node = _new(Not)
+    _set_not_arg(node, arg)
+    return node
 
 
 def conj(args: Iterable[Formula]) -> Formula:
@@ -95,30 +110,45 @@ def disj(args: Iterable[Formula]) -> Formula:
 
 
 def implies(left: Formula, right: Formula) -> Formula:
-    return Implies(left, right)
+    return _binary(Implies, left, right)
 
 
 def iff(left: Formula, right: Formula) -> Formula:
-    return Iff(left, right)
+    return _binary(Iff, left, right)
 
 
 def next_(arg: Formula) -> Formula:
-    return Next(arg)
+    node = _new(Next)
+    _set_next_arg(node, arg)
+    return node
+
+
+def _binary(kind, left: Formula, right: Formula) -> Formula:
+    node = _new(kind)
+    set_left, set_right = _set_sides[kind]
+    set_left(node, left)
+    set_right(node, right)
+    return node
 
 
 def _associative(kind, args, unit, zero):
     flat = []
     for arg in args:
-        if arg == unit:
+        if isinstance(arg, Const):  # the unit or the zero
+            if arg.value == zero.value:
+                return zero
             continue
-        if arg == zero:
-            return zero
-        flat.extend(arg.args if isinstance(arg, kind) else (arg,))
+        if isinstance(arg, kind):
+            flat.extend(arg.args)
+        else:
+            flat.append(arg)
     if not flat:
         return unit
     if len(flat) == 1:
         return flat[0]
-    return kind(tuple(flat))
+    node = _new(kind)
+    _set_args[kind](node, tuple(flat))
+    return node
 
 
 # --- printers ---------------------------------------------------------------------------

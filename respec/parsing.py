@@ -40,8 +40,8 @@ from typing import NamedTuple
 
 from respec.errors import CodedError
 from respec.ltl import (
-    FALSE, TRUE, And, Const, Formula, Iff, Implies, Next, Not, Or, Var, conj, disj, iff, implies,
-    neg, next_, var, variables,
+    FALSE, FIELD_SETTERS, TRUE, And, Const, Formula, Iff, Implies, Next, Not, Or, Var, conj, disj, iff,
+    implies, neg, next_, var, variables,
 )
 from respec.spec import FORMULA_SECTIONS, PROPOSITION_SECTIONS, SLUGS_HEADERS, GR1Specification
 
@@ -399,6 +399,128 @@ def _scope_problem(scope: _Scope, name: str, next_step: bool) -> str:
     return ''
 
 
+# --- infix lines without the token objects ------------------------------------------------
+#
+# A file's lines that no shape covers are read by a shunting-yard loop over plain strings
+# (about three times faster than the parser above, which keeps every token's position for its
+# messages). It builds the parser's very tree with the same constructors, and it gives up
+# (None) on anything it does not expect, so that the parser reads that line and explains any
+# error: non-ASCII text, integers, numbers, a bad character, a misplaced operator, a
+# proposition the section does not allow, a nested next.
+
+_QUICK_LINE = re.compile(r"[A-Za-z0-9_.@' \t&|^!~()<>/\\-]*")
+# Each operator spelled with several characters becomes one mark of its own (longest first,
+# as the parser's scanner reads them), which then stands apart like the one-character ones.
+_QUICK_SPELLINGS = (('<-->', '\x10'), ('<->', '\x10'), ('-->', '\x11'), ('->', '\x11'),
+                    ('&&', '\x12'), ('/\\', '\x12'), ('||', '\x13'), ('\\/', '\x13'))
+_QUICK_PADDED = ('(', ')', '!', '~', '&', '|', '^', '\x10', '\x11', '\x12', '\x13')
+# Binding strength of each binary operator, as _BINARY_LEVEL.
+_QUICK_LEVEL = {'&': 4, '\x12': 4, '|': 3, '\x13': 3, '^': 2, '\x11': 1, '\x10': 0}
+_QUICK_NAME_START = frozenset(string.ascii_letters + '_')
+# Besides the binary operators' levels (0-4), the operator stack holds these marks.
+_OPEN, _NOT, _NEXT = -1, -2, -3
+_QUICK_KIND = {**_QUICK_LEVEL, '(': _OPEN, '!': _NOT, '~': _NOT, 'next': _NEXT, ')': 5, 'TRUE': 6, 'FALSE': 7}
+_CLOSE, _TRUE, _FALSE = 5, 6, 7
+
+
+def _quick_infix(line: str, scope: _Scope) -> Formula | None:
+    """The formula of one infix line of a specification file, or None (see above)."""
+    if not line.isascii() or scope.integers or _QUICK_LINE.fullmatch(line) is None:
+        return None
+    for spelling, mark in _QUICK_SPELLINGS:
+        if spelling in line:
+            line = line.replace(spelling, mark)
+    if '-' in line or '<' in line or '>' in line or '/' in line or '\\' in line:
+        return None  # a comparison, or a broken operator
+    for operator in _QUICK_PADDED:
+        if operator in line:
+            line = line.replace(operator, f' {operator} ')
+    known, now, following = scope.names, scope.current, scope.next_step
+    operands, operators, counts = [], [], []
+    push, push_operator = operands.append, operators.append
+    kinds = _QUICK_KIND
+    in_next = False
+    expect_operand = True
+    for token in line.split():
+        kind = kinds.get(token)
+        if expect_operand:
+            if kind is None:  # a proposition
+                if token[0] not in _QUICK_NAME_START:
+                    return None  # a number, or a word starting with '.', '@' or a prime
+                if "'" in token:
+                    name = token[:-1]
+                    if in_next or "'" in name or (known is not None and name not in following):
+                        return None
+                    operand = next_(_var(name))
+                elif known is None or token in (following if in_next else now):
+                    operand = _var(token)
+                else:
+                    return None
+            elif kind < 0:  # '(', '!' or next
+                if kind == _NEXT:
+                    if in_next:
+                        return None
+                    in_next = True
+                push_operator(kind)
+                continue
+            elif kind == _TRUE:
+                operand = TRUE
+            elif kind == _FALSE:
+                operand = FALSE
+            else:
+                return None  # a binary operator or ')' where an operand belongs
+            expect_operand = False
+        elif kind is None or kind < 0 or kind > _CLOSE:
+            return None  # an operand or a unary operator after an operand
+        elif kind == _CLOSE:
+            while operators and operators[-1] >= 0:
+                _quick_reduce(operands, operators, counts)
+            if not operators or operators.pop() != _OPEN:
+                return None
+            operand = operands.pop()
+        else:  # a binary operator; kind is its level
+            while operators and operators[-1] > kind:
+                _quick_reduce(operands, operators, counts)
+            if operators and operators[-1] == kind:
+                if kind >= 3:  # a run of & or |: one node for the whole run, as the parser makes
+                    counts[-1] += 1
+                    expect_operand = True
+                    continue
+                _quick_reduce(operands, operators, counts)  # left associative
+            push_operator(kind)
+            counts.append(2)
+            expect_operand = True
+            continue
+        # An operand is complete: the unary operators just before it apply.
+        while operators and operators[-1] < _OPEN:
+            if operators.pop() == _NOT:
+                operand = neg(operand)
+            else:
+                operand = next_(operand)
+                in_next = False
+        push(operand)
+    if expect_operand:
+        return None
+    while operators:
+        if operators[-1] < 0:
+            return None  # an unclosed '('
+        _quick_reduce(operands, operators, counts)
+    return operands[0]
+
+
+def _quick_reduce(operands: list, operators: list, counts: list) -> None:
+    """Replace the operands of the operator on top of the stack by its formula."""
+    level, count = operators.pop(), counts.pop()
+    arguments = operands[-count:]
+    del operands[-count:]
+    if level == 4:
+        operands.append(conj(arguments))
+    elif level == 3:
+        operands.append(disj(arguments))
+    else:
+        operands.append(_combine(('<->', '->', '^')[level], *arguments))
+
+
 # --- prefix (slugsin) ---------------------------------------------------------------------
 
 _PREFIX_TOKEN = re.compile(r'\S+')
@@ -681,6 +803,10 @@ def _column(content: str) -> int:
 
 
 def _parse_line(line: str, syntax: str, scope: _Scope, source: _Source) -> Formula:
+    if syntax == 'infix':
+        formula = _quick_infix(line, scope)
+        if formula is not None:
+            return formula
     try:
         return _parse(line, syntax, scope, source)
     except ParseError as infix_error:
@@ -722,6 +848,8 @@ _MAX_SHAPE_PLACEHOLDERS = 64
 _MAX_SHAPE_NESTING = 32
 _SHAPES: dict[str, dict[str, object]] = {}  # syntax -> shape -> compiled (or False)
 _MAX_SHAPES = 1 << 14
+_LINES_WORTH_COMPILING = 8     # lines sharing a shape before it is compiled
+_LINES_WORTH_GROUPING = 1000   # sections this large may be left to the parser whole
 
 
 def _parse_section_by_shapes(lines: list[str], syntax: str, scope: _Scope, leaves: _LeafNodes,
@@ -730,8 +858,9 @@ def _parse_section_by_shapes(lines: list[str], syntax: str, scope: _Scope, leave
 
     The shapes and propositions of all lines are found at once (a few passes of str.translate
     over the joined text, not a scan per line), and the lines of each shape are built together.
-    A shape seen on one line only is left to the parser: compiling costs more than parsing
-    one line, and the lines of a large file are either alike or all different.
+    A shape not compiled yet is compiled only when enough lines share it (compiling costs as
+    much as parsing a dozen lines); a large section whose lines are mostly unlike each other is
+    left to the parser whole.
     """
     joined = '\n'.join(lines)
     if not lines or any(mark in joined for mark in _MARKS):
@@ -748,7 +877,7 @@ def _parse_section_by_shapes(lines: list[str], syntax: str, scope: _Scope, leave
     for shape, indices in lines_of_shape.items():
         compiled = compiled_shapes.get(shape)
         if compiled is None:
-            if len(indices) == 1:
+            if len(indices) < _LINES_WORTH_COMPILING:
                 continue
             compiled = _compiled_shape(compiled_shapes, shape, syntax, starts[indices[0] + 1] - starts[indices[0]])
         if compiled is False:
@@ -785,8 +914,11 @@ def _shapes_by_translation(marked: str):
     # In a line's outline each word is a run of marks as long as the word; lines are grouped
     # by outline, then outlines by shape (one placeholder per word).
     outline_of_line = marked.translate(_OUTLINE).split('\n')
+    lines_of_outline = _positions(outline_of_line)
+    if _mostly_unlike(lines_of_outline, len(outline_of_line)):
+        return [], [], {}
     word_counts, lines_of_shape = {}, {}
-    for outline, indices in _positions(outline_of_line).items():
+    for outline, indices in lines_of_outline.items():
         if _OUTLINE_NON_NAME.search(outline):
             return None
         shape = _OUTLINE_WORD.sub(_PLACEHOLDER, outline)
@@ -805,8 +937,16 @@ def _shapes_by_expression(marked: str):
     else:
         shapes = _PLACEHOLDER.join(parts[0::2])
     shape_of_line = shapes.split('\n')
+    lines_of_shape = _positions(shape_of_line)
+    if _mostly_unlike(lines_of_shape, len(shape_of_line)):
+        return [], [], {}
     starts = list(itertools.accumulate(map(str.count, shape_of_line, itertools.repeat(_PLACEHOLDER)), initial=0))
-    return names, starts, _positions(shape_of_line)
+    return names, starts, lines_of_shape
+
+
+def _mostly_unlike(groups: dict, lines: int) -> bool:
+    """Whether a large section's lines fall into more groups than half their number."""
+    return lines >= _LINES_WORTH_GROUPING and 2 * len(groups) > lines
 
 
 def _positions(items: list[str]) -> dict[str, list[int]]:
@@ -900,9 +1040,9 @@ class _LeafNodes:
         kind, inner = _LEAF_PARTS[factory]
         nodes = list(map(object.__new__, itertools.repeat(kind, len(missing))))
         if inner is None:
-            _consume(map(Var.name.__set__, nodes, missing))
+            _consume(map(FIELD_SETTERS[Var]['name'], nodes, missing))
         else:
-            _consume(map(kind.arg.__set__, nodes, self(inner, missing)))
+            _consume(map(FIELD_SETTERS[kind]['arg'], nodes, self(inner, missing)))
         made.update(zip(missing, nodes))
         return list(map(made.__getitem__, names))
 
@@ -918,8 +1058,8 @@ _LEAF_PARTS = {'Var': (Var, None), 'NotVar': (Not, 'Var'), 'NextVar': (Next, 'Va
 # which matters for the millions of nodes of a large file; the nodes are the same).
 _BUILDER_NAMES = {
     'TRUE': TRUE, 'FALSE': FALSE, 'new': object.__new__, 'repeat': itertools.repeat, 'consume': _consume,
-    **{f'{kind.__name__}_{name}': getattr(kind, name).__set__
-       for kind in (Not, Next, And, Or, Implies, Iff) for name in kind.__dataclass_fields__},
+    **{f'{kind.__name__}_{name}': setter
+       for kind in (Not, Next, And, Or, Implies, Iff) for name, setter in FIELD_SETTERS[kind].items()},
     **{kind.__name__: kind for kind in (Not, Next, And, Or, Implies, Iff)},
 }
 

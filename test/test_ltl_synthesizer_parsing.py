@@ -172,6 +172,7 @@ def test_prefix_round_trip_is_structural_up_to_normal_form_and_equivalent(formul
 
 
 RENAMED = {'a': 'b', 'b': 'x_1', 'c': 'a', 'x_1': 'y.2', 'y.2': 'c'}
+ALIKE_LINES = 10  # lines of one shape in the tests below: enough for the shape to be compiled
 
 
 def renamed(formula):
@@ -192,7 +193,8 @@ def renamed(formula):
 def test_files_of_repeated_line_shapes_parse_as_the_parser_parses_each_line(lines):
     """Large files are parsed by line shape (compiled on the second sighting); every line must
     still give the parser's own tree, in both syntaxes and under the sections' rules."""
-    lines = [f for line in lines for f in (line, renamed(line), renamed(renamed(line)))]
+    lines = [f for line in lines for f in itertools.islice(itertools.accumulate(
+        itertools.repeat(line, ALIKE_LINES), lambda previous, _: renamed(previous)), ALIKE_LINES)]
     for printer, syntax, parse_file in ((to_infix, 'infix', parse_structuredslugs),
                                         (to_prefix, 'prefix', parse_slugsin)):
         texts = [printer(line) for line in lines]
@@ -200,16 +202,17 @@ def test_files_of_repeated_line_shapes_parse_as_the_parser_parses_each_line(line
         assert parse_file(text).sys_trans == [parse_formula(t, syntax) for t in texts], syntax
 
 
-@pytest.mark.parametrize('parse_file, lines', [
-    (parse_structuredslugs, ['a -> next(b)', 'b -> next(a)', 'a -> next(c)']),
-    (parse_slugsin, ["| ! a b'", "| ! b a'", "| ! a c'"]),
-    (parse_slugsin, ["& 0 a'", "& 0 b'", "& 0 c'"]),  # FALSE whatever the name: the name is still checked
+@pytest.mark.parametrize('parse_file, alike, bad', [
+    (parse_structuredslugs, ['a -> next(b)', 'b -> next(a)'], 'a -> next(c)'),
+    (parse_slugsin, ["| ! a b'", "| ! b a'"], "| ! a c'"),
+    (parse_slugsin, ["& 0 a'", "& 0 b'"], "& 0 c'"),  # FALSE whatever the name: the name is still checked
 ])
-def test_a_line_breaking_the_section_rules_is_reported_even_when_its_shape_is_known(parse_file, lines):
+def test_a_line_breaking_the_section_rules_is_reported_even_when_its_shape_is_known(parse_file, alike, bad):
+    lines = alike * ALIKE_LINES + [bad]
     text = '\n'.join(['[INPUT]', 'a', 'b', '[OUTPUT]', 'c', '[ENV_TRANS]', *lines])
     with pytest.raises(ParseError) as error:
         parse_file(text)
-    assert error.value.token.startswith('c') and error.value.line == 9
+    assert error.value.token.startswith('c') and error.value.line == 6 + len(lines)
     assert 'next-step' in str(error.value)
 
 
@@ -232,7 +235,7 @@ def specification_texts(draw):
         # Few patterns per section, so that lines share shapes.
         patterns = draw(st.lists(st.sampled_from(LINE_PATTERNS), min_size=1, max_size=3))
         parts += [draw(st.sampled_from(patterns)).format(draw(names), draw(names))
-                  for _ in range(draw(st.integers(0, 8)))]
+                  for _ in range(draw(st.integers(0, 3 * ALIKE_LINES)))]
     return draw(st.sampled_from(['\n', '\r\n'])).join(parts)
 
 
@@ -247,14 +250,44 @@ def parse_outcome(parse_file, text):
 @given(specification_texts())
 def test_parsing_by_line_shapes_gives_what_the_parser_gives_line_by_line(text):
     """The same specification or the same first error (with its position) as parsing every
-    line with the parser, whichever shapes earlier files left compiled."""
+    line with the parser (no shapes, no quick reading), whichever shapes earlier files left
+    compiled."""
     import respec.parsing
 
     for parse_file in (parse_structuredslugs, parse_slugsin):
         by_shapes = parse_outcome(parse_file, text)
         with pytest.MonkeyPatch.context() as patch:
             patch.setattr(respec.parsing, '_parse_section_by_shapes', lambda lines, *_: [None] * len(lines))
+            patch.setattr(respec.parsing, '_quick_infix', lambda *_: None)
             assert by_shapes == parse_outcome(parse_file, text)
+
+
+TOKENS = ['a', 'b', 'c', "a'", "c'", 'x.y', 'TRUE', 'FALSE', 'next', 'next(', '(', ')', '!', '~', '&', '&&', '|',
+          '||', '^', '->', '-->', '<->', '<-->', '/\\', '\\/', '1', "'", '-', '<', '>', '=', 'a@1', 'zz', '\u00e9']
+
+
+@settings(max_examples=3000, deadline=None, database=None)
+@given(st.lists(st.tuples(st.sampled_from(TOKENS), st.sampled_from(['', ' '])), min_size=1, max_size=14),
+       st.sampled_from(['sys_trans', 'env_trans', 'sys_init']))
+def test_the_quick_infix_reading_gives_the_parsers_tree_or_leaves_the_line_to_it(pieces, section):
+    """Any sequence of tokens, valid or not: the quick reading either declines or agrees with
+    the parser (which then does not fail)."""
+    from respec.parsing import _parse, _quick_infix, _scopes, _Source
+
+    line = ''.join(token + space for token, space in pieces).strip()
+    scope = _scopes(['a', 'x.y', 'a@1'], ['b', 'c'])[section]
+    quick = _quick_infix(line, scope)
+    if quick is not None:
+        assert quick == _parse(line, 'infix', scope, _Source())
+
+
+@settings(max_examples=300, deadline=None, database=None)
+@given(formulas(NAMES))
+def test_the_quick_infix_reading_reads_every_printed_formula(formula):
+    from respec.parsing import _quick_infix, _scopes
+
+    scope = _scopes(['a', 'b'], ['c', 'x_1', 'y.2'])['sys_trans']
+    assert _quick_infix(to_infix(formula), scope) == parse_formula(to_infix(formula))
 
 
 @settings(max_examples=150, deadline=None, database=None)

@@ -423,8 +423,10 @@ _QUICK_KIND = {**_QUICK_LEVEL, '(': _OPEN, '!': _NOT, '~': _NOT, 'next': _NEXT, 
 _CLOSE, _TRUE, _FALSE = 5, 6, 7
 
 
-def _quick_infix(line: str, scope: _Scope) -> Formula | None:
-    """The formula of one infix line of a specification file, or None (see above)."""
+def _quick_infix(line: str, scope: _Scope, variables: dict[str, Var] | None = None) -> Formula | None:
+    """The formula of one infix line of a specification file, or None (see above).
+    ``variables``: the file's proposition nodes by name (shared, and added to)."""
+    variables = {} if variables is None else variables
     if not line.isascii() or scope.integers or _QUICK_LINE.fullmatch(line) is None:
         return None
     for spelling, mark in _QUICK_SPELLINGS:
@@ -451,9 +453,10 @@ def _quick_infix(line: str, scope: _Scope) -> Formula | None:
                     name = token[:-1]
                     if in_next or "'" in name or (known is not None and name not in following):
                         return None
-                    operand = next_(_var(name))
+                    operand = variables.get(name) or variables.setdefault(name, var(name))
+                    operand = next_(operand)
                 elif known is None or token in (following if in_next else now):
-                    operand = _var(token)
+                    operand = variables.get(token) or variables.setdefault(token, var(token))
                 else:
                     return None
             elif kind < 0:  # '(', '!' or next
@@ -773,6 +776,10 @@ def _parse_slugs_file(text: str, filename: str, syntax: str, check=None) -> GR1S
             parsed = _parse_section_by_shapes(lines, syntax, scope, leaves, check) \
                 if not scope.integers else [None] * len(lines)
             for index, formula in enumerate(parsed):
+                if check is not None and index % _LINES_BETWEEN_CHECKS == 0:
+                    check()
+                if formula is None and syntax == 'infix':
+                    formula = parsed[index] = _quick_infix(lines[index], scope, leaves.variables)
                 if formula is None:
                     parsed[index] = _parse_line(lines[index], syntax, scope, sections[section].source(index, filename))
             formulas[section] = parsed
@@ -803,10 +810,6 @@ def _column(content: str) -> int:
 
 
 def _parse_line(line: str, syntax: str, scope: _Scope, source: _Source) -> Formula:
-    if syntax == 'infix':
-        formula = _quick_infix(line, scope)
-        if formula is not None:
-            return formula
     try:
         return _parse(line, syntax, scope, source)
     except ParseError as infix_error:
@@ -1028,6 +1031,7 @@ class _LeafNodes:
 
     def __init__(self):
         self._made: dict[str, dict[str, Formula]] = {factory: {} for factory in _LEAF_PARTS}
+        self.variables: dict[str, Var] = self._made['Var']  # name -> its Var node
 
     def __call__(self, factory: str, names: list[str]) -> list[Formula]:
         """The ``factory`` leaf ('Var', 'NotVar', ...) of each of ``names``."""

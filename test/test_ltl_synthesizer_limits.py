@@ -71,10 +71,14 @@ def test_unrealizable_runaway_explanation_is_bounded_too():
     assert f'{2**200} initial state(s)' in result.explanation.replace('.0 initial', ' initial')
 
 
-def test_parsing_checks_the_interrupt():
-    text = '[INPUT]\nx\n\n[OUTPUT]\ny\n\n[SYS_TRANS]\n' + 'x -> next(y)\n' * 5000
+@pytest.mark.parametrize('lines', [
+    ['x -> next(y)'] * 5000,                                            # one shape
+    [' & '.join(['x'] * length) + ' -> next(y)' for length in range(1, 1500)],  # all unlike
+])
+def test_parsing_checks_the_interrupt(lines):
+    text = '[INPUT]\nx\n\n[OUTPUT]\ny\n\n[SYS_TRANS]\n' + '\n'.join(lines) + '\n'
     cancel = threading.Event()
     cancel.set()
     with pytest.raises(SynthesisCancelled):
         parse_structuredslugs(text, check=Interrupt(cancel))
-    assert len(parse_structuredslugs(text, check=Interrupt()).sys_trans) == 5000
+    assert len(parse_structuredslugs(text, check=Interrupt()).sys_trans) == len(lines)

@@ -9,7 +9,7 @@ Figures (results/gr1synth.md):
   ``--size-mb`` MB: a compiled task (the chain family of bench_synthesizer.py with as many
   actions as fill the size, as structuredslugs and as slugsin: what a large generated
   specification looks like), and random formulas where no two lines share a shape (the worst
-  case for the parser);
+  case: every line is read on its own), in both syntaxes;
 - whole runs, verdict only (slugs' default, no ``--explicitStrategy``): ``gr1synth`` and, when a
   ``slugs`` executable is on PATH, slugs on the same slugsin files (CPU seconds, peak RSS).
 """
@@ -204,8 +204,10 @@ def main(argv=None) -> int:
         files['compiled task (chain family), structuredslugs'] = ('task.structuredslugs', task)
         files['compiled task (chain family), slugsin'] = (
             'task.slugsin', parse_structuredslugs(task).to_slugsin())
-        files['random formulas, no shape repeated, structuredslugs'] = (
-            'random.structuredslugs', generated_spec(size))
+        random_text = generated_spec(size)
+        files['random formulas, no shape repeated, structuredslugs'] = ('random.structuredslugs', random_text)
+        files['random formulas, no shape repeated, slugsin'] = (
+            'random.slugsin', parse_structuredslugs(random_text).to_slugsin())
         for label, (name, text) in files.items():
             path = Path(directory) / name
             path.write_text(text)

@@ -778,8 +778,9 @@ def _parse_slugs_file(text: str, filename: str, syntax: str, check=None) -> GR1S
             for index, formula in enumerate(parsed):
                 if check is not None and index % _LINES_BETWEEN_CHECKS == 0:
                     check()
-                if formula is None and syntax == 'infix':
-                    formula = parsed[index] = _quick_infix(lines[index], scope, leaves.variables)
+                if formula is None:
+                    quick = _quick_infix if syntax == 'infix' else _quick_prefix
+                    formula = parsed[index] = quick(lines[index], scope, leaves.variables)
                 if formula is None:
                     parsed[index] = _parse_line(lines[index], syntax, scope, sections[section].source(index, filename))
             formulas[section] = parsed
@@ -819,6 +820,45 @@ def _parse_line(line: str, syntax: str, scope: _Scope, source: _Source) -> Formu
             return _parse(line, 'prefix', scope, source)
         except ParseError:
             raise infix_error from None
+
+
+def _quick_prefix(line: str, scope: _Scope, variables: dict[str, Var]) -> Formula | None:
+    """The formula of one slugsin line of a specification file, read right to left over plain
+    strings (the parser's very tree: its runs of & and | flatten the same), or None for the
+    parser to read: memory buffers, undeclared or misplaced propositions, malformed lines.
+    ``variables``: the file's proposition nodes by name (shared, and added to)."""
+    now, following = scope.current, scope.next_step
+    if scope.names is None or '$' in line or '?' in line:
+        return None
+    operands = []
+    push, pop = operands.append, operands.pop
+    for token in reversed(line.split()):
+        kind = _QUICK_PREFIX_KIND.get(token)
+        if kind is None:  # a proposition: declared ones are well-formed names
+            if token[-1] == "'":
+                name = token[:-1]
+                if name not in following:
+                    return None
+                push(next_(variables.get(name) or variables.setdefault(name, var(name))))
+            elif token in now:
+                push(variables.get(token) or variables.setdefault(token, var(token)))
+            else:
+                return None
+        elif kind == '!':
+            if not operands:
+                return None
+            push(neg(pop()))
+        elif kind in ('1', '0'):
+            push(TRUE if kind == '1' else FALSE)
+        else:
+            if len(operands) < 2:
+                return None
+            left = pop()
+            push(_combine(kind, left, pop()))
+    return operands[0] if len(operands) == 1 else None
+
+
+_QUICK_PREFIX_KIND = {token: token for token in ('!', '&', '|', '^', '1', '0')}
 
 
 # --- lines by shape ---------------------------------------------------------------------------

@@ -259,6 +259,7 @@ def test_parsing_by_line_shapes_gives_what_the_parser_gives_line_by_line(text):
         with pytest.MonkeyPatch.context() as patch:
             patch.setattr(respec.parsing, '_parse_section_by_shapes', lambda lines, *_: [None] * len(lines))
             patch.setattr(respec.parsing, '_quick_infix', lambda *_: None)
+            patch.setattr(respec.parsing, '_quick_prefix', lambda *_: None)
             assert by_shapes == parse_outcome(parse_file, text)
 
 
@@ -281,13 +282,31 @@ def test_the_quick_infix_reading_gives_the_parsers_tree_or_leaves_the_line_to_it
         assert quick == _parse(line, 'infix', scope, _Source())
 
 
+PREFIX_TOKENS = ['a', 'b', 'c', "a'", "c'", "b'", 'x.y', '!', '&', '|', '^', '1', '0', '2', "'", 'a@1', 'zz', '$',
+                 '?', 'TRUE', "a''", 'next']
+
+
+@settings(max_examples=3000, deadline=None, database=None)
+@given(st.lists(st.sampled_from(PREFIX_TOKENS), min_size=1, max_size=12),
+       st.sampled_from(['sys_trans', 'env_trans', 'sys_init']))
+def test_the_quick_prefix_reading_gives_the_parsers_tree_or_leaves_the_line_to_it(tokens, section):
+    from respec.parsing import _parse, _quick_prefix, _scopes, _Source
+
+    line = ' '.join(tokens)
+    scope = _scopes(['a', 'x.y', 'a@1'], ['b', 'c'])[section]
+    quick = _quick_prefix(line, scope, {})
+    if quick is not None:
+        assert quick == _parse(line, 'prefix', scope, _Source())
+
+
 @settings(max_examples=300, deadline=None, database=None)
 @given(formulas(NAMES))
-def test_the_quick_infix_reading_reads_every_printed_formula(formula):
-    from respec.parsing import _quick_infix, _scopes
+def test_the_quick_readings_read_every_printed_formula(formula):
+    from respec.parsing import _quick_infix, _quick_prefix, _scopes
 
     scope = _scopes(['a', 'b'], ['c', 'x_1', 'y.2'])['sys_trans']
     assert _quick_infix(to_infix(formula), scope) == parse_formula(to_infix(formula))
+    assert _quick_prefix(to_prefix(formula), scope, {}) == parse_formula(to_prefix(formula), 'prefix')
 
 
 @settings(max_examples=150, deadline=None, database=None)

@@ -824,9 +824,9 @@ def _parse_line(line: str, syntax: str, scope: _Scope, source: _Source) -> Formu
 
 def _quick_prefix(line: str, scope: _Scope, variables: dict[str, Var]) -> Formula | None:
     """The formula of one slugsin line of a specification file, read right to left over plain
-    strings (the parser's very tree: its runs of & and | flatten the same), or None for the
-    parser to read: memory buffers, undeclared or misplaced propositions, malformed lines.
-    ``variables``: the file's proposition nodes by name (shared, and added to)."""
+    strings (the parser's very tree), or None for the parser to read: memory buffers,
+    undeclared or misplaced propositions, malformed lines. ``variables``: the file's
+    proposition nodes by name (shared, and added to)."""
     now, following = scope.current, scope.next_step
     if scope.names is None or '$' in line or '?' in line:
         return None
@@ -844,18 +844,34 @@ def _quick_prefix(line: str, scope: _Scope, variables: dict[str, Var]) -> Formul
                 push(variables.get(token) or variables.setdefault(token, var(token)))
             else:
                 return None
+        elif kind == '1' or kind == '0':
+            push(TRUE if kind == '1' else FALSE)
         elif kind == '!':
             if not operands:
                 return None
-            push(neg(pop()))
-        elif kind in ('1', '0'):
-            push(TRUE if kind == '1' else FALSE)
+            operand = pop()
+            push(neg(operand if operand.__class__ is not list else _finished(operand)))
+        elif len(operands) < 2:
+            return None
         else:
-            if len(operands) < 2:
-                return None
-            left = pop()
-            push(_combine(kind, left, pop()))
-    return operands[0] if len(operands) == 1 else None
+            left, right = pop(), pop()
+            if left.__class__ is list:
+                left = _finished(left)
+            if right.__class__ is list:
+                if right[0] == kind:
+                    right.append(left)  # "& a & b c": one node for the run, as the parser makes
+                    push(right)
+                    continue
+                right = _finished(right)
+            push([kind, right, left] if kind == '&' or kind == '|' else _combine(kind, left, right))
+    return _finished(operands[0]) if len(operands) == 1 else None
+
+
+def _finished(operand):
+    """A formula, from a formula or a run: [operator, operands last first] (_quick_prefix)."""
+    if operand.__class__ is not list:
+        return operand
+    return conj(operand[:0:-1]) if operand[0] == '&' else disj(operand[:0:-1])
 
 
 _QUICK_PREFIX_KIND = {token: token for token in ('!', '&', '|', '^', '1', '0')}

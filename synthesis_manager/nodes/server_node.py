@@ -39,8 +39,7 @@ from synthesis_manager.ros.errors import log_internal_error
 from synthesis_manager.ros.node_main import node_main
 from synthesis_manager.ros.qos import action_server_qos, service_qos
 from synthesis_manager.ros.robot_state import RobotStateListener
-from synthesis_manager.ros.stage_calls import (Preempted, ServerStopping, StageCaller, StageFailed,
-                                               next_executor_turn)
+from synthesis_manager.ros.stage_calls import Preempted, ServerStopping, StageCaller, StageFailed
 from synthesis_manager.ros.worker_pool import WorkerPool
 from synthesis_msgs.action import BehaviorSynthesis, FlexBESynthesis
 from synthesis_msgs.msg import FSAutomaton, LTLSpecification
@@ -355,18 +354,19 @@ class BehaviorSynthesisServer(Node):
                      not task.unordered_goals, custom_ltl or None)
         deadline = time.monotonic() + self.parameter('diagnosis_timeout')
         stop = threading.Event()
-        # The worker only waits on the child process; the executor keeps serving.
-        diagnosis = self.diagnoses.submit(self._diagnosis, arguments, deadline, stop, details)
-        diagnosis.add_done_callback(lambda _: self._wake_executor())
-        while not diagnosis.done():
+
+        def watch():
             if goal_handle.is_cancel_requested or self._stopping.is_set():
                 stop.set()
-            await next_executor_turn()
+
+        # The worker only waits on the child process; the executor keeps serving.
+        message = await self.diagnoses.run(self._diagnosis, arguments, deadline, stop, details,
+                                           wake=self._wake_executor, each_turn=watch)
         if goal_handle.is_cancel_requested:
             raise Preempted()
         if self._stopping.is_set():
             raise ServerStopping('diagnosis: the server is shutting down', 'diagnosis')
-        return diagnosis.result()
+        return message
 
     def _diagnosis(self, arguments: tuple, deadline: float, stop: threading.Event, details: str) -> str:
         try:

@@ -58,13 +58,16 @@ class WorkerPool:
         self._jobs.put((future, function, args))
         return future
 
-    async def run(self, function, *args, wake=None):
+    async def run(self, function, *args, wake=None, each_turn=None):
         """Await ``function(*args)`` from a coroutine; ``wake()`` is called when it is done
-        (pass the executor's ``wake`` so the waiting callback resumes at once)."""
+        (pass the executor's ``wake`` so the waiting callback resumes at once), ``each_turn()``
+        each time the waiting coroutine resumes (e.g. to pass a cancel on to the job)."""
         future = self.submit(function, *args)
         if wake is not None:
             future.add_done_callback(lambda _: wake())
         while not future.done():
+            if each_turn is not None:
+                each_turn()
             await next_executor_turn()
         return future.result()
 

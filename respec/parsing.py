@@ -770,6 +770,7 @@ def _parse_slugs_file(text: str, filename: str, syntax: str, check=None) -> GR1S
     scopes = _scopes(declared['env_props'], declared['sys_props'], integers)
     formulas = {}
     leaves = _LeafNodes()
+    quick = _quick_infix if syntax == 'infix' else _quick_prefix
     with _collector_paused():
         for section in FORMULA_SECTIONS:
             scope, lines = scopes[section], sections[section].lines
@@ -779,7 +780,6 @@ def _parse_slugs_file(text: str, filename: str, syntax: str, check=None) -> GR1S
                 if check is not None and index % _LINES_BETWEEN_CHECKS == 0:
                     check()
                 if formula is None:
-                    quick = _quick_infix if syntax == 'infix' else _quick_prefix
                     formula = parsed[index] = quick(lines[index], scope, leaves.variables)
                 if formula is None:
                     parsed[index] = _parse_line(lines[index], syntax, scope, sections[section].source(index, filename))

@@ -36,6 +36,7 @@ class RosHarness:
         self.context = None
         self.executor = None
         self._thread = None
+        self._closing = threading.Event()
 
     def __enter__(self) -> 'RosHarness':
         if self.domain_id is None:
@@ -59,8 +60,15 @@ class RosHarness:
     def _spin(self):
         from rclpy.executors import ExternalShutdownException
 
-        with contextlib.suppress(ExternalShutdownException):
+        try:
             self.executor.spin()
+        except ExternalShutdownException:
+            pass
+        except Exception:
+            if not self._closing.is_set():
+                raise
+            # The teardown shut the context down while the executor was between two waits.
+
 
     def add_node(self, node_factory, *args, **kwargs):
         """Create a node in this harness's context and spin it; returns the node."""
@@ -70,8 +78,10 @@ class RosHarness:
         return node
 
     def __exit__(self, *exc_info):
+        self._closing.set()
         try:
             stop_executor(self.executor, self.nodes)
+            self._thread.join(timeout=1.0)  # the spin ends with the executor, before the context
             for node in reversed(self.nodes):
                 node.destroy_node()
             if self._default_context:  # renews the global context for the next user

@@ -58,16 +58,25 @@ class RosHarness:
         return self
 
     def _spin(self):
+        from rclpy.exceptions import InvalidHandle
         from rclpy.executors import ExternalShutdownException
 
-        try:
-            self.executor.spin()
-        except ExternalShutdownException:
-            pass
-        except Exception:
-            if not self._closing.is_set():
-                raise
-            # The teardown shut the context down while the executor was between two waits.
+        while True:
+            try:
+                self.executor.spin()
+                return
+            except ExternalShutdownException:
+                return
+            except InvalidHandle:
+                # An entity destroyed from another thread (e.g. flexbe_core's proxies shut down
+                # at the end of a behavior) while the executor gathered its wait set: the next
+                # turn leaves it out.
+                if self._closing.is_set():
+                    return
+            except Exception:
+                if not self._closing.is_set():
+                    raise
+                return  # the teardown shut the context down between two waits
 
 
     def add_node(self, node_factory, *args, **kwargs):

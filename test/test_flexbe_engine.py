@@ -46,7 +46,7 @@ def test_exported_behavior_loads_in_flexbe_core_and_create_builds_the_machine(ro
         behavior = behavior_class(node)
         machine = behavior.create()
     finally:
-        reset_flexbe_proxies()
+        reset_flexbe_proxies(ros.executor, node)
     assert isinstance(machine, OperatableStateMachine)
     root = states[0]
     assert list(machine.outcomes) == root.outcomes

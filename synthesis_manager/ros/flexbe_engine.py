@@ -136,8 +136,14 @@ def observe_top_level_states(machine, recorder: EngineTraceRecorder) -> None:
         state.execute = observed
 
 
-def reset_flexbe_proxies() -> None:
-    """flexbe_core keeps its proxies in class attributes; forget them so the next run starts clean."""
+def reset_flexbe_proxies(executor=None, node=None) -> None:
+    """flexbe_core keeps its proxies in class attributes; forget them so the next run starts clean.
+
+    With ``executor`` and ``node`` (the behavior's), the node is taken off the executor first,
+    so that no proxy callback starts while the proxies are shut down.
+    """
+    if executor is not None and node is not None:
+        executor.remove_node(node)
     from flexbe_core.proxy import (ProxyActionClient, ProxyPublisher, ProxyServiceCaller,
                                    ProxySubscriberCached, shutdown_proxies)
 
@@ -174,7 +180,7 @@ def run_on_flexbe(states, simulator, simulator_lock, domain_id: int, system: str
             try:
                 outcome = _execute(behavior_class(node), checksum, autonomy, recorder, max_wall_time)
             finally:
-                reset_flexbe_proxies()
+                reset_flexbe_proxies(ros.executor, node)
     finally:
         recorder.close()
     result = recorder.result()

@@ -20,12 +20,16 @@ Two sections matter here:
         walk:  {motion: gait, steps: 4, step_length: 0.15}
       actions:                      # action -> motion
         look_down: {motion: head_tilt, tilt_deg: 45}
-        object_template: {motion: operator_input}
+        object_template: {motion: operator_input, provides: template_id}
       invalidations:                # on completion of key, forget these completions
         footstep_execution: [footstep_plan]
       scenario:
         operator_inputs: {object_template: true, target_pose: true}
+        operator_answers: {object_template: 1}   # what the operator answers (default: by kind)
         sensors: {obj_detected: true}
+      scene:                        # objects by template id, reach (see atlas_sim.operator_data)
+        objects: {1: pickup_object}
+        reach: 1.0
       faults:                       # capability -> fault (see atlas_sim.faults)
         pickup_object: {fail_first: 1}
       stand_in: "..."               # set when the humanoid does not model this robot but only
@@ -72,7 +76,36 @@ class ScenarioConfig:
     """What the (simulated) operator and environment provide."""
 
     operator_inputs: Dict[str, bool] = field(default_factory=dict)
+    #: input action -> the answer the operator gives (e.g. a template id)
+    operator_answers: Dict[str, Any] = field(default_factory=dict)
     sensors: Dict[str, bool] = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
+class SceneConfig:
+    """The objects the robot can act on, by template id (see atlas_sim.operator_data), and its reach (m)."""
+
+    objects: Dict[int, str] = field(default_factory=lambda: {1: "pickup_object"})
+    reach: float = 1.0
+
+    @classmethod
+    def from_dict(cls, section: Optional[Mapping[str, Any]]) -> "SceneConfig":
+        section = dict(section or {})
+        unknown = set(section) - {"objects", "reach"}
+        if unknown:
+            raise SimulationConfigError(f"unknown keys in simulation.scene: {sorted(unknown)}",
+                                        item=sorted(unknown)[0])
+        objects = cls().objects if "objects" not in section else {}
+        for key, body in (section.get("objects") or {}).items():
+            if isinstance(key, bool) or not isinstance(key, int) or not isinstance(body, str):
+                raise SimulationConfigError("simulation.scene.objects maps integer template ids to model "
+                                            f"body names, got {key!r}: {body!r}", item=str(key))
+            objects[key] = body
+        reach = section.get("reach", cls.reach)
+        if isinstance(reach, bool) or not isinstance(reach, (int, float)) or not reach > 0:
+            raise SimulationConfigError(f"simulation.scene.reach must be a positive number, got {reach!r}",
+                                        item="scene.reach")
+        return cls(objects=objects, reach=float(reach))
 
 
 @dataclass(frozen=True)
@@ -92,6 +125,7 @@ class SimulationConfig:
     actions: Dict[str, Dict[str, Any]] = field(default_factory=dict)
     invalidations: Dict[str, Tuple[str, ...]] = field(default_factory=dict)
     scenario: ScenarioConfig = ScenarioConfig()
+    scene: SceneConfig = SceneConfig()
     faults: Dict[str, Dict[str, Any]] = field(default_factory=dict)
     stand_in: Optional[str] = None
 
@@ -107,6 +141,7 @@ class SimulationConfig:
         scenario_section = section.get("scenario") or {}
         scenario = ScenarioConfig(
             operator_inputs={str(k): bool(v) for k, v in (scenario_section.get("operator_inputs") or {}).items()},
+            operator_answers={str(k): v for k, v in (scenario_section.get("operator_answers") or {}).items()},
             sensors={str(k): bool(v) for k, v in (scenario_section.get("sensors") or {}).items()},
         )
         return cls(
@@ -123,6 +158,7 @@ class SimulationConfig:
             actions={str(k): dict(v or {}) for k, v in (section.get("actions") or {}).items()},
             invalidations={str(k): tuple(v or ()) for k, v in (section.get("invalidations") or {}).items()},
             scenario=scenario,
+            scene=SceneConfig.from_dict(section.get("scene")),
             faults={str(k): dict(v or {}) for k, v in (section.get("faults") or {}).items()},
             stand_in=str(section["stand_in"]) if section.get("stand_in") else None,
         )
@@ -130,7 +166,7 @@ class SimulationConfig:
 
 _SIMULATION_KEYS = {
     "initial_mode", "timestep", "control_period", "real_time_factor", "seed", "fault_delay",
-    "settle", "fall", "modes", "actions", "invalidations", "scenario", "faults", "stand_in",
+    "settle", "fall", "modes", "actions", "invalidations", "scenario", "scene", "faults", "stand_in",
 }
 
 

@@ -115,15 +115,18 @@ class DiscreteSemantics:
         return DiscreteState(mode=mode)
 
     # ----------------------------------------------------------------- checks
-    def refusal(self, state: DiscreteState, name: str) -> Optional[str]:
-        """Why ``name`` cannot start now, or ``None`` if it may start."""
+    def refusal(self, state: DiscreteState, name: str, exempt: Iterable[str] = ()) -> Optional[str]:
+        """Why ``name`` cannot start now, or ``None`` if it may start.
+
+        ``exempt`` names preconditions not to check (the request carries the data they stand for).
+        """
         if not self.abstraction.is_capability(name):
             return f"unknown capability {name!r}"
         if name in state.running:
             return f"{name} is already running"
         if self.abstraction.is_mode(name):
             return self._mode_refusal(state, name)
-        return self._precondition_refusal(state, name)
+        return self._precondition_refusal(state, name, set(exempt))
 
     def _mode_refusal(self, state: DiscreteState, target: str) -> Optional[str]:
         if state.pending_mode is not None:
@@ -132,8 +135,8 @@ class DiscreteSemantics:
             return f"transition {state.mode} -> {target} is not allowed"
         return None
 
-    def _precondition_refusal(self, state: DiscreteState, action: str) -> Optional[str]:
-        unmet = [p for p in self.abstraction.actions[action] if not self._holds(state, p)]
+    def _precondition_refusal(self, state: DiscreteState, action: str, exempt: Set[str]) -> Optional[str]:
+        unmet = [p for p in self.abstraction.actions[action] if p not in exempt and not self._holds(state, p)]
         if unmet:
             return f"preconditions of {action} not met: {', '.join(unmet)}"
         return None

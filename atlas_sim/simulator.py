@@ -3,7 +3,9 @@
 A *request* names one capability of the robot config (a control mode such as
 ``stand`` or an action such as ``look_down``).  Its lifecycle:
 
-1. ``start(name)`` checks, in order: the robot has not fallen; the discrete
+1. ``start(name, data)`` checks, in order: the robot has not fallen; the data
+   the request carries (or the simulator's own operator answers) is valid and the
+   object it names is within reach (``atlas_sim.operator_data``); the discrete
    rules allow it (``DiscreteSemantics.refusal``); its motion's joint groups
    are free.  A refused request is finished at once with outcome ``failed``
    and does not change the discrete state.  Otherwise the request *runs*; an
@@ -28,7 +30,7 @@ import itertools
 import time as wallclock
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Callable, Dict, Iterable, List, Optional, Union
+from typing import Any, Callable, Dict, Iterable, List, Mapping, Optional, Union
 
 import numpy as np
 
@@ -36,6 +38,7 @@ from .config import SimulationConfigError, SystemConfig, load_system_config
 from .discrete import COMPLETED, FAILED, Abstraction, DiscreteSemantics, DiscreteState
 from .faults import FaultInjector, FaultSpec
 from .kinematics import POSTURES
+from .operator_data import TEMPLATE_ID, datum_refusal, provided_datum
 from .motions import (
     DEFAULT_ACTION_ENTRY,
     DEFAULT_MODE_ENTRY,
@@ -116,6 +119,10 @@ class AtlasSimulator:
             fall_criteria=FallCriteria(self.settings.min_pelvis_height, self.settings.max_torso_tilt_deg),
         )
         self._substeps = max(1, round(self.settings.control_period / self.physics.timestep))
+        #: input action -> the data kind it provides (e.g. object_template -> template_id)
+        self.provides: Dict[str, str] = {
+            name: kind for name, entry in self.settings.actions.items()
+            if (kind := provided_datum(entry, name)) is not None}
         self._validate_settings()
         self._listeners: List[Listener] = []
         self.reset()
@@ -144,6 +151,13 @@ class AtlasSimulator:
             self._motion_for(name)  # raises on unknown motion kinds, poses or parameters
         for entry in settings.faults.values():
             FaultSpec.from_dict(entry)
+        for body in settings.scene.objects.values():
+            self.physics.body_position(body)  # raises KeyError naming a body the model lacks
+        for name, answer in settings.scenario.operator_answers.items():
+            kind = self.provides.get(name)
+            reason = datum_refusal(kind, answer, settings.scene) if kind else f"{name} provides no data"
+            if reason:
+                raise SimulationConfigError(f"simulation.scenario.operator_answers.{name}: {reason}", item=name)
 
     def reset(self) -> None:
         """Back to the initial mode at rest, forgetting completions and fault counters."""
@@ -155,6 +169,8 @@ class AtlasSimulator:
             {name: FaultSpec.from_dict(entry) for name, entry in self.settings.faults.items()},
         )
         self.operator_inputs: Dict[str, bool] = dict(self.settings.scenario.operator_inputs)
+        #: data kind -> what the simulator's own operator answered (input actions run here)
+        self.answers: Dict[str, Any] = {}
         self.sensors: Dict[str, bool] = {s: False for s in self.abstraction.sensors}
         self.sensors.update(self.settings.scenario.sensors)
         posture = POSTURES[self._posture_of_mode(self.state.mode)]
@@ -206,11 +222,16 @@ class AtlasSimulator:
             raise KeyError(f"unknown capability {name!r}")
 
     # -------------------------------------------------------------- requests
-    def start(self, name: str) -> Request:
-        """Start a request; returns its handle (possibly already failed)."""
-        return self._start(name, self._refusal(name))
+    def start(self, name: str, data: Optional[Mapping[str, Any]] = None) -> Request:
+        """Start a request; returns its handle (possibly already failed).
 
-    def start_concurrently(self, names: Iterable[str]) -> List[Request]:
+        ``data``: the userdata that reached the request (e.g. ``{"template_id": 1}``); None
+        means the request carries none and the simulator's own operator answers count.
+        """
+        return self._start(name, self._refusal(name, data))
+
+    def start_concurrently(self, names: Iterable[str],
+                           data: Optional[Mapping[str, Mapping[str, Any]]] = None) -> List[Request]:
         """Start several requests in one instant.
 
         The discrete checks of all of them use the state *before* any of them
@@ -221,13 +242,47 @@ class AtlasSimulator:
         names = list(names)
         if len(set(names)) != len(names):
             raise ValueError(f"duplicate names in {names}")
-        refusals = [self._refusal(name) for name in names]
+        data = data or {}
+        refusals = [self._refusal(name, data.get(name)) for name in names]
         return [self._start(name, refusal) for name, refusal in zip(names, refusals)]
 
-    def _refusal(self, name: str) -> Optional[str]:
+    def _refusal(self, name: str, data: Optional[Mapping[str, Any]] = None) -> Optional[str]:
         if self._fall_reason:
             return f"robot has fallen: {self._fall_reason}"
-        return self.semantics.refusal(self.state, name)
+        needs = self.needed_data(name)
+        if data is None:  # the in-process operator: input actions ran on the simulator
+            refusal = self.semantics.refusal(self.state, name)
+            values = self.answers
+        else:
+            for precondition, kind in needs.items():
+                if kind not in data:
+                    return f"{name} needs {kind} (what {precondition} provides); the request carries none"
+                reason = datum_refusal(kind, data[kind], self.settings.scene)
+                if reason:
+                    return f"{name}: {reason}"
+            refusal = self.semantics.refusal(self.state, name, exempt=needs)
+            values = data
+        if refusal is None and TEMPLATE_ID in needs.values() and TEMPLATE_ID in values:
+            refusal = self._reach_refusal(name, values[TEMPLATE_ID])
+        return refusal
+
+    def needed_data(self, name: str) -> Dict[str, str]:
+        """Input action -> data kind, for the input actions among ``name``'s preconditions."""
+        preconditions = self.abstraction.actions.get(name, ())
+        return {p: self.provides[p] for p in preconditions if p in self.provides}
+
+    def _reach_refusal(self, name: str, template_id: int) -> Optional[str]:
+        """An action that moves the arms on an object needs the object within reach."""
+        entry = self.settings.actions.get(name, {})
+        if entry.get("motion") != "arm_sequence":
+            return None
+        body = self.settings.scene.objects[template_id]
+        offset = self.physics.body_position(body)[:2] - self.physics.pelvis_position()[:2]
+        distance = float(np.hypot(*offset))
+        if distance > self.settings.scene.reach:
+            return (f"object {template_id} ({body}) is {distance:.2f} m away, beyond reach "
+                    f"({self.settings.scene.reach:g} m)")
+        return None
 
     def _start(self, name: str, refusal: Optional[str]) -> Request:
         now = self.time
@@ -345,10 +400,22 @@ class AtlasSimulator:
         self.semantics.finish(self.state, request.name, outcome)
         if outcome == COMPLETED:
             self.outputs.update(request.motion.effects)
+            if request.name in self.provides:
+                kind = self.provides[request.name]
+                self.answers[kind] = self.operator_answer(request.name)
         request.result = RequestResult(request.name, outcome, reason, request.started_at, self.time)
         self.history.append(request.result)
         self._notify("finished", request)
         return request.result
+
+    def operator_answer(self, name: str) -> Any:
+        """What the simulated operator answers for the input action ``name``."""
+        answers = self.settings.scenario.operator_answers
+        if name in answers:
+            return answers[name]
+        if self.provides[name] == TEMPLATE_ID:
+            return min(self.settings.scene.objects, default=None)
+        return [0.0, 0.0, 0.0]
 
     def _notify(self, event: str, request: Request) -> None:
         for listener in self._listeners:

@@ -10,6 +10,8 @@
         states: atlas_sim_flexbe_states          # state classes (module: class name in snake_case)
         state_classes: {InputState: flexbe_states}   # classes from another package
         behaviors: atlas_sim_flexbe_behaviors    # the :BEHAVIOR behaviors
+      userdata:                 # optional: keys states read that no state writes -> default (source text)
+        grasp_preference: '0'
       states:                   # activation proposition <p>_a (or sensor) -> FlexBE state
         look_down_a:
           class_decl: {name: TiltHeadState, param_names: [desired_tilt], param_values: [TiltHeadState.DOWN_45]}
@@ -18,6 +20,10 @@
           userdata_keys: []     # optional, same length as userdata_remapping
           userdata_remapping: []
 
+``userdata`` declares what the machine needs from outside: a synthesized machine declares the
+keys its states use as input keys of its root container, and an exported behavior gives them
+these defaults (FlexBE's behavior userdata). Every key a state reads must be written by some
+state or declared here (checked against the real state classes in the test suite).
 ``class_decl.name`` is a state class, or ``:BEHAVIOR`` together with ``behavior_class``.
 A state's outcomes are the values of its ``output_mapping`` in file order; a list-valued
 ``autonomy`` follows that order. Every problem raises an ``SMGenerationError`` subclass whose ``item``
@@ -80,6 +86,7 @@ class FlexBEConfig:
     states_package: str = ''             # FlexBE package of the state classes ('' unknown)
     state_class_packages: dict[str, str] = field(default_factory=dict)  # exceptions: class -> package
     behavior_package: str = ''           # FlexBE package of the :BEHAVIOR behaviors
+    userdata: dict[str, str] = field(default_factory=dict)  # key from outside -> default (source)
 
     def state_package(self, state_class: str) -> str:
         """The FlexBE package implementing ``state_class`` ('' when the config names none)."""
@@ -130,7 +137,24 @@ def parse_flexbe_config(section: dict, system: str = '') -> FlexBEConfig:
     return FlexBEConfig(system=system, sm_outcomes=sm_outcomes, states=states,
                         states_package=packages.get('states', ''),
                         state_class_packages=dict(packages.get('state_classes', {})),
-                        behavior_package=packages.get('behaviors', ''))
+                        behavior_package=packages.get('behaviors', ''),
+                        userdata=_userdata(section.get('userdata')))
+
+
+def _userdata(raw) -> dict[str, str]:
+    key = 'flexbe.userdata'
+    if raw is None:
+        return {}
+    if not isinstance(raw, dict):
+        raise UserdataConfigInvalidError(f'{key} must map userdata keys to default values', key)
+    for name, default in raw.items():
+        if not isinstance(name, str) or not name.isidentifier():
+            raise UserdataConfigInvalidError(f'{key}: {name!r} is not a userdata key (a Python name)', key)
+        if isinstance(default, (list, dict)):
+            raise UserdataConfigInvalidError(f'{key}.{name}: the default is Python source text, got {default!r}',
+                                             f'{key}.{name}')
+    # Like parameter values, defaults are source text: None stays None, 0 becomes '0'.
+    return {name: 'None' if default is None else str(default) for name, default in raw.items()}
 
 
 def _packages(raw) -> dict:

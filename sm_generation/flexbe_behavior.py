@@ -245,7 +245,7 @@ def _behavior_code(machine: _Machine, config: FlexBEConfig, behavior_name: str, 
         f'{INDENT * 2}# Additional initialization code can be added inside the following tags',
         f'{INDENT * 2}# [MANUAL_INIT]', '', f'{INDENT * 2}# [/MANUAL_INIT]', '',
         f'{INDENT * 2}# Behavior comments:', '',
-        *_create_method(machine),
+        *_create_method(machine, config.userdata),
         f'{INDENT}# Private functions can be added inside the following tags', f'{INDENT}# [MANUAL_FUNC]', '',
         f'{INDENT}# [/MANUAL_FUNC]',
     ]
@@ -260,7 +260,7 @@ def _container_variables(machine: _Machine) -> dict[str, str]:
     return {c.state_path: f'_sm_{c.name.lower()}_{index}' for index, c in enumerate(machine.containers())}
 
 
-def _create_method(machine: _Machine) -> list[str]:
+def _create_method(machine: _Machine, defaults: dict[str, str]) -> list[str]:
     body = INDENT * 2
     root = machine.root
     outcome_entries = {e.name: e for e in machine.outcome_entries}
@@ -268,8 +268,11 @@ def _create_method(machine: _Machine) -> list[str]:
     lines = [f'{INDENT}def create(self):', f'{body}"""Create state machine."""', f'{body}# Root state machine']
     if placed:
         lines.append(f'{body}# {_positions(placed)}')
-    lines.append(f'{body}_state_machine = OperatableStateMachine(outcomes={_list(root.outcomes)})')
-    lines += [f'{body}_state_machine.userdata.{key} = None' for key in machine.userdata_keys()]
+    # The root's input keys come from outside (the behavior's userdata, with the configured
+    # defaults); the other keys are written by states before they are read.
+    keys = f', input_keys={_list(root.input_keys)}' if root.input_keys else ''
+    lines.append(f'{body}_state_machine = OperatableStateMachine(outcomes={_list(root.outcomes)}{keys})')
+    lines += [f'{body}_state_machine.userdata.{key} = {defaults.get(key, "None")}' for key in machine.userdata_keys()]
     lines += ['', f'{body}# Additional creation code can be added inside the following tags',
               f'{body}# [MANUAL_CREATE]', '', f'{body}# [/MANUAL_CREATE]', '']
     variables = _container_variables(machine)

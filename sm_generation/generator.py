@@ -80,7 +80,15 @@ def generate_from_config(automaton, config: FlexBEConfig, initial_conditions: li
                      'FlexBE cannot take it, so it is left out', source, target)
     if reduce:
         machine = reduce_machine(machine)
-    return _instantiate(machine)
+    entries = _instantiate(machine)
+    entries[0].input_keys = declared_userdata(entries, config)
+    return entries
+
+
+def declared_userdata(entries: list[StateInstantiation], config: FlexBEConfig) -> list[str]:
+    """The keys of ``config.userdata`` that the machine's states use: the root's input keys."""
+    used = {key for entry in entries for key in entry.userdata_remapping}
+    return sorted(key for key in config.userdata if key in used)
 
 
 def machine_from_view(view: AutomatonView, initial_conditions: list[str] | None) -> Machine:

@@ -86,6 +86,27 @@ def test_refused_capabilities_fail_with_the_reason_and_unknown_ones_are_rejected
     assert unknown is None  # goal rejected
 
 
+def test_goals_carry_the_states_userdata_which_the_robot_checks(ros):
+    """FlexBE's states send the template id the operator chose; no object_template runs here."""
+    node = sim_node(ros, initial_conditions='manipulate')
+    client = Client(ros)
+
+    def pickup(value_text):
+        goal = ExecuteCapability.Goal(capability='pickup_object', userdata_keys=['template_id'],
+                                      userdata_values=[value_text])
+        return client.results([client.action.send_goal_async(goal)])[0]
+
+    wrong = pickup('7')
+    assert wrong.outcome == 'failed'
+    assert wrong.reason == 'pickup_object: template_id 7 names no object of the scene (known template ids: 1)'
+    not_json = pickup('one')
+    assert not_json.outcome == 'failed' and "template_id 'one' is not an object template id" in not_json.reason
+    assert 'object_template' not in node.simulator.completed_actions()
+    right = pickup('1')
+    assert (right.outcome, right.reason) == ('completed', 'pickup_object completed')
+    assert node.simulator.snapshot()['holding_object']
+
+
 def test_parameters_set_initial_conditions_and_faults(ros):
     node = sim_node(ros, initial_conditions='stand,object_template', fail=['look_down'],
                     fail_first='manipulate:1', seed=3)

@@ -158,7 +158,7 @@ def test_six_goal_machine_progress_readable_drawing_details_and_one_state_count(
     page.mouse.click(box['x'] + box['width'] / 2, box['y'] + box['height'] / 2)
     details = page.inner_text('#state-details')
     assert 'GetTemplatePregraspState' in details
-    assert 'preference ← grasp_preference' in details and 'pre_grasp ← pregrasp_pose' in details
+    assert 'template_id ← template_id' in details and 'pre_grasp ← pregrasp_pose' in details
     assert 'not_available → failed' in details and 'autonomy' in details
     assert page.is_visible('#graph-legend') and 'concurrency container' in page.inner_text('#graph-legend')
     assert '_a' in page.inner_text('#specification-legend') and '_m' in page.inner_text('#specification-legend')

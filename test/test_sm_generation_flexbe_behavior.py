@@ -4,6 +4,7 @@ What the real FlexBE engine makes of the package is tested in test_flexbe_engine
 """
 
 import ast
+import dataclasses
 from pathlib import Path
 
 import pytest
@@ -12,6 +13,7 @@ from sm_generation import SMGenerationError, generate_state_machine, load_automa
 from sm_generation.config import load_flexbe_config, parse_flexbe_config
 from sm_generation.flexbe_behavior import (behavior_class_name, behavior_module_name, behavior_package,
                                            state_module_name)
+from sm_generation.generator import generate_from_config
 
 ROOT = Path(__file__).resolve().parent.parent
 AUTOMATA = ROOT / 'test' / 'automata'
@@ -83,6 +85,34 @@ def test_userdata_lives_in_the_root_and_reaches_the_pickup_behavior():
     assert 'from atlas_sim_flexbe_behaviors.pickup_object_sm import PickupObjectSM' in code
     manifest = package.files['manifest/pickup_and_grasp.xml']
     assert '<contains name="Grasp Object" />' in manifest and '<contains name="Pickup Object" />' in manifest
+
+
+def test_declared_userdata_becomes_the_roots_input_keys_with_its_defaults():
+    """Keys no state writes are declared on the root (StateInstantiation) and defaulted on export."""
+    declared = dataclasses.replace(load_flexbe_config('atlas'), userdata={'template_id': '1', 'unused_key': "'x'"})
+    states = generate_from_config(load_automaton(AUTOMATA / 'two_behaviors.yaml'), declared)
+    assert states[0].state_path == '/' and states[0].input_keys == ['template_id']
+    assert all(not s.input_keys for s in states[1:] if s.state_class != ':CONCURRENCY')
+    code = behavior_package(states, declared, 'Pickup And Grasp', date=DATE).files[
+        'synthesized_flexbe_behaviors/pickup_and_grasp_sm.py']
+    assert "OperatableStateMachine(outcomes=['finished', 'failed'], input_keys=['template_id'])" in code
+    assert '_state_machine.userdata.template_id = 1' in code
+
+
+def test_the_atlas_machine_reads_no_key_from_outside():
+    """ATLAS's states get all their data from other states: the WebUI saves any synthesized machine."""
+    states, _ = export('two_behaviors.yaml', name='Pickup And Grasp')
+    assert states[0].input_keys == []
+
+
+@pytest.mark.parametrize('userdata, item', [
+    ([1], 'flexbe.userdata'), ({'not a name': 1}, 'flexbe.userdata'), ({'key': [1]}, 'flexbe.userdata.key')])
+def test_bad_declared_userdata_names_the_item(userdata, item):
+    section = {'sm_outcomes': {'finished': 'finished'}, 'userdata': userdata,
+               'states': {'x_a': {'class_decl': {'name': 'LogState'}, 'output_mapping': {'x_c': ['done']}}}}
+    with pytest.raises(SMGenerationError) as raised:
+        parse_flexbe_config(section, 'atlas')
+    assert raised.value.item == item
 
 
 def test_autonomy_levels_and_positions_come_from_the_machine():

@@ -1,7 +1,9 @@
 """ROS 2 node ``atlas_sim``: the simulated ATLAS behind an action server and a state topic.
 
 * action server ``atlas_sim/execute`` (synthesis_msgs/action/ExecuteCapability): the goal
-  names one capability (control mode or action); the result is ``completed``/``failed``,
+  names one capability (control mode or action) and may carry the requesting state's
+  userdata (e.g. the operator's ``template_id``), which the simulator checks as the robot
+  would (atlas_sim.operator_data); the result is ``completed``/``failed``,
   the simulator's reason and the sim time it ended. Goals may overlap, as concurrency
   containers need: goals arriving within ``batch_window`` wall seconds of each other start
   in the same sim instant (``AtlasSimulator.start_concurrently``). Requests cannot be
@@ -36,6 +38,7 @@ from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.node import Node
 
 from atlas_sim.executor import make_simulator, parse_faults
+from atlas_sim.operator_data import decode_userdata
 from respec.naming import parse_names
 from synthesis_manager.ros.errors import log_internal_error
 from synthesis_manager.ros.node_main import node_main
@@ -61,9 +64,10 @@ def robot_state_message(snapshot: dict) -> RobotState:
 class _Job:
     """A goal waiting for its request to be started and finished by the physics thread."""
 
-    def __init__(self, capability: str, sensor: bool = False):
+    def __init__(self, capability: str, sensor: bool = False, data: dict | None = None):
         self.capability = capability
         self.sensor = sensor      # wait until the sensor reads true (no request)
+        self.data = data          # the requesting state's userdata (None: it sent none)
         self.request = None
         self.finished = threading.Event()
 
@@ -147,7 +151,8 @@ class AtlasSimNode(Node):
         return GoalResponse.ACCEPT
 
     def execute(self, goal_handle, name: str | None = None, sensor: bool = False):
-        job = _Job(name or goal_handle.request.capability, sensor)
+        goal = goal_handle.request
+        job = _Job(name or goal.capability, sensor, decode_userdata(goal.userdata_keys, goal.userdata_values))
         with self.lock:
             self._pending.append(job)
             self._last_arrival = time.monotonic()
@@ -222,12 +227,13 @@ class AtlasSimNode(Node):
         names = [job.capability for job in jobs]
         duplicates = {n for n in names if names.count(n) > 1}
         unique = [job for job in jobs if job.capability not in duplicates]
-        requests = self.simulator.start_concurrently([job.capability for job in unique])
+        requests = self.simulator.start_concurrently([job.capability for job in unique],
+                                                     {job.capability: job.data for job in unique})
         for job, request in zip(unique, requests):
             job.request = request
         for job in jobs:  # the same capability twice at once: one runs, the others are refused
             if job.capability in duplicates:
-                job.request = self.simulator.start(job.capability)
+                job.request = self.simulator.start(job.capability, job.data)
         self._running.extend(jobs)
         self._finish_jobs()
         return True

@@ -22,7 +22,7 @@ Created on Sun Nov 22 2026
 """
 
 
-from atlas_sim_flexbe_states.capability_action_state import CapabilityActionState
+from atlas_sim_flexbe_states.object_action_state import ObjectActionState
 from flexbe_core import Autonomy
 from flexbe_core import Behavior
 from flexbe_core import ConcurrencyContainer
@@ -59,7 +59,7 @@ class GraspObjectSM(Behavior):
         OperatableStateMachine.initialize_ros(node)
         PriorityContainer.initialize_ros(node)
         initialize_proxies(node)
-        CapabilityActionState.initialize_ros(node)
+        ObjectActionState.initialize_ros(node)
         CheckConditionState.initialize_ros(node)
 
         # references to used behaviors
@@ -93,9 +93,10 @@ class GraspObjectSM(Behavior):
 
             # x:300 y:80
             OperatableStateMachine.add('Grasp',
-                                       CapabilityActionState(capability='grasp_object'),
+                                       ObjectActionState(capability='grasp_object'),
                                        transitions={'completed': 'finished', 'failed': 'failed'},
-                                       autonomy={'completed': Autonomy.Low, 'failed': Autonomy.Off})
+                                       autonomy={'completed': Autonomy.Low, 'failed': Autonomy.Off},
+                                       remapping={'template_id': 'template_id'})
 
         return _state_machine
 

@@ -6,6 +6,8 @@ states running concurrently (a ConcurrencyContainer) each need their own. Nothin
 blocks in ``execute``: the goal is sent on enter, the result is polled.
 """
 
+import json
+
 from flexbe_core import Logger
 from flexbe_core.proxy import ProxyActionClient
 
@@ -18,6 +20,13 @@ COMPLETED = 'completed'  # ExecuteCapability result outcome meaning success
 SERVER_WAIT = 5.0
 
 
+def capability_goal(capability, userdata=None):
+    """The ExecuteCapability goal: the capability and the userdata values as JSON text."""
+    userdata = dict(userdata or {})
+    return ExecuteCapability.Goal(capability=capability, userdata_keys=list(userdata),
+                                  userdata_values=[json.dumps(value, default=str) for value in userdata.values()])
+
+
 class CapabilityRequest:
     """Runs ``capability`` (None: the state's parameters name nothing the simulator can do)."""
 
@@ -28,8 +37,8 @@ class CapabilityRequest:
         self._failure = None
         self._topic = CAPABILITY_ACTION_PREFIX + capability if capability else None
 
-    def start(self, unsupported_reason=''):
-        """Send the goal (on_enter)."""
+    def start(self, unsupported_reason='', userdata=None):
+        """Send the goal (on_enter); ``userdata``: the keys the robot needs, e.g. ``{'template_id': 1}``."""
         self.result, self._failure = None, None
         if not self._topic:
             self._failure = unsupported_reason or f'{self.state_name}: nothing the simulator can do'
@@ -39,7 +48,7 @@ class CapabilityRequest:
             # Registered on first use, where waiting for discovery is expected (a client made
             # while the behavior is built would report the not yet discovered server as an error).
             ProxyActionClient.setupClient(self._topic, ExecuteCapability, wait_duration=SERVER_WAIT)
-            ProxyActionClient.send_goal(self._topic, ExecuteCapability.Goal(capability=self.capability),
+            ProxyActionClient.send_goal(self._topic, capability_goal(self.capability, userdata),
                                         wait_duration=SERVER_WAIT)
         except Exception as error:  # pylint: disable=broad-except  (no server, wrong type)
             self._failure = f'{self.state_name}: could not request {self.capability}: {error}'

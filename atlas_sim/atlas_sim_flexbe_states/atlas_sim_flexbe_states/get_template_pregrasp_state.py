@@ -9,7 +9,9 @@ class GetTemplatePregraspState(EventState):
     """
     Gets the pregrasp pose of the selected object template (the simulator's pregrasp_pose capability).
 
-    ># preference   int      Index of the preferred grasp of the template.
+    -- preference   int      Index of the preferred grasp of the template.
+
+    ># template_id  int      The object template (the operator's choice).
 
     #> pre_grasp    object   The pregrasp pose (in the simulator: what it reported).
 
@@ -18,13 +20,14 @@ class GetTemplatePregraspState(EventState):
     <= not_available         The template has no such grasp.
     """
 
-    def __init__(self):
+    def __init__(self, preference=0):
         super().__init__(outcomes=['done', 'failed', 'not_available'],
-                         input_keys=['preference'], output_keys=['pre_grasp'])
+                         input_keys=['template_id'], output_keys=['pre_grasp'])
+        self._preference = preference
         self._run = CapabilityRequest('pregrasp_pose', type(self).__name__)
 
     def on_enter(self, userdata):
-        self._run.start()
+        self._run.start(userdata={'template_id': userdata.template_id})
 
     def execute(self, userdata):
         outcome = self._run.outcome('done', 'failed')

@@ -9,19 +9,21 @@ class PlanEndeffectorPoseState(EventState):
     """
     Plans a motion of one hand to a target pose (the simulator's pregrasp_plan capability).
 
+    -- hand         string   Which hand ('left' or 'right').
+
     ># target_pose  object   Pose the end effector should reach.
-    ># hand         string   Which hand ('left' or 'right').
 
     <= planned               A plan was found.
     <= failed                No plan was found.
     """
 
-    def __init__(self):
-        super().__init__(outcomes=['planned', 'failed'], input_keys=['target_pose', 'hand'])
+    def __init__(self, hand='right'):
+        super().__init__(outcomes=['planned', 'failed'], input_keys=['target_pose'])
+        self._hand = hand
         self._run = CapabilityRequest('pregrasp_plan', type(self).__name__)
 
     def on_enter(self, userdata):
-        Logger.loginfo(f'PlanEndeffectorPoseState: planning {userdata.hand} hand to {userdata.target_pose}')
+        Logger.loginfo(f'PlanEndeffectorPoseState: planning {self._hand} hand to {userdata.target_pose}')
         self._run.start()
 
     def execute(self, userdata):

@@ -1,0 +1,262 @@
+"""GR(1) specifications for robots described by capabilities (CNU's flexbe_synthesis format).
+
+Our encoding of a capability system (see ``respec.capabilities`` for the file format). For
+each capability ``c``: a system proposition ``c_a`` (c runs) and one environment proposition
+per transition outcome its FlexBE outcomes mean (``c_c`` completed, ``c_f`` failure).
+
+Environment (assumptions)
+  * no outcome initially; no outcome of ``c`` unless ``c`` ran; at most one at a time;
+  * fairness: a capability that keeps running eventually completes, □◇(¬c_a ∨ ◯c_c).
+
+System (guarantees)
+  * exactly one capability runs, or the machine has ended in an SM outcome, at every step
+    after the first (CNU's one-hot activation); SM outcomes are final;
+  * a running capability keeps running until one of its outcomes arrives (FlexBE cannot
+    leave a state that has not returned);
+  * ``preconditions`` hold whenever a capability starts (or restarts after an outcome);
+  * ``transition_relation``: after outcome ``t`` of ``c``, the next capability is one of
+    each listed choice;
+  * ``postconditions``: outcome ``t`` of ``c`` sets the listed memories and integers in the
+    same step (``@x`` lets the system choose ``x``); memories and integers keep their values
+    otherwise;
+  * the request: initial conditions set initial values (a capability or memory name means its
+    memory, ``c_a`` starts ``c``, ``x=2`` an integer); the goals' conjunction is reached, then
+    the machine ends in its success outcome (``finished``), □◇finished — or, when the system
+    has no SM outcomes (CNU's "infinite" mappings), each goal holds infinitely often.
+
+Initial values not given by the request or the spec file: no capability runs, memories as
+declared (default false), integers at their lowest value.
+"""
+
+from __future__ import annotations
+
+from typing import Mapping, Sequence
+
+from respec.capabilities import COMPLETED, CapabilityConfigError, CapabilitySystem, Literal, parse_literal
+from respec.ltl import TRUE, Formula, conj, disj, iff, implies, neg, next_, var
+from respec.naming import memory
+from respec.parsing import IntegerVariable
+from respec.spec import FORMULA_SECTIONS, GR1Specification
+from respec.state_library import StateClass, capability_outcomes
+
+from ltl_specification.errors import (InvalidFormulaError, InvalidGoalsError, InvalidInitialConditionsError,
+                                      UnknownPropositionError)
+
+FAILED_OUTCOME = 'failed'
+
+
+class CapabilitySpecification:
+    """The propositions of a capability system and the literals over them (current or next step)."""
+
+    def __init__(self, system: CapabilitySystem, outcomes: Mapping[str, tuple[str, ...]]):
+        self.system = system
+        self.outcome_props: dict[str, dict[str, str]] = {}   # capability -> transition outcome -> proposition
+        for name in system.capabilities:
+            meanings = {system.transition_outcome(name, o) for o in outcomes[name]}
+            self.outcome_props[name] = {t: system.outcome_proposition(name, t)
+                                        for t in system.transition_outcomes if t in meanings}
+        self.activations = {name: f'{name}_a' for name in system.capabilities}
+        self.sm_props = list(dict.fromkeys(system.sm_outcomes.values()))
+        self.integers = {name: IntegerVariable(name, r.low, r.high) for name, r in system.integers.items()}
+        self.memories = dict.fromkeys(system.capabilities, False)
+        self.memories.update(system.memory)
+        self.env_props = [p for props in self.outcome_props.values() for p in props.values()]
+        self.env_props += [p for p in system.spec_inputs if p not in self.env_props]
+        self.sys_props = [*self.activations.values(), *self.sm_props]
+        self.sys_props += [p for p in system.spec_outputs if p not in self.sys_props]
+        for name, integer in self.integers.items():
+            (self.env_props if system.integers[name].environment else self.sys_props).extend(integer.bits)
+        self.used_memories: dict[str, None] = {}
+
+    def propositions(self) -> set[str]:
+        return set(self.env_props) | set(self.sys_props)
+
+    def atom(self, literal: Literal, next_step: bool, item: str, error=CapabilityConfigError) -> Formula:
+        """The formula of a literal; a capability or memory name means its memory proposition."""
+        if literal.value is not None:
+            formula = self.integers[literal.name].equals(literal.value, next_step)
+            return neg(formula) if literal.negated else formula
+        if literal.name in self.memories:
+            self.used_memories.setdefault(literal.name)
+            name = memory(literal.name)
+        elif literal.name in self.propositions():
+            name = literal.name
+        else:
+            known = sorted({*self.memories, *self.propositions(), *self.integers})
+            raise error(f'{self.system.system}: {item} names {literal.name!r}, which is no capability, memory, '
+                        f'integer or proposition of the system (known: {", ".join(known)})', item=literal.name)
+        formula = next_(var(name)) if next_step else var(name)
+        return neg(formula) if literal.negated else formula
+
+    def outcome_next(self, capability: str) -> Formula:
+        return disj(next_(var(p)) for p in self.outcome_props[capability].values())
+
+
+def compile_capability_task(system: CapabilitySystem, library: Mapping[str, StateClass],
+                            initial_conditions: Sequence[str], goals: Sequence[str],
+                            custom_ltl=None) -> GR1Specification:
+    """The GR(1) specification of reaching ``goals`` from ``initial_conditions`` on ``system``.
+
+    State classes are checked against ``library`` first (StateClassError names the bad one).
+    """
+    if custom_ltl and any(custom_ltl.get(s) for s in FORMULA_SECTIONS + ('env_props', 'sys_props')):
+        raise InvalidFormulaError(f'{system.system} is described by capabilities; custom LTL is not supported '
+                                  'for it (put the formulas into its capability file)', item=system.system)
+    if not goals:
+        raise InvalidGoalsError(f'no goals given: name a capability, memory or proposition of {system.system}',
+                                item='')
+    spec = CapabilitySpecification(system, capability_outcomes(system, library))
+    parts = {section: [] for section in FORMULA_SECTIONS}
+    _environment(spec, parts)
+    _activations(spec, parts)
+    _goals(spec, goals, parts)
+    setters = _conditions(spec, parts)
+    _initial_values(spec, initial_conditions, parts)
+    _frames(spec, setters, parts)
+    memories = [memory(m) for m in spec.used_memories]
+    return GR1Specification(env_props=list(spec.env_props), sys_props=[*spec.sys_props, *memories], **parts)
+
+
+def _environment(spec: CapabilitySpecification, parts: dict) -> None:
+    for name, props in spec.outcome_props.items():
+        running = var(spec.activations[name])
+        outcomes = list(props.values())
+        parts['env_init'] += [neg(var(p)) for p in outcomes]
+        parts['env_trans'] += [implies(neg(running), neg(next_(var(p)))) for p in outcomes]
+        parts['env_trans'] += [neg(conj([next_(var(a)), next_(var(b))]))
+                               for i, a in enumerate(outcomes) for b in outcomes[i + 1:]]
+        progress = props.get(COMPLETED) or (outcomes[0] if outcomes else None)
+        if progress:
+            parts['env_liveness'].append(disj([neg(running), next_(var(progress))]))
+    parts['env_init'] += [neg(var(p)) for p in spec.system.spec_inputs]
+
+
+def _activations(spec: CapabilitySpecification, parts: dict) -> None:
+    activities = [*spec.activations.values(), *spec.sm_props]
+    parts['sys_trans'].append(disj(next_(var(a)) for a in activities))
+    parts['sys_trans'] += [neg(conj([next_(var(a)), next_(var(b))]))
+                           for i, a in enumerate(activities) for b in activities[i + 1:]]
+    parts['sys_init'] += [neg(conj([var(a), var(b)])) for i, a in enumerate(activities) for b in activities[i + 1:]]
+    parts['sys_trans'] += [implies(var(o), next_(var(o))) for o in spec.sm_props]
+    for name, activation in spec.activations.items():
+        parts['sys_trans'].append(implies(conj([var(activation), neg(spec.outcome_next(name))]),
+                                          next_(var(activation))))
+
+
+def _conditions(spec: CapabilitySpecification, parts: dict) -> dict[str, list[Formula]]:
+    """Preconditions, transition relations and postconditions; returns the outcomes that set
+    each memory or integer (the others keep their values)."""
+    system = spec.system
+    setters: dict[str, list[Formula]] = {}   # memory or integer -> the outcomes (next step) that set it
+    for name, capability in system.capabilities.items():
+        activation = var(spec.activations[name])
+        if capability.preconditions:
+            required = conj(disj(spec.atom(term, True, f'{name}.preconditions') for term in clause)
+                            for clause in capability.preconditions)
+            starts = conj([next_(activation), disj([neg(activation), spec.outcome_next(name)])])
+            parts['sys_trans'].append(implies(starts, required))
+        for outcome, clauses in capability.transition_relation.items():
+            happened = _outcome_happens(spec, name, outcome, 'transition_relation')
+            for clause in clauses:
+                targets = [_target(spec, term) for term in clause]
+                parts['sys_trans'].append(implies(happened, disj(targets)))
+        for outcome, literals in capability.postconditions.items():
+            happened = _outcome_happens(spec, name, outcome, 'postconditions')
+            for literal in literals:
+                key = literal.name if literal.name in spec.integers else (
+                    literal.name if literal.name in spec.memories else None)
+                if key is None:
+                    target = spec.atom(literal, True, f'{name}.postconditions')
+                    if literal.name in spec.env_props:
+                        raise CapabilityConfigError(f'{system.system}: capability {name!r} postcondition sets '
+                                                    f'{literal.name!r}, an environment proposition',
+                                                    item=f'{name}.postconditions')
+                    parts['sys_trans'].append(implies(happened, target))
+                    continue
+                setters.setdefault(key, []).append(happened)
+                if key in spec.memories:
+                    spec.used_memories.setdefault(key)
+                if not literal.choose:
+                    parts['sys_trans'].append(implies(happened, spec.atom(literal, True, f'{name}.postconditions')))
+    return setters
+
+
+def _frames(spec: CapabilitySpecification, setters: dict[str, list[Formula]], parts: dict) -> None:
+    """Memories and system integers keep their values unless an outcome sets them."""
+    variables = [(name, [memory(name)]) for name in spec.used_memories]
+    variables += [(name, integer.bits) for name, integer in spec.integers.items()
+                  if not spec.system.integers[name].environment]
+    for name, bits in variables:
+        unchanged = conj(iff(next_(var(b)), var(b)) for b in bits)
+        changes = setters.get(name)
+        parts['sys_trans'].append(implies(neg(disj(changes)), unchanged) if changes else unchanged)
+    for integer in spec.integers.values():
+        if integer.in_range(True) is not TRUE:
+            parts['sys_trans' if not spec.system.integers[integer.name].environment else 'env_trans'].append(
+                integer.in_range(True))
+
+
+def _outcome_happens(spec: CapabilitySpecification, name: str, outcome: str, key: str) -> Formula:
+    proposition = spec.outcome_props[name].get(outcome)
+    if proposition is None:
+        raise CapabilityConfigError(f'{spec.system.system}: capability {name!r} {key} names outcome {outcome!r}, '
+                                    f'which none of its FlexBE outcomes means', item=f'{name}.{key}.{outcome}')
+    return next_(var(proposition))
+
+
+def _target(spec: CapabilitySpecification, term: Literal) -> Formula:
+    if term.name in spec.activations:
+        proposition = spec.activations[term.name]
+    else:
+        proposition = spec.system.sm_outcomes[term.name]
+    formula = next_(var(proposition))
+    return neg(formula) if term.negated else formula
+
+
+def _request_literal(spec: CapabilitySpecification, text: str, what: str, error) -> Literal:
+    try:  # one grammar for files and requests
+        return parse_literal(text, text, f'{spec.system.system} {what}', spec.system.integers, False)
+    except CapabilityConfigError as problem:
+        raise error(str(problem), item=text) from None
+
+
+def _goals(spec: CapabilitySpecification, goals: Sequence[str], parts: dict) -> None:
+    literals = [_request_literal(spec, goal, 'goal', InvalidGoalsError) for goal in goals]
+    atoms = [spec.atom(literal, False, 'goal', UnknownPropositionError) for literal in literals]
+    success = next((o for o in spec.sm_props if o != FAILED_OUTCOME), None)
+    if success is None:
+        parts['sys_liveness'] += atoms
+        return
+    reached = conj(spec.atom(literal, True, 'goal', UnknownPropositionError) for literal in literals)
+    parts['sys_trans'].append(implies(next_(var(success)), disj([var(success), reached])))
+    parts['sys_liveness'].append(var(success))
+
+
+def _initial_values(spec: CapabilitySpecification, initial_conditions: Sequence[str], parts: dict) -> None:
+    given: dict[str, Formula] = {}    # variable -> its initial condition(s)
+    for text in [*spec.system.spec_initial, *initial_conditions]:
+        literal = _request_literal(spec, text, 'initial condition', InvalidInitialConditionsError)
+        formula = spec.atom(literal, False, 'initial condition', UnknownPropositionError)
+        key = literal.name
+        if key in spec.env_props and key not in spec.system.spec_inputs:
+            raise InvalidInitialConditionsError(f'initial condition {text!r}: outcomes cannot hold initially',
+                                                item=text)
+        given[key] = formula
+    for name in spec.activations.values():
+        if name not in given:
+            given[name] = neg(var(name))
+    for name in spec.sm_props:
+        given.setdefault(name, neg(var(name)))
+    for name in spec.used_memories:
+        given.setdefault(name, var(memory(name)) if spec.memories[name] else neg(var(memory(name))))
+    for name, integer in spec.integers.items():
+        given.setdefault(name, integer.equals(integer.low, False))
+    environment = set(spec.env_props)
+    for key, formula in given.items():
+        bits = spec.integers[key].bits if key in spec.integers else [key]
+        section = 'env_init' if bits[0] in environment else 'sys_init'
+        parts[section].append(formula)
+    for integer in spec.integers.values():
+        if integer.in_range(False) is not TRUE:
+            environment_owned = spec.system.integers[integer.name].environment
+            parts['env_init' if environment_owned else 'sys_init'].append(integer.in_range(False))

@@ -1,0 +1,478 @@
+"""Robots described by capabilities, in the format of CNU's flexbe_synthesis (ROS-free).
+
+A system file of ours may point at CNU's files instead of describing the robot itself::
+
+    system: vending_demo
+    cnu_capabilities: vending/vending_capabilities.yaml   # required
+    cnu_spec: vending/vending_demo_capabilities_spec.yaml # optional: extra propositions, initial values
+    cnu_mappings: mappings/global_mappings.yaml           # optional: outcome names, SM outcomes
+
+Paths are relative to the system file. Without ``cnu_mappings`` the meaning of CNU's global
+mappings applies (``done``/``finished``/``received``/``true`` complete, the usual failure
+names fail; the machine ends in ``finished``).
+
+A capability names its FlexBE ``interface`` class, its ``parameters`` (constants, or ``@var``:
+the value the strategy gives integer variable ``var`` while the capability runs),
+``preconditions`` (a list of conjuncts, each ``a | b | ...``), ``postconditions`` and
+``transition_relation`` per outcome (a plain list means the completion outcome) and
+``autonomy`` per FlexBE outcome. Inside conditions a capability name or a ``memory:`` name
+means its memory proposition ``<name>_m``; ``x=3`` / ``x!=3`` compare an integer variable;
+``@x`` (postconditions only) lets the system choose ``x``; other names must be propositions
+of the capability system (``<cap>_a``, ``<cap>_c``, or the spec's INPUT/OUTPUT).
+
+Integer variables (``variable_mappings``, or ``x:0...3`` in the spec) are slugs-style
+integers, bit-blasted exactly as structured slugs does (``x@0.0.3``, ``x@1``), so the
+specification files we write are valid structured-slugs input too.
+
+Every problem raises ``CapabilityConfigError`` whose ``item`` is ``<capability>.<key>`` (or
+the file key) of the offending entry.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import yaml
+
+from respec.systems import SystemConfigError
+
+CAPABILITIES_KEY, SPEC_KEY, MAPPINGS_KEY = 'cnu_capabilities', 'cnu_spec', 'cnu_mappings'
+SYSTEM_FILE_KEYS = ('system', CAPABILITIES_KEY, SPEC_KEY, MAPPINGS_KEY, 'reduce')
+COMPLETED, FAILURE = 'completed', 'failure'
+
+# The meaning of CNU's generic global_mappings.yaml, used when a system names no mappings file.
+DEFAULT_STATE_OUTCOMES = {
+    'done': COMPLETED, 'finished': COMPLETED, 'received': COMPLETED, 'true': COMPLETED,
+    'aborted': FAILURE, 'canceled': FAILURE, 'data_error': FAILURE, 'empty': FAILURE,
+    'failed': FAILURE, 'false': FAILURE, 'no_connection': FAILURE, 'param_error': FAILURE,
+    'timeout': FAILURE, 'unavailable': FAILURE,
+}
+DEFAULT_SM_OUTCOMES = {'finished': 'finished'}
+DEFAULT_TRANSITION_OUTCOMES = (COMPLETED, FAILURE)
+
+_NAME = re.compile(r'^[A-Za-z][A-Za-z0-9_]*$')
+_COMPARISON = re.compile(r'^([A-Za-z][A-Za-z0-9_]*)\s*(!=|=)\s*(-?[0-9]+)$')
+_INTEGER_DECLARATION = re.compile(r'^([A-Za-z][A-Za-z0-9_]*)\s*:\s*(-?[0-9]+)\s*\.\.\.\s*(-?[0-9]+)$')
+_CAPABILITY_KEYS = ('interface', 'parameters', 'preconditions', 'postconditions', 'transition_relation',
+                    'autonomy', 'outcomes')
+_FILE_KEYS = ('name', 'capabilities', 'variable_mappings', 'state_outcome_mappings', 'memory')
+_SPEC_SECTIONS = ('INPUT', 'OUTPUT', 'ENV_INIT', 'SYS_INIT')
+# YAML reads `true`/`false` keys as booleans; CNU's mappings quote them, but be lenient.
+_YAML_WORDS = {True: 'true', False: 'false'}
+
+
+class CapabilityConfigError(SystemConfigError):
+    """A CNU capability, spec or mappings file is invalid; ``item`` names the entry."""
+
+    code = 'ABSTRACTION_CONFIG_INVALID'
+
+
+@dataclass(frozen=True)
+class Literal:
+    """One term of a condition: ``name`` (a proposition, memory or integer), negated or compared.
+
+    ``value`` is None for a Boolean term; for an integer term it is the compared value and
+    ``negated`` means ``!=``. ``choose`` marks ``@var`` (the system picks the value).
+    """
+
+    name: str
+    negated: bool = False
+    value: int | None = None
+    choose: bool = False
+
+
+Clause = tuple[Literal, ...]   # a disjunction
+
+
+@dataclass(frozen=True)
+class Capability:
+    name: str
+    interface: str
+    parameters: dict
+    preconditions: tuple[Clause, ...]
+    postconditions: dict[str, tuple[Literal, ...]]          # transition outcome -> literals
+    transition_relation: dict[str, tuple[Clause, ...]]      # transition outcome -> clauses of targets
+    autonomy: dict[str, int]                                # FlexBE outcome -> level
+    declared_outcomes: tuple[str, ...] = ()                 # FlexBE outcomes given in the file, if any
+
+    def variable_parameters(self) -> dict[str, str]:
+        """Parameters taken from the strategy: parameter -> integer variable (``@var``)."""
+        return {key: value[1:] for key, value in self.parameters.items()
+                if isinstance(value, str) and value.startswith('@')}
+
+
+@dataclass(frozen=True)
+class IntegerRange:
+    name: str
+    low: int
+    high: int
+    environment: bool = False
+    value_names: dict[int, str] = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
+class CapabilitySystem:
+    """A validated CNU capability system (all mappings in file order)."""
+
+    system: str
+    capabilities: dict[str, Capability]
+    integers: dict[str, IntegerRange]
+    memory: dict[str, bool]                 # memory name (without _m) -> initial value
+    state_outcomes: dict[str, str]          # FlexBE outcome -> transition outcome
+    sm_outcomes: dict[str, str]             # SM-outcome key -> machine outcome
+    transition_outcomes: tuple[str, ...]
+    spec_inputs: tuple[str, ...] = ()       # Boolean propositions the spec file adds
+    spec_outputs: tuple[str, ...] = ()
+    spec_initial: tuple[str, ...] = ()      # the spec's ENV_INIT and SYS_INIT entries (text)
+    reduce: bool = True
+    source: str = ''
+
+    def outcome_proposition(self, capability: str, transition_outcome: str) -> str:
+        """CNU's name: the capability and the outcome's first letter (``br_c``, ``pay_f``)."""
+        return f'{capability}_{transition_outcome[0]}'
+
+    def transition_outcome(self, capability: str, outcome: str) -> str:
+        """The transition outcome a FlexBE outcome of ``capability`` means."""
+        key = outcome if outcome in self.state_outcomes else _YAML_WORDS.get(outcome, outcome)
+        if key not in self.state_outcomes:
+            raise CapabilityConfigError(
+                f'{self.system}: outcome {outcome!r} of capability {capability!r} has no '
+                f'state_outcome_mappings entry (known: {", ".join(self.state_outcomes)})',
+                item=f'{capability}.outcomes.{outcome}')
+        return self.state_outcomes[key]
+
+
+def is_capability_document(document: dict) -> bool:
+    """Whether a parsed system file points at CNU capability files."""
+    return isinstance(document, dict) and CAPABILITIES_KEY in document
+
+
+def load_capability_system(document: dict, system: str, base_dir: str | Path) -> CapabilitySystem:
+    """The capability system a system file (``document``, found in ``base_dir``) points at."""
+    for key in document:
+        if key not in SYSTEM_FILE_KEYS:
+            raise CapabilityConfigError(f'{system}.yaml: unknown key {key!r} next to {CAPABILITIES_KEY} '
+                                        f'(expected {", ".join(SYSTEM_FILE_KEYS)})', item=str(key))
+    reduce = document.get('reduce', True)
+    if not isinstance(reduce, bool):
+        raise CapabilityConfigError(f'{system}.yaml: reduce must be true or false', item='reduce')
+    capabilities = _read_yaml(document, CAPABILITIES_KEY, base_dir, system, required=True)
+    spec = _read_yaml(document, SPEC_KEY, base_dir, system) or {}
+    mappings = _read_yaml(document, MAPPINGS_KEY, base_dir, system)
+    return capability_system_from_dicts(capabilities, spec, mappings, system, reduce,
+                                        source=str(document[CAPABILITIES_KEY]))
+
+
+def capability_system_from_dicts(capabilities: object, spec: object = None, mappings: object = None,
+                                 system: str = '<dict>', reduce: bool = True, source: str = '') -> CapabilitySystem:
+    """Validate parsed CNU files (capabilities, spec, mappings) and build the system."""
+    if not isinstance(capabilities, dict):
+        raise CapabilityConfigError(f'{system}: the capabilities file must hold a mapping', item=CAPABILITIES_KEY)
+    for key in capabilities:
+        if key not in _FILE_KEYS:
+            raise CapabilityConfigError(f'{system}: unknown key {key!r} in the capabilities file '
+                                        f'(expected {", ".join(_FILE_KEYS)})', item=str(key))
+    state_outcomes, sm_outcomes, transition_outcomes = _mappings(mappings, system)
+    own = capabilities.get('state_outcome_mappings') or {}
+    if not isinstance(own, dict):
+        raise CapabilityConfigError(f'{system}: state_outcome_mappings must be a mapping',
+                                    item='state_outcome_mappings')
+    state_outcomes = {**state_outcomes, **{_word(k): str(v) for k, v in own.items()}}
+    for outcome, meaning in state_outcomes.items():
+        if meaning not in transition_outcomes:
+            raise CapabilityConfigError(f'{system}: outcome {outcome!r} maps to {meaning!r}, not one of '
+                                        f'{", ".join(transition_outcomes)}', item=f'state_outcome_mappings.{outcome}')
+
+    integers = _integers(capabilities.get('variable_mappings'), system)
+    inputs, outputs, initial = _spec(spec, system, integers)
+    memory = _memory(capabilities.get('memory'), system)
+    raw = capabilities.get('capabilities')
+    if not isinstance(raw, dict) or not raw:
+        raise CapabilityConfigError(f'{system}: capabilities must be a non-empty mapping', item='capabilities')
+    names = set(raw) | set(memory)
+    parsed = {}
+    for name, entry in raw.items():
+        if not isinstance(name, str) or not _NAME.match(name):
+            raise CapabilityConfigError(f'{system}: invalid capability name {name!r}', item=str(name))
+        parsed[name] = _capability(name, entry, system, transition_outcomes, state_outcomes, integers, names)
+    result = CapabilitySystem(system=system, capabilities=parsed, integers=integers, memory=memory,
+                              state_outcomes=state_outcomes, sm_outcomes=sm_outcomes,
+                              transition_outcomes=transition_outcomes, spec_inputs=inputs, spec_outputs=outputs,
+                              spec_initial=initial, reduce=reduce, source=source)
+    _check_targets(result)
+    return result
+
+
+# --- files ----------------------------------------------------------------------------------
+
+def _read_yaml(document: dict, key: str, base_dir, system: str, required: bool = False):
+    value = document.get(key)
+    if value is None:
+        if required:
+            raise CapabilityConfigError(f'{system}.yaml: {key} must name a file', item=key)
+        return None
+    if not isinstance(value, str) or not value:
+        raise CapabilityConfigError(f'{system}.yaml: {key} must be a path, got {value!r}', item=key)
+    path = Path(base_dir) / value
+    try:
+        text = path.read_text()
+    except OSError as error:
+        raise CapabilityConfigError(f'{system}.yaml: {key} {value!r} cannot be read ({error.strerror})',
+                                    item=key) from None
+    try:
+        return yaml.safe_load(text)
+    except yaml.YAMLError as error:
+        raise CapabilityConfigError(f'{system}.yaml: {key} {value!r} is not valid YAML: {error}', item=key) from None
+
+
+def _mappings(mappings, system: str):
+    if mappings is None:
+        return dict(DEFAULT_STATE_OUTCOMES), dict(DEFAULT_SM_OUTCOMES), DEFAULT_TRANSITION_OUTCOMES
+    if not isinstance(mappings, dict):
+        raise CapabilityConfigError(f'{system}: the mappings file must hold a mapping', item=MAPPINGS_KEY)
+    transition_outcomes = mappings.get('transition_outcomes', list(DEFAULT_TRANSITION_OUTCOMES))
+    if (not isinstance(transition_outcomes, list) or not transition_outcomes
+            or not all(isinstance(o, str) and _NAME.match(o) for o in transition_outcomes)):
+        raise CapabilityConfigError(f'{system}: transition_outcomes must list outcome names',
+                                    item='transition_outcomes')
+    letters = [o[0] for o in transition_outcomes]
+    if len(set(letters)) != len(letters) or 'a' in letters or 'm' in letters:
+        raise CapabilityConfigError(f'{system}: transition_outcomes need distinct first letters other than '
+                                    f'a and m (the activation and memory suffixes)', item='transition_outcomes')
+    result = []
+    for key in ('state_outcome_mappings', 'sm_outcome_mappings'):
+        value = mappings.get(key) or {}
+        if not isinstance(value, dict) or not all(isinstance(v, str) and v for v in value.values()):
+            raise CapabilityConfigError(f'{system}: {key} must map names to names', item=key)
+        result.append({_word(k): v for k, v in value.items()})
+    return result[0], result[1], tuple(transition_outcomes)
+
+
+def _word(key) -> str:
+    return _YAML_WORDS.get(key, str(key)) if isinstance(key, bool) else str(key)
+
+
+def _integers(raw, system: str) -> dict[str, IntegerRange]:
+    if raw is None:
+        return {}
+    if not isinstance(raw, dict):
+        raise CapabilityConfigError(f'{system}: variable_mappings must be a mapping', item='variable_mappings')
+    integers = {}
+    for side, environment in (('env_props', True), ('sys_props', False)):
+        variables = raw.get(side) or {}
+        if not isinstance(variables, dict):
+            raise CapabilityConfigError(f'{system}: variable_mappings.{side} must be a mapping',
+                                        item=f'variable_mappings.{side}')
+        for name, values in variables.items():
+            where = f'variable_mappings.{side}.{name}'
+            if not isinstance(name, str) or not _NAME.match(name) or name in integers:
+                raise CapabilityConfigError(f'{system}: invalid or repeated variable name {name!r}', item=where)
+            if (not isinstance(values, dict) or not values
+                    or not all(isinstance(v, int) and not isinstance(v, bool) for v in values)):
+                raise CapabilityConfigError(f'{system}: {where} must map integer values to names', item=where)
+            integers[name] = IntegerRange(name, min(values), max(values), environment,
+                                          {int(k): str(v) for k, v in values.items()})
+    unknown = set(raw) - {'env_props', 'sys_props'}
+    if unknown:
+        raise CapabilityConfigError(f'{system}: variable_mappings may only hold env_props and sys_props',
+                                    item=f'variable_mappings.{sorted(unknown)[0]}')
+    return integers
+
+
+def _spec(spec, system: str, integers: dict[str, IntegerRange]):
+    """The spec file's propositions and initial values (its formulas are the capabilities')."""
+    if not spec:
+        return (), (), ()
+    if not isinstance(spec, dict):
+        raise CapabilityConfigError(f'{system}: the spec file must hold a mapping', item=SPEC_KEY)
+    sections = spec.get('specs') or {}
+    if not isinstance(sections, dict):
+        raise CapabilityConfigError(f'{system}: specs must map slugs sections to lists', item='specs')
+    inputs, outputs, initial = [], [], []
+    for section, entries in sections.items():
+        where = f'specs.{section}'
+        if section not in _SPEC_SECTIONS:
+            raise CapabilityConfigError(f'{system}: spec section {section!r} is not supported for capability '
+                                        f'systems (supported: {", ".join(_SPEC_SECTIONS)})', item=where)
+        if not isinstance(entries, list) or not all(isinstance(e, str) and e.strip() for e in entries):
+            raise CapabilityConfigError(f'{system}: {where} must be a list of strings', item=where)
+        for entry in entries:
+            entry = entry.strip()
+            if section in ('INPUT', 'OUTPUT'):
+                declaration = _INTEGER_DECLARATION.match(entry)
+                if declaration:
+                    name, low, high = declaration[1], int(declaration[2]), int(declaration[3])
+                    known = integers.get(name)
+                    if low > high or (known and (known.low, known.high) != (low, high)):
+                        raise CapabilityConfigError(f'{system}: {where} declares {entry!r}, which differs from '
+                                                    'variable_mappings or is empty', item=entry)
+                    if not known:
+                        integers[name] = IntegerRange(name, low, high, section == 'INPUT')
+                elif _NAME.match(entry):
+                    (inputs if section == 'INPUT' else outputs).append(entry)
+                else:
+                    raise CapabilityConfigError(f'{system}: {where} entry {entry!r} is not a name or '
+                                                'name:low...high', item=entry)
+            else:
+                initial.append(entry)
+    return tuple(inputs), tuple(outputs), tuple(initial)
+
+
+def _memory(raw, system: str) -> dict[str, bool]:
+    if raw is None:
+        return {}
+    if not isinstance(raw, dict):
+        raise CapabilityConfigError(f'{system}: memory must be a mapping', item='memory')
+    memory = {}
+    for side, names in raw.items():
+        if side != 'sys_props' or not isinstance(names, dict):
+            raise CapabilityConfigError(f'{system}: memory may only hold sys_props: name -> initial value',
+                                        item=f'memory.{side}')
+        for name, initial in names.items():
+            name = str(name).removesuffix('_m')
+            if not _NAME.match(name) or not isinstance(initial, bool):
+                raise CapabilityConfigError(f'{system}: memory entry {name!r} needs a name and true/false',
+                                            item=f'memory.sys_props.{name}')
+            memory[name] = initial
+    return memory
+
+
+# --- capabilities ---------------------------------------------------------------------------
+
+def _capability(name: str, entry, system: str, transition_outcomes, state_outcomes, integers, names):
+    where = f'{system}: capability {name!r}'
+    if not isinstance(entry, dict):
+        raise CapabilityConfigError(f'{where} must be a mapping', item=name)
+    for key in entry:
+        if key not in _CAPABILITY_KEYS:
+            raise CapabilityConfigError(f'{where}: unknown key {key!r} (expected {", ".join(_CAPABILITY_KEYS)})',
+                                        item=f'{name}.{key}')
+    interface = entry.get('interface')
+    if not isinstance(interface, str) or not _NAME.match(interface):
+        raise CapabilityConfigError(f'{where}: interface must name a FlexBE state class', item=f'{name}.interface')
+    parameters = entry.get('parameters') or {}
+    if not isinstance(parameters, dict) or not all(isinstance(k, str) and _NAME.match(k) for k in parameters):
+        raise CapabilityConfigError(f'{where}: parameters must map parameter names to values',
+                                    item=f'{name}.parameters')
+    for key, value in parameters.items():
+        if isinstance(value, str) and value.startswith('@') and value[1:] not in integers:
+            raise CapabilityConfigError(f'{where}: parameter {key} takes {value!r}, but {value[1:]!r} is no '
+                                        f'integer variable (known: {", ".join(integers) or "none"})',
+                                        item=f'{name}.parameters.{key}')
+    declared = entry.get('outcomes') or ()
+    if declared and (not isinstance(declared, list) or not all(isinstance(o, str) for o in declared)):
+        raise CapabilityConfigError(f'{where}: outcomes must list FlexBE outcome names', item=f'{name}.outcomes')
+
+    def outcome_key(key, what: str) -> str:
+        key = _word(key)
+        if key in transition_outcomes:
+            return key
+        if key in state_outcomes:
+            return state_outcomes[key]
+        raise CapabilityConfigError(f'{where}: {what} key {key!r} is neither a transition outcome '
+                                    f'({", ".join(transition_outcomes)}) nor a mapped FlexBE outcome',
+                                    item=f'{name}.{what}.{key}')
+
+    def literal(text, key: str, allow_choice: bool) -> Literal:
+        return parse_literal(text, f'{name}.{key}', where, integers, allow_choice)
+
+    preconditions = tuple(tuple(literal(term, 'preconditions', False) for term in _terms(clause, name, 'preconditions'))
+                          for clause in _list(entry.get('preconditions'), name, 'preconditions'))
+    postconditions: dict[str, tuple[Literal, ...]] = {}
+    for key, items in _by_outcome(entry.get('postconditions'), name, 'postconditions').items():
+        outcome = outcome_key(key, 'postconditions')
+        literals = []
+        for item in _list(items, name, f'postconditions.{key}'):
+            if '|' in str(item):
+                raise CapabilityConfigError(f'{where}: postcondition {item!r} is a disjunction; postconditions '
+                                            'are single literals', item=f'{name}.postconditions.{key}')
+            literals.append(literal(item, f'postconditions.{key}', True))
+        postconditions[outcome] = postconditions.get(outcome, ()) + tuple(literals)
+    relation: dict[str, tuple[Clause, ...]] = {}
+    for key, items in _by_outcome(entry.get('transition_relation'), name, 'transition_relation').items():
+        outcome = outcome_key(key, 'transition_relation')
+        # A list of targets under one outcome is one choice (CNU: "must transition to one of these").
+        targets = tuple(literal(term, f'transition_relation.{key}', False)
+                        for item in _list(items, name, f'transition_relation.{key}')
+                        for term in _terms(item, name, 'transition_relation'))
+        relation[outcome] = relation.get(outcome, ()) + (targets,)
+    autonomy = {}
+    raw_autonomy = entry.get('autonomy') or {}
+    if not isinstance(raw_autonomy, dict):
+        raise CapabilityConfigError(f'{where}: autonomy must map FlexBE outcomes to levels 0..3', item=f'{name}.autonomy')
+    for outcome, level in raw_autonomy.items():
+        if isinstance(level, bool) or not isinstance(level, int) or not 0 <= level <= 3:
+            raise CapabilityConfigError(f'{where}: autonomy of {outcome!r} must be 0..3, got {level!r}',
+                                        item=f'{name}.autonomy.{outcome}')
+        autonomy[_word(outcome)] = level
+    return Capability(name, interface, dict(parameters), preconditions, postconditions, relation, autonomy,
+                      tuple(declared))
+
+
+def _list(value, name: str, key: str) -> list:
+    if value is None:
+        return []
+    if isinstance(value, str):
+        return [value]
+    if not isinstance(value, list) or not all(isinstance(v, (str, bool)) for v in value):
+        raise CapabilityConfigError(f'capability {name!r}: {key} must be a list of conditions', item=f'{name}.{key}')
+    return [_word(v) for v in value]
+
+
+def _by_outcome(value, name: str, key: str) -> dict:
+    """A per-outcome mapping; a plain list means the completion outcome (as CNU reads it)."""
+    if value is None:
+        return {}
+    if isinstance(value, (list, str)):
+        return {COMPLETED: value}
+    if not isinstance(value, dict):
+        raise CapabilityConfigError(f'capability {name!r}: {key} must be a list or a mapping of outcomes to lists',
+                                    item=f'{name}.{key}')
+    return value
+
+
+def _terms(clause: str, name: str, key: str) -> list[str]:
+    terms = [term.strip() for term in str(clause).split('|')]
+    if not all(terms):
+        raise CapabilityConfigError(f'capability {name!r}: {key} entry {clause!r} has an empty term',
+                                    item=f'{name}.{key}')
+    return terms
+
+
+def parse_literal(text: str, item: str, where: str, integers, allow_choice: bool) -> Literal:
+    """One condition term: ``[!]name``, ``name=value``, ``name!=value`` or (``allow_choice``) ``@name``."""
+    text = str(text).strip()
+    if text.startswith('@'):
+        if not allow_choice or text[1:] not in integers:
+            raise CapabilityConfigError(f'{where}: {text!r} must name an integer variable, in a postcondition',
+                                        item=item)
+        return Literal(text[1:], choose=True)
+    comparison = _COMPARISON.match(text)
+    if comparison:
+        variable, operator, value = comparison[1], comparison[2], int(comparison[3])
+        known = integers.get(variable)
+        if known is None or not known.low <= value <= known.high:
+            raise CapabilityConfigError(f'{where}: {text!r} compares {variable!r}, which is no integer variable '
+                                        f'with that value in range', item=item)
+        return Literal(variable, operator == '!=', value)
+    negated = text.startswith('!')
+    name = text[1:].strip() if negated else text
+    if not _NAME.match(name):
+        raise CapabilityConfigError(f'{where}: condition {text!r} is not [!]name, name=value or @name', item=item)
+    if name in integers:
+        raise CapabilityConfigError(f'{where}: {name!r} is an integer variable; compare it (name=value)', item=item)
+    return Literal(name, negated)
+
+
+def _check_targets(system: CapabilitySystem) -> None:
+    for capability in system.capabilities.values():
+        for outcome, clauses in capability.transition_relation.items():
+            for clause in clauses:
+                for target in clause:
+                    if target.name not in system.capabilities and target.name not in system.sm_outcomes:
+                        raise CapabilityConfigError(
+                            f'{system.system}: capability {capability.name!r} transition_relation names '
+                            f'{target.name!r}, which is neither a capability nor an SM outcome',
+                            item=f'{capability.name}.transition_relation')

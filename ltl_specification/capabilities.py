@@ -82,7 +82,7 @@ class CapabilitySpecification:
         elif literal.name in self.propositions():
             name = literal.name
         else:
-            known = sorted({*self.memories, *self.propositions(), *self.integers})
+            known = sorted(n for n in {*self.memories, *self.propositions(), *self.integers} if '@' not in n)
             raise error(f'{self.system.system}: {item} names {literal.name!r}, which is no capability, memory, '
                         f'integer or proposition of the system (known: {", ".join(known)})', item=literal.name)
         formula = next_(var(name)) if next_step else var(name)

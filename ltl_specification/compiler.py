@@ -50,6 +50,7 @@ from respec.components import (
     control_mode_specification, goal_groups, goal_specification, initial_conditions_groups,
     initial_conditions_specification,
 )
+from respec.capabilities import CapabilitySystem, capability_system_of
 from respec.ltl import variables
 from respec.naming import DEFAULT_SM_OUTCOMES, FAILED, FINISHED, activation, outcome_proposition, parse_names
 from respec.parsing import ParseError, UnknownVariableError, parse_formula, spec_from_text_sections
@@ -57,8 +58,10 @@ from respec.spec import (
     FORMULA_SECTIONS, PROPOSITION_SECTIONS, SECTIONS, GR1Specification, PropositionConflictError,
     merge_specifications,
 )
+from respec.state_library import StateClass, workspace_state_library
 from respec.systems import ConfigFileInvalidError, UnknownSystemError as UnknownSystemConfig
 
+from ltl_specification.capabilities import compile_capability_task
 from ltl_specification.errors import (
     InvalidAbstractionError, InvalidFormulaError, InvalidGoalsError, InvalidInitialConditionsError,
     InvalidSmOutcomesError, UnknownPropositionError, UnknownSystemError,
@@ -96,8 +99,14 @@ class CompiledSpecification(GR1Specification):
 def compile_task(system: str, initial_conditions: Sequence[str] | str, goals: Sequence[str] | str,
                  sm_outcomes: Sequence[str] = DEFAULT_SM_OUTCOMES, strict_order: bool = True,
                  custom_ltl: Mapping[str, Sequence[str]] | None = None,
-                 config_dir: str | Path | None = None) -> CompiledSpecification:
+                 config_dir: str | Path | None = None,
+                 state_library: Mapping[str, StateClass] | None = None) -> CompiledSpecification:
     """Compile the GR(1) specification of reaching ``goals`` from ``initial_conditions``.
+
+    A system described by CNU capability files (``respec.capabilities``) is compiled by
+    ``ltl_specification.capabilities``; its state classes are checked against
+    ``state_library`` (default: the FlexBE state packages on ``AMENT_PREFIX_PATH``), and
+    ``sm_outcomes`` and ``strict_order`` do not apply (its mappings name its outcomes).
 
     Goals and initial conditions are action or control-mode names (a list, or one
     comma-separated string). At most one initial condition may be a control mode; without
@@ -106,6 +115,12 @@ def compile_task(system: str, initial_conditions: Sequence[str] | str, goals: Se
     env_props / sys_props, new proposition names) that are conjoined to the result.
     Raises a ``SpecificationError`` subclass naming the offending item.
     """
+    capability_system = load_capability_system(system, config_dir)
+    if capability_system is not None:
+        library = workspace_state_library() if state_library is None else state_library
+        return CompiledSpecification(**_spec_fields(compile_capability_task(
+            capability_system, library, _names(initial_conditions, 'initial conditions', InvalidInitialConditionsError),
+            _names(goals, 'goals', InvalidGoalsError), custom_ltl)))
     abstraction = load_task_abstraction(system, config_dir)
     sm_outcomes = _check_sm_outcomes(sm_outcomes)
     goals = _check_goals(abstraction, goals)
@@ -129,8 +144,11 @@ def compile_task(system: str, initial_conditions: Sequence[str] | str, goals: Se
     provenance = Provenance(system, tuple(initial_conditions), tuple(goals), sm_outcomes, strict_order,
                             pertinence, tuple(s for s in SECTIONS if custom_ltl and custom_ltl.get(s)),
                             tuple(groups))
-    return CompiledSpecification(**{f.name: getattr(spec, f.name) for f in fields(GR1Specification)},
-                                 provenance=provenance)
+    return CompiledSpecification(**_spec_fields(spec), provenance=provenance)
+
+
+def _spec_fields(spec: GR1Specification) -> dict:
+    return {f.name: getattr(spec, f.name) for f in fields(GR1Specification)}
 
 
 def _sub_specifications(abstraction: RobotAbstraction, pertinence: Pertinence, initial_conditions: list[str],
@@ -188,6 +206,15 @@ def explain(spec: CompiledSpecification) -> str:
 
 
 # --- request validation ---------------------------------------------------------------------
+
+def load_capability_system(system: str, config_dir) -> CapabilitySystem | None:
+    try:
+        return capability_system_of(system, config_dir)
+    except UnknownSystemConfig as error:
+        raise UnknownSystemError(str(error), item=error.item) from error
+    except ConfigFileInvalidError as error:
+        raise InvalidAbstractionError(str(error), item=error.item) from error
+
 
 def load_task_abstraction(system: str, config_dir) -> RobotAbstraction:
     try:

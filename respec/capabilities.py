@@ -36,7 +36,7 @@ from pathlib import Path
 
 import yaml
 
-from respec.systems import SystemConfigError
+from respec.systems import SystemConfigError, load_system_file, system_config_path
 
 CAPABILITIES_KEY, SPEC_KEY, MAPPINGS_KEY = 'cnu_capabilities', 'cnu_spec', 'cnu_mappings'
 SYSTEM_FILE_KEYS = ('system', CAPABILITIES_KEY, SPEC_KEY, MAPPINGS_KEY, 'reduce')
@@ -147,6 +147,15 @@ class CapabilitySystem:
 def is_capability_document(document: dict) -> bool:
     """Whether a parsed system file points at CNU capability files."""
     return isinstance(document, dict) and CAPABILITIES_KEY in document
+
+
+def capability_system_of(system: str, config_dir: str | Path | None = None) -> CapabilitySystem | None:
+    """The capability system ``config/<system>.yaml`` points at, or None for a system of our own format."""
+    path = system_config_path(system, config_dir)
+    document = load_system_file(system, config_dir)
+    if not is_capability_document(document):
+        return None
+    return load_capability_system(document, system, path.parent)
 
 
 def load_capability_system(document: dict, system: str, base_dir: str | Path) -> CapabilitySystem:

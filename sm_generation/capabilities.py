@@ -101,7 +101,14 @@ def _flexbe_config(system: CapabilitySystem, outcomes, library, variants) -> Fle
             parameter_names=tuple(parameters), parameter_values=tuple(parameter_source(v) for v in parameters.values()),
             output_mapping=mapping, autonomy={o: capability.autonomy.get(o, DEFAULT_AUTONOMY) for o in outcomes[name]},
             userdata_keys=(), userdata_remapping=())
+    return capability_flexbe_config(system, library, states)
+
+
+def capability_flexbe_config(system: CapabilitySystem, library: Mapping[str, StateClass],
+                             states: dict[str, StateConfig] | None = None) -> FlexBEConfig:
+    """The FlexBE side of a capability system: its SM outcomes and the package of each state class
+    (what ``sm_generation.flexbe_behavior`` needs to export a machine as a behavior)."""
     packages = {c.interface: library[c.interface].package for c in system.capabilities.values()}
     sm_outcomes = {o: o for o in dict.fromkeys(system.sm_outcomes.values())}
-    return FlexBEConfig(system=system.system, sm_outcomes=sm_outcomes, states=states,
+    return FlexBEConfig(system=system.system, sm_outcomes=sm_outcomes, states=states or {},
                         state_class_packages=packages)

@@ -1,0 +1,298 @@
+"""Robots described by CNU's capability YAML (flexbe_synthesis) as robot systems of ours.
+
+CNU's examples come from the pinned snapshot (``flexbe_sources``); each test writes a system
+file into tmp_path that points at them, as a user's config/<system>.yaml would.
+"""
+
+from pathlib import Path
+
+import networkx as nx
+import pytest
+import yaml
+
+from ltl_specification import compile_task
+from ltl_synthesizer import synthesize
+from respec.automaton import automaton_from_strategy
+from respec.capabilities import CapabilityConfigError, capability_system_of
+from respec.ltl import conj, evaluate
+from respec.state_library import StateClass, StateClassError, workspace_state_library
+from sm_generation import generate_state_machine, validate_state_machine
+
+# CNU's request defaults (flexbe_synthesis_examples/request_*.py) and the state counts
+# test_synthesis_example_pairs.py expects (post-reduction).
+EXAMPLES = {
+    'coffee_maker': dict(capabilities='coffee_maker/capabilities/coffee_capabilities.yaml',
+                         spec='coffee_maker/specs/coffee_demo_capabilities_spec.yaml', mappings='infinite_mappings.yaml',
+                         initial_conditions=['bd_a'], goals=['br_c'], cnu_states=4),
+    'coffee_maker_extended': dict(capabilities='coffee_maker/capabilities/coffee_capabilities_extended.yaml',
+                                  spec='coffee_maker/specs/coffee_demo_capabilities_spec.yaml',
+                                  mappings='infinite_mappings.yaml', initial_conditions=['bd_a'], goals=['br_c'],
+                                  cnu_states=4),
+    'vending_demo': dict(capabilities='vending_demo/capabilities/vending_capabilities.yaml',
+                         spec='vending_demo/specs/vending_demo_capabilities_spec.yaml', mappings='global_mappings.yaml',
+                         initial_conditions=['prep_pay_a'], goals=['soda'], cnu_states=6),
+    'vending_demo_extended': dict(capabilities='vending_demo/capabilities/vending_capabilities_extended.yaml',
+                                  spec='vending_demo/specs/vending_demo_capabilities_spec.yaml',
+                                  mappings='global_mappings.yaml', initial_conditions=['prep_pay_a'], goals=['soda'],
+                                  cnu_states=6),
+    # CNU runs hello_world from a fixed machine (4 states); synthesizing it needs a goal.
+    'hello_world': dict(capabilities='hello_world/capabilities/hello_world_capabilities.yaml', spec=None,
+                        mappings='global_mappings.yaml', initial_conditions=[], goals=['say_world'], cnu_states=4),
+}
+
+
+def write_system(config_dir: Path, name: str, cnu: Path, **entries) -> Path:
+    """A system file pointing at CNU's files (paths relative to it, as users write them)."""
+    config_dir.mkdir(parents=True, exist_ok=True)
+    lines = [f'system: {name}'] + [f'{key}: {value}' for key, value in entries.items() if value is not None]
+    path = config_dir / f'{name}.yaml'
+    path.write_text('\n'.join(lines) + '\n')
+    return path
+
+
+def example_system(config_dir: Path, cnu: Path, name: str) -> dict:
+    example = EXAMPLES[name]
+    examples = cnu / 'flexbe_synthesis_examples' / 'example'
+    write_system(config_dir, name, cnu,
+                 cnu_capabilities=examples / example['capabilities'],
+                 cnu_spec=examples / example['spec'] if example['spec'] else None,
+                 cnu_mappings=cnu / 'flexbe_synthesis_generic' / 'mappings' / example['mappings'])
+    return example
+
+
+@pytest.fixture
+def cnu(flexbe_sources) -> Path:
+    return flexbe_sources / 'flexbe_synthesis'
+
+
+@pytest.fixture
+def library(flexbe):
+    return workspace_state_library(str(flexbe))
+
+
+def top_level_states(states):
+    return [s for s in states if s.state_path != '/' and s.state_path.count('/') == 1 and s.state_class != ':OUTCOME']
+
+
+def synthesized(config_dir, name, library):
+    example = EXAMPLES[name]
+    spec = compile_task(name, example['initial_conditions'], example['goals'], config_dir=config_dir,
+                        state_library=library)
+    result = synthesize(spec)
+    assert result.realizable
+    automaton = automaton_from_strategy(result.strategy, spec)
+    states = generate_state_machine(automaton, name, config_dir, state_library=library)
+    return spec, result.strategy, states
+
+
+def strategy_violations(spec, strategy) -> list[str]:
+    """The explicit strategy checked against the specification: initial nodes satisfy the
+    initial conditions, every edge both safety sections, every environment move allowed by
+    env_trans is answered, and no cycle fair to the environment misses a system liveness."""
+    names = strategy['variables']
+    n_inputs = len(spec.env_props)
+    nodes = {name: dict(zip(names, map(bool, node['state']))) for name, node in strategy['nodes'].items()}
+    problems = []
+    initial = conj([*spec.env_init, *spec.sys_init])
+    if not any(evaluate(initial, values) for values in nodes.values()):
+        problems.append('no node satisfies the initial conditions')
+    env_trans, sys_trans = conj(spec.env_trans), conj(spec.sys_trans)
+    edges = []
+    for name, node in strategy['nodes'].items():
+        answered = set()
+        for successor in node['trans']:
+            current, following = nodes[name], nodes[str(successor)]
+            edges.append((name, str(successor)))
+            if not evaluate(env_trans, current, following) or not evaluate(sys_trans, current, following):
+                problems.append(f'edge {name}->{successor} violates a safety formula')
+            answered.add(tuple(following[v] for v in spec.env_props))
+        for bits in range(2 ** n_inputs):
+            inputs = tuple(bool(bits >> k & 1) for k in range(n_inputs))
+            following = {**nodes[name], **dict(zip(spec.env_props, inputs))}
+            if inputs not in answered and evaluate(env_trans, nodes[name], following):
+                problems.append(f'node {name}: environment move {inputs} has no answer')
+    for goal in spec.sys_liveness:
+        graph = nx.DiGraph((a, b) for a, b in edges if not evaluate(goal, nodes[a], nodes[b]))
+        for component in nx.strongly_connected_components(graph):
+            inside = list(graph.subgraph(component).edges)
+            if inside and all(any(evaluate(fair, nodes[a], nodes[b]) for a, b in inside)
+                              for fair in spec.env_liveness):
+                problems.append(f'a fair cycle through {sorted(component)} misses a goal')
+    return problems
+
+
+@pytest.mark.parametrize('name', list(EXAMPLES))
+def test_cnu_example_requests_succeed_with_at_most_cnus_state_count(name, cnu, library, tmp_path):
+    example = example_system(tmp_path, cnu, name)
+    spec, strategy, states = synthesized(tmp_path, name, library)
+    assert strategy_violations(spec, strategy) == []
+    # A machine that never exits (CNU's coffee maker) has no outcomes, which our validator flags.
+    never_exits = ['/: a container needs outcomes'] if not states[0].outcomes else []
+    assert validate_state_machine(states) == never_exits
+    assert len(top_level_states(states)) <= example['cnu_states']
+    # Every capability state is the capability's own FlexBE class with its parameters.
+    capabilities = capability_system_of(name, tmp_path).capabilities
+    for state in top_level_states(states):
+        capability = capabilities[state.name]
+        assert state.state_class == capability.interface
+        assert dict(zip(state.parameter_names, state.parameter_values))['text' if 'text' in capability.parameters
+                                                                        else 'hint'] is not None
+
+
+def test_coffee_maker_cycles_button_grind_brew_and_retries_failures(cnu, library, tmp_path):
+    example_system(tmp_path, cnu, 'coffee_maker_extended')
+    _, _, states = synthesized(tmp_path, 'coffee_maker_extended', library)
+    root, by_name = states[0], {s.name: s for s in top_level_states(states)}
+    assert root.outcomes == [] and root.initial_state_name == 'bd'   # CNU's coffee machine never exits
+    assert dict(zip(by_name['bd'].outcomes, by_name['bd'].transitions)) == {'button': 'gr', 'fail': 'bd'}
+    assert dict(zip(by_name['gr'].outcomes, by_name['gr'].transitions)) == {'grind': 'br', 'fail': 'gr'}
+    assert dict(zip(by_name['br'].outcomes, by_name['br'].transitions)) == {'brew': 'bd', 'fail': 'br'}
+    assert by_name['bd'].autonomy == [2, 3]   # autonomy per outcome, from the capability file
+    assert by_name['bd'].parameter_values[0] == "['button', 'fail']"
+
+
+def test_vending_demo_uses_cnus_proposition_names_and_integer_variable(cnu, library, tmp_path):
+    example_system(tmp_path, cnu, 'vending_demo')
+    spec, _, states = synthesized(tmp_path, 'vending_demo', library)
+    assert {'prep_pay_a', 'soda_a', 'finished', 'soda_m', 'item@0.0.3', 'item@1'} <= set(spec.sys_props)
+    assert {'soda_c', 'pay_c'} <= set(spec.env_props)
+    path, name = [], states[0].initial_state_name
+    by_name = {s.name: s for s in top_level_states(states)}
+    while name in by_name:
+        path.append(name)
+        name = by_name[name].transitions[0]
+    assert path == ['prep_pay', 'pay', 'select', 'soda'] and name == 'finished'
+    # The same request gives byte-identical specifications and machines.
+    again_spec, _, again = synthesized(tmp_path, 'vending_demo', library)
+    assert again_spec.to_structuredslugs() == spec.to_structuredslugs()
+    assert [s.to_dict() for s in again] == [s.to_dict() for s in states]
+
+
+def test_at_var_parameters_take_the_value_the_strategy_chose(library, tmp_path):
+    capabilities = {
+        'name': 'shop',
+        'variable_mappings': {'sys_props': {'item': {0: 'None', 1: 'tea', 2: 'cake'}}},
+        'capabilities': {
+            'choose': {'interface': 'LogState', 'parameters': {'text': 'choose'},
+                       'preconditions': ['!choose'], 'postconditions': ['choose', '@item'],
+                       'transition_relation': ['give']},
+            'give': {'interface': 'LogState', 'parameters': {'text': '@item'},
+                     'preconditions': ['choose', 'item!=0'], 'postconditions': ['give']},
+        },
+    }
+    (tmp_path / 'shop_capabilities.yaml').write_text(yaml.safe_dump(capabilities))
+    write_system(tmp_path, 'shop', None, cnu_capabilities='shop_capabilities.yaml')
+    for goal, value in (('item=2', "'cake'"), ('item=1', "'tea'")):
+        spec = compile_task('shop', [], ['give', goal], config_dir=tmp_path, state_library=library)
+        automaton = automaton_from_strategy(synthesize(spec).strategy, spec)
+        states = generate_state_machine(automaton, 'shop', tmp_path, state_library=library)
+        give = next(s for s in top_level_states(states) if s.state_class == 'LogState' and s.name.startswith('give'))
+        assert give.name == f'give_{value.strip(chr(39))}'
+        assert dict(zip(give.parameter_names, give.parameter_values)) == {'text': value}
+
+
+def test_missing_state_class_and_unknown_parameter_are_named(cnu, tmp_path):
+    example_system(tmp_path, cnu, 'vending_demo')
+    log_only = {'LogState': StateClass('LogState', 'flexbe_states', ('text', 'severity'), ('text',),
+                                       outcomes=('done',))}
+    spec = compile_task('vending_demo', ['prep_pay_a'], ['soda'], config_dir=tmp_path, state_library=log_only)
+    assert 'soda_a' in spec.sys_props
+    extended = example_system(tmp_path, cnu, 'vending_demo_extended')
+    with pytest.raises(StateClassError) as missing:
+        compile_task('vending_demo_extended', extended['initial_conditions'], extended['goals'],
+                     config_dir=tmp_path, state_library=log_only)
+    assert missing.value.item == 'pay.interface' and 'OperatorDecisionState' in str(missing.value)
+    no_text = {'LogState': StateClass('LogState', 'flexbe_states', ('message',), (), outcomes=('done',))}
+    with pytest.raises(StateClassError) as parameter:
+        compile_task('vending_demo', ['prep_pay_a'], ['soda'], config_dir=tmp_path, state_library=no_text)
+    assert parameter.value.item == 'prep_pay.parameters.text'  # the first capability of the file
+
+
+def test_the_workspace_library_reads_flexbe_state_packages_without_importing_them(library):
+    log = library['LogState']
+    assert log.package == 'flexbe_states' and log.outcomes == ('done',) and log.required == ('text',)
+    assert library['OperatorDecisionState'].outcomes is None   # given at construction
+    assert workspace_state_library('') == {}
+
+
+@pytest.mark.parametrize('capabilities, item', [
+    ({'capabilities': {'a': {'parameters': {'text': 'x'}}}}, 'a.interface'),
+    ({'capabilities': {'a': {'interface': 'LogState', 'preconditions': ['b=1']}}}, 'a.preconditions'),
+    ({'capabilities': {'a': {'interface': 'LogState', 'postconditions': {'sometimes': ['a']}}}},
+     'a.postconditions.sometimes'),
+    ({'capabilities': {'a': {'interface': 'LogState', 'transition_relation': ['nowhere']}}}, 'a.transition_relation'),
+    ({'capabilities': {'a': {'interface': 'LogState', 'autonomy': {'done': 7}}}}, 'a.autonomy.done'),
+    ({'capabilities': {'a': {'interface': 'LogState', 'parameters': {'text': '@level'}}}}, 'a.parameters.text'),
+    ({'capabilities': {'a': {'interface': 'LogState', 'colour': 'red'}}}, 'a.colour'),
+    ({'capabilities': {'a': {'interface': 'LogState', 'parameters': {'text': 'x'}, 'preconditions': ['ghost']}}},
+     'ghost'),
+    ({'capabilities': {'a': {'interface': 'LogState', 'parameters': {'text': 'x'}, 'autonomy': {'finished': 1}}}},
+     'a.autonomy.finished'),
+])
+def test_bad_capability_files_name_the_capability_and_key(capabilities, item, library, tmp_path):
+    (tmp_path / 'bad.yaml').write_text(yaml.safe_dump({'name': 'bad', **capabilities}))
+    write_system(tmp_path, 'robot', None, cnu_capabilities='bad.yaml')
+    with pytest.raises(CapabilityConfigError) as error:
+        compile_task('robot', [], ['a'], config_dir=tmp_path, state_library=library)
+    assert error.value.item == item, str(error.value)
+    assert error.value.code in ('ABSTRACTION_CONFIG_INVALID', 'CONFIG_VARIABLE_CONFIG_INVALID')
+
+
+def test_bad_system_files_are_reported_not_raised_as_tracebacks(tmp_path, library):
+    write_system(tmp_path, 'robot', None, cnu_capabilities='missing.yaml')
+    with pytest.raises(CapabilityConfigError) as missing:
+        compile_task('robot', [], ['a'], config_dir=tmp_path, state_library=library)
+    assert missing.value.item == 'cnu_capabilities'
+    (tmp_path / 'broken.yaml').write_text('capabilities: [unclosed\n')
+    write_system(tmp_path, 'robot', None, cnu_capabilities='broken.yaml')
+    with pytest.raises(CapabilityConfigError, match='not valid YAML'):
+        compile_task('robot', [], ['a'], config_dir=tmp_path, state_library=library)
+
+
+def test_cnu_behaviors_run_on_the_real_flexbe_engine(cnu, library, tmp_path):
+    from sm_generation.capabilities import capability_flexbe_config
+    from sm_generation.flexbe_behavior import behavior_package
+    from synthesis_manager.ros.flexbe_engine import load_behavior_class
+    from synthesis_manager.ros.harness import RosHarness
+
+    for name in ('vending_demo', 'vending_demo_extended', 'hello_world'):
+        example_system(tmp_path, cnu, name)
+        _, _, states = synthesized(tmp_path, name, library)
+        config = capability_flexbe_config(capability_system_of(name, tmp_path), library)
+        package = behavior_package(states, config, f'CNU {name.replace("_", " ")}')
+        behavior_class, checksum = load_behavior_class(package, tmp_path / name)
+        with RosHarness(default_context=True) as ros:  # flexbe_core uses rclpy's global context
+            outcome, visited = run_behavior(ros, behavior_class, checksum, name)
+        assert outcome == 'finished', name
+        expected = ['say_hello', 'say_world'] if name == 'hello_world' else ['prep_pay', 'pay', 'select', 'soda']
+        assert visited == expected, name
+
+
+def run_behavior(ros, behavior_class, checksum, name):
+    """flexbe_onboard's sequence (set_up, prepare_for_execution, confirm, execute) in full
+    autonomy; returns the outcome and the top-level states entered, in order."""
+    from rclpy.node import Node
+
+    from flexbe_core import set_node
+    from synthesis_manager.ros.flexbe_engine import FULL_AUTONOMY, reset_flexbe_proxies
+
+    node = ros.add_node(Node, f'flexbe_{name}')
+    set_node(node)
+    visited = []
+    try:
+        behavior = behavior_class(node)
+        behavior.set_up(beh_id=checksum, autonomy_level=FULL_AUTONOMY, debug=False)
+        behavior.prepare_for_execution({})
+        for state in behavior._state_machine._states:  # noqa: SLF001 - flexbe_core keeps no public list
+            original = state.execute
+
+            def observed(*args, _state=state, _original=original, **kwargs):
+                if not visited or visited[-1] != _state.name:
+                    visited.append(_state.name)
+                return _original(*args, **kwargs)
+            state.execute = observed
+        behavior.confirm()
+        outcome = behavior.execute()
+    finally:
+        reset_flexbe_proxies(ros.executor, node)
+    return outcome, visited

@@ -296,3 +296,31 @@ def run_behavior(ros, behavior_class, checksum, name):
     finally:
         reset_flexbe_proxies(ros.executor, node)
     return outcome, visited
+
+
+def test_cnu_examples_through_our_behavior_synthesis_action(cnu, flexbe, tmp_path, ros, monkeypatch):
+    """The in-process suite (all four nodes) serves a CNU system from its config_dir."""
+    from rclpy.node import Node
+
+    from synthesis_manager.client import SynthesisClient, make_goal
+    from synthesis_manager.suite import suite_node_factories
+    from test_synthesis_manager_pipeline import suite_args
+
+    monkeypatch.setenv('AMENT_PREFIX_PATH', str(flexbe))   # the nodes read the workspace's state classes
+    config_dir = tmp_path / 'config'
+    for name in ('vending_demo_extended', 'coffee_maker'):
+        example_system(config_dir, cnu, name)
+    for factory in suite_node_factories(suite_args(tmp_path, config_dir=str(config_dir))):
+        ros.add_node(factory)
+    client = SynthesisClient(ros.add_node(Node, 'cnu_client'))
+    assert client.wait_for_server(timeout=10.0)
+    for name, count in (('vending_demo_extended', 4), ('coffee_maker', 3)):
+        example = EXAMPLES[name]
+        outcome = client.run(make_goal(system=name, initial_conditions=example['initial_conditions'],
+                                       goals=example['goals']), timeout=120)
+        assert outcome.error_name == 'SUCCESS', outcome.message
+        assert len([s for s in outcome.states if s['state_path'].count('/') == 1
+                    and s['state_class'] != ':OUTCOME' and s['state_path'] != '/']) == count
+    bad = client.run(make_goal(system='vending_demo_extended', initial_conditions=['prep_pay_a'],
+                               goals=['lemonade']), timeout=60)
+    assert bad.error_name == 'UNKNOWN_PROPOSITION' and 'lemonade' in bad.message

@@ -26,9 +26,10 @@ from __future__ import annotations
 
 import json
 import math
+import pickle
 from typing import Any, Mapping, Optional
 
-from .config import SceneConfig, SimulationConfigError
+from .config import SceneConfig, SimulationConfig, SimulationConfigError
 
 TEMPLATE_ID = "template_id"
 TARGET_POSE = "target_pose"
@@ -49,6 +50,30 @@ def provided_datum(entry: Mapping[str, Any], action: str) -> Optional[str]:
         raise SimulationConfigError(f"simulation.actions.{action}.provides: unknown data kind {kind!r}; "
                                     f"known: {', '.join(DATA_KINDS)}", item=action)
     return kind
+
+
+def operator_answer(settings: SimulationConfig, name: str, kind: str) -> Any:
+    """What the simulated operator answers for the input action ``name`` (of data ``kind``).
+
+    ``scenario.operator_answers`` when it names one; else the scene's first object for a
+    template and the robot's own place for a pose.
+    """
+    answers = settings.scenario.operator_answers
+    if name in answers:
+        return answers[name]
+    if kind == TEMPLATE_ID:
+        return min(settings.scene.objects, default=None)
+    return [0.0, 0.0, 0.0]
+
+
+def answers_by_request_type(settings: SimulationConfig, request_capabilities: Mapping[int, str]) -> dict:
+    """BehaviorInput request type -> the answer, for the input actions behind FlexBE's InputStates."""
+    answers = {}
+    for request_type, name in request_capabilities.items():
+        kind = provided_datum(settings.actions.get(name, {}), name)
+        if kind is not None:
+            answers[request_type] = operator_answer(settings, name, kind)
+    return answers
 
 
 def quoted(value: Any) -> str:
@@ -91,3 +116,42 @@ def decode_userdata(keys, values) -> Optional[dict]:
     for key in keys[len(values):]:
         data[key] = None
     return data
+
+
+def flexbe_input_data(value: Any) -> str:
+    """The ``data`` of a BehaviorInput result, as FlexBE's flexbe_input writes it for InputState."""
+    return str(pickle.dumps(value))
+
+
+def parse_answers(entries, source: str) -> dict:
+    """``{request type: answer}`` from a mapping (a scenario file) or ``TYPE=VALUE`` texts.
+
+    Values are YAML (``1``, ``[0.6, 0.0, 0.0]``); request types are BehaviorInput's numbers.
+    Raises SimulationConfigError naming the bad entry.
+    """
+    import yaml  # only the operator's command line reads answers as text
+
+    if isinstance(entries, Mapping):
+        items = list(entries.items())
+    else:
+        items = []
+        for text in entries:
+            request_type, separator, value = str(text).partition('=')
+            if not separator:
+                raise SimulationConfigError(f'{source}: expected TYPE=VALUE, got {quoted(text)}', item=str(text))
+            try:
+                items.append((request_type.strip(), yaml.safe_load(value)))
+            except yaml.YAMLError as error:
+                raise SimulationConfigError(f'{source}: {quoted(value)} is no YAML value ({error.problem})',
+                                            item=str(text)) from None
+    answers = {}
+    for request_type, value in items:
+        try:
+            number = int(request_type)
+        except (TypeError, ValueError):
+            number = -1
+        if isinstance(request_type, bool) or not 0 <= number <= 255:
+            raise SimulationConfigError(f'{source}: {quoted(request_type)} is no BehaviorInput request type '
+                                        '(0-255)', item=str(request_type))
+        answers[number] = value
+    return answers

@@ -38,7 +38,7 @@ from .config import SimulationConfigError, SystemConfig, load_system_config
 from .discrete import COMPLETED, FAILED, Abstraction, DiscreteSemantics, DiscreteState
 from .faults import FaultInjector, FaultSpec
 from .kinematics import POSTURES
-from .operator_data import TEMPLATE_ID, datum_refusal, provided_datum
+from .operator_data import TEMPLATE_ID, datum_refusal, operator_answer, provided_datum
 from .motions import (
     DEFAULT_ACTION_ENTRY,
     DEFAULT_MODE_ENTRY,
@@ -402,20 +402,11 @@ class AtlasSimulator:
             self.outputs.update(request.motion.effects)
             if request.name in self.provides:
                 kind = self.provides[request.name]
-                self.answers[kind] = self.operator_answer(request.name)
+                self.answers[kind] = operator_answer(self.settings, request.name, kind)
         request.result = RequestResult(request.name, outcome, reason, request.started_at, self.time)
         self.history.append(request.result)
         self._notify("finished", request)
         return request.result
-
-    def operator_answer(self, name: str) -> Any:
-        """What the simulated operator answers for the input action ``name``."""
-        answers = self.settings.scenario.operator_answers
-        if name in answers:
-            return answers[name]
-        if self.provides[name] == TEMPLATE_ID:
-            return min(self.settings.scene.objects, default=None)
-        return [0.0, 0.0, 0.0]
 
     def _notify(self, event: str, request: Request) -> None:
         for listener in self._listeners:

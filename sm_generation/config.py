@@ -42,6 +42,9 @@ from sm_generation.errors import (AutonomyConfigInvalidError, FlexBEConfigInvali
                                   UserdataConfigInvalidError)
 
 BEHAVIOR_CLASS = ':BEHAVIOR'
+# flexbe_states' state that asks the operator (flexbe/behavior_input); its ``request`` parameter
+# is a flexbe_msgs/BehaviorInput request type.
+INPUT_STATE_CLASS = 'InputState'
 # FlexBE autonomy levels: Off/Inherit 0, Low 1, High 2, Full 3.
 AUTONOMY_LEVELS = range(0, 4)
 
@@ -98,6 +101,18 @@ class FlexBEConfig:
             if outcome_proposition in state.output_mapping:
                 return state
         return None
+
+
+def input_request_capabilities(config: FlexBEConfig) -> dict[int, str]:
+    """BehaviorInput request type -> the capability its InputState implements (e.g. 0 -> object_template)."""
+    import ast
+
+    capabilities = {}
+    for state in config.states.values():
+        if state.state_class == INPUT_STATE_CLASS and 'request' in state.parameter_names:
+            value = state.parameter_values[state.parameter_names.index('request')]
+            capabilities[int(ast.literal_eval(value))] = state.label
+    return capabilities
 
 
 def load_flexbe_config(system: str, config_dir: str | Path | None = None) -> FlexBEConfig:

@@ -115,3 +115,50 @@ def test_only_operator_inputs_provide_data(document):
     with pytest.raises(SimulationConfigError) as raised:
         AtlasSimulator(SystemConfig.from_dict(document))
     assert raised.value.item == 'look_down'
+
+
+def test_answers_are_pickled_as_flexbe_input_does_and_read_back_as_input_state_does():
+    import ast
+    import pickle
+
+    from atlas_sim.operator_data import flexbe_input_data
+
+    for value in (1, [0.6, 0.0, 0.0]):
+        assert pickle.loads(ast.literal_eval(flexbe_input_data(value))) == value
+
+
+def test_the_configured_operator_answers_by_request_type():
+    from synthesis_manager.nodes.operator_node import configured_answers
+
+    assert configured_answers('atlas') == {0: 1, 3: [0.6, 0.0, 0.0]}
+    assert configured_answers('mobile_manipulator') == {}
+
+
+@pytest.mark.parametrize('entries, item', [
+    (['0'], '0'), (['x=1'], 'x'), (['300=1'], '300'), (['0=[1,'], '0=[1,'), ({'zero': 1}, 'zero')])
+def test_bad_answers_name_the_entry(entries, item):
+    from atlas_sim.operator_data import parse_answers
+
+    with pytest.raises(SimulationConfigError) as raised:
+        parse_answers(entries, '--answer')
+    assert raised.value.item == item
+
+
+def test_answers_from_text_and_files():
+    from atlas_sim.operator_data import parse_answers
+
+    assert parse_answers(['0=7', '3=[1, 2, 0.5]'], '--answer') == {0: 7, 3: [1, 2, 0.5]}
+    assert parse_answers({0: 2}, 'scenario.yaml') == {0: 2}
+
+
+def test_the_operator_command_refuses_a_bad_answer_before_starting_ros():
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    command = Path(sys.executable).parent / 'atlas-sim-operator'
+    done = subprocess.run([str(command), '--answer', 'zero'], capture_output=True, text=True, timeout=60)
+    assert done.returncode == 2
+    assert "--answer: expected TYPE=VALUE, got 'zero'" in done.stderr
+    shown = subprocess.run([str(command), '--help'], capture_output=True, text=True, timeout=60)
+    assert shown.returncode == 0 and 'flexbe/behavior_input' in shown.stdout and '(default: atlas)' in shown.stdout

@@ -19,10 +19,8 @@ there, on the same ROS domain as the simulator node.
 
 from __future__ import annotations
 
-import ast
 import contextlib
 import importlib.util
-import pickle
 import sys
 import tempfile
 import threading
@@ -32,33 +30,20 @@ from pathlib import Path
 
 from atlas_sim.engine_trace import EngineTraceRecorder
 from atlas_sim.executor import ExecutionLimitError
-from sm_generation.config import load_flexbe_config
+from atlas_sim.operator_data import answers_by_request_type, flexbe_input_data
+from sm_generation.config import input_request_capabilities, load_flexbe_config
 from sm_generation.flexbe_behavior import behavior_package
 from sm_generation.instantiation import StateInstantiation
 
 FULL_AUTONOMY = 3
-INPUT_STATE = 'InputState'
 BEHAVIOR_INPUT_ACTION = 'flexbe/behavior_input'
-# What the simulated operator answers, by BehaviorInput request type (flexbe_msgs): the id
-# of the one object template in the simulated scene, a target pose (x, y, yaw).
-OPERATOR_ANSWERS = {0: 1, 3: [0.6, 0.0, 0.0]}
 PREEMPTED = 'preempted'
-
-
-def input_request_capabilities(config) -> dict[int, str]:
-    """BehaviorInput request type -> operator-input capability, from the InputStates of the config."""
-    capabilities = {}
-    for state in config.states.values():
-        if state.state_class == INPUT_STATE and 'request' in state.parameter_names:
-            value = state.parameter_values[state.parameter_names.index('request')]
-            capabilities[int(ast.literal_eval(value))] = state.label
-    return capabilities
 
 
 class SimulatedOperator:
     """The operator behind ``flexbe/behavior_input`` (what FlexBE's UI serves for InputState)."""
 
-    def __init__(self, node, request_capabilities: dict[int, str]):
+    def __init__(self, node, request_capabilities: dict[int, str], answers: dict[int, object]):
         from flexbe_msgs.action import BehaviorInput
         from rclpy.action import ActionClient, ActionServer
         from rclpy.callback_groups import ReentrantCallbackGroup
@@ -69,6 +54,7 @@ class SimulatedOperator:
         self._types = (BehaviorInput, ExecuteCapability)
         group = ReentrantCallbackGroup()
         self.request_capabilities = dict(request_capabilities)
+        self.answers = dict(answers)
         self.clients = {capability: ActionClient(node, ExecuteCapability, CAPABILITY_ACTION_PREFIX + capability,
                                                  callback_group=group)
                         for capability in set(self.request_capabilities.values())}
@@ -80,7 +66,7 @@ class SimulatedOperator:
         result = behavior_input.Result(result_code=behavior_input.Result.RESULT_ABORTED)
         request_type = goal_handle.request.request_type
         capability = self.request_capabilities.get(request_type)
-        if capability is None or request_type not in OPERATOR_ANSWERS:
+        if capability is None or request_type not in self.answers:
             result.data = f'the simulated operator has no answer for request type {request_type}'
             goal_handle.abort()
             return result
@@ -92,7 +78,7 @@ class SimulatedOperator:
                 done = (await handle.get_result_async()).result
                 if done.outcome == 'completed':
                     result.result_code = behavior_input.Result.RESULT_OK
-                    result.data = str(pickle.dumps(OPERATOR_ANSWERS[request_type]))
+                    result.data = flexbe_input_data(self.answers[request_type])
                 reason = done.reason
             else:
                 reason = 'the simulator rejected the request'
@@ -175,7 +161,9 @@ def run_on_flexbe(states, simulator, simulator_lock, domain_id: int, system: str
         with contextlib.redirect_stdout(sys.stderr), tempfile.TemporaryDirectory(prefix='flexbe_behavior_') as directory, \
                 RosHarness(domain_id=domain_id, default_context=True) as ros:
             behavior_class, checksum = load_behavior_class(package, Path(directory))
-            SimulatedOperator(ros.add_node(Node, 'simulated_operator'), input_request_capabilities(config))
+            requests = input_request_capabilities(config)
+            SimulatedOperator(ros.add_node(Node, 'simulated_operator'), requests,
+                              answers_by_request_type(simulator.settings, requests))
             node = ros.add_node(Node, 'flexbe_onboard')
             try:
                 outcome = _execute(behavior_class(node), checksum, autonomy, recorder, max_wall_time)

@@ -37,9 +37,11 @@ WEBUI_SITE = REPOSITORY / 'build' / 'flexbe_webui_site'
 # served from, so it only fully works on 8000; runs on one machine take turns (a lock file).
 WEBUI_PORT = 8000
 # The WebUI's settings for our legacy interface (what README tells FlexBE users to set).
+# initialize_flexbe_core: false generates code for the pinned engine 2.3.3 (README).
 WEBUI_SETTINGS = {'synthesis_enabled': True, 'synthesis_topic': '/behavior_synthesis',
                   'synthesis_type': 'synthesis_msgs/BehaviorSynthesisAction',
-                  'synthesis_system': 'system_wide', 'pkg_cache_enabled': False}
+                  'synthesis_system': 'system_wide', 'pkg_cache_enabled': False,
+                  'initialize_flexbe_core': False, 'default_package': 'synthesized_flexbe_behaviors'}
 PAPER_TASK = ('stand_prep', 'look_down, pickup_object')
 
 # The container's content in the page model: states, transitions, initial state, outcomes.
@@ -119,8 +121,8 @@ def synthesis_server(ros_domain, tmp_path_factory):
 
 @pytest.fixture(scope='module')
 def exported_behavior(tmp_path_factory):
-    """The paper task as `export-behavior` writes it, registered in an ament prefix of its own
-    (as a colcon install of the package would be): (name, top-level states, prefix, code folder)."""
+    """The paper task as `export-behavior` writes it, installed with pip into a prefix of its own
+    (as a user without colcon does): (name, top-level states, prefix, its site-packages)."""
     from ltl_specification import compile_task
     from ltl_synthesizer import synthesize
     from respec.automaton import automaton_from_strategy
@@ -133,17 +135,16 @@ def exported_behavior(tmp_path_factory):
     states = generate_state_machine(automaton_from_strategy(synthesize(spec).strategy, spec), 'atlas',
                                     initial_conditions=initial)
     package = behavior_package(states, load_flexbe_config('atlas'), 'Look Down Pickup Object')
-    prefix = tmp_path_factory.mktemp('exported_prefix')
-    folder = package.write(prefix / 'src')
-    index = prefix / 'share' / 'ament_index' / 'resource_index' / 'packages'
-    index.mkdir(parents=True)
-    (index / package.package).touch()
-    (prefix / 'share' / package.package).mkdir()
-    (prefix / 'share' / package.package / 'package.xml').symlink_to(folder / 'package.xml')
-    (prefix / 'lib' / package.package).mkdir(parents=True)
-    (prefix / 'lib' / package.package / 'manifest').symlink_to(folder / 'manifest')
+    work = tmp_path_factory.mktemp('exported')
+    folder = package.write(work / 'src')
+    prefix = work / 'install'
+    installed = subprocess.run([sys.executable, '-m', 'pip', 'install', '--quiet', '--no-deps',
+                                '--no-build-isolation', '--no-index', '--prefix', str(prefix), str(folder)],
+                               capture_output=True, text=True, timeout=300)
+    assert installed.returncode == 0, installed.stderr
+    site = prefix / 'lib' / f'python{sys.version_info.major}.{sys.version_info.minor}' / 'site-packages'
     top = sorted(s.name for s in states if s.parent_path == '/' and s.state_class != ':OUTCOME')
-    return package.behavior_name, top, prefix, folder
+    return package.behavior_name, top, prefix, site
 
 
 @pytest.fixture(scope='module')
@@ -272,3 +273,52 @@ def test_our_behaviors_open_in_the_behavior_dashboard(editor, exported_behavior)
                              ('Grasp Object', ['Check Template', 'Grasp'])]:
         loaded = editor.evaluate(LOAD_BEHAVIOR, behavior)
         assert loaded == {'error': None, 'states': states}
+
+
+FIVE_GOALS = ('stand_prep', 'look_down, pregrasp, pickup_object, approach_object, footstep_execution')
+# What a FlexBE user does around a synthesized container before saving: name the behavior,
+# pick the package, make the container the initial state, connect its outcomes, press Save.
+PREPARE_AND_SAVE = """name => {
+    UI.Dashboard.setBehaviorName(name);
+    UI.Dashboard.setBehaviorDescription('Synthesized in the WebUI: from stand_prep, five goals');
+    UI.Dashboard.setBehaviorAuthor('behavior-synthesis test');
+    UI.Dashboard.setBehaviorPackage('synthesized_flexbe_behaviors');
+    const root = Behavior.getStatemachine();
+    const container = root.getStateByName('Container');
+    root.setInitialState(container);
+    for (const outcome of ['finished', 'failed']) {
+        root.addTransition(new Transition(container, root.getSMOutcomeByName(outcome), outcome, 0));
+    }
+    const refusal = Checking.checkBehavior();
+    if (refusal === undefined) UI.Menu.saveBehaviorClicked();
+    return refusal === undefined ? null : refusal;
+}"""
+
+
+def test_a_five_goal_synthesis_saves_in_the_webui_and_its_imports_exist(editor, exported_behavior):
+    """Every key the synthesized states read is written in the machine: the WebUI's check accepts it."""
+    import ast
+    import builtins
+    import importlib
+
+    synthesize_in_new_container(editor, *FIVE_GOALS)
+    editor.wait_for_function(f'() => ({READ_CONTAINER})("/Container")?.states.length > 0', timeout=120_000)
+    assert editor.evaluate(PREPARE_AND_SAVE, 'Five Goals Saved') is None
+    editor.wait_for_function("() => document.getElementById('terminal').innerText"
+                             ".includes('Save behavior was successful!')", timeout=60_000)
+    saved = exported_behavior[3] / 'synthesized_flexbe_behaviors' / 'five_goals_saved_sm.py'
+    tree = ast.parse(saved.read_text(encoding='utf-8'))
+    imported = [(node.module, alias.name) for node in ast.walk(tree) if isinstance(node, ast.ImportFrom)
+                for alias in node.names]
+    assert ('atlas_sim_flexbe_states.object_action_state', 'ObjectActionState') not in imported  # inside a behavior
+    assert ('flexbe_states.input_state', 'InputState') in imported
+    missing = [f'{module}.{name}' for module, name in imported
+               if not hasattr(importlib.import_module(module), name)]
+    assert missing == []
+    # The known upstream mismatch (README): WebUI 4.0.3 calls two flexbe_core names it does not import.
+    used = {node.id for node in ast.walk(tree) if isinstance(node, ast.Name) and isinstance(node.ctx, ast.Load)}
+    defined = ({name for _, name in imported} | set(dir(builtins))
+               | {node.id for node in ast.walk(tree) if isinstance(node, ast.Name) and isinstance(node.ctx, ast.Store)}
+               | {node.arg for node in ast.walk(tree) if isinstance(node, ast.arg)}
+               | {node.name for node in ast.walk(tree) if isinstance(node, (ast.ClassDef, ast.FunctionDef))})
+    assert sorted(used - defined) == ['StateLogger', 'initialize_proxies']

@@ -160,6 +160,28 @@ class Operator:
             return '\n'.join(m.text for m in self.logs)
 
 
+def test_be_launcher_starts_the_installed_behavior(ros, onboard, flexbe_sources):
+    """FlexBE's own command line (flexbe_widget's be_launcher), as README tells users to start it."""
+    from flexbe_msgs.msg import BEStatus
+
+    system = onboard()
+    operator = Operator(ros)
+    operator.wait_for_servers()
+    operator.wait_until(lambda: any(s.code == BEStatus.READY for s in operator.statuses), 40, 'READY from onboard')
+    engine = flexbe_sources / 'flexbe_behavior_engine'
+    system.environment['PYTHONPATH'] = os.pathsep.join(
+        [system.environment['PYTHONPATH'], *(str(engine / name) for name in ('flexbe_widget', 'flexbe_input',
+                                                                              'flexbe_mirror')),
+         str(flexbe_sources / 'rosidl_runtime_py')])
+    system.start('launcher', [sys.executable, str(engine / 'flexbe_widget' / 'bin' / 'be_launcher'),
+                              '-b', BEHAVIOR, '-a', '3'])
+    ended = (BEStatus.FINISHED, BEStatus.FAILED, BEStatus.ERROR)
+    status = operator.wait_until(lambda: next((s for s in operator.statuses if s.code in ended), None), 120,
+                                 'end of the behavior started by be_launcher')
+    ok, details = finished_with(status, 'finished', system)
+    assert ok, details + '\n--- be_launcher\n' + system.log('launcher')[-2000:]
+
+
 def finished_with(status, outcome, system):
     from flexbe_msgs.msg import BEStatus
 

@@ -40,7 +40,8 @@ _PACKAGE_PREFIX = re.compile(r'[A-Za-z0-9_]+/')
 def field_mismatches(source_fields: dict[str, str], target_fields: dict[str, str]) -> list[str]:
     """Why messages with ``source_fields`` cannot be copied field by field into ones with
     ``target_fields`` (field name -> rosidl type; nested types compare without their package)."""
-    plain = lambda fields: {name: _PACKAGE_PREFIX.sub('', kind) for name, kind in fields.items()}  # noqa: E731
+    def plain(fields):
+        return {name: _PACKAGE_PREFIX.sub('', kind) for name, kind in fields.items()}
     source, target = plain(source_fields), plain(target_fields)
     return [f'{name}: {source.get(name, "missing")} vs {kind}'
             for name, kind in target.items() if source.get(name) != kind]

@@ -107,12 +107,13 @@ def load_flexbe_synthesis_interface() -> FlexBESynthesisInterface:
         mismatches = field_mismatches(StateInstantiation.get_fields_and_field_types(),
                                       CnuState.get_fields_and_field_types())
         if mismatches:
-            raise ImportError(f'flexbe_msgs/StateInstantiation differs from ours: {"; ".join(mismatches)}')
+            raise TypeError(f'flexbe_msgs/StateInstantiation differs from ours: {"; ".join(mismatches)}')
     except Exception as error:  # whatever makes it unusable: say it once, serve our type
         from synthesis_msgs.action import FlexBESynthesis
         from synthesis_msgs.msg import FlexBESynthesisRequest, SynthesisErrorCode
 
-        reason = (f'{CNU_PACKAGE} not importable ({type(error).__name__}: {error}): '
+        problem = 'not importable' if isinstance(error, ImportError) else 'not usable'
+        reason = (f'{CNU_PACKAGE} {problem} ({type(error).__name__}: {error}): '
                   f'/flexbe_synthesis offers {FALLBACK_TYPE} instead')
         return FlexBESynthesisInterface(FlexBESynthesis, FlexBESynthesisRequest, SynthesisErrorCode,
                                         StateInstantiation, OutcomeCondition, fallback_reason=reason)

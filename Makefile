@@ -18,6 +18,10 @@ SYSTEM_PACKAGES := graphviz chromium
 FLEXBE_SOURCES ?= $(if $(wildcard ../shared/third_party/flexbe_behavior_engine),$(abspath ../shared/third_party))
 FLEXBE_ENGINE = $(FLEXBE_SOURCES)/flexbe_behavior_engine
 FLEXBE_MSGS_BUILD := build/flexbe_msgs
+# CNU's synthesis interface (flexbe_synthesis_msgs/action/FlexBESynthesis, which `serve` offers
+# on /flexbe_synthesis when importable); on a user's machine it comes from their FlexBE workspace.
+FLEXBE_SYNTHESIS_MSGS ?= $(FLEXBE_SOURCES)/flexbe_synthesis/flexbe_synthesis_msgs
+FLEXBE_SYNTHESIS_MSGS_BUILD := build/flexbe_synthesis_msgs
 # The FlexBE WebUI needs an older web stack than our GUI (starlette<0.47): installed into a
 # folder of its own that only the WebUI's process (test/test_flexbe_webui.py) puts on its path.
 WEBUI_SITE := build/flexbe_webui_site
@@ -63,12 +67,12 @@ $(VENV)/.msgs-installed: $(MSGS_SOURCES) $(VENV)/.project-installed
 	  cmake --build . -j2 > cmake-build.log && cmake --install . > cmake-install.log
 	touch $@
 
-# FlexBE from FLEXBE_SOURCES: flexbe_msgs built like synthesis_msgs (through our wrapper
-# project, the snapshot stays untouched), flexbe_core/flexbe_states/flexbe_onboard and our
+# FlexBE from FLEXBE_SOURCES: flexbe_msgs and then CNU's flexbe_synthesis_msgs built like
+# synthesis_msgs (through our wrapper projects, the snapshots stay untouched), flexbe_core/flexbe_states/flexbe_onboard and our
 # FlexBE packages importable through a .pth file, a tf2_ros stand-in last on the path (only
 # found when no real tf2_ros is installed), and the FlexBE packages registered in an ament
 # index under $(FLEXBE_PREFIX).
-flexbe: setup $(VENV)/.flexbe-msgs-installed $(WEBUI_SITE)/.installed
+flexbe: setup $(VENV)/.flexbe-msgs-installed $(VENV)/.flexbe-synthesis-msgs-installed $(WEBUI_SITE)/.installed
 	@site=$$($(BIN)/python -c 'import sysconfig; print(sysconfig.get_path("purelib"))'); \
 	  printf '%s\n' $(addprefix $(abspath $(FLEXBE_ENGINE))/,flexbe_core flexbe_states flexbe_onboard) \
 	    $(abspath $(FLEXBE_PACKAGES)) $(abspath test/flexbe_env/python) > $$site/flexbe.pth
@@ -80,7 +84,7 @@ flexbe: setup $(VENV)/.flexbe-msgs-installed $(WEBUI_SITE)/.installed
 	  ln -s $$pkg/package.xml $(FLEXBE_PREFIX)/share/$$name/package.xml; \
 	  if [ -d $$pkg/manifest ]; then mkdir -p $(FLEXBE_PREFIX)/lib/$$name && ln -s $$pkg/manifest $(FLEXBE_PREFIX)/lib/$$name/manifest; fi; \
 	done
-	$(BIN)/python -c 'import flexbe_core, flexbe_states, flexbe_msgs.action, atlas_sim_flexbe_states, atlas_sim_flexbe_behaviors'
+	$(BIN)/python -c 'import flexbe_core, flexbe_states, flexbe_msgs.action, flexbe_synthesis_msgs.action, atlas_sim_flexbe_states, atlas_sim_flexbe_behaviors'
 	@echo "FlexBE from $(FLEXBE_SOURCES); FlexBE packages indexed under AMENT_PREFIX_PATH=$(abspath $(FLEXBE_PREFIX))"
 
 # Configured in build/: a source folder holding our wrapper CMakeLists.txt next to the
@@ -95,6 +99,26 @@ $(VENV)/.flexbe-msgs-installed: test/flexbe_env/flexbe_msgs/CMakeLists.txt $(VEN
 	cd $(FLEXBE_MSGS_BUILD)/build && \
 	  AMENT_PREFIX_PATH=$(abspath $(VENV)) PATH=$(abspath $(BIN)):$$PATH \
 	  cmake ../source -DFLEXBE_MSGS_DIR=$(abspath $(FLEXBE_ENGINE))/flexbe_msgs \
+	    -DCMAKE_INSTALL_PREFIX=$(abspath $(VENV)) \
+	    -DCMAKE_PREFIX_PATH=$(abspath $(VENV)) -DPython3_EXECUTABLE=$(abspath $(BIN)/python) \
+	    -DBUILD_TESTING=OFF > cmake-configure.log && \
+	  AMENT_PREFIX_PATH=$(abspath $(VENV)) PATH=$(abspath $(BIN)):$$PATH \
+	  cmake --build . -j2 > cmake-build.log && cmake --install . > cmake-install.log
+	touch $@
+
+# CNU's package the same way, against the flexbe_msgs above (its result carries
+# flexbe_msgs/StateInstantiation[]).
+$(VENV)/.flexbe-synthesis-msgs-installed: test/flexbe_env/flexbe_synthesis_msgs/CMakeLists.txt \
+    $(VENV)/.flexbe-msgs-installed \
+    $(wildcard $(FLEXBE_SYNTHESIS_MSGS)/package.xml $(FLEXBE_SYNTHESIS_MSGS)/msg/* $(FLEXBE_SYNTHESIS_MSGS)/srv/* $(FLEXBE_SYNTHESIS_MSGS)/action/*)
+	@test -f "$(FLEXBE_SYNTHESIS_MSGS)/package.xml" || \
+	  { echo "CNU's flexbe_synthesis_msgs not found: set FLEXBE_SYNTHESIS_MSGS to its folder (got '$(FLEXBE_SYNTHESIS_MSGS)')" >&2; exit 1; }
+	rm -rf $(FLEXBE_SYNTHESIS_MSGS_BUILD) && mkdir -p $(FLEXBE_SYNTHESIS_MSGS_BUILD)/source $(FLEXBE_SYNTHESIS_MSGS_BUILD)/build
+	ln -s $(abspath test/flexbe_env/flexbe_synthesis_msgs/CMakeLists.txt) $(FLEXBE_SYNTHESIS_MSGS_BUILD)/source/CMakeLists.txt
+	ln -s $(abspath $(FLEXBE_SYNTHESIS_MSGS))/package.xml $(FLEXBE_SYNTHESIS_MSGS_BUILD)/source/package.xml
+	cd $(FLEXBE_SYNTHESIS_MSGS_BUILD)/build && \
+	  AMENT_PREFIX_PATH=$(abspath $(VENV)) PATH=$(abspath $(BIN)):$$PATH \
+	  cmake ../source -DFLEXBE_SYNTHESIS_MSGS_DIR=$(abspath $(FLEXBE_SYNTHESIS_MSGS)) \
 	    -DCMAKE_INSTALL_PREFIX=$(abspath $(VENV)) \
 	    -DCMAKE_PREFIX_PATH=$(abspath $(VENV)) -DPython3_EXECUTABLE=$(abspath $(BIN)/python) \
 	    -DBUILD_TESTING=OFF > cmake-configure.log && \

@@ -10,15 +10,25 @@ import yaml
 
 from respec.naming import DEFAULT_SM_OUTCOMES
 from synthesis_manager.ros.action_client import RaceFreeActionClient
-from synthesis_manager.ros.conversions import error_name, flexbe_error_name, msg_to_sections, msg_to_state_dict
+from synthesis_manager.ros.cnu_interface import load_flexbe_synthesis_interface
+from synthesis_manager.ros.conversions import error_name, msg_to_sections, msg_to_state_dict
 from synthesis_manager.ros.harness import wait_for
-from synthesis_msgs.action import BehaviorSynthesis, FlexBESynthesis
-from synthesis_msgs.msg import (BehaviorSynthesisRequest, FlexBESynthesisRequest, LTLSpecification,
-                                SynthesisOptions)
+from synthesis_msgs.action import BehaviorSynthesis
+from synthesis_msgs.msg import BehaviorSynthesisRequest, LTLSpecification, SynthesisOptions
 
 ACTION_NAME = 'behavior_synthesis'
-# The two action interfaces of the server: name -> action type.
-ACTIONS = {'behavior_synthesis': BehaviorSynthesis, 'flexbe_synthesis': FlexBESynthesis}
+# The two action interfaces of the server.
+ACTIONS = ('behavior_synthesis', 'flexbe_synthesis')
+
+
+def action_type(action_name: str):
+    """The type of one of ACTIONS, as a server in this environment offers it (FlexBESynthesis:
+    CNU's when importable); other names are served with BehaviorSynthesis."""
+    if action_name == 'flexbe_synthesis':
+        return load_flexbe_synthesis_interface().action_type
+    return BehaviorSynthesis
+
+
 GOAL_STATUS_NAMES = {4: 'SUCCEEDED', 5: 'CANCELED', 6: 'ABORTED'}
 
 
@@ -63,16 +73,18 @@ def make_goal(system: str, initial_conditions, goals, sm_outcomes=DEFAULT_SM_OUT
 
 def make_flexbe_goal(system: str, initial_conditions, goals, sm_outcomes=DEFAULT_SM_OUTCOMES,
                      option: str | None = None, name: str = '', timeout: float = 0.0,
-                     unordered: bool = False) -> FlexBESynthesis.Goal:
-    """A FlexBESynthesis goal (CNU's interface): the options travel as YAML."""
+                     unordered: bool = False):
+    """A FlexBESynthesis goal of the type offered (CNU's interface): the options travel as YAML."""
     as_list = lambda names: [names] if isinstance(names, str) else list(names)  # noqa: E731
     options = {name: True for name in (option,) if name}
     if unordered:
         options['unordered_goals'] = True
-    request = FlexBESynthesisRequest(
+    interface = load_flexbe_synthesis_interface()
+    request = interface.request_type(
         system_name=system, initial_conditions=as_list(initial_conditions), goals=as_list(goals),
         sm_outcomes=list(sm_outcomes), spec_name=name, synthesis_timeout_s=float(timeout))
-    return FlexBESynthesis.Goal(request=request, synthesis_options=yaml.safe_dump(options) if options else '')
+    return interface.action_type.Goal(request=request,
+                                      synthesis_options=yaml.safe_dump(options) if options else '')
 
 
 def automaton_to_dict(automaton) -> dict:
@@ -88,9 +100,10 @@ def automaton_to_dict(automaton) -> dict:
 def outcome_from_result(result, seconds: float) -> SynthesisOutcome:
     """A result of either action; FlexBESynthesis results carry CNU's codes and `messages`."""
     states = [msg_to_state_dict(s) for s in result.states]
-    if isinstance(result, FlexBESynthesis.Result):
+    if 'messages' in result.get_fields_and_field_types():  # FlexBESynthesis, either type
         return SynthesisOutcome(
-            error_code=result.error_code.value, error_name=flexbe_error_name(result.error_code.value),
+            error_code=result.error_code.value, error_name=error_name(result.error_code.value,
+                                                                      type(result.error_code)),
             message='\n'.join(result.messages), states=states, seconds=seconds)
     return SynthesisOutcome(
         error_code=result.error_code.value, error_name=error_name(result.error_code.value),
@@ -116,10 +129,9 @@ class SynthesisClient:
     """
 
     def __init__(self, node, action_name: str = ACTION_NAME):
-        """``action_name``: one of ACTIONS (its type), or any name served with BehaviorSynthesis."""
+        """``action_name``: one of ACTIONS, or any name served with BehaviorSynthesis."""
         self.node = node
-        self.action_client = RaceFreeActionClient(node, ACTIONS.get(action_name, BehaviorSynthesis),
-                                                  action_name)
+        self.action_client = RaceFreeActionClient(node, action_type(action_name), action_name)
 
     def wait_for_server(self, timeout: float = 10.0) -> bool:
         return self.action_client.wait_for_server(timeout_sec=timeout)

@@ -3,6 +3,7 @@
 FlexBE WebUI 4.0.3 fills a BehaviorSynthesis goal field by field from
 ``{request: {name, system, goal, initial_condition, sm_outcomes}}``; newer revisions send one
 payload with every field-name alias to CNU's FlexBESynthesis and keep the fields the type has.
+/flexbe_synthesis offers CNU's own type when flexbe_synthesis_msgs is importable, else ours.
 """
 
 from argparse import Namespace
@@ -10,9 +11,12 @@ from argparse import Namespace
 import pytest
 
 from synthesis_manager.client import SynthesisClient, make_flexbe_goal, make_goal
+from synthesis_manager.ros.cnu_interface import load_flexbe_synthesis_interface
 from synthesis_manager.suite import suite_node_factories
-from synthesis_msgs.action import BehaviorSynthesis, FlexBESynthesis
-from synthesis_msgs.msg import SynthesisErrorCode
+from synthesis_msgs.action import BehaviorSynthesis
+
+FLEXBE_SYNTHESIS = load_flexbe_synthesis_interface()
+SynthesisErrorCode = FLEXBE_SYNTHESIS.error_code_type
 
 PAPER_TASK = dict(system='atlas', initial_conditions=['stand_prep'], goals=['look_down', 'pickup_object'])
 # What WebUI 4.0.3 sends for a container "Container" with the default outcomes.
@@ -90,7 +94,7 @@ def test_webui_4_0_3_payload_names_the_behavior_by_its_container_path(suite):
 
 
 def test_alias_filled_payload_against_flexbe_synthesis_gives_the_same_machine(suite):
-    goal = fill_known_aliases(FlexBESynthesis.Goal(), WEBUI_ALIAS_PAYLOAD)
+    goal = fill_known_aliases(FLEXBE_SYNTHESIS.action_type.Goal(), WEBUI_ALIAS_PAYLOAD)
     assert list(goal.request.goals) == ['look_down, pickup_object'] and goal.synthesis_options == ''
     flexbe, _ = run_with_feedback(suite.flexbe_synthesis, goal)
     assert (flexbe.goal_status, flexbe.error_name) == ('SUCCEEDED', 'SUCCESS'), flexbe.message

@@ -2,7 +2,8 @@
 synthesis -> state machine generation.
 
 Both actions (the original BehaviorSynthesis and CNU's FlexBESynthesis, which FlexBE WebUI
-revisions send) are read into one SynthesisTask and run the same pipeline with the same cancel.
+revisions send) are read into one SynthesisTask and run the same pipeline with the same cancel;
+synthesis_manager.ros.cnu_interface chooses FlexBESynthesis' type (CNU's own when importable).
 Each stage is an asynchronous call to its service node, awaited by the goal's coroutine
 (synthesis_manager.ros.stage_calls): a waiting goal holds no executor thread, so any number
 of goals run side by side and the executor keeps serving. Cancel requests, the stage's time
@@ -33,15 +34,15 @@ from synthesis_manager.limits import check_message, check_timeout
 from synthesis_manager.nodes.atlas_sim_node import STATE_TOPIC
 from synthesis_manager.requests import (InvalidRequest, SynthesisTask, task_from_behavior_synthesis,
                                         task_from_flexbe_synthesis)
-from synthesis_manager.ros.conversions import (error_code, error_name, flexbe_error_code, is_empty_spec,
-                                               msg_to_sections)
+from synthesis_manager.ros.cnu_interface import load_flexbe_synthesis_interface
+from synthesis_manager.ros.conversions import error_code, error_name, is_empty_spec, msg_to_sections
 from synthesis_manager.ros.errors import log_internal_error
 from synthesis_manager.ros.node_main import node_main
 from synthesis_manager.ros.qos import action_server_qos, service_qos
 from synthesis_manager.ros.robot_state import RobotStateListener
 from synthesis_manager.ros.stage_calls import Preempted, ServerStopping, StageCaller, StageFailed
 from synthesis_manager.ros.worker_pool import WorkerPool
-from synthesis_msgs.action import BehaviorSynthesis, FlexBESynthesis
+from synthesis_msgs.action import BehaviorSynthesis
 from synthesis_msgs.msg import FSAutomaton, LTLSpecification
 from synthesis_msgs.srv import (CancelSynthesis, GenerateFlexBESM, GenerateLTLSpecification,
                                 SynthesizeAutomaton)
@@ -94,18 +95,14 @@ def behavior_synthesis_result(outcome: PipelineOutcome):
         ltl_specification=outcome.ltl_specification, automaton=outcome.automaton)
 
 
-def flexbe_synthesis_result(outcome: PipelineOutcome):
-    return FlexBESynthesis.Result(
-        error_code=flexbe_error_code(outcome.error_name), states=outcome.states,
-        messages=outcome.notes + ([] if outcome.succeeded else [f'{outcome.error_name}: {outcome.message}']))
-
-
-INTERFACES = (
-    ActionInterface(BehaviorSynthesis, 'behavior_synthesis', task_from_behavior_synthesis,
-                    behavior_synthesis_result),
-    ActionInterface(FlexBESynthesis, 'flexbe_synthesis', task_from_flexbe_synthesis,
-                    flexbe_synthesis_result),
-)
+def action_interfaces(flexbe_synthesis) -> tuple[ActionInterface, ...]:
+    """The served actions; ``flexbe_synthesis``: the FlexBESynthesisInterface offered."""
+    def flexbe_synthesis_result(outcome: PipelineOutcome):
+        return flexbe_synthesis.result(outcome.error_name, outcome.message, outcome.states, outcome.notes)
+    return (ActionInterface(BehaviorSynthesis, 'behavior_synthesis', task_from_behavior_synthesis,
+                            behavior_synthesis_result),
+            ActionInterface(flexbe_synthesis.action_type, 'flexbe_synthesis', task_from_flexbe_synthesis,
+                            flexbe_synthesis_result))
 
 
 class FeedbackChannel:
@@ -138,7 +135,8 @@ def flexbe_log_publisher(node: Node, topic: str) -> Callable[[str], None]:
 
 class BehaviorSynthesisServer(Node):
     """Action servers ``behavior_synthesis`` (synthesis_msgs/action/BehaviorSynthesis) and
-    ``flexbe_synthesis`` (synthesis_msgs/action/FlexBESynthesis, CNU's interface).
+    ``flexbe_synthesis`` (CNU's flexbe_synthesis_msgs/action/FlexBESynthesis when importable, else
+    our look-alike synthesis_msgs/action/FlexBESynthesis; the log says why, once).
 
     Parameters: ``default_system`` (for requests naming none or ``system_wide``),
     ``flexbe_log_topic`` (FlexBE's operator log; '' disables it), ``service_timeout`` (seconds
@@ -182,6 +180,9 @@ class BehaviorSynthesisServer(Node):
         self.synthesis_cancel = client(CancelSynthesis, 'ltl_synthesis/cancel')
         self.generator = client(GenerateFlexBESM, 'sm_generate')
         self.robot_state = RobotStateListener(self, self.parameter('robot_state_topic'), callback_group=group)
+        flexbe_synthesis = load_flexbe_synthesis_interface()
+        if flexbe_synthesis.fallback_reason:
+            self.get_logger().info(flexbe_synthesis.fallback_reason)
         # rclpy keeps each result for result_timeout seconds (default 900: ~38 KB per goal).
         self.action_servers = [
             ActionServer(self, interface.action_type, interface.action_name,
@@ -190,7 +191,7 @@ class BehaviorSynthesisServer(Node):
                          cancel_callback=lambda _: CancelResponse.ACCEPT, callback_group=group,
                          result_timeout=max(1, round(self.parameter('result_retention'))),
                          **action_server_qos())
-            for interface in INTERFACES]
+            for interface in action_interfaces(flexbe_synthesis)]
 
     def _executor_for(self, interface):
         """The execute callback of ``interface``'s action server (a coroutine function)."""

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 from respec.automaton import Automaton, AutomatonState as CoreState
 from synthesis_msgs.msg import (AutomatonState, FSAutomaton, LTLSpecification, OutcomeCondition,
-                                StateInstantiation, SynthesisErrorCode, SynthesisErrorCodes)
+                                StateInstantiation, SynthesisErrorCodes)
 
 LTL_SECTIONS = ('sys_props', 'env_props', 'sys_init', 'env_init', 'sys_trans', 'env_trans',
                 'sys_liveness', 'env_liveness')
@@ -19,32 +19,15 @@ def error_code(name: str = 'SUCCESS', message: str = '') -> SynthesisErrorCodes:
                                message=message)
 
 
+def constants(message_type) -> dict[str, int]:
+    """A message type's integer constants, name -> value (e.g. an error code's)."""
+    return {name: value for name, value in vars(message_type).items()
+            if name.isupper() and isinstance(value, int) and not isinstance(value, bool)}
+
+
 def error_name(value: int, codes=SynthesisErrorCodes) -> str:
     """The constant name of an error code value, e.g. -21 -> 'SPEC_UNSYNTHESIZABLE'."""
-    for name, constant in vars(codes).items():
-        if name.isupper() and constant == value:
-            return name
-    return str(value)
-
-
-def flexbe_error_name(value: int) -> str:
-    """The name of a FlexBESynthesis error code value (CNU's constants)."""
-    return error_name(value, SynthesisErrorCode)
-
-
-# Our error names without a same-named constant in CNU's SynthesisErrorCode go to the generic
-# failure of their stage (their message keeps the precise name).
-_FLEXBE_STAGE_FAILURES = ((-9, 'BEHAVIOR_SYNTHESIS_FAILED'), (-19, 'SPEC_COMPILATION_FAILED'),
-                          (-29, 'SYNTHESIS_FAILED'), (-49, 'SM_GENERATION_FAILED'))
-
-
-def flexbe_error_code(name: str) -> SynthesisErrorCode:
-    """Our error name -> FlexBESynthesis' SynthesisErrorCode (CNU's constants)."""
-    if name.isupper() and hasattr(SynthesisErrorCode, name):
-        return SynthesisErrorCode(value=getattr(SynthesisErrorCode, name))
-    value = getattr(SynthesisErrorCodes, name, SynthesisErrorCodes.FAILURE)
-    stage = next((failure for lowest, failure in _FLEXBE_STAGE_FAILURES if value >= lowest), 'FAILURE')
-    return SynthesisErrorCode(value=getattr(SynthesisErrorCode, stage))
+    return next((name for name, constant in constants(codes).items() if constant == value), str(value))
 
 
 def spec_to_msg(spec) -> LTLSpecification:

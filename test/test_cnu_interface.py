@@ -1,0 +1,263 @@
+"""CNU's own action type on /flexbe_synthesis (flexbe_synthesis_msgs/action/FlexBESynthesis).
+
+With CNU's package built by `make flexbe`, an unmodified rclpy ActionClient of that type gets
+the same states as /behavior_synthesis, CNU's error codes and a working cancel. Without it, the
+server offers our look-alike type there and says once why.
+"""
+
+import sys
+import time
+from argparse import Namespace
+
+import pytest
+
+from sm_generation.instantiation import OutcomeCondition as CoreCondition, StateInstantiation as CoreState
+from synthesis_manager.client import SynthesisClient, make_flexbe_goal, make_goal
+from synthesis_manager.ros.cnu_interface import (FALLBACK_TYPE, cnu_error_name, copy_message,
+                                                 field_mismatches, load_flexbe_synthesis_interface)
+from synthesis_manager.ros.conversions import constants, msg_to_state_dict, state_to_msg
+from synthesis_manager.suite import suite_node_factories
+from synthesis_msgs.msg import SynthesisErrorCodes
+
+PAPER_TASK = dict(system='atlas', initial_conditions=['stand_prep'], goals=['look_down', 'pickup_object'])
+CNU_STAGES = ('BEHAVIOR_SYNTHESIS_FAILED', 'SPEC_COMPILATION_FAILED', 'SYNTHESIS_FAILED',
+              'SM_GENERATION_FAILED')
+
+
+# --- ROS-free mapping and copying ------------------------------------------------------------
+
+@pytest.mark.parametrize('name, expected', [
+    ('SUCCESS', 'SUCCESS'), ('PREEMPTED', 'PREEMPTED'), ('INVALID_REQUEST', 'INVALID_REQUEST'),
+    ('SPEC_UNSYNTHESIZABLE', 'SPEC_UNSYNTHESIZABLE'), ('AUTOMATON_INVALID', 'AUTOMATON_INVALID'),
+    ('BUSY', 'BEHAVIOR_SYNTHESIS_FAILED'), ('TIMEOUT', 'BEHAVIOR_SYNTHESIS_FAILED'),
+    ('UNKNOWN_PROPOSITION', 'SPEC_COMPILATION_FAILED'),
+    ('LTL_SPEC_COMPILATION_FAILED', 'SPEC_COMPILATION_FAILED'),
+    ('SYNTHESIS_TIMEOUT', 'SYNTHESIS_FAILED'), ('FAILURE', 'FAILURE'),
+])
+def test_our_error_names_map_to_cnus_constant_or_their_stages_failure(name, expected):
+    cnu_names = {'SUCCESS', 'FAILURE', 'PREEMPTED', 'INVALID_REQUEST', 'SPEC_UNSYNTHESIZABLE',
+                 'AUTOMATON_INVALID', *CNU_STAGES}
+    assert cnu_error_name(name, getattr(SynthesisErrorCodes, name), cnu_names) == expected
+
+
+def test_field_mismatches_ignore_the_package_of_nested_types_only():
+    ours = {'state_path': 'string', 'cond_transition': 'sequence<synthesis_msgs/OutcomeCondition>',
+            'position': 'float[2]'}
+    theirs = {**ours, 'cond_transition': 'sequence<flexbe_msgs/OutcomeCondition>'}
+    assert field_mismatches(ours, theirs) == []
+    assert field_mismatches(ours, {**theirs, 'position': 'float[3]', 'extra': 'string'}) == [
+        'position: float[2] vs float[3]', 'extra: missing vs string']
+
+
+def a_concurrency_state() -> CoreState:
+    """A state that uses every field, including cond_transition's OutcomeCondition."""
+    return CoreState(
+        state_path='/Container/parallel', state_class=':CONCURRENCY', initial_state_name='',
+        input_keys=['a'], output_keys=['b'], cond_outcome=['done', 'failed'],
+        cond_transition=[CoreCondition(['x', 'y'], ['done', 'done']), CoreCondition(['x'], ['failed'])],
+        behavior_class='', parameter_names=['p'], parameter_values=['1'], position=[12.5, -3.0],
+        outcomes=['done', 'failed'], transitions=['next', 'failed'], autonomy=[0, 3],
+        userdata_keys=['a', 'b'], userdata_remapping=['a', 'c'])
+
+
+# --- With CNU's package (built by `make flexbe`) ----------------------------------------------
+
+@pytest.fixture
+def cnu_package(flexbe):
+    """CNU's flexbe_synthesis_msgs, which `make flexbe` builds with FlexBE: a failure, not a skip."""
+    try:
+        import flexbe_synthesis_msgs.action  # noqa: F401
+    except ImportError as error:
+        pytest.fail(f'flexbe_synthesis_msgs is not importable ({error}); run `make flexbe`')
+
+
+def test_cnu_type_is_offered_and_states_copy_field_by_field(cnu_package):
+    from flexbe_msgs.msg import OutcomeCondition, StateInstantiation
+    from flexbe_synthesis_msgs.action import FlexBESynthesis
+    from flexbe_synthesis_msgs.msg import SynthesisErrorCode
+
+    interface = load_flexbe_synthesis_interface()
+    assert interface.fallback_reason == ''
+    assert interface.action_type is FlexBESynthesis
+    assert interface.type_name == 'flexbe_synthesis_msgs/action/FlexBESynthesis'
+    ours = state_to_msg(a_concurrency_state())
+    assert field_mismatches(type(ours).get_fields_and_field_types(),
+                            StateInstantiation.get_fields_and_field_types()) == []
+    (copied,) = interface.states([ours])
+    assert type(copied) is StateInstantiation
+    assert all(type(condition) is OutcomeCondition for condition in copied.cond_transition)
+    assert msg_to_state_dict(copied) == msg_to_state_dict(ours) == a_concurrency_state().to_dict()
+    again = copy_message(ours, StateInstantiation, {'cond_transition': OutcomeCondition})
+    assert msg_to_state_dict(again) == msg_to_state_dict(copied)
+
+    # every error of ours becomes one of CNU's constants, with CNU's values
+    cnu = constants(SynthesisErrorCode)
+    for name in constants(SynthesisErrorCodes):
+        code = interface.error_code(name)
+        assert type(code) is SynthesisErrorCode and code.value in cnu.values()
+        if name in cnu:
+            assert code.value == cnu[name]
+    assert interface.error_code('UNKNOWN_SYSTEM').value == SynthesisErrorCode.SPEC_COMPILATION_FAILED
+
+
+def start_suite(ros, byproducts_dir):
+    """The suite's nodes, as `behavior-synthesis serve` starts them, in ``ros``."""
+    args = Namespace(config_dir='', byproducts_dir=str(byproducts_dir), backend='builtin',
+                     slugs_executable='slugs', synthesis_timeout=60.0, service_timeout=2.0, default_system='')
+    for factory in suite_node_factories(args):
+        ros.add_node(factory)
+    return ros
+
+
+@pytest.fixture
+def suite(ros, tmp_path):
+    return start_suite(ros, tmp_path)
+
+
+class PlainCnuClient:
+    """An unmodified rclpy ActionClient of CNU's type, spun by its own executor in the test's
+    thread (as a script would use it): nothing of ours between it and the server."""
+
+    def __init__(self, ros):
+        import rclpy
+        from rclpy.action import ActionClient
+        from rclpy.executors import SingleThreadedExecutor
+
+        from flexbe_synthesis_msgs.action import FlexBESynthesis
+
+        self.action_type = FlexBESynthesis
+        self.node = rclpy.create_node('plain_cnu_client', context=ros.context)
+        self.executor = SingleThreadedExecutor(context=ros.context)
+        self.executor.add_node(self.node)
+        self.client = ActionClient(self.node, FlexBESynthesis, 'flexbe_synthesis')
+        self.feedback = []
+
+    def close(self):
+        self.client.destroy()
+        self.executor.shutdown()
+        self.node.destroy_node()
+
+    def wait(self, future, timeout: float = 120.0):
+        self.executor.spin_until_future_complete(future, timeout_sec=timeout)
+        assert future.done(), f'no answer within {timeout} s'
+        return future.result()
+
+    def goal(self, initial_conditions, goals, **request):
+        goal = self.action_type.Goal()
+        goal.request.system_name = 'atlas'
+        goal.request.initial_conditions = list(initial_conditions)
+        goal.request.goals = list(goals)
+        for name, value in request.items():
+            setattr(goal.request, name, value)
+        return goal
+
+    def send(self, goal):
+        assert self.client.wait_for_server(timeout_sec=10.0), 'no /flexbe_synthesis server of CNU\'s type'
+        handle = self.wait(self.client.send_goal_async(goal, feedback_callback=self._on_feedback))
+        assert handle.accepted
+        return handle
+
+    def run(self, goal):
+        return self.wait(self.send(goal).get_result_async())
+
+    def _on_feedback(self, message):
+        self.feedback.append(message.feedback.status)
+
+
+@pytest.fixture
+def plain_cnu_client(cnu_package, suite):
+    client = PlainCnuClient(suite)
+    yield client
+    client.close()
+
+
+def test_unmodified_cnu_client_gets_success_and_the_states_of_behavior_synthesis(plain_cnu_client, suite):
+    from action_msgs.msg import GoalStatus
+    from flexbe_msgs.msg import StateInstantiation
+    from flexbe_synthesis_msgs.msg import SynthesisErrorCode
+
+    from rclpy.node import Node
+
+    goal = plain_cnu_client.goal(PAPER_TASK['initial_conditions'], PAPER_TASK['goals'])
+    response = plain_cnu_client.run(goal)
+    result = response.result
+    assert response.status == GoalStatus.STATUS_SUCCEEDED, list(result.messages)
+    assert result.error_code.value == SynthesisErrorCode.SUCCESS == 1 and list(result.messages) == []
+    assert result.states and all(type(state) is StateInstantiation for state in result.states)
+
+    legacy = SynthesisClient(suite.add_node(Node, 'legacy_client'), 'behavior_synthesis')
+    assert legacy.wait_for_server(timeout=10.0)
+    reference = legacy.run(make_goal(**PAPER_TASK), timeout=120)
+    assert reference.succeeded, reference.message
+    # field by field, in the same order
+    assert [msg_to_state_dict(state) for state in result.states] == reference.states
+    assert plain_cnu_client.feedback[-1].startswith('Generated a state machine')
+
+
+def test_bad_goals_get_cnus_error_codes_and_a_message(plain_cnu_client):
+    from action_msgs.msg import GoalStatus
+    from flexbe_synthesis_msgs.msg import SynthesisErrorCode
+
+    unknown = plain_cnu_client.run(plain_cnu_client.goal(['stand_prep'], ['fly_away']))
+    assert unknown.status == GoalStatus.STATUS_ABORTED
+    assert unknown.result.error_code.value == SynthesisErrorCode.SPEC_COMPILATION_FAILED == -10
+    (message,) = unknown.result.messages
+    assert message.startswith('UNKNOWN_PROPOSITION:') and "'fly_away'" in message
+    assert list(unknown.result.states) == []
+
+    spec_file = plain_cnu_client.run(plain_cnu_client.goal(['stand_prep'], ['look_down'],
+                                                           specification_file_name='mine.yaml'))
+    assert spec_file.result.error_code.value == SynthesisErrorCode.INVALID_REQUEST == -2
+    (message,) = spec_file.result.messages
+    assert message.startswith('INVALID_REQUEST:') and 'mine.yaml' in message
+
+
+def test_cancel_from_an_unmodified_cnu_client(plain_cnu_client, runaway_synthesis):
+    from action_msgs.msg import GoalStatus
+    from flexbe_synthesis_msgs.msg import SynthesisErrorCode
+
+    handle = plain_cnu_client.send(plain_cnu_client.goal(['stand_prep'], ['look_down']))
+    deadline = time.monotonic() + 30.0
+    while not any(status.startswith('Synthesizing') for status in plain_cnu_client.feedback):
+        assert time.monotonic() < deadline, plain_cnu_client.feedback
+        plain_cnu_client.executor.spin_once(timeout_sec=0.1)
+    cancelled_at = time.monotonic()
+    plain_cnu_client.wait(handle.cancel_goal_async(), timeout=10.0)
+    response = plain_cnu_client.wait(handle.get_result_async(), timeout=10.0)
+    assert time.monotonic() - cancelled_at < 5.0
+    assert response.status == GoalStatus.STATUS_CANCELED
+    assert response.result.error_code.value == SynthesisErrorCode.PREEMPTED == -9
+    assert response.result.messages[-1].startswith('PREEMPTED:')
+
+
+# --- Without CNU's package ---------------------------------------------------------------------
+
+@pytest.fixture
+def without_cnu_package(monkeypatch):
+    """Make flexbe_synthesis_msgs (and its submodules, if already imported) unimportable."""
+    names = {'flexbe_synthesis_msgs', 'flexbe_synthesis_msgs.action', 'flexbe_synthesis_msgs.msg'}
+    names |= {name for name in sys.modules if name.startswith('flexbe_synthesis_msgs.')}
+    for name in names:
+        monkeypatch.setitem(sys.modules, name, None)
+
+
+def test_without_cnu_package_our_type_is_served_and_the_reason_logged_once(
+        without_cnu_package, ros, tmp_path, capfd):
+    from rclpy.node import Node
+
+    from synthesis_msgs.action import FlexBESynthesis
+
+    interface = load_flexbe_synthesis_interface()
+    assert interface.action_type is FlexBESynthesis
+    assert interface.fallback_reason.startswith('flexbe_synthesis_msgs not importable (')
+    assert interface.fallback_reason.endswith(f'/flexbe_synthesis offers {FALLBACK_TYPE} instead')
+
+    start_suite(ros, tmp_path)
+    client = SynthesisClient(ros.add_node(Node, 'fallback_client'), 'flexbe_synthesis')
+    assert client.wait_for_server(timeout=10.0)
+    outcome = client.run(make_flexbe_goal(**PAPER_TASK), timeout=120)
+    assert outcome.succeeded and outcome.states, outcome.message
+    services = dict(client.node.get_service_names_and_types())
+    offered = services['/flexbe_synthesis/_action/send_goal']
+    assert offered == ['synthesis_msgs/action/FlexBESynthesis_SendGoal']
+    assert capfd.readouterr().err.count('flexbe_synthesis_msgs not importable') == 1

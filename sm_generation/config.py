@@ -10,8 +10,8 @@
         states: atlas_sim_flexbe_states          # state classes (module: class name in snake_case)
         state_classes: {InputState: flexbe_states}   # classes from another package
         behaviors: atlas_sim_flexbe_behaviors    # the :BEHAVIOR behaviors
-      userdata:                 # optional: keys states read that no state writes -> default (source text)
-        grasp_preference: '0'
+      userdata:                 # optional: defaults of keys from outside (source text)
+        goal_pose: '[2.0, 0.0, 0.0]'
       states:                   # activation proposition <p>_a (or sensor) -> FlexBE state
         look_down_a:
           class_decl: {name: TiltHeadState, param_names: [desired_tilt], param_values: [TiltHeadState.DOWN_45]}
@@ -19,11 +19,13 @@
           autonomy: 0           # one level for all outcomes, or a list in outcome order
           userdata_keys: []     # optional, same length as userdata_remapping
           userdata_remapping: []
+          writes: []            # optional: the remapped keys the state writes (its output keys)
 
-``userdata`` declares what the machine needs from outside: a synthesized machine declares the
-keys its states use as input keys of its root container, and an exported behavior gives them
-these defaults (FlexBE's behavior userdata). Every key a state reads must be written by some
-state or declared here (checked against the real state classes in the test suite).
+Userdata: a state reads the keys it remaps and does not list under ``writes``. A synthesized
+machine declares the keys its states read and none of its states writes as input keys of its
+root container (e.g. ``template_id`` when ``object_template`` held initially, so no InputState
+runs); an exported behavior gives them the defaults of ``userdata`` (else ``None``), FlexBE's
+behavior userdata. ``writes`` is checked against the real state classes in the test suite.
 ``class_decl.name`` is a state class, or ``:BEHAVIOR`` together with ``behavior_class``.
 A state's outcomes are the values of its ``output_mapping`` in file order; a list-valued
 ``autonomy`` follows that order. Every problem raises an ``SMGenerationError`` subclass whose ``item``
@@ -62,6 +64,12 @@ class StateConfig:
     autonomy: dict[str, int]                     # state outcome -> autonomy level
     userdata_keys: tuple[str, ...]
     userdata_remapping: tuple[str, ...]
+    writes: tuple[str, ...] = ()                 # remapped keys the state writes
+
+    @property
+    def reads(self) -> tuple[str, ...]:
+        """The remapped keys the state reads."""
+        return tuple(key for key in self.userdata_remapping if key not in self.writes)
 
     @property
     def label(self) -> str:
@@ -245,11 +253,15 @@ def _state_config(proposition: str, entry) -> StateConfig:
     if len(set(keys)) != len(keys):
         raise UserdataConfigInvalidError(f'{where}.userdata_keys lists a key twice',
                                          f'{where}.userdata_keys')
+    writes = _string_list(entry.get('writes'), f'{where}.writes', UserdataConfigInvalidError)
+    if set(writes) - set(remapping):
+        raise UserdataConfigInvalidError(f'{where}.writes names {sorted(set(writes) - set(remapping))[0]!r}, '
+                                         'which is none of its userdata_remapping', f'{where}.writes')
     return StateConfig(proposition=proposition, state_class=decl['name'],
                        behavior_class=behavior_class if decl['name'] == BEHAVIOR_CLASS else '',
                        parameter_names=names, parameter_values=values,
                        output_mapping=output_mapping, autonomy=autonomy,
-                       userdata_keys=keys, userdata_remapping=remapping)
+                       userdata_keys=keys, userdata_remapping=remapping, writes=writes)
 
 
 def _output_mapping(raw, where: str) -> dict[str, tuple[str, ...]]:

@@ -106,14 +106,15 @@ def generate_from_config(automaton, config: FlexBEConfig, initial_conditions: li
     if reduce:
         machine = reduce_machine(machine)
     entries = _instantiate(machine)
-    entries[0].input_keys = declared_userdata(entries, config)
+    entries[0].input_keys = userdata_from_outside(machine)
     return entries
 
 
-def declared_userdata(entries: list[StateInstantiation], config: FlexBEConfig) -> list[str]:
-    """The keys of ``config.userdata`` that the machine's states use: the root's input keys."""
-    used = {key for entry in entries for key in entry.userdata_remapping}
-    return sorted(key for key in config.userdata if key in used)
+def userdata_from_outside(machine: Machine) -> list[str]:
+    """The keys the machine's states read and none of them writes: the root's input keys."""
+    parts = [part for state in machine.states.values() for part in state.parts]
+    written = {key for part in parts for key in part.writes}
+    return sorted({key for part in parts for key in part.reads} - written)
 
 
 def machine_from_view(view: AutomatonView, initial_conditions: list[str] | None) -> Machine:

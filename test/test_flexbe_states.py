@@ -90,31 +90,32 @@ def test_flexbe_onboard_finds_the_configured_behaviors_through_the_ament_index(f
         assert source.endswith(f'{behavior_module_name(state.behavior_class)}.py')
 
 
-def read_and_written_keys(system, flexbe_node):
-    """(keys some state reads, keys some state writes), after remapping, from the real classes."""
-    read, written = set(), set()
-    for state in CONFIGS[system].states.values():
-        remap = dict(zip(state.userdata_keys, state.userdata_remapping))
-        if state.is_behavior():
-            package = CONFIGS[system].behavior_package
-            module = importlib.import_module(f'{package}.{behavior_module_name(state.behavior_class)}')
-            machine = getattr(module, behavior_class_name(state.behavior_class))(flexbe_node).create()
-            inputs, outputs = machine.input_keys, machine.output_keys
-        else:
-            cls = state_class(system, state)
-            arguments = {name: eval(value, {state.state_class: cls})  # noqa: S307 - our own config
-                         for name, value in zip(state.parameter_names, state.parameter_values)}
-            instance = cls(**arguments)
-            inputs, outputs = instance.input_keys, instance.output_keys
-        read |= {remap.get(key, key) for key in inputs}
-        written |= {remap.get(key, key) for key in outputs}
-    return read, written
+def real_userdata(system, state, flexbe_node):
+    """(input keys, output keys) of the configured class or behavior, remapped as configured."""
+    remap = dict(zip(state.userdata_keys, state.userdata_remapping))
+    if state.is_behavior():
+        package = CONFIGS[system].behavior_package
+        module = importlib.import_module(f'{package}.{behavior_module_name(state.behavior_class)}')
+        instance = getattr(module, behavior_class_name(state.behavior_class))(flexbe_node).create()
+    else:
+        cls = state_class(system, state)
+        instance = cls(**{name: eval(value, {state.state_class: cls})  # noqa: S307 - our own config
+                          for name, value in zip(state.parameter_names, state.parameter_values)})
+    return ({remap.get(key, key) for key in instance.input_keys}, {remap.get(key, key) for key in instance.output_keys})
+
+
+@pytest.mark.parametrize('entry', [(system, s) for system, c in CONFIGS.items() for s in c.states.values()],
+                         ids=label)
+def test_configured_writes_are_the_classes_output_keys(flexbe_node, entry):
+    """sm_generation decides which keys a machine needs from outside by ``writes``: it must be true."""
+    system, state = entry
+    inputs, outputs = real_userdata(system, state, flexbe_node)
+    assert set(state.writes) == outputs and set(state.reads) == inputs
 
 
 @pytest.mark.parametrize('system', SYSTEMS)
-def test_every_key_a_state_reads_is_written_by_a_state_or_declared(flexbe_node, system):
-    """What the root container must declare (flexbe.userdata) so the WebUI can save any machine."""
-    read, written = read_and_written_keys(system, flexbe_node)
-    declared = set(CONFIGS[system].userdata)
-    assert read - written <= declared, f'read but never written nor declared: {sorted(read - written - declared)}'
-    assert declared <= read - written, f'declared but written or unused: {sorted(declared - (read - written))}'
+def test_userdata_defaults_are_for_keys_no_state_writes(system):
+    states = CONFIGS[system].states.values()
+    read = {key for state in states for key in state.reads}
+    written = {key for state in states for key in state.writes}
+    assert set(CONFIGS[system].userdata) <= read - written

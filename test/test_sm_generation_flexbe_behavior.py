@@ -87,22 +87,35 @@ def test_userdata_lives_in_the_root_and_reaches_the_pickup_behavior():
     assert '<contains name="Grasp Object" />' in manifest and '<contains name="Pickup Object" />' in manifest
 
 
-def test_declared_userdata_becomes_the_roots_input_keys_with_its_defaults():
-    """Keys no state writes are declared on the root (StateInstantiation) and defaulted on export."""
-    declared = dataclasses.replace(load_flexbe_config('atlas'), userdata={'template_id': '1', 'unused_key': "'x'"})
-    states = generate_from_config(load_automaton(AUTOMATA / 'two_behaviors.yaml'), declared)
+def test_keys_read_but_written_by_no_state_are_the_roots_input_keys_with_their_defaults():
+    """Pickup and grasp without an InputState (object_template held initially): template_id comes from outside."""
+    states, package = export('two_behaviors.yaml', name='Pickup And Grasp')
     assert states[0].state_path == '/' and states[0].input_keys == ['template_id']
     assert all(not s.input_keys for s in states[1:] if s.state_class != ':CONCURRENCY')
-    code = behavior_package(states, declared, 'Pickup And Grasp', date=DATE).files[
-        'synthesized_flexbe_behaviors/pickup_and_grasp_sm.py']
+    code = package.files['synthesized_flexbe_behaviors/pickup_and_grasp_sm.py']
     assert "OperatableStateMachine(outcomes=['finished', 'failed'], input_keys=['template_id'])" in code
+    assert '_state_machine.userdata.template_id = None' in code
+    with_default = dataclasses.replace(load_flexbe_config('atlas'), userdata={'template_id': '1'})
+    code = behavior_package(states, with_default, 'Pickup And Grasp', date=DATE).files[
+        'synthesized_flexbe_behaviors/pickup_and_grasp_sm.py']
     assert '_state_machine.userdata.template_id = 1' in code
 
 
-def test_the_atlas_machine_reads_no_key_from_outside():
-    """ATLAS's states get all their data from other states: the WebUI saves any synthesized machine."""
-    states, _ = export('two_behaviors.yaml', name='Pickup And Grasp')
+def test_keys_written_in_the_machine_are_not_input_keys():
+    """The InputState writes template_id before pregrasp_pose reads it: nothing comes from outside."""
+    states, _ = export('concurrent.yaml')
     assert states[0].input_keys == []
+    assert generate_from_config(load_automaton(AUTOMATA / 'concurrent.yaml'),
+                                load_flexbe_config('atlas'))[0].input_keys == []
+
+
+def test_writes_must_name_remapped_keys():
+    section = {'sm_outcomes': {'finished': 'finished'},
+               'states': {'x_a': {'class_decl': {'name': 'LogState'}, 'output_mapping': {'x_c': ['done']},
+                                  'userdata_keys': ['data'], 'userdata_remapping': ['value'], 'writes': ['data']}}}
+    with pytest.raises(SMGenerationError) as raised:
+        parse_flexbe_config(section, 'atlas')
+    assert raised.value.item == 'flexbe.states.x_a.writes'
 
 
 @pytest.mark.parametrize('userdata, item', [

@@ -5,7 +5,8 @@ An exported behavior package is installed into a prefix the way a user without c
 the ament index, ``atlas-sim-node`` is the robot and ``atlas-sim-operator`` answers InputState
 exactly as flexbe_input's ``input_action_server`` does (a pickled value and nothing else). A
 ``flexbe_msgs/BehaviorSelection`` on ``flexbe/start_behavior`` starts it, as be_launcher and
-the WebUI do; ``flexbe/status`` (BEStatus) reports the outcome.
+the WebUI do; ``flexbe/status`` (BEStatus) reports the outcome. One test uses flexbe_input's
+own ``input_action_server`` with its Qt window (PyQt5, offscreen) and a scripted typist.
 """
 
 from __future__ import annotations
@@ -49,16 +50,18 @@ def installed_prefix(tmp_path_factory):
 class OnboardSystem:
     """The robot, the operator and FlexBE's onboard executive as processes on the test's domain."""
 
-    def __init__(self, ros, prefix: Path, flexbe_prefix: Path, logs: Path, sim_arguments=(), operator_arguments=()):
+    def __init__(self, ros, prefix: Path, flexbe_prefix: Path, logs: Path, sim_arguments=(), operator_arguments=(),
+                 operator_command=None, operator_path=()):
         self.site = prefix / 'lib' / f'python{sys.version_info.major}.{sys.version_info.minor}' / 'site-packages'
         self.ament_prefix_path = os.pathsep.join([str(prefix), str(flexbe_prefix), sys.prefix])
         self.environment = dict(os.environ, ROS_DOMAIN_ID=str(ros.domain_id), MUJOCO_GL='egl',
                                 AMENT_PREFIX_PATH=self.ament_prefix_path,
-                                PYTHONPATH=os.pathsep.join(filter(None, [str(self.site), os.environ.get('PYTHONPATH')])))
+                                PYTHONPATH=os.pathsep.join(filter(None, [str(self.site), *operator_path,
+                                                                           os.environ.get('PYTHONPATH')])))
         self.logs = logs
         self.processes = {}
         self.start('sim', [str(BIN / 'atlas-sim-node'), '--ros-args', '-p', 'speed:=20.0', *sim_arguments])
-        self.start('operator', [str(BIN / 'atlas-sim-operator'), *operator_arguments])
+        self.start('operator', operator_command or [str(BIN / 'atlas-sim-operator'), *operator_arguments])
         self.start('onboard', [sys.executable, '-m', 'flexbe_onboard.start_behavior'])
 
     def start(self, name, command):
@@ -87,8 +90,9 @@ def onboard(ros, installed_prefix, flexbe, tmp_path, monkeypatch):
     """Start the processes (sim and operator arguments as given); stopped after the test."""
     systems = []
 
-    def start(sim_arguments=(), operator_arguments=()):
-        system = OnboardSystem(ros, installed_prefix, flexbe, tmp_path, sim_arguments, operator_arguments)
+    def start(sim_arguments=(), operator_arguments=(), operator_command=None, operator_path=()):
+        system = OnboardSystem(ros, installed_prefix, flexbe, tmp_path, sim_arguments, operator_arguments,
+                               operator_command, operator_path)
         systems.append(system)
         monkeypatch.setenv('AMENT_PREFIX_PATH', system.ament_prefix_path)  # this process's BehaviorLibrary
         monkeypatch.syspath_prepend(str(system.site))
@@ -180,6 +184,18 @@ def test_be_launcher_starts_the_installed_behavior(ros, onboard, flexbe_sources)
                                  'end of the behavior started by be_launcher')
     ok, details = finished_with(status, 'finished', system)
     assert ok, details + '\n--- be_launcher\n' + system.log('launcher')[-2000:]
+
+
+def test_flexbe_inputs_own_input_server_and_window_answer_the_input_state(ros, onboard, flexbe_sources):
+    """The operator types 1 into flexbe_input's real Qt window (offscreen): the behavior finishes."""
+    engine = flexbe_sources / 'flexbe_behavior_engine'
+    system = onboard(operator_command=[sys.executable, str(Path(__file__).parent / 'flexbe_env' / 'typing_operator.py'),
+                                       '1'],
+                     operator_path=[str(engine / 'flexbe_input')])
+    status = Operator(ros).start_behavior(BEHAVIOR)
+    ok, details = finished_with(status, 'finished', system)
+    assert ok, details
+    assert "typing '1' into: 'Specify desired object template\\nint'" in system.log('operator')
 
 
 def finished_with(status, outcome, system):

@@ -42,6 +42,25 @@ def asks_for_robot_state(initial_conditions: Sequence[str]) -> bool:
     return True
 
 
+def reads_robot_state(initial_conditions: Sequence[str], system: str, config_dir=None) -> bool:
+    """Whether the server must read the robot's state for this request (``asks_for_robot_state``).
+
+    A robot described by CNU's capability files keeps CNU's meaning of no initial conditions:
+    its specification already gives them (``current`` still asks the robot).
+    """
+    from respec.capabilities import capability_system_of
+    from respec.errors import CodedError
+
+    if not asks_for_robot_state(initial_conditions):
+        return False
+    if CURRENT in initial_conditions:
+        return True
+    try:
+        return capability_system_of(system, config_dir) is None
+    except CodedError:  # an unknown or broken system: compiling the task reports it
+        return True
+
+
 def initial_conditions_from_robot_state(mode: str, completed_actions: Iterable[str],
                                         source: str = 'the robot state') -> list[str]:
     """𝓘 of a robot: its control ``mode`` first, then its ``completed_actions`` in their order.

@@ -60,6 +60,7 @@ def suite_node_factories(args=None, names=SUITE_NODE_NAMES):
             synthesis_timeout=getattr(args, 'synthesis_timeout', None),
             service_timeout=getattr(args, 'service_timeout', None),
             default_system=getattr(args, 'default_system', ''),
+            config_dir=getattr(args, 'config_dir', ''),
             robot_state_topic=getattr(args, 'robot_state_topic', ''),
             robot_state_timeout=getattr(args, 'robot_state_timeout', None))),
     }

@@ -324,3 +324,44 @@ def test_cnu_examples_through_our_behavior_synthesis_action(cnu, flexbe, tmp_pat
     bad = client.run(make_goal(system='vending_demo_extended', initial_conditions=['prep_pay_a'],
                                goals=['lemonade']), timeout=60)
     assert bad.error_name == 'UNKNOWN_PROPOSITION' and 'lemonade' in bad.message
+
+
+def test_cnu_examples_through_cnus_own_action_type(cnu, flexbe, tmp_path, ros, monkeypatch):
+    """An unmodified client of flexbe_synthesis_msgs/FlexBESynthesis sends CNU's request defaults."""
+    from flexbe_synthesis_msgs.msg import SynthesisErrorCode
+
+    from synthesis_manager.suite import suite_node_factories
+    from test_cnu_interface import PlainCnuClient
+    from test_synthesis_manager_pipeline import suite_args
+
+    monkeypatch.setenv('AMENT_PREFIX_PATH', str(flexbe))
+    config_dir = tmp_path / 'config'
+    names = ('coffee_maker', 'vending_demo', 'hello_world')
+    for name in names:
+        example_system(config_dir, cnu, name)
+    for factory in suite_node_factories(suite_args(tmp_path, config_dir=str(config_dir))):
+        ros.add_node(factory)
+    client = PlainCnuClient(ros)
+    try:
+        for name in names:
+            example = EXAMPLES[name]
+            goal = client.goal(example['initial_conditions'], example['goals'], system_name=name,
+                               sm_outcomes=['finished', 'failed'])
+            result = client.run(goal).result
+            assert result.error_code.value == SynthesisErrorCode.SUCCESS, (name, list(result.messages))
+            top = [s for s in result.states if s.state_path.count('/') == 1
+                   and s.state_class != ':OUTCOME' and s.state_path != '/']
+            assert 0 < len(top) <= example['cnu_states'], (name, [s.state_path for s in top])
+    finally:
+        client.close()
+
+
+def test_no_initial_conditions_keep_cnus_meaning_for_capability_systems(cnu, tmp_path):
+    """CNU: empty initial conditions come from the specification; our robots read the robot state."""
+    from ltl_specification.initial_conditions import reads_robot_state
+
+    example_system(tmp_path, cnu, 'hello_world')
+    assert not reads_robot_state([], 'hello_world', tmp_path)
+    assert reads_robot_state(['current'], 'hello_world', tmp_path)
+    assert reads_robot_state([], 'atlas') and not reads_robot_state(['stand'], 'atlas')
+    assert reads_robot_state([], 'no_such_system', tmp_path)  # compiling reports the unknown system

@@ -24,8 +24,8 @@ from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.node import Node
 
 from ltl_specification.errors import InvalidInitialConditionsError
-from ltl_specification.initial_conditions import (asks_for_robot_state, detected_status,
-                                                  initial_conditions_from_robot_state)
+from ltl_specification.initial_conditions import (detected_status, initial_conditions_from_robot_state,
+                                                  reads_robot_state)
 from ltl_synthesizer.errors import SynthesisError
 from ltl_synthesizer.isolated import SynthesisProcesses
 from respec.errors import INTERNAL_ERROR, CodedError
@@ -152,6 +152,7 @@ class BehaviorSynthesisServer(Node):
     def __init__(self, **kwargs):
         super().__init__('behavior_synthesis_server', **kwargs)
         self.declare_parameter('default_system', 'atlas')
+        self.declare_parameter('config_dir', '')  # the compilation node's: which systems are CNU's
         self.declare_parameter('service_timeout', 5.0)
         self.declare_parameter('compilation_timeout', 30.0)
         self.declare_parameter('synthesis_timeout', 120.0)
@@ -317,7 +318,7 @@ class BehaviorSynthesisServer(Node):
     async def with_initial_conditions(self, goal_handle, task: SynthesisTask, outcome: PipelineOutcome,
                                 feedback) -> SynthesisTask:
         """``task``, with the robot's initial conditions when it names none or ``current``."""
-        if not asks_for_robot_state(task.initial_conditions):
+        if not reads_robot_state(task.initial_conditions, task.system, self.parameter('config_dir') or None):
             return task
         topic, timeout = self.robot_state.topic, self.parameter('robot_state_timeout')
         feedback(f'Reading the initial conditions from {topic}', 0.02)

@@ -45,7 +45,7 @@ from atlas_sim.config import load_system_config
 from atlas_sim.trace_check import OutcomeTracker, Trace, TraceStep
 from respec.abstraction import load_abstraction
 from respec.errors import CodedError
-from respec.naming import ACTIVATION_SUFFIX, outcome_proposition
+from respec.naming import COMPLETED, activated, is_activation, outcome_proposition
 from respec.systems import system_config_path
 from sm_generation.config import load_flexbe_config
 
@@ -209,7 +209,7 @@ def make_simulator(system: str = 'atlas', config_dir: str | Path | None = None, 
     config = dataclasses.replace(config, simulation=dataclasses.replace(config.simulation, **changes))
     simulator = AtlasSimulator(config)
     for action in actions:  # completed before the run: as if they had just reported completion
-        simulator.semantics.finish(simulator.state, action, 'completed')
+        simulator.semantics.finish(simulator.state, action, COMPLETED)
     return simulator
 
 
@@ -326,7 +326,7 @@ class Part:
 
     @property
     def capability(self) -> str:
-        return self.proposition[:-len(ACTIVATION_SUFFIX)] if self.kind == 'capability' else ''
+        return activated(self.proposition) if self.kind == 'capability' else ''
 
 
 class StateMapping:
@@ -361,7 +361,7 @@ class StateMapping:
             raise UnmappedStateError(f'state {node.path!r} ({what}) matches no entry of flexbe.states of '
                                      f'{self.flexbe.system!r}', item=node.path)
         config = matches[0]
-        kind = 'capability' if config.proposition.endswith(ACTIVATION_SUFFIX) else 'sensor'
+        kind = 'capability' if is_activation(config.proposition) else 'sensor'
         return Part(node, kind, config.proposition, dict(config.output_mapping))
 
     def sm_outcome_propositions(self) -> dict[str, str]:

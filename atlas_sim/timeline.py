@@ -11,8 +11,9 @@ from __future__ import annotations
 from pathlib import Path
 
 from atlas_sim.trace_check import Trace
+from respec.naming import COMPLETED, FAILED
 
-OUTCOME_COLOURS = {'completed': '#3a9d5d', 'failed': '#d64541', None: '#9e9e9e'}
+OUTCOME_COLOURS = {COMPLETED: '#3a9d5d', FAILED: '#d64541', None: '#9e9e9e'}
 
 
 def mode_segments(trace: Trace) -> list[tuple[str, float, float]]:
@@ -21,7 +22,7 @@ def mode_segments(trace: Trace) -> list[tuple[str, float, float]]:
         return []
     modes = {s.mode_at_entry for s in trace.steps} | {s.mode_at_exit for s in trace.steps}
     changes = sorted((r['time'], r['capability']) for s in trace.steps for r in s.results
-                     if r['outcome'] == 'completed' and r['capability'] in modes)
+                     if r['outcome'] == COMPLETED and r['capability'] in modes)
     segments, mode, start = [], trace.steps[0].mode_at_entry, trace.steps[0].entered_at
     for when, new_mode in changes:
         if new_mode != mode:

@@ -54,7 +54,7 @@ from dataclasses import asdict, dataclass, field
 
 from respec.errors import CodedError
 from respec.ltl import And, Const, Formula, Iff, Implies, Next, Not, Or, Var, mentions_next, to_infix
-from respec.naming import ACTIVATION_SUFFIX, COMPLETED, DEFAULT_SM_OUTCOMES, MEMORY_SUFFIX, outcome_proposition
+from respec.naming import COMPLETED, DEFAULT_SM_OUTCOMES, FINISHED, is_activation, outcome_proposition, remembered
 from respec.spec import GR1Specification
 
 # Each SM outcome is the system proposition of the same name.
@@ -121,7 +121,7 @@ class OutcomeTracker:
         self.control_modes = set(control_modes)
         self.mode = initial_mode
         # capability -> its last reported outcome, cleared by a new activation (eqs. (5), (6))
-        self.reported = {action: 'completed' for action in completed_actions}
+        self.reported = {action: COMPLETED for action in completed_actions}
         self.sensors = dict(sensors or {})
 
     def activate(self, capabilities) -> None:
@@ -130,7 +130,7 @@ class OutcomeTracker:
 
     def report(self, capability: str, outcome: str) -> None:
         self.reported[capability] = outcome
-        if capability in self.control_modes and outcome == 'completed':
+        if capability in self.control_modes and outcome == COMPLETED:
             self.mode = capability
 
     def read_sensors(self, sensors: dict) -> None:
@@ -140,7 +140,7 @@ class OutcomeTracker:
         """The outcome propositions (and sensors) that are true now, sorted."""
         true = {outcome_proposition(self.mode, COMPLETED)}  # eq. (10): the current mode
         for capability, outcome in self.reported.items():
-            if capability in self.control_modes and outcome == 'completed':
+            if capability in self.control_modes and outcome == COMPLETED:
                 continue  # only the current mode's completion is true
             true.add(outcome_proposition(capability, outcome))
         true.update(name for name, value in self.sensors.items() if value)
@@ -266,7 +266,7 @@ def check_trace(trace: Trace, spec: GR1Specification, goals: list[str] | None = 
     checker = _Checker(trace, spec)
     violations = checker.run()
     goals = list(goals) if goals is not None else [
-        p[:-len(MEMORY_SUFFIX)] for p in spec.sys_props if p.endswith(MEMORY_SUFFIX)]
+        remembered(p) for p in spec.sys_props if remembered(p)]
     completed_at, goal_violations = check_goal_order(trace, goals, ordered)
     violations.extend(goal_violations)
     return TraceCheckReport(ok=not violations, outcome=trace.outcome, violations=violations,
@@ -285,7 +285,7 @@ def check_goal_order(trace: Trace, goals: list[str], ordered: bool = True):
     completed_at: dict[str, int | None] = {goal: None for goal in goals}
     for step in trace.steps:
         completions = {r['capability'] for r in step.results
-                       if r.get('outcome') == 'completed' and not r.get('abandoned')
+                       if r.get('outcome') == COMPLETED and not r.get('abandoned')
                        and r['capability'] in step.capabilities}
         counted_before = dict(completed_at)
         for index, goal in enumerate(goals):
@@ -296,7 +296,7 @@ def check_goal_order(trace: Trace, goals: list[str], ordered: bool = True):
                 completed_at[goal] = step.index
     violations = []
     finished_prop = trace.sm_outcome_propositions.get(trace.outcome or '', '')
-    if trace.outcome is not None and finished_prop == 'finished':
+    if trace.outcome is not None and finished_prop == FINISHED:
         missing = [g for g in goals if completed_at[g] is None]
         if missing:
             order = ' in order' if ordered else ''
@@ -312,7 +312,7 @@ class _Checker:
     def __init__(self, trace: Trace, spec: GR1Specification):
         self.trace, self.spec = trace, spec
         self.sm_props = {prop for prop in trace.sm_outcome_propositions.values() if prop in spec.sys_props}
-        self.activation_props = [p for p in spec.sys_props if p.endswith(ACTIVATION_SUFFIX)]
+        self.activation_props = [p for p in spec.sys_props if is_activation(p)]
         self.memory_props = [p for p in spec.sys_props
                              if p not in self.sm_props and p not in self.activation_props]
         self.positions = self._positions()

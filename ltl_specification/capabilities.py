@@ -32,9 +32,9 @@ from __future__ import annotations
 
 from typing import Mapping, Sequence
 
-from respec.capabilities import COMPLETED, CapabilityConfigError, CapabilitySystem, Literal, parse_literal
+from respec.capabilities import CapabilityConfigError, CapabilitySystem, Literal, parse_literal
 from respec.ltl import TRUE, Formula, conj, disj, iff, implies, neg, next_, var
-from respec.naming import memory
+from respec.naming import COMPLETED, FAILED, activation, memory
 from respec.parsing import IntegerVariable
 from respec.spec import FORMULA_SECTIONS, GR1Specification
 from respec.state_library import StateClass, capability_outcomes
@@ -42,7 +42,6 @@ from respec.state_library import StateClass, capability_outcomes
 from ltl_specification.errors import (InvalidFormulaError, InvalidGoalsError, InvalidInitialConditionsError,
                                       UnknownPropositionError)
 
-FAILED_OUTCOME = 'failed'
 
 
 class CapabilitySpecification:
@@ -55,7 +54,7 @@ class CapabilitySpecification:
             meanings = {system.transition_outcome(name, o) for o in outcomes[name]}
             self.outcome_props[name] = {t: system.outcome_proposition(name, t)
                                         for t in system.transition_outcomes if t in meanings}
-        self.activations = {name: f'{name}_a' for name in system.capabilities}
+        self.activations = {name: activation(name) for name in system.capabilities}
         self.sm_props = list(dict.fromkeys(system.sm_outcomes.values()))
         self.integers = {name: IntegerVariable(name, r.low, r.high) for name, r in system.integers.items()}
         self.memories = dict.fromkeys(system.capabilities, False)
@@ -223,7 +222,7 @@ def _request_literal(spec: CapabilitySpecification, text: str, what: str, error)
 def _goals(spec: CapabilitySpecification, goals: Sequence[str], parts: dict) -> None:
     literals = [_request_literal(spec, goal, 'goal', InvalidGoalsError) for goal in goals]
     atoms = [spec.atom(literal, False, 'goal', UnknownPropositionError) for literal in literals]
-    success = next((o for o in spec.sm_props if o != FAILED_OUTCOME), None)
+    success = next((o for o in spec.sm_props if o != FAILED), None)
     if success is None:
         parts['sys_liveness'] += atoms
         return

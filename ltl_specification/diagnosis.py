@@ -23,7 +23,7 @@ from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
 from respec.abstraction import RobotAbstraction
-from respec.activation_outcomes import activation, memory, outcome_proposition
+from respec.naming import DEFAULT_SM_OUTCOMES, activation, memory, outcome_proposition
 from respec.components import (SOURCE_ACTIONS, SOURCE_CONTROL_MODES, SOURCE_CUSTOM, SOURCE_GOALS,
                                SOURCE_INITIAL_CONDITIONS, SOURCE_SM_OUTCOMES, FormulaGroup)
 from respec.ltl import Formula, evaluate, mentions_next, to_infix, variables
@@ -352,7 +352,7 @@ def play_in_words(steps: list[dict], provenance, abstraction: RobotAbstraction) 
 
 # --- for the pipeline -------------------------------------------------------------------------
 
-def explain_unsynthesizable(details: str, system: str, initial_conditions, goals, sm_outcomes=('finished', 'failed'),
+def explain_unsynthesizable(details: str, system: str, initial_conditions, goals, sm_outcomes=DEFAULT_SM_OUTCOMES,
                             strict_order: bool = True, custom_ltl=None, robotics_semantics: bool = True,
                             config_dir=None, deadline: float | None = None,
                             cancel: threading.Event | None = None) -> str:

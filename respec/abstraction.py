@@ -24,11 +24,11 @@ import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from respec.naming import DEFAULT_SM_OUTCOMES, activation, memory, outcome_proposition
+from respec.naming import COMPLETED, DEFAULT_SM_OUTCOMES, FAILED, activation, memory, outcome_proposition
 from respec.systems import SystemConfigError, load_system_file
 
 _NAME = re.compile(r'^[A-Za-z][A-Za-z0-9_]*$')
-DEFAULT_OUTCOMES = ('completed', 'failed')
+DEFAULT_OUTCOMES = (COMPLETED, FAILED)
 _SECTION_KEYS = ('outcomes', 'initial_mode', 'control_modes', 'actions', 'sensors')
 # An outcome starting with 'a' or 'm' would name the same proposition as an activation
 # (<p>_a) or a goal memory (<g>_m).

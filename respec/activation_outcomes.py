@@ -15,7 +15,7 @@ from __future__ import annotations
 from typing import Iterable, Mapping, Sequence
 
 from respec.ltl import FALSE, TRUE, Formula, conj, disj, iff, implies, neg, next_, var
-from respec.naming import COMPLETED, activation, memory, outcome_proposition
+from respec.naming import COMPLETED, FAILED, FINISHED, activation, memory, outcome_proposition
 
 
 
@@ -253,7 +253,7 @@ def strict_goal_order(goals: Sequence[str], success: str = COMPLETED) -> list[Fo
     return formulas
 
 
-def success_outcome(goals: Sequence[str], finished: str = 'finished') -> Formula:
+def success_outcome(goals: Sequence[str], finished: str = FINISHED) -> Formula:
     """Eq. (18a), sys_trans: the state machine finishes exactly when all goals are achieved.
 
     □(π_SM^c ⇔ ⋀_g μ_g)
@@ -261,7 +261,7 @@ def success_outcome(goals: Sequence[str], finished: str = 'finished') -> Formula
     return iff(var(finished), conj([var(memory(g)) for g in goals]))
 
 
-def failure_outcome(failure_propositions: Sequence[str], failed: str = 'failed') -> Formula:
+def failure_outcome(failure_propositions: Sequence[str], failed: str = FAILED) -> Formula:
     """Eq. (18b), sys_trans: the state machine fails exactly when something has failed.
 
     □(π_SM^f ⇔ ⋁ π^f) over the failure outcomes of every action and control mode.

@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 
 from respec.errors import CodedError
 from respec.ltl import conj, evaluate
-from respec.naming import MEMORY_SUFFIX
+from respec.naming import is_memory
 from respec.spec import GR1Specification
 
 
@@ -37,10 +37,6 @@ class Automaton:
     initial_states: list[str] = field(default_factory=list)
 
 
-def is_memory_proposition(name: str) -> bool:
-    return name.endswith(MEMORY_SUFFIX)
-
-
 def automaton_from_strategy(strategy: dict, spec: GR1Specification,
                             drop_memory: bool = True) -> Automaton:
     """The automaton of a slugs JSON strategy; ``initial_states`` are the nodes whose valuation
@@ -51,7 +47,7 @@ def automaton_from_strategy(strategy: dict, spec: GR1Specification,
         raise AutomatonError(
             f"strategy variables {strategy.get('variables')} do not match the specification's "
             f'inputs then outputs {expected}', item='variables')
-    kept = [i for i, name in enumerate(outputs) if not (drop_memory and is_memory_proposition(name))]
+    kept = [i for i, name in enumerate(outputs) if not (drop_memory and is_memory(name))]
     nodes = strategy['nodes']
     n_inputs = len(inputs)
     states = []

@@ -36,11 +36,12 @@ from pathlib import Path
 
 import yaml
 
+from respec.naming import COMPLETED, FINISHED
 from respec.systems import SystemConfigError, load_system_file, system_config_path
 
 CAPABILITIES_KEY, SPEC_KEY, MAPPINGS_KEY = 'cnu_capabilities', 'cnu_spec', 'cnu_mappings'
 SYSTEM_FILE_KEYS = ('system', CAPABILITIES_KEY, SPEC_KEY, MAPPINGS_KEY, 'reduce')
-COMPLETED, FAILURE = 'completed', 'failure'
+FAILURE = 'failure'  # CNU's transition outcome of a failure; success is COMPLETED
 
 # The meaning of CNU's generic global_mappings.yaml, used when a system names no mappings file.
 DEFAULT_STATE_OUTCOMES = {
@@ -49,7 +50,7 @@ DEFAULT_STATE_OUTCOMES = {
     'failed': FAILURE, 'false': FAILURE, 'no_connection': FAILURE, 'param_error': FAILURE,
     'timeout': FAILURE, 'unavailable': FAILURE,
 }
-DEFAULT_SM_OUTCOMES = {'finished': 'finished'}
+CNU_SM_OUTCOMES = {FINISHED: FINISHED}  # CNU's global mappings: outcome -> SM outcome
 DEFAULT_TRANSITION_OUTCOMES = (COMPLETED, FAILURE)
 
 _NAME = re.compile(r'^[A-Za-z][A-Za-z0-9_]*$')
@@ -238,7 +239,7 @@ def _read_yaml(document: dict, key: str, base_dir, system: str, required: bool =
 
 def _mappings(mappings, system: str):
     if mappings is None:
-        return dict(DEFAULT_STATE_OUTCOMES), dict(DEFAULT_SM_OUTCOMES), DEFAULT_TRANSITION_OUTCOMES
+        return dict(DEFAULT_STATE_OUTCOMES), dict(CNU_SM_OUTCOMES), DEFAULT_TRANSITION_OUTCOMES
     if not isinstance(mappings, dict):
         raise CapabilityConfigError(f'{system}: the mappings file must hold a mapping', item=MAPPINGS_KEY)
     transition_outcomes = mappings.get('transition_outcomes', list(DEFAULT_TRANSITION_OUTCOMES))

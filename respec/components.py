@@ -22,6 +22,7 @@ from dataclasses import dataclass
 from typing import Mapping, Sequence
 
 from respec import activation_outcomes as ao
+from respec.naming import FAILED, FINISHED
 from respec.ltl import Formula
 from respec.spec import FORMULA_SECTIONS, GR1Specification
 
@@ -151,7 +152,7 @@ def action_specification(actions: Mapping[str, Sequence[str]], outcomes: Sequenc
 
 def goal_groups(goals: Sequence[str], sm_outcomes: Sequence[str], strict_order: bool,
                 failure_propositions: Sequence[str], success: str = ao.COMPLETED,
-                finished: str = 'finished', failed: str = 'failed') -> list[FormulaGroup]:
+                finished: str = FINISHED, failed: str = FAILED) -> list[FormulaGroup]:
     """Formulas (16)-(20), as groups (one per goal for (16), (17) and (20))."""
     groups = _GroupList()
     for g, formula in zip(goals, ao.goal_memory_initial_conditions(goals)):
@@ -177,7 +178,7 @@ def goal_groups(goals: Sequence[str], sm_outcomes: Sequence[str], strict_order: 
 
 def goal_specification(goals: Sequence[str], sm_outcomes: Sequence[str], strict_order: bool,
                        failure_propositions: Sequence[str], success: str = ao.COMPLETED,
-                       finished: str = 'finished', failed: str = 'failed') -> GR1Specification:
+                       finished: str = FINISHED, failed: str = FAILED) -> GR1Specification:
     """Formulas (16)-(20): goal memories, state-machine outcomes and the single liveness.
 
     ``sm_outcomes`` contains ``finished`` and optionally ``failed``; ``failure_propositions``

@@ -38,6 +38,30 @@ def memory(goal: str) -> str:
     return f'{goal}{MEMORY_SUFFIX}'
 
 
+def activated(proposition: str) -> str | None:
+    """The action or control mode ``p`` an activation proposition ``p_a`` names (None: not one)."""
+    return _strip(proposition, ACTIVATION_SUFFIX)
+
+
+def is_activation(proposition: str) -> bool:
+    return activated(proposition) is not None
+
+
+def remembered(proposition: str) -> str | None:
+    """The goal ``g`` a memory proposition ``g_m`` names (None: not one)."""
+    return _strip(proposition, MEMORY_SUFFIX)
+
+
+def is_memory(proposition: str) -> bool:
+    return remembered(proposition) is not None
+
+
+def _strip(proposition: str, suffix: str) -> str | None:
+    if proposition.endswith(suffix) and len(proposition) > len(suffix):
+        return proposition[:-len(suffix)]
+    return None
+
+
 def parse_names(text) -> list[str]:
     """``'look_down, pickup_object'`` (or a list of such texts) -> ``['look_down', 'pickup_object']``."""
     if isinstance(text, (list, tuple)):

@@ -18,6 +18,7 @@ from typing import Mapping
 
 from respec.automaton import Automaton, AutomatonState
 from respec.capabilities import CapabilitySystem
+from respec.naming import activation
 from respec.parsing import IntegerVariable
 from respec.state_library import StateClass, capability_outcomes
 from sm_generation.config import FlexBEConfig, StateConfig
@@ -62,12 +63,12 @@ def _with_parameter_variants(automaton, system: CapabilitySystem):
         values.update(zip(inputs, state.input_valuation))
         active = []
         for name, capability in system.capabilities.items():
-            if not values.get(f'{name}_a'):
+            if not values.get(activation(name)):
                 continue
             chosen = {parameter: _integer_value(integers[variable], values, system.integers[variable].value_names)
                       for parameter, variable in capability.variable_parameters().items()}
             label = '_'.join(_UNSAFE.sub('_', str(v)).strip('_') or 'none' for v in chosen.values())
-            proposition = f'{name}_{label}_a' if chosen else f'{name}_a'
+            proposition = activation(f'{name}_{label}' if chosen else name)
             variants.setdefault(proposition, (name, chosen))
             active.append(proposition)
         rows.append((state, active, [bool(values.get(o)) for o in sm_props]))

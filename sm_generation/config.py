@@ -37,7 +37,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from respec.naming import ACTIVATION_SUFFIX
+from respec.naming import activated
 from respec.systems import ConfigFileInvalidError, UnknownSystemError, load_section
 from sm_generation.errors import (AutonomyConfigInvalidError, FlexBEConfigInvalidError, NoSystemConfigError,
                                   SMGenerationError, StateConfigInvalidError, SystemConfigNotFoundError,
@@ -74,9 +74,7 @@ class StateConfig:
     @property
     def label(self) -> str:
         """Readable name: the proposition without its activation suffix (``look_down_a`` -> ``look_down``)."""
-        if self.proposition.endswith(ACTIVATION_SUFFIX) and len(self.proposition) > len(ACTIVATION_SUFFIX):
-            return self.proposition[:-len(ACTIVATION_SUFFIX)]
-        return self.proposition
+        return activated(self.proposition) or self.proposition
 
     @property
     def outcomes(self) -> tuple[str, ...]:

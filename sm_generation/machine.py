@@ -29,7 +29,7 @@ from __future__ import annotations
 from collections import deque
 from dataclasses import dataclass, field
 
-from respec.naming import ACTIVATION_SUFFIX, MEMORY_SUFFIX
+from respec.naming import activation, is_memory
 from sm_generation.config import FlexBEConfig, StateConfig
 from sm_generation.errors import (AutomatonInvalidError, InitialConditionsInvalidError, InputValuationInvalidError,
                                   NextStateInvalidError, NoInitialStateError, OutputValuationInvalidError,
@@ -94,7 +94,7 @@ class AutomatonView:
         self.activation_props = [v for v in self.output_variables if v in config.states]
         self.sensor_props = [v for v in self.input_variables if v in config.states]
         for index, prop in enumerate(self.output_variables):
-            if prop in config.sm_outcomes or prop in config.states or prop.endswith(MEMORY_SUFFIX):
+            if prop in config.sm_outcomes or prop in config.states or is_memory(prop):
                 continue
             if any(state.output_valuation[index] for state in self.states.values()):
                 raise StateConfigInvalidError(f'output proposition {prop!r} is activated by the automaton but has '
@@ -247,7 +247,7 @@ class AutomatonView:
             if condition in self.input_variables:
                 props.append(condition)
                 continue
-            state = self.config.states.get(condition + ACTIVATION_SUFFIX) or self.config.states.get(condition)
+            state = self.config.states.get(activation(condition)) or self.config.states.get(condition)
             if state is None:
                 raise InitialConditionsInvalidError(
                     f'initial condition {condition!r} is neither a proposition of this automaton nor a state '

@@ -39,7 +39,7 @@ def test_empty_list():
     ('/pregrasp_pose', {'autonomy': [0, 0, 300]}, 'autonomy must be a list of int8'),
     ('/pregrasp_pose', {'position': [1.0]}, 'position must be two numbers'),
     ('/pregrasp_pose', {'outcomes': 'done'}, 'outcomes must be a list of strings'),
-    ('/pregrasp_pose', {'parameter_names': ['x']}, 'parameter_names and parameter_values'),
+    ('/pregrasp_pose', {'parameter_names': ['x', 'y']}, 'parameter_names and parameter_values'),
     ('/pregrasp_pose', {'userdata_keys': ['x']}, 'userdata_keys and userdata_remapping'),
     ('/pregrasp_pose', {'state_class': ':BEHAVIOR'}, ':BEHAVIOR without behavior_class'),
     ('/pregrasp_pose', {'state_class': ''}, 'empty state_class'),

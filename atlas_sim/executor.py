@@ -48,15 +48,17 @@ from respec.errors import CodedError
 from respec.naming import COMPLETED, activated, is_activation, outcome_proposition
 from respec.systems import system_config_path
 from sm_generation.config import load_flexbe_config
+from sm_generation.generator import DECISION_CLASS, NOTHING_CLASS
+from sm_generation.instantiation import StateInstantiation
 
 ROOT_PATH = '/'
-STATEMACHINE = ':STATEMACHINE'
-CONCURRENCY = ':CONCURRENCY'
-BEHAVIOR = ':BEHAVIOR'
-OUTCOME = ':OUTCOME'
+STATEMACHINE = StateInstantiation.CLASS_STATEMACHINE
+CONCURRENCY = StateInstantiation.CLASS_CONCURRENCY
+BEHAVIOR = StateInstantiation.CLASS_BEHAVIOR
+OUTCOME = StateInstantiation.CLASS_OUTCOME
 # The generator's helper states (flexbe_states) and how they return.
-LOG_STATE = 'LogState'
-DECISION_STATE = 'OperatorDecisionState'
+LOG_STATE = NOTHING_CLASS
+DECISION_STATE = DECISION_CLASS
 
 
 # --- errors -----------------------------------------------------------------------------------

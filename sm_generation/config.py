@@ -38,12 +38,13 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from respec.naming import activated
+from sm_generation.instantiation import StateInstantiation
 from respec.systems import ConfigFileInvalidError, UnknownSystemError, load_section
 from sm_generation.errors import (AutonomyConfigInvalidError, FlexBEConfigInvalidError, NoSystemConfigError,
                                   SMGenerationError, StateConfigInvalidError, SystemConfigNotFoundError,
                                   UserdataConfigInvalidError)
 
-BEHAVIOR_CLASS = ':BEHAVIOR'
+BEHAVIOR_CLASS = StateInstantiation.CLASS_BEHAVIOR
 # flexbe_states' state that asks the operator (flexbe/behavior_input); its ``request`` parameter
 # is a flexbe_msgs/BehaviorInput request type.
 INPUT_STATE_CLASS = 'InputState'

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from sm_generation.instantiation import StateInstantiation
+
 
 def state_machine_tree(states: list[dict]) -> str:
     """The state machine as an indented tree: containers, their states and transitions.
@@ -16,8 +18,8 @@ def state_machine_tree(states: list[dict]) -> str:
         indent = '  ' * depth
         name = '/' if path == '/' else path.rsplit('/', 1)[-1]
         kind = state['state_class']
-        if kind == ':BEHAVIOR':
-            kind = f":BEHAVIOR {state['behavior_class']}"
+        if kind == StateInstantiation.CLASS_BEHAVIOR:
+            kind = f"{kind} {state['behavior_class']}"
         details = []
         if state.get('initial_state_name'):
             details.append(f"initial: {state['initial_state_name']}")

@@ -8,7 +8,7 @@ import time
 from dataclasses import asdict, dataclass, field
 
 from respec.naming import DEFAULT_SM_OUTCOMES, parse_names
-from sm_generation.instantiation import count_states
+from sm_generation.instantiation import StateInstantiation, count_states
 from synthesis_manager.limits import oversized_strings, too_long
 from synthesis_manager.web.artifacts import available_artifacts, download_labels
 from synthesis_manager.web.errors import InvalidJobRequestError, NotFoundError
@@ -146,7 +146,7 @@ def result_summary(outcome: dict) -> dict:
         'automaton_states': automaton_states,
         'state_machine_states': count_states(states),
         'state_instantiations': len(states),
-        'concurrency_containers': sum(1 for s in states if s['state_class'] == ':CONCURRENCY'),
+        'concurrency_containers': sum(1 for s in states if s['state_class'] == StateInstantiation.CLASS_CONCURRENCY),
         'seconds': outcome.get('seconds', 0.0),
     }
 

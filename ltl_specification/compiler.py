@@ -59,7 +59,7 @@ from respec.spec import (
     merge_specifications,
 )
 from respec.state_library import StateClass, workspace_state_library
-from respec.systems import ConfigFileInvalidError, UnknownSystemError as UnknownSystemConfig
+from respec.systems import ConfigFileInvalidError, SystemNotFoundError
 
 from ltl_specification.capabilities import compile_capability_task
 from ltl_specification.errors import (
@@ -210,7 +210,7 @@ def explain(spec: CompiledSpecification) -> str:
 def load_capability_system(system: str, config_dir) -> CapabilitySystem | None:
     try:
         return capability_system_of(system, config_dir)
-    except UnknownSystemConfig as error:
+    except SystemNotFoundError as error:
         raise UnknownSystemError(str(error), item=error.item) from error
     except ConfigFileInvalidError as error:
         raise InvalidAbstractionError(str(error), item=error.item) from error
@@ -219,7 +219,7 @@ def load_capability_system(system: str, config_dir) -> CapabilitySystem | None:
 def load_task_abstraction(system: str, config_dir) -> RobotAbstraction:
     try:
         return load_abstraction(system, config_dir)
-    except UnknownSystemConfig as error:
+    except SystemNotFoundError as error:
         raise UnknownSystemError(str(error), item=error.item) from error
     except (AbstractionConfigError, ConfigFileInvalidError) as error:
         raise InvalidAbstractionError(str(error), item=error.item) from error

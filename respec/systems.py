@@ -28,7 +28,7 @@ class SystemConfigError(CodedError):
     code = 'CONFIG_FILE_INVALID'
 
 
-class UnknownSystemError(SystemConfigError):
+class SystemNotFoundError(SystemConfigError):
     """No configuration file exists for the requested system."""
 
     code = 'UNKNOWN_SYSTEM'
@@ -53,14 +53,14 @@ def available_systems(config_dir: str | Path | None = None) -> list[str]:
 
 
 def system_config_path(system: str, config_dir: str | Path | None = None) -> Path:
-    """Path of the configuration file of ``system``; raises UnknownSystemError if absent."""
+    """Path of the configuration file of ``system``; raises SystemNotFoundError if absent."""
     directory = Path(config_dir) if config_dir else default_config_dir()
     if not isinstance(system, str) or not _SYSTEM_NAME.match(system):
-        raise UnknownSystemError(f'invalid system name {system!r}', item=str(system))
+        raise SystemNotFoundError(f'invalid system name {system!r}', item=str(system))
     path = directory / f'{system}.yaml'
     if not path.is_file():
         known = ', '.join(available_systems(directory)) or 'none'
-        raise UnknownSystemError(
+        raise SystemNotFoundError(
             f'unknown system {system!r}: no {path.name} in {directory} (known systems: {known})',
             item=system)
     return path

@@ -39,7 +39,7 @@ from pathlib import Path
 
 from respec.naming import activated
 from sm_generation.instantiation import StateInstantiation
-from respec.systems import ConfigFileInvalidError, UnknownSystemError, load_section
+from respec.systems import ConfigFileInvalidError, SystemNotFoundError, load_section
 from sm_generation.errors import (AutonomyConfigInvalidError, FlexBEConfigInvalidError, NoSystemConfigError,
                                   SMGenerationError, StateConfigInvalidError, SystemConfigNotFoundError,
                                   UserdataConfigInvalidError)
@@ -129,7 +129,7 @@ def load_flexbe_config(system: str, config_dir: str | Path | None = None) -> Fle
                                         str(config_dir))
     try:
         section = load_section(system, 'flexbe', config_dir)
-    except UnknownSystemError as error:
+    except SystemNotFoundError as error:
         raise NoSystemConfigError(str(error), error.item or system) from error
     except ConfigFileInvalidError as error:
         raise FlexBEConfigInvalidError(str(error), error.item) from error

@@ -32,7 +32,7 @@ from pathlib import Path
 
 from respec.capabilities import CapabilitySystem, capability_system_of
 from respec.state_library import workspace_state_library
-from respec.systems import ConfigFileInvalidError, UnknownSystemError
+from respec.systems import ConfigFileInvalidError, SystemNotFoundError
 from sm_generation.config import FlexBEConfig, StateConfig, load_flexbe_config
 from sm_generation.errors import (FlexBEConfigInvalidError, NoSystemConfigError, SMGenerationError,
                                   SystemConfigNotFoundError)
@@ -89,7 +89,7 @@ def _capability_system(system: str, config_dir) -> CapabilitySystem | None:
         raise SystemConfigNotFoundError(f'configuration directory {config_dir} does not exist', str(config_dir))
     try:
         return capability_system_of(system, config_dir)
-    except UnknownSystemError as error:
+    except SystemNotFoundError as error:
         raise NoSystemConfigError(str(error), error.item or system) from error
     except ConfigFileInvalidError as error:
         raise FlexBEConfigInvalidError(str(error), error.item) from error

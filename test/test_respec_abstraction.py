@@ -3,7 +3,7 @@
 import pytest
 
 from respec.abstraction import AbstractionConfigError, abstraction_from_dict, load_abstraction
-from respec.systems import UnknownSystemError
+from respec.systems import SystemNotFoundError
 
 
 def section(**overrides):
@@ -57,7 +57,7 @@ def test_defaults_outcomes_and_optional_sections():
 
 
 def test_unknown_system():
-    with pytest.raises(UnknownSystemError) as caught:
+    with pytest.raises(SystemNotFoundError) as caught:
         load_abstraction('no_such_robot')
     assert caught.value.item == 'no_such_robot'
 

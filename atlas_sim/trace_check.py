@@ -53,7 +53,7 @@ from __future__ import annotations
 from dataclasses import asdict, dataclass, field
 
 from respec.errors import CodedError
-from respec.ltl import And, Const, Formula, Iff, Implies, Next, Not, Or, Var, mentions_next, to_infix
+from respec.ltl import Formula, Next, mentions_next, partial_evaluate, to_infix
 from respec.naming import COMPLETED, DEFAULT_SM_OUTCOMES, FINISHED, is_activation, outcome_proposition, remembered
 from respec.spec import GR1Specification
 
@@ -148,37 +148,6 @@ class OutcomeTracker:
 
 
 # --- three-valued evaluation ----------------------------------------------------------------
-
-def partial_evaluate(formula: Formula, current: dict, next_step: dict):
-    """Kleene truth value of ``formula`` on a step: True, False, or None if it depends on
-    variables missing from the valuations (strong Kleene logic, so partial assignments can
-    already refute a formula)."""
-    if isinstance(formula, Const):
-        return formula.value
-    if isinstance(formula, Var):
-        return current.get(formula.name)
-    if isinstance(formula, Next):
-        return partial_evaluate(formula.arg, next_step, {})
-    if isinstance(formula, Not):
-        value = partial_evaluate(formula.arg, current, next_step)
-        return None if value is None else not value
-    if isinstance(formula, (And, Or)):
-        absorbing = isinstance(formula, Or)  # True absorbs a disjunction, False a conjunction
-        unknown = False
-        for arg in formula.args:
-            value = partial_evaluate(arg, current, next_step)
-            if value is absorbing:
-                return absorbing
-            unknown |= value is None
-        return None if unknown else not absorbing
-    if isinstance(formula, Implies):
-        return partial_evaluate(Or((Not(formula.left), formula.right)), current, next_step)
-    if isinstance(formula, Iff):
-        left = partial_evaluate(formula.left, current, next_step)
-        right = partial_evaluate(formula.right, current, next_step)
-        return None if left is None or right is None else left == right
-    raise TypeError(f'not a formula: {formula!r}')
-
 
 def least_violating_assignments(formulas, current: dict, next_known: dict, unknown: list[str],
                                 first_only: bool = False):

@@ -137,9 +137,9 @@ def _activations(spec: CapabilitySpecification, parts: dict) -> None:
                            for i, a in enumerate(activities) for b in activities[i + 1:]]
     parts['sys_init'] += [neg(conj([var(a), var(b)])) for i, a in enumerate(activities) for b in activities[i + 1:]]
     parts['sys_trans'] += [implies(var(o), next_(var(o))) for o in spec.sm_props]
-    for name, activation in spec.activations.items():
-        parts['sys_trans'].append(implies(conj([var(activation), neg(spec.outcome_next(name))]),
-                                          next_(var(activation))))
+    for name, active in spec.activations.items():
+        parts['sys_trans'].append(implies(conj([var(active), neg(spec.outcome_next(name))]),
+                                          next_(var(active))))
 
 
 def _conditions(spec: CapabilitySpecification, parts: dict) -> dict[str, list[Formula]]:

@@ -265,3 +265,34 @@ def evaluate(formula: Formula, current: dict[str, bool], next_step: dict[str, bo
     if isinstance(formula, Iff):
         return evaluate(formula.left, current, next_step) == evaluate(formula.right, current, next_step)
     raise TypeError(f'not a formula: {formula!r}')
+
+
+def partial_evaluate(formula: Formula, current: dict, next_step: dict):
+    """Kleene truth value of ``formula`` on a step: True, False, or None if it depends on
+    variables missing from the valuations (strong Kleene logic, so partial assignments can
+    already refute a formula)."""
+    if isinstance(formula, Const):
+        return formula.value
+    if isinstance(formula, Var):
+        return current.get(formula.name)
+    if isinstance(formula, Next):
+        return partial_evaluate(formula.arg, next_step, {})
+    if isinstance(formula, Not):
+        value = partial_evaluate(formula.arg, current, next_step)
+        return None if value is None else not value
+    if isinstance(formula, (And, Or)):
+        absorbing = isinstance(formula, Or)  # True absorbs a disjunction, False a conjunction
+        unknown = False
+        for arg in formula.args:
+            value = partial_evaluate(arg, current, next_step)
+            if value is absorbing:
+                return absorbing
+            unknown |= value is None
+        return None if unknown else not absorbing
+    if isinstance(formula, Implies):
+        return partial_evaluate(Or((Not(formula.left), formula.right)), current, next_step)
+    if isinstance(formula, Iff):
+        left = partial_evaluate(formula.left, current, next_step)
+        right = partial_evaluate(formula.right, current, next_step)
+        return None if left is None or right is None else left == right
+    raise TypeError(f'not a formula: {formula!r}')

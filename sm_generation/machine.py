@@ -135,12 +135,12 @@ class AutomatonView:
         """What FlexBE sees when the automaton moves from ``source`` to ``target``."""
         now, before = self.inputs(target), self.inputs(source)
         pairs = []
-        for activation in activations:
-            seen = [p for p in self.config.states[activation].output_mapping if now.get(p)]
+        for active in activations:
+            seen = [p for p in self.config.states[active].output_mapping if now.get(p)]
             if len(seen) > 1:
-                raise InputValuationInvalidError(f'state {target!r} reports several outcomes of {activation!r} '
+                raise InputValuationInvalidError(f'state {target!r} reports several outcomes of {active!r} '
                                                  f'at once: {", ".join(seen)}', target)
-            pairs.extend((activation, p) for p in seen)
+            pairs.extend((active, p) for p in seen)
         for sensor in self.sensor_props:
             if now[sensor] and not before[sensor]:
                 pairs.append((sensor, sensor))

@@ -352,8 +352,10 @@ class BehaviorSynthesisServer(Node):
         (``details`` alone when there is no diagnosis within diagnosis_timeout). A cancel or
         shutdown ends the diagnosis at once."""
         custom_ltl = msg_to_sections(task.custom_ltl) if task.custom_ltl is not None else None
-        arguments = (details, task.system, task.initial_conditions, task.goals, task.sm_outcomes,
-                     not task.unordered_goals, custom_ltl or None)
+        # The same robot configuration as the compilation node's (config_dir), by keyword.
+        arguments = dict(details=details, system=task.system, initial_conditions=task.initial_conditions,
+                         goals=task.goals, sm_outcomes=task.sm_outcomes, strict_order=not task.unordered_goals,
+                         custom_ltl=custom_ltl or None, config_dir=self.parameter('config_dir') or None)
         deadline = time.monotonic() + self.parameter('diagnosis_timeout')
         stop = threading.Event()
 
@@ -370,10 +372,10 @@ class BehaviorSynthesisServer(Node):
             raise ServerStopping('diagnosis: the server is shutting down', 'diagnosis')
         return message
 
-    def _diagnosis(self, arguments: tuple, deadline: float, stop: threading.Event, details: str) -> str:
+    def _diagnosis(self, arguments: dict, deadline: float, stop: threading.Event, details: str) -> str:
         try:
             # The diagnosis keeps its own deadline; the child is killed only if it overruns.
-            return self.diagnosis_processes.call(DIAGNOSIS, arguments, {'deadline': deadline}, cancel=stop,
+            return self.diagnosis_processes.call(DIAGNOSIS, (), {**arguments, 'deadline': deadline}, cancel=stop,
                                                  deadline=deadline + DIAGNOSIS_GRACE)
         except SynthesisError:  # stopped, out of time, or its process died: the verdict stands without it
             return details

@@ -199,7 +199,9 @@ def test_a_cancel_ends_the_diagnosis_at_once(suite, endless_diagnosis):
 
     def on_feedback(status, _):
         if status.startswith('Diagnosing') and not cancel.is_set():
-            time.sleep(0.5)  # the diagnosis process is busy by now
+            deadline = time.monotonic() + 20  # the diagnosis process is busy once it wrote its pid
+            while not endless_diagnosis.exists() and time.monotonic() < deadline:
+                time.sleep(0.05)
             cancelled_at.append(time.monotonic())
             cancel.set()
 

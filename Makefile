@@ -68,7 +68,7 @@ $(VENV)/.msgs-installed: $(MSGS_SOURCES) $(VENV)/.project-installed
 	touch $@
 
 # FlexBE from FLEXBE_SOURCES: flexbe_msgs and then CNU's flexbe_synthesis_msgs built like
-# synthesis_msgs (through our wrapper projects, the snapshots stay untouched), flexbe_core/flexbe_states/flexbe_onboard and our
+# synthesis_msgs (through our wrapper project, the snapshots stay untouched), flexbe_core/flexbe_states/flexbe_onboard and our
 # FlexBE packages importable through a .pth file, a tf2_ros stand-in last on the path (only
 # found when no real tf2_ros is installed), and the FlexBE packages registered in an ament
 # index under $(FLEXBE_PREFIX).
@@ -87,43 +87,39 @@ flexbe: setup $(VENV)/.flexbe-msgs-installed $(VENV)/.flexbe-synthesis-msgs-inst
 	$(BIN)/python -c 'import flexbe_core, flexbe_states, flexbe_msgs.action, flexbe_synthesis_msgs.action, atlas_sim_flexbe_states, atlas_sim_flexbe_behaviors'
 	@echo "FlexBE from $(FLEXBE_SOURCES); FlexBE packages indexed under AMENT_PREFIX_PATH=$(abspath $(FLEXBE_PREFIX))"
 
-# Configured in build/: a source folder holding our wrapper CMakeLists.txt next to the
-# snapshot's package.xml (ament installs package.xml from the source folder).
-$(VENV)/.flexbe-msgs-installed: test/flexbe_env/flexbe_msgs/CMakeLists.txt $(VENV)/.project-installed \
+# FlexBE's interface packages, unmodified, through our wrapper project: configured in build/ in
+# a source folder holding the wrapper next to the package's own package.xml (ament installs
+# package.xml from the source folder). $(1) package, $(2) its folder, $(3) its interface
+# dependencies (;-separated), $(4) build folder.
+INTERFACES_WRAPPER := test/flexbe_env/interfaces/CMakeLists.txt
+define build_interfaces
+rm -rf $(4) && mkdir -p $(4)/source $(4)/build
+ln -s $(abspath $(INTERFACES_WRAPPER)) $(4)/source/CMakeLists.txt
+ln -s $(abspath $(2))/package.xml $(4)/source/package.xml
+cd $(4)/build && \
+  AMENT_PREFIX_PATH=$(abspath $(VENV)) PATH=$(abspath $(BIN)):$$PATH \
+  cmake ../source -DPACKAGE_NAME=$(1) -DINTERFACES_DIR=$(abspath $(2)) '-DINTERFACE_DEPENDENCIES=$(3)' \
+    -DCMAKE_INSTALL_PREFIX=$(abspath $(VENV)) \
+    -DCMAKE_PREFIX_PATH=$(abspath $(VENV)) -DPython3_EXECUTABLE=$(abspath $(BIN)/python) \
+    -DBUILD_TESTING=OFF > cmake-configure.log && \
+  AMENT_PREFIX_PATH=$(abspath $(VENV)) PATH=$(abspath $(BIN)):$$PATH \
+  cmake --build . -j2 > cmake-build.log && cmake --install . > cmake-install.log
+endef
+
+$(VENV)/.flexbe-msgs-installed: $(INTERFACES_WRAPPER) $(VENV)/.project-installed \
     $(wildcard $(FLEXBE_ENGINE)/flexbe_msgs/package.xml $(FLEXBE_ENGINE)/flexbe_msgs/*/*)
 	@test -f "$(FLEXBE_ENGINE)/flexbe_msgs/package.xml" || \
 	  { echo "FlexBE sources not found: set FLEXBE_SOURCES to the folder holding flexbe_behavior_engine/ (got '$(FLEXBE_SOURCES)')" >&2; exit 1; }
-	rm -rf $(FLEXBE_MSGS_BUILD) && mkdir -p $(FLEXBE_MSGS_BUILD)/source $(FLEXBE_MSGS_BUILD)/build
-	ln -s $(abspath test/flexbe_env/flexbe_msgs/CMakeLists.txt) $(FLEXBE_MSGS_BUILD)/source/CMakeLists.txt
-	ln -s $(abspath $(FLEXBE_ENGINE))/flexbe_msgs/package.xml $(FLEXBE_MSGS_BUILD)/source/package.xml
-	cd $(FLEXBE_MSGS_BUILD)/build && \
-	  AMENT_PREFIX_PATH=$(abspath $(VENV)) PATH=$(abspath $(BIN)):$$PATH \
-	  cmake ../source -DFLEXBE_MSGS_DIR=$(abspath $(FLEXBE_ENGINE))/flexbe_msgs \
-	    -DCMAKE_INSTALL_PREFIX=$(abspath $(VENV)) \
-	    -DCMAKE_PREFIX_PATH=$(abspath $(VENV)) -DPython3_EXECUTABLE=$(abspath $(BIN)/python) \
-	    -DBUILD_TESTING=OFF > cmake-configure.log && \
-	  AMENT_PREFIX_PATH=$(abspath $(VENV)) PATH=$(abspath $(BIN)):$$PATH \
-	  cmake --build . -j2 > cmake-build.log && cmake --install . > cmake-install.log
+	$(call build_interfaces,flexbe_msgs,$(FLEXBE_ENGINE)/flexbe_msgs,action_msgs;std_msgs;builtin_interfaces,$(FLEXBE_MSGS_BUILD))
 	touch $@
 
 # CNU's package the same way, against the flexbe_msgs above (its result carries
 # flexbe_msgs/StateInstantiation[]).
-$(VENV)/.flexbe-synthesis-msgs-installed: test/flexbe_env/flexbe_synthesis_msgs/CMakeLists.txt \
-    $(VENV)/.flexbe-msgs-installed \
+$(VENV)/.flexbe-synthesis-msgs-installed: $(INTERFACES_WRAPPER) $(VENV)/.flexbe-msgs-installed \
     $(wildcard $(FLEXBE_SYNTHESIS_MSGS)/package.xml $(FLEXBE_SYNTHESIS_MSGS)/msg/* $(FLEXBE_SYNTHESIS_MSGS)/srv/* $(FLEXBE_SYNTHESIS_MSGS)/action/*)
 	@test -f "$(FLEXBE_SYNTHESIS_MSGS)/package.xml" || \
 	  { echo "CNU's flexbe_synthesis_msgs not found: set FLEXBE_SYNTHESIS_MSGS to its folder (got '$(FLEXBE_SYNTHESIS_MSGS)')" >&2; exit 1; }
-	rm -rf $(FLEXBE_SYNTHESIS_MSGS_BUILD) && mkdir -p $(FLEXBE_SYNTHESIS_MSGS_BUILD)/source $(FLEXBE_SYNTHESIS_MSGS_BUILD)/build
-	ln -s $(abspath test/flexbe_env/flexbe_synthesis_msgs/CMakeLists.txt) $(FLEXBE_SYNTHESIS_MSGS_BUILD)/source/CMakeLists.txt
-	ln -s $(abspath $(FLEXBE_SYNTHESIS_MSGS))/package.xml $(FLEXBE_SYNTHESIS_MSGS_BUILD)/source/package.xml
-	cd $(FLEXBE_SYNTHESIS_MSGS_BUILD)/build && \
-	  AMENT_PREFIX_PATH=$(abspath $(VENV)) PATH=$(abspath $(BIN)):$$PATH \
-	  cmake ../source -DFLEXBE_SYNTHESIS_MSGS_DIR=$(abspath $(FLEXBE_SYNTHESIS_MSGS)) \
-	    -DCMAKE_INSTALL_PREFIX=$(abspath $(VENV)) \
-	    -DCMAKE_PREFIX_PATH=$(abspath $(VENV)) -DPython3_EXECUTABLE=$(abspath $(BIN)/python) \
-	    -DBUILD_TESTING=OFF > cmake-configure.log && \
-	  AMENT_PREFIX_PATH=$(abspath $(VENV)) PATH=$(abspath $(BIN)):$$PATH \
-	  cmake --build . -j2 > cmake-build.log && cmake --install . > cmake-install.log
+	$(call build_interfaces,flexbe_synthesis_msgs,$(FLEXBE_SYNTHESIS_MSGS),action_msgs;flexbe_msgs,$(FLEXBE_SYNTHESIS_MSGS_BUILD))
 	touch $@
 
 $(WEBUI_SITE)/.installed: | $(BIN)/python

@@ -20,7 +20,10 @@ Modules (MuJoCo is imported only by ``physics``, ``simulator``, ``rendering``)
                 arm_sequence, compute, operator_input.
 ``physics``     ``HumanoidPhysics``: model loading, targets, fall detection.
 ``simulator``   ``AtlasSimulator``, ``Request``, ``RequestResult``.
+``operator_data`` the data operator inputs provide (template id, target pose) and its checks.
 ``rendering``   ``FrameRenderer``, ``KeyFrameRecorder``, ``save_png``.
+``robot``       the ``Robot`` protocol, ``SimulatedRobot``, ``make_simulator``, ``parse_faults``.
+``machine``     a StateInstantiation list as a validated tree (``load_machine``).
 ``executor``    runs a synthesized state machine on a robot (``execute_state_machine``).
 ``trace_check`` checks an executed trace against the specification and the goal order.
 ``closed_loop`` ``run_and_check``: execute, record key frames, check, draw the timeline.

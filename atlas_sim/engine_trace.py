@@ -29,7 +29,8 @@ from __future__ import annotations
 import contextlib
 import threading
 
-from atlas_sim.executor import ExecutionResult, StateMapping, entered_step, load_machine
+from atlas_sim.executor import ExecutionResult, StateMapping, entered_step
+from atlas_sim.machine import load_machine
 from atlas_sim.trace_check import OutcomeTracker, Trace, TraceStep
 
 

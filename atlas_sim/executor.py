@@ -24,8 +24,9 @@ children did) keeps running, as its activation proposition stays true; a running
 that the next state does not activate is abandoned (the robot cannot cancel it) and
 whatever it still reports is recorded, so the trace check sees it.
 
-The robot is anything with the :class:`Robot` protocol: :class:`SimulatedRobot` drives an
-``AtlasSimulator`` directly; ``synthesis_manager.nodes.atlas_sim_robot.RosRobot`` drives the simulator node.
+The robot is anything with the :class:`atlas_sim.robot.Robot` protocol: ``SimulatedRobot`` drives
+an ``AtlasSimulator`` directly; ``synthesis_manager.nodes.atlas_sim_robot.RosRobot`` drives the
+simulator node. The machine is read and validated by :mod:`atlas_sim.machine`.
 
     sim = make_simulator('atlas', initial_conditions=['stand_prep'])
     run = execute_state_machine(states, SimulatedRobot(sim), system='atlas')
@@ -34,50 +35,21 @@ The robot is anything with the :class:`Robot` protocol: :class:`SimulatedRobot` 
 
 from __future__ import annotations
 
-import dataclasses
 import re
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Callable, Protocol, Sequence
+from typing import Any, Callable
 
-from atlas_sim.config import load_system_config
+from atlas_sim.machine import (BEHAVIOR, CONCURRENCY, DECISION_STATE, LOG_STATE, ExecutionError, StateNode,
+                               UndeclaredOutcomeError, load_machine)
+from atlas_sim.robot import CapabilityResult, Robot
 from atlas_sim.trace_check import OutcomeTracker, Trace, TraceStep
 from respec.abstraction import load_abstraction
-from respec.errors import CodedError
-from respec.naming import COMPLETED, activated, is_activation, outcome_proposition
-from respec.systems import system_config_path
+from respec.naming import activated, is_activation, outcome_proposition
 from sm_generation.config import load_flexbe_config
-from sm_generation.generator import DECISION_CLASS, NOTHING_CLASS
-from sm_generation.instantiation import StateInstantiation
-
-ROOT_PATH = '/'
-STATEMACHINE = StateInstantiation.CLASS_STATEMACHINE
-CONCURRENCY = StateInstantiation.CLASS_CONCURRENCY
-BEHAVIOR = StateInstantiation.CLASS_BEHAVIOR
-OUTCOME = StateInstantiation.CLASS_OUTCOME
-# The generator's helper states (flexbe_states) and how they return.
-LOG_STATE = NOTHING_CLASS
-DECISION_STATE = DECISION_CLASS
-
 
 # --- errors -----------------------------------------------------------------------------------
-
-class ExecutionError(CodedError):
-    """The run could not go on; ``item`` names the offending state, ``trace`` holds what ran."""
-
-    code = 'BEHAVIOR_SYNTHESIS_FAILED'
-
-    def __init__(self, message: str, item: str, trace: Trace | None = None):
-        super().__init__(message, item)
-        self.trace = trace
-
-
-class MachineInvalidError(ExecutionError):
-    """The StateInstantiation list is not a machine this executive can run."""
-
-    code = 'INVALID_REQUEST'
-
 
 class UnmappedStateError(ExecutionError):
     """A state whose class/parameters match no entry of the system's ``flexbe.states``."""
@@ -85,234 +57,10 @@ class UnmappedStateError(ExecutionError):
     code = 'CONFIG_VARIABLE_CONFIG_INVALID'
 
 
-class UndeclaredOutcomeError(ExecutionError):
-    """A state returned an outcome that it does not declare (so it has no transition)."""
-
-    code = 'AUTOMATON_INVALID'
-
-
 class ExecutionLimitError(ExecutionError):
     """The run reached its robot-time or state-count limit without an SM outcome."""
 
     code = 'TIMEOUT'
-
-
-class InitialConditionError(CodedError, ValueError):
-    """An initial condition the simulator cannot start in; ``item`` names it."""
-
-    code = 'INVALID_INITIAL_CONDITIONS'
-
-
-class FaultSpecError(CodedError, ValueError):
-    """A malformed fault ('capability:k') or one naming an unknown capability; ``item`` names it."""
-
-    code = 'INVALID_REQUEST'
-
-
-# --- the robot ---------------------------------------------------------------------------------
-
-@dataclass(frozen=True)
-class CapabilityResult:
-    """How one activation of a capability ended, on the robot's clock."""
-
-    capability: str
-    outcome: str  # 'completed' or 'failed'
-    reason: str
-    time: float
-
-
-class Robot(Protocol):
-    """What the executive needs from a robot (or its simulator)."""
-
-    def start_concurrently(self, capabilities: Sequence[str]) -> list[Any]:
-        """Start capabilities in one instant; returns one opaque handle per capability."""
-
-    def step(self) -> None:
-        """Let the robot run for a short while (one control period)."""
-
-    def result(self, handle) -> CapabilityResult | None:
-        """The result of a started capability, or None while it runs."""
-
-    def snapshot(self) -> dict:
-        """Robot state: at least time, mode, completed_actions, sensors, pelvis_height, fallen."""
-
-
-class SimulatedRobot:
-    """The :class:`Robot` protocol on an in-process ``AtlasSimulator`` (fast: no ROS)."""
-
-    def __init__(self, simulator):
-        self.simulator = simulator
-
-    def start_concurrently(self, capabilities):
-        return self.simulator.start_concurrently(list(capabilities))
-
-    def step(self) -> None:
-        self.simulator.step()
-
-    def result(self, handle) -> CapabilityResult | None:
-        done = handle.result
-        return None if done is None else CapabilityResult(done.name, done.outcome, done.reason, done.finished_at)
-
-    def snapshot(self) -> dict:
-        return self.simulator.snapshot()
-
-
-def parse_faults(fail=(), fail_first=(), probability=()) -> dict:
-    """Fault entries (``simulation.faults`` shape) from command-line style lists.
-
-    ``fail``: capability names that always fail; ``fail_first``: 'capability:k' (the first
-    k attempts fail); ``probability``: 'capability:p'. Raises FaultSpecError naming the entry.
-    """
-    faults: dict[str, dict] = {}
-    for name in fail:
-        faults.setdefault(name, {})['always'] = True
-    for entry, key, convert in [(e, 'fail_first', int) for e in fail_first] + \
-                               [(e, 'probability', float) for e in probability]:
-        name, _, value = entry.partition(':')
-        try:
-            faults.setdefault(name.strip(), {})[key] = convert(value)
-        except ValueError:
-            raise FaultSpecError(f'expected CAPABILITY:{"K" if convert is int else "P"}, got {entry!r}',
-                                 item=entry) from None
-    return faults
-
-
-def make_simulator(system: str = 'atlas', config_dir: str | Path | None = None, initial_conditions=(),
-                   faults: dict | None = None, seed: int | None = None, **simulation_changes):
-    """An ``AtlasSimulator`` for ``system``, started in the given initial conditions.
-
-    ``initial_conditions`` name at most one control mode (the initial mode; default: the
-    config's) and actions that have already completed. ``faults`` (capability -> entry of
-    ``simulation.faults``) are added to the config's, ``seed`` replaces its seed.
-    """
-    from atlas_sim.simulator import AtlasSimulator  # here: importing the executor needs no MuJoCo
-
-    config = load_system_config(system_config_path(system, config_dir))
-    modes = [c for c in initial_conditions if c in config.abstraction.control_modes]
-    actions = [c for c in initial_conditions if c in config.abstraction.actions]
-    unknown = [c for c in initial_conditions if c not in modes and c not in actions]
-    if unknown:
-        raise InitialConditionError(f'initial condition {unknown[0]!r} is neither a control mode nor an '
-                                    f'action of {system}', item=unknown[0])
-    if len(modes) > 1:
-        raise InitialConditionError(f'initial conditions name several control modes: {modes[0]!r} and '
-                                    f'{modes[1]!r}', item=modes[1])
-    capabilities = {*config.abstraction.control_modes, *config.abstraction.actions}
-    for name in faults or {}:
-        if name not in capabilities:
-            raise FaultSpecError(f'fault for {name!r}, which is not a capability of {system}', item=name)
-    changes = dict(simulation_changes)
-    if modes:
-        changes['initial_mode'] = modes[0]
-    if faults:
-        changes['faults'] = {**config.simulation.faults, **faults}
-    if seed is not None:
-        changes['seed'] = int(seed)
-    config = dataclasses.replace(config, simulation=dataclasses.replace(config.simulation, **changes))
-    simulator = AtlasSimulator(config)
-    for action in actions:  # completed before the run: as if they had just reported completion
-        simulator.semantics.finish(simulator.state, action, COMPLETED)
-    return simulator
-
-
-# --- the machine -----------------------------------------------------------------------------
-
-@dataclass
-class StateNode:
-    """One entry of the StateInstantiation list, as the executive needs it."""
-
-    path: str
-    state_class: str
-    behavior_class: str = ''
-    parameter_values: tuple[str, ...] = ()
-    outcomes: list[str] = field(default_factory=list)
-    transitions: list[str] = field(default_factory=list)
-    initial_state_name: str = ''
-    conditions: list[tuple[str, list[tuple[str, str]]]] = field(default_factory=list)
-    children: list[StateNode] = field(default_factory=list)
-
-    @property
-    def name(self) -> str:
-        return self.path.rstrip('/').rsplit('/', 1)[-1]
-
-    def next_target(self, outcome: str) -> str:
-        if outcome not in self.outcomes:
-            raise UndeclaredOutcomeError(f'state {self.path!r} returned {outcome!r}, which is not one of its '
-                                         f'outcomes {self.outcomes}', item=self.path)
-        return self.transitions[self.outcomes.index(outcome)]
-
-
-def _as_dict(entry) -> dict:
-    if isinstance(entry, dict):
-        return entry
-    if hasattr(entry, 'to_dict'):
-        return entry.to_dict()
-    raise MachineInvalidError(f'not a StateInstantiation: {entry!r}', item=repr(entry)[:60])
-
-
-def load_machine(states) -> StateNode:
-    """The root node with its top-level states (and their children), validated."""
-    entries = [_as_dict(e) for e in states]
-    nodes: dict[str, StateNode] = {}
-    for entry in entries:
-        path = str(entry.get('state_path', ''))
-        if not path.startswith('/'):
-            raise MachineInvalidError(f'state path {path!r} does not start with "/"', item=path)
-        if path in nodes:
-            raise MachineInvalidError(f'two entries have the state path {path!r}', item=path)
-        outcomes, transitions = list(entry.get('outcomes', [])), list(entry.get('transitions', []))
-        if len(outcomes) != len(transitions) and entry.get('state_class') != OUTCOME:
-            raise MachineInvalidError(f'state {path!r} has {len(outcomes)} outcomes but '
-                                      f'{len(transitions)} transitions', item=path)
-        conditions = []
-        for outcome, condition in zip(entry.get('cond_outcome', []), entry.get('cond_transition', [])):
-            condition = condition if isinstance(condition, dict) else condition.to_dict()
-            conditions.append((str(outcome), list(zip(condition['state_name'], condition['state_outcome']))))
-        nodes[path] = StateNode(
-            path=path, state_class=str(entry.get('state_class', '')),
-            behavior_class=str(entry.get('behavior_class', '')),
-            parameter_values=tuple(str(v) for v in entry.get('parameter_values', [])),
-            outcomes=outcomes, transitions=transitions,
-            initial_state_name=str(entry.get('initial_state_name', '')), conditions=conditions)
-    root = nodes.get(ROOT_PATH)
-    if root is None or root.state_class != STATEMACHINE:
-        raise MachineInvalidError('no root entry (state_path "/", class :STATEMACHINE)', item=ROOT_PATH)
-    for path, node in nodes.items():
-        if path == ROOT_PATH or node.state_class == OUTCOME:
-            continue
-        parent = nodes.get(path.rsplit('/', 1)[0] or ROOT_PATH)
-        if parent is None:
-            raise MachineInvalidError(f'state {path!r} has no parent entry', item=path)
-        if parent is not root and parent.state_class != CONCURRENCY:
-            raise MachineInvalidError(f'state {path!r} is nested in {parent.path!r} ({parent.state_class}); '
-                                      'only concurrency containers may hold states here', item=path)
-        parent.children.append(node)
-    _validate_targets(root)
-    return root
-
-
-def _validate_targets(root: StateNode) -> None:
-    names = {child.name for child in root.children}
-    if root.initial_state_name not in names:
-        raise MachineInvalidError(f'initial state {root.initial_state_name!r} is not a state of the machine',
-                                  item=root.initial_state_name)
-    for state in root.children:
-        for target in state.transitions:
-            if target not in names and target not in root.outcomes:
-                raise MachineInvalidError(f'state {state.path!r} leads to {target!r}, which is neither a state '
-                                          'nor an outcome of the machine', item=state.path)
-        if state.state_class == CONCURRENCY:
-            if not state.children:
-                raise MachineInvalidError(f'container {state.path!r} has no states', item=state.path)
-            inner = {child.name for child in state.children}
-            for outcome, condition in state.conditions:
-                if outcome not in state.outcomes:
-                    raise MachineInvalidError(f'container {state.path!r} has condition outcome {outcome!r} '
-                                              'that it does not declare', item=state.path)
-                for name, _ in condition:
-                    if name not in inner:
-                        raise MachineInvalidError(f'a condition of {state.path!r} names {name!r}, which is '
-                                                  'not one of its states', item=state.path)
 
 
 # --- mapping states to capabilities ---------------------------------------------------------------
@@ -580,7 +328,5 @@ def execute_state_machine(states, robot: Robot, system: str = 'atlas', config_di
     return Executive(states, robot, StateMapping(system, config_dir), **options).run()
 
 
-__all__ = ['Robot', 'SimulatedRobot', 'CapabilityResult', 'make_simulator', 'parse_faults',
-           'execute_state_machine', 'Executive', 'ExecutionResult', 'StateMapping', 'load_machine',
-           'ExecutionError', 'MachineInvalidError', 'UnmappedStateError', 'UndeclaredOutcomeError',
-           'ExecutionLimitError', 'InitialConditionError', 'FaultSpecError']
+__all__ = ['execute_state_machine', 'Executive', 'ExecutionResult', 'StateMapping', 'UnmappedStateError',
+           'ExecutionLimitError']

@@ -37,7 +37,8 @@ def synthesized_machine(initial_conditions, goals, sm_outcomes):
 
 
 def run_direct(states, initial_conditions, faults):
-    from atlas_sim.executor import SimulatedRobot, execute_state_machine, make_simulator, parse_faults
+    from atlas_sim.executor import execute_state_machine
+    from atlas_sim.robot import SimulatedRobot, make_simulator, parse_faults
 
     simulator = make_simulator('atlas', initial_conditions=initial_conditions, faults=parse_faults(**faults))
     started = time.perf_counter()
@@ -49,7 +50,8 @@ def run_over_ros(states, initial_conditions, faults, speed):
     from rclpy.node import Node
     from rclpy.parameter import Parameter
 
-    from atlas_sim.executor import execute_state_machine, make_simulator, parse_faults
+    from atlas_sim.executor import execute_state_machine
+    from atlas_sim.robot import make_simulator, parse_faults
     from synthesis_manager.nodes.atlas_sim_node import AtlasSimNode
     from synthesis_manager.nodes.atlas_sim_robot import RosRobot
     from synthesis_manager.ros.harness import RosHarness
@@ -70,7 +72,7 @@ def run_on_flexbe_engine(states, initial_conditions, faults, speed):
     """The real FlexBE engine (flexbe_core from `make flexbe`) drives the simulator node."""
     from rclpy.parameter import Parameter
 
-    from atlas_sim.executor import make_simulator, parse_faults
+    from atlas_sim.robot import make_simulator, parse_faults
     from synthesis_manager.nodes.atlas_sim_node import AtlasSimNode
     from synthesis_manager.ros.flexbe_engine import run_on_flexbe
     from synthesis_manager.ros.harness import RosHarness

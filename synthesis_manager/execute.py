@@ -49,7 +49,7 @@ import sys
 from pathlib import Path
 
 from atlas_sim.closed_loop import DeferredEvents, run_and_check
-from atlas_sim.executor import ExecutionError
+from atlas_sim.machine import ExecutionError
 from respec.parsing import spec_from_text_sections
 from synthesis_manager.send_goal import ProgressBar, add_goal_arguments, goal_from_args, print_summary
 from synthesis_manager.suite import SuiteUnavailable, add_suite_arguments, in_process_suite
@@ -95,7 +95,7 @@ def add_arguments(parser):
 
 
 def run(args) -> int:
-    from atlas_sim.executor import FaultSpecError, InitialConditionError, make_simulator, parse_faults
+    from atlas_sim.robot import FaultSpecError, InitialConditionError, make_simulator, parse_faults
     from ltl_specification.errors import InvalidInitialConditionsError
     from ltl_specification.initial_conditions import asks_for_robot_state
     from respec.systems import SystemConfigError
@@ -164,7 +164,7 @@ class _Session:
             if self.uses_ros_sim:
                 self._robot = _ros_robot(self.ros, self.args, self.simulator)
             else:
-                from atlas_sim.executor import SimulatedRobot
+                from atlas_sim.robot import SimulatedRobot
 
                 self._robot = SimulatedRobot(self.simulator), None
         return self._robot

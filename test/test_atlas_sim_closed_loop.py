@@ -9,7 +9,8 @@ import math
 
 import pytest
 
-from atlas_sim.executor import SimulatedRobot, execute_state_machine, make_simulator, parse_faults
+from atlas_sim.executor import execute_state_machine
+from atlas_sim.robot import SimulatedRobot, make_simulator, parse_faults
 from atlas_sim.trace_check import check_trace
 from ltl_specification import compile_task
 from ltl_synthesizer import synthesize

@@ -6,7 +6,8 @@ outcomes; the recorded trace must check clean and match what our executive recor
 """
 
 from atlas_sim.engine_trace import EngineTraceRecorder
-from atlas_sim.executor import SimulatedRobot, execute_state_machine, make_simulator
+from atlas_sim.executor import execute_state_machine
+from atlas_sim.robot import SimulatedRobot, make_simulator
 from atlas_sim.trace_check import check_trace
 from ltl_specification import compile_task
 from ltl_synthesizer import synthesize

@@ -2,10 +2,10 @@
 
 import pytest
 
-from atlas_sim.executor import (CapabilityResult, ExecutionLimitError, FaultSpecError, InitialConditionError,
-                                MachineInvalidError, SimulatedRobot, UndeclaredOutcomeError,
-                                UnmappedStateError, execute_state_machine, load_machine, make_simulator,
-                                parse_faults)
+from atlas_sim.executor import ExecutionLimitError, UnmappedStateError, execute_state_machine
+from atlas_sim.machine import MachineInvalidError, UndeclaredOutcomeError, load_machine
+from atlas_sim.robot import (CapabilityResult, FaultSpecError, InitialConditionError, SimulatedRobot, make_simulator,
+                             parse_faults)
 from atlas_sim.trace_check import check_trace
 from ltl_specification import compile_task
 from sm_generation import StateInstantiation

@@ -10,7 +10,7 @@ import pytest
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 
-from atlas_sim.executor import make_simulator, parse_faults
+from atlas_sim.robot import make_simulator, parse_faults
 from synthesis_manager.nodes.atlas_sim_node import AtlasSimNode
 from atlas_sim.trace_check import check_trace
 from ltl_specification import compile_task

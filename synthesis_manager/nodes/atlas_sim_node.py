@@ -37,7 +37,7 @@ from rclpy.action import ActionServer, CancelResponse, GoalResponse
 from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.node import Node
 
-from atlas_sim.executor import make_simulator, parse_faults
+from atlas_sim.robot import make_simulator, parse_faults
 from atlas_sim.operator_data import decode_userdata
 from respec.naming import parse_names
 from synthesis_manager.ros.errors import log_internal_error

@@ -15,7 +15,7 @@ from pathlib import Path
 from typing import Callable
 
 from atlas_sim.closed_loop import run_and_check
-from atlas_sim.executor import SimulatedRobot, make_simulator, parse_faults
+from atlas_sim.robot import SimulatedRobot, make_simulator, parse_faults
 from ltl_specification.diagnosis import goal_findings, impossible_next_goals
 from respec.abstraction import load_abstraction
 from respec.errors import INTERNAL_ERROR, CodedError

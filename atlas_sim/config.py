@@ -46,10 +46,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Dict, Mapping, Optional, Tuple
 
-import yaml
-
 from respec.abstraction import RobotAbstraction, abstraction_from_document
 from respec.errors import CodedError
+from respec.systems import read_config_file, system_config_path
 
 class SimulationConfigError(CodedError, ValueError):
     """The ``simulation:`` section is invalid; ``item`` names the offending key or capability."""
@@ -190,5 +189,9 @@ class SystemConfig:
 
 def load_system_config(path: Path | str = DEFAULT_CONFIG) -> SystemConfig:
     """Read a robot-system YAML file."""
-    with open(path, "r", encoding="utf-8") as stream:
-        return SystemConfig.from_dict(yaml.safe_load(stream))
+    return SystemConfig.from_dict(read_config_file(path))
+
+
+def system_config(system: str, config_dir: str | Path | None = None) -> SystemConfig:
+    """The configuration of ``system`` (``config/<system>.yaml`` or in ``config_dir``)."""
+    return load_system_config(system_config_path(system, config_dir))

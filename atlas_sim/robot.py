@@ -11,10 +11,9 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Protocol, Sequence
 
-from atlas_sim.config import load_system_config
+from atlas_sim.config import system_config
 from respec.errors import CodedError
 from respec.naming import COMPLETED
-from respec.systems import system_config_path
 
 
 class InitialConditionError(CodedError, ValueError):
@@ -105,7 +104,7 @@ def make_simulator(system: str = 'atlas', config_dir: str | Path | None = None, 
     """
     from atlas_sim.simulator import AtlasSimulator  # here: importing the executor needs no MuJoCo
 
-    config = load_system_config(system_config_path(system, config_dir))
+    config = system_config(system, config_dir)
     modes = [c for c in initial_conditions if c in config.abstraction.control_modes]
     actions = [c for c in initial_conditions if c in config.abstraction.actions]
     unknown = [c for c in initial_conditions if c not in modes and c not in actions]

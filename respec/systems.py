@@ -68,7 +68,12 @@ def system_config_path(system: str, config_dir: str | Path | None = None) -> Pat
 
 def load_system_file(system: str, config_dir: str | Path | None = None) -> dict:
     """Parse the whole configuration file of ``system`` into a dict."""
-    path = system_config_path(system, config_dir)
+    return read_config_file(system_config_path(system, config_dir))
+
+
+def read_config_file(path: str | Path) -> dict:
+    """A system configuration file as a dict (raises ConfigFileInvalidError naming the file)."""
+    path = Path(path)
     try:
         document = yaml.load(path.read_text(), Loader=_SAFE_LOADER)
     except yaml.YAMLError as error:

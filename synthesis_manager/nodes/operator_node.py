@@ -23,9 +23,8 @@ from pathlib import Path
 
 import yaml
 
-from atlas_sim.config import SimulationConfigError, load_system_config
+from atlas_sim.config import SimulationConfigError, system_config
 from atlas_sim.operator_data import answers_by_request_type, flexbe_input_data, parse_answers, quoted
-from respec.systems import system_config_path
 from sm_generation.config import input_request_capabilities, load_flexbe_config
 
 NODE_NAME = 'atlas_sim_operator'
@@ -34,7 +33,7 @@ BEHAVIOR_INPUT_ACTION = 'flexbe/behavior_input'
 
 def configured_answers(system: str = 'atlas', config_dir=None) -> dict:
     """Request type -> answer, from the system's InputStates and its simulated operator."""
-    settings = load_system_config(system_config_path(system, config_dir)).simulation
+    settings = system_config(system, config_dir).simulation
     return answers_by_request_type(settings, input_request_capabilities(load_flexbe_config(system, config_dir)))
 
 

@@ -12,7 +12,7 @@ Modules (MuJoCo is imported only by ``physics``, ``simulator``, ``rendering``)
 ------------------------------------------------------------------------------
 ``config``      ``load_system_config(path) -> SystemConfig`` (abstraction +
                 simulation sections; the schema is documented there).
-``discrete``    ``Abstraction``, ``DiscreteState``, ``DiscreteSemantics``: the
+``discrete``    ``DiscreteState``, ``DiscreteSemantics``: the
                 mode/precondition/validity rules, testable without physics.
 ``faults``      ``FaultSpec(always, fail_first, probability)``, ``FaultInjector``.
 ``kinematics``  joint groups, arm poses, whole-body ``POSTURES``, leg IK.
@@ -92,7 +92,6 @@ _EXPORTS = {
     "save_png": "rendering",
     "FaultSpec": "faults",
     "FaultInjector": "faults",
-    "Abstraction": "discrete",
     "DiscreteSemantics": "discrete",
     "DiscreteState": "discrete",
     "SystemConfig": "config",

@@ -28,53 +28,12 @@ The rules, taken from the ``abstraction:`` section of the robot config:
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Dict, Iterable, List, Mapping, Optional, Set, Tuple
+from typing import Dict, Iterable, List, Mapping, Optional, Set
 
 from .config import SimulationConfigError
 from respec.abstraction import RobotAbstraction
 from respec.naming import COMPLETED, FAILED
 
-
-
-class Abstraction:
-    """Read-only view of control modes, actions and their relations."""
-
-    def __init__(self, config: RobotAbstraction) -> None:
-        # ``config`` is validated (respec.abstraction): no name is both a mode and an
-        # action, and every precondition is a capability.
-        self.control_modes: Dict[str, Tuple[str, ...]] = dict(config.control_modes)
-        self.actions: Dict[str, Tuple[str, ...]] = dict(config.actions)
-        self.outcomes = tuple(config.outcomes)
-        self.sensors = tuple(config.sensors)
-
-    def is_mode(self, name: str) -> bool:
-        return name in self.control_modes
-
-    def is_action(self, name: str) -> bool:
-        return name in self.actions
-
-    def is_capability(self, name: str) -> bool:
-        return self.is_mode(name) or self.is_action(name)
-
-    @property
-    def capabilities(self) -> Tuple[str, ...]:
-        return tuple(self.control_modes) + tuple(self.actions)
-
-    def transition_allowed(self, current: str, target: str) -> bool:
-        return target == current or target in self.control_modes.get(current, ())
-
-    def dependents(self, action: str) -> Set[str]:
-        """Actions whose preconditions include ``action``, directly or transitively."""
-        found: Set[str] = set()
-        frontier = [action]
-        while frontier:
-            needed = frontier.pop()
-            for name, preconditions in self.actions.items():
-                if needed in preconditions and name not in found:
-                    found.add(name)
-                    frontier.append(name)
-        found.discard(action)
-        return found
 
 
 @dataclass
@@ -98,7 +57,7 @@ class DiscreteSemantics:
 
     def __init__(
         self,
-        abstraction: Abstraction,
+        abstraction: RobotAbstraction,
         invalidations: Optional[Mapping[str, Iterable[str]]] = None,
     ) -> None:
         self.abstraction = abstraction

@@ -35,7 +35,7 @@ from typing import Any, Callable, Dict, Iterable, List, Mapping, Optional, Union
 import numpy as np
 
 from .config import SimulationConfigError, SystemConfig, load_system_config
-from .discrete import COMPLETED, FAILED, Abstraction, DiscreteSemantics, DiscreteState
+from .discrete import COMPLETED, FAILED, DiscreteSemantics, DiscreteState
 from .faults import FaultInjector, FaultSpec
 from .kinematics import POSTURES
 from .operator_data import TEMPLATE_ID, datum_refusal, operator_answer, provided_datum
@@ -111,7 +111,7 @@ class AtlasSimulator:
             config = load_system_config(config) if config is not None else load_system_config()
         self.config = config
         self.settings = config.simulation
-        self.abstraction = Abstraction(config.abstraction)
+        self.abstraction = config.abstraction
         self.semantics = DiscreteSemantics(self.abstraction, self.settings.invalidations)
         self.physics = HumanoidPhysics(
             model_path,

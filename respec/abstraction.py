@@ -74,6 +74,37 @@ class RobotAbstraction:
         """All control modes, then all actions, in file order."""
         return [*self.control_modes, *self.actions]
 
+    @property
+    def capabilities(self) -> tuple[str, ...]:
+        """What a robot can be asked to do: every control mode, then every action."""
+        return tuple(self.items())
+
+    def is_mode(self, name: str) -> bool:
+        return name in self.control_modes
+
+    def is_action(self, name: str) -> bool:
+        return name in self.actions
+
+    def is_capability(self, name: str) -> bool:
+        return self.is_mode(name) or self.is_action(name)
+
+    def transition_allowed(self, current: str, target: str) -> bool:
+        """Self-loops are implied; otherwise the target must be listed under the current mode."""
+        return target == current or target in self.control_modes.get(current, ())
+
+    def dependents(self, action: str) -> set[str]:
+        """Actions whose preconditions include ``action``, directly or transitively."""
+        found: set[str] = set()
+        frontier = [action]
+        while frontier:
+            needed = frontier.pop()
+            for name, preconditions in self.actions.items():
+                if needed in preconditions and name not in found:
+                    found.add(name)
+                    frontier.append(name)
+        found.discard(action)
+        return found
+
 
 def load_abstraction(system: str, config_dir: str | Path | None = None) -> RobotAbstraction:
     """Load and validate the ``abstraction:`` section of ``config/<system>.yaml``."""

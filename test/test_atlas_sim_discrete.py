@@ -9,7 +9,7 @@ import pytest
 
 from atlas_sim.config import DEFAULT_CONFIG, SystemConfig, load_system_config
 from respec.abstraction import AbstractionConfigError
-from atlas_sim.discrete import COMPLETED, FAILED, Abstraction, DiscreteSemantics
+from atlas_sim.discrete import COMPLETED, FAILED, DiscreteSemantics
 from atlas_sim.faults import FaultInjector, FaultSpec
 from atlas_sim.kinematics import LegGeometry, POSTURES, sagittal_leg_ik
 from atlas_sim.motions import GaitMotion, KeyframeMotion, OperatorInputMotion, build_motion
@@ -25,7 +25,7 @@ def atlas():
 @pytest.fixture
 def semantics(atlas):
     sim = atlas.simulation
-    return DiscreteSemantics(Abstraction(atlas.abstraction), sim.invalidations)
+    return DiscreteSemantics(atlas.abstraction, sim.invalidations)
 
 
 def run(semantics, state, name, outcome=COMPLETED):

@@ -166,15 +166,18 @@ def _sub_specifications(abstraction: RobotAbstraction, pertinence: Pertinence, i
     failures = [outcome_proposition(item, o) for item in items for o in abstraction.failure_outcomes]
     actions = {a: abstraction.actions[a] for a in pertinence.actions}
     goal_arguments = (goals, sm_outcomes, strict_order, failures, abstraction.success_outcome)
+    # Each formula is built once: the groups are the provenance, the parts are made of them.
+    mode_groups = control_mode_groups(adjacency, outcomes, retry)
+    action_groups_ = action_groups(actions, outcomes, retry)
+    initial_groups = initial_conditions_groups(items, initially_completed, outcomes)
+    goals_groups = goal_groups(*goal_arguments)
     parts = [
-        control_mode_specification(adjacency, outcomes, retry),
-        action_specification(actions, outcomes, retry),
-        initial_conditions_specification(items, initially_completed, outcomes),
-        goal_specification(*goal_arguments),
+        control_mode_specification(adjacency, outcomes, retry, groups=mode_groups),
+        action_specification(actions, outcomes, retry, groups=action_groups_),
+        initial_conditions_specification(items, initially_completed, outcomes, groups=initial_groups),
+        goal_specification(*goal_arguments, groups=goals_groups),
     ]
-    groups = [*control_mode_groups(adjacency, outcomes, retry), *action_groups(actions, outcomes, retry),
-              *initial_conditions_groups(items, initially_completed, outcomes), *goal_groups(*goal_arguments)]
-    return parts, groups
+    return parts, [*mode_groups, *action_groups_, *initial_groups, *goals_groups]
 
 
 def _custom_groups(custom_formulas: dict[str, list]) -> list[FormulaGroup]:

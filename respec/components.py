@@ -106,14 +106,15 @@ def control_mode_groups(adjacency: Mapping[str, Sequence[str]], outcomes: Sequen
 
 
 def control_mode_specification(adjacency: Mapping[str, Sequence[str]], outcomes: Sequence[str],
-                               retry_after_failure: bool = False) -> GR1Specification:
+                               retry_after_failure: bool = False, groups=None) -> GR1Specification:
     """Formulas (3)-(5) and (9)-(13) for the control modes in ``adjacency``.
 
     ``adjacency`` maps every mode to the modes it may change to, its own self-loop included.
+    ``groups``: those formulas, when the caller already built them (``control_mode_groups``).
     """
     modes = list(adjacency)
     return specification_from_groups(
-        control_mode_groups(adjacency, outcomes, retry_after_failure),
+        groups if groups is not None else control_mode_groups(adjacency, outcomes, retry_after_failure),
         env_props=[ao.outcome_proposition(m, o) for m in modes for o in outcomes],
         sys_props=[ao.activation(m) for m in modes])
 
@@ -142,10 +143,11 @@ def action_groups(actions: Mapping[str, Sequence[str]], outcomes: Sequence[str],
 
 
 def action_specification(actions: Mapping[str, Sequence[str]], outcomes: Sequence[str],
-                         retry_after_failure: bool = False) -> GR1Specification:
-    """Formulas (3)-(8) for each action in ``actions`` (action -> its preconditions)."""
+                         retry_after_failure: bool = False, groups=None) -> GR1Specification:
+    """Formulas (3)-(8) for each action in ``actions`` (action -> its preconditions);
+    ``groups`` when already built (``action_groups``)."""
     return specification_from_groups(
-        action_groups(actions, outcomes, retry_after_failure),
+        groups if groups is not None else action_groups(actions, outcomes, retry_after_failure),
         env_props=[ao.outcome_proposition(a, o) for a in actions for o in outcomes],
         sys_props=[ao.activation(a) for a in actions])
 
@@ -178,13 +180,15 @@ def goal_groups(goals: Sequence[str], sm_outcomes: Sequence[str], strict_order: 
 
 def goal_specification(goals: Sequence[str], sm_outcomes: Sequence[str], strict_order: bool,
                        failure_propositions: Sequence[str], success: str = ao.COMPLETED,
-                       finished: str = FINISHED, failed: str = FAILED) -> GR1Specification:
+                       finished: str = FINISHED, failed: str = FAILED, groups=None) -> GR1Specification:
     """Formulas (16)-(20): goal memories, state-machine outcomes and the single liveness.
 
     ``sm_outcomes`` contains ``finished`` and optionally ``failed``; ``failure_propositions``
-    are the failure outcomes that make the state machine fail (18b).
+    are the failure outcomes that make the state machine fail (18b). ``groups`` when already
+    built (``goal_groups``).
     """
     return specification_from_groups(
+        groups if groups is not None else
         goal_groups(goals, sm_outcomes, strict_order, failure_propositions, success, finished, failed),
         sys_props=[ao.memory(g) for g in goals] + list(sm_outcomes))
 
@@ -204,6 +208,8 @@ def initial_conditions_groups(items: Sequence[str], initially_completed: Sequenc
 
 
 def initial_conditions_specification(items: Sequence[str], initially_completed: Sequence[str],
-                                     outcomes: Sequence[str]) -> GR1Specification:
-    """Formulas (14) and (15) over all ``items`` (actions and modes) of the task."""
-    return specification_from_groups(initial_conditions_groups(items, initially_completed, outcomes))
+                                     outcomes: Sequence[str], groups=None) -> GR1Specification:
+    """Formulas (14) and (15) over all ``items`` (actions and modes) of the task; ``groups``
+    when already built (``initial_conditions_groups``)."""
+    return specification_from_groups(
+        groups if groups is not None else initial_conditions_groups(items, initially_completed, outcomes))

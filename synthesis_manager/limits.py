@@ -10,19 +10,13 @@ from __future__ import annotations
 
 import math
 
+from respec.errors import quoted
 from synthesis_manager.requests import InvalidRequest
 
 #: Longest string accepted in any request field, in UTF-8 bytes.
 MAX_STRING_BYTES = 64 * 1024
 #: Largest HTTP request body the web GUI reads.
 MAX_BODY_BYTES = 1024 * 1024
-#: How much of a refused value an error message quotes.
-QUOTED_CHARACTERS = 40
-
-
-def quote_start(text: str, length: int = QUOTED_CHARACTERS) -> str:
-    """``text`` quoted for an error message, cut after ``length`` characters."""
-    return repr(text) if len(text) <= length else repr(text[:length]) + '...'
 
 
 def check_timeout(value, item: str = 'timeout') -> float:
@@ -30,10 +24,10 @@ def check_timeout(value, item: str = 'timeout') -> float:
     try:
         seconds = float(value)
     except (TypeError, ValueError):
-        raise InvalidRequest(f'{item} must be a number of seconds, got {quote_start(str(value))}') from None
+        raise InvalidRequest(f'{item} must be a number of seconds, got {quoted(value)}') from None
     if not math.isfinite(seconds) or seconds < 0:
         raise InvalidRequest(f'{item} must be a finite number of seconds >= 0 (0: the default), '
-                             f'got {value!r}')
+                             f'got {quoted(value)}')
     return seconds
 
 
@@ -76,4 +70,4 @@ def check_message(message, path: str = 'request', limit: int = MAX_STRING_BYTES)
 def too_long(field_path: str, value: str, limit: int = MAX_STRING_BYTES) -> str:
     """The error message for an oversized string, quoting only its start."""
     return (f'{field_path} is {utf8_length(value)} bytes long; the limit is {limit} bytes '
-            f'(it starts {quote_start(value)})')
+            f'(it starts {quoted(value)})')

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import hashlib
+import math
 import re
 from dataclasses import dataclass
 from types import SimpleNamespace
@@ -10,7 +11,7 @@ from typing import Any
 
 import yaml
 
-from respec.errors import CodedError
+from respec.errors import CodedError, quoted
 from respec.naming import DEFAULT_SM_OUTCOMES, parse_names
 
 OPTION_NAMES = ('ltl_compilation_only', 'ltl_synthesis_only', 'ltl_steps_only')
@@ -96,36 +97,78 @@ def byproduct_file_stem(behavior: str) -> str:
     return stem
 
 
+#: Deepest nesting of mappings and lists accepted in a request's YAML.
+MAX_YAML_DEPTH = 16
+
+
+class _RequestYamlLoader(yaml.SafeLoader):
+    """YAML from a request: no aliases (a few hundred bytes of nested aliases expand to
+    gigabytes) and at most MAX_YAML_DEPTH levels, both refused while composing, before any
+    value is built."""
+
+    def __init__(self, stream, item: str):
+        super().__init__(stream)
+        self.item, self.depth = item, 0
+
+    def compose_node(self, parent, index):
+        if self.check_event(yaml.AliasEvent):
+            mark = self.peek_event().start_mark
+            raise InvalidRequest(f'{self.item}: YAML aliases (*name) are not accepted '
+                                 f'(line {mark.line + 1}, column {mark.column + 1})', self.item)
+        self.depth += 1
+        if self.depth > MAX_YAML_DEPTH:
+            raise InvalidRequest(f'{self.item}: YAML nested deeper than {MAX_YAML_DEPTH} levels', self.item)
+        try:
+            return super().compose_node(parent, index)
+        finally:
+            self.depth -= 1
+
+
+def load_request_yaml(text: str, item: str):
+    """The value of a request's YAML field ``item``; an InvalidRequest naming it if it is not
+    valid YAML, uses aliases or nests too deeply. The message quotes none of the text."""
+    loader = _RequestYamlLoader(text, item)
+    try:
+        return loader.get_single_data()
+    except yaml.YAMLError as error:
+        mark = getattr(error, 'problem_mark', None)
+        where = f' (line {mark.line + 1}, column {mark.column + 1})' if mark is not None else ''
+        problem = getattr(error, 'problem', None) or 'malformed'
+        raise InvalidRequest(f'{item} is not valid YAML: {quoted(problem, 80)}{where}', item) from None
+    finally:
+        loader.dispose()
+
+
 def parse_synthesis_options(text: str) -> dict:
     """FlexBESynthesis ``synthesis_options`` (YAML) -> ``{'option', 'timeout', 'unordered_goals'}``.
 
     Empty text means the defaults. Accepted: one option name (``ltl_compilation_only``), or a
     mapping of option flags, ``timeout`` (seconds) and ``unordered_goals``. Anything else is an
-    InvalidRequest naming the bad item.
+    InvalidRequest naming the bad item (quoting at most the start of a value).
     """
-    try:
-        options = yaml.safe_load(text or '')
-    except yaml.YAMLError as error:
-        raise InvalidRequest(f'synthesis_options is not valid YAML: {error}') from None
+    options = load_request_yaml(text or '', 'synthesis_options')
     if options is None:
         options = {}
     if isinstance(options, str):
         options = {options: True}
     if not isinstance(options, dict):
-        raise InvalidRequest(f'synthesis_options must be a YAML mapping, got {options!r}')
+        raise InvalidRequest(f'synthesis_options must be a YAML mapping, got {quoted(options)}',
+                             'synthesis_options')
     known = (*OPTION_NAMES, 'timeout', 'unordered_goals')
     for key, value in options.items():
         if key not in known:
-            raise InvalidRequest(f'unknown synthesis option {key!r} (known: {", ".join(known)})')
+            raise InvalidRequest(f'unknown synthesis option {quoted(key)} (known: {", ".join(known)})',
+                                 'synthesis_options')
         if key == 'timeout':
-            if isinstance(value, bool) or not isinstance(value, (int, float)) or value < 0:
-                raise InvalidRequest(f'synthesis option timeout must be a number >= 0, got {value!r}')
+            if (isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value)
+                    or value < 0):
+                raise InvalidRequest(f'synthesis option timeout must be a finite number >= 0, '
+                                     f'got {quoted(value)}', 'timeout')
         elif not isinstance(value, bool):
-            raise InvalidRequest(f'synthesis option {key} must be true or false, got {value!r}')
+            raise InvalidRequest(f'synthesis option {key} must be true or false, got {quoted(value)}', key)
     flags = SimpleNamespace(**{name: bool(options.get(name, False)) for name in OPTION_NAMES})
     return {'option': selected_option(flags), 'timeout': float(options.get('timeout', 0.0)),
             'unordered_goals': bool(options.get('unordered_goals', False))}
-
 
 
 def make_task(*, system: str, initial_conditions, goals, sm_outcomes, name: str,
@@ -154,7 +197,7 @@ def task_from_flexbe_synthesis(goal, default_system: str) -> SynthesisTask:
     """A FlexBESynthesis goal (CNU's interface); ``synthesis_options`` is YAML."""
     request = goal.request
     if request.specification_file_name:
-        raise InvalidRequest(f'specification_file_name {request.specification_file_name!r}: this server '
+        raise InvalidRequest(f'specification_file_name {quoted(request.specification_file_name)}: this server '
                              'compiles specifications itself; leave it empty')
     options = parse_synthesis_options(goal.synthesis_options)
     if options['option'] == 'ltl_synthesis_only':

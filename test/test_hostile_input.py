@@ -1,0 +1,73 @@
+"""Hostile input costs little (issue 25, ROS-free part): YAML alias bombs and deep nesting in
+request YAML, and the one quoting rule of every message. The full attack sizes are in
+bench/bench_reliability.py."""
+
+import resource
+import time
+
+import pytest
+
+from respec.errors import QUOTED_CHARACTERS, quoted
+from synthesis_manager.requests import MAX_YAML_DEPTH, InvalidRequest, parse_synthesis_options
+
+
+def alias_bomb(levels: int) -> str:
+    """A few hundred bytes that yaml.safe_load expands to 9**levels strings."""
+    lines = ['a0: &a0 [lol, lol, lol, lol, lol, lol, lol, lol, lol]']
+    lines += [f'a{i}: &a{i} [' + ', '.join([f'*a{i - 1}'] * 9) + ']' for i in range(1, levels)]
+    return '\n'.join(lines)
+
+
+def peak_rss_mib() -> float:
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+
+
+def test_a_yaml_alias_bomb_is_refused_before_it_expands():
+    bomb = alias_bomb(9)  # 9**9 = 387 million strings if expanded
+    assert len(bomb) < 1000
+    before, started = peak_rss_mib(), time.process_time()
+    with pytest.raises(InvalidRequest, match='aliases') as raised:
+        parse_synthesis_options(bomb)
+    assert time.process_time() - started < 1.0
+    assert peak_rss_mib() - before < 50
+    assert raised.value.code == 'INVALID_REQUEST' and raised.value.item == 'synthesis_options'
+    assert len(str(raised.value)) < 200 and 'lol' not in str(raised.value)
+
+
+def test_a_single_alias_is_refused_too():
+    with pytest.raises(InvalidRequest, match='aliases'):
+        parse_synthesis_options('timeout: &t 3\nunordered_goals: *t')
+
+
+@pytest.mark.parametrize('text', ['[' * 5000 + ']' * 5000, '{a: ' * 3000 + '1' + '}' * 3000,
+                                  '\n'.join(' ' * level + 'a:' for level in range(200)) + ' 1'])
+def test_deeply_nested_options_are_a_short_invalid_request(text):
+    with pytest.raises(InvalidRequest, match=f'deeper than {MAX_YAML_DEPTH}') as raised:
+        parse_synthesis_options(text)
+    assert len(str(raised.value)) < 100
+
+
+def test_yaml_errors_quote_no_input():
+    with pytest.raises(InvalidRequest, match='not valid YAML') as raised:
+        parse_synthesis_options('timeout: [' + 'x' * 10_000)
+    assert 'x' * 50 not in str(raised.value) and len(str(raised.value)) < 200
+
+
+@pytest.mark.parametrize('text', ['x' * 10_000 + ': 1', 'timeout: ' + '9' * 5000 + '.5e' + '9' * 3,
+                                  'ltl_steps_only: ' + 'y' * 10_000])
+def test_refused_option_values_are_quoted_by_their_start(text):
+    with pytest.raises(InvalidRequest) as raised:
+        parse_synthesis_options(text)
+    assert len(str(raised.value)) < 250
+
+
+@pytest.mark.parametrize('value', ['a' * 100_000, ['a' * 100_000] * 1000, {'k' * 1000: list(range(10_000))},
+                                   [[[[[['deep']]]]]] * 1000, b'b' * 100_000, 10 ** 4000])
+def test_quoting_is_short_whatever_the_value(value):
+    shown = quoted(value)
+    assert len(shown) <= QUOTED_CHARACTERS + 5
+
+
+def test_short_values_are_quoted_whole():
+    assert quoted('look_down') == "'look_down'"
+    assert quoted(['a', 'b']) == "['a', 'b']"

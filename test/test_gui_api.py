@@ -178,11 +178,11 @@ def test_unknown_names_in_urls_are_404_and_the_server_keeps_serving(client):
                        ('/api/jobs/no-such-job/artifacts/state_machine.yaml', 'no-such-job')):
         response = client.get(path)
         assert response.status_code == 404 and response.json()['item'] == item
-    assert client.post('/api/jobs/no-such-job/cancel').status_code == 404
+    assert client.post('/api/jobs/no-such-job/cancel', json={}).status_code == 404
     _, job = run_job(client, {**PAPER_TASK, 'option': 'ltl_compilation_only'})
     wrong = client.get(f"/api/jobs/{job['id']}/artifacts/state_machine.gif")
     assert wrong.status_code == 404 and wrong.json()['item'] == 'state_machine.gif'
-    again = client.post(f"/api/jobs/{job['id']}/cancel")
+    again = client.post(f"/api/jobs/{job['id']}/cancel", json={})
     assert again.status_code == 409 and 'already finished' in again.json()['message']
     assert client.get('/api/systems').status_code == 200
 
@@ -192,7 +192,7 @@ def test_cancel_a_job_before_it_is_sent(client, backend):
     try:
         job = client.post('/api/jobs', json=PAPER_TASK).json()
         assert client.get(f"/api/jobs/{job['id']}").json()['state'] == 'queued'
-        assert client.post(f"/api/jobs/{job['id']}/cancel").status_code == 202
+        assert client.post(f"/api/jobs/{job['id']}/cancel", json={}).status_code == 202
         _, final = follow(client, job['id'])
     finally:
         backend.job_gate.set()
@@ -207,7 +207,7 @@ def test_cancel_a_running_synthesis(client, runaway_synthesis):
         for line in response.iter_lines():
             if line.startswith('data: ') and 'Synthesizing' in json.loads(line[6:])['status']:
                 break
-    assert client.post(f"/api/jobs/{job['id']}/cancel").json()['cancel_requested'] is True
+    assert client.post(f"/api/jobs/{job['id']}/cancel", json={}).json()['cancel_requested'] is True
     _, final = follow(client, job['id'])
     assert final['outcome']['error_name'] == 'PREEMPTED'
     assert final['outcome']['seconds'] < 30

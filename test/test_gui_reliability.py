@@ -129,3 +129,66 @@ def test_a_foreign_host_header_is_refused(gui):
         assert error['error'] == 'BAD_HOST'
     for host in (f'127.0.0.1:{port}', f'localhost:{port}'):
         assert request(url, 'GET', '/api/systems', headers={'Host': host})[0] == 200
+
+
+def post_raw(url, path, body: bytes, content_type):
+    """A POST with exactly this body and Content-Type (None: no header); (status, headers, JSON)."""
+    parts = urllib.parse.urlsplit(url)
+    connection = http.client.HTTPConnection(parts.hostname, parts.port, timeout=60)
+    try:
+        connection.request('POST', path, body=body, headers={'Content-Type': content_type} if content_type else {})
+        response = connection.getresponse()
+        payload = response.read()
+        return response.status, dict(response.getheaders()), json.loads(payload) if payload.startswith(b'{') else None
+    finally:
+        connection.close()
+
+
+def test_posts_a_cross_site_form_could_send_are_refused(gui):
+    """Forms (urlencoded, multipart, text/plain) need no CORS preflight: no POST may act on them."""
+    backend, url = gui
+    jobs_before = len(backend._jobs)
+    for content_type, body in [(None, b''), ('text/plain', b'{}'), ('application/x-www-form-urlencoded', b'a=1'),
+                               ('multipart/form-data; boundary=x', b'--x--')]:
+        for path in ('/api/jobs', '/api/jobs/any/simulations', '/api/jobs/any/cancel'):
+            status, _, error = post_raw(url, path, body, content_type)
+            assert (status, error['error'], error['item']) == (415, 'UNSUPPORTED_MEDIA_TYPE', 'content-type'), path
+    assert len(backend._jobs) == jobs_before
+    assert post_raw(url, '/api/goal-check', json.dumps({'system': 'atlas', 'goals': ['look_down']}).encode(),
+                    'application/json; charset=utf-8')[0] == 200
+
+
+def test_simulations_are_bounded_at_once_and_per_job(gui):
+    from synthesis_manager.web.simulations import Simulation
+
+    backend, url = gui
+    status, job = request(url, 'POST', '/api/jobs', PAPER_TASK)
+    job = wait_until_finished(url, job['id'])
+    assert job['outcome']['error_name'] == 'SUCCESS'
+    # The job already ran as many simulations as it keeps: the oldest ones make room.
+    old = [Simulation(id=f"{job['id']}-old{i}", job_id=job['id'], state='finished')
+           for i in range(backend.max_simulations_per_job)]
+    backend._simulations.update({run.id: run for run in old})
+
+    with ThreadPoolExecutor(6) as pool:
+        answers = list(pool.map(lambda _: post_raw(url, f"/api/jobs/{job['id']}/simulations", b'{}',
+                                                   'application/json'), range(6)))
+    started = [body for status, _, body in answers if status == 202]
+    refused = [(headers, body) for status, headers, body in answers if status == 429]
+    assert len(started) == backend.max_running_simulations == 2
+    assert len(refused) == 4
+    assert all(int(headers['retry-after']) > 0 and body['error'] == 'BUSY' and body['item'] == 'simulations'
+               for headers, body in refused)
+    runs_of_job = [run.id for run in list(backend._simulations.values()) if run.job_id == job['id']]
+    assert len(runs_of_job) == backend.max_simulations_per_job
+    assert request(url, 'GET', f"/api/simulations/{old[0].id}")[0] == 404  # the oldest were forgotten
+
+    deadline = time.monotonic() + 300
+    while any(request(url, 'GET', f"/api/simulations/{run['id']}")[1]['state'] != 'finished' for run in started):
+        assert time.monotonic() < deadline
+        time.sleep(0.5)
+    status, _, run = post_raw(url, f"/api/jobs/{job['id']}/simulations", b'{}', 'application/json')
+    assert status == 202  # room again once they have finished
+    while request(url, 'GET', f"/api/simulations/{run['id']}")[1]['state'] != 'finished':
+        assert time.monotonic() < deadline
+        time.sleep(0.5)

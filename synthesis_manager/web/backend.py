@@ -6,6 +6,7 @@ import dataclasses
 import itertools
 import logging
 import os
+import shutil
 import tempfile
 import threading
 import time
@@ -24,12 +25,14 @@ from respec.parsing import spec_from_text_sections
 from respec.systems import SystemConfigError, available_systems, load_section
 from synthesis_manager.web.artifacts import ARTIFACTS, Artifact
 from synthesis_manager.web.errors import (ArtifactFailedError, BusyError, InvalidJobRequestError,
-                                          NotAvailableError, NotFoundError)
+                                          NotAvailableError, NotFoundError, TooManyRequestsError)
 from synthesis_manager.web.jobs import JOB_OPTIONS, Job, JobRequest, local_outcome, names_field
 from synthesis_manager.web.simulations import Simulation, simulation_available
 
 logger = logging.getLogger(__name__)
 
+
+SIMULATION_RETRY_AFTER = 10  # seconds: a short simulation's run time
 
 GoalRunner = Callable[[JobRequest, Callable[[str, float], None], threading.Event], dict]
 
@@ -45,11 +48,16 @@ class SynthesisBackend:
     """
 
     def __init__(self, run_goal: GoalRunner, config_dir: str | Path | None = None,
-                 max_jobs: int = 100, max_unfinished_jobs: int = 50, description: str = ''):
+                 max_jobs: int = 100, max_unfinished_jobs: int = 50, description: str = '',
+                 max_running_simulations: int = 2, max_simulations_per_job: int = 5):
         self.run_goal = run_goal
         self.config_dir = config_dir or None
         self.max_jobs = max_jobs
         self.max_unfinished_jobs = max_unfinished_jobs
+        # A simulation takes ~0.5 GB and a core for up to minutes: only a few run at once, and
+        # a job keeps only its newest few runs (frames included).
+        self.max_running_simulations = max_running_simulations
+        self.max_simulations_per_job = max_simulations_per_job
         self.description = description
         self.job_gate = threading.Event()
         self.job_gate.set()
@@ -201,10 +209,32 @@ class SynthesisBackend:
             raise NotAvailableError(support['note'], job.request.system)
         simulation = Simulation(id=f'{job_id}-sim{next(self._counter)}', job_id=job_id, fail_first=fail_first)
         with self._lock:
+            self._admit_simulation(job_id)
             self._simulations[simulation.id] = simulation
         threading.Thread(target=self._simulate, args=(simulation, job), name=f'gui-{simulation.id}',
                          daemon=True).start()
         return simulation.to_dict()
+
+    def _admit_simulation(self, job_id: str):
+        """Refuse a run beyond max_running_simulations (429); make room for it among the job's
+        max_simulations_per_job newest runs by forgetting its oldest finished one. Holds _lock."""
+        running = [run for run in self._simulations.values() if run.state != 'finished']
+        if len(running) >= self.max_running_simulations:
+            raise TooManyRequestsError(
+                f'{len(running)} simulations are running (at most {self.max_running_simulations} at once); '
+                'try again when one has finished', 'simulations', retry_after=SIMULATION_RETRY_AFTER)
+        runs = [run for run in self._simulations.values() if run.job_id == job_id]
+        finished = [run for run in runs if run.state == 'finished']
+        for run in finished[:max(0, len(runs) + 1 - self.max_simulations_per_job)]:
+            self._forget_simulation(run.id)
+
+    def _forget_simulation(self, simulation_id: str):
+        """Drop a finished simulation and its recorded frames. Holds _lock."""
+        self._simulations.pop(simulation_id, None)
+        shutil.rmtree(self._record_dir(simulation_id), ignore_errors=True)
+
+    def _record_dir(self, simulation_id: str) -> Path:
+        return Path(self._simulation_dir.name) / simulation_id
 
     def simulation_status(self, simulation_id: str) -> dict:
         return self._simulation(simulation_id).to_dict()
@@ -248,7 +278,7 @@ class SynthesisBackend:
             run = run_and_check(job.outcome['states'], SimulatedRobot(simulator), simulator, request.system,
                                 spec_from_text_sections(job.outcome['ltl_specification']), list(request.goals),
                                 ordered=not request.unordered, config_dir=self.config_dir,
-                                record_dir=Path(self._simulation_dir.name) / simulation.id,
+                                record_dir=self._record_dir(simulation.id),
                                 max_robot_time=300.0, max_wall_time=300.0, on_progress=progress)
             self._update(simulation, outcome=run.result.outcome, check=run.check.to_dict(),
                          timeline_png=run.timeline, frames=run.frames,
@@ -278,7 +308,7 @@ class SynthesisBackend:
             for key in [k for k in self._artifacts if k[0] == job_id]:
                 del self._artifacts[key]
             for run_id in [r for r, run in self._simulations.items() if run.job_id == job_id]:
-                del self._simulations[run_id]
+                self._forget_simulation(run_id)
 
     def _update(self, record, **changes):
         """Change a Job or Simulation and bump its revision (what the event streams watch)."""

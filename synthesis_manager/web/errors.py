@@ -56,3 +56,16 @@ class BusyError(GuiRequestError):
     status = 503
     kind = 'BUSY'
     code = 'BUSY'
+
+
+class TooManyRequestsError(GuiRequestError):
+    """Too much of one kind of work is running: try again after ``retry_after`` seconds
+    (sent as the Retry-After header)."""
+
+    status = 429
+    kind = 'BUSY'
+    code = 'BUSY'
+
+    def __init__(self, message: str, item='', retry_after: int = 10):
+        super().__init__(message, item)
+        self.retry_after = retry_after

@@ -6,12 +6,16 @@
   accepted too.
 - A body over ``max_body_bytes`` (default 1 MB): 413, whether announced by Content-Length or
   streamed in chunks; the body is never read further (a 50 MB name once cost 860 MB of RAM).
+- A POST (PUT, PATCH) whose Content-Type is not ``application/json``: 415. A page from another
+  site can make a browser send a form (urlencoded, multipart or text/plain) without asking,
+  but not a JSON request, so no other site can start work here (a simulation costs GBs).
 """
 
 from __future__ import annotations
 
 import json
 
+from respec.errors import quoted
 from synthesis_manager.limits import MAX_BODY_BYTES
 
 LOOPBACK_ADDRESSES = ('127.0.0.1', '::1')
@@ -47,12 +51,17 @@ class RequestGuard:
         if server is not None and host not in accepted_hosts(*server[:2]):
             return await _refuse(send, 421, 'BAD_HOST', 'host',
                                  f'this server answers only to {server[0]}:{server[1]}, not to Host '
-                                 f'{host[:100]!r}')
+                                 f'{quoted(host)}')
         declared = headers.get('content-length', '')
         if declared.isdigit() and int(declared) > self.max_body_bytes:
             return await _refuse(send, 413, 'TOO_LARGE', 'body', self._too_large())
         if scope['method'] not in ('POST', 'PUT', 'PATCH'):
             return await self.app(scope, receive, send)
+        media_type = headers.get('content-type', '').split(';', 1)[0].strip().lower()
+        if media_type != 'application/json':
+            return await _refuse(send, 415, 'UNSUPPORTED_MEDIA_TYPE', 'content-type',
+                                 f'{scope["method"]} requests must be sent as application/json, not '
+                                 f'{quoted(media_type) if media_type else "without a Content-Type"}')
         body = bytearray()
         while True:
             message = await receive()

@@ -19,8 +19,9 @@
 
 Bad input is answered with a 4xx JSON body ``{"error", "item", "message"}`` whose ``item``
 names the offending system, field, job or artifact; the server keeps serving. Requests with
-a foreign Host header (421) or a body over 1 MB (413) are refused first (web.guards); a new
-job while too many are unfinished is 503 BUSY.
+a foreign Host header (421), a body over 1 MB (413) or a POST whose body is not declared JSON
+(415: what a cross-site form can send) are refused first (web.guards); a new job while too many
+are unfinished is 503 BUSY, a simulation while too many run is 429 BUSY with Retry-After.
 
 The backend does the work: :class:`synthesis_manager.web.backend.SynthesisBackend` keeps
 the jobs, validates requests and builds the downloads; the synthesis itself is a
@@ -57,7 +58,9 @@ def create_app(backend) -> FastAPI:
 
     @app.exception_handler(GuiRequestError)
     async def gui_error(_request, error: GuiRequestError):
-        return JSONResponse(error.to_dict(), status_code=error.status)
+        retry_after = getattr(error, 'retry_after', None)
+        return JSONResponse(error.to_dict(), status_code=error.status,
+                            headers={'Retry-After': str(retry_after)} if retry_after else None)
 
     @app.exception_handler(RequestValidationError)
     async def malformed(_request, error: RequestValidationError):

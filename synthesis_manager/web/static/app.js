@@ -38,6 +38,9 @@ function element(tag, attributes = {}, ...children) {
 
 async function api(method, path, body) {
   const options = { method, headers: {} };
+  // The server takes POSTs only as JSON (what no cross-site form can send): a POST without
+  // a body sends {}.
+  if (body === undefined && method === 'POST') body = {};
   if (body !== undefined) {
     options.headers['Content-Type'] = 'application/json';
     options.body = JSON.stringify(body);

@@ -10,6 +10,11 @@ Retention: after each synthesis only the newest ``keep_last`` sets (a set = one 
 files) are kept, and with ``max_age`` > 0 sets older than that many seconds go too.
 ``keep_last=0`` keeps none: the files live in a private temporary directory (the slugs
 backend still needs them on disk) that is removed when the synthesis ends.
+
+Retention only ever deletes what the suite wrote: each set has a marker ``.<spec_name>.byproducts``
+(written before its files), and only the three files of a marked set (and the marker) are
+deleted. A user's ``precious.json`` in the same directory is never touched, even when the
+directory is shared with other programs.
 """
 
 from __future__ import annotations
@@ -21,26 +26,31 @@ import tempfile
 import time
 from pathlib import Path
 
-from respec.errors import CodedError
+from respec.errors import CodedError, quoted
 
 EXTENSIONS = ('structuredslugs', 'slugsin', 'json')
 DEFAULT_SPEC_NAME = 'synthesized_spec'
 DEFAULT_KEEP_LAST = 200
 # File stems stay inside the directory: no separators, no leading dot, no "..".
 SPEC_NAME = re.compile(r'^[A-Za-z0-9][A-Za-z0-9_.-]{0,99}$')
-_BYPRODUCT_FILE = re.compile(r'^(?P<stem>.+)\.(?:' + '|'.join(EXTENSIONS) + r')$')
+_MARKER_SUFFIX = '.byproducts'
+_MARKER_SIGNATURE = 'behavior synthesis byproducts; retention may delete: '
+_MARKER_FILE = re.compile(r'^\.(?P<stem>.+)' + re.escape(_MARKER_SUFFIX) + '$')
 
 
 class InvalidSpecName(CodedError):
     code = 'INVALID_SPEC_NAME'
 
 
+def is_spec_name(name: str) -> bool:
+    return bool(SPEC_NAME.match(name)) and '..' not in name
+
+
 def checked_spec_name(spec_name: str) -> str:
     """``spec_name`` (or the default), refusing names that could leave the directory."""
     name = spec_name or DEFAULT_SPEC_NAME
-    if not SPEC_NAME.match(name) or '..' in name:
-        shown = spec_name if len(spec_name) <= 40 else spec_name[:40] + '...'
-        raise InvalidSpecName(f'invalid spec_name {shown!r}: use letters, digits, "_", "-" and "." '
+    if not is_spec_name(name):
+        raise InvalidSpecName(f'invalid spec_name {quoted(spec_name)}: use letters, digits, "_", "-" and "." '
                               '(at most 100, no path separators or "..")', 'spec_name')
     return name
 
@@ -52,6 +62,18 @@ class ByproductSet:
         self.name = checked_spec_name(spec_name)
         self.directory = directory
         self.paths = {extension: directory / f'{self.name}.{extension}' for extension in EXTENSIONS}
+        self.marker = directory / f'.{self.name}{_MARKER_SUFFIX}'
+
+    def mark(self):
+        """Record that this set's files are ours (retention deletes nothing else)."""
+        self.marker.write_text(_MARKER_SIGNATURE + ', '.join(path.name for path in self.paths.values()) + '\n')
+
+    def is_marked(self) -> bool:
+        try:
+            with self.marker.open(encoding='utf-8', errors='replace') as marker:
+                return marker.read(len(_MARKER_SIGNATURE)) == _MARKER_SIGNATURE
+        except OSError:
+            return False
 
     def write(self, extension: str, text: str) -> Path:
         path = self.paths[extension]
@@ -81,25 +103,23 @@ class ByproductStore:
                 yield ByproductSet(Path(private), spec_name)
             return
         self.directory.mkdir(parents=True, exist_ok=True)
+        files = ByproductSet(self.directory, spec_name)
+        files.mark()
         try:
-            yield ByproductSet(self.directory, spec_name)
+            yield files
         finally:
             self.prune()
 
     def prune(self, now: float | None = None) -> list[Path]:
-        """Delete the sets the policy no longer keeps; returns the deleted files."""
+        """Delete the marked sets the policy no longer keeps; returns the deleted files."""
         newest: dict[str, float] = {}
-        files: dict[str, list[Path]] = {}
         with os.scandir(self.directory) as entries:
-            for entry in entries:
-                match = _BYPRODUCT_FILE.match(entry.name)
-                if not match or not entry.is_file(follow_symlinks=False):
-                    continue
-                with contextlib.suppress(FileNotFoundError):  # another node may prune too
-                    mtime = entry.stat(follow_symlinks=False).st_mtime
-                    stem = match['stem']
-                    files.setdefault(stem, []).append(Path(entry.path))
-                    newest[stem] = max(newest.get(stem, 0.0), mtime)
+            marked = [match['stem'] for match in map(_MARKER_FILE.match, (entry.name for entry in entries))
+                      if match and is_spec_name(match['stem'])]
+        for stem in marked:
+            files = ByproductSet(self.directory, stem)
+            if files.is_marked():
+                newest[stem] = self._last_written(files)
         by_age = sorted(newest, key=newest.get, reverse=True)
         doomed = by_age[self.keep_last:]
         if self.max_age > 0:
@@ -107,8 +127,18 @@ class ByproductStore:
             doomed += [stem for stem in by_age[:self.keep_last] if newest[stem] < cutoff]
         deleted = []
         for stem in doomed:
-            for path in files[stem]:
-                with contextlib.suppress(FileNotFoundError):
-                    path.unlink()
-                    deleted.append(path)
+            files = ByproductSet(self.directory, stem)
+            for path in [*files.paths.values(), files.marker]:  # the marker last: a retry finds the rest
+                with contextlib.suppress(FileNotFoundError):  # another node may prune too
+                    if path.is_file() and not path.is_symlink():
+                        path.unlink()
+                        deleted.append(path)
         return deleted
+
+    def _last_written(self, files: ByproductSet) -> float:
+        """When a marked set was last written: its files' newest mtime, else its marker's."""
+        def mtimes(paths):
+            for path in paths:
+                with contextlib.suppress(FileNotFoundError):
+                    yield path.stat(follow_symlinks=False).st_mtime
+        return max(mtimes(files.paths.values()), default=None) or max(mtimes([files.marker]), default=0.0)

@@ -15,13 +15,17 @@ def write_set(store, name):
         return files
 
 
+def visible_files(directory):
+    return [path for path in directory.iterdir() if not path.name.startswith('.')]
+
+
 def test_dotted_spec_names_keep_separate_files(tmp_path):
     store = ByproductStore(tmp_path)
     write_set(store, 'collide.one')
     write_set(store, 'collide.two')
     assert (tmp_path / 'collide.one.slugsin').read_text() == 'collide.one slugsin\n'
     assert (tmp_path / 'collide.two.slugsin').read_text() == 'collide.two slugsin\n'
-    assert len(list(tmp_path.iterdir())) == 6
+    assert len(visible_files(tmp_path)) == 6
 
 
 def test_only_the_newest_sets_are_kept(tmp_path):
@@ -33,7 +37,7 @@ def test_only_the_newest_sets_are_kept(tmp_path):
             os.utime(path, (stamp, stamp))
     store.prune()
     assert sorted(p.name for p in tmp_path.glob('*.json')) == ['spec3.json', 'spec4.json', 'spec5.json']
-    assert len(list(tmp_path.iterdir())) == 9
+    assert len(visible_files(tmp_path)) == 9
 
 
 def test_sets_older_than_max_age_go(tmp_path):
@@ -44,7 +48,7 @@ def test_sets_older_than_max_age_go(tmp_path):
         os.utime(path, (time.time() - 120, time.time() - 120))
     (tmp_path / 'notes.txt').write_text('not a byproduct')
     store.prune()
-    assert sorted(p.name for p in tmp_path.iterdir()) == [
+    assert sorted(p.name for p in visible_files(tmp_path)) == [
         'new.json', 'new.slugsin', 'new.structuredslugs', 'notes.txt']
 
 
@@ -60,3 +64,19 @@ def test_names_that_could_leave_the_directory_are_refused(tmp_path, name):
     with pytest.raises(InvalidSpecName):
         write_set(ByproductStore(tmp_path), name)
     assert not list(tmp_path.iterdir())
+
+
+def test_retention_deletes_only_files_the_suite_wrote(tmp_path):
+    """Pointed at a directory holding a user's files, retention leaves them alone, whatever
+    their extension, age or name (issue 25)."""
+    foreign = {'precious.json': 'mine', 'notes.slugsin': 'mine too', 'spec0x.structuredslugs': 'and this',
+               '.hidden.byproducts': 'not a marker of a valid set'}
+    for name, text in foreign.items():
+        (tmp_path / name).write_text(text)
+        os.utime(tmp_path / name, (1, 1))  # older than anything the suite writes
+    store = ByproductStore(tmp_path, keep_last=1, max_age=60)
+    for index in range(3):
+        write_set(store, f'spec{index}')
+    store.prune(now=time.time() + 3600)  # every set of ours is too old now
+    assert {name: (tmp_path / name).read_text() for name in foreign} == foreign
+    assert sorted(path.name for path in tmp_path.iterdir()) == sorted(foreign)

@@ -188,7 +188,7 @@ def test_dotted_spec_names_do_not_overwrite_each_other(ros, tmp_path):
         assert client.run(make_goal(**PAPER_TASK, name=name, option='ltl_steps_only'),
                           timeout=60).error_name == 'SUCCESS'
     stems = [byproduct_file_stem(name) for name in ('collide.one', 'collide.two')]
-    assert sorted(path.name for path in tmp_path.iterdir()) == [
+    assert sorted(path.name for path in tmp_path.iterdir() if not path.name.startswith('.')) == [
         f'{stem}.{extension}' for stem in stems for extension in ('json', 'slugsin', 'structuredslugs')]
 
 

@@ -4,6 +4,7 @@ import os
 import signal
 import threading
 import time
+from concurrent.futures import ThreadPoolExecutor
 
 import pytest
 
@@ -28,8 +29,14 @@ def processes():
 
 def children_of_this_process() -> set[int]:
     """The synthesis processes (multiprocessing's resource tracker aside)."""
-    with open(f'/proc/{os.getpid()}/task/{os.getpid()}/children') as children:
-        pids = {int(pid) for pid in children.read().split()}
+    pids = set()
+    for entry in filter(str.isdigit, os.listdir('/proc')):  # by parent: a thread's children file ends with it
+        try:
+            with open(f'/proc/{entry}/stat') as stat:
+                if int(stat.read().rsplit(')', 1)[1].split()[1]) == os.getpid():
+                    pids.add(int(entry))
+        except (FileNotFoundError, NotADirectoryError, ProcessLookupError, IndexError):
+            pass
     found = set()
     for pid in pids:
         try:
@@ -122,3 +129,34 @@ def test_close_kills_busy_and_idle_children():
     while children_of_this_process() and time.monotonic() < deadline:
         time.sleep(0.05)
     assert children_of_this_process() == set()
+
+
+def rss_kib(pid: int) -> int:
+    with open(f'/proc/{pid}/status') as status:
+        return next(int(line.split()[1]) for line in status if line.startswith('VmRSS:'))
+
+
+def test_idle_children_are_released_and_fresh_prepared_ones_replace_them():
+    """After a burst the used children (their heaps grown by what they solved) end once idle;
+    the prepared number of fresh children, at baseline RSS, stay (issue 25)."""
+    processes = SynthesisProcesses(idle_seconds=1.0)
+    try:
+        processes.prepare(1)
+        time.sleep(1.0)  # let the fresh child import the synthesizer
+        baseline = sum(rss_kib(pid) for pid in children_of_this_process())
+        spec = compile_task('atlas', ['stand_prep'], ['look_down', 'pickup_object'])
+        with ThreadPoolExecutor(3) as pool:  # three at once: three children
+            assert all(result.realizable for result in pool.map(lambda _: processes.synthesize(spec), range(6)))
+            list(pool.map(lambda _: processes.call('time:sleep', (0.5,)), range(3)))
+        used = children_of_this_process()
+        assert len(used) >= 2 and processes.idle_count >= 2
+        deadline = time.monotonic() + 10
+        while (children_of_this_process() & used or processes.idle_count != 1) and time.monotonic() < deadline:
+            time.sleep(0.1)
+        assert not children_of_this_process() & used  # every used child has ended
+        assert processes.idle_count == 1 and len(children_of_this_process()) == 1
+        time.sleep(0.5)
+        assert sum(rss_kib(pid) for pid in children_of_this_process()) < 1.5 * baseline
+        assert processes.synthesize(spec).realizable  # and the next synthesis is served at once
+    finally:
+        processes.close()

@@ -10,13 +10,17 @@ both cases; only with ``--explicitStrategy`` (``--counterStrategy``) is a strate
 (counter-strategy) computed, and written to OUTPUT or stdout; only with ``--explain`` is the
 reason for unrealizability computed and printed. A malformed or unreadable input exits with
 status 1 (as slugs) and a ``file:line:col: ... near 'token'`` message; the time limit exits
-with 3, the memory limit with 4. Formulas may be nested to any depth. Heavy modules (CUDD)
+with 3 (reading the input counts: a FIFO nobody writes to ends there too), the memory limit
+with 4 (also while parsing). ``--timeout`` and ``--memory-limit`` must be finite numbers
+>= 0 (0: no limit); anything else exits with 2, as every usage error. Formulas may be nested
+to any depth. Heavy modules (CUDD)
 load only when a specification is synthesized, so ``--help`` is instant.
 """
 
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 import time
 from pathlib import Path
@@ -46,24 +50,61 @@ def _parser() -> argparse.ArgumentParser:
                         help='only convert INPUT.structuredslugs to slugsin')
     parser.add_argument('--explain', action='store_true',
                         help='when unrealizable, say why (losing initial states, blocked goal, a play)')
-    parser.add_argument('--timeout', type=float, default=None, metavar='SECONDS',
-                        help='give up after this many seconds (exit status 3)')
-    parser.add_argument('--memory-limit', type=float, default=2048, metavar='MB',
-                        help='give up beyond this much BDD memory (default 2048; exit status 4)')
+    parser.add_argument('--timeout', type=_limit, default=None, metavar='SECONDS',
+                        help='give up after this many seconds, reading the input included (exit status 3)')
+    parser.add_argument('--memory-limit', type=_limit, default=2048, metavar='MB',
+                        help='give up beyond this much memory (default 2048, 0: none; exit status 4)')
     parser.add_argument('input', metavar='INPUT')
     parser.add_argument('output', metavar='OUTPUT', nargs='?')
     return parser
 
 
-def read_specification(path: str, check=None):
+def _limit(text: str) -> float:
+    """A limit given on the command line: a finite number >= 0 (NaN would mean no limit)."""
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not math.isfinite(value) or value < 0:
+        raise argparse.ArgumentTypeError(f'must be a finite number >= 0, not {text[:40]!r}')
+    return value
+
+
+def read_specification(path: str, check=None, deadline: float | None = None):
     """Parse a .slugsin or .structuredslugs file (by extension) into a GR1Specification;
-    ``check`` (e.g. an ltl_synthesizer Interrupt) is called regularly while parsing."""
+    ``check`` (e.g. an ltl_synthesizer Interrupt) is called regularly while parsing. Reading
+    that has not ended by ``deadline`` (a FIFO no one writes to) raises SynthesisCancelled."""
     from respec.parsing import parse_slugsin, parse_structuredslugs
     if path.endswith('.structuredslugs'):
-        return parse_structuredslugs(Path(path).read_text(), filename=path, check=check)
-    if path.endswith('.slugsin'):
-        return parse_slugsin(Path(path).read_text(), filename=path, check=check)
-    raise ValueError(f"{path}: unknown input format (expected .slugsin or .structuredslugs)")
+        parse = parse_structuredslugs
+    elif path.endswith('.slugsin'):
+        parse = parse_slugsin
+    else:
+        raise ValueError(f"{path}: unknown input format (expected .slugsin or .structuredslugs)")
+    return parse(_read_text(path, deadline), filename=path, check=check)
+
+
+def _read_text(path: str, deadline: float | None) -> str:
+    if deadline is None:
+        return Path(path).read_text()
+    import threading
+    from ltl_synthesizer.errors import SynthesisCancelled
+    outcome = {}
+
+    def read():  # opening a FIFO blocks until a writer comes: in a thread the process may leave
+        try:
+            outcome['text'] = Path(path).read_text()
+        except BaseException as error:  # re-raised in the caller's thread
+            outcome['error'] = error
+
+    reader = threading.Thread(target=read, name='gr1synth-input', daemon=True)
+    reader.start()
+    reader.join(max(0.0, deadline - time.monotonic()))
+    if reader.is_alive():
+        raise SynthesisCancelled(f'timeout: {path} was still being read')
+    if 'error' in outcome:
+        raise outcome['error']
+    return outcome['text']
 
 
 def _write(text: str, output: str | None) -> None:
@@ -140,10 +181,14 @@ def _run(args) -> int:
     memory_limit = int(args.memory_limit * 2**20) if args.memory_limit > 0 else None
     interrupt = Interrupt(None, deadline, memory_limit)
     try:
-        spec = read_specification(args.input, check=interrupt)
+        spec = read_specification(args.input, check=interrupt, deadline=deadline)
     except SynthesisCancelled as error:
         print(f'gr1synth: error: {error}', file=sys.stderr)
         return EXIT_TIMEOUT
+    except (SynthesisMemoryExceeded, MemoryError) as error:
+        print(f'gr1synth: error: memory limit: {error or "out of memory"} (while parsing {args.input})',
+              file=sys.stderr)
+        return EXIT_MEMORY
     except (ParseError, OSError, ValueError) as error:
         print(f'gr1synth: error: {error}', file=sys.stderr)
         return EXIT_MALFORMED

@@ -1,6 +1,7 @@
 """The gr1synth command line, run as a subprocess the way tools that wrap slugs run it."""
 
 import json
+import os
 import subprocess
 import sys
 import time
@@ -152,3 +153,30 @@ def test_the_time_limit_stops_a_runaway_strategy_extraction(tmp_path):
     # Without --explicitStrategy there is nothing to enumerate: the verdict comes at once.
     done = gr1synth('--timeout', '60', write(tmp_path, 'runaway.structuredslugs', RUNAWAY))
     assert done.returncode == 0 and 'realizable' in done.stderr
+
+
+# --- hostile limits and inputs (issue 25) ----------------------------------------------------
+
+@pytest.mark.parametrize('option', ['--timeout', '--memory-limit'])
+@pytest.mark.parametrize('value', ['nan', 'inf', '-inf', '-1', 'soon'])
+def test_limits_that_are_no_limits_are_refused(tmp_path, option, value):
+    done = gr1synth(f'{option}={value}', write(tmp_path, 'spec.structuredslugs', RUNAWAY))
+    assert done.returncode == 2 and option in done.stderr and 'finite number >= 0' in done.stderr
+    assert 'Traceback' not in done.stderr
+
+
+def test_the_memory_limit_hit_while_parsing_exits_with_4(tmp_path):
+    # 200,000 lines of formulas: parsing alone grows the process well beyond 1 MB.
+    text = '[INPUT]\nx\n\n[OUTPUT]\ny\n\n[SYS_TRANS]\n' + '(x | y) & (!x | next(y))\n' * 200_000
+    done = gr1synth('--memory-limit', '1', write(tmp_path, 'big.structuredslugs', text))
+    assert done.returncode == 4, done.stderr[-2000:]
+    assert 'memory' in done.stderr and 'Traceback' not in done.stderr
+
+
+def test_a_fifo_no_one_writes_to_ends_at_the_time_limit(tmp_path):
+    fifo = tmp_path / 'input.structuredslugs'
+    os.mkfifo(fifo)
+    started = time.monotonic()
+    done = gr1synth('--timeout', '1', fifo)
+    assert done.returncode == 3 and 'timeout' in done.stderr and 'Traceback' not in done.stderr
+    assert time.monotonic() - started < 1 + 10  # interpreter start-up on a loaded machine included

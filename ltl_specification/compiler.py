@@ -51,6 +51,7 @@ from respec.components import (
     initial_conditions_specification,
 )
 from respec.capabilities import CapabilitySystem, capability_system_of
+from respec.errors import quoted
 from respec.ltl import variables
 from respec.naming import DEFAULT_SM_OUTCOMES, FAILED, FINISHED, activation, outcome_proposition, parse_names
 from respec.parsing import ParseError, UnknownVariableError, parse_formula, spec_from_text_sections
@@ -302,26 +303,26 @@ def _parse_custom_ltl(custom_ltl) -> dict[str, list]:
     if not custom_ltl:
         return {}
     if not isinstance(custom_ltl, Mapping):
-        raise InvalidFormulaError(f'custom LTL must map section names to lists, got {custom_ltl!r}',
-                                  item=repr(custom_ltl))
+        raise InvalidFormulaError(f'custom LTL must map section names to lists, got {quoted(custom_ltl)}',
+                                  item=quoted(custom_ltl))
     parsed = {}
     for section, entries in custom_ltl.items():
         if section not in SECTIONS:
             raise InvalidFormulaError(
-                f'unknown custom LTL section {section!r} (expected one of {", ".join(SECTIONS)})', item=str(section))
+                f'unknown custom LTL section {quoted(section)} (expected one of {", ".join(SECTIONS)})', item=str(section))
         if isinstance(entries, str) or not isinstance(entries, (list, tuple)):
-            raise InvalidFormulaError(f'custom LTL section {section} must be a list of strings', item=repr(entries))
+            raise InvalidFormulaError(f'custom LTL section {section} must be a list of strings', item=quoted(entries))
         if section in PROPOSITION_SECTIONS:
             for name in entries:
                 if not isinstance(name, str):
-                    raise InvalidFormulaError(f'custom {section} entry {name!r} is not a name', item=repr(name))
+                    raise InvalidFormulaError(f'custom {section} entry {quoted(name)} is not a name', item=quoted(name))
             continue
         parsed[section] = []
         for text in entries:
             try:
                 parsed[section].append(parse_formula(text))
             except ParseError as error:
-                raise InvalidFormulaError(f'custom {section} formula {text!r}: {error}', item=str(text)) from error
+                raise InvalidFormulaError(f'custom {section} formula {quoted(text)}: {error}', item=str(text)) from error
     return parsed
 
 
@@ -356,7 +357,7 @@ def _check_custom_scopes(spec: GR1Specification, custom_ltl) -> None:
         spec_from_text_sections(sections)
     except UnknownVariableError as error:
         raise UnknownPropositionError(
-            f'custom LTL names unknown proposition {error.token!r} ({error}); '
+            f'custom LTL names unknown proposition {quoted(error.token)} ({error}); '
             f'the task defines: {", ".join(spec.propositions())}', item=error.token) from error
     except ParseError as error:
         raise InvalidFormulaError(f'custom LTL: {error}', item=_custom_entry(custom_ltl, error)) from error

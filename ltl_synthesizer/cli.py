@@ -13,7 +13,8 @@ status 1 (as slugs) and a ``file:line:col: ... near 'token'`` message; the time 
 with 3 (reading the input counts: a FIFO nobody writes to ends there too), the memory limit
 with 4 (also while parsing). ``--timeout`` and ``--memory-limit`` must be finite numbers
 >= 0 (0: no limit); anything else exits with 2, as every usage error. Formulas may be nested
-to any depth. Heavy modules (CUDD)
+up to respec.nesting.MAX_FORMULA_NESTING (10,000) levels deep; deeper ones are malformed (1).
+Heavy modules (CUDD)
 load only when a specification is synthesized, so ``--help`` is instant.
 """
 
@@ -30,10 +31,6 @@ UNREALIZABLE_LINE = 'RESULT: Specification is unrealizable.'
 EXIT_MALFORMED = 1
 EXIT_TIMEOUT = 3
 EXIT_MEMORY = 4
-# Formula trees are walked recursively (parsing, translation, printing): the work runs in a
-# thread whose stack holds formulas nested this deep and more (slugs handles 3,000).
-DEEP_STACK_BYTES = 1 << 30
-DEEP_RECURSION_LIMIT = 1_000_000
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -143,7 +140,7 @@ def main(argv=None) -> int:
 
 
 def run_with_deep_stack(function, *args):
-    """``function(*args)`` in a thread with a deep stack, so that no formula is too deeply nested."""
+    """``function(*args)`` in a thread with room for formulas nested as deeply as the parsers accept."""
     import threading
     outcome = {}
 
@@ -153,9 +150,9 @@ def run_with_deep_stack(function, *args):
         except BaseException as error:  # re-raised in the caller's thread
             outcome['error'] = error
 
+    from respec.nesting import allow_deep_formulas
     previous_stack, previous_limit = threading.stack_size(), sys.getrecursionlimit()
-    threading.stack_size(DEEP_STACK_BYTES)
-    sys.setrecursionlimit(DEEP_RECURSION_LIMIT)
+    allow_deep_formulas()
     try:
         worker = threading.Thread(target=target, name='gr1synth', daemon=True)
         worker.start()

@@ -266,4 +266,8 @@ def _die_with_parent(parent_pid: int) -> None:
 
 
 if __name__ == '__main__':
-    _serve(int(sys.argv[1]))
+    from respec.nesting import allow_deep_formulas
+    allow_deep_formulas()  # requests are served in a thread with room for any formula accepted
+    server = threading.Thread(target=_serve, args=(int(sys.argv[1]),), name='synthesis-process')
+    server.start()
+    server.join()

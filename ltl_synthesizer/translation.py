@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from dd import cudd
 
+from respec.errors import quoted
 from respec.ltl import And, Const, Formula, Iff, Implies, Next, Not, Or, Var, children, to_infix
 from respec.spec import GR1Specification
 
@@ -81,7 +82,7 @@ class Translator:
         if isinstance(formula, Var):
             if formula.name not in self.declared:
                 raise UnknownPropositionError(
-                    f"{section}: unknown proposition '{formula.name}' (declare it as an input or output)",
+                    f"{section}: unknown proposition {quoted(formula.name)} (declare it as an input or output)",
                     item=formula.name)
             return bdd.var(primed(formula.name) if under_next else formula.name)
         if isinstance(formula, Next):

@@ -38,11 +38,12 @@ from functools import lru_cache
 from operator import add
 from typing import NamedTuple
 
-from respec.errors import CodedError
+from respec.errors import CodedError, quoted
 from respec.ltl import (
     FALSE, FIELD_SETTERS, TRUE, And, Const, Formula, Iff, Implies, Next, Not, Or, Var, conj, disj, iff,
     implies, neg, next_, var, variables,
 )
+from respec.nesting import MAX_FORMULA_NESTING, too_deep
 from respec.spec import FORMULA_SECTIONS, PROPOSITION_SECTIONS, SLUGS_HEADERS, GR1Specification
 
 __all__ = [
@@ -69,7 +70,7 @@ class ParseError(CodedError):
         self.line = line
         self.column = column
         self.token = token
-        super().__init__(f'{filename}:{line}:{column}: {problem} near {token!r}', item=token)
+        super().__init__(f'{filename}:{line}:{column}: {problem} near {quoted(token)}', item=token)
 
 
 class UnknownVariableError(ParseError):
@@ -175,6 +176,7 @@ class _InfixParser:
         self.scope = scope
         self.tokens = _infix_tokens(text, source)
         self.position = 0
+        self.depth = 0
 
     def parse(self) -> Formula:
         if self.peek().kind == 'end':
@@ -218,16 +220,28 @@ class _InfixParser:
             else:
                 left = _combine(token.text, left, right)
 
+    def deeper(self, token: _Token) -> None:
+        """One nesting level more (a '(', '!' or next); refused beyond MAX_FORMULA_NESTING."""
+        self.depth += 1
+        if self.depth > MAX_FORMULA_NESTING:
+            raise self.error(too_deep(), token)
+
     def unary(self, in_next: bool) -> Formula:
         token = self.peek()
         if token.kind == 'op' and token.text == '!':
             self.take()
-            return neg(self.unary(in_next))
+            self.deeper(token)
+            formula = neg(self.unary(in_next))
+            self.depth -= 1
+            return formula
         if token.kind == 'next':
             self.take()
             if in_next:
                 raise self.error('nested next is not GR(1)', token)
-            return next_(self.unary(in_next=True))
+            self.deeper(token)
+            formula = next_(self.unary(in_next=True))
+            self.depth -= 1
+            return formula
         return self.atom(in_next)
 
     def atom(self, in_next: bool) -> Formula:
@@ -238,12 +252,12 @@ class _InfixParser:
             return self.comparison(in_next)
         if self.scope.integers and token.kind == 'op' and token.text == '(':
             # '(' opens either a Boolean formula or an integer sum; try the sum first.
-            start = self.position - 1
+            start, depth = self.position - 1, self.depth
             self.position = start
             try:
                 return self.comparison(in_next)
             except ParseError:
-                self.position = start + 1
+                self.position, self.depth = start + 1, depth
         if token.kind in ('TRUE', 'FALSE'):
             return TRUE if token.kind == 'TRUE' else FALSE
         if token.kind == 'name':
@@ -253,7 +267,9 @@ class _InfixParser:
                 raise self.error('primed variable inside next() is a nested next', token)
             return next_(self.variable(token, next_step=True))
         if token.kind == 'op' and token.text == '(':
+            self.deeper(token)
             inner = self.binary(0, in_next)
+            self.depth -= 1
             closing = self.take()
             if not (closing.kind == 'op' and closing.text == ')'):
                 raise self.error("expected ')'", closing)
@@ -293,10 +309,12 @@ class _InfixParser:
             if integer.bits:
                 problem = _scope_problem(self.scope, integer.bits[0], next_step)
                 if problem:
-                    raise self.error(problem.replace(repr(integer.bits[0]), repr(integer.name)), token)
+                    raise self.error(problem.replace(quoted(integer.bits[0]), quoted(integer.name)), token)
             return [(integer, next_step)]
         if token.kind == 'op' and token.text == '(':
+            self.deeper(token)
             terms = self.sum(in_next)
+            self.depth -= 1
             closing = self.take()
             if not (closing.kind == 'op' and closing.text == ')'):
                 raise self.error("expected ')'", closing)
@@ -391,11 +409,11 @@ def _scope_problem(scope: _Scope, name: str, next_step: bool) -> str:
         return ''
     where = f' in {scope.section}' if scope.section else ''
     if name not in scope.names:
-        return f'unknown variable {name!r}{where}'
+        return f'unknown variable {quoted(name)}{where}'
     allowed = scope.next_step if next_step else scope.current
     if name not in allowed:
         step = 'next-step' if next_step else 'current'
-        return f'{step} variable {name!r} is not allowed{where}'
+        return f'{step} variable {quoted(name)} is not allowed{where}'
     return ''
 
 
@@ -429,6 +447,8 @@ def _quick_infix(line: str, scope: _Scope, variables: dict[str, Var] | None = No
     variables = {} if variables is None else variables
     if not line.isascii() or scope.integers or _QUICK_LINE.fullmatch(line) is None:
         return None
+    if line.count('(') + line.count('!') + line.count('~') + line.count('next') > MAX_FORMULA_NESTING:
+        return None  # perhaps nested too deeply: the parser counts the levels
     for spelling, mark in _QUICK_SPELLINGS:
         if spelling in line:
             line = line.replace(spelling, mark)
@@ -541,6 +561,7 @@ class _PrefixParser:
             line = line.split('#', 1)[0]
             self.tokens += [(m.group(), line_number, m.start() + 1) for m in _PREFIX_TOKEN.finditer(line)]
         self.position = 0
+        self.depth = 0
         self.end = (text.count('\n') + 1, len(text.rsplit('\n', 1)[-1]) + 1)
 
     def parse(self) -> Formula:
@@ -569,6 +590,16 @@ class _PrefixParser:
 
     def formula(self, memory: list[Formula] | None) -> Formula:
         token = self.take()
+        self.depth += 1
+        if self.depth > MAX_FORMULA_NESTING:
+            raise self.error(too_deep(), token)
+        try:
+            return self.operation(token, memory)
+        finally:
+            self.depth -= 1
+
+    def operation(self, token, memory: list[Formula] | None) -> Formula:
+        """The formula that starts with ``token``."""
         text = token[0]
         if text == '!':
             return neg(self.formula(memory))
@@ -619,7 +650,7 @@ def parse_formula(text: str, syntax: str = 'infix') -> Formula:
     Any variable name is accepted; specification parsers check names against declarations.
     """
     if not isinstance(text, str):
-        raise ParseError('formula must be a string', repr(text))
+        raise ParseError('formula must be a string', quoted(text))
     return _parse(text, syntax, _ANY, _Source())
 
 
@@ -830,6 +861,8 @@ def _quick_prefix(line: str, scope: _Scope, variables: dict[str, Var]) -> Formul
     now, following = scope.current, scope.next_step
     if scope.names is None or '$' in line or '?' in line:
         return None
+    if len(line) > 2 * MAX_FORMULA_NESTING and line.count(' ') > MAX_FORMULA_NESTING:
+        return None  # perhaps nested too deeply: the parser counts the levels
     operands = []
     push, pop = operands.append, operands.pop
     for token in reversed(line.split()):

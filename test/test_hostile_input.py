@@ -1,5 +1,6 @@
 """Hostile input costs little (issue 25, ROS-free part): YAML alias bombs and deep nesting in
-request YAML, and the one quoting rule of every message. The full attack sizes are in
+request YAML, formulas nested beyond the one nesting limit, and the one quoting rule of every
+message. The full attack sizes are in
 bench/bench_reliability.py."""
 
 import resource
@@ -8,6 +9,9 @@ import time
 import pytest
 
 from respec.errors import QUOTED_CHARACTERS, quoted
+from respec.ltl import var
+from respec.nesting import MAX_FORMULA_NESTING
+from respec.parsing import ParseError, UnknownVariableError, parse_formula, parse_structuredslugs
 from synthesis_manager.requests import MAX_YAML_DEPTH, InvalidRequest, parse_synthesis_options
 
 
@@ -71,3 +75,37 @@ def test_quoting_is_short_whatever_the_value(value):
 def test_short_values_are_quoted_whole():
     assert quoted('look_down') == "'look_down'"
     assert quoted(['a', 'b']) == "['a', 'b']"
+
+
+# --- deep nesting: one limit for every parser ------------------------------------------------
+
+def in_deep_thread(function, *args):
+    from ltl_synthesizer.cli import run_with_deep_stack
+    return run_with_deep_stack(function, *args)
+
+
+@pytest.mark.parametrize('syntax, formula', [
+    ('infix', '(' * (MAX_FORMULA_NESTING + 1) + 'x' + ')' * (MAX_FORMULA_NESTING + 1)),
+    ('infix', '!' * (MAX_FORMULA_NESTING + 1) + 'x'),
+    ('infix', '!(' * (MAX_FORMULA_NESTING // 2 + 1) + 'x' + ')' * (MAX_FORMULA_NESTING // 2 + 1)),
+    ('prefix', '! ' * (MAX_FORMULA_NESTING + 1) + 'x'),
+    ('prefix', '| x & y ' * (MAX_FORMULA_NESTING // 2 + 1) + 'x'),
+])
+def test_formulas_nested_beyond_the_limit_are_invalid_formulas(syntax, formula):
+    with pytest.raises(ParseError, match=f'nested deeper than {MAX_FORMULA_NESTING}') as raised:
+        in_deep_thread(parse_formula, formula, syntax)
+    assert raised.value.code == 'INVALID_FORMULA' and len(str(raised.value)) < 200
+
+
+def test_formulas_nested_up_to_the_limit_are_read_in_files_too():
+    deepest = '(' * MAX_FORMULA_NESTING + 'x' + ')' * MAX_FORMULA_NESTING
+    spec = in_deep_thread(parse_structuredslugs, f'[OUTPUT]\nx\n\n[SYS_TRANS]\n{deepest}\n')
+    assert spec.sys_trans == [var('x')]
+    with pytest.raises(ParseError, match='nested deeper'):
+        in_deep_thread(parse_structuredslugs, f'[OUTPUT]\nx\n\n[SYS_TRANS]\n!({deepest})\n')
+
+
+def test_an_unknown_proposition_is_quoted_by_its_start():
+    with pytest.raises(UnknownVariableError) as raised:
+        parse_structuredslugs('[OUTPUT]\nx\n\n[SYS_TRANS]\n' + 'y' * 60_000 + '\n')
+    assert raised.value.code == 'UNKNOWN_PROPOSITION' and len(str(raised.value)) < 250

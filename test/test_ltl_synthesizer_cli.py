@@ -180,3 +180,12 @@ def test_a_fifo_no_one_writes_to_ends_at_the_time_limit(tmp_path):
     done = gr1synth('--timeout', '1', fifo)
     assert done.returncode == 3 and 'timeout' in done.stderr and 'Traceback' not in done.stderr
     assert time.monotonic() - started < 1 + 10  # interpreter start-up on a loaded machine included
+
+
+def test_formulas_nested_beyond_the_limit_are_malformed(tmp_path):
+    from respec.nesting import MAX_FORMULA_NESTING
+    depth = MAX_FORMULA_NESTING + 1
+    text = '[INPUT]\n\n[OUTPUT]\nx\n\n[SYS_TRANS]\n' + '(' * depth + 'x' + ')' * depth + '\n'
+    done = gr1synth(write(tmp_path, 'too_deep.structuredslugs', text))
+    assert done.returncode == 1 and f'nested deeper than {MAX_FORMULA_NESTING}' in done.stderr
+    assert 'Traceback' not in done.stderr and len(done.stderr) < 300

@@ -246,3 +246,37 @@ def test_a_synthesis_over_its_memory_limit_ends_with_a_clear_error(ros, tmp_path
     assert '64' in outcome.message and 'memory' in outcome.message
     assert time.monotonic() - started < 120
     assert client.run(make_goal(**PAPER_TASK), timeout=60).error_name == 'SUCCESS'
+
+
+# --- hostile input (issue 25) -----------------------------------------------------------------
+
+def test_deeply_nested_custom_ltl_gets_its_specific_code_at_once(ros, tmp_path):
+    """5,000 parentheses (within the limit) are read like any formula; beyond the one nesting
+    limit of every parser the answer is INVALID_FORMULA with a short message, no traceback."""
+    from respec.nesting import MAX_FORMULA_NESTING
+    client = start_suite(ros, tmp_path)
+    within = client.run(make_goal(**PAPER_TASK, option='ltl_compilation_only', ltl_specification={
+        'sys_trans': ['(' * 5000 + 'look_down_a' + ')' * 5000]}), timeout=60)
+    assert within.error_name == 'SUCCESS', within.message
+    depth = MAX_FORMULA_NESTING + 1
+    for formula in ('(' * depth + 'look_down_a' + ')' * depth, '!' * 3 * depth + 'look_down_a'):
+        started = time.monotonic()
+        outcome = client.run(make_goal(**PAPER_TASK, ltl_specification={'sys_trans': [formula]}), timeout=60)
+        assert time.monotonic() - started < 5
+        assert outcome.error_name == 'INVALID_FORMULA', outcome.message[:300]
+        assert f'nested deeper than {MAX_FORMULA_NESTING}' in outcome.message and len(outcome.message) < 300
+
+
+def test_a_yaml_bomb_in_synthesis_options_is_refused_at_once(ros, tmp_path):
+    from synthesis_manager.client import make_flexbe_goal
+    start_suite(ros, tmp_path)
+    client = SynthesisClient(ros.add_node(Node, 'flexbe_client'), 'flexbe_synthesis')
+    assert client.wait_for_server(timeout=10.0)
+    goal = make_flexbe_goal(**PAPER_TASK)
+    goal.synthesis_options = '\n'.join(['a0: &a0 [lol, lol, lol, lol, lol, lol, lol, lol, lol]'] + [
+        f'a{i}: &a{i} [' + ', '.join([f'*a{i - 1}'] * 9) + ']' for i in range(1, 9)])
+    started = time.monotonic()
+    outcome = client.run(goal, timeout=60)
+    assert time.monotonic() - started < 5
+    assert 'INVALID_REQUEST' in outcome.message and 'aliases' in outcome.message
+    assert len(outcome.message) < 300

@@ -590,8 +590,8 @@ class _PrefixParser:
 
     def formula(self, memory: list[Formula] | None) -> Formula:
         token = self.take()
-        self.depth += 1
-        if self.depth > MAX_FORMULA_NESTING:
+        self.depth += 1  # operators nest; a leaf below the deepest one is no level of its own
+        if self.depth > MAX_FORMULA_NESTING and token[0] in ('!', '^', '&', '|', '$'):
             raise self.error(too_deep(), token)
         try:
             return self.operation(token, memory)

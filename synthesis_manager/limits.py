@@ -9,8 +9,9 @@ refuses larger bodies than :data:`MAX_BODY_BYTES` with 413.
 from __future__ import annotations
 
 import math
+import time
 
-from respec.errors import quoted
+from respec.errors import CodedError, quoted
 from synthesis_manager.requests import InvalidRequest
 
 #: Longest string accepted in any request field, in UTF-8 bytes.
@@ -71,3 +72,38 @@ def too_long(field_path: str, value: str, limit: int = MAX_STRING_BYTES) -> str:
     """The error message for an oversized string, quoting only its start."""
     return (f'{field_path} is {utf8_length(value)} bytes long; the limit is {limit} bytes '
             f'(it starts {quoted(value)})')
+
+
+class GoalTimedOut(CodedError):
+    """The goal's own time limit passed (its whole pipeline, queues included)."""
+
+    code = 'TIMEOUT'
+
+
+class GoalDeadline:
+    """A goal's time limit over its whole pipeline: queue waits, every stage, the answer.
+
+    ``limit`` seconds (0: none, each stage has only its own limit) count from ``started``
+    (a time.monotonic() instant: when the goal was accepted, not when work on it began).
+    """
+
+    def __init__(self, limit: float, started: float | None = None):
+        self.limit = limit
+        self.deadline = (time.monotonic() if started is None else started) + limit if limit else None
+
+    def stage_limit(self, stage_limit: float, stage: str) -> float:
+        """Seconds ``stage`` may take: its own limit, cut to what is left of the goal's;
+        GoalTimedOut when nothing is left."""
+        if self.deadline is None:
+            return stage_limit
+        left = self.deadline - time.monotonic()
+        if left <= 0:
+            raise self.timed_out(stage)
+        return min(stage_limit, left)
+
+    def passed(self) -> bool:
+        return self.deadline is not None and time.monotonic() >= self.deadline
+
+    def timed_out(self, stage: str) -> GoalTimedOut:
+        return GoalTimedOut(f'the goal\'s time limit of {self.limit:g} s passed ({stage}; the limit counts '
+                            'the whole pipeline, waiting included)', 'timeout')

@@ -121,10 +121,10 @@ def test_cancel_in_the_middle_of_synthesis_really_stops_it(ros, tmp_path):
 def test_synthesis_time_limit_gives_synthesis_timeout_and_the_server_keeps_serving(ros, tmp_path):
     client, _ = start(ros, tmp_path)
     started = time.monotonic()
-    outcome = client.run(make_goal(**LONG_TASK, timeout=0.5), timeout=60)
+    outcome = client.run(make_goal(**LONG_TASK, timeout=2.5), timeout=60)
     assert outcome.error_name == 'SYNTHESIS_TIMEOUT'
-    assert '0.5' in outcome.message
-    assert time.monotonic() - started < 10
+    assert '2.5 s' in outcome.message  # the goal's limit: it counts compilation and waiting too
+    assert time.monotonic() - started < 2.5 + 1 + 1  # the answer within a second of it (+ client overhead)
     assert client.run(make_goal(**PAPER_TASK), timeout=60).error_name == 'SUCCESS'
 
 

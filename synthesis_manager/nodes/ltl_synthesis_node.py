@@ -28,10 +28,13 @@ from synthesis_manager.ros.conversions import automaton_to_msg, error_code, msg_
 from synthesis_manager.ros.errors import reported_error
 from synthesis_manager.ros.node_main import node_main
 from synthesis_manager.ros.qos import service_qos
-from synthesis_manager.ros.worker_pool import WorkerPool
+from synthesis_manager.ros.worker_pool import Abandoned, WorkerPool
 from synthesis_msgs.srv import CancelSynthesis, SynthesizeAutomaton
 
 BACKENDS = ('builtin', 'slugs')
+
+
+WAKE_PERIOD = 0.1  # seconds
 
 
 class LTLSynthesisNode(Node):
@@ -73,6 +76,8 @@ class LTLSynthesisNode(Node):
         if self.parameter('backend') == 'builtin':
             self.synthesis_processes.prepare()
         group = ReentrantCallbackGroup()
+        # Wakes the executor, so that requests waiting for a worker see their deadline or cancel pass.
+        self.create_timer(WAKE_PERIOD, lambda: None, callback_group=group)
         self.create_service(SynthesizeAutomaton, 'ltl_synthesis', self.on_request, callback_group=group,
                             qos_profile=service_qos())
         self.create_service(CancelSynthesis, 'ltl_synthesis/cancel', self.on_cancel_request,
@@ -120,8 +125,12 @@ class LTLSynthesisNode(Node):
             timeout = check_timeout(request.timeout, 'request.timeout') or self.parameter('timeout')
             # The time limit starts now: waiting for a worker counts.
             deadline = time.monotonic() + timeout
-            await self.workers.run(self._synthesize, request, response, cancel, timeout, deadline,
-                                   wake=self._wake_executor)
+            try:
+                await self.workers.run(self._synthesize, request, response, cancel, timeout, deadline,
+                                       wake=self._wake_executor,
+                                       give_up=lambda: cancel.is_set() or time.monotonic() > deadline)
+            except Abandoned:  # stopped while waiting for a worker
+                self._stopped(response, 'cancelled' if cancel.is_set() else 'timeout', timeout)
         except ParseError as error:  # the original's code for a malformed specification
             response.synthesizable = False
             response.error_code = error_code('SYNTHESIS_FAILED', f'malformed specification: {error}')

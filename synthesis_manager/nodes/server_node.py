@@ -22,6 +22,7 @@ from typing import Callable
 from rclpy.action import ActionServer, CancelResponse, GoalResponse
 from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.node import Node
+from rclpy.time import Time
 
 from ltl_specification.errors import InvalidInitialConditionsError
 from ltl_specification.initial_conditions import (detected_status, initial_conditions_from_robot_state,
@@ -30,7 +31,7 @@ from ltl_synthesizer.errors import SynthesisError
 from ltl_synthesizer.isolated import SynthesisProcesses
 from respec.errors import INTERNAL_ERROR, CodedError
 from sm_generation.instantiation import count_states
-from synthesis_manager.limits import check_message, check_timeout
+from synthesis_manager.limits import GoalDeadline, check_message, check_timeout
 from synthesis_manager.nodes.atlas_sim_node import STATE_TOPIC
 from synthesis_manager.requests import (InvalidRequest, SynthesisTask, task_from_behavior_synthesis,
                                         task_from_flexbe_synthesis)
@@ -40,7 +41,7 @@ from synthesis_manager.ros.errors import log_internal_error
 from synthesis_manager.ros.node_main import node_main
 from synthesis_manager.ros.qos import action_server_qos, service_qos
 from synthesis_manager.ros.robot_state import RobotStateListener
-from synthesis_manager.ros.stage_calls import Preempted, ServerStopping, StageCaller, StageFailed
+from synthesis_manager.ros.stage_calls import Preempted, ServerStopping, StageCaller, StageFailed, StageTimedOut
 from synthesis_manager.ros.worker_pool import WorkerPool
 from synthesis_msgs.action import BehaviorSynthesis
 from synthesis_msgs.msg import FSAutomaton, LTLSpecification
@@ -52,6 +53,7 @@ from synthesis_msgs.srv import (CancelSynthesis, GenerateFlexBESM, GenerateLTLSp
 # tests can put a stand-in there).
 DIAGNOSIS = 'ltl_specification.diagnosis:explain_unsynthesizable'
 DIAGNOSIS_GRACE = 1.0  # seconds past diagnosis_timeout before the diagnosis process is killed
+SYNTHESIS_ANSWER_GRACE = 1.0  # seconds past its time limit the synthesis node has to answer SYNTHESIS_TIMEOUT
 
 
 class Busy(CodedError):
@@ -228,8 +230,9 @@ class BehaviorSynthesisServer(Node):
             check_message(goal_handle.request, 'goal')
             task = interface.read_goal(goal_handle.request, self.parameter('default_system'))
             check_timeout(task.timeout)
+            deadline = GoalDeadline(task.timeout, started=self.accepted_at(goal_handle))
             with self.admitted():
-                await self.run_pipeline(goal_handle, task, outcome, feedback)
+                await self.run_pipeline(goal_handle, task, outcome, feedback, deadline)
         except Preempted:
             outcome.fail('PREEMPTED', 'cancelled by the client')
             goal_handle.canceled()
@@ -268,7 +271,19 @@ class BehaviorSynthesisServer(Node):
             with self._lock:
                 self._active_goals -= 1
 
-    async def run_pipeline(self, goal_handle, task: SynthesisTask, outcome: PipelineOutcome, feedback):
+    def accepted_at(self, goal_handle) -> float:
+        """When the goal was accepted (time.monotonic()): its time limit counts from then."""
+        # rclpy stamps GoalInfo with the server's clock on acceptance; ServerGoalHandle exposes
+        # only its goal_id, so the stamp is read from the GoalInfo it keeps.
+        stamp = getattr(goal_handle, '_goal_info', None)
+        if stamp is None:
+            return time.monotonic()
+        waited = (self.get_clock().now() - Time.from_msg(stamp.stamp)).nanoseconds / 1e9
+        return time.monotonic() - max(0.0, waited)
+
+    async def run_pipeline(self, goal_handle, task: SynthesisTask, outcome: PipelineOutcome, feedback,
+                           deadline: GoalDeadline | None = None):
+        deadline = deadline or GoalDeadline(task.timeout)
         goal_id = bytes(goal_handle.goal_id.uuid).hex()
         spec_name = task.byproduct_stem or f'{task.system or "behavior"}_{goal_id[:8]}'
 
@@ -278,13 +293,13 @@ class BehaviorSynthesisServer(Node):
                                      'in request.ltl_specification')
             outcome.ltl_specification = task.custom_ltl
         else:
-            task = await self.with_initial_conditions(goal_handle, task, outcome, feedback)
+            task = await self.with_initial_conditions(goal_handle, task, outcome, feedback, deadline)
             feedback('Compiling the LTL specification', 0.05)
             compiled = await self.call(goal_handle, self.compiler, GenerateLTLSpecification.Request(
                 system=task.system, goals=task.goals, initial_conditions=task.initial_conditions,
                 sm_outcomes=task.sm_outcomes, custom_ltl=task.custom_ltl or LTLSpecification(),
                 unordered_goals=task.unordered_goals),
-                'LTL compilation', self.parameter('compilation_timeout'))
+                'LTL compilation', self.parameter('compilation_timeout'), deadline=deadline)
             self.check(compiled.error_code)
             outcome.ltl_specification = compiled.ltl_specification
             feedback('Compiled the LTL specification', 1 / 3)
@@ -292,14 +307,18 @@ class BehaviorSynthesisServer(Node):
                 return
 
         feedback('Synthesizing an automaton', 0.4)
-        timeout = task.timeout or self.parameter('synthesis_timeout')
+        # The synthesizer gets what is left of the goal's time and answers SYNTHESIS_TIMEOUT then.
+        timeout = deadline.stage_limit(task.timeout, 'LTL synthesis') if task.timeout else \
+            self.parameter('synthesis_timeout')
         synthesized = await self.call(goal_handle, self.synthesizer, SynthesizeAutomaton.Request(
             ltl_specification=outcome.ltl_specification, spec_name=spec_name,
             timeout=float(timeout), request_id=goal_id),
-            'LTL synthesis', timeout + 5.0, on_cancel=lambda: self.cancel_synthesis(goal_id))
-        if task.option != 'ltl_synthesis_only' and error_name(synthesized.error_code.value) == 'SPEC_UNSYNTHESIZABLE':
+            'LTL synthesis', timeout + SYNTHESIS_ANSWER_GRACE, on_cancel=lambda: self.cancel_synthesis(goal_id))
+        if task.timeout and error_name(synthesized.error_code.value) == 'SYNTHESIS_TIMEOUT':
+            synthesized.error_code.message = str(deadline.timed_out('LTL synthesis'))  # the goal's limit, not what was left        if task.option != 'ltl_synthesis_only' and error_name(synthesized.error_code.value) == 'SPEC_UNSYNTHESIZABLE':
             feedback('Diagnosing why the task cannot be done', 0.6)
-            synthesized.error_code.message = await self.diagnose(goal_handle, task, synthesized.error_code.message)
+            synthesized.error_code.message = await self.diagnose(goal_handle, task, synthesized.error_code.message,
+                                                                 deadline)
         self.check(synthesized.error_code)
         outcome.automaton = synthesized.automaton
         feedback(f'Synthesized an automaton with {len(outcome.automaton.automaton)} states', 2 / 3)
@@ -310,17 +329,18 @@ class BehaviorSynthesisServer(Node):
         generated = await self.call(goal_handle, self.generator, GenerateFlexBESM.Request(
             automaton=outcome.automaton, system=task.system,
             initial_conditions=task.initial_conditions),
-            'state machine generation', self.parameter('generation_timeout'))
+            'state machine generation', self.parameter('generation_timeout'), deadline=deadline)
         self.check(generated.error_code)
         outcome.states = list(generated.state_definition)
         feedback(f'Generated a state machine with {count_states(outcome.states)} states', 1.0)
 
     async def with_initial_conditions(self, goal_handle, task: SynthesisTask, outcome: PipelineOutcome,
-                                feedback) -> SynthesisTask:
+                                      feedback, deadline: GoalDeadline) -> SynthesisTask:
         """``task``, with the robot's initial conditions when it names none or ``current``."""
         if not reads_robot_state(task.initial_conditions, task.system, self.parameter('config_dir') or None):
             return task
-        topic, timeout = self.robot_state.topic, self.parameter('robot_state_timeout')
+        topic = self.robot_state.topic
+        timeout = deadline.stage_limit(self.parameter('robot_state_timeout'), 'reading the robot state')
         feedback(f'Reading the initial conditions from {topic}', 0.02)
         state = await self.robot_state.next_state_async(
             timeout, should_stop=lambda: goal_handle.is_cancel_requested or self._stopping.is_set())
@@ -342,12 +362,21 @@ class BehaviorSynthesisServer(Node):
         if code.value != code.SUCCESS:
             raise StageFailed(code)
 
-    async def call(self, goal_handle, client, request, stage: str, timeout: float, on_cancel=None):
-        """Call a stage's service; wait watching for cancel, time limit, shutdown and the node."""
-        return await self.stages.call(client, request, stage, timeout, self.parameter('service_timeout'),
-                                      cancelled=lambda: goal_handle.is_cancel_requested, on_cancel=on_cancel)
+    async def call(self, goal_handle, client, request, stage: str, timeout: float, on_cancel=None,
+                   deadline: GoalDeadline | None = None):
+        """Call a stage's service; wait watching for cancel, the stage's and the goal's time
+        limit, shutdown and the node."""
+        limit = deadline.stage_limit(timeout, stage) if deadline is not None else timeout
+        try:
+            return await self.stages.call(client, request, stage, limit, self.parameter('service_timeout'),
+                                          cancelled=lambda: goal_handle.is_cancel_requested, on_cancel=on_cancel)
+        except StageTimedOut:
+            if deadline is not None and deadline.passed():
+                raise deadline.timed_out(stage) from None
+            raise
 
-    async def diagnose(self, goal_handle, task: SynthesisTask, details: str) -> str:
+    async def diagnose(self, goal_handle, task: SynthesisTask, details: str,
+                       goal_deadline: GoalDeadline | None = None) -> str:
         """Why ``task`` cannot be done, in plain words ahead of the synthesizer's ``details``
         (``details`` alone when there is no diagnosis within diagnosis_timeout). A cancel or
         shutdown ends the diagnosis at once."""
@@ -357,6 +386,10 @@ class BehaviorSynthesisServer(Node):
                          goals=task.goals, sm_outcomes=task.sm_outcomes, strict_order=not task.unordered_goals,
                          custom_ltl=custom_ltl or None, config_dir=self.parameter('config_dir') or None)
         deadline = time.monotonic() + self.parameter('diagnosis_timeout')
+        if goal_deadline is not None and goal_deadline.deadline is not None:
+            deadline = min(deadline, goal_deadline.deadline)  # the verdict comes within the goal's limit
+            if deadline <= time.monotonic():
+                return details
         stop = threading.Event()
 
         def watch():

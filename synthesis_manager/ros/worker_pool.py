@@ -26,6 +26,10 @@ class PoolFull(CodedError):
     code = 'BUSY'
 
 
+class Abandoned(Exception):
+    """The caller gave up on a job that had not started (see WorkerPool.run's ``give_up``)."""
+
+
 class WorkerPool:
     def __init__(self, workers: int, max_waiting: int, name: str = 'worker'):
         if workers < 1 or max_waiting < 0:
@@ -58,16 +62,20 @@ class WorkerPool:
         self._jobs.put((future, function, args))
         return future
 
-    async def run(self, function, *args, wake=None, each_turn=None):
+    async def run(self, function, *args, wake=None, each_turn=None, give_up=None):
         """Await ``function(*args)`` from a coroutine; ``wake()`` is called when it is done
         (pass the executor's ``wake`` so the waiting callback resumes at once), ``each_turn()``
-        each time the waiting coroutine resumes (e.g. to pass a cancel on to the job)."""
+        each time the waiting coroutine resumes (e.g. to pass a cancel on to the job). When
+        ``give_up()`` is true while the job still waits for a worker, it is dropped and
+        Abandoned raised: a job past its deadline must not wait for a worker to say so."""
         future = self.submit(function, *args)
         if wake is not None:
             future.add_done_callback(lambda _: wake())
         while not future.done():
             if each_turn is not None:
                 each_turn()
+            if give_up is not None and give_up() and future.cancel():
+                raise Abandoned()
             await next_executor_turn()
         return future.result()
 

@@ -140,7 +140,7 @@ def compile_task(system: str, initial_conditions: Sequence[str] | str, goals: Se
         spec = merge_specifications(parts)
     except PropositionConflictError as error:
         raise InvalidFormulaError(
-            f'custom LTL declares {error.item!r} with the wrong kind: {error}', item=error.item) from error
+            f'custom LTL declares {quoted(error.item)} with the wrong kind: {error}', item=error.item) from error
     _check_custom_scopes(spec, custom_ltl)
     provenance = Provenance(system, tuple(initial_conditions), tuple(goals), sm_outcomes, strict_order,
                             pertinence, tuple(s for s in SECTIONS if custom_ltl and custom_ltl.get(s)),
@@ -235,11 +235,11 @@ def _names(value: Sequence[str] | str | None, what: str, error) -> list[str]:
     if isinstance(value, str):
         value = parse_names(value)
     if not isinstance(value, (list, tuple)):
-        raise error(f'{what} must be a list of names, got {value!r}', item=repr(value))
+        raise error(f'{what} must be a list of names, got {quoted(value)}', item=quoted(value))
     names = list(value)
     for name in names:
         if not isinstance(name, str) or not name:
-            raise error(f'{what} must be non-empty names, got {name!r}', item=repr(name))
+            raise error(f'{what} must be non-empty names, got {quoted(name)}', item=quoted(name))
     return names
 
 
@@ -248,7 +248,7 @@ def _check_sm_outcomes(sm_outcomes) -> tuple[str, ...]:
     for name in names:
         if name not in (FINISHED, FAILED):
             raise InvalidSmOutcomesError(
-                f'unsupported state-machine outcome {name!r} (supported: [finished, failed] or [finished])',
+                f'unsupported state-machine outcome {quoted(name)} (supported: [finished, failed] or [finished])',
                 item=name)
     normalized = tuple(o for o in (FINISHED, FAILED) if o in names)
     if len(names) != len(set(names)) or normalized not in SUPPORTED_SM_OUTCOMES:
@@ -265,10 +265,10 @@ def _check_goals(abstraction: RobotAbstraction, goals) -> list[str]:
     for index, goal in enumerate(names):
         if abstraction.kind_of(goal) is None:
             raise UnknownPropositionError(
-                f'unknown goal {goal!r}: not an action or control mode of {abstraction.system} '
+                f'unknown goal {quoted(goal)}: not an action or control mode of {abstraction.system} '
                 f'(known: {", ".join(abstraction.items())})', item=goal)
         if goal in names[:index]:
-            raise InvalidGoalsError(f'goal {goal!r} is given twice', item=goal)
+            raise InvalidGoalsError(f'goal {quoted(goal)} is given twice', item=goal)
     return names
 
 
@@ -277,7 +277,7 @@ def _check_initial_conditions(abstraction: RobotAbstraction, initial_conditions)
     for name in names:
         if abstraction.kind_of(name) is None:
             raise UnknownPropositionError(
-                f'unknown initial condition {name!r}: not an action or control mode of '
+                f'unknown initial condition {quoted(name)}: not an action or control mode of '
                 f'{abstraction.system} (known: {", ".join(abstraction.items())})', item=name)
     return list(dict.fromkeys(names))
 

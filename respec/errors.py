@@ -6,6 +6,8 @@ import reprlib
 
 #: How much of a user's value any message quotes: a refused value may be megabytes long.
 QUOTED_CHARACTERS = 40
+#: Longest ``item`` an error keeps (it names the bad item, sometimes by its value).
+ITEM_CHARACTERS = 200
 
 #: The code reported for an exception that is no CodedError: a programming error, whose
 #: traceback is logged.
@@ -20,7 +22,7 @@ class CodedError(Exception):
 
     def __init__(self, message: str, item=''):
         super().__init__(message)
-        self.item = item
+        self.item = item if not isinstance(item, str) or len(item) <= ITEM_CHARACTERS else item[:ITEM_CHARACTERS] + '...'
 
     def __reduce__(self):
         # Pickled whole (item and the subclass's own attributes), e.g. when a synthesis process

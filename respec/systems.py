@@ -14,7 +14,7 @@ from pathlib import Path
 
 import yaml
 
-from respec.errors import CodedError
+from respec.errors import CodedError, quoted
 
 CONFIG_DIR_ENV = 'BEHAVIOR_SYNTHESIS_CONFIG_DIR'
 _SYSTEM_NAME = re.compile(r'^[A-Za-z][A-Za-z0-9_]*$')
@@ -56,12 +56,12 @@ def system_config_path(system: str, config_dir: str | Path | None = None) -> Pat
     """Path of the configuration file of ``system``; raises SystemNotFoundError if absent."""
     directory = Path(config_dir) if config_dir else default_config_dir()
     if not isinstance(system, str) or not _SYSTEM_NAME.match(system):
-        raise SystemNotFoundError(f'invalid system name {system!r}', item=str(system))
+        raise SystemNotFoundError(f'invalid system name {quoted(system)}', item=str(system))
     path = directory / f'{system}.yaml'
     if not path.is_file():
         known = ', '.join(available_systems(directory)) or 'none'
         raise SystemNotFoundError(
-            f'unknown system {system!r}: no {path.name} in {directory} (known systems: {known})',
+            f'unknown system {quoted(system)}: no {path.name} in {directory} (known systems: {known})',
             item=system)
     return path
 

@@ -29,6 +29,7 @@ from __future__ import annotations
 from collections import deque
 from dataclasses import dataclass, field
 
+from respec.errors import quoted
 from respec.naming import activation, is_memory
 from sm_generation.config import FlexBEConfig, StateConfig
 from sm_generation.errors import (AutomatonInvalidError, InitialConditionsInvalidError, InputValuationInvalidError,
@@ -77,7 +78,7 @@ class AutomatonView:
         self.initial_states = [str(n) for n in (getattr(automaton, 'initial_states', None) or [])]
         for name in self.initial_states:
             if name not in self.states:
-                raise AutomatonInvalidError(f'initial state {name!r} is not a state', name)
+                raise AutomatonInvalidError(f'initial state {quoted(name)} is not a state', name)
         self._classify_variables()
         self.activations = {name: self._true_activations(state) for name, state in self.states.items()}
         self.exits = {name: self._exit_outcome(state) for name, state in self.states.items()}
@@ -250,7 +251,7 @@ class AutomatonView:
             state = self.config.states.get(activation(condition)) or self.config.states.get(condition)
             if state is None:
                 raise InitialConditionsInvalidError(
-                    f'initial condition {condition!r} is neither a proposition of this automaton nor a state '
+                    f'initial condition {quoted(condition)} is neither a proposition of this automaton nor a state '
                     f'of system {self.config.system!r}', condition)
             completion = next(iter(state.output_mapping))
             if completion in self.input_variables:

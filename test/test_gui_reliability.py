@@ -192,3 +192,33 @@ def test_simulations_are_bounded_at_once_and_per_job(gui):
     while request(url, 'GET', f"/api/simulations/{run['id']}")[1]['state'] != 'finished':
         assert time.monotonic() < deadline
         time.sleep(0.5)
+
+
+@pytest.mark.parametrize('path, body', [
+    ('/api/jobs', {**PAPER_TASK, 'system': ['x' * 1000] * 800}),
+    ('/api/jobs', {**PAPER_TASK, 'k' * 60_000: 1}),
+    ('/api/jobs', {**PAPER_TASK, 'option': {'a': 'x' * 60_000}}),
+    ('/api/jobs', {**PAPER_TASK, 'name': ['n' * 60_000]}),
+    ('/api/goal-check', {'system': ['x' * 60_000] * 14}),
+    ('/api/jobs/' + 'j' * 8000 + '/simulations', {}),
+    ('/api/jobs/' + 'j' * 8000 + '/cancel', {}),
+])
+def test_refusals_never_echo_more_than_the_start_of_the_input(gui, path, body):
+    _, url = gui
+    status, error = request(url, 'POST', path, body)
+    assert 400 <= status < 500 and error is not None
+    assert len(json.dumps(error)) < 600, error
+
+
+def test_an_unknown_job_id_in_a_get_is_not_echoed(gui):
+    _, url = gui
+    status, error = request(url, 'GET', '/api/jobs/' + 'j' * 8000)
+    assert status == 404 and len(json.dumps(error)) < 600
+
+
+def test_a_job_naming_a_huge_unknown_goal_is_answered_briefly(gui):
+    _, url = gui
+    status, job = request(url, 'POST', '/api/jobs', {**PAPER_TASK, 'goals': ['x' * 60_000]})
+    assert status == 202
+    outcome = wait_until_finished(url, job['id'])['outcome']
+    assert outcome['error_name'] == 'UNKNOWN_PROPOSITION' and len(outcome['message']) < 600

@@ -39,6 +39,7 @@ from rclpy.node import Node
 
 from atlas_sim.robot import make_simulator, parse_faults
 from atlas_sim.operator_data import decode_userdata
+from respec.errors import quoted
 from respec.naming import parse_names
 from synthesis_manager.ros.errors import log_internal_error
 from synthesis_manager.ros.node_main import node_main
@@ -140,13 +141,13 @@ class AtlasSimNode(Node):
     def accept_goal(self, goal_request) -> GoalResponse:
         known = self.simulator.abstraction.is_capability(goal_request.capability)
         if not known:
-            self.get_logger().warning(f'rejecting unknown capability {goal_request.capability!r}')
+            self.get_logger().warning(f'rejecting unknown capability {quoted(goal_request.capability)}')
         return GoalResponse.ACCEPT if known else GoalResponse.REJECT
 
     def accept_named_goal(self, name: str, goal_request) -> GoalResponse:
         """A per-capability server: the goal may repeat its capability's name or leave it empty."""
         if goal_request.capability not in ('', name):
-            self.get_logger().warning(f'rejecting {goal_request.capability!r} sent to the {name!r} server')
+            self.get_logger().warning(f'rejecting {quoted(goal_request.capability)} sent to the {name!r} server')
             return GoalResponse.REJECT
         return GoalResponse.ACCEPT
 

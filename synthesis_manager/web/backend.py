@@ -19,7 +19,7 @@ from atlas_sim.closed_loop import run_and_check
 from atlas_sim.robot import SimulatedRobot, make_simulator, parse_faults
 from ltl_specification.diagnosis import goal_findings, impossible_next_goals
 from respec.abstraction import load_abstraction
-from respec.errors import INTERNAL_ERROR, CodedError
+from respec.errors import INTERNAL_ERROR, CodedError, quoted
 from respec.naming import DEFAULT_SM_OUTCOMES, FINISHED
 from respec.parsing import spec_from_text_sections
 from respec.systems import SystemConfigError, available_systems, load_section
@@ -78,7 +78,7 @@ class SynthesisBackend:
     def choices(self, system: str) -> dict:
         """The control modes and actions of ``system``, in file order, with their relations."""
         if system not in self.systems():
-            raise NotFoundError(f'unknown system {system!r} (known systems: {", ".join(self.systems())})',
+            raise NotFoundError(f'unknown system {quoted(system)} (known systems: {", ".join(self.systems())})',
                                 system)
         try:
             abstraction = load_abstraction(system, self.config_dir)
@@ -114,7 +114,7 @@ class SynthesisBackend:
             raise InvalidJobRequestError('the request body must be a JSON object', 'body')
         system = body.get('system')
         if system not in self.systems():
-            raise NotFoundError(f'unknown system {system!r}', str(system))
+            raise NotFoundError(f'unknown system {quoted(system)}', str(system))
         initial_conditions = names_field(body, 'initial_conditions')
         goals = names_field(body, 'goals')
         strict_order = not body.get('unordered', False)
@@ -153,7 +153,7 @@ class SynthesisBackend:
     def cancel_job(self, job_id: str) -> dict:
         job = self._job(job_id)
         if job.finished:
-            raise NotAvailableError(f'job {job_id!r} has already finished '
+            raise NotAvailableError(f'job {quoted(job_id)} has already finished '
                                     f'({job.outcome["error_name"]})', job_id)
         job.cancel_requested.set()
         self._note(job, 'Cancel requested', job.progress)
@@ -168,13 +168,13 @@ class SynthesisBackend:
     def artifact(self, job_id: str, name: str) -> Artifact:
         job = self._job(job_id)
         if name not in ARTIFACTS:
-            raise NotFoundError(f'unknown artifact {name!r} (artifacts: {", ".join(ARTIFACTS)})', name)
+            raise NotFoundError(f'unknown artifact {quoted(name)} (artifacts: {", ".join(ARTIFACTS)})', name)
         if not job.finished:
-            raise NotAvailableError(f'job {job_id!r} has not finished yet', job_id)
+            raise NotAvailableError(f'job {quoted(job_id)} has not finished yet', job_id)
         kind = ARTIFACTS[name]
         if not kind.present(job.outcome):
             raise NotAvailableError(
-                f'job {job_id!r} ({job.outcome["error_name"]}) has no {name}', name)
+                f'job {quoted(job_id)} ({job.outcome["error_name"]}) has no {name}', name)
         key = (job_id, name)
         if key not in self._artifacts:
             try:
@@ -197,13 +197,13 @@ class SynthesisBackend:
             raise InvalidJobRequestError('the request body must be a JSON object', 'body')
         unknown = sorted(set(body) - {'fail_first'})
         if unknown:
-            raise InvalidJobRequestError(f'unknown field {unknown[0]!r} (fields: fail_first)', unknown[0])
+            raise InvalidJobRequestError(f'unknown field {quoted(unknown[0])} (fields: fail_first)', unknown[0])
         fail_first = names_field(body, 'fail_first')
         if not self.can_simulate:
             raise NotAvailableError('simulation needs atlas_sim and MuJoCo, which are not installed',
                                     'atlas_sim')
         if not (job.finished and job.outcome.get('states')):
-            raise NotAvailableError(f'job {job_id!r} has no state machine to simulate', job_id)
+            raise NotAvailableError(f'job {quoted(job_id)} has no state machine to simulate', job_id)
         support = self.simulation_support(job.request.system)
         if not support['available']:
             raise NotAvailableError(support['note'], job.request.system)
@@ -245,21 +245,21 @@ class SynthesisBackend:
     def simulation_frame(self, simulation_id: str, index: int) -> Artifact:
         simulation = self._simulation(simulation_id)
         if not 0 <= index < len(simulation.frames):
-            raise NotFoundError(f'simulation {simulation_id!r} has no frame {index}', str(index))
+            raise NotFoundError(f'simulation {quoted(simulation_id)} has no frame {index}', str(index))
         path = simulation.frames[index]
         return Artifact(path.read_bytes(), 'image/png', path.name)
 
     def simulation_timeline(self, simulation_id: str) -> Artifact:
         simulation = self._simulation(simulation_id)
         if simulation.timeline_png is None:
-            raise NotAvailableError(f'simulation {simulation_id!r} has no timeline yet', simulation_id)
+            raise NotAvailableError(f'simulation {quoted(simulation_id)} has no timeline yet', simulation_id)
         return Artifact(simulation.timeline_png.read_bytes(), 'image/png', f'{simulation_id}_timeline.png')
 
     def _simulation(self, simulation_id: str) -> Simulation:
         with self._lock:
             simulation = self._simulations.get(simulation_id)
         if simulation is None:
-            raise NotFoundError(f'unknown simulation {simulation_id!r}', simulation_id)
+            raise NotFoundError(f'unknown simulation {quoted(simulation_id)}', simulation_id)
         return simulation
 
     def _simulate(self, simulation: Simulation, job: Job):
@@ -298,7 +298,7 @@ class SynthesisBackend:
         with self._lock:
             job = self._jobs.get(job_id)
         if job is None:
-            raise NotFoundError(f'unknown job {job_id!r}', job_id)
+            raise NotFoundError(f'unknown job {quoted(job_id)}', job_id)
         return job
 
     def _forget_old_jobs(self):

@@ -7,7 +7,7 @@ SynthesisErrorCodes name, as for every user-facing error.
 
 from __future__ import annotations
 
-from respec.errors import CodedError
+from respec.errors import CodedError, quoted
 
 
 class GuiRequestError(CodedError):
@@ -18,7 +18,8 @@ class GuiRequestError(CodedError):
     code = 'INVALID_REQUEST'
 
     def to_dict(self) -> dict:
-        return {'error': self.kind, 'code': self.code, 'item': self.item, 'message': str(self)}
+        item = self.item if isinstance(self.item, str) else quoted(self.item)
+        return {'error': self.kind, 'code': self.code, 'item': item, 'message': str(self)}
 
 
 class NotFoundError(GuiRequestError):

@@ -7,6 +7,7 @@ import threading
 import time
 from dataclasses import asdict, dataclass, field
 
+from respec.errors import quoted
 from respec.naming import DEFAULT_SM_OUTCOMES, parse_names
 from sm_generation.instantiation import StateInstantiation, count_states
 from synthesis_manager.limits import oversized_strings, too_long
@@ -47,12 +48,12 @@ class JobRequest:
         unknown = sorted(set(body) - set(REQUEST_FIELDS))
         if unknown:
             raise InvalidJobRequestError(
-                f'unknown field {unknown[0]!r} (fields: {", ".join(REQUEST_FIELDS)})', unknown[0])
+                f'unknown field {quoted(unknown[0])} (fields: {", ".join(REQUEST_FIELDS)})', unknown[0])
         system = body.get('system')
         if not isinstance(system, str) or not system:
             raise InvalidJobRequestError('field "system" must name a system', 'system')
         if system not in systems:
-            raise NotFoundError(f'unknown system {system!r} (known systems: {", ".join(systems)})', system)
+            raise NotFoundError(f'unknown system {quoted(system)} (known systems: {", ".join(systems)})', system)
         goals = names_field(body, 'goals')
         if not goals:
             raise InvalidJobRequestError('field "goals" must name at least one goal', 'goals')
@@ -60,14 +61,14 @@ class JobRequest:
         option = body.get('option') or None
         if option is not None and option not in JOB_OPTIONS:
             raise InvalidJobRequestError(
-                f'unknown option {option!r} (options: {", ".join(JOB_OPTIONS)})', str(option))
+                f'unknown option {quoted(option)} (options: {", ".join(JOB_OPTIONS)})', str(option))
         unordered = body.get('unordered', False)
         if not isinstance(unordered, bool):
             raise InvalidJobRequestError('field "unordered" must be true or false', 'unordered')
         name = body.get('name') or ''
         if not isinstance(name, str) or (name and not _NAME.match(name)):
             raise InvalidJobRequestError(
-                f'behavior name {name!r} must start with a letter and contain only letters, '
+                f'behavior name {quoted(name)} must start with a letter and contain only letters, '
                 'digits and underscores', str(name))
         return cls(system=system, initial_conditions=names_field(body, 'initial_conditions'), goals=goals,
                    sm_outcomes=sm_outcomes, option=option, unordered=unordered, name=name)
@@ -76,13 +77,13 @@ class JobRequest:
 def names_field(body: dict, key: str) -> tuple[str, ...]:
     value = body.get(key) or []
     if isinstance(value, list) and not all(isinstance(v, str) for v in value):
-        raise InvalidJobRequestError(f'field {key!r} must be a list of names', key)
+        raise InvalidJobRequestError(f'field {quoted(key)} must be a list of names', key)
     if not isinstance(value, (str, list)):
-        raise InvalidJobRequestError(f'field {key!r} must be a list of names or comma-separated text', key)
+        raise InvalidJobRequestError(f'field {quoted(key)} must be a list of names or comma-separated text', key)
     names = tuple(parse_names(value))
     for name in names:
         if not _NAME.match(name):
-            raise InvalidJobRequestError(f'{key}: {name!r} is not a proposition name', name)
+            raise InvalidJobRequestError(f'{key}: {quoted(name)} is not a proposition name', name)
     return names
 
 

@@ -144,7 +144,9 @@ class SynthesisClient:
         handle = wait_for(self.action_client.send_goal_async(goal, feedback_callback=on_feedback),
                             timeout)
         if not handle.accepted:
-            return SynthesisOutcome(-2, 'INVALID_REQUEST', 'the server rejected the goal')
+            # The server rejects goals only in a flood (see BehaviorSynthesisServer.admit_goal).
+            return SynthesisOutcome(-5, 'BUSY', 'the server rejected the goal: too many goals are in '
+                                    'progress (twice max_active_goals); try again later')
         done = threading.Event()
         requests = []
 

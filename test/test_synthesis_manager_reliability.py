@@ -295,3 +295,44 @@ def test_goal_time_limits_hold_under_load(ros, tmp_path):
         assert names(limited) == Counter({'SYNTHESIS_TIMEOUT': 3}), [o.message for o in limited]
         assert all('2 s' in outcome.message for outcome in limited)
         assert seconds < 2.0 + 1.0 + 1.0  # the invalid goal's second included
+
+
+def test_a_flood_is_rejected_on_arrival_and_reported_busy(ros, tmp_path):
+    client = start_suite(ros, tmp_path, server_parameters=[Parameter('max_active_goals', value=0)])
+    started = time.monotonic()
+    outcome = client.run(make_goal(**PAPER_TASK), timeout=30)
+    assert outcome.error_name == 'BUSY' and 'rejected' in outcome.message
+    assert time.monotonic() - started < 2
+
+
+def default_qos_client(ros):
+    """A client as the ros2 CLI and the FlexBE WebUI make it: rclpy's default depth-10 queues."""
+    from rclpy.action import ActionClient
+    from synthesis_msgs.action import BehaviorSynthesis
+
+    client = ActionClient(ros.add_node(Node, 'default_qos_client'), BehaviorSynthesis, 'behavior_synthesis')
+    assert client.wait_for_server(timeout_sec=10)
+    return client
+
+
+def test_a_default_qos_client_hears_every_answer_of_a_bounded_burst(ros, tmp_path):
+    """30 goals sent at once by a plain rclpy client (results asked for as each goal is
+    accepted, as the ros2 CLI does): every goal is answered."""
+    from synthesis_manager.ros.conversions import error_name
+    start_suite(ros, tmp_path)
+    client = default_qos_client(ros)
+    sent = [client.send_goal_async(make_goal(**PAPER_TASK, name=f'plain{i}', option='ltl_compilation_only'))
+            for i in range(30)]
+    results = []
+    deadline = time.monotonic() + 60
+    for future in sent:
+        while not future.done():
+            assert time.monotonic() < deadline, 'a goal response was lost'
+            time.sleep(0.01)
+        assert future.result().accepted
+        results.append(future.result().get_result_async())
+    for future in results:
+        while not future.done():
+            assert time.monotonic() < deadline, 'a result was lost'
+            time.sleep(0.01)
+    assert Counter(error_name(f.result().result.error_code.value) for f in results) == {'SUCCESS': 30}

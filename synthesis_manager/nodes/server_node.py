@@ -8,7 +8,9 @@ Each stage is an asynchronous call to its service node, awaited by the goal's co
 (synthesis_manager.ros.stage_calls): a waiting goal holds no executor thread, so any number
 of goals run side by side and the executor keeps serving. Cancel requests, the stage's time
 limit, shutdown and the stage's node going away end the wait; a cancel is forwarded to the
-synthesizer. Beyond ``max_active_goals`` goals at once, new goals are answered BUSY at once.
+synthesizer. Beyond ``max_active_goals`` goals at once, new goals are answered BUSY at once;
+beyond twice that many accepted and unfinished (a flood), new goals are rejected on arrival.
+A goal's ``timeout`` counts its whole pipeline from acceptance (synthesis_manager.limits).
 """
 
 from __future__ import annotations
@@ -167,6 +169,7 @@ class BehaviorSynthesisServer(Node):
         self.declare_parameter('result_retention', 60.0)
         self._stopping = threading.Event()
         self._active_goals = 0
+        self._accepted_goals = 0  # accepted and not finished: running, or waiting for the executor
         self._lock = threading.Lock()
         self.stages = StageCaller(self)
         self.diagnoses = WorkerPool(workers=2, max_waiting=self.parameter('max_active_goals'), name='diagnosis')
@@ -190,7 +193,7 @@ class BehaviorSynthesisServer(Node):
         self.action_servers = [
             ActionServer(self, interface.action_type, interface.action_name,
                          self._executor_for(interface),
-                         goal_callback=lambda _: GoalResponse.ACCEPT,
+                         goal_callback=self.admit_goal,
                          cancel_callback=lambda _: CancelResponse.ACCEPT, callback_group=group,
                          result_timeout=max(1, round(self.parameter('result_retention'))),
                          **action_server_qos())
@@ -199,7 +202,10 @@ class BehaviorSynthesisServer(Node):
     def _executor_for(self, interface):
         """The execute callback of ``interface``'s action server (a coroutine function)."""
         async def execute(goal_handle):
-            return await self.execute(goal_handle, interface)
+            try:
+                return await self.execute(goal_handle, interface)
+            finally:
+                self.goal_finished()
         return execute
 
     def stop_work(self):
@@ -255,6 +261,20 @@ class BehaviorSynthesisServer(Node):
             self.get_logger().warning(failure)
             goal_handle.abort()
         return interface.make_result(outcome)
+
+    def admit_goal(self, _goal_request) -> GoalResponse:
+        """Accept a goal unless a flood is under way: beyond max_active_goals accepted goals
+        the next ones are answered BUSY (a result), beyond twice that they are rejected at
+        once (one response, no result for a client to lose; send-goal reports it as BUSY)."""
+        with self._lock:
+            if self._accepted_goals >= 2 * self.parameter('max_active_goals'):
+                return GoalResponse.REJECT
+            self._accepted_goals += 1
+        return GoalResponse.ACCEPT
+
+    def goal_finished(self):
+        with self._lock:
+            self._accepted_goals -= 1
 
     @contextlib.contextmanager
     def admitted(self):

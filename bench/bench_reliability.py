@@ -9,16 +9,25 @@
   samples after warm-up (the first ``--warmup`` goals, which also covers the server's 60 s
   result retention).
 
-The server and GUI run as their real console entry points in separate processes on a
-reserved ROS domain; the clients are in this process. Prints a table and writes
-bench/results/reliability.md.
+- attacks (issue 25, full sizes; small ones are in the tests): a 9-level YAML alias bomb
+  in ``synthesis_options``, custom LTL nested 5,000 and 30,000 deep, negative/NaN and 3 s
+  time limits in a burst behind slow syntheses, a plain rclpy client with the default depth-10
+  queues sending 200 goals and then a 10,000-goal flood, and 40 GUI simulations at once. Each
+  says what came back, how long after its limit, and the server's peak RSS growth.
+- idle: the server's RSS (with its synthesis processes) after a burst and after they idled.
 
-    .venv/bin/python bench/bench_reliability.py [--goals 2000] [--in-flight 4] [--warmup 600]
+The server and GUI run as their real console entry points in separate processes on a
+reserved ROS domain; the clients are in this process. Prints a table and writes the sections
+run into bench/results/reliability.md (the others are kept).
+
+    .venv/bin/python bench/bench_reliability.py [--sections burst,soak,gui,attacks,idle]
+        [--goals 2000] [--in-flight 4] [--warmup 600] [--flood 10000]
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import os
 import re
@@ -111,7 +120,9 @@ def burst(client, count: int = 50) -> dict:
             'pipelines, median s': statistics.median(seconds for fast, _, seconds in answers if not fast)}
 
 
-def gui_burst(domain: int, byproducts: str, jobs: int = 20) -> dict:
+@contextlib.contextmanager
+def gui_process(domain: int, byproducts: str):
+    """``behavior-synthesis gui`` (with its suite) in its own process: yields (url, pid)."""
     from synthesis_manager.ros.env import prepare_ros_environment
 
     environment = prepare_ros_environment(domain, environ=dict(os.environ))
@@ -119,32 +130,34 @@ def gui_burst(domain: int, byproducts: str, jobs: int = 20) -> dict:
                                 '--byproducts-dir', byproducts], env=environment,
                                stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
     try:
-        url = re.search(r'http://\S+?/', process.stdout.readline()).group(0)
-
-        def post(index):
-            request = urllib.request.Request(url + 'api/jobs', method='POST',
-                                             data=json.dumps({**GUI_TASK, 'name': f'job{index}'}).encode(),
-                                             headers={'Content-Type': 'application/json'})
-            with urllib.request.urlopen(request, timeout=60) as response:
-                return json.load(response)['id']
-
-        def finish(job_id):
-            deadline = time.monotonic() + 300
-            while time.monotonic() < deadline:
-                with urllib.request.urlopen(f'{url}api/jobs/{job_id}', timeout=60) as response:
-                    job = json.load(response)
-                if job['state'] == 'finished':
-                    return job['outcome']['error_name']
-                time.sleep(0.2)
-            return 'UNFINISHED'
-
-        started = time.monotonic()
-        with ThreadPoolExecutor(jobs) as pool:
-            codes = list(pool.map(finish, list(pool.map(post, range(jobs)))))
-        return {'jobs': jobs, 'codes': Counter(codes), 'all finished after s': time.monotonic() - started}
+        yield re.search(r'http://\S+?/', process.stdout.readline()).group(0), process.pid
     finally:
         process.send_signal(signal.SIGINT)
         process.wait(timeout=30)
+
+
+def gui_burst(url: str, jobs: int = 20) -> dict:
+    def post(index):
+        request = urllib.request.Request(url + 'api/jobs', method='POST',
+                                         data=json.dumps({**GUI_TASK, 'name': f'job{index}'}).encode(),
+                                         headers={'Content-Type': 'application/json'})
+        with urllib.request.urlopen(request, timeout=60) as response:
+            return json.load(response)['id']
+
+    def finish(job_id):
+        deadline = time.monotonic() + 300
+        while time.monotonic() < deadline:
+            with urllib.request.urlopen(f'{url}api/jobs/{job_id}', timeout=60) as response:
+                job = json.load(response)
+            if job['state'] == 'finished':
+                return job['outcome']['error_name']
+            time.sleep(0.2)
+        return 'UNFINISHED'
+
+    started = time.monotonic()
+    with ThreadPoolExecutor(jobs) as pool:
+        codes = list(pool.map(finish, list(pool.map(post, range(jobs)))))
+    return {'jobs': jobs, 'codes': Counter(codes), 'all finished after s': time.monotonic() - started}
 
 
 def soak(client, server_pid: int, goals: int, in_flight: int, warmup: int) -> dict:
@@ -178,15 +191,35 @@ def soak(client, server_pid: int, goals: int, in_flight: int, warmup: int) -> di
             'RSS slope KiB per minute': 60 * slope([(t, rss) for _, t, rss in after_warmup])}
 
 
+def idle_release(client, server_pid: int, idle_seconds: float = 35.0) -> dict:
+    """The server's RSS with its synthesis processes before a burst, after it, and after idling."""
+    from synthesis_manager.client import make_goal
+
+    before = rss_kib(server_pid)
+    with ThreadPoolExecutor(8) as pool:
+        list(pool.map(lambda i: timed_run(client, make_goal(*TASK, name=f'idle{i}')), range(64)))
+    after = rss_kib(server_pid)
+    time.sleep(idle_seconds)
+    return {'RSS before the burst MiB': before / 1024, 'RSS after 64 goals, 8 at once MiB': after / 1024,
+            f'RSS after {idle_seconds:g} s idle MiB': rss_kib(server_pid) / 1024}
+
+
+SECTIONS = ('burst', 'soak', 'gui', 'attacks', 'idle')
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument('--sections', default=','.join(SECTIONS), help=f'comma-separated subset of {SECTIONS}')
     parser.add_argument('--goals', type=int, default=2000, help='goals in the soak')
     parser.add_argument('--in-flight', type=int, default=4, help='soak goals in progress at once')
     parser.add_argument('--warmup', type=int, default=600, help='soak goals before the RSS slope counts')
+    parser.add_argument('--flood', type=int, default=10_000, help='goals of the default-QoS flood')
     args = parser.parse_args(argv)
+    sections = args.sections.split(',')
 
     from rclpy.node import Node
 
+    import reliability_attacks as attacks
     from synthesis_manager.client import SynthesisClient, make_goal
     from synthesis_manager.ros.harness import RosHarness, reserve_domain_id
 
@@ -200,19 +233,44 @@ def main(argv=None) -> int:
                     assert client.wait_for_server(timeout=60.0), 'serve did not come up'
                     for _ in range(3):  # warm-up: imports, discovery
                         timed_run(client, make_goal(*TASK))
-                    print('burst: 50 goals at once to serve', flush=True)
-                    report['burst'] = burst(client)
-                    print(f'soak: {args.goals} goals, {args.in_flight} in flight', flush=True)
-                    report['soak'] = soak(client, serve.process.pid, args.goals, args.in_flight, args.warmup)
+                    if 'idle' in sections:
+                        print('idle: RSS after a burst and after idling', flush=True)
+                        report['idle synthesis processes'] = idle_release(client, serve.process.pid)
+                    if 'burst' in sections:
+                        print('burst: 50 goals at once to serve', flush=True)
+                        report['burst'] = burst(client)
+                    if 'attacks' in sections:
+                        print('attacks: hostile goals, limits under load, default-QoS clients', flush=True)
+                        flexbe_client = SynthesisClient(ros.add_node(Node, 'bench_flexbe_client'), 'flexbe_synthesis')
+                        assert flexbe_client.wait_for_server(timeout=60.0)
+                        report['hostile goals'] = attacks.hostile_goals(client, flexbe_client, serve.process.pid, rss_kib)
+                        runaway = make_goal('atlas', [], [], option='ltl_synthesis_only', timeout=30.0, ltl_specification={
+                            'sys_props': [f'p{i}' for i in range(200)], 'env_props': ['e'], 'sys_liveness': ['p0']})
+                        report['time limits under load'] = attacks.limits_under_load(client, runaway)
+                        plain = attacks.default_qos_client(ros.add_node(Node, 'bench_default_qos_client'))
+                        report['default-QoS client, 200 goals'] = attacks.default_qos_burst(plain, 200)
+                        report[f'default-QoS client, {args.flood} goals'] = attacks.default_qos_burst(plain, args.flood)
+                    if 'soak' in sections:
+                        print(f'soak: {args.goals} goals, {args.in_flight} in flight', flush=True)
+                        report['soak'] = soak(client, serve.process.pid, args.goals, args.in_flight, args.warmup)
             finally:
                 serve.stop()
-        with reserve_domain_id() as domain:
-            print('gui: 20 jobs at once', flush=True)
-            report['gui'] = gui_burst(domain, byproducts)
+        if 'gui' in sections or 'attacks' in sections:
+            with reserve_domain_id() as domain, gui_process(domain, byproducts) as (url, gui_pid):
+                if 'gui' in sections:
+                    print('gui: 20 jobs at once', flush=True)
+                    report['gui'] = gui_burst(url)
+                if 'attacks' in sections:
+                    print('gui: 40 simulations at once', flush=True)
+                    report['gui simulations at once'] = attacks.gui_simulation_flood(url, gui_pid, rss_kib)
 
+    kept = _sections(RESULTS.read_text()) if RESULTS.exists() else {}
     lines = ['# Reliability under load', '',
              'Measured by `bench/bench_reliability.py` (2-core machine shared with other work; '
              'wall-clock times are indicative only).', '']
+    for section, text in kept.items():
+        if section not in report:
+            lines += text
     for section, figures in report.items():
         lines += [f'## {section}', '', '| figure | value |', '|---|---|']
         for name, value in figures.items():
@@ -225,6 +283,18 @@ def main(argv=None) -> int:
     RESULTS.parent.mkdir(exist_ok=True)
     RESULTS.write_text(text)
     return 0
+
+
+def _sections(text: str) -> dict[str, list[str]]:
+    """The ``## section`` blocks of an earlier results file, by title (kept when not rerun)."""
+    sections, current = {}, None
+    for line in text.splitlines():
+        if line.startswith('## '):
+            current = line[3:]
+            sections[current] = []
+        if current is not None:
+            sections[current].append(line)
+    return sections
 
 
 if __name__ == '__main__':

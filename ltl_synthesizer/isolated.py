@@ -37,6 +37,8 @@ from ltl_synthesizer.errors import SynthesisCancelled, SynthesisError
 
 # How often the caller looks at its cancel flag and deadline while a child works.
 POLL_SECONDS = 0.02
+#: How much lower the children's CPU priority is than their parent's.
+CHILD_NICENESS = 5
 #: How long an idle child is kept for the next synthesis.
 IDLE_SECONDS = 30.0
 _LENGTH_BYTES = 8
@@ -266,6 +268,9 @@ def _die_with_parent(parent_pid: int) -> None:
 
 
 if __name__ == '__main__':
+    # Below the parent's priority: syntheses filling every core must not delay the parent's
+    # answers (time limits, cancels, BUSY) on a loaded machine.
+    os.nice(CHILD_NICENESS)
     from respec.nesting import allow_deep_formulas
     allow_deep_formulas()  # requests are served in a thread with room for any formula accepted
     server = threading.Thread(target=_serve, args=(int(sys.argv[1]),), name='synthesis-process')

@@ -8,7 +8,7 @@ synthesis must stop, so stopping takes milliseconds whatever CUDD is doing, and 
 memory are released with the process. Idle children are kept for the next synthesis (a new
 one costs the start of a Python interpreter, a fraction of a second), but not for long: a
 child idle for ``idle_seconds`` is ended (its heap grows with what it solved; after a burst,
-idle children held 2.6x the baseline RSS), and the ``prepare``\ d number of fresh ones replaces them.
+idle children held 2.6x the baseline RSS), and as many fresh ones as were prepared replace them.
 
     processes = SynthesisProcesses()
     result = processes.synthesize(spec, cancel=event, deadline=time.monotonic() + 60)

@@ -151,7 +151,8 @@ def assert_busy_synthesizing(pid: int, within: float = 1.0):
     before = {child: cpu_seconds(child) for child in synthesizers}
     time.sleep(within)
     used = max(cpu_seconds(child) - seconds for child, seconds in before.items())
-    assert used > within / 3, f'no synthesis process of {pid} is computing ({used:.2f} s CPU in {within} s)'
+    # A fifth of a core: synthesis processes run niced (+5), and this machine is shared.
+    assert used > within / 5, f'no synthesis process of {pid} is computing ({used:.2f} s CPU in {within} s)'
 
 
 def assert_no_synthesis_running(pid: int, within: float = 1.0):

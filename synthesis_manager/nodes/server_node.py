@@ -335,7 +335,8 @@ class BehaviorSynthesisServer(Node):
             timeout=float(timeout), request_id=goal_id),
             'LTL synthesis', timeout + SYNTHESIS_ANSWER_GRACE, on_cancel=lambda: self.cancel_synthesis(goal_id))
         if task.timeout and error_name(synthesized.error_code.value) == 'SYNTHESIS_TIMEOUT':
-            synthesized.error_code.message = str(deadline.timed_out('LTL synthesis'))  # the goal's limit, not what was left
+            # Name the goal's limit, not the time that was left of it.
+            synthesized.error_code.message = str(deadline.timed_out('LTL synthesis'))
         if task.option != 'ltl_synthesis_only' and error_name(synthesized.error_code.value) == 'SPEC_UNSYNTHESIZABLE':
             feedback('Diagnosing why the task cannot be done', 0.6)
             synthesized.error_code.message = await self.diagnose(goal_handle, task, synthesized.error_code.message,

@@ -17,7 +17,7 @@ import warnings
 from dataclasses import dataclass, field
 from functools import cached_property
 
-from dd import cudd
+from ltl_synthesizer.cudd_import import cudd
 
 from respec.spec import GR1Specification
 

@@ -40,10 +40,14 @@ INITIAL_CACHE_SLOTS = 2**14
 # 10-45% slower); 'automatic' options switch them on above it.
 SMALL_GAME_PROPOSITIONS = 36
 
-# Automatic dynamic reordering starts once this many BDD nodes are alive: games that stay
-# below it (every ATLAS task) solve faster on the static order, games whose BDDs grow past
-# it (AMBA, moving obstacle: bench/bench_gr1_families.py) need sifting, 3-15x faster with
-# it. A node count, not a time, so the same request always takes the same path.
+# Automatic dynamic reordering. Sifting from the start, as slugs does, is 2-5x faster on
+# games with several system goals (a Y/X family per goal stays alive and one order must suit
+# them all: AMBA) and on small pure safety games over wide integers (moving obstacle: few
+# variables, large BDDs). Elsewhere it starts on the static order and switches sifting on only
+# once this many BDD nodes are alive: ATLAS tasks (one goal, an assumption per action) would
+# lose up to 2x to sifting, cinderella (many variables, small BDDs) 4x
+# (bench/bench_gr1_families.py, bench_goals.py). A node count, not a time: the same request
+# always takes the same path.
 DYNAMIC_REORDERING_FROM_NODES = 100_000
 REORDERING_CHECK_PERIOD = 4
 # ... and the sifting pass also runs on smaller games whose safety relations have this many nodes.
@@ -54,8 +58,8 @@ SIFTED_RELATION_NODES = 1000
 class Options:
     """Tuning switches of the symbolic engine (defaults are the measured best; see bench/)."""
 
-    # Dynamic reordering (CUDD's automatic sifting); None = automatic: switched on once the
-    # BDDs grow past DYNAMIC_REORDERING_FROM_NODES live nodes.
+    # Dynamic reordering (CUDD's automatic sifting); None = automatic: from the start with
+    # several system goals or on small safety games, else past DYNAMIC_REORDERING_FROM_NODES.
     reordering: bool | None = None
     # None = automatic: on for games of more than SMALL_GAME_PROPOSITIONS propositions
     # (reachable_only: and with some liveness goal; see SymbolicGame).
@@ -191,7 +195,9 @@ class SymbolicGame:
             # action's activation and outcomes; one sifting pass on the relations finds such
             # placements (3x faster multi-goal solving) for a few milliseconds.
             self.bdd.reorder()
-        self.reordering = bool(self.options.reordering)
+        sift_from_start = len(self.sys_goals) > 1 or not (large or has_liveness)
+        self.reordering = sift_from_start if self.options.reordering is None \
+            else self.options.reordering
         self._enforce_calls = 0
         if self.reordering:
             self.bdd.configure(reordering=True)
@@ -247,10 +253,12 @@ class SymbolicGame:
         """``exists y'. sys_trans & target``: the system has a legal move into ``target``."""
         return self._relational_product(target, self.sys_partition)
 
-    def system_can_move_into(self, positions):
+    def system_can_move_into(self, positions, remember: bool = True):
         """``exists y'. sys_trans & positions'``, memoized: the assumptions' inner fixpoints
         share start sets, and each outer iteration restarts them from the previous one's
-        results (see ``start_outer_iteration``)."""
+        results (see ``start_outer_iteration``). Sets that never recur (``remember=False``)
+        stay out of the memo: kept alive, they would slow every garbage collection and
+        reordering (the safety fixpoint of moving obstacle 24x24: 2.5x slower)."""
         key = int(positions)
         found = self._moves_into.get(key) or self._previous_moves_into.get(key)
         if found is None or found[0] != positions:
@@ -258,7 +266,8 @@ class SymbolicGame:
             # the target may take any values elsewhere, so take CUDD's simplest such BDD.
             target = positions if self.care == self.true else cudd.restrict(positions, self.care)
             found = (positions, self.system_can_respond(self.prime(target)))
-        self._moves_into[key] = found
+        if remember:
+            self._moves_into[key] = found
         return found[1]
 
     def start_outer_iteration(self):

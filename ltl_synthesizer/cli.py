@@ -231,9 +231,12 @@ def _run(args) -> int:
         processes = SynthesisProcesses()
         synthesize = processes.synthesize
     try:
+        # In-process JSON strategies are written while they are extracted (bounded memory).
+        stream = args.explicitStrategy and args.jsonOutput and deadline is None
         result = synthesize(spec, robotics_semantics=args.sysInitRoboticsSemantics,
                             deadline=deadline, counterstrategy=args.counterStrategy,
-                            explain=args.explain, strategy=args.explicitStrategy,
+                            explain=args.explain,
+                            strategy='stream' if stream else args.explicitStrategy,
                             memory_limit=memory_limit)
     except SynthesisCancelled as error:
         print(f'gr1synth: error: {error}', file=sys.stderr)
@@ -257,10 +260,14 @@ def _run(args) -> int:
         strategy = result.counterstrategy
     else:
         return 0
-    if args.jsonOutput:
-        _write_chunks(strategy_json_chunks(strategy), args.output)
-    else:
-        _write(strategy_to_text(strategy), args.output)
+    try:
+        if args.jsonOutput:
+            _write_chunks(strategy_json_chunks(strategy), args.output)
+        else:
+            _write(strategy_to_text(strategy), args.output)
+    except SynthesisMemoryExceeded as error:  # a streamed strategy is extracted while written
+        print(f'gr1synth: error: {error}', file=sys.stderr)
+        return EXIT_MEMORY
     return 0
 
 

@@ -152,6 +152,18 @@ def _strategy_json(variables, nodes: dict) -> dict:
 
 def extract_strategy(game: SymbolicGame, solution: SystemSolution) -> dict:
     """The explicit strategy as slugs' JSON object (``nodes`` keyed by decimal strings)."""
+    return _strategy_json(game.variables, dict(strategy_nodes(game, solution)))
+
+
+def streamed_strategy(game: SymbolicGame, solution: SystemSolution) -> dict:
+    """As ``extract_strategy``, but ``nodes`` is an iterator of ``(name, node)`` pairs made as
+    they are read (``strategy_json_chunks`` writes them out): memory holds the numbering of
+    the nodes, not their edges."""
+    return _strategy_json(game.variables, strategy_nodes(game, solution))
+
+
+def strategy_nodes(game: SymbolicGame, solution: SystemSolution):
+    """The strategy's nodes ``(name, node)`` in increasing number (breadth-first order)."""
     steps = goal_steps(game, solution)
     variables = game.variables
     next_variables = [game.to_next[name] for name in variables]
@@ -160,7 +172,6 @@ def extract_strategy(game: SymbolicGame, solution: SystemSolution) -> dict:
     for state in enumerate_states(game, initial, variables):
         numbering.number(tuple(state[name] for name in variables), 0)
 
-    nodes = {}
     while numbering.queue:
         values, rank = numbering.queue.popleft()
         game.interrupt.check()
@@ -175,9 +186,8 @@ def extract_strategy(game: SymbolicGame, solution: SystemSolution) -> dict:
             next_rank = goals_here.successor_goal(rank, following)
             next_values = tuple(following[name] for name in next_variables)
             successors.append(numbering.number(next_values, next_rank))
-        nodes[str(numbering.index[(values, rank)])] = {
+        yield str(numbering.index[(values, rank)]), {
             'rank': rank, 'state': [int(v) for v in values], 'trans': successors}
-    return _strategy_json(variables, nodes)
 
 
 def extract_counterstrategy(game: SymbolicGame, solution: EnvironmentSolution,
@@ -321,25 +331,29 @@ def strategy_to_json(strategy: dict) -> str:
 
 
 def strategy_json_chunks(strategy: dict, nodes_per_chunk: int = 1000):
-    """``strategy_to_json`` in pieces of ``nodes_per_chunk`` nodes, for writing as they come."""
+    """``strategy_to_json`` in pieces of ``nodes_per_chunk`` nodes, for writing as they come.
+    ``strategy['nodes']`` is a dict, or an iterator of ``(name, node)`` in increasing number
+    (``streamed_strategy``)."""
     names = ', '.join(_json_string(name) for name in strategy['variables'])
     yield (f'{{"version": {strategy["version"]},\n "slugs": {_json_string(strategy["slugs"])},\n\n'
            f' "variables": [{names}],\n\n "nodes": {{\n')
-    node_ids = sorted(strategy['nodes'], key=int)
-    lines = []
-    for position, node_name in enumerate(node_ids):
-        node = strategy['nodes'][node_name]
+    nodes = strategy['nodes']
+    if isinstance(nodes, dict):
+        nodes = sorted(nodes.items(), key=lambda item: int(item[0]))
+    lines, position = [], 0
+    for position, (node_name, node) in enumerate(nodes, start=1):
         rank = node['rank']
         rank_text = f'[{rank[0]}, {rank[1]}]' if isinstance(rank, (list, tuple)) else str(rank)
         state = ', '.join('null' if v is None else str(v) for v in node['state'])
         trans = ', '.join(map(str, node['trans']))
-        separator = ',' if position + 1 < len(node_ids) else ''
-        lines.append(f'"{node_name}": {{\n\t"rank": {rank_text},\n\t"state": [{state}],\n'
-                     f'\t"trans": [{trans}]\n}}{separator}\n\n')
+        # The separator goes before each node but the first: the last is not known ahead.
+        separator = ',\n\n' if position > 1 else ''
+        lines.append(f'{separator}"{node_name}": {{\n\t"rank": {rank_text},\n\t"state": [{state}],\n'
+                     f'\t"trans": [{trans}]\n}}')
         if len(lines) == nodes_per_chunk:
             yield ''.join(lines)
             lines = []
-    lines.append('}}\n')
+    lines.append('\n\n}}\n' if position else '}}\n')
     yield ''.join(lines)
 
 

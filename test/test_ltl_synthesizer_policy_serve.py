@@ -82,6 +82,10 @@ def test_streamed_json_is_the_same_text_in_pieces():
     chunks = list(strategy_json_chunks(strategy, nodes_per_chunk=7))
     assert len(chunks) > 10 and ''.join(chunks) == strategy_to_json(strategy)
     assert json.loads(''.join(chunks))['nodes'].keys() == strategy['nodes'].keys()
+    # Streamed: the nodes are made while the text is written, with the same bytes.
+    streamed = synthesize(spec, robotics_semantics=False, strategy='stream').strategy
+    assert not isinstance(streamed['nodes'], dict)
+    assert ''.join(strategy_json_chunks(streamed, nodes_per_chunk=5)) == strategy_to_json(strategy)
 
 
 # --- automatic policy -----------------------------------------------------------------------

@@ -199,6 +199,7 @@ class SymbolicGame:
         self.reordering = sift_from_start if self.options.reordering is None \
             else self.options.reordering
         self._enforce_calls = 0
+        self._order_frozen = False
         if self.reordering:
             self.bdd.configure(reordering=True)
         # Positions outside this set never matter (see relevant_positions); set by the solver.
@@ -282,9 +283,16 @@ class SymbolicGame:
         self._reorder_when_large()
         return ~self._relational_product(~responses, self.env_partition)
 
+    def freeze_order(self) -> None:
+        """No more reordering: after the solve, the work is many small operations on BDDs
+        already built, which a late sifting pass (seconds) would not repay (slugs also stops
+        reordering before extracting strategies)."""
+        self.bdd.configure(reordering=False)
+        self._order_frozen = True
+
     def _reorder_when_large(self) -> None:
         """Automatic reordering: switch CUDD's sifting on once the BDDs have grown large."""
-        if self.reordering or self.options.reordering is not None:
+        if self.reordering or self.options.reordering is not None or self._order_frozen:
             return
         # Reading CUDD's statistics scans its unique table: look every few operations only.
         self._enforce_calls += 1

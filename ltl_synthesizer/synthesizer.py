@@ -96,6 +96,8 @@ def _synthesize(spec, robotics_semantics, interrupt, counterstrategy, explain, o
 
     solution = solve_system_game(game, stop_when_losing=still_possible)
     realizable = solution.complete and still_possible(solution.winning)
+    if realizable:  # the counter-game of an unrealizable one is another solve: it may sift
+        game.freeze_order()
     solved = time.perf_counter()
     result = SynthesisResult(realizable=realizable)
     if realizable:

@@ -184,6 +184,11 @@ def plot(rows: list[dict], timeout: float) -> None:
         plt.close(figure)
 
 
+def _in_family_order(rows: list[dict]) -> list[dict]:
+    order = list(gr1_families.FAMILIES)
+    return sorted(rows, key=lambda row: order.index(row['family']))  # stable within a family
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument('--slugs', help='slugs executable (compared when given)')
@@ -192,14 +197,19 @@ def main(argv=None) -> int:
     parser.add_argument('--families', default=','.join(gr1_families.FAMILIES))
     parser.add_argument('--max-sizes', type=int, default=None)
     args = parser.parse_args(argv)
+    families = args.families.split(',')
+    # Rows of the families not run this time are kept from the previous report.
+    previous = RESULTS / 'gr1_families.json'
+    kept = [row for row in json.loads(previous.read_text()) if row['family'] not in families] \
+        if previous.exists() else []
     rows = []
     with tempfile.TemporaryDirectory() as directory:
-        for name in args.families.split(','):
+        for name in families:
             sizes = gr1_families.FAMILIES[name][:args.max_sizes]
             rows += bench_family(name, sizes, args.slugs, args.timeout, args.strategy_timeout,
                                  Path(directory))
-            write_report(rows, args.timeout)
-    plot(rows, args.timeout)
+            write_report(_in_family_order(kept + rows), args.timeout)
+    plot(_in_family_order(kept + rows), args.timeout)
     return 0
 
 

@@ -51,7 +51,10 @@ def _parser() -> argparse.ArgumentParser:
                         help='give up after this many seconds, reading the input included (exit status 3)')
     parser.add_argument('--memory-limit', type=_limit, default=2048, metavar='MB',
                         help='give up beyond this much memory (default 2048, 0: none; exit status 4)')
-    parser.add_argument('input', metavar='INPUT')
+    parser.add_argument('--serve', action='store_true',
+                        help='resident mode: read one request per line on stdin (a JSON list of '
+                             'gr1synth arguments), answer one JSON line each on stdout')
+    parser.add_argument('input', metavar='INPUT', nargs='?')
     parser.add_argument('output', metavar='OUTPUT', nargs='?')
     return parser
 
@@ -65,6 +68,22 @@ def _limit(text: str) -> float:
     if not math.isfinite(value) or value < 0:
         raise argparse.ArgumentTypeError(f'must be a finite number >= 0, not {text[:40]!r}')
     return value
+
+
+def _arguments(argv):
+    parser = _parser()
+    args = parser.parse_args(argv)
+    if args.serve:
+        if args.input:
+            parser.error('--serve reads its requests from stdin: no INPUT')
+    elif not args.input:
+        parser.error('the following arguments are required: INPUT')
+    elif args.output and not (args.explicitStrategy or args.counterStrategy or args.convert):
+        # As slugs ("too many file names"): an output file is only ever a strategy's.
+        print('gr1synth: error: an OUTPUT file is written only with --explicitStrategy, '
+              '--counterStrategy or --convert', file=sys.stderr)
+        raise SystemExit(EXIT_MALFORMED)
+    return args
 
 
 def read_specification(path: str, check=None, deadline: float | None = None):
@@ -105,10 +124,16 @@ def _read_text(path: str, deadline: float | None) -> str:
 
 
 def _write(text: str, output: str | None) -> None:
+    _write_chunks([text], output)
+
+
+def _write_chunks(chunks, output: str | None) -> None:
+    """Write text pieces as they come (a large strategy is never one string in memory)."""
     if output:
-        Path(output).write_text(text)
+        with open(output, 'w') as stream:
+            stream.writelines(chunks)
     else:
-        sys.stdout.write(text)
+        sys.stdout.writelines(chunks)
         sys.stdout.flush()
 
 
@@ -135,7 +160,10 @@ def main(argv=None) -> int:
         # one long CUDD operation holds the interpreter (a Python handler would wait for it).
         import signal
         signal.signal(signal.SIGINT, signal.SIG_DFL)
-    args = _parser().parse_args(argv)
+    args = _arguments(argv)
+    if args.serve:
+        from ltl_synthesizer.serve import serve
+        return serve(sys.stdin, sys.stdout)
     return run_with_deep_stack(_run, args)
 
 
@@ -203,9 +231,12 @@ def _run(args) -> int:
         processes = SynthesisProcesses()
         synthesize = processes.synthesize
     try:
+        # In-process JSON strategies are written while they are extracted (bounded memory).
+        stream = args.explicitStrategy and args.jsonOutput and deadline is None
         result = synthesize(spec, robotics_semantics=args.sysInitRoboticsSemantics,
                             deadline=deadline, counterstrategy=args.counterStrategy,
-                            explain=args.explain, strategy=args.explicitStrategy,
+                            explain=args.explain,
+                            strategy='stream' if stream else args.explicitStrategy,
                             memory_limit=memory_limit)
     except SynthesisCancelled as error:
         print(f'gr1synth: error: {error}', file=sys.stderr)
@@ -222,12 +253,21 @@ def _run(args) -> int:
     print(REALIZABLE_LINE if result.realizable else UNREALIZABLE_LINE, file=sys.stderr)
     if not result.realizable and args.explain and result.explanation:
         print(result.explanation, file=sys.stderr)
-    from ltl_synthesizer.strategy import strategy_to_json
-    printer = strategy_to_json if args.jsonOutput else strategy_to_text
+    from ltl_synthesizer.strategy import strategy_json_chunks
     if result.realizable and args.explicitStrategy:
-        _write(printer(result.strategy), args.output)
+        strategy = result.strategy
     elif not result.realizable and args.counterStrategy:
-        _write(printer(result.counterstrategy), args.output)
+        strategy = result.counterstrategy
+    else:
+        return 0
+    try:
+        if args.jsonOutput:
+            _write_chunks(strategy_json_chunks(strategy), args.output)
+        else:
+            _write(strategy_to_text(strategy), args.output)
+    except SynthesisMemoryExceeded as error:  # a streamed strategy is extracted while written
+        print(f'gr1synth: error: {error}', file=sys.stderr)
+        return EXIT_MEMORY
     return 0
 
 

@@ -97,7 +97,7 @@ def solve_system_game(game: SymbolicGame, stop_when_losing=None) -> SystemSoluti
     # to the same greatest fixpoint). The safety game's winning positions are one, and cheap;
     # on typical specifications they are exactly the winning positions, so the first Z
     # iteration is already the confirming one (instead of two or three full iterations).
-    Z = safe = _safe_positions(game, game.relevant_positions())
+    Z = safe = _safe_positions(game, game.relevant_positions(), stop_when_losing)
     if stop_when_losing is not None and not stop_when_losing(safe):
         return SystemSolution(safe, [], complete=False)
     warm_starts = WarmStarts()
@@ -119,15 +119,16 @@ def solve_system_game(game: SymbolicGame, stop_when_losing=None) -> SystemSoluti
             return SystemSolution(Z, [], complete=False)
 
 
-def _safe_positions(game: SymbolicGame, within):
+def _safe_positions(game: SymbolicGame, within, stop_when_losing=None):
     """``nu Z. within & cox(Z')``: positions (among ``within``) from which the system can keep
     both safety sections forever. Every winning position is one (a winning strategy stays
-    among them)."""
+    among them). Stops early (returning the current Z) once ``stop_when_losing`` says the
+    initial positions are lost: Z only shrinks."""
     Z = within
     while True:
-        next_Z = Z & game.enforce(game.system_can_move_into(Z))
-        if next_Z == Z:
-            return Z
+        next_Z = Z & game.enforce(game.system_can_move_into(Z, remember=False))
+        if next_Z == Z or (stop_when_losing is not None and not stop_when_losing(next_Z)):
+            return next_Z
         Z = next_Z
 
 

@@ -76,6 +76,47 @@ def _successor_goal(game: SymbolicGame, goals, rank: int, transition: dict[str, 
     return goal
 
 
+def _responses(game: SymbolicGame, moves):
+    """One response per environment move in ``moves`` (over next-step variables): for each
+    next input valuation, in increasing order (False before True, in declared order), the
+    smallest output valuation -- what repeated ``pick`` over inputs then outputs would
+    choose, with one BDD cofactor and one pick over the outputs per move instead of a pick
+    over every variable and a subtraction."""
+    bdd, next_inputs = game.bdd, game.next_inputs
+    answered_inputs = bdd.exist(game.next_outputs, moves)
+    if answered_inputs == game.false:
+        return
+    valuations = sorted(tuple(valuation[name] for name in next_inputs) for valuation in
+                        bdd.pick_iter(answered_inputs, care_vars=set(next_inputs)))
+    for values in valuations:
+        inputs = dict(zip(next_inputs, values))
+        outputs, _ = game.pick(bdd.let(inputs, moves) if inputs else moves, game.next_outputs)
+        yield inputs, outputs
+
+
+class _GoalsAt:
+    """The system goals cofactored by one position's state (over next-step variables only),
+    so that each of the position's transitions is evaluated on its next step alone."""
+
+    def __init__(self, game: SymbolicGame, state: dict[str, bool]):
+        self.game, self.state = game, state
+        self.cofactors = {}
+
+    def holds(self, goal: int, following: dict[str, bool]) -> bool:
+        if goal not in self.cofactors:
+            self.cofactors[goal] = self.game.bdd.let(self.state, self.game.sys_goals[goal])
+        return self.game.evaluate(self.cofactors[goal], following)
+
+    def successor_goal(self, rank: int, following: dict[str, bool]) -> int:
+        """As ``_successor_goal``, for a transition from this position."""
+        goals = len(self.game.sys_goals)
+        goal, first_try = rank, True
+        while (goal != rank or first_try) and self.holds(goal, following):
+            goal = (goal + 1) % goals
+            first_try = False
+        return goal
+
+
 def _moves_from(game: SymbolicGame, state: dict[str, bool]):
     """The moves from one position allowed by env_trans, and those allowed by both safety
     sections, each as the position's state cube conjoined with the relation."""
@@ -111,15 +152,26 @@ def _strategy_json(variables, nodes: dict) -> dict:
 
 def extract_strategy(game: SymbolicGame, solution: SystemSolution) -> dict:
     """The explicit strategy as slugs' JSON object (``nodes`` keyed by decimal strings)."""
+    return _strategy_json(game.variables, dict(strategy_nodes(game, solution)))
+
+
+def streamed_strategy(game: SymbolicGame, solution: SystemSolution) -> dict:
+    """As ``extract_strategy``, but ``nodes`` is an iterator of ``(name, node)`` pairs made as
+    they are read (``strategy_json_chunks`` writes them out): memory holds the numbering of
+    the nodes, not their edges."""
+    return _strategy_json(game.variables, strategy_nodes(game, solution))
+
+
+def strategy_nodes(game: SymbolicGame, solution: SystemSolution):
+    """The strategy's nodes ``(name, node)`` in increasing number (breadth-first order)."""
     steps = goal_steps(game, solution)
     variables = game.variables
-    next_names = game.next_inputs + game.next_outputs
+    next_variables = [game.to_next[name] for name in variables]
     numbering = _Numbering()
     initial = solution.winning & game.env_init & game.sys_init
     for state in enumerate_states(game, initial, variables):
         numbering.number(tuple(state[name] for name in variables), 0)
 
-    nodes = {}
     while numbering.queue:
         values, rank = numbering.queue.popleft()
         game.interrupt.check()
@@ -127,19 +179,15 @@ def extract_strategy(game: SymbolicGame, solution: SystemSolution) -> dict:
         env_moves, legal = _moves_from(game, state)
         # Without the state cube, the picks below work on smaller BDDs.
         moves = game.bdd.exist(variables, goal_moves(game, steps[rank], env_moves, legal))
+        goals_here = _GoalsAt(game, state)
         successors = []
-        while moves != game.false:
-            choice, _ = game.pick(moves, next_names)
-            transition = dict(state)
-            transition.update(choice)
-            next_rank = _successor_goal(game, game.sys_goals, rank, transition)
-            next_values = tuple(choice[game.to_next[name]] for name in variables)
+        for inputs, outputs in _responses(game, moves):
+            following = {**inputs, **outputs}
+            next_rank = goals_here.successor_goal(rank, following)
+            next_values = tuple(following[name] for name in next_variables)
             successors.append(numbering.number(next_values, next_rank))
-            # One response per environment move: drop every move with the same next inputs.
-            moves &= ~game.cube({name: choice[name] for name in game.next_inputs})
-        nodes[str(numbering.index[(values, rank)])] = {
+        yield str(numbering.index[(values, rank)]), {
             'rank': rank, 'state': [int(v) for v in values], 'trans': successors}
-    return _strategy_json(variables, nodes)
 
 
 def extract_counterstrategy(game: SymbolicGame, solution: EnvironmentSolution,
@@ -279,21 +327,34 @@ def losing_initial_positions(game: SymbolicGame, environment_wins, robotics_sema
 
 def strategy_to_json(strategy: dict) -> str:
     """Print a (counter-)strategy exactly in slugs' ``--jsonOutput`` layout."""
+    return ''.join(strategy_json_chunks(strategy))
+
+
+def strategy_json_chunks(strategy: dict, nodes_per_chunk: int = 1000):
+    """``strategy_to_json`` in pieces of ``nodes_per_chunk`` nodes, for writing as they come.
+    ``strategy['nodes']`` is a dict, or an iterator of ``(name, node)`` in increasing number
+    (``streamed_strategy``)."""
     names = ', '.join(_json_string(name) for name in strategy['variables'])
-    lines = [f'{{"version": {strategy["version"]},\n "slugs": {_json_string(strategy["slugs"])},\n\n',
-             f' "variables": [{names}],\n\n "nodes": {{\n']
-    node_ids = sorted(strategy['nodes'], key=int)
-    for position, node_name in enumerate(node_ids):
-        node = strategy['nodes'][node_name]
+    yield (f'{{"version": {strategy["version"]},\n "slugs": {_json_string(strategy["slugs"])},\n\n'
+           f' "variables": [{names}],\n\n "nodes": {{\n')
+    nodes = strategy['nodes']
+    if isinstance(nodes, dict):
+        nodes = sorted(nodes.items(), key=lambda item: int(item[0]))
+    lines, position = [], 0
+    for position, (node_name, node) in enumerate(nodes, start=1):
         rank = node['rank']
         rank_text = f'[{rank[0]}, {rank[1]}]' if isinstance(rank, (list, tuple)) else str(rank)
         state = ', '.join('null' if v is None else str(v) for v in node['state'])
-        trans = ', '.join(str(t) for t in node['trans'])
-        separator = ',' if position + 1 < len(node_ids) else ''
-        lines.append(f'"{node_name}": {{\n\t"rank": {rank_text},\n\t"state": [{state}],\n'
-                     f'\t"trans": [{trans}]\n}}{separator}\n\n')
-    lines.append('}}\n')
-    return ''.join(lines)
+        trans = ', '.join(map(str, node['trans']))
+        # The separator goes before each node but the first: the last is not known ahead.
+        separator = ',\n\n' if position > 1 else ''
+        lines.append(f'{separator}"{node_name}": {{\n\t"rank": {rank_text},\n\t"state": [{state}],\n'
+                     f'\t"trans": [{trans}]\n}}')
+        if len(lines) == nodes_per_chunk:
+            yield ''.join(lines)
+            lines = []
+    lines.append('\n\n}}\n' if position else '}}\n')
+    yield ''.join(lines)
 
 
 def _json_string(text: str) -> str:

@@ -17,7 +17,7 @@ import warnings
 from dataclasses import dataclass, field
 from functools import cached_property
 
-from dd import cudd
+from ltl_synthesizer.cudd_import import cudd
 
 from respec.spec import GR1Specification
 
@@ -40,13 +40,29 @@ INITIAL_CACHE_SLOTS = 2**14
 # 10-45% slower); 'automatic' options switch them on above it.
 SMALL_GAME_PROPOSITIONS = 36
 
+# Automatic dynamic reordering. Sifting from the start, as slugs does, is 2-5x faster on
+# games with several system goals (a Y/X family per goal stays alive and one order must suit
+# them all: AMBA) and on small pure safety games over wide integers (moving obstacle: few
+# variables, large BDDs). Elsewhere it starts on the static order and switches sifting on only
+# once this many BDD nodes are alive: ATLAS tasks (one goal, an assumption per action) would
+# lose up to 2x to sifting, cinderella (many variables, small BDDs) 4x
+# (bench/bench_gr1_families.py, bench_goals.py). A node count, not a time: the same request
+# always takes the same path.
+DYNAMIC_REORDERING_FROM_NODES = 100_000
+REORDERING_CHECK_PERIOD = 4
+# ... and the sifting pass also runs on smaller games whose safety relations have this many nodes.
+SIFTED_RELATION_NODES = 1000
+
 
 @dataclass
 class Options:
     """Tuning switches of the symbolic engine (defaults are the measured best; see bench/)."""
 
-    reordering: bool = False  # dynamic reordering throughout (CUDD's automatic sifting)
-    # None = automatic: on for games of more than SMALL_GAME_PROPOSITIONS propositions.
+    # Dynamic reordering (CUDD's automatic sifting); None = automatic: from the start with
+    # several system goals or on small safety games, else past DYNAMIC_REORDERING_FROM_NODES.
+    reordering: bool | None = None
+    # None = automatic: on for games of more than SMALL_GAME_PROPOSITIONS propositions
+    # (reachable_only: and with some liveness goal; see SymbolicGame).
     sift_once: bool | None = None  # one sifting pass after the relations are built (see SymbolicGame)
     cluster_limit: int = DEFAULT_CLUSTER_LIMIT
     variable_order: str = 'affinity'  # 'affinity' (co-occurrence) or 'declared'
@@ -131,8 +147,6 @@ class SymbolicGame:
         check_declarations(spec)
         self.variables = self.inputs + self.outputs
         large = len(self.variables) > SMALL_GAME_PROPOSITIONS
-        self.sift_once = large if self.options.sift_once is None else self.options.sift_once
-        self.reachable_only = large if self.options.reachable_only is None else self.options.reachable_only
         self.bdd = cudd.BDD(memory_estimate=MEMORY_ESTIMATE, initial_cache_size=INITIAL_CACHE_SLOTS)
         self.bdd.configure(reordering=False)
         if self.interrupt.memory_limit is not None:
@@ -163,14 +177,30 @@ class SymbolicGame:
         # Assumptions that constrain no next output factor out of exists y' (see gr1).
         self.env_goal_ignores_outputs = [not self.mentions_next_outputs(goal)
                                          for goal in self.env_goals]
+        # A pure safety game is solved by one greatest fixpoint, no dearer than the
+        # reachability search itself (cinderella: 0.01 s solving after 2.5 s of search).
+        has_liveness = any(goal != self.true for goal in self.env_goals + self.sys_goals)
+        self.reachable_only = (large and has_liveness) if self.options.reachable_only is None \
+            else self.options.reachable_only
         self.env_partition = self._partition(self.env_trans_parts, set(self.next_inputs))
         self.sys_partition = self._partition(self.sys_trans_parts, set(self.next_outputs))
+        # Few propositions but wide integers (grids, counters) also make large relations,
+        # whose bits the static order cannot place well (moving obstacle 16x16: 3x faster).
+        relation_nodes = sum(len(cluster) for cluster in
+                             self.env_partition.clusters + self.sys_partition.clusters)
+        self.sift_once = (large or relation_nodes >= SIFTED_RELATION_NODES) \
+            if self.options.sift_once is None else self.options.sift_once
         if self.sift_once:
             # The static order cannot know that e.g. a memory proposition belongs next to its
             # action's activation and outcomes; one sifting pass on the relations finds such
             # placements (3x faster multi-goal solving) for a few milliseconds.
             self.bdd.reorder()
-        if self.options.reordering:
+        sift_from_start = len(self.sys_goals) > 1 or not (large or has_liveness)
+        self.reordering = sift_from_start if self.options.reordering is None \
+            else self.options.reordering
+        self._enforce_calls = 0
+        self._order_frozen = False
+        if self.reordering:
             self.bdd.configure(reordering=True)
         # Positions outside this set never matter (see relevant_positions); set by the solver.
         self.care = self.true
@@ -224,10 +254,12 @@ class SymbolicGame:
         """``exists y'. sys_trans & target``: the system has a legal move into ``target``."""
         return self._relational_product(target, self.sys_partition)
 
-    def system_can_move_into(self, positions):
+    def system_can_move_into(self, positions, remember: bool = True):
         """``exists y'. sys_trans & positions'``, memoized: the assumptions' inner fixpoints
         share start sets, and each outer iteration restarts them from the previous one's
-        results (see ``start_outer_iteration``)."""
+        results (see ``start_outer_iteration``). Sets that never recur (``remember=False``)
+        stay out of the memo: kept alive, they would slow every garbage collection and
+        reordering (the safety fixpoint of moving obstacle 24x24: 2.5x slower)."""
         key = int(positions)
         found = self._moves_into.get(key) or self._previous_moves_into.get(key)
         if found is None or found[0] != positions:
@@ -235,7 +267,8 @@ class SymbolicGame:
             # the target may take any values elsewhere, so take CUDD's simplest such BDD.
             target = positions if self.care == self.true else cudd.restrict(positions, self.care)
             found = (positions, self.system_can_respond(self.prime(target)))
-        self._moves_into[key] = found
+        if remember:
+            self._moves_into[key] = found
         return found[1]
 
     def start_outer_iteration(self):
@@ -247,7 +280,27 @@ class SymbolicGame:
         """Positions where every next input allowed by env_trans has a response:
         ``forall x'. env_trans -> responses`` (``responses`` over current vars and next inputs)."""
         self.interrupt.check()
+        self._reorder_when_large()
         return ~self._relational_product(~responses, self.env_partition)
+
+    def freeze_order(self) -> None:
+        """No more reordering: after the solve, the work is many small operations on BDDs
+        already built, which a late sifting pass (seconds) would not repay (slugs also stops
+        reordering before extracting strategies)."""
+        self.bdd.configure(reordering=False)
+        self._order_frozen = True
+
+    def _reorder_when_large(self) -> None:
+        """Automatic reordering: switch CUDD's sifting on once the BDDs have grown large."""
+        if self.reordering or self.options.reordering is not None or self._order_frozen:
+            return
+        # Reading CUDD's statistics scans its unique table: look every few operations only.
+        self._enforce_calls += 1
+        if self._enforce_calls % REORDERING_CHECK_PERIOD:
+            return
+        if self._cudd_statistics()['n_nodes'] > DYNAMIC_REORDERING_FROM_NODES:
+            self.reordering = True
+            self.bdd.configure(reordering=True)
 
     def cox(self, target):
         """Enforceable predecessor of a set of transitions (slugs' "cox").
@@ -347,10 +400,13 @@ class SymbolicGame:
             return False
         raise ValueError('assignment does not fix every variable of the function')
 
-    def statistics(self) -> dict:
+    def _cudd_statistics(self) -> dict:
         with warnings.catch_warnings():  # dd warns that 'mem' is now in bytes; we know
             warnings.simplefilter('ignore')
-            stats = self.bdd.statistics()
+            return self.bdd.statistics()
+
+    def statistics(self) -> dict:
+        stats = self._cudd_statistics()
         return {'bdd_nodes': stats.get('n_nodes'), 'peak_bdd_nodes': stats.get('peak_nodes'),
                 'reorderings': stats.get('n_reorderings'), 'bdd_memory_bytes': stats.get('mem')}
 

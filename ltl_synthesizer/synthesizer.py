@@ -11,7 +11,7 @@ from respec.spec import GR1Specification
 
 from ltl_synthesizer.explain import explain_unrealizable
 from ltl_synthesizer.gr1 import solve_environment_game, solve_system_game
-from ltl_synthesizer.strategy import extract_counterstrategy, extract_strategy
+from ltl_synthesizer.strategy import extract_counterstrategy, extract_strategy, streamed_strategy
 from ltl_synthesizer.symbolic import Interrupt, Options, SymbolicGame, memory_exceeded
 
 # Default memory limit of one synthesis: BDD memory, in bytes.
@@ -43,10 +43,13 @@ def initial_positions_win(game: SymbolicGame, winning, robotics_semantics: bool)
 def synthesize(spec: GR1Specification, robotics_semantics: bool = True,
                cancel: threading.Event | None = None, deadline: float | None = None,
                counterstrategy: bool = False, explain: bool = True,
-               options: Options | None = None, strategy: bool = True,
+               options: Options | None = None, strategy: bool | str = True,
                memory_limit: int | None = DEFAULT_MEMORY_LIMIT) -> SynthesisResult:
     """Decide realizability of ``spec``; extract an explicit strategy (``strategy``), or a
     counter-strategy (``counterstrategy``) and an explanation (``explain``) when unrealizable.
+
+    ``strategy='stream'``: the strategy's ``nodes`` are an iterator, made while it is read
+    (``strategy_json_chunks`` writes them out; memory holds no edges).
 
     Limits (all optional, checked in every long loop of every phase): ``cancel`` (a
     threading.Event) raises ``SynthesisCancelled`` (code PREEMPTED), ``deadline`` (a
@@ -93,10 +96,14 @@ def _synthesize(spec, robotics_semantics, interrupt, counterstrategy, explain, o
 
     solution = solve_system_game(game, stop_when_losing=still_possible)
     realizable = solution.complete and still_possible(solution.winning)
+    if realizable:  # the counter-game of an unrealizable one is another solve: it may sift
+        game.freeze_order()
     solved = time.perf_counter()
     result = SynthesisResult(realizable=realizable)
     if realizable:
-        if strategy:
+        if strategy == 'stream':
+            result.strategy = streamed_strategy(game, solution)
+        elif strategy:
             result.strategy = extract_strategy(game, solution)
         if game.env_init & game.sys_init == game.false:
             result.stats['warnings'] = ['ENV_INIT and SYS_INIT are contradictory: realizable '
@@ -114,6 +121,6 @@ def _synthesize(spec, robotics_semantics, interrupt, counterstrategy, explain, o
         'build_seconds': built - start, 'solve_seconds': solved - built,
         'extract_seconds': finished - solved, 'total_seconds': finished - start,
         'variables': len(game.variables), 'strategy_nodes':
-            len(result.strategy['nodes']) if result.strategy else 0,
+            len(result.strategy['nodes']) if result.strategy and strategy != 'stream' else 0,
         **game.statistics()})
     return result

@@ -7,7 +7,7 @@ explicit stack, so formulas may be nested to any depth.
 
 from __future__ import annotations
 
-from dd import cudd
+from ltl_synthesizer.cudd_import import cudd
 
 from respec.errors import quoted
 from respec.ltl import And, Const, Formula, Iff, Implies, Next, Not, Or, Var, children, to_infix

@@ -815,6 +815,7 @@ def _parse_slugs_file(text: str, filename: str, syntax: str, check=None) -> GR1S
                 if formula is None:
                     parsed[index] = _parse_line(lines[index], syntax, scope, sections[section].source(index, filename))
             formulas[section] = parsed
+    _check_declared_before_use(sections, formulas, integers, filename)
     # Like slugs' compiler, keep integers in range: initially and after every step.
     for variable in integers.values():
         owner = 'env' if variable.bits and variable.bits[0] in declared['env_props'] else 'sys'
@@ -823,6 +824,34 @@ def _parse_slugs_file(text: str, filename: str, syntax: str, check=None) -> GR1S
             if limit != TRUE:
                 formulas[section].append(limit)
     return GR1Specification(**declared, **formulas)
+
+
+def _check_declared_before_use(sections, formulas, integers, filename: str) -> None:
+    """slugs reads a file top to bottom: a formula may use only variables declared above it.
+    Only files with a formula section above a declaration section need the (slower) look."""
+    def lines_of(section):  # the file line of each of the section's lines
+        return [sections[section].source(index, filename).line
+                for index in range(len(sections[section].lines))]
+    last_declaration = max((part[1] for section in PROPOSITION_SECTIONS
+                            for part in sections[section]._parts), default=0)
+    if not any(part[1] < last_declaration for section in FORMULA_SECTIONS
+               for part in sections[section]._parts):
+        return
+    declared_at = {}
+    bit_owner = {bit: variable.name for variable in integers.values() for bit in variable.bits}
+    for section in PROPOSITION_SECTIONS:
+        for name, line in zip(sections[section].lines, lines_of(section)):
+            declared_at[name.partition(':')[0].strip()] = line
+    for section in FORMULA_SECTIONS:
+        for index, (formula, line) in enumerate(zip(formulas[section], lines_of(section))):
+            if line > last_declaration:
+                continue
+            for name in sorted(variables(formula)):
+                name = bit_owner.get(name, name)
+                if declared_at.get(name, 0) > line:
+                    raise sections[section].source(index, filename).error(
+                        f"variable '{name}' is used before its section declares it "
+                        f'(line {declared_at[name]})', name, 1, 1)
 
 
 def _integer_variable(declaration: re.Match, seen: set[str], source: _Source) -> IntegerVariable:

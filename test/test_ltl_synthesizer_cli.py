@@ -92,9 +92,13 @@ def test_unrealizable_exits_zero_and_explains_only_when_asked(tmp_path):
 
 def test_without_explicit_strategy_only_the_verdict(tmp_path):
     source = write(tmp_path, 'copy.structuredslugs', REALIZABLE)
-    done = gr1synth(source, tmp_path / 'out.json')
+    done = gr1synth(source)
     assert done.returncode == 0 and done.stdout == ''
     assert done.stderr == 'RESULT: Specification is realizable.\n'
+    # As slugs (issue 24): an output file name without --explicitStrategy is refused.
+    done = gr1synth(source, tmp_path / 'out.json')
+    assert done.returncode == 1 and 'RESULT' not in done.stderr
+    assert '--explicitStrategy' in done.stderr
     assert not (tmp_path / 'out.json').exists()
 
 

@@ -1,0 +1,219 @@
+"""Ours vs slugs on the public GR(1) families (issue 24): CPU time per family and size, with
+the differential checks, one table (results/gr1_families.md) and one PNG per family.
+
+    nice -n 10 python bench/bench_gr1_families.py --slugs /path/to/slugs [--timeout 120]
+    python bench/bench_gr1_families.py --families cinderella,amba --max-sizes 4
+
+For each family (bench/gr1_families.py) and size, smallest first: the structuredslugs text is
+converted once to slugsin (our parser) and both tools run on that same file, each in a fresh
+process, realizability only (slugs' default), CPU seconds (user + system of the child,
+start-up included). A tool that times out is not run on the family's larger sizes.
+Differential checks on every instance both finish: the verdicts agree; and, when realizable,
+our explicit strategy (``gr1synth --explicitStrategy --jsonOutput``, bounded by
+``--strategy-timeout``) passes bench/strategy_check.py, an independent checker.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import signal
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+RESULTS = ROOT / 'bench' / 'results'
+sys.path[:0] = [str(ROOT), str(ROOT / 'bench')]
+
+import gr1_families  # noqa: E402
+
+GR1SYNTH = [sys.executable, '-m', 'ltl_synthesizer']
+
+
+def run_timed(command: list[str], timeout: float, stdout=subprocess.DEVNULL) -> dict:
+    """Run ``command``; its CPU seconds (user + system, children included), exit status and
+    stderr; ``timeout`` True when killed at the time limit."""
+    with tempfile.TemporaryFile() as errors:
+        start = time.monotonic()
+        process = subprocess.Popen(command, stdout=stdout, stderr=errors, cwd=ROOT,
+                                   start_new_session=True)
+        timed_out = False
+        while True:
+            pid, status, usage = os.wait4(process.pid, os.WNOHANG)
+            if pid:
+                break
+            if time.monotonic() - start > timeout:
+                os.killpg(process.pid, signal.SIGKILL)
+                pid, status, usage = os.wait4(process.pid, 0)
+                timed_out = True
+                break
+            time.sleep(0.02)
+        process.returncode = os.waitstatus_to_exitcode(status)
+        errors.seek(0)
+        text = errors.read().decode(errors='replace')
+    return {'cpu': usage.ru_utime + usage.ru_stime, 'timeout': timed_out,
+            'status': process.returncode, 'stderr': text, 'rss_mb': usage.ru_maxrss / 1024}
+
+
+def verdict(result: dict):
+    if result['timeout'] or result['status'] != 0:
+        return None
+    if 'Specification is realizable' in result['stderr']:
+        return True
+    if 'Specification is unrealizable' in result['stderr']:
+        return False
+    return None
+
+
+def strategy_check(spec, slugsin: Path, timeout: float) -> str:
+    """Extract our explicit strategy and check it independently; a short outcome text."""
+    from strategy_check import check_strategy
+    output = slugsin.with_suffix('.json')
+    run = run_timed(GR1SYNTH + ['--explicitStrategy', '--jsonOutput', str(slugsin), str(output)],
+                    timeout)
+    if run['timeout']:
+        return f'not checked (extraction > {timeout:.0f} s)'
+    if run['status'] != 0:
+        return f'extraction failed: {run["stderr"].strip()[-200:]}'
+    strategy = json.loads(output.read_text())
+    output.unlink()
+    problems = check_strategy(spec, strategy)
+    size = len(strategy['nodes'])
+    return f'ok ({size} nodes)' if not problems else f'FAILED ({size} nodes): {problems[0]}'
+
+
+def bench_family(name: str, sizes, slugs: str | None, timeout: float, strategy_timeout: float,
+                 directory: Path) -> list[dict]:
+    from respec.parsing import parse_structuredslugs
+    rows = []
+    ours_alive, slugs_alive = True, slugs is not None
+    for label, generator, arguments in sizes:
+        if not (ours_alive or slugs_alive):
+            break
+        text = generator(*arguments)
+        spec = parse_structuredslugs(text, filename=f'{name}.structuredslugs')
+        slugsin = directory / f'{name}_{"_".join(map(str, arguments))}.slugsin'
+        slugsin.write_text(spec.to_slugsin())
+        row = {'family': name, 'size': label, 'limit': timeout,
+               'variables': len(spec.env_props) + len(spec.sys_props)}
+        if ours_alive:
+            ours = run_timed(GR1SYNTH + [str(slugsin)], timeout)
+            row['ours'] = None if ours['timeout'] else ours['cpu']
+            row['ours_verdict'] = verdict(ours)
+            ours_alive = not ours['timeout']
+        if slugs_alive:
+            theirs = run_timed([slugs, str(slugsin)], timeout)
+            row['slugs'] = None if theirs['timeout'] else theirs['cpu']
+            row['slugs_verdict'] = verdict(theirs)
+            slugs_alive = not theirs['timeout']
+        checks = []
+        if row.get('ours_verdict') is not None and row.get('slugs_verdict') is not None:
+            checks.append('verdicts agree' if row['ours_verdict'] == row['slugs_verdict']
+                          else 'VERDICTS DISAGREE')
+        if row.get('ours_verdict'):
+            checks.append('strategy ' + strategy_check(spec, slugsin, strategy_timeout))
+        row['checks'] = '; '.join(checks)
+        slugsin.unlink()
+        rows.append(row)
+        print(f"{name:16s} {label:18s} vars={row['variables']:3d} ours={_cell(row, 'ours'):>8s} "
+              f"slugs={_cell(row, 'slugs'):>8s} {_verdict_text(row)}  {row['checks']}", flush=True)
+    return rows
+
+
+def _cell(row: dict, tool: str) -> str:
+    if tool not in row:
+        return '-'
+    return f"> {row.get('limit', 0):.0f} s" if row[tool] is None else f'{row[tool]:.2f}'
+
+
+def _verdict_text(row: dict) -> str:
+    value = row.get('ours_verdict', row.get('slugs_verdict'))
+    return {True: 'realizable', False: 'unrealizable', None: '?'}[value]
+
+
+def write_report(rows: list[dict], timeout: float) -> None:
+    lines = ['# Ours (gr1synth) vs slugs on the public GR(1) families', '',
+             'CPU seconds (user + system, start-up included) of a fresh process, realizability '
+             f'only, on the same slugsin file; "> N s": killed at the time limit, "-" = not run '
+             '(the tool timed out on a smaller size). Ratio = ours / slugs. Checks: verdicts '
+             'agree; our explicit strategy passes bench/strategy_check.py (independent).', '',
+             'Generated by `nice -n 10 python bench/bench_gr1_families.py --slugs SLUGS`.', '',
+             '| family | size | variables | verdict | ours | slugs | ratio | checks |',
+             '|---|---|---|---|---|---|---|---|']
+    for row in rows:
+        ratio = '-'
+        if row.get('ours') is not None and row.get('slugs'):
+            ratio = f"{row['ours'] / row['slugs']:.2f}"
+        elif row.get('ours') is not None and 'slugs' in row:
+            ratio = 'slugs timed out'
+        lines.append(f"| {row['family']} | {row['size']} | {row['variables']} | {_verdict_text(row)} "
+                     f"| {_cell(row, 'ours')} | {_cell(row, 'slugs')} | {ratio} | {row['checks']} |")
+    RESULTS.mkdir(parents=True, exist_ok=True)
+    (RESULTS / 'gr1_families.md').write_text('\n'.join(lines) + '\n')
+    (RESULTS / 'gr1_families.json').write_text(json.dumps(rows, indent=1) + '\n')
+
+
+def plot(rows: list[dict], timeout: float) -> None:
+    import matplotlib
+    matplotlib.use('Agg')
+    import matplotlib.pyplot as plt
+    for family in dict.fromkeys(row['family'] for row in rows):
+        family_rows = [row for row in rows if row['family'] == family]
+        labels = [row['size'] for row in family_rows]
+        figure, axes = plt.subplots(figsize=(8, 4.5))
+        for tool, marker in (('ours', 'o'), ('slugs', 's')):
+            points = [(index, row[tool]) for index, row in enumerate(family_rows)
+                      if row.get(tool) is not None]
+            if points:
+                axes.plot(*zip(*points), marker=marker, label='gr1synth (ours)' if tool == 'ours' else 'slugs')
+            timeouts = [(index, row.get('limit', timeout)) for index, row in enumerate(family_rows)
+                        if tool in row and row[tool] is None]
+            if timeouts:
+                axes.plot(*zip(*timeouts), marker='x', linestyle='none',
+                          color='red' if tool == 'slugs' else 'black', label=f'{tool} timeout')
+        axes.set_yscale('log')
+        axes.set_xticks(range(len(labels)))
+        axes.set_xticklabels(labels, rotation=30, ha='right', fontsize=8)
+        axes.set_ylabel('CPU seconds')
+        axes.set_title(f'{family}: ours vs slugs (realizability)')
+        axes.legend()
+        figure.tight_layout()
+        figure.savefig(RESULTS / f'gr1_families_{family}.png', dpi=90)
+        plt.close(figure)
+
+
+def _in_family_order(rows: list[dict]) -> list[dict]:
+    order = list(gr1_families.FAMILIES)
+    return sorted(rows, key=lambda row: order.index(row['family']))  # stable within a family
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument('--slugs', help='slugs executable (compared when given)')
+    parser.add_argument('--timeout', type=float, default=120, help='seconds per run')
+    parser.add_argument('--strategy-timeout', type=float, default=60)
+    parser.add_argument('--families', default=','.join(gr1_families.FAMILIES))
+    parser.add_argument('--max-sizes', type=int, default=None)
+    args = parser.parse_args(argv)
+    families = args.families.split(',')
+    # Rows of the families not run this time are kept from the previous report.
+    previous = RESULTS / 'gr1_families.json'
+    kept = [row for row in json.loads(previous.read_text()) if row['family'] not in families] \
+        if previous.exists() else []
+    rows = []
+    with tempfile.TemporaryDirectory() as directory:
+        for name in families:
+            sizes = gr1_families.FAMILIES[name][:args.max_sizes]
+            rows += bench_family(name, sizes, args.slugs, args.timeout, args.strategy_timeout,
+                                 Path(directory))
+            write_report(_in_family_order(kept + rows), args.timeout)
+    plot(_in_family_order(kept + rows), args.timeout)
+    return 0
+
+
+if __name__ == '__main__':
+    sys.exit(main())

@@ -1,0 +1,156 @@
+"""Issue 24: the automatic engine policy, strictness as slugs, ``gr1synth --serve``, streamed
+JSON strategies and the lean start-up."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from ltl_synthesizer import Options, synthesize
+from ltl_synthesizer.strategy import strategy_json_chunks, strategy_to_json
+from ltl_synthesizer.symbolic import SMALL_GAME_PROPOSITIONS, SymbolicGame
+from respec.parsing import ParseError, parse_slugsin, parse_structuredslugs
+
+REPOSITORY = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(REPOSITORY / 'bench'))
+
+import gr1_families  # noqa: E402
+from strategy_check import check_strategy  # noqa: E402
+
+REALIZABLE = '[INPUT]\nx\n[OUTPUT]\ny\n[SYS_TRANS]\nnext(y) <-> next(x)\n[SYS_LIVENESS]\ny | !x\n'
+
+
+def gr1synth(*arguments, stdin=None):
+    return subprocess.run([sys.executable, '-m', 'ltl_synthesizer', *map(str, arguments)],
+                          input=stdin, capture_output=True, text=True, cwd=REPOSITORY, timeout=120)
+
+
+# --- strictness -----------------------------------------------------------------------------
+
+@pytest.mark.parametrize('text, parse', [
+    ('[INPUT]\na\n[SYS_TRANS]\n| b a\n[OUTPUT]\nb\n', parse_slugsin),
+    ('[INPUT]\na\n[SYS_TRANS]\nb | a\n[OUTPUT]\nb\n', parse_structuredslugs),
+    ('[ENV_INIT]\nn = 2\n[INPUT]\nn:0...3\n', parse_structuredslugs),
+])
+def test_a_variable_used_before_its_declaration_is_an_error(text, parse):
+    with pytest.raises(ParseError, match='used before its section declares it'):
+        parse(text, filename='late')
+
+
+def test_formula_sections_above_declarations_of_other_variables_are_fine():
+    spec = parse_slugsin('[INPUT]\na\n[SYS_TRANS]\n| ! a a\n[OUTPUT]\nb\n')
+    assert spec.sys_props == ['b'] and len(spec.sys_trans) == 1
+
+
+def test_late_declaration_exits_1_on_the_command_line(tmp_path):
+    source = tmp_path / 'late.slugsin'
+    source.write_text('[INPUT]\na\n[SYS_TRANS]\n| b a\n[OUTPUT]\nb\n')
+    done = gr1synth(source)
+    assert done.returncode == 1 and f'{source}:4:' in done.stderr and "'b'" in done.stderr
+
+
+# --- resident mode --------------------------------------------------------------------------
+
+def test_serve_answers_each_request_as_the_command_would(tmp_path):
+    source = tmp_path / 'spec.structuredslugs'
+    source.write_text(REALIZABLE)
+    requests = [[str(source)], ['--explicitStrategy', '--jsonOutput', str(source)],
+                [str(source), str(tmp_path / 'out.json')], ['--nonsense'], [str(tmp_path / 'none.slugsin')]]
+    done = gr1synth('--serve', stdin=''.join(json.dumps(r) + '\n' for r in requests) + 'not json\n')
+    assert done.returncode == 0
+    answers = [json.loads(line) for line in done.stdout.splitlines()]
+    assert len(answers) == len(requests) + 1
+    assert answers[0] == {'status': 0, 'stdout': '', 'stderr': 'RESULT: Specification is realizable.\n'}
+    alone = gr1synth('--explicitStrategy', '--jsonOutput', source)
+    assert answers[1]['stdout'] == alone.stdout and answers[1]['status'] == 0
+    assert answers[2]['status'] == 1 and not (tmp_path / 'out.json').exists()
+    assert answers[3]['status'] == 2 and 'unrecognized arguments' in answers[3]['stderr']
+    assert answers[4]['status'] == 1
+    assert answers[5]['status'] == 1 and 'error' in answers[5]['stderr']
+
+
+# --- streamed strategies --------------------------------------------------------------------
+
+def test_streamed_json_is_the_same_text_in_pieces():
+    spec = parse_structuredslugs(gr1_families.factory(4, 3, 1, 1))
+    strategy = synthesize(spec, robotics_semantics=False).strategy
+    assert len(strategy['nodes']) > 100
+    chunks = list(strategy_json_chunks(strategy, nodes_per_chunk=7))
+    assert len(chunks) > 10 and ''.join(chunks) == strategy_to_json(strategy)
+    assert json.loads(''.join(chunks))['nodes'].keys() == strategy['nodes'].keys()
+    # Streamed: the nodes are made while the text is written, with the same bytes.
+    streamed = synthesize(spec, robotics_semantics=False, strategy='stream').strategy
+    assert not isinstance(streamed['nodes'], dict)
+    assert ''.join(strategy_json_chunks(streamed, nodes_per_chunk=5)) == strategy_to_json(strategy)
+
+
+# --- automatic policy -----------------------------------------------------------------------
+
+def test_pure_safety_games_skip_the_reachability_search():
+    spec = parse_structuredslugs(gr1_families.cinderella(6, 3, 11, 6))
+    game = SymbolicGame(spec)
+    assert len(game.variables) > SMALL_GAME_PROPOSITIONS
+    assert not game.reachable_only and not game.reordering
+
+
+def test_several_system_goals_sift_from_the_start():
+    game = SymbolicGame(parse_structuredslugs(gr1_families.amba(2)))
+    assert len(game.sys_goals) > 1 and game.reordering
+
+
+@pytest.mark.parametrize('family, arguments, realizable', [
+    ('amba', (2,), True), ('cinderella', (5, 2, 6, 4), False), ('cinderella', (5, 2, 7, 4), True),
+    ('factory', (3, 3, 1, 1), False), ('factory', (4, 3, 1, 1), True),
+    ('moving_obstacle', (8, 0), True), ('moving_obstacle', (8, 1), False),
+])
+def test_families_verdicts_are_the_same_under_every_engine_choice(family, arguments, realizable):
+    spec = parse_structuredslugs(getattr(gr1_families, family)(*arguments))
+    verdicts = {synthesize(spec, robotics_semantics=False, strategy=False, explain=False,
+                           options=options).realizable
+                for options in (Options(), Options(reordering=True), Options(reordering=False),
+                                Options(reachable_only=True), Options(sift_once=True))}
+    assert verdicts == {realizable}
+
+
+def test_automatic_reordering_switches_on_past_the_node_threshold(monkeypatch):
+    from ltl_synthesizer import symbolic
+    monkeypatch.setattr(symbolic, 'DYNAMIC_REORDERING_FROM_NODES', 10)
+    monkeypatch.setattr(symbolic, 'REORDERING_CHECK_PERIOD', 1)
+    spec = parse_structuredslugs(gr1_families.evasion(24, 8).replace(
+        '!requestPending2\n', ''))  # one system goal and an (implicit) assumption
+    game = SymbolicGame(spec)
+    assert not game.reordering and len(game.sys_goals) == 1
+    game.cox(game.true)
+    assert game.reordering
+
+
+def test_strategies_of_family_instances_pass_the_independent_check():
+    for generator, arguments in ((gr1_families.amba, (2,)), (gr1_families.factory, (4, 3, 1, 1)),
+                                 (gr1_families.moving_obstacle, (8, 0))):
+        spec = parse_structuredslugs(generator(*arguments))
+        result = synthesize(spec, robotics_semantics=False)
+        assert result.realizable
+        assert check_strategy(spec, result.strategy) == []
+
+
+def test_the_independent_check_catches_a_broken_strategy():
+    spec = parse_structuredslugs(REALIZABLE)
+    strategy = synthesize(spec, robotics_semantics=False).strategy
+    broken = json.loads(json.dumps(strategy))
+    for node in broken['nodes'].values():
+        node['state'][1] = 1 - node['state'][1]  # y no longer follows x
+    assert check_strategy(spec, broken)
+
+
+# --- start-up -------------------------------------------------------------------------------
+
+def test_synthesis_does_not_load_networkx():
+    code = ('import sys; from ltl_synthesizer import synthesize; import ltl_synthesizer.symbolic; '
+            'print("networkx" in sys.modules)')
+    done = subprocess.run([sys.executable, '-c', code], capture_output=True, text=True,
+                          cwd=REPOSITORY, timeout=60)
+    assert done.stdout.strip() == 'False'

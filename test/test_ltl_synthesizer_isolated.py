@@ -160,3 +160,18 @@ def test_idle_children_are_released_and_fresh_prepared_ones_replace_them():
         assert processes.synthesize(spec).realizable  # and the next synthesis is served at once
     finally:
         processes.close()
+
+
+def test_a_child_outlives_the_thread_that_started_it():
+    """Children are started from worker threads that end; the child must stay usable (the
+    kernel's parent-death signal would kill it with its starting thread)."""
+    processes = SynthesisProcesses()
+    try:
+        starter = threading.Thread(target=lambda: processes.call('time:sleep', (0.0,)))
+        starter.start()
+        starter.join()
+        time.sleep(1.0)
+        (child,) = children_of_this_process()
+        assert processes.call('os:getpid') == child  # the same child serves the next call
+    finally:
+        processes.close()

@@ -34,7 +34,7 @@ from typing import Mapping, Sequence
 
 from respec.capabilities import CapabilityConfigError, CapabilitySystem, Literal, parse_literal
 from respec.ltl import TRUE, Formula, conj, disj, iff, implies, neg, next_, var
-from respec.naming import COMPLETED, FAILED, activation, memory
+from respec.naming import COMPLETED, FAILED, activation, did_you_mean, memory
 from respec.parsing import IntegerVariable
 from respec.spec import FORMULA_SECTIONS, GR1Specification
 from respec.state_library import StateClass, capability_outcomes
@@ -83,7 +83,8 @@ class CapabilitySpecification:
         else:
             known = sorted(n for n in {*self.memories, *self.propositions(), *self.integers} if '@' not in n)
             raise error(f'{self.system.system}: {item} names {literal.name!r}, which is no capability, memory, '
-                        f'integer or proposition of the system (known: {", ".join(known)})', item=literal.name)
+                        f'integer or proposition of the system{did_you_mean(literal.name, known)} '
+                        f'(known: {", ".join(known)})', item=literal.name)
         formula = next_(var(name)) if next_step else var(name)
         return neg(formula) if literal.negated else formula
 

@@ -53,7 +53,8 @@ from respec.components import (
 from respec.capabilities import CapabilitySystem, capability_system_of
 from respec.errors import quoted
 from respec.ltl import variables
-from respec.naming import DEFAULT_SM_OUTCOMES, FAILED, FINISHED, activation, outcome_proposition, parse_names
+from respec.naming import (DEFAULT_SM_OUTCOMES, FAILED, FINISHED, activation, did_you_mean, outcome_proposition,
+                           parse_names)
 from respec.parsing import ParseError, UnknownVariableError, parse_formula, spec_from_text_sections
 from respec.spec import (
     FORMULA_SECTIONS, PROPOSITION_SECTIONS, SECTIONS, GR1Specification, PropositionConflictError,
@@ -68,6 +69,7 @@ from ltl_specification.errors import (
     InvalidSmOutcomesError, UnknownPropositionError, UnknownSystemError,
 )
 from ltl_specification.pertinence import Pertinence, infer_pertinence
+from ltl_specification.reachability import config_file, unreachable_goal_modes
 
 SUPPORTED_SM_OUTCOMES = (DEFAULT_SM_OUTCOMES, (FINISHED,))
 
@@ -129,6 +131,7 @@ def compile_task(system: str, initial_conditions: Sequence[str] | str, goals: Se
     initial_mode = _initial_mode(abstraction, initial_conditions)
     custom_formulas = _parse_custom_ltl(custom_ltl)
     mentioned, sensors = _items_mentioned(abstraction, custom_formulas)
+    _check_goal_modes_reachable(abstraction, goals, initial_mode, config_file(system, config_dir))
 
     pertinence = infer_pertinence(abstraction, initial_mode, initial_conditions, goals, mentioned)
     parts, groups = _sub_specifications(abstraction, pertinence, initial_conditions, goals, sm_outcomes,
@@ -265,8 +268,9 @@ def _check_goals(abstraction: RobotAbstraction, goals) -> list[str]:
     for index, goal in enumerate(names):
         if abstraction.kind_of(goal) is None:
             raise UnknownPropositionError(
-                f'unknown goal {quoted(goal)}: not an action or control mode of {abstraction.system} '
-                f'(known: {", ".join(abstraction.items())})', item=goal)
+                f'unknown goal {quoted(goal)}: not an action or control mode of {abstraction.system}'
+                f'{did_you_mean(goal, abstraction.items())} (known: {", ".join(abstraction.items())})',
+                item=goal)
         if goal in names[:index]:
             raise InvalidGoalsError(f'goal {quoted(goal)} is given twice', item=goal)
     return names
@@ -278,8 +282,20 @@ def _check_initial_conditions(abstraction: RobotAbstraction, initial_conditions)
         if abstraction.kind_of(name) is None:
             raise UnknownPropositionError(
                 f'unknown initial condition {quoted(name)}: not an action or control mode of '
-                f'{abstraction.system} (known: {", ".join(abstraction.items())})', item=name)
+                f'{abstraction.system}{did_you_mean(name, abstraction.items())} '
+                f'(known: {", ".join(abstraction.items())})', item=name)
     return list(dict.fromkeys(names))
+
+
+def _check_goal_modes_reachable(abstraction: RobotAbstraction, goals: list[str], initial_mode: str | None,
+                                where: str) -> None:
+    """A goal whose mode no route from the initial mode reaches, in the sentence every channel
+    shows (the one the GUI's form and the pre-check use, naming the missing transition)."""
+    if initial_mode is None:
+        return
+    unreachable = unreachable_goal_modes(abstraction, goals, initial_mode, strict_order=False, where=where)
+    if unreachable:
+        raise InvalidGoalsError(unreachable[0].sentence, item=unreachable[0].item)
 
 
 def _initial_mode(abstraction: RobotAbstraction, initial_conditions: list[str]) -> str | None:
@@ -357,7 +373,8 @@ def _check_custom_scopes(spec: GR1Specification, custom_ltl) -> None:
         spec_from_text_sections(sections)
     except UnknownVariableError as error:
         raise UnknownPropositionError(
-            f'custom LTL names unknown proposition {quoted(error.token)} ({error}); '
+            f'custom LTL names unknown proposition {quoted(error.token)} ({error})'
+            f'{did_you_mean(error.token, spec.propositions())}; '
             f'the task defines: {", ".join(spec.propositions())}', item=error.token) from error
     except ParseError as error:
         raise InvalidFormulaError(f'custom LTL: {error}', item=_custom_entry(custom_ltl, error)) from error

@@ -20,33 +20,21 @@ from __future__ import annotations
 import itertools
 import threading
 from dataclasses import asdict, dataclass, field
-from pathlib import Path
 
 from respec.abstraction import RobotAbstraction
 from respec.naming import DEFAULT_SM_OUTCOMES, activation, memory, outcome_proposition
 from respec.components import (SOURCE_ACTIONS, SOURCE_CONTROL_MODES, SOURCE_CUSTOM, SOURCE_GOALS,
                                SOURCE_INITIAL_CONDITIONS, SOURCE_SM_OUTCOMES, FormulaGroup)
 from respec.ltl import Formula, evaluate, mentions_next, to_infix, variables
-from respec.systems import system_config_path
 from ltl_synthesizer.errors import SynthesisCancelled
 from ltl_synthesizer.unrealizable_core import environment_play, unrealizable_core
 
 from ltl_specification.compiler import CompiledSpecification, compile_task, load_task_abstraction
-from ltl_specification.pertinence import mode_distances
+from ltl_specification.reachability import Finding, config_file, modes_needed_by, unreachable_goal_modes
 
 PLAY_LENGTH = 8
 # Custom formulas are checked by enumerating their variables' values: at most this many.
 MAX_ENUMERATED_VARIABLES = 14
-
-
-@dataclass(frozen=True)
-class Finding:
-    """One impossible part of a request, found before synthesis."""
-
-    sentence: str
-    equation: str      # the paper equation whose formulas make it impossible
-    config_item: str   # the configuration entry or request field to change
-    item: str          # the goal, mode, action or custom formula concerned
 
 
 @dataclass
@@ -102,12 +90,6 @@ class Diagnosis:
 
 # --- pre-check -------------------------------------------------------------------------------
 
-def config_file(system: str, config_dir=None) -> str:
-    """The configuration file as users know it, e.g. 'config/atlas.yaml'."""
-    path = Path(system_config_path(system, config_dir))
-    return f'{path.parent.name}/{path.name}'
-
-
 def precheck(spec: CompiledSpecification, config_dir=None) -> list[Finding]:
     """Impossible requests that the abstraction and the request alone reveal (see module doc)."""
     provenance = spec.provenance
@@ -115,20 +97,12 @@ def precheck(spec: CompiledSpecification, config_dir=None) -> list[Finding]:
     where = config_file(provenance.system, config_dir)
     findings = []
     if provenance.pertinence.initial_mode is not None:
-        findings += _unreachable_goal_modes(abstraction, provenance.goals, provenance.pertinence.initial_mode,
+        findings += unreachable_goal_modes(abstraction, provenance.goals, provenance.pertinence.initial_mode,
                                             provenance.strict_order, where)
     custom = [g for g in provenance.groups if g.source == SOURCE_CUSTOM]
     findings += _forbidden_activations(custom, provenance)
     findings += _contradictory_custom_ltl(custom, provenance.groups)
     return findings
-
-
-def modes_needed_by(abstraction: RobotAbstraction, item: str) -> list[str]:
-    """The control modes the robot must be in to achieve ``item``: the mode itself, or the
-    action's mode preconditions (action preconditions persist once completed, modes do not)."""
-    if abstraction.kind_of(item) == 'control_mode':
-        return [item]
-    return [p for p in abstraction.actions.get(item, ()) if abstraction.kind_of(p) == 'control_mode']
 
 
 def goal_findings(system: str, initial_conditions, goals, strict_order: bool = True,
@@ -143,7 +117,7 @@ def goal_findings(system: str, initial_conditions, goals, strict_order: bool = T
     if initial_mode is None:
         return []
     known = [g for g in goals if abstraction.kind_of(g) is not None]
-    return _unreachable_goal_modes(abstraction, known, initial_mode, strict_order, config_file(system, config_dir))
+    return unreachable_goal_modes(abstraction, known, initial_mode, strict_order, config_file(system, config_dir))
 
 
 def impossible_next_goals(system: str, initial_conditions, goals, strict_order: bool = True,
@@ -159,38 +133,6 @@ def impossible_next_goals(system: str, initial_conditions, goals, strict_order: 
         if last:
             impossible[candidate] = last[0].sentence
     return impossible
-
-
-def _unreachable_goal_modes(abstraction: RobotAbstraction, goals, initial_mode: str, strict_order: bool,
-                            where: str) -> list[Finding]:
-    """Eq. (9) only allows the configured mode changes, so every goal's mode must be reachable
-    from the initial mode; with eq. (20) goal i counts only after goal i-1, so it must be
-    reachable from the mode the previous goal left the robot in."""
-    findings = []
-    mode, reason = initial_mode, f'the robot starts in {initial_mode}'
-    for number, goal in enumerate(goals, start=1):
-        for needed in modes_needed_by(abstraction, goal):
-            if needed not in mode_distances(abstraction.control_modes, mode):
-                findings.append(Finding(
-                    _unreachable_sentence(abstraction, number, goal, needed, mode, reason, where),
-                    '(9)', f'control_modes.{mode} in {where}', goal))
-            if not strict_order:
-                continue
-            mode = needed
-            reason = (f'after goal {number} ({goal}) the robot is in {needed}' if needed == goal else
-                      f'goal {number} ({goal}) needs the robot in {needed}')
-    return findings
-
-
-def _unreachable_sentence(abstraction: RobotAbstraction, number: int, goal: str, needed: str, mode: str,
-                          reason: str, where: str) -> str:
-    what = f'goal {number} ({goal})' + ('' if needed == goal else f', which needs the robot in {needed},')
-    adjacent = ', '.join(abstraction.control_modes[mode]) or 'no other mode'
-    reachable = [m for m in mode_distances(abstraction.control_modes, mode) if m != mode]
-    beyond = ('' if set(reachable) <= {*abstraction.control_modes[mode]} else
-              f'; no mode reachable from {mode} ({", ".join(reachable)}) changes to {needed} either')
-    return (f'{what[0].upper()}{what[1:]} can never be achieved: {reason}, and {mode} -> {needed} '
-            f'is not a transition in {where} (from {mode} the robot can only change to {adjacent}{beyond}).')
 
 
 def _forbidden_activations(custom: list[FormulaGroup], provenance) -> list[Finding]:

@@ -8,6 +8,7 @@ machine's outcomes (by default ``finished`` and ``failed``).
 
 from __future__ import annotations
 
+import difflib
 import re
 
 ACTIVATION_SUFFIX = '_a'
@@ -67,3 +68,9 @@ def parse_names(text) -> list[str]:
     if isinstance(text, (list, tuple)):
         text = ','.join(text)
     return [name for name in _SEPARATORS.split(_DECORATION.sub(' ', text or '')) if name]
+
+
+def did_you_mean(name: str, known) -> str:
+    """``'; did you mean look_down?'`` for a misspelled ``name`` close to one of ``known``, else ''."""
+    close = difflib.get_close_matches(name, list(known), n=2, cutoff=0.7)
+    return f'; did you mean {" or ".join(close)}?' if close else ''

@@ -92,7 +92,8 @@ def test_unreachable_mode_goal_is_rejected():
     with pytest.raises(InvalidGoalsError) as caught:
         compile_task('atlas', ['stand'], ['stand_prep'])
     assert caught.value.item == 'stand_prep' and caught.value.code == 'INVALID_GOALS'
-    assert 'cannot be reached' in str(caught.value)
+    assert 'stand -> stand_prep is not a transition in config/atlas.yaml' in str(caught.value)
+    assert 'can only change to manipulate, step, walk' in str(caught.value)
 
 
 def test_shortest_paths_leave_detours_out():
@@ -372,3 +373,16 @@ def test_every_task_is_well_formed_and_deterministic(goals, strict, retry):
     assert 'stand_prep' in p.modes and set(goals) <= set(p.modes) | set(p.actions)
     again = compile_task('atlas', ['stand_prep'], goals, sm_outcomes=sm_outcomes, strict_order=strict)
     assert again.to_slugsin() == spec.to_slugsin()
+
+
+def test_misspelled_goal_and_initial_condition_suggest_the_close_name():
+    with pytest.raises(UnknownPropositionError) as caught:
+        compile_task('atlas', ['stand'], ['look_dwon'])
+    assert caught.value.code == 'UNKNOWN_PROPOSITION' and caught.value.item == 'look_dwon'
+    assert 'did you mean look_down?' in str(caught.value)
+    with pytest.raises(UnknownPropositionError) as caught:
+        compile_task('atlas', ['stnad'], ['look_down'])
+    assert 'did you mean stand?' in str(caught.value)
+    with pytest.raises(UnknownPropositionError) as caught:
+        compile_task('atlas', ['stand'], ['xyzzy'])
+    assert 'did you mean' not in str(caught.value)

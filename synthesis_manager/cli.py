@@ -31,13 +31,25 @@ SUBCOMMANDS = {
 }
 
 
+class HelpFormatter(argparse.RawDescriptionHelpFormatter):
+    """Every option's help ends with its default (unless it says it already, or has none)."""
+
+    def _get_help_string(self, action):
+        text = action.help or ''
+        if action.option_strings and '%(default)' not in text and '(default' not in text \
+                and action.default not in (None, False, '', [], argparse.SUPPRESS):
+            text += ' (default: %(default)s)'
+        return text
+
+
 def build_parser(only: str | None = None) -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog='behavior-synthesis',
         description='Reactive high-level behavior synthesis: goals -> GR(1) LTL -> FlexBE state machine.')
     subparsers = parser.add_subparsers(dest='command', metavar='COMMAND')
     for name, (module_name, help_text) in SUBCOMMANDS.items():
-        subparser = subparsers.add_parser(name, help=help_text, description=help_text)
+        subparser = subparsers.add_parser(name, help=help_text, description=help_text,
+                                          formatter_class=HelpFormatter)
         if only in (None, name):
             module = importlib.import_module(module_name)
             module.add_arguments(subparser)
@@ -54,6 +66,10 @@ def main(argv: list[str] | None = None) -> int:
     if not getattr(args, 'run', None):
         parser.print_help()
         return 0 if not argv or '-h' in argv or '--help' in argv else 2
+    if getattr(args, 'goals', '') is None:  # a command of the suite's task (send-goal, demo, execute, ...)
+        from synthesis_manager.send_goal import use_demo_goals_unless_given
+
+        use_demo_goals_unless_given(args, args.command)
     with stop_signals_interrupt() as received:
         try:
             return args.run(args)

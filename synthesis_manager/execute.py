@@ -61,9 +61,6 @@ EXIT_STATUS_HELP = __doc__[__doc__.index('Exit status:'):]
 
 
 def add_arguments(parser):
-    import argparse
-
-    parser.formatter_class = argparse.RawDescriptionHelpFormatter
     parser.epilog = EXIT_STATUS_HELP
     add_goal_arguments(parser, with_options=False)
     parser.set_defaults(name='execute')
@@ -83,6 +80,8 @@ def add_arguments(parser):
     group.add_argument('--engine', choices=('ours', 'flexbe'), default='ours',
                        help='who runs the state machine: our fast executive (default) or the real FlexBE '
                             'engine (flexbe_core, e.g. from `make flexbe`; implies --ros-sim)')
+    group.add_argument('--verbose', action='store_true',
+                       help="with --engine flexbe: show flexbe_core's INFO log lines and progress notes")
     group.add_argument('--ros-sim', action='store_true',
                        help='run the simulator as the atlas_sim node and drive it over ROS')
     group.add_argument('--speed', type=float, default=10.0,
@@ -270,7 +269,7 @@ def _execute(args, outcome, robot, simulator, goals, report, log, sim_node, reco
 
         run_machine = lambda _tick: run_on_flexbe(  # noqa: E731
             outcome.states, simulator, sim_node.lock, domain_id, args.system, args.config_dir or None,
-            max_wall_time=args.max_robot_time * 10 + 60)
+            max_wall_time=args.max_robot_time * 10 + 60, verbose=args.verbose)
     try:
         run = run_and_check(outcome.states, robot, simulator, args.system,
                             spec_from_text_sections(outcome.ltl_specification), goals,

@@ -19,12 +19,17 @@ from synthesis_manager.ros.harness import RosHarness, environment_domain_id
 from synthesis_manager.summary import spec_size, state_machine_tree
 
 
+# The paper's task, which a command runs when no --goals are given (and says so).
+DEMO_GOALS = 'look_down,pickup_object'
+
+
 def add_goal_arguments(parser, with_options: bool = True):
     """The task description shared by send-goal, demo and execute."""
     parser.add_argument('--system', default='atlas', help='robot system (a config/<system>.yaml)')
     parser.add_argument('--initial-conditions', default='stand_prep',
                         help='comma-separated initial conditions')
-    parser.add_argument('--goals', default='look_down,pickup_object', help='comma-separated goals, in order')
+    parser.add_argument('--goals', help='comma-separated goals, in order (default: the paper\'s demo task, '
+                        f'{DEMO_GOALS}, which is said on stderr)')
     parser.add_argument('--sm-outcomes', default='finished,failed',
                         help='state machine outcomes: finished,failed or finished (retry on failure)')
     parser.add_argument('--unordered', action='store_true', help='goals may be achieved in any order')
@@ -45,6 +50,16 @@ def add_arguments(parser):
     parser.add_argument('--timeout', type=float, default=120.0, help='seconds to wait for the result')
     parser.add_argument('--json', action='store_true', help='print the result as one JSON object')
     parser.add_argument('-o', '--output', help='also write the JSON result to this file')
+
+
+def use_demo_goals_unless_given(args, command: str, stream=sys.stderr) -> None:
+    """No --goals: the paper's demo task, said once so that nobody wonders where it came from."""
+    if args.goals is not None:
+        return
+    args.goals = DEMO_GOALS
+    if command != 'demo' and not getattr(args, 'synthesis_only', None):
+        print(f'{command}: no --goals given: using the demo task --initial-conditions {args.initial_conditions} '
+              f'--goals {DEMO_GOALS}', file=stream)
 
 
 def goal_from_args(args):
@@ -76,6 +91,7 @@ def read_spec_file(path: str) -> dict:
     return parse_structuredslugs(text, filename=path).to_text_sections()
 
 
+SERVER_WAIT = 10.0  # seconds to wait for the action server to appear
 # Seconds an interrupted send-goal waits for its cancelled goal's result (it exits within 3 s).
 CANCEL_GRACE = 2.0
 
@@ -118,11 +134,12 @@ def run(args) -> int:
         print(f'send-goal: cannot read the request: {error}', file=sys.stderr)
         return 2
 
+    print(f'send-goal: waiting for /{args.action}…', file=sys.stderr, flush=True)
     with RosHarness(domain_id=environment_domain_id()) as ros:
         client = SynthesisClient(ros.add_node(Node, 'behavior_synthesis_client'), args.action)
-        if not client.wait_for_server(timeout=10.0):
-            print(f'send-goal: no /{args.action} action server (start one with '
-                  '`behavior-synthesis serve`)', file=sys.stderr)
+        if not client.wait_for_server(timeout=SERVER_WAIT):
+            print(f'send-goal: no /{args.action} action server after {SERVER_WAIT:g} s (start one with '
+                  '`behavior-synthesis serve` or `behavior-synthesis gui`)', file=sys.stderr)
             return 1
         progress = None if args.json else ProgressBar()
         cancel = threading.Event()

@@ -159,3 +159,27 @@ def test_mobile_manipulator_tasks_on_the_flexbe_engine(ros, goals):
                         max_wall_time=120.0)
     assert run.outcome == 'finished' and run.trace.steps[-1].state == f'/{goals[-1]}'
     assert check_trace(run.trace, spec, goals=goals).ok
+
+
+def test_execute_on_the_flexbe_engine_is_quiet_unless_verbose():
+    """flexbe_core logs ~100 INFO lines a run: shown with --verbose only; nothing else leaks out
+    (no 'exception was never retrieved' from callbacks that failed as the nodes went down)."""
+    import os
+    import re
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    command = [str(Path(sys.executable).parent / 'behavior-synthesis'), 'execute', '--engine', 'flexbe',
+               '--speed', '20', '--initial-conditions', 'stand_prep', '--goals', 'look_down,pickup_object']
+    quiet = subprocess.run(command, capture_output=True, text=True, timeout=300, env=dict(os.environ))
+    assert quiet.returncode == 0, quiet.stderr[-2000:]
+    assert 'outcome: finished' in quiet.stdout
+    lines = [line for line in quiet.stderr.splitlines() if line.strip()]
+    assert all(re.match(r'\[[#.]{30}\] +\d+% ', line) for line in lines), quiet.stderr  # the progress bar only
+    assert '100% Generated a state machine' in lines[-1]
+    verbose = subprocess.run([*command, '--verbose'], capture_output=True, text=True, timeout=300,
+                             env=dict(os.environ))
+    assert verbose.returncode == 0, verbose.stderr[-2000:]
+    assert len([line for line in verbose.stderr.splitlines() if '[INFO]' in line and '[flexbe_onboard]' in line]) > 20
+    assert 'never retrieved' not in verbose.stderr

@@ -79,6 +79,19 @@ def test_send_goal_fails_with_the_code_and_message(served):
     assert result.returncode == 1
     outcome = json.loads(result.stdout)
     assert outcome['error_name'] == 'UNKNOWN_PROPOSITION' and 'levitate' in outcome['message']
+    assert 'did you mean' not in outcome['message']  # nothing close to "levitate"
+    misspelled = send_goal(served, '--goals', 'look_dwon')
+    assert misspelled.returncode == 1
+    assert "unknown goal 'look_dwon': not an action or control mode of atlas; did you mean look_down?" \
+        in misspelled.stdout
+
+
+def test_send_goal_gives_the_sentence_naming_the_missing_transition(served):
+    result = send_goal(served, '--initial-conditions', 'stand', '--goals', 'look_down,stand_prep')
+    assert result.returncode == 1 and 'result: INVALID_GOALS' in result.stdout
+    assert ('Goal 2 (stand_prep) can never be achieved: the robot starts in stand, and stand -> '
+            'stand_prep is not a transition in config/atlas.yaml (from stand the robot can only change to '
+            'manipulate, step, walk).') in result.stdout
 
 
 def test_ctrl_c_cancels_the_goal(served, tmp_path):
@@ -95,15 +108,37 @@ def test_ctrl_c_cancels_the_goal(served, tmp_path):
     assert json.loads(stdout)['error_name'] == 'PREEMPTED'
 
 
-def test_send_goal_without_a_server_says_so():
+def test_send_goal_without_a_server_says_what_it_waits_for_at_once_and_that_it_uses_the_demo_task():
     from synthesis_manager.ros.harness import reserve_domain_id
 
     with reserve_domain_id() as domain:
         environment = prepare_ros_environment(domain, environ=dict(os.environ))
-        result = subprocess.run(CLI + ['send-goal'], env=environment, capture_output=True, text=True,
-                                timeout=60)
-    assert result.returncode == 1
-    assert 'no /behavior_synthesis action server' in result.stderr
+        started = time.monotonic()
+        process = subprocess.Popen(CLI + ['send-goal'], env=environment, stdout=subprocess.PIPE,
+                                   stderr=subprocess.PIPE, text=True)
+        first_lines = [process.stderr.readline(), process.stderr.readline()]
+        said_within = time.monotonic() - started
+        rest = process.stderr.read()
+        assert process.wait(60) == 1
+    assert first_lines == ['send-goal: no --goals given: using the demo task --initial-conditions stand_prep '
+                           '--goals look_down,pickup_object\n', 'send-goal: waiting for /behavior_synthesis…\n']
+    assert said_within < 5.0  # at once (the interpreter and rclpy start), not after the 10 s wait
+    assert 'no /behavior_synthesis action server after 10 s (start one with `behavior-synthesis serve`' in rest
+
+
+@pytest.mark.parametrize('command, defaults', [
+    ('send-goal', ['(default: atlas)', '(default: stand_prep)', '(default: finished,failed)',
+                   '(default: 120.0)', "(default: the paper's demo task, look_down,pickup_object"]),
+    ('execute', ['(default: atlas)', '(default: 10.0)', '(default: 300.0)',
+                 '--verbose', 'Exit status:']),
+    ('gui', ['(default 127.0.0.1: this machine only)', '(default: 600.0)']),
+])
+def test_help_shows_the_defaults(command, defaults):
+    result = subprocess.run(CLI + [command, '--help'], capture_output=True, text=True, timeout=60)
+    assert result.returncode == 0
+    text = ' '.join(result.stdout.split())  # argparse wraps lines
+    for default in defaults:
+        assert default in text, (default, result.stdout)
 
 
 def test_demo_writes_every_artifact(tmp_path):

@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import contextlib
 import importlib.util
+import os
 import sys
 import tempfile
 import threading
@@ -143,12 +144,15 @@ def reset_flexbe_proxies(executor=None, node=None) -> None:
 
 def run_on_flexbe(states, simulator, simulator_lock, domain_id: int, system: str = 'atlas', config_dir=None,
                   behavior_name: str = 'Synthesized Behavior', autonomy: int = FULL_AUTONOMY,
-                  max_wall_time: float = 600.0):
+                  max_wall_time: float = 600.0, verbose: bool = False):
     """Run ``states`` (StateInstantiation objects or dicts) on FlexBE; returns an ExecutionResult.
 
     The simulator node must be running on ``domain_id`` around ``simulator``. Raises
     ExecutionLimitError (with the partial trace) if no outcome came within ``max_wall_time``.
+    flexbe_core's INFO log lines and progress notes (about a hundred per run) are shown on
+    stderr only when ``verbose``; its warnings and errors always are.
     """
+    from rclpy.logging import LoggingSeverity
     from rclpy.node import Node
 
     from synthesis_manager.ros.harness import RosHarness
@@ -157,20 +161,25 @@ def run_on_flexbe(states, simulator, simulator_lock, domain_id: int, system: str
     config = load_flexbe_config(system, config_dir)
     package = behavior_package(states, config, behavior_name, date=time.strftime('%a %b %d %Y'))
     recorder = EngineTraceRecorder(states, simulator, system, config_dir, simulator_lock)
+    notes = sys.stderr if verbose else open(os.devnull, 'w')  # noqa: SIM115 - closed below
     try:  # flexbe_core prints progress notes: keep them off stdout, which is the command's output
-        with contextlib.redirect_stdout(sys.stderr), tempfile.TemporaryDirectory(prefix='flexbe_behavior_') as directory, \
+        with contextlib.redirect_stdout(notes), tempfile.TemporaryDirectory(prefix='flexbe_behavior_') as directory, \
                 RosHarness(domain_id=domain_id, default_context=True) as ros:
             behavior_class, checksum = load_behavior_class(package, Path(directory))
             requests = input_request_capabilities(config)
             SimulatedOperator(ros.add_node(Node, 'simulated_operator'), requests,
                               answers_by_request_type(simulator.settings, requests))
             node = ros.add_node(Node, 'flexbe_onboard')
+            if not verbose:
+                node.get_logger().set_level(LoggingSeverity.WARN)
             try:
                 outcome = _execute(behavior_class(node), checksum, autonomy, recorder, max_wall_time)
             finally:
                 reset_flexbe_proxies(ros.executor, node)
     finally:
         recorder.close()
+        if notes is not sys.stderr:
+            notes.close()
     result = recorder.result()
     if outcome == PREEMPTED or result.outcome is None:
         raise ExecutionLimitError(f'no SM outcome within {max_wall_time:g} s on the FlexBE engine '

@@ -100,9 +100,20 @@ class RosHarness:
             else:
                 self.context.try_shutdown()
             self._thread.join(timeout=5.0)
+            retrieve_teardown_exceptions(self.executor)
         finally:
             self._stack.close()
         return False
+
+
+def retrieve_teardown_exceptions(executor) -> None:
+    """Take the exceptions of callbacks that failed as the executor stopped (typically "cannot use
+    Destroyable", or a flexbe_core proxy already torn down). rclpy fetches a callback's exception
+    on its next spin; with no next spin it prints 'The following exception was never retrieved'
+    when the callback is garbage collected, long after and with no context."""
+    for handler in list(getattr(executor, '_futures', ())):  # rclpy keeps no public list
+        if handler.done():
+            handler.exception()
 
 
 def wait_for(future, timeout: float = 10.0):

@@ -44,9 +44,52 @@ def test_dot_merges_parallel_transitions_into_one_outcome_cell_and_arrow(concurr
     assert pregrasp_pose.transitions.count('failed') == 2  # 'failed' and 'not_available'
     assert '>failed, not_available<' in dot
     arrows = [line for line in dot.splitlines() if line.startswith('  "state:pregrasp_pose":')]
-    assert arrows == ['  "state:pregrasp_pose":o0:s -> "outcome:finished" [id="edge:pregrasp_pose->finished"];',
+    # coloured by autonomy as in the FlexBE editor (done: Low, the failures: Off), failures dashed
+    assert arrows == ['  "state:pregrasp_pose":o0:s -> "outcome:finished" [id="edge:pregrasp_pose->finished", '
+                      'class="autonomy-low", color="#5466d8"];',
                       '  "state:pregrasp_pose":o1:s -> "outcome:failed" [id="edge:pregrasp_pose->failed", '
-                      'color="#c62828", style=dashed];']
+                      'class="autonomy-off", color="#7d7d70", style=dashed];']
+    assert pregrasp_pose.autonomy == [1, 0, 0]
+
+
+TWELVE_GOALS = ['look_down', 'approach_object', 'pregrasp', 'grasp_object', 'pickup_object',
+                'footstep_execution', 'object_template', 'pregrasp_pose', 'footstep_plan', 'target_pose',
+                'pregrasp_plan', 'footstep_goal']
+
+
+@pytest.fixture(scope='module')
+def twelve_goals():
+    from ltl_specification import compile_task
+    from ltl_synthesizer import synthesize
+    from respec.automaton import automaton_from_strategy
+
+    spec = compile_task('atlas', ['stand_prep'], TWELVE_GOALS)
+    automaton = automaton_from_strategy(synthesize(spec).strategy, spec)
+    return generate_state_machine(automaton, 'atlas', initial_conditions=['stand_prep'])
+
+
+def test_a_long_machine_wraps_its_main_path_into_columns_with_a_failure_rail(twelve_goals, tmp_path):
+    import re
+    import xml.etree.ElementTree as ET
+
+    dot = to_dot(twelve_goals)
+    top = [s for s in twelve_goals if s.parent_path == '/' and s.state_class != ':OUTCOME']
+    assert len(top) > export.WRAP_AFTER
+    columns = export._grid(top, twelve_goals[0].initial_state_name)
+    assert len(columns) >= 3 and columns[0][0] == twelve_goals[0].initial_state_name
+    assert sorted(sum(columns, [])) == sorted(s.name for s in top)  # every state once
+    # one failure outcome per column, no dashed arrow funnelling into one node
+    failed_nodes = re.findall(r'^    "(outcome:failed(?::\d+)?)" \[', dot, flags=re.M)
+    assert failed_nodes == ['outcome:failed'] + [f'outcome:failed:{c}' for c in range(1, len(columns))]
+    assert 'style=dashed' not in dot and '-> "outcome:failed' not in dot.split('{ rank=sink;')[0]
+    assert '>aborted,<BR/>no_connection,<BR/>data_error<' in dot  # long outcome cells wrap
+    # the path goes on in the next column through a connector, not an arrow around the grid
+    for left, right in zip(columns, columns[1:]):
+        assert f'id="continue:{left[-1]}->{right[0]}"' in dot and f'label="→ {right[0]}"' in dot
+    # laid out wider than tall, about a page: readable at Fit on a desktop screen
+    svg = ET.parse(render(dot, tmp_path / 'twelve.svg')).getroot()
+    _, _, width, height = (float(v) for v in svg.get('viewBox').split())
+    assert width < 1100 and height < 900 and width > height, (width, height)
 
 
 def test_dot_labels_behaviours_and_escapes_quotes():

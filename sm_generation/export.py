@@ -96,12 +96,14 @@ def to_dot(states: list[StateInstantiation]) -> str:
              '  graph [fontname="Helvetica", bgcolor="transparent"];',
              '  node [shape=plain, fontname="Helvetica", fontsize=14];',
              '  edge [fontname="Helvetica", fontsize=12, color="#4a5560", arrowsize=0.8];']
+    column_of = {state: index for index, column in enumerate(columns) for state in column}
     for state in top:
         failing = _failing_groups(state, names)
         label = (_container_label(state, inner[state.state_path], failing) if inner[state.state_path] else
                  _state_label(state, failing))
+        css = f'state column-{column_of[state.name]}' if columns else 'state'  # its failure outcome's copy
         lines.append(f'  {_quote("state:" + state.name)} [id={_quote("state:" + state.name)}, '
-                     f'class="state", label=<{label}>];')
+                     f'class="{css}", label=<{label}>];')
     failure_outcomes = [o for o in machine_outcomes if o != FINISHED]
     copies = {o: [_outcome_node(o, c) for c in range(len(columns))] for o in failure_outcomes} if columns else {}
     lines.append('  { rank=sink;')
@@ -112,10 +114,8 @@ def to_dot(states: list[StateInstantiation]) -> str:
                          f'label={_quote(outcome)}, shape=box, style="rounded,filled,bold", color="{colour}", '
                          f'fillcolor="{colour}22", margin="0.25,0.08"];')
     lines.append('  }')
-    column_of: dict[str, int] = {}
     if columns:
         lines += _grid_lines(columns, copies, FINISHED in machine_outcomes)
-        column_of = {state: index for index, column in enumerate(columns) for state in column}
     if root and root.initial_state_name:
         lines.append('  "start" [id="start", shape=circle, style=filled, fillcolor="#4a5560", label="", width=0.18];')
         lines.append(f'  "start" -> {_quote("state:" + root.initial_state_name)}:n [id="edge:start", label=" initial"];')

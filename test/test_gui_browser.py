@@ -67,8 +67,11 @@ def page(gui, browser_context):
 def choose_task(page, goals, initial_conditions=('stand_prep',)):
     page.select_option('#system', 'atlas')
     page.wait_for_selector('#initial-actions input[value="look_down"]')
-    for box in page.locator('input[name="initial-condition"]').all():
+    for box in page.locator('input[name="initial-condition"]').all():  # actions already completed
         box.set_checked(box.get_attribute('value') in initial_conditions)
+    for mode in page.locator('input[name="initial-mode"]').all():  # the one control mode (radio buttons)
+        if mode.get_attribute('value') in initial_conditions:
+            mode.check()
     for goal in goals:
         page.select_option('#goal-choice', goal)
         page.click('#add-goal')
@@ -80,7 +83,7 @@ def result_code(page, timeout=120_000):
 
 
 def test_paper_task_shows_progress_draws_the_machine_and_downloads_yaml(page, tmp_path):
-    assert page.is_checked('input[name="initial-condition"][value="stand_prep"]')  # the default
+    assert page.is_checked('input[name="initial-mode"][value="stand_prep"]')  # the default
     choose_task(page, ['look_down', 'pickup_object'])
     assert page.locator('#goals li').evaluate_all('items => items.map(i => i.dataset.goal)') == [
         'look_down', 'pickup_object']
@@ -113,6 +116,7 @@ def test_paper_task_shows_progress_draws_the_machine_and_downloads_yaml(page, tm
         page.click('a[data-artifact="flexbe_behavior.zip"]')
     assert download_info.value.suggested_filename.endswith('flexbe_behavior.zip')
     assert 'FlexBE behavior package' in page.inner_text('a[data-artifact="flexbe_behavior.zip"]')
+    assert page.locator('a[data-artifact="flexbe_behavior.zip"]').count() == 1  # offered once
 
     picture = tmp_path / 'gui-result.png'
     page.screenshot(path=str(picture), full_page=True)
@@ -135,18 +139,38 @@ def test_goals_can_be_reordered_and_removed(page):
 
 
 def test_a_bad_request_shows_the_pipeline_message(page):
-    choose_task(page, ['look_down'], initial_conditions=('stand_prep', 'walk'))
+    # the banner gives the same sentence as the form's goal check, the CLI and the action result
+    choose_task(page, ['look_down', 'stand_prep'], initial_conditions=('stand',))
+    page.check('#unordered')  # in any order, so the pre-check does not stop it: the compiler does
+    warning = page.locator('#goals li[data-goal="stand_prep"] .goal-warning')
+    page.wait_for_function("document.querySelector('#goals li[data-goal=\"stand_prep\"] .goal-warning')"
+                           ".textContent.length > 0")
     page.click('#synthesize')
-    assert result_code(page) == 'INVALID_INITIAL_CONDITIONS'
-    assert 'walk' in page.inner_text('#result-message')
+    assert result_code(page) == 'INVALID_GOALS'
+    sentence = page.inner_text('#result-message')
+    assert ('Goal 2 (stand_prep) can never be achieved: the robot starts in stand, and stand -> stand_prep is not a '
+            'transition in config/atlas.yaml (from stand the robot can only change to manipulate, step, walk).'
+            ) in sentence
+    assert warning.inner_text() in sentence
     assert page.locator('#result-banner.bad').count() == 1
 
 
-def test_a_request_without_goals_is_refused_with_a_message(page):
+def test_one_initial_control_mode_only_radio_buttons(page):
+    choose_task(page, ['look_down'], initial_conditions=('stand_prep',))
+    assert page.get_attribute('input[name="initial-mode"][value="walk"]', 'type') == 'radio'
+    page.check('input[name="initial-mode"][value="walk"]')
+    assert not page.is_checked('input[name="initial-mode"][value="stand_prep"]')
+    assert page.locator('input[name="initial-mode"]:checked').count() == 1
+
+
+def test_a_request_without_goals_is_refused_in_the_page_without_asking_the_server(page):
+    sent = []
+    page.on('request', lambda request: sent.append(request.url) if request.url.endswith('/api/jobs') else None)
     choose_task(page, [])
     page.click('#synthesize')
-    assert result_code(page) == 'INVALID_REQUEST'
-    assert 'at least one goal' in page.inner_text('#result-message')
+    assert 'Add at least one goal' in page.inner_text('#form-problem')
+    assert page.evaluate('document.activeElement.id') == 'goal-choice'
+    assert page.is_hidden('#result') and sent == []
     assert page.is_enabled('#synthesize')
 
 

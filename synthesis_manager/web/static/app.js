@@ -70,18 +70,21 @@ async function loadSystems() {
 
 async function loadChoices() {
   choices = await api('GET', `/api/systems/${encodeURIComponent($('system').value)}`);
-  const checkbox = (name, hint, checked) => {
-    const box = element('input', { type: 'checkbox', value: name, name: 'initial-condition' });
+  // The robot starts in one control mode (radio buttons); any actions may be completed already.
+  const choice = (type, group, name, hint, checked) => {
+    const box = element('input', { type, value: name, name: group });
     box.checked = checked;
     return element('label', { className: 'choice', title: hint }, box, ` ${name}`);
   };
   const defaults = new Set(choices.default_initial_conditions);
   $('initial-control-modes').replaceChildren(
-    element('span', { className: 'group-title', text: 'Control modes' }),
-    ...choices.control_modes.map((m) => checkbox(m.name, `next: ${m.next.join(', ') || '—'}`, defaults.has(m.name))));
+    element('span', { className: 'group-title', text: 'Control mode (one)' }),
+    ...choices.control_modes.map((m) => choice('radio', 'initial-mode', m.name, `next: ${m.next.join(', ') || '—'}`,
+      defaults.has(m.name))));
   $('initial-actions').replaceChildren(
     element('span', { className: 'group-title', text: 'Actions (already completed)' }),
-    ...choices.actions.map((a) => checkbox(a.name, `needs: ${a.preconditions.join(', ') || 'nothing'}`, false)));
+    ...choices.actions.map((a) => choice('checkbox', 'initial-condition', a.name,
+      `needs: ${a.preconditions.join(', ') || 'nothing'}`, defaults.has(a.name))));
 
   const group = (label, items, hint) => element('optgroup', { label },
     ...items.map((item) => element('option', { value: item.name, title: hint(item), text: item.name })));
@@ -153,7 +156,8 @@ function currentRequest() {
   const checked = (selector) => document.querySelector(selector).value;
   return {
     system: $('system').value,
-    initial_conditions: [...document.querySelectorAll('input[name="initial-condition"]:checked')].map((b) => b.value),
+    initial_conditions: [...document.querySelectorAll('input[name="initial-mode"]:checked, input[name="initial-condition"]:checked')]
+      .map((b) => b.value),
     goals: [...$('goals').children].map((item) => item.dataset.goal),
     sm_outcomes: checked('input[name="sm-outcomes"]:checked').split(','),
     option: checked('input[name="option"]:checked') || null,
@@ -164,13 +168,34 @@ function currentRequest() {
 
 // --- running a job -----------------------------------------------------------------------
 
+// What the form can tell before asking the server: no goals, a behavior name it would refuse.
+function requestProblem(request) {
+  if (!request.goals.length && request.option !== 'ltl_synthesis_only') {
+    return { field: 'goal-choice', message: 'Add at least one goal: pick it in the list and press “Add goal”.' };
+  }
+  const name = $('behavior-name');
+  if (!name.checkValidity()) {
+    return { field: 'behavior-name', message: `Behavior name “${name.value}”: ${$('behavior-name-hint').textContent.trim()}` };
+  }
+  return null;
+}
+
 async function synthesize(event) {
   event.preventDefault();
+  const request = currentRequest();
+  const problem = requestProblem(request);
+  $('form-problem').textContent = problem ? problem.message : '';
+  $('behavior-name-hint').classList.toggle('bad', problem !== null && problem.field === 'behavior-name');
+  if (problem) {
+    $('status').textContent = 'Not sent: see the note above.';
+    $(problem.field).focus();
+    return;
+  }
   stopFollowing();
   resetResult();
   let job;
   try {
-    job = await api('POST', '/api/jobs', currentRequest());
+    job = await api('POST', '/api/jobs', request);
   } catch (error) {
     showRequestError(error);
     return;
@@ -255,7 +280,7 @@ function showProgress(job) {
   if (job.id === shownProgress.id && job.revision < shownProgress.revision) return;
   shownProgress = { id: job.id, revision: job.revision };
   if (job.state === 'finished') $('progress').value = job.progress;
-  $('status').textContent = job.status;
+  $('status').textContent = job.state === 'finished' ? resultWord(job.status) : job.status;
   $('timeline').replaceChildren(...job.timeline.map((entry) => element('li', {},
     element('span', { className: 'time', text: formatSeconds(entry.seconds) }),
     element('span', { text: entry.status }))));
@@ -298,6 +323,12 @@ function showBanner(code, message, good) {
   $('result-details-text').textContent = details;
   const top = $('result-banner').getBoundingClientRect().top;
   if (top < 0 || top > window.innerHeight) $('result-banner').scrollIntoView({ block: 'start' });
+  $('result-banner').focus({ preventScroll: true });  // keyboard and screen-reader users land on the result
+}
+
+// One word per outcome everywhere on the page: a cancelled job is "CANCELLED" (ROS says PREEMPTED).
+function resultWord(errorName) {
+  return errorName === 'PREEMPTED' ? 'CANCELLED' : errorName;
 }
 
 function showRequestError(error) {
@@ -311,7 +342,7 @@ function showResult(job) {
   const { outcome, summary } = job;
   const message = outcome.message || (summary.succeeded ? describeSuccess(job) : '');
   const cancelled = outcome.error_name === 'PREEMPTED';
-  showBanner(cancelled ? 'CANCELLED' : outcome.error_name, message, cancelled ? null : summary.succeeded);
+  showBanner(resultWord(outcome.error_name), message, cancelled ? null : summary.succeeded);
   showSummary(summary, job.stages);
   if (job.artifacts.includes('state_machine.svg')) drawStateMachine(job);
   showDownloads(job);
@@ -321,7 +352,7 @@ function showResult(job) {
 }
 
 function describeSuccess(job) {
-  const goals = job.request.goals.join(', then ');
+  const goals = job.request.unordered ? `${job.request.goals.join(', ')} (in any order)` : job.request.goals.join(', then ');
   const from = job.request.initial_conditions.join(', ') || 'nothing';
   return `from ${from}: ${goals}`;
 }
@@ -386,9 +417,10 @@ const AUTONOMY = { 0: 'Off', 1: 'Low', 2: 'High', 3: 'Full' };
 
 function showDownloads(job) {
   const exportable = job.artifacts.includes('flexbe_behavior.zip');
-  $('export-flexbe').hidden = !exportable;
+  $('export-flexbe-offer').hidden = !exportable;  // the button and its caption, or neither
   if (exportable) $('export-flexbe').href = `/api/jobs/${job.id}/artifacts/flexbe_behavior.zip`;
-  $('downloads').replaceChildren(...job.artifacts.map((name) => element('li', {},
+  const listed = job.artifacts.filter((name) => name !== 'flexbe_behavior.zip');  // offered once, above
+  $('downloads').replaceChildren(...listed.map((name) => element('li', {},
     element('a', { href: `/api/jobs/${job.id}/artifacts/${name}`, download: '', 'data-artifact': name,
       text: job.download_labels[name] || name }))));
   $('downloads-section').hidden = job.artifacts.length === 0;
@@ -423,9 +455,13 @@ function offerSimulation(job) {
 function resetSimulation() {
   if (simulationEvents) simulationEvents.close();
   simulationEvents = null;
+  stopPlaying();
   $('simulate').disabled = false;
   $('simulation-status').textContent = '';
+  $('simulation-live').textContent = '';
   $('simulation-view').hidden = true;
+  $('robot-view').hidden = true;
+  $('graph-layout').classList.remove('simulating');
   $('simulation-steps').replaceChildren();
   $('simulation-frames').replaceChildren();
   frameList = [];
@@ -450,6 +486,8 @@ async function simulate() {
     return;
   }
   showSimulation(simulation);
+  // Follow the robot: the drawing and the robot side by side, in view.
+  $('graph-section').scrollIntoView({ block: 'start', behavior: 'instant' });
   const end = () => {
     simulationEvents = null;
     $('simulate').disabled = false;
@@ -483,7 +521,8 @@ function streamEvents(url, handlers) {
 function showSimulation(simulation) {
   const base = `/api/simulations/${simulation.id}`;
   const running = simulation.state !== 'finished';
-  let status = `Running: ${simulation.steps.length} states, robot time ${simulation.robot_time.toFixed(2)} s`;
+  let status = simulation.steps.length === 0 ? 'Starting the simulator…'
+    : `Running: ${simulation.steps.length} states, robot time ${simulation.robot_time.toFixed(2)} s`;
   let outcomeClass = '';
   if (!running) {
     status = simulation.error
@@ -494,7 +533,14 @@ function showSimulation(simulation) {
   }
   $('simulation-status').textContent = status;
   $('simulation-status').className = `status ${outcomeClass}`;
+  $('simulation-live').textContent = status;
+  $('simulation-live').className = `status ${outcomeClass}`;
   $('simulation-view').hidden = false;
+  $('robot-view').hidden = false;
+  if (!$('graph-layout').classList.contains('simulating')) {
+    $('graph-layout').classList.add('simulating');
+    StateMachineView.fit();  // the drawing just got narrower
+  }
   const outcomeCell = (step) => {
     if (!step.state_outcome) return element('td', { text: '…' });
     const ends = ['finished', 'failed'].includes(step.transition) ? ` outcome-${step.transition}` : '';
@@ -528,10 +574,12 @@ function showSimulation(simulation) {
 // Key frames: the latest one large with a caption, a scrubber over all of them, and
 // captioned thumbnails.
 let frameList = [];
+let player = null;  // the timer of the frame player
 function showFrames(base, frames) {
   if (!frames.length) return;
   const followLatest = Number($('frame-scrubber').value) >= frameList.length - 1;
-  frameList = frames.map((frame) => ({ src: `${base}/frames/${frame.index}`, caption: frameCaption(frame.label) }));
+  frameList = frames.map((frame) => ({ src: `${base}/frames/${frame.index}`, caption: frameCaption(frame.label),
+    time: frameTime(frame.label) }));
   $('frame-scrubber').max = String(frames.length - 1);
   $('simulation-frames').replaceChildren(...frameList.map((frame, index) => {
     const figure = element('figure', { 'data-frame': String(index) },
@@ -539,7 +587,30 @@ function showFrames(base, frames) {
     figure.addEventListener('click', () => showFrame(index));
     return figure;
   }));
-  showFrame(followLatest ? frames.length - 1 : Number($('frame-scrubber').value));
+  if (!player) showFrame(followLatest ? frames.length - 1 : Number($('frame-scrubber').value));
+}
+
+// Play the key frames as the run went: each stays up for the robot time until the next one.
+function playFrames() {
+  if (player) { stopPlaying(); return; }
+  if (!frameList.length) return;
+  $('play-frames').textContent = '❚❚ Pause';
+  let index = Number($('frame-scrubber').value) >= frameList.length - 1 ? 0 : Number($('frame-scrubber').value);
+  const next = () => {
+    showFrame(index);
+    if (index >= frameList.length - 1) { stopPlaying(); return; }
+    const gap = Math.max(0.05, (frameList[index + 1].time - frameList[index].time) || 0.5);
+    index += 1;
+    player = setTimeout(next, gap * 1000);
+  };
+  player = -1;
+  next();
+}
+
+function stopPlaying() {
+  if (player) clearTimeout(player);
+  player = null;
+  $('play-frames').textContent = '▶ Play';
 }
 
 function showFrame(index) {
@@ -554,6 +625,11 @@ function showFrame(index) {
 }
 
 // key frame files are named <index>_<sim time>s_<capability>_<event>
+function frameTime(label) {
+  const match = label.match(/^\d+_0*(\d+\.\d+)s_/);
+  return match ? Number(match[1]) : NaN;
+}
+
 function frameCaption(label) {
   const match = label.match(/^\d+_0*(\d+\.\d+)s_(.*)$/);
   return match ? `t = ${match[1]} s: ${match[2].replace(/_/g, ' ')}` : label.replace(/_/g, ' ');
@@ -571,7 +647,9 @@ document.addEventListener('DOMContentLoaded', () => {
   $('request-form').addEventListener('submit', synthesize);
   $('cancel').addEventListener('click', cancel);
   $('simulate').addEventListener('click', simulate);
-  $('frame-scrubber').addEventListener('input', (event) => showFrame(Number(event.target.value)));
+  $('frame-scrubber').addEventListener('input', (event) => { stopPlaying(); showFrame(Number(event.target.value)); });
+  $('play-frames').addEventListener('click', playFrames);
+  $('behavior-name').addEventListener('input', () => $('behavior-name-hint').classList.remove('bad'));
   $('initial-conditions').addEventListener('change', checkGoals);
   $('unordered').addEventListener('change', checkGoals);
   loadSystems().then(() => document.body.classList.add('ready'),

@@ -94,6 +94,11 @@ const StateMachineView = (() => {
       zoomAt(event.deltaY < 0 ? ZOOM_STEP : 1 / ZOOM_STEP, event.clientX, event.clientY);
     }, { passive: false });
     viewport.addEventListener('keydown', (event) => {
+      if ((event.key === 'Enter' || event.key === ' ') && event.target.closest && event.target.closest('g.node')) {
+        event.preventDefault();
+        select(event.target);
+        return;
+      }
       if (event.key === '+' || event.key === '=') zoomAt(ZOOM_STEP);
       else if (event.key === '-') zoomAt(1 / ZOOM_STEP);
       else if (event.key === '0') fit(false);
@@ -127,6 +132,13 @@ const StateMachineView = (() => {
     svg.setAttribute('preserveAspectRatio', 'xMinYMin meet');
     // Graphviz adds a tooltip <title> to every node and edge; the ids say enough.
     svg.querySelectorAll('g > title').forEach((title) => title.remove());
+    // States are reached with Tab and explained with Enter, as with a click.
+    svg.querySelectorAll('g.node[id^="state:"]').forEach((node) => {
+      node.setAttribute('tabindex', '0');
+      node.setAttribute('role', 'button');
+      node.setAttribute('aria-label', `state ${node.id.slice('state:'.length)}: show its details`);
+      node.addEventListener('focus', () => revealNode(node));
+    });
     viewport = element('div', { className: 'graph-viewport', tabindex: '0', 'aria-label': 'state machine drawing; drag to pan, wheel or + and - to zoom' }, svg);
     const button = (text, label, action) => {
       const b = element('button', { type: 'button', className: 'small', title: label, 'aria-label': label, text });
@@ -157,7 +169,7 @@ const StateMachineView = (() => {
       if (step.transition) {
         const edge = document.getElementById(`edge:${name}->${step.transition}`);
         if (edge) edge.classList.add('taken');
-        const outcome = document.getElementById(`outcome:${step.transition}`);
+        const outcome = outcomeBox(step.transition, name);
         if (outcome && !running && index === steps.length - 1) outcome.classList.add('ended');
       }
     });
@@ -165,9 +177,31 @@ const StateMachineView = (() => {
       const start = document.getElementById('edge:start');
       if (start) start.classList.add('taken');
     }
+    const current = svg.querySelector('g.node.active, g.node.ended');
+    if (current) revealNode(current);  // follow the robot through a machine larger than the view
+  }
+
+  // Pan a focused state into view (keyboard users cannot drag).
+  function revealNode(node) {
+    const box = node.getBoundingClientRect();
+    const area = viewport.getBoundingClientRect();
+    if (box.left >= area.left && box.right <= area.right && box.top >= area.top && box.bottom <= area.bottom) return;
+    view.x += (box.left + box.width / 2 - (area.left + area.width / 2)) / scale();
+    view.y += (box.top + box.height / 2 - (area.top + area.height / 2)) / scale();
+    apply();
+  }
+
+  // The box of machine outcome ``name`` under the column of state ``stateName`` (long machines
+  // repeat failure outcomes per column: outcome:<name>:<column>), else the only one.
+  function outcomeBox(name, stateName) {
+    const state = document.getElementById(`state:${stateName}`);
+    const column = state ? [...state.classList].find((c) => c.startsWith('column-')) : null;
+    const number = column ? Number(column.slice('column-'.length)) : 0;
+    return document.getElementById(number ? `outcome:${name}:${number}` : `outcome:${name}`)
+      || document.getElementById(`outcome:${name}`);
   }
 
   function clear() { svg = null; viewport = null; states = []; }
 
-  return { show, markRun, clear, zoomIn: () => zoomAt(ZOOM_STEP) };
+  return { show, markRun, clear, fit: (readableOnly = true) => { if (svg) fit(readableOnly); }, zoomIn: () => zoomAt(ZOOM_STEP) };
 })();

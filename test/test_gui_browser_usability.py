@@ -146,11 +146,15 @@ def test_six_goal_machine_progress_readable_drawing_details_and_one_state_count(
     assert ink >= 10, ink  # the glyphs themselves, measured on the screenshot
     shot(page, 'six-goals-zoomed')
 
-    # merged parallel edges: one arrow per target, outcomes listed together in one cell
+    # merged parallel transitions: outcomes listed together in one cell; in a machine this long
+    # the failure cell is red and the column's own 'failed' box below says where it goes (no arrow)
     node_texts = page.locator('g[id="state:approach_object"] text').all_text_contents()
     assert 'failed, aborted' in node_texts
     targets = page.locator('g.edge[id^="edge:approach_object->"]').evaluate_all('edges => edges.map(e => e.id)')
-    assert len(targets) == len(set(targets)) == 2
+    assert targets == ['edge:approach_object->target_pose']
+    failing_cell = page.locator('g[id="state:approach_object"] text', has_text='failed, aborted')
+    assert failing_cell.get_attribute('fill') == '#c62828'
+    assert page.locator('g.node[id^="outcome:failed"]').count() >= 2
 
     # clicking a state explains it like the FlexBE editor
     name = page.locator('g[id="state:pregrasp_pose"] text').first

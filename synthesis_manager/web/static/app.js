@@ -599,9 +599,10 @@ function playFrames() {
   const next = () => {
     showFrame(index);
     if (index >= frameList.length - 1) { stopPlaying(); return; }
-    const gap = Math.max(0.05, (frameList[index + 1].time - frameList[index].time) || 0.5);
+    const gap = frameList[index + 1].time - frameList[index].time;  // robot seconds (NaN: no time in the name)
+    const wait = Number.isFinite(gap) ? Math.max(0.05, gap) : 0.5;
     index += 1;
-    player = setTimeout(next, gap * 1000);
+    player = setTimeout(next, wait * 1000);
   };
   player = -1;
   next();

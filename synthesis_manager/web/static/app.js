@@ -97,8 +97,10 @@ async function loadChoices() {
 
 // Ask the server which goals cannot come next (and which chosen goals can never be
 // achieved) and say so in the picker and the list, before anything is synthesized.
+let goalChecks = 0;  // replies can overtake each other: only the newest check's is shown
 async function checkGoals() {
   const request = currentRequest();
+  const number = ++goalChecks;
   let check;
   try {
     check = await api('POST', '/api/goal-check', { system: request.system, initial_conditions: request.initial_conditions,
@@ -106,6 +108,7 @@ async function checkGoals() {
   } catch (error) {
     return;  // the synthesis itself will report what is wrong
   }
+  if (number !== goalChecks) return;
   for (const option of $('goal-choice').options) {
     const why = check.impossible_next[option.value];
     option.textContent = why ? `${option.value} (impossible here)` : option.value;

@@ -187,6 +187,9 @@ def test_cancel_a_queued_job(page, gui):
     finally:
         backend.job_gate.set()
     assert 'cancelled' in page.inner_text('#result-message')
+    # one word for it on the whole page (ROS calls it PREEMPTED)
+    page.wait_for_function("document.getElementById('status').textContent === 'CANCELLED'", timeout=10_000)
+    assert 'PREEMPTED' not in page.inner_text('#result') + page.inner_text('#request-form')
     assert page.locator('#result-banner.neutral').count() == 1
     # The job's last event may reach the timeline a moment after the result banner.
     page.wait_for_function("document.querySelector('#timeline').innerText.includes('Cancelled')", timeout=10_000)

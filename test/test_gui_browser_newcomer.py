@@ -7,30 +7,18 @@ are also written there (docs/gui-12-goals.png, docs/gui-simulation.png).
 """
 
 import os
-import time
 from pathlib import Path
 
 import pytest
 
-from test_gui_browser import browser_context, choose_task, gui_server, open_page, result_code  # noqa: F401
+from test_gui_browser import browser_context, choose_task, result_code  # noqa: F401
+from test_gui_browser_usability import gui, page  # noqa: F401 - the GUI and a 1400x900 tab
 
 TWELVE_GOALS = ['look_down', 'approach_object', 'pregrasp', 'grasp_object', 'pickup_object',
                 'footstep_execution', 'object_template', 'pregrasp_pose', 'footstep_plan', 'target_pose',
                 'pregrasp_plan', 'footstep_goal']
 DOCS_SHOTS_ENV = 'BEHAVIOR_SYNTHESIS_DOCS_SHOTS'
-WINDOW = {'width': 1400, 'height': 900}
-
-
-@pytest.fixture(scope='module')
-def gui(tmp_path_factory):
-    with gui_server(tmp_path_factory.mktemp('gui-newcomer'), synthesis_timeout=120, goal_timeout=200) as served:
-        yield served
-
-
-@pytest.fixture
-def page(gui, browser_context):  # noqa: F811
-    with open_page(browser_context, gui[0], viewport=WINDOW) as page:
-        yield page
+WINDOW = {'width': 1400, 'height': 900}  # the usability tests' tab
 
 
 def docs_shot(page, name):
@@ -193,21 +181,6 @@ def test_after_a_failure_no_export_caption_is_left_and_unordered_goals_are_not_s
     message = page.inner_text('#result-message')
     assert 'look_down, pickup_object (in any order)' in message and 'then' not in message
     assert page.is_visible('#export-flexbe') and page.locator('[data-artifact="flexbe_behavior.zip"]').count() == 1
-
-
-def test_a_cancelled_job_is_cancelled_in_the_banner_and_the_status(page, gui):
-    _, backend = gui
-    backend.job_gate.clear()
-    try:
-        choose_task(page, ['look_down'])
-        page.click('#synthesize')
-        page.wait_for_selector('#cancel:enabled')
-        page.click('#cancel')
-        assert result_code(page) == 'CANCELLED'
-    finally:
-        backend.job_gate.set()
-    page.wait_for_function("document.getElementById('status').textContent === 'CANCELLED'", timeout=10_000)
-    assert 'PREEMPTED' not in page.inner_text('#result') + page.inner_text('#request-form')
 
 
 # --- 8. FlexBE conventions -------------------------------------------------------------------------

@@ -30,7 +30,7 @@ from ltl_synthesizer.errors import SynthesisCancelled
 from ltl_synthesizer.unrealizable_core import environment_play, unrealizable_core
 
 from ltl_specification.compiler import CompiledSpecification, compile_task, load_task_abstraction
-from ltl_specification.reachability import Finding, config_file, modes_needed_by, unreachable_goal_modes
+from ltl_specification.reachability import Finding, config_file, unreachable_goal_modes
 
 PLAY_LENGTH = 8
 # Custom formulas are checked by enumerating their variables' values: at most this many.

@@ -162,3 +162,12 @@ def test_send_goal_shows_the_error_name_and_message_of_either_interface(served, 
     assert any(line.startswith('message: ') and 'levitate' in line for line in summary), result.stdout
     success = send_goal(served, '--action', action, '--system', 'system_wide', '--json')
     assert json.loads(success.stdout)['error_name'] == 'SUCCESS', success.stdout
+
+
+@pytest.mark.parametrize('script', ['ltl-compilation-node', 'ltl-synthesis-node', 'sm-generation-node',
+                                    'behavior-synthesis-server', 'atlas-sim-node'])
+def test_node_scripts_answer_help_instead_of_starting(script):
+    result = subprocess.run([str(Path(sys.executable).parent / script), '--help'], capture_output=True, text=True,
+                            timeout=30)
+    assert result.returncode == 0 and result.stdout.startswith(f'usage: {script} [--ros-args')
+    assert 'ready' not in result.stdout  # it did not start the node

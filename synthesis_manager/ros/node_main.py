@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import sys
+from pathlib import Path
 
 from synthesis_manager.ros.env import init_ros
 
@@ -63,4 +64,10 @@ def stop_executor(executor, nodes, timeout: float = 1.0):
 
 def node_main(node_factory, name: str):
     """Console-script body for a single node."""
+    own_arguments = sys.argv[1:sys.argv.index('--ros-args')] if '--ros-args' in sys.argv else sys.argv[1:]
+    if {'-h', '--help'} & set(own_arguments):  # say what it is, do not start it
+        print(f'usage: {Path(sys.argv[0]).name} [--ros-args -p NAME:=VALUE ...]\n\n'
+              f'Runs the ROS 2 node {name} until Ctrl-C (SIGINT) or SIGTERM, on $ROS_DOMAIN_ID, DDS on '
+              'loopback.\nIts parameters and their defaults: "Running the nodes" in docs/nodes.md.')
+        sys.exit(0)
     sys.exit(run_nodes(node_factory, argv=sys.argv, ready_message=f'{name} ready'))

@@ -110,6 +110,8 @@ def as_run(argv: list[str]) -> list[str]:
     first = argv[0]
     if first.startswith('.venv/bin/'):
         first = str(BIN / first[len('.venv/bin/'):])
+    elif '/' not in first and (BIN / first).exists():  # as typed in a shell where the venv is on PATH
+        first = str(BIN / first)
     return [first, *argv[1:]]
 
 

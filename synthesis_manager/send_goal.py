@@ -52,14 +52,14 @@ def add_arguments(parser):
     parser.add_argument('-o', '--output', help='also write the JSON result to this file')
 
 
-def use_demo_goals_unless_given(args, command: str, stream=sys.stderr) -> None:
+def use_demo_goals_unless_given(args, command: str, stream=None) -> None:
     """No --goals: the paper's demo task, said once so that nobody wonders where it came from."""
     if args.goals is not None:
         return
     args.goals = DEMO_GOALS
     if command != 'demo' and not getattr(args, 'synthesis_only', None):
         print(f'{command}: no --goals given: using the demo task --initial-conditions {args.initial_conditions} '
-              f'--goals {DEMO_GOALS}', file=stream)
+              f'--goals {DEMO_GOALS}', file=stream or sys.stderr)  # sys.stderr as it is now
 
 
 def goal_from_args(args):

@@ -142,6 +142,7 @@ def test_export_behavior_writes_the_package_the_editor_would(capsys, tmp_path):
     assert '<flexbe_behaviors />' in (folder / 'package.xml').read_text()
     code, output = run_cli(capsys, 'export-behavior', '--name', '9 lives', '-o', str(tmp_path))
     assert code == 2 and "'9 lives'" in output.err
+    assert 'export-behavior: no --goals given: using the demo task' in output.err  # said, not silent
 
 
 @pytest.mark.parametrize('goals', [['dock'], ['place']])

@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import argparse
 import math
+import os
 import sys
 import time
 from pathlib import Path
@@ -128,10 +129,25 @@ def _write(text: str, output: str | None) -> None:
 
 
 def _write_chunks(chunks, output: str | None) -> None:
-    """Write text pieces as they come (a large strategy is never one string in memory)."""
-    if output:
+    """Write text pieces as they come (a large strategy is never one string in memory).
+
+    A file appears only complete: the pieces go to a hidden file beside it, renamed at the end,
+    so an interrupted run (a streamed strategy is extracted while written) leaves no output.
+    A device or FIFO (``/dev/stdout``) is written directly.
+    """
+    if output and os.path.exists(output) and not os.path.isfile(output):
         with open(output, 'w') as stream:
             stream.writelines(chunks)
+    elif output:
+        folder, name = os.path.split(os.path.abspath(output))
+        partial = os.path.join(folder, f'.{name}.{os.getpid()}.partial')
+        try:
+            with open(partial, 'w') as stream:
+                stream.writelines(chunks)
+            os.replace(partial, output)
+        finally:
+            if os.path.exists(partial):
+                os.remove(partial)
     else:
         sys.stdout.writelines(chunks)
         sys.stdout.flush()

@@ -30,8 +30,8 @@ _EXPORTS = {
     'Options': 'ltl_synthesizer.symbolic', 'Interrupt': 'ltl_synthesizer.symbolic',
     'SynthesisCancelled': 'ltl_synthesizer.errors', 'SynthesisError': 'ltl_synthesizer.errors',
     'SynthesisMemoryExceeded': 'ltl_synthesizer.errors',
-    'UnknownPropositionError': 'ltl_synthesizer.errors',
-    'InvalidFormulaError': 'ltl_synthesizer.errors',
+    'UndeclaredPropositionError': 'ltl_synthesizer.errors',
+    'NotGR1FormulaError': 'ltl_synthesizer.errors',
 }
 
 __all__ = sorted(_EXPORTS)

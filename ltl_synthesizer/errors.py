@@ -11,13 +11,13 @@ class SynthesisError(CodedError):
     code = 'SYNTHESIS_FAILED'
 
 
-class UnknownPropositionError(SynthesisError):
+class UndeclaredPropositionError(SynthesisError):
     """A formula mentions a proposition that is declared neither as input nor as output."""
 
     code = 'UNKNOWN_PROPOSITION'
 
 
-class InvalidFormulaError(SynthesisError):
+class NotGR1FormulaError(SynthesisError):
     """A formula is outside the GR(1) fragment (nested next, next in an initial condition...)."""
 
     code = 'INVALID_FORMULA'

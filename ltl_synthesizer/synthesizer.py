@@ -55,7 +55,7 @@ def synthesize(spec: GR1Specification, robotics_semantics: bool = True,
     threading.Event) raises ``SynthesisCancelled`` (code PREEMPTED), ``deadline`` (a
     ``time.monotonic()`` instant) raises ``SynthesisCancelled`` (code SYNTHESIS_TIMEOUT),
     ``memory_limit`` (bytes of BDD memory, default 2 GiB) raises ``SynthesisMemoryExceeded``.
-    ``UnknownPropositionError`` / ``InvalidFormulaError`` for formulas outside the declared
+    ``UndeclaredPropositionError`` / ``NotGR1FormulaError`` for formulas outside the declared
     propositions or GR(1).
     """
     interrupt = Interrupt(cancel, deadline, memory_limit)

@@ -13,7 +13,7 @@ from respec.errors import quoted
 from respec.ltl import And, Const, Formula, Iff, Implies, Next, Not, Or, Var, children, to_infix
 from respec.spec import GR1Specification
 
-from ltl_synthesizer.errors import InvalidFormulaError, UnknownPropositionError
+from ltl_synthesizer.errors import NotGR1FormulaError, UndeclaredPropositionError
 
 INIT_SECTIONS = ('env_init', 'sys_init')
 
@@ -37,14 +37,14 @@ class Translator:
         section (no next step in initial conditions, no next output in env_trans) apply."""
         self.check()
         if section in INIT_SECTIONS and any(under_next for _, under_next in walk(formula)):
-            raise InvalidFormulaError(
+            raise NotGR1FormulaError(
                 f'{section}: initial conditions cannot refer to the next step: {to_infix(formula)}',
                 item=to_infix(formula))
         if section == 'env_trans':
             bad = next_outputs(formula, self.outputs)
             if bad:
                 # slugs rejects this too: the environment moves first and cannot see the system's move.
-                raise InvalidFormulaError(
+                raise NotGR1FormulaError(
                     f"env_trans: environment assumption refers to the next value of output '{bad[0]}': "
                     f'{to_infix(formula)}', item=bad[0])
         return self._translate(formula, section)
@@ -62,7 +62,7 @@ class Translator:
         while stack:
             formula, under_next, expanded = stack.pop()
             if isinstance(formula, Next) and under_next:
-                raise InvalidFormulaError(f'{section}: nested next is not GR(1): {to_infix(formula)}',
+                raise NotGR1FormulaError(f'{section}: nested next is not GR(1): {to_infix(formula)}',
                                           item=to_infix(formula))
             inner = under_next or isinstance(formula, Next)
             if not expanded and children(formula):
@@ -81,7 +81,7 @@ class Translator:
             return bdd.true if formula.value else bdd.false
         if isinstance(formula, Var):
             if formula.name not in self.declared:
-                raise UnknownPropositionError(
+                raise UndeclaredPropositionError(
                     f"{section}: unknown proposition {quoted(formula.name)} (declare it as an input or output)",
                     item=formula.name)
             return bdd.var(primed(formula.name) if under_next else formula.name)
@@ -103,7 +103,7 @@ class Translator:
             return ~args[0] | args[1]
         if isinstance(formula, Iff):
             return bdd.apply('<=>', args[0], args[1])
-        raise InvalidFormulaError(f'{section}: not a formula: {formula!r}', item=repr(formula))
+        raise NotGR1FormulaError(f'{section}: not a formula: {formula!r}', item=repr(formula))
 
 
 def walk(formula: Formula):
@@ -126,9 +126,9 @@ def check_declarations(spec: GR1Specification) -> None:
     seen = set()
     for name in list(spec.env_props) + list(spec.sys_props):
         if not isinstance(name, str) or not name or name.endswith("'"):
-            raise UnknownPropositionError(f'invalid proposition name {name!r}', item=name)
+            raise UndeclaredPropositionError(f'invalid proposition name {name!r}', item=name)
         if name in seen:
-            raise UnknownPropositionError(f"proposition '{name}' is declared twice", item=name)
+            raise UndeclaredPropositionError(f"proposition '{name}' is declared twice", item=name)
         seen.add(name)
 
 

@@ -10,7 +10,7 @@ import pytest
 
 from ltl_specification import compile_task
 from ltl_synthesizer import SynthesisCancelled, synthesize
-from ltl_synthesizer.errors import SynthesisMemoryExceeded, UnknownPropositionError
+from ltl_synthesizer.errors import SynthesisMemoryExceeded, UndeclaredPropositionError
 from ltl_synthesizer.isolated import SynthesisProcessDied, SynthesisProcesses
 from respec.ltl import var
 from respec.spec import GR1Specification
@@ -65,7 +65,7 @@ def test_unrealizable_specs_come_back_with_their_explanation(processes):
 
 def test_errors_come_back_as_the_synthesizers_own(processes):
     bad = GR1Specification(sys_props=['a'], sys_trans=[var('nowhere')])
-    with pytest.raises(UnknownPropositionError) as error:
+    with pytest.raises(UndeclaredPropositionError) as error:
         processes.synthesize(bad)
     assert error.value.item == 'nowhere' and error.value.code == 'UNKNOWN_PROPOSITION'
     with pytest.raises(SynthesisMemoryExceeded) as error:

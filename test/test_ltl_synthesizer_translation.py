@@ -4,7 +4,7 @@ import itertools
 
 import pytest
 
-from ltl_synthesizer import InvalidFormulaError, Options, UnknownPropositionError
+from ltl_synthesizer import NotGR1FormulaError, Options, UndeclaredPropositionError
 from ltl_synthesizer.symbolic import SymbolicGame, primed
 from respec.ltl import FALSE, TRUE, conj, disj, iff, implies, neg, next_, var
 from respec.spec import GR1Specification
@@ -66,29 +66,29 @@ def test_prime_and_unprime_are_inverse():
 
 
 def test_unknown_proposition_is_named():
-    with pytest.raises(UnknownPropositionError) as raised:
+    with pytest.raises(UndeclaredPropositionError) as raised:
         game(sys_liveness=[var('ghost')])
     assert raised.value.item == 'ghost' and raised.value.code == 'UNKNOWN_PROPOSITION'
     assert "sys_liveness: unknown proposition 'ghost'" in str(raised.value)
 
 
 def test_nested_next_and_next_in_init_are_rejected():
-    with pytest.raises(InvalidFormulaError) as raised:
+    with pytest.raises(NotGR1FormulaError) as raised:
         game(sys_trans=[next_(next_(a))])
     assert raised.value.code == 'INVALID_FORMULA' and 'nested next' in str(raised.value)
-    with pytest.raises(InvalidFormulaError) as raised:
+    with pytest.raises(NotGR1FormulaError) as raised:
         game(sys_init=[next_(b)])
     assert 'initial conditions' in str(raised.value) and raised.value.item == 'next(b)'
 
 
 def test_environment_cannot_constrain_the_next_output():
-    with pytest.raises(InvalidFormulaError) as raised:
+    with pytest.raises(NotGR1FormulaError) as raised:
         game(env_trans=[implies(a, next_(b))])
     assert raised.value.item == 'b'
 
 
 def test_duplicate_declaration_is_named():
-    with pytest.raises(UnknownPropositionError) as raised:
+    with pytest.raises(UndeclaredPropositionError) as raised:
         SymbolicGame(GR1Specification(env_props=['a'], sys_props=['a']))
     assert raised.value.item == 'a'
 

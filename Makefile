@@ -9,7 +9,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 MSGS_BUILD := build/synthesis_msgs
 MSGS_SOURCES := $(wildcard synthesis_msgs/msg/*.msg synthesis_msgs/srv/*.srv synthesis_msgs/action/*.action) \
-                synthesis_msgs/CMakeLists.txt synthesis_msgs/package.xml
+                synthesis_msgs/CMakeLists.txt synthesis_msgs/cmake/wheel_include_filter.cmake synthesis_msgs/package.xml
 SYSTEM_PACKAGES := graphviz chromium
 
 .PHONY: setup run test bench serve clean system-packages flexbe
@@ -106,7 +106,7 @@ cd $(4)/build && \
   cmake --build . -j2 > cmake-build.log && cmake --install . > cmake-install.log
 endef
 
-$(VENV)/.flexbe-msgs-installed: $(INTERFACES_WRAPPER) $(VENV)/.project-installed \
+$(VENV)/.flexbe-msgs-installed: $(INTERFACES_WRAPPER) synthesis_msgs/cmake/wheel_include_filter.cmake $(VENV)/.project-installed \
     $(wildcard $(FLEXBE_ENGINE)/flexbe_msgs/package.xml $(FLEXBE_ENGINE)/flexbe_msgs/*/*)
 	@test -f "$(FLEXBE_ENGINE)/flexbe_msgs/package.xml" || \
 	  { echo "FlexBE sources not found: set FLEXBE_SOURCES to the folder holding flexbe_behavior_engine/ (got '$(FLEXBE_SOURCES)')" >&2; exit 1; }

@@ -185,10 +185,7 @@ def capability_system_from_dicts(capabilities: object, spec: object = None, mapp
             raise CapabilityConfigError(f'{system}: unknown key {key!r} in the capabilities file '
                                         f'(expected {", ".join(_FILE_KEYS)})', item=str(key))
     state_outcomes, sm_outcomes, transition_outcomes = _mappings(mappings, system)
-    own = capabilities.get('state_outcome_mappings') or {}
-    if not isinstance(own, dict):
-        raise CapabilityConfigError(f'{system}: state_outcome_mappings must be a mapping',
-                                    item='state_outcome_mappings')
+    own = _mapping(capabilities.get('state_outcome_mappings'), system, 'state_outcome_mappings')
     state_outcomes = {**state_outcomes, **{_word(k): str(v) for k, v in own.items()}}
     for outcome, meaning in state_outcomes.items():
         if meaning not in transition_outcomes:
@@ -264,17 +261,20 @@ def _word(key) -> str:
     return _YAML_WORDS.get(key, str(key)) if isinstance(key, bool) else str(key)
 
 
-def _integers(raw, system: str) -> dict[str, IntegerRange]:
+def _mapping(raw, system: str, key: str) -> dict:
+    """The mapping under ``key`` (empty when absent); anything else names the key."""
     if raw is None:
         return {}
     if not isinstance(raw, dict):
-        raise CapabilityConfigError(f'{system}: variable_mappings must be a mapping', item='variable_mappings')
+        raise CapabilityConfigError(f'{system}: {key} must be a mapping', item=key)
+    return raw
+
+
+def _integers(raw, system: str) -> dict[str, IntegerRange]:
+    raw = _mapping(raw, system, 'variable_mappings')
     integers = {}
     for side, environment in (('env_props', True), ('sys_props', False)):
-        variables = raw.get(side) or {}
-        if not isinstance(variables, dict):
-            raise CapabilityConfigError(f'{system}: variable_mappings.{side} must be a mapping',
-                                        item=f'variable_mappings.{side}')
+        variables = _mapping(raw.get(side), system, f'variable_mappings.{side}')
         for name, values in variables.items():
             where = f'variable_mappings.{side}.{name}'
             if not isinstance(name, str) or not _NAME.match(name) or name in integers:
@@ -331,10 +331,7 @@ def _spec(spec, system: str, integers: dict[str, IntegerRange]):
 
 
 def _memory(raw, system: str) -> dict[str, bool]:
-    if raw is None:
-        return {}
-    if not isinstance(raw, dict):
-        raise CapabilityConfigError(f'{system}: memory must be a mapping', item='memory')
+    raw = _mapping(raw, system, 'memory')
     memory = {}
     for side, names in raw.items():
         if side != 'sys_props' or not isinstance(names, dict):

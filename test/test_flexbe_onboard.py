@@ -212,7 +212,10 @@ def test_an_exported_behavior_finishes_onboard_with_flexbe_inputs_plain_answer(r
     status = operator.start_behavior(BEHAVIOR)
     ok, details = finished_with(status, 'finished', system)
     assert ok, details
-    last = operator.wait_until(lambda: operator.robot[-1] if operator.robot else None, 5, 'robot state')
+    # The state topic is periodic: the newest message received may predate the end of pickup_object.
+    last = operator.wait_until(lambda: next((m for m in reversed(operator.robot)
+                                             if 'pickup_object' in m.completed_actions), None),
+                               10, 'a robot state after pickup_object')
     # The robot acted on the template id that flowed through userdata: it never ran object_template.
     assert last.holding_object and last.mode == 'manipulate'
     assert 'object_template' not in last.completed_actions and 'pickup_object' in last.completed_actions

@@ -47,13 +47,13 @@ from pathlib import Path
 from typing import Any, Dict, Mapping, Optional, Tuple
 
 from respec.abstraction import RobotAbstraction, abstraction_from_document
-from respec.errors import CodedError
+from respec.errors import CodedError, ErrorCode
 from respec.systems import read_config_file, system_config_path
 
 class SimulationConfigError(CodedError, ValueError):
     """The ``simulation:`` section is invalid; ``item`` names the offending key or capability."""
 
-    code = 'CONFIG_FILE_INVALID'
+    code = ErrorCode.CONFIG_FILE_INVALID
 
 
 #: config/ next to the atlas_sim package (the repository layout).

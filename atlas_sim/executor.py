@@ -46,6 +46,7 @@ from atlas_sim.machine import (BEHAVIOR, CONCURRENCY, DECISION_STATE, LOG_STATE,
 from atlas_sim.robot import CapabilityResult, Robot
 from atlas_sim.trace_check import OutcomeTracker, Trace, TraceStep
 from respec.abstraction import load_abstraction
+from respec.errors import ErrorCode
 from respec.naming import activated, is_activation, outcome_proposition
 from sm_generation.config import load_flexbe_config
 
@@ -54,13 +55,13 @@ from sm_generation.config import load_flexbe_config
 class UnmappedStateError(ExecutionError):
     """A state whose class/parameters match no entry of the system's ``flexbe.states``."""
 
-    code = 'CONFIG_VARIABLE_CONFIG_INVALID'
+    code = ErrorCode.CONFIG_VARIABLE_CONFIG_INVALID
 
 
 class ExecutionLimitError(ExecutionError):
     """The run reached its robot-time or state-count limit without an SM outcome."""
 
-    code = 'TIMEOUT'
+    code = ErrorCode.TIMEOUT
 
 
 # --- mapping states to capabilities ---------------------------------------------------------------

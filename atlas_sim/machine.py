@@ -5,7 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from atlas_sim.trace_check import Trace
-from respec.errors import CodedError
+from respec.errors import CodedError, ErrorCode
 from sm_generation.generator import DECISION_CLASS, NOTHING_CLASS
 from sm_generation.instantiation import StateInstantiation
 
@@ -23,7 +23,7 @@ DECISION_STATE = DECISION_CLASS
 class ExecutionError(CodedError):
     """The run could not go on; ``item`` names the offending state, ``trace`` holds what ran."""
 
-    code = 'BEHAVIOR_SYNTHESIS_FAILED'
+    code = ErrorCode.BEHAVIOR_SYNTHESIS_FAILED
 
     def __init__(self, message: str, item: str, trace: Trace | None = None):
         super().__init__(message, item)
@@ -33,13 +33,13 @@ class ExecutionError(CodedError):
 class MachineInvalidError(ExecutionError):
     """The StateInstantiation list is not a machine this executive can run."""
 
-    code = 'INVALID_REQUEST'
+    code = ErrorCode.INVALID_REQUEST
 
 
 class UndeclaredOutcomeError(ExecutionError):
     """A state returned an outcome that it does not declare (so it has no transition)."""
 
-    code = 'AUTOMATON_INVALID'
+    code = ErrorCode.AUTOMATON_INVALID
 
 
 @dataclass

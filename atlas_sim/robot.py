@@ -12,20 +12,20 @@ from pathlib import Path
 from typing import Any, Protocol, Sequence
 
 from atlas_sim.config import system_config
-from respec.errors import CodedError
+from respec.errors import CodedError, ErrorCode
 from respec.naming import COMPLETED
 
 
 class InitialConditionError(CodedError, ValueError):
     """An initial condition the simulator cannot start in; ``item`` names it."""
 
-    code = 'INVALID_INITIAL_CONDITIONS'
+    code = ErrorCode.INVALID_INITIAL_CONDITIONS
 
 
 class FaultSpecError(CodedError, ValueError):
     """A malformed fault ('capability:k') or one naming an unknown capability; ``item`` names it."""
 
-    code = 'INVALID_REQUEST'
+    code = ErrorCode.INVALID_REQUEST
 
 
 @dataclass(frozen=True)

@@ -52,7 +52,7 @@ from __future__ import annotations
 
 from dataclasses import asdict, dataclass, field
 
-from respec.errors import CodedError
+from respec.errors import CodedError, ErrorCode
 from respec.ltl import Formula, Next, mentions_next, partial_evaluate, to_infix
 from respec.naming import COMPLETED, DEFAULT_SM_OUTCOMES, FINISHED, is_activation, outcome_proposition, remembered
 from respec.spec import GR1Specification
@@ -64,7 +64,7 @@ DEFAULT_SM_OUTCOME_PROPOSITIONS = {outcome: outcome for outcome in DEFAULT_SM_OU
 class TraceError(CodedError):
     """A trace that cannot be checked (malformed); ``item`` names the offending entry."""
 
-    code = 'INVALID_REQUEST'
+    code = ErrorCode.INVALID_REQUEST
 
 
 # --- traces -------------------------------------------------------------------------------

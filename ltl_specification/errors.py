@@ -7,52 +7,52 @@ constant that reports it.
 
 from __future__ import annotations
 
-from respec.errors import CodedError
+from respec.errors import CodedError, ErrorCode
 
 
 class SpecificationError(CodedError):
     """Compiling a task specification failed; ``item`` names what was wrong."""
 
-    code = 'LTL_SPEC_COMPILATION_FAILED'
+    code = ErrorCode.LTL_SPEC_COMPILATION_FAILED
 
 
 class UnknownSystemError(SpecificationError):
     """No configuration file exists for the requested system."""
 
-    code = 'UNKNOWN_SYSTEM'
+    code = ErrorCode.UNKNOWN_SYSTEM
 
 
 class InvalidAbstractionError(SpecificationError):
     """The system's configuration file or its ``abstraction:`` section is invalid."""
 
-    code = 'ABSTRACTION_CONFIG_INVALID'
+    code = ErrorCode.ABSTRACTION_CONFIG_INVALID
 
 
 class InvalidInitialConditionsError(SpecificationError):
     """An initial condition is unknown, or the initial control mode is missing or ambiguous."""
 
-    code = 'INVALID_INITIAL_CONDITIONS'
+    code = ErrorCode.INVALID_INITIAL_CONDITIONS
 
 
 class InvalidGoalsError(SpecificationError):
     """No goals, an unknown or repeated goal, or a goal that cannot be reached."""
 
-    code = 'INVALID_GOALS'
+    code = ErrorCode.INVALID_GOALS
 
 
 class InvalidSmOutcomesError(SpecificationError):
     """The requested state-machine outcomes are not [finished, failed] or [finished]."""
 
-    code = 'INVALID_SM_OUTCOMES'
+    code = ErrorCode.INVALID_SM_OUTCOMES
 
 
 class InvalidFormulaError(SpecificationError):
     """A custom LTL formula does not parse or does not fit its GR(1) section."""
 
-    code = 'INVALID_FORMULA'
+    code = ErrorCode.INVALID_FORMULA
 
 
 class UnknownPropositionError(SpecificationError):
     """A custom LTL formula names a proposition that the task does not define."""
 
-    code = 'UNKNOWN_PROPOSITION'
+    code = ErrorCode.UNKNOWN_PROPOSITION

@@ -2,25 +2,25 @@
 
 from __future__ import annotations
 
-from respec.errors import CodedError
+from respec.errors import CodedError, ErrorCode
 
 
 class SynthesisError(CodedError):
     """Base class: ``code`` names a SynthesisErrorCodes constant, ``item`` is the offending item."""
 
-    code = 'SYNTHESIS_FAILED'
+    code = ErrorCode.SYNTHESIS_FAILED
 
 
 class UndeclaredPropositionError(SynthesisError):
     """A formula mentions a proposition that is declared neither as input nor as output."""
 
-    code = 'UNKNOWN_PROPOSITION'
+    code = ErrorCode.UNKNOWN_PROPOSITION
 
 
 class NotGR1FormulaError(SynthesisError):
     """A formula is outside the GR(1) fragment (nested next, next in an initial condition...)."""
 
-    code = 'INVALID_FORMULA'
+    code = ErrorCode.INVALID_FORMULA
 
 
 class SynthesisCancelled(SynthesisError):
@@ -30,7 +30,7 @@ class SynthesisCancelled(SynthesisError):
     belongs to a class.
     """
 
-    code = 'PREEMPTED'
+    code = ErrorCode.PREEMPTED
 
     def __new__(cls, reason: str = 'cancelled'):
         if cls is SynthesisCancelled and reason == 'timeout':
@@ -45,7 +45,7 @@ class SynthesisCancelled(SynthesisError):
 class SynthesisTimedOut(SynthesisCancelled):
     """Synthesis passed its deadline."""
 
-    code = 'SYNTHESIS_TIMEOUT'
+    code = ErrorCode.SYNTHESIS_TIMEOUT
 
     def __init__(self, reason: str = 'timeout'):
         super().__init__(reason)

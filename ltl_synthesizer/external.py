@@ -18,6 +18,7 @@ import time
 from pathlib import Path
 
 from ltl_synthesizer.errors import SynthesisCancelled, SynthesisError
+from respec.errors import ErrorCode
 
 REALIZABLE_LINE = 'RESULT: Specification is realizable.'
 UNREALIZABLE_LINE = 'RESULT: Specification is unrealizable.'
@@ -27,7 +28,7 @@ _POLL_SECONDS = 0.05
 class ExternalSynthesizerError(SynthesisError):
     """The executable is missing, crashed, wrote no usable result; ``item`` names the executable."""
 
-    code = 'SYNTHESIZER_BACKEND_FAILED'
+    code = ErrorCode.SYNTHESIZER_BACKEND_FAILED
 
 
 def run_external_synthesizer(executable: str, slugsin_path, output_path,

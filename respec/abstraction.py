@@ -24,6 +24,7 @@ import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from respec.errors import ErrorCode
 from respec.naming import COMPLETED, DEFAULT_SM_OUTCOMES, FAILED, activation, memory, outcome_proposition
 from respec.systems import SystemConfigError, load_system_file
 
@@ -38,7 +39,7 @@ _RESERVED_OUTCOME_LETTERS = ('a', 'm')
 class AbstractionConfigError(SystemConfigError):
     """The ``abstraction:`` section is invalid; ``item`` names the offending entry."""
 
-    code = 'ABSTRACTION_CONFIG_INVALID'
+    code = ErrorCode.ABSTRACTION_CONFIG_INVALID
 
 
 @dataclass(frozen=True)

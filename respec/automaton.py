@@ -10,14 +10,14 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from respec.errors import CodedError
+from respec.errors import CodedError, ErrorCode
 from respec.ltl import conj, evaluate
 from respec.naming import is_memory
 from respec.spec import GR1Specification
 
 
 class AutomatonError(CodedError):
-    code = 'AUTOMATON_INVALID'
+    code = ErrorCode.AUTOMATON_INVALID
 
 
 @dataclass

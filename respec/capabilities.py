@@ -36,6 +36,7 @@ from pathlib import Path
 
 import yaml
 
+from respec.errors import ErrorCode
 from respec.naming import COMPLETED, FINISHED
 from respec.systems import SystemConfigError, load_system_file, system_config_path
 
@@ -67,7 +68,7 @@ _YAML_WORDS = {True: 'true', False: 'false'}
 class CapabilityConfigError(SystemConfigError):
     """A CNU capability, spec or mappings file is invalid; ``item`` names the entry."""
 
-    code = 'ABSTRACTION_CONFIG_INVALID'
+    code = ErrorCode.ABSTRACTION_CONFIG_INVALID
 
 
 @dataclass(frozen=True)

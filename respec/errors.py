@@ -1,7 +1,14 @@
-"""The base of every error the suite reports to its users."""
+"""The suite's error vocabulary: the error codes, the base of every error reported to users,
+and how a message quotes a user's value.
+
+ROS-free cores speak :class:`ErrorCode`; the ROS shell turns a code into a
+``synthesis_msgs/SynthesisErrorCodes`` message by its integer value (the message declares the
+same constants; a test keeps the two equal).
+"""
 
 from __future__ import annotations
 
+import enum
 import reprlib
 
 #: How much of a user's value any message quotes: a refused value may be megabytes long.
@@ -9,16 +16,89 @@ QUOTED_CHARACTERS = 40
 #: Longest ``item`` an error keeps (it names the bad item, sometimes by its value).
 ITEM_CHARACTERS = 200
 
+
+
+class ErrorCode(enum.StrEnum):
+    """Every result code of the suite: a string, its name (so messages, JSON and comparisons
+    read "INVALID_FORMULA"), with the integer ``number`` of synthesis_msgs/SynthesisErrorCodes
+    (the original's codes plus the ones marked "added" there)."""
+
+    def __new__(cls, name: str, number: int):
+        member = str.__new__(cls, name)
+        member._value_, member.number = name, number
+        return member
+
+    @staticmethod
+    def _generate_next_value_(name, start, count, last_values):
+        return name
+
+    SUCCESS = enum.auto(), 1
+    FAILURE = enum.auto(), 99999
+    # synthesis management
+    BEHAVIOR_SYNTHESIS_FAILED = enum.auto(), -1
+    INVALID_REQUEST = enum.auto(), -2
+    SERVICE_UNAVAILABLE = enum.auto(), -3
+    TIMEOUT = enum.auto(), -4
+    BUSY = enum.auto(), -5
+    PREEMPTED = enum.auto(), -9
+    # specification compilation
+    LTL_SPEC_COMPILATION_FAILED = enum.auto(), -10
+    UNKNOWN_SYSTEM = enum.auto(), -11
+    UNKNOWN_PROPOSITION = enum.auto(), -12
+    INVALID_INITIAL_CONDITIONS = enum.auto(), -13
+    INVALID_GOALS = enum.auto(), -14
+    INVALID_SM_OUTCOMES = enum.auto(), -15
+    INVALID_FORMULA = enum.auto(), -16
+    ABSTRACTION_CONFIG_INVALID = enum.auto(), -17
+    # LTL synthesis
+    SYNTHESIS_FAILED = enum.auto(), -20
+    SPEC_UNSYNTHESIZABLE = enum.auto(), -21
+    SYNTHESIS_TIMEOUT = enum.auto(), -22
+    INVALID_SPEC_NAME = enum.auto(), -23
+    SYNTHESIZER_BACKEND_FAILED = enum.auto(), -24
+    # state machine generation
+    SM_GENERATION_FAILED = enum.auto(), -30
+    NO_SYSTEMS_FILE = enum.auto(), -31
+    NO_SYSTEM_CONFIG = enum.auto(), -32
+    SYSTEM_CONFIG_NOT_FOUND = enum.auto(), -33
+    CONFIG_FILE_INVALID = enum.auto(), -34
+    CONFIG_AUTONOMY_INVALID = enum.auto(), -35
+    CONFIG_VARIABLE_CONFIG_INVALID = enum.auto(), -36
+    AUTOMATON_INVALID = enum.auto(), -37
+    AUTOMATON_NO_INITIAL_STATE = enum.auto(), -38
+    AUTOMATON_NEXT_STATE_INVALID = enum.auto(), -39
+    AUTOMATON_INPUT_VALUATION_INVALID = enum.auto(), -40
+    AUTOMATON_OUTPUT_VALUATION_INVALID = enum.auto(), -41
+    CONFIG_USERDATA_INVALID = enum.auto(), -42
+
+    @classmethod
+    def from_number(cls, number: int) -> ErrorCode:
+        """The code of ``number``; ValueError for a number this suite does not know."""
+        try:
+            return _BY_NUMBER[number]
+        except KeyError:
+            raise ValueError(f'{number} is no SynthesisErrorCodes value') from None
+
+    @classmethod
+    def name_of(cls, number: int) -> str:
+        """The name of ``number``, or the number itself for a code this suite does not know
+        (another server's answer is shown, never mistaken for a known code)."""
+        code = _BY_NUMBER.get(number)
+        return str(number) if code is None else code.name
+
+
+_BY_NUMBER = {code.number: code for code in ErrorCode}
+
 #: The code reported for an exception that is no CodedError: a programming error, whose
 #: traceback is logged.
-INTERNAL_ERROR = 'FAILURE'
+INTERNAL_ERROR = ErrorCode.FAILURE
 
 
 class CodedError(Exception):
-    """An error for users: ``code`` names a synthesis_msgs/SynthesisErrorCodes constant
-    (the ROS nodes report it as that value) and ``item`` names the offending item."""
+    """An error for users: ``code`` (an :class:`ErrorCode`) says what kind, ``item`` names the
+    offending item."""
 
-    code = 'FAILURE'
+    code = ErrorCode.FAILURE
 
     def __init__(self, message: str, item=''):
         super().__init__(message)
@@ -28,6 +108,12 @@ class CodedError(Exception):
         # Pickled whole (item and the subclass's own attributes), e.g. when a synthesis process
         # reports it: Exception's default pickling would call __init__ with the message only.
         return _rebuild_coded_error, (type(self), self.args, self.__dict__)
+
+
+class ControlFlowSignal(Exception):
+    """Not an error: raised to unwind work that must stop (a goal its client cancelled, a
+    queued job its caller gave up on). Whoever catches it answers in its own way; it is never
+    reported as a failure or logged as a bug. Subclasses say what stopped."""
 
 
 def _rebuild_coded_error(cls, args, state):

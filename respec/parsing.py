@@ -38,7 +38,7 @@ from functools import lru_cache
 from operator import add
 from typing import NamedTuple
 
-from respec.errors import CodedError, quoted
+from respec.errors import CodedError, ErrorCode, quoted
 from respec.ltl import (
     FALSE, FIELD_SETTERS, TRUE, And, Const, Formula, Iff, Implies, Next, Not, Or, Var, conj, disj, iff,
     implies, neg, next_, var, variables,
@@ -61,7 +61,7 @@ _KEYWORDS = {'TRUE', 'FALSE', 'next'}
 class ParseError(CodedError):
     """A syntax or naming error at ``filename:line:column``; ``item`` is the offending token."""
 
-    code = 'INVALID_FORMULA'
+    code = ErrorCode.INVALID_FORMULA
 
     def __init__(self, problem: str, token: str, filename: str = '<string>', line: int = 1,
                  column: int = 1):
@@ -76,7 +76,7 @@ class ParseError(CodedError):
 class UnknownVariableError(ParseError):
     """A formula mentions a proposition that no [INPUT] / [OUTPUT] section declares."""
 
-    code = 'UNKNOWN_PROPOSITION'
+    code = ErrorCode.UNKNOWN_PROPOSITION
 
 
 class _Token(NamedTuple):

@@ -9,7 +9,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field, fields
 from typing import Iterable
 
-from respec.errors import CodedError
+from respec.errors import CodedError, ErrorCode
 from respec.ltl import Formula, to_infix, to_prefix, variables
 
 PROPOSITION_SECTIONS = ('env_props', 'sys_props')
@@ -93,7 +93,7 @@ class GR1Specification:
 class PropositionConflictError(CodedError, ValueError):
     """A proposition is declared as both an environment and a system proposition."""
 
-    code = 'INVALID_FORMULA'
+    code = ErrorCode.INVALID_FORMULA
 
 
 def merge_specifications(specifications: Iterable[GR1Specification]) -> GR1Specification:

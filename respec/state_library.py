@@ -21,6 +21,7 @@ from pathlib import Path
 from typing import Mapping
 
 from respec.capabilities import CapabilityConfigError, CapabilitySystem
+from respec.errors import ErrorCode
 
 FLEXBE_STATES_EXPORT = '<flexbe_states'
 
@@ -127,7 +128,7 @@ def _literal_outcomes(init: ast.FunctionDef) -> tuple[str, ...] | None:
 class StateClassError(CapabilityConfigError):
     """A capability names a state class the workspace lacks, or a parameter the class does not take."""
 
-    code = 'CONFIG_VARIABLE_CONFIG_INVALID'
+    code = ErrorCode.CONFIG_VARIABLE_CONFIG_INVALID
 
 
 def capability_outcomes(system: CapabilitySystem, library: Mapping[str, StateClass]) -> dict[str, tuple[str, ...]]:

@@ -14,7 +14,7 @@ from pathlib import Path
 
 import yaml
 
-from respec.errors import CodedError, quoted
+from respec.errors import CodedError, ErrorCode, quoted
 
 CONFIG_DIR_ENV = 'BEHAVIOR_SYNTHESIS_CONFIG_DIR'
 _SYSTEM_NAME = re.compile(r'^[A-Za-z][A-Za-z0-9_]*$')
@@ -25,13 +25,13 @@ _SAFE_LOADER = getattr(yaml, 'CSafeLoader', yaml.SafeLoader)
 class SystemConfigError(CodedError):
     """A system configuration problem; ``item`` names the offending system, file or key."""
 
-    code = 'CONFIG_FILE_INVALID'
+    code = ErrorCode.CONFIG_FILE_INVALID
 
 
 class SystemNotFoundError(SystemConfigError):
     """No configuration file exists for the requested system."""
 
-    code = 'UNKNOWN_SYSTEM'
+    code = ErrorCode.UNKNOWN_SYSTEM
 
 
 class ConfigFileInvalidError(SystemConfigError):

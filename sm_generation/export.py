@@ -17,7 +17,7 @@ from pathlib import Path
 
 import yaml
 
-from respec.errors import CodedError
+from respec.errors import CodedError, ErrorCode
 from respec.naming import FINISHED
 from sm_generation.instantiation import StateInstantiation
 
@@ -29,7 +29,7 @@ GOOD_COLOUR, BAD_COLOUR = '#2e7d32', '#c62828'
 class RenderError(CodedError):
     """Rendering failed; ``item`` names the missing program or the output file."""
 
-    code = 'SM_GENERATION_FAILED'
+    code = ErrorCode.SM_GENERATION_FAILED
 
 
 def to_yaml(states: list[StateInstantiation]) -> str:

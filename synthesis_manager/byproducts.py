@@ -26,7 +26,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from respec.errors import CodedError, quoted
+from respec.errors import CodedError, ErrorCode, quoted
 
 EXTENSIONS = ('structuredslugs', 'slugsin', 'json')
 DEFAULT_SPEC_NAME = 'synthesized_spec'
@@ -39,7 +39,7 @@ _MARKER_FILE = re.compile(r'^\.(?P<stem>.+)' + re.escape(_MARKER_SUFFIX) + '$')
 
 
 class InvalidSpecName(CodedError):
-    code = 'INVALID_SPEC_NAME'
+    code = ErrorCode.INVALID_SPEC_NAME
 
 
 def is_spec_name(name: str) -> bool:

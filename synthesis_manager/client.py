@@ -8,6 +8,7 @@ from dataclasses import dataclass, field
 
 import yaml
 
+from respec.errors import ErrorCode
 from respec.naming import DEFAULT_SM_OUTCOMES
 from synthesis_manager.ros.action_client import RaceFreeActionClient
 from synthesis_manager.ros.cnu_interface import load_flexbe_synthesis_interface
@@ -47,7 +48,7 @@ class SynthesisOutcome:
 
     @property
     def succeeded(self) -> bool:
-        return self.error_name == 'SUCCESS'
+        return self.error_name == ErrorCode.SUCCESS
 
     def to_dict(self) -> dict:
         return {'error_code': self.error_code, 'error_name': self.error_name,

@@ -19,6 +19,7 @@ import time
 import uvicorn
 from rclpy.node import Node
 
+from respec.errors import ErrorCode
 from synthesis_manager.client import SynthesisClient, SynthesisOutcome, make_goal
 from synthesis_manager.ros.harness import RosHarness, environment_domain_id
 from synthesis_manager.suite import add_suite_arguments, suite_node_factories
@@ -52,7 +53,7 @@ class RosGoalRunner:
     def __call__(self, request, feedback, cancel) -> dict:
         if not self.client.wait_for_server(timeout=self.server_timeout):
             return SynthesisOutcome(
-                -3, 'SERVICE_UNAVAILABLE', 'no /behavior_synthesis action server answered within '
+                ErrorCode.SERVICE_UNAVAILABLE.number, ErrorCode.SERVICE_UNAVAILABLE, 'no /behavior_synthesis action server answered within '
                 f'{self.server_timeout:g} s (start one with `behavior-synthesis serve`)').to_dict()
         goal = make_goal(request.system, request.initial_conditions, request.goals, request.sm_outcomes,
                          option=request.option, name=request.name, unordered=request.unordered)

@@ -11,7 +11,7 @@ from __future__ import annotations
 import math
 import time
 
-from respec.errors import CodedError, quoted
+from respec.errors import CodedError, ErrorCode, quoted
 from synthesis_manager.requests import InvalidRequest
 
 #: Longest string accepted in any request field, in UTF-8 bytes.
@@ -74,10 +74,22 @@ def too_long(field_path: str, value: str, limit: int = MAX_STRING_BYTES) -> str:
             f'(it starts {quoted(value)})')
 
 
+class BusyError(CodedError):
+    """Too much work is in progress (goals, queued syntheses, GUI jobs or simulations): the
+    request is refused, nothing was started. ``retry_after``: seconds after which trying again
+    may work, when that is known (the GUI sends it as Retry-After)."""
+
+    code = ErrorCode.BUSY
+
+    def __init__(self, message: str, item='', retry_after: int | None = None):
+        super().__init__(message, item)
+        self.retry_after = retry_after
+
+
 class GoalTimedOut(CodedError):
     """The goal's own time limit passed (its whole pipeline, queues included)."""
 
-    code = 'TIMEOUT'
+    code = ErrorCode.TIMEOUT
 
 
 class GoalDeadline:

@@ -11,7 +11,7 @@ from typing import Any
 
 import yaml
 
-from respec.errors import CodedError, quoted
+from respec.errors import CodedError, ErrorCode, quoted
 from respec.naming import DEFAULT_SM_OUTCOMES, parse_names
 
 OPTION_NAMES = ('ltl_compilation_only', 'ltl_synthesis_only', 'ltl_steps_only')
@@ -20,7 +20,7 @@ OPTION_NAMES = ('ltl_compilation_only', 'ltl_synthesis_only', 'ltl_steps_only')
 class InvalidRequest(CodedError):
     """A request the server cannot run (contradictory or malformed options)."""
 
-    code = 'INVALID_REQUEST'
+    code = ErrorCode.INVALID_REQUEST
 
 
 def selected_option(options) -> str | None:

@@ -8,7 +8,7 @@ import functools
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 
-from respec.errors import CodedError
+from respec.errors import CodedError, ErrorCode
 from synthesis_manager.client import SynthesisClient
 from synthesis_manager.nodes.ltl_compilation_node import LTLCompilationNode
 from synthesis_manager.nodes.ltl_synthesis_node import LTLSynthesisNode
@@ -71,7 +71,7 @@ def suite_node_factories(args=None, names=SUITE_NODE_NAMES):
 class SuiteUnavailable(CodedError):
     """The in-process suite's action server did not come up."""
 
-    code = 'SERVICE_UNAVAILABLE'
+    code = ErrorCode.SERVICE_UNAVAILABLE
 
 
 @contextlib.contextmanager

@@ -21,7 +21,7 @@ import time
 from rclpy.action import ActionClient
 
 from atlas_sim.robot import CapabilityResult
-from respec.errors import CodedError
+from respec.errors import CodedError, ErrorCode
 from synthesis_manager.nodes.atlas_sim_node import ACTION_NAME, STATE_TOPIC
 from synthesis_msgs.action import ExecuteCapability
 from synthesis_msgs.msg import RobotState
@@ -30,7 +30,7 @@ from synthesis_msgs.msg import RobotState
 class RobotUnavailableError(CodedError):
     """The atlas_sim node does not answer."""
 
-    code = 'SERVICE_UNAVAILABLE'
+    code = ErrorCode.SERVICE_UNAVAILABLE
 
 
 class _Goal:

@@ -41,7 +41,7 @@ class LTLCompilationNode(Node):
             self.get_logger().warning(response.error_code.message)
             return response
         response.ltl_specification = spec_to_msg(spec)
-        response.error_code = error_code('SUCCESS')
+        response.error_code = error_code()
         return response
 
 

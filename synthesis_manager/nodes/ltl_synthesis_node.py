@@ -20,7 +20,7 @@ from ltl_synthesizer.external import run_external_synthesizer
 from ltl_synthesizer.isolated import SynthesisProcesses
 from ltl_synthesizer.strategy import strategy_to_json
 from respec.automaton import automaton_from_strategy
-from respec.errors import CodedError
+from respec.errors import ErrorCode
 from respec.parsing import ParseError, spec_from_text_sections
 from synthesis_manager.byproducts import DEFAULT_KEEP_LAST, ByproductStore
 from synthesis_manager.limits import check_message, check_timeout
@@ -133,7 +133,7 @@ class LTLSynthesisNode(Node):
                 self._stopped(response, 'cancelled' if cancel.is_set() else 'timeout', timeout)
         except ParseError as error:  # the original's code for a malformed specification
             response.synthesizable = False
-            response.error_code = error_code('SYNTHESIS_FAILED', f'malformed specification: {error}')
+            response.error_code = error_code(ErrorCode.SYNTHESIS_FAILED, f'malformed specification: {error}')
         except Exception as error:  # every failure becomes an error code; the node keeps serving
             response.synthesizable = False
             response.error_code = reported_error(error, self.get_logger(), 'synthesis failed')
@@ -174,21 +174,21 @@ class LTLSynthesisNode(Node):
                 explanation = stderr.strip()
             else:
                 response.error_code = error_code(
-                    'SYNTHESIS_FAILED', f'unknown backend {backend!r} (use one of {", ".join(BACKENDS)})')
+                    ErrorCode.SYNTHESIS_FAILED, f'unknown backend {backend!r} (use one of {", ".join(BACKENDS)})')
                 return
             response.synthesizable = realizable
             if not realizable:
                 response.error_code = error_code(
-                    'SPEC_UNSYNTHESIZABLE',
+                    ErrorCode.SPEC_UNSYNTHESIZABLE,
                     f'specification {files.name!r} is unrealizable: {explanation}'.rstrip(': '))
                 return
             files.write('json', strategy_to_json(strategy))
         response.automaton = automaton_to_msg(automaton_from_strategy(strategy, spec))
-        response.error_code = error_code('SUCCESS')
+        response.error_code = error_code()
 
     @staticmethod
     def _stopped(response, reason: str, timeout: float):
-        code = 'SYNTHESIS_TIMEOUT' if reason == 'timeout' else 'PREEMPTED'
+        code = ErrorCode.SYNTHESIS_TIMEOUT if reason == 'timeout' else ErrorCode.PREEMPTED
         response.error_code = error_code(code, f'synthesis stopped: {reason} (time limit {timeout:g} s)')
 
 

@@ -31,9 +31,9 @@ from ltl_specification.initial_conditions import (detected_status, initial_condi
                                                   reads_robot_state)
 from ltl_synthesizer.errors import SynthesisError
 from ltl_synthesizer.isolated import SynthesisProcesses
-from respec.errors import INTERNAL_ERROR, CodedError
+from respec.errors import INTERNAL_ERROR, CodedError, ErrorCode
 from sm_generation.instantiation import count_states
-from synthesis_manager.limits import GoalDeadline, check_message, check_timeout
+from synthesis_manager.limits import BusyError, GoalDeadline, check_message, check_timeout
 from synthesis_manager.nodes.atlas_sim_node import STATE_TOPIC
 from synthesis_manager.requests import (InvalidRequest, SynthesisTask, task_from_behavior_synthesis,
                                         task_from_flexbe_synthesis)
@@ -58,17 +58,11 @@ DIAGNOSIS_GRACE = 1.0  # seconds past diagnosis_timeout before the diagnosis pro
 SYNTHESIS_ANSWER_GRACE = 1.0  # seconds past its time limit the synthesis node has to answer SYNTHESIS_TIMEOUT
 
 
-class Busy(CodedError):
-    """Too many goals are in progress."""
-
-    code = 'BUSY'
-
-
 @dataclass
 class PipelineOutcome:
     """What a goal produced, whichever action it came through."""
 
-    error_name: str = 'SUCCESS'
+    code: ErrorCode = ErrorCode.SUCCESS
     message: str = ''
     ltl_specification: LTLSpecification = field(default_factory=LTLSpecification)
     automaton: FSAutomaton = field(default_factory=FSAutomaton)
@@ -77,10 +71,10 @@ class PipelineOutcome:
 
     @property
     def succeeded(self) -> bool:
-        return self.error_name == 'SUCCESS'
+        return self.code == ErrorCode.SUCCESS
 
-    def fail(self, name: str, message: str):
-        self.error_name, self.message = name, message
+    def fail(self, code: ErrorCode, message: str):
+        self.code, self.message = code, message
 
 
 @dataclass(frozen=True)
@@ -95,14 +89,14 @@ class ActionInterface:
 
 def behavior_synthesis_result(outcome: PipelineOutcome):
     return BehaviorSynthesis.Result(
-        error_code=error_code(outcome.error_name, outcome.message), states=outcome.states,
+        error_code=error_code(outcome.code, outcome.message), states=outcome.states,
         ltl_specification=outcome.ltl_specification, automaton=outcome.automaton)
 
 
 def action_interfaces(flexbe_synthesis) -> tuple[ActionInterface, ...]:
     """The served actions; ``flexbe_synthesis``: the FlexBESynthesisInterface offered."""
     def flexbe_synthesis_result(outcome: PipelineOutcome):
-        return flexbe_synthesis.result(outcome.error_name, outcome.message, outcome.states, outcome.notes)
+        return flexbe_synthesis.result(outcome.code, outcome.message, outcome.states, outcome.notes)
     return (ActionInterface(BehaviorSynthesis, 'behavior_synthesis', task_from_behavior_synthesis,
                             behavior_synthesis_result),
             ActionInterface(flexbe_synthesis.action_type, 'flexbe_synthesis', task_from_flexbe_synthesis,
@@ -240,11 +234,9 @@ class BehaviorSynthesisServer(Node):
             with self.admitted():
                 await self.run_pipeline(goal_handle, task, outcome, feedback, deadline)
         except Preempted:
-            outcome.fail('PREEMPTED', 'cancelled by the client')
+            outcome.fail(ErrorCode.PREEMPTED, 'cancelled by the client')
             goal_handle.canceled()
             return interface.make_result(outcome)
-        except StageFailed as failure:
-            outcome.fail(failure.error_name, str(failure))
         except CodedError as error:
             outcome.fail(error.code, str(error))
         except Exception as error:  # a bug: logged with its traceback; the server keeps serving
@@ -255,7 +247,7 @@ class BehaviorSynthesisServer(Node):
         else:
             # Clients that drop the result of an aborted goal still see why: the last feedback
             # says it, and FlexBE WebUI 4.0.3 (which also drops feedback) shows FlexBE's log.
-            failure = f'{outcome.error_name}: {outcome.message}'
+            failure = f'{outcome.code}: {outcome.message}'
             feedback(failure)
             self.log_to_flexbe(f'Behavior synthesis failed: {failure}')
             self.get_logger().warning(failure)
@@ -278,11 +270,11 @@ class BehaviorSynthesisServer(Node):
 
     @contextlib.contextmanager
     def admitted(self):
-        """Count a goal in while it runs; raise Busy when max_active_goals are running."""
+        """Count a goal in while it runs; raise BusyError when max_active_goals are running."""
         limit = self.parameter('max_active_goals')
         with self._lock:
             if self._active_goals >= limit:
-                raise Busy(f'the server is busy: {self._active_goals} goals in progress '
+                raise BusyError(f'the server is busy: {self._active_goals} goals in progress '
                            f'(max_active_goals {limit}); try again later')
             self._active_goals += 1
         try:
@@ -334,10 +326,10 @@ class BehaviorSynthesisServer(Node):
             ltl_specification=outcome.ltl_specification, spec_name=spec_name,
             timeout=float(timeout), request_id=goal_id),
             'LTL synthesis', timeout + SYNTHESIS_ANSWER_GRACE, on_cancel=lambda: self.cancel_synthesis(goal_id))
-        if task.timeout and error_name(synthesized.error_code.value) == 'SYNTHESIS_TIMEOUT':
+        if task.timeout and error_name(synthesized.error_code.value) == ErrorCode.SYNTHESIS_TIMEOUT:
             # Name the goal's limit, not the time that was left of it.
             synthesized.error_code.message = str(deadline.timed_out('LTL synthesis'))
-        if task.option != 'ltl_synthesis_only' and error_name(synthesized.error_code.value) == 'SPEC_UNSYNTHESIZABLE':
+        if task.option != 'ltl_synthesis_only' and error_name(synthesized.error_code.value) == ErrorCode.SPEC_UNSYNTHESIZABLE:
             feedback('Diagnosing why the task cannot be done', 0.6)
             synthesized.error_code.message = await self.diagnose(goal_handle, task, synthesized.error_code.message,
                                                                  deadline)

@@ -41,7 +41,7 @@ class SMGenerationNode(Node):
             self.get_logger().warning(response.error_code.message)
             return response
         response.state_definition = [state_to_msg(state) for state in states]
-        response.error_code = error_code('SUCCESS')
+        response.error_code = error_code()
         return response
 
 

@@ -13,8 +13,9 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass
 
+from respec.errors import ErrorCode
 from synthesis_manager.ros.conversions import constants
-from synthesis_msgs.msg import OutcomeCondition, StateInstantiation, SynthesisErrorCodes
+from synthesis_msgs.msg import OutcomeCondition, StateInstantiation
 
 CNU_PACKAGE = 'flexbe_synthesis_msgs'
 FALLBACK_TYPE = 'synthesis_msgs/FlexBESynthesis'
@@ -26,12 +27,13 @@ _STAGE_FAILURES = ((-9, 'BEHAVIOR_SYNTHESIS_FAILED'), (-19, 'SPEC_COMPILATION_FA
                    (-29, 'SYNTHESIS_FAILED'), (-49, 'SM_GENERATION_FAILED'))
 
 
-def cnu_error_name(name: str, value: int, cnu_names) -> str:
-    """The CNU constant for our error ``name`` (whose value in our SynthesisErrorCodes is
-    ``value``): the same-named one when CNU has it, else its stage's generic failure."""
-    if name in cnu_names:
-        return name
-    return next((failure for lowest, failure in _STAGE_FAILURES if value >= lowest), 'FAILURE')
+def cnu_error_name(code: ErrorCode, cnu_names) -> str:
+    """The CNU constant for our error ``code``: the same-named one when CNU has it, else its
+    stage's generic failure."""
+    code = ErrorCode(code)
+    if code.name in cnu_names:
+        return code.name
+    return next((failure for lowest, failure in _STAGE_FAILURES if code.number >= lowest), 'FAILURE')
 
 
 _PACKAGE_PREFIX = re.compile(r'[A-Za-z0-9_]+/')
@@ -74,12 +76,10 @@ class FlexBESynthesisInterface:
         """e.g. ``flexbe_synthesis_msgs/action/FlexBESynthesis``."""
         return f'{self.action_type.__module__.split(".")[0]}/action/{self.action_type.__name__}'
 
-    def error_code(self, name: str):
-        """Our error name -> this type's SynthesisErrorCode."""
-        ours = constants(SynthesisErrorCodes)
+    def error_code(self, code: ErrorCode):
+        """Our error code -> this type's SynthesisErrorCode."""
         codes = constants(self.error_code_type)
-        chosen = cnu_error_name(name, ours.get(name, SynthesisErrorCodes.FAILURE), codes)
-        return self.error_code_type(value=codes[chosen])
+        return self.error_code_type(value=codes[cnu_error_name(code, codes)])
 
     def states(self, states: list) -> list:
         """Our StateInstantiation messages as this type's (flexbe_msgs' for CNU's type)."""
@@ -88,10 +88,10 @@ class FlexBESynthesisInterface:
         return [copy_message(state, self.state_type, {'cond_transition': self.condition_type})
                 for state in states]
 
-    def result(self, error_name: str, message: str, states: list, notes: list):
+    def result(self, code: ErrorCode, message: str, states: list, notes: list):
         """The action's result: CNU's code, the states, and on failure ``NAME: message``."""
-        failure = [] if error_name == 'SUCCESS' else [f'{error_name}: {message}']
-        return self.action_type.Result(error_code=self.error_code(error_name), states=self.states(states),
+        failure = [] if code == ErrorCode.SUCCESS else [f'{code}: {message}']
+        return self.action_type.Result(error_code=self.error_code(code), states=self.states(states),
                                        messages=list(notes) + failure)
 
 

@@ -6,6 +6,7 @@ Nodes stay thin: they call a core function and use these helpers on the way in a
 from __future__ import annotations
 
 from respec.automaton import Automaton, AutomatonState as CoreState
+from respec.errors import ErrorCode
 from synthesis_msgs.msg import (AutomatonState, FSAutomaton, LTLSpecification, OutcomeCondition,
                                 StateInstantiation, SynthesisErrorCodes)
 
@@ -13,10 +14,10 @@ LTL_SECTIONS = ('sys_props', 'env_props', 'sys_init', 'env_init', 'sys_trans', '
                 'sys_liveness', 'env_liveness')
 
 
-def error_code(name: str = 'SUCCESS', message: str = '') -> SynthesisErrorCodes:
-    """A SynthesisErrorCodes message from a constant's name (unknown names become FAILURE)."""
-    return SynthesisErrorCodes(value=getattr(SynthesisErrorCodes, name, SynthesisErrorCodes.FAILURE),
-                               message=message)
+def error_code(code: ErrorCode | str = ErrorCode.SUCCESS, message: str = '') -> SynthesisErrorCodes:
+    """The SynthesisErrorCodes message of ``code`` (an ErrorCode or its name; any other name
+    is a programming error: ValueError)."""
+    return SynthesisErrorCodes(value=ErrorCode(code).number, message=message)
 
 
 def constants(message_type) -> dict[str, int]:
@@ -25,8 +26,11 @@ def constants(message_type) -> dict[str, int]:
             if name.isupper() and isinstance(value, int) and not isinstance(value, bool)}
 
 
-def error_name(value: int, codes=SynthesisErrorCodes) -> str:
-    """The constant name of an error code value, e.g. -21 -> 'SPEC_UNSYNTHESIZABLE'."""
+def error_name(value: int, codes=None) -> str:
+    """The constant name of an error code value, e.g. -21 -> 'SPEC_UNSYNTHESIZABLE' (ours, or
+    of the message type ``codes``, such as CNU's); an unknown value is shown as its number."""
+    if codes is None:
+        return ErrorCode.name_of(value)
     return next((name for name, constant in constants(codes).items() if constant == value), str(value))
 
 

@@ -24,40 +24,49 @@ from typing import Callable
 
 from rclpy.callback_groups import ReentrantCallbackGroup
 
-from respec.errors import CodedError
-from synthesis_manager.ros.conversions import error_name
+from respec.errors import CodedError, ControlFlowSignal, ErrorCode
 
 WATCH_PERIOD = 0.1
 
 
-class StageFailed(Exception):
-    """A pipeline service answered with an error: the goal ends with that answer."""
+class StageFailed(CodedError):
+    """A pipeline service answered with an error code: the goal ends with that answer, relayed.
+    The one error whose code is per instance (it is the stage's); an answer whose number this
+    suite does not know keeps the class's code and names the number."""
+
+    code = ErrorCode.BEHAVIOR_SYNTHESIS_FAILED
 
     def __init__(self, answer):
-        self.error_name = error_name(answer.value)
-        super().__init__(answer.message or self.error_name)
+        try:
+            self.code = ErrorCode.from_number(answer.value)
+        except ValueError:
+            super().__init__(f'a stage answered the unknown error code {answer.value}: {answer.message}',
+                             answer.value)
+        else:
+            super().__init__(answer.message or self.code.name)
 
 
 class StageUnavailable(CodedError):
     """A pipeline service is not there, or its node went away while working."""
 
-    code = 'SERVICE_UNAVAILABLE'
+    code = ErrorCode.SERVICE_UNAVAILABLE
 
 
 class StageTimedOut(CodedError):
     """A pipeline service did not answer in time."""
 
-    code = 'TIMEOUT'
+    code = ErrorCode.TIMEOUT
 
 
 class ServerStopping(CodedError):
     """The server shuts down while a goal waits on a stage."""
 
-    code = 'BEHAVIOR_SYNTHESIS_FAILED'
+    code = ErrorCode.BEHAVIOR_SYNTHESIS_FAILED
 
 
-class Preempted(Exception):
-    """The client cancelled the goal."""
+class Preempted(ControlFlowSignal):
+    """Control flow, not an error: the client cancelled the goal while it waited on a stage
+    (the goal then ends cancelled, with PREEMPTED)."""
 
 
 class _NextExecutorTurn:
@@ -108,7 +117,7 @@ class StageCaller:
                                            'away before answering', provider)
             if failure is not None:
                 client.remove_pending_request(future)
-                if on_cancel is not None and getattr(failure, 'code', '') != 'SERVICE_UNAVAILABLE':
+                if on_cancel is not None and getattr(failure, 'code', None) != ErrorCode.SERVICE_UNAVAILABLE:
                     on_cancel()  # tell the service to stop working for nobody
                 raise failure
             await next_executor_turn()

@@ -4,7 +4,7 @@ A service callback that synthesizes for a minute must not hold an executor threa
 handful of them every thread is taken and cancel requests, other services and the action
 server wait. The callback instead hands the work to this pool and awaits it; the pool runs
 at most ``workers`` jobs at once, keeps up to ``max_waiting`` more in arrival order and
-refuses the rest (:class:`PoolFull`, reported as BUSY), so a burst is bounded.
+refuses the rest (:class:`~synthesis_manager.limits.BusyError`), so a burst is bounded.
 
 Worker threads are daemons: a synthesis that ignored its cancel event could otherwise keep
 the process alive after SIGTERM.
@@ -16,18 +16,14 @@ import queue
 import threading
 from concurrent.futures import Future
 
-from respec.errors import CodedError
+from respec.errors import ControlFlowSignal
+from synthesis_manager.limits import BusyError
 from synthesis_manager.ros.stage_calls import next_executor_turn
 
 
-class PoolFull(CodedError):
-    """Too many jobs are running or waiting."""
-
-    code = 'BUSY'
-
-
-class Abandoned(Exception):
-    """The caller gave up on a job that had not started (see WorkerPool.run's ``give_up``)."""
+class Abandoned(ControlFlowSignal):
+    """Control flow, not an error: the caller gave up on a job that had not started (see
+    WorkerPool.run's ``give_up``); the caller answers its request itself."""
 
 
 class WorkerPool:
@@ -46,10 +42,10 @@ class WorkerPool:
             return self._outstanding
 
     def submit(self, function, *args) -> Future:
-        """Queue ``function(*args)``; raises PoolFull when the pool is at its limit."""
+        """Queue ``function(*args)``; raises BusyError when the pool is at its limit."""
         with self._lock:
             if self._outstanding >= self.workers + self.max_waiting:
-                raise PoolFull(f'{self._outstanding} jobs are running or waiting (limit '
+                raise BusyError(f'{self._outstanding} jobs are running or waiting (limit '
                                f'{self.workers} running + {self.max_waiting} waiting); try again later',
                                self.name)
             self._outstanding += 1

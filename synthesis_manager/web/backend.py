@@ -19,13 +19,14 @@ from atlas_sim.closed_loop import run_and_check
 from atlas_sim.robot import SimulatedRobot, make_simulator, parse_faults
 from ltl_specification.diagnosis import goal_findings, impossible_next_goals
 from respec.abstraction import load_abstraction
-from respec.errors import INTERNAL_ERROR, CodedError, quoted
+from respec.errors import INTERNAL_ERROR, CodedError, ErrorCode, quoted
 from respec.naming import DEFAULT_SM_OUTCOMES, FINISHED
 from respec.parsing import spec_from_text_sections
 from respec.systems import SystemConfigError, available_systems, load_section
+from synthesis_manager.limits import BusyError
 from synthesis_manager.web.artifacts import ARTIFACTS, Artifact
-from synthesis_manager.web.errors import (ArtifactFailedError, BusyError, InvalidJobRequestError,
-                                          NotAvailableError, NotFoundError, TooManyRequestsError)
+from synthesis_manager.web.errors import (ArtifactFailedError, InvalidJobRequestError, NotAvailableError,
+                                          NotFoundError)
 from synthesis_manager.web.jobs import JOB_OPTIONS, Job, JobRequest, local_outcome, names_field
 from synthesis_manager.web.simulations import Simulation, simulation_available
 
@@ -220,7 +221,7 @@ class SynthesisBackend:
         max_simulations_per_job newest runs by forgetting its oldest finished one. Holds _lock."""
         running = [run for run in self._simulations.values() if run.state != 'finished']
         if len(running) >= self.max_running_simulations:
-            raise TooManyRequestsError(
+            raise BusyError(
                 f'{len(running)} simulations are running (at most {self.max_running_simulations} at once); '
                 'try again when one has finished', 'simulations', retry_after=SIMULATION_RETRY_AFTER)
         runs = [run for run in self._simulations.values() if run.job_id == job_id]
@@ -322,7 +323,7 @@ class SynthesisBackend:
             if job.cancel_requested.is_set():
                 break
         if job.cancel_requested.is_set():  # never sent: nothing to cancel downstream
-            self._finish(job, local_outcome('PREEMPTED', 'cancelled before it was sent', job))
+            self._finish(job, local_outcome(ErrorCode.PREEMPTED, 'cancelled before it was sent', job))
             return
         self._update(job, state='running', status='sending the goal')
 
@@ -341,8 +342,8 @@ class SynthesisBackend:
         self._update(job, status=status, progress=float(progress), timeline=job.timeline + [entry])
 
     def _finish(self, job: Job, outcome: dict):
-        if outcome['error_name'] == 'PREEMPTED':
+        if outcome['error_name'] == ErrorCode.PREEMPTED:
             self._note(job, 'Cancelled', job.progress)
         self._update(job, state='finished', outcome=outcome, status=outcome['error_name'],
                      finished_after=round(time.monotonic() - job.created, 4),
-                     progress=1.0 if outcome['error_name'] == 'SUCCESS' else job.progress)
+                     progress=1.0 if outcome['error_name'] == ErrorCode.SUCCESS else job.progress)

@@ -2,12 +2,27 @@
 ``{"error", "code", "item", "message"}``.
 
 ``error`` names the kind of HTTP failure (``NOT_FOUND``, ...); ``code`` is the
-SynthesisErrorCodes name, as for every user-facing error.
+SynthesisErrorCodes name, as for every user-facing error. A :class:`BusyError` (too much work in
+progress) is 503, or 429 with Retry-After when it says when to come back.
 """
 
 from __future__ import annotations
 
-from respec.errors import CodedError, quoted
+from respec.errors import CodedError, ErrorCode, quoted
+from synthesis_manager.limits import BusyError
+
+
+def http_answer(error: CodedError) -> tuple[int, dict, dict | None]:
+    """Status, JSON body and headers answering ``error`` (a GuiRequestError or BusyError)."""
+    if isinstance(error, BusyError):
+        headers = {'Retry-After': str(error.retry_after)} if error.retry_after else None
+        return (429 if error.retry_after else 503), _body('BUSY', error), headers
+    return error.status, _body(error.kind, error), None
+
+
+def _body(kind: str, error: CodedError) -> dict:
+    item = error.item if isinstance(error.item, str) else quoted(error.item)
+    return {'error': kind, 'code': error.code, 'item': item, 'message': str(error)}
 
 
 class GuiRequestError(CodedError):
@@ -15,11 +30,10 @@ class GuiRequestError(CodedError):
 
     status = 400
     kind = 'BAD_REQUEST'
-    code = 'INVALID_REQUEST'
+    code = ErrorCode.INVALID_REQUEST
 
     def to_dict(self) -> dict:
-        item = self.item if isinstance(self.item, str) else quoted(self.item)
-        return {'error': self.kind, 'code': self.code, 'item': item, 'message': str(self)}
+        return _body(self.kind, self)
 
 
 class NotFoundError(GuiRequestError):
@@ -48,25 +62,4 @@ class ArtifactFailedError(GuiRequestError):
 
     status = 500
     kind = 'ARTIFACT_FAILED'
-    code = 'FAILURE'
-
-
-class BusyError(GuiRequestError):
-    """Too many jobs are unfinished: the request is refused, try again later."""
-
-    status = 503
-    kind = 'BUSY'
-    code = 'BUSY'
-
-
-class TooManyRequestsError(GuiRequestError):
-    """Too much of one kind of work is running: try again after ``retry_after`` seconds
-    (sent as the Retry-After header)."""
-
-    status = 429
-    kind = 'BUSY'
-    code = 'BUSY'
-
-    def __init__(self, message: str, item='', retry_after: int = 10):
-        super().__init__(message, item)
-        self.retry_after = retry_after
+    code = ErrorCode.FAILURE

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import json
 
-from respec.errors import quoted
+from respec.errors import ErrorCode, quoted
 from synthesis_manager.limits import MAX_BODY_BYTES
 
 LOOPBACK_ADDRESSES = ('127.0.0.1', '::1')
@@ -93,7 +93,7 @@ def _replay(body: bytes, receive):
 
 async def _refuse(send, status: int, error: str, item: str, message: str):
     """Answer with the GUI's error body ``{"error", "code", "item", "message"}``."""
-    payload = json.dumps({'error': error, 'code': 'INVALID_REQUEST', 'item': item, 'message': message}).encode()
+    payload = json.dumps({'error': error, 'code': ErrorCode.INVALID_REQUEST, 'item': item, 'message': message}).encode()
     await send({'type': 'http.response.start', 'status': status,
                 'headers': [(b'content-type', b'application/json'),
                             (b'content-length', str(len(payload)).encode()),

@@ -7,13 +7,12 @@ import threading
 import time
 from dataclasses import asdict, dataclass, field
 
-from respec.errors import quoted
+from respec.errors import ErrorCode, quoted
 from respec.naming import DEFAULT_SM_OUTCOMES, parse_names
 from sm_generation.instantiation import StateInstantiation, count_states
 from synthesis_manager.limits import oversized_strings, too_long
 from synthesis_manager.web.artifacts import available_artifacts, download_labels
 from synthesis_manager.web.errors import InvalidJobRequestError, NotFoundError
-from synthesis_msgs.msg import SynthesisErrorCodes
 
 # The stop-early options the page offers (ltl_synthesis_only needs a whole specification).
 JOB_OPTIONS = ('ltl_compilation_only', 'ltl_steps_only')
@@ -122,7 +121,7 @@ class Job:
 
 def local_outcome(error_name: str, message: str, job: Job) -> dict:
     """An outcome (SynthesisOutcome.to_dict() shape) for a job that never got a result."""
-    return {'error_code': getattr(SynthesisErrorCodes, error_name), 'error_name': error_name, 'message': message,
+    return {'error_code': ErrorCode(error_name).number, 'error_name': error_name, 'message': message,
             'states': [], 'ltl_specification': {}, 'automaton': {},
             'seconds': round(time.monotonic() - job.created, 4)}
 
@@ -132,14 +131,14 @@ def result_summary(outcome: dict) -> dict:
     sections = outcome.get('ltl_specification') or {}
     automaton_states = len((outcome.get('automaton') or {}).get('states') or [])
     states = outcome.get('states') or []
-    if outcome.get('error_name') == 'SPEC_UNSYNTHESIZABLE':
+    if outcome.get('error_name') == ErrorCode.SPEC_UNSYNTHESIZABLE:
         realizable = False
     elif automaton_states:
         realizable = True
     else:
         realizable = None  # synthesis did not run (compile only, or an earlier failure)
     return {
-        'succeeded': outcome.get('error_name') == 'SUCCESS',
+        'succeeded': outcome.get('error_name') == ErrorCode.SUCCESS,
         'realizable': realizable,
         'input_propositions': len(sections.get('env_props', [])),
         'output_propositions': len(sections.get('sys_props', [])),

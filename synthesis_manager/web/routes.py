@@ -43,7 +43,8 @@ from fastapi.responses import FileResponse, HTMLResponse, JSONResponse, Response
 from fastapi.staticfiles import StaticFiles
 
 from synthesis_manager.web.artifacts import Artifact
-from synthesis_manager.web.errors import GuiRequestError, InvalidJobRequestError, NotFoundError
+from synthesis_manager.limits import BusyError
+from synthesis_manager.web.errors import GuiRequestError, InvalidJobRequestError, NotFoundError, http_answer
 from synthesis_manager.web.guards import RequestGuard
 
 STATIC_DIR = Path(__file__).with_name('static')
@@ -57,10 +58,10 @@ def create_app(backend) -> FastAPI:
     app.add_middleware(RequestGuard)  # Host check and the body size limit, before any route
 
     @app.exception_handler(GuiRequestError)
-    async def gui_error(_request, error: GuiRequestError):
-        retry_after = getattr(error, 'retry_after', None)
-        return JSONResponse(error.to_dict(), status_code=error.status,
-                            headers={'Retry-After': str(retry_after)} if retry_after else None)
+    @app.exception_handler(BusyError)
+    async def gui_error(_request, error):
+        status, body, headers = http_answer(error)
+        return JSONResponse(body, status_code=status, headers=headers)
 
     @app.exception_handler(RequestValidationError)
     async def malformed(_request, error: RequestValidationError):

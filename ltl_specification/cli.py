@@ -19,6 +19,7 @@ import yaml
 
 from ltl_specification.compiler import compile_task, explain
 from ltl_specification.errors import InvalidFormulaError, SpecificationError
+from respec.errors import ExitStatus, exit_status_help
 from respec.naming import parse_names
 
 FORMATS = ('structuredslugs', 'slugsin', 'json')
@@ -26,6 +27,7 @@ FORMATS = ('structuredslugs', 'slugsin', 'json')
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Add the ``compile`` options to ``parser``."""
+    parser.epilog = exit_status_help(ExitStatus.OK, ExitStatus.FAILED, ExitStatus.USAGE)
     parser.add_argument('--system', required=True, help='robot system, e.g. atlas (config/<system>.yaml)')
     parser.add_argument('--initial-conditions', default='',
                         help='comma-separated actions/control modes that hold initially '
@@ -55,7 +57,7 @@ def run(args: argparse.Namespace) -> int:
     except SpecificationError as error:
         message = ' '.join(str(error).split())
         print(f'error: {error.code}: {message} [item: {error.item!r}]', file=sys.stderr)
-        return 2
+        return ExitStatus.FAILED
     if args.format == 'json':
         text = json.dumps(spec.to_text_sections(), indent=2) + '\n'
     elif args.format == 'slugsin':
@@ -74,12 +76,13 @@ def run(args: argparse.Namespace) -> int:
         diagnosis = diagnose(spec, config_dir=args.config_dir)
         if diagnosis is not None:
             print(f'SPEC_UNSYNTHESIZABLE: {diagnosis.message()}', file=sys.stderr)
-            return 1
-    return 0
+            return ExitStatus.FAILED
+    return ExitStatus.OK
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog='behavior-synthesis compile', description=__doc__.split('\n')[0])
+    parser = argparse.ArgumentParser(prog='behavior-synthesis compile', description=__doc__.split('\n')[0],
+                                     formatter_class=argparse.RawDescriptionHelpFormatter)
     add_arguments(parser)
     return run(parser.parse_args(argv))
 

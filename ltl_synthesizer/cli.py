@@ -27,16 +27,18 @@ import sys
 import time
 from pathlib import Path
 
+from respec.errors import ExitStatus, exit_status_help
+
 REALIZABLE_LINE = 'RESULT: Specification is realizable.'
 UNREALIZABLE_LINE = 'RESULT: Specification is unrealizable.'
-EXIT_MALFORMED = 1
-EXIT_TIMEOUT = 3
-EXIT_MEMORY = 4
 
 
 def _parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
-        prog='gr1synth', description='GR(1) synthesis with slugs-compatible input and output.')
+        prog='gr1synth', description='GR(1) synthesis with slugs-compatible input and output.',
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+        epilog=exit_status_help(ExitStatus.OK, ExitStatus.FAILED, ExitStatus.USAGE, ExitStatus.TIMED_OUT,
+                                ExitStatus.OUT_OF_MEMORY))
     parser.add_argument('--explicitStrategy', action='store_true',
                         help='write an explicit-state strategy when realizable')
     parser.add_argument('--jsonOutput', action='store_true', help="strategies in slugs' JSON format")
@@ -83,7 +85,7 @@ def _arguments(argv):
         # As slugs ("too many file names"): an output file is only ever a strategy's.
         print('gr1synth: error: an OUTPUT file is written only with --explicitStrategy, '
               '--counterStrategy or --convert', file=sys.stderr)
-        raise SystemExit(EXIT_MALFORMED)
+        raise SystemExit(ExitStatus.FAILED)
     return args
 
 
@@ -225,18 +227,18 @@ def _run(args) -> int:
         spec = read_specification(args.input, check=interrupt, deadline=deadline)
     except SynthesisCancelled as error:
         print(f'gr1synth: error: {error}', file=sys.stderr)
-        return EXIT_TIMEOUT
+        return ExitStatus.TIMED_OUT
     except (SynthesisMemoryExceeded, MemoryError) as error:
         print(f'gr1synth: error: memory limit: {error or "out of memory"} (while parsing {args.input})',
               file=sys.stderr)
-        return EXIT_MEMORY
+        return ExitStatus.OUT_OF_MEMORY
     except (ParseError, OSError, ValueError) as error:
         print(f'gr1synth: error: {error}', file=sys.stderr)
-        return EXIT_MALFORMED
+        return ExitStatus.FAILED
 
     if args.convert:
         _write(spec.to_slugsin(), args.output)
-        return 0
+        return ExitStatus.OK
 
     if deadline is None:
         from ltl_synthesizer.synthesizer import synthesize
@@ -256,13 +258,13 @@ def _run(args) -> int:
                             memory_limit=memory_limit)
     except SynthesisCancelled as error:
         print(f'gr1synth: error: {error}', file=sys.stderr)
-        return EXIT_TIMEOUT
+        return ExitStatus.TIMED_OUT
     except SynthesisMemoryExceeded as error:
         print(f'gr1synth: error: {error}', file=sys.stderr)
-        return EXIT_MEMORY
+        return ExitStatus.OUT_OF_MEMORY
     except SynthesisError as error:
         print(f'gr1synth: error: {args.input}: {error}', file=sys.stderr)
-        return EXIT_MALFORMED
+        return ExitStatus.FAILED
     finally:
         if deadline is not None:
             processes.close()
@@ -275,7 +277,7 @@ def _run(args) -> int:
     elif not result.realizable and args.counterStrategy:
         strategy = result.counterstrategy
     else:
-        return 0
+        return ExitStatus.OK
     try:
         if args.jsonOutput:
             _write_chunks(strategy_json_chunks(strategy), args.output)
@@ -283,8 +285,8 @@ def _run(args) -> int:
             _write(strategy_to_text(strategy), args.output)
     except SynthesisMemoryExceeded as error:  # a streamed strategy is extracted while written
         print(f'gr1synth: error: {error}', file=sys.stderr)
-        return EXIT_MEMORY
-    return 0
+        return ExitStatus.OUT_OF_MEMORY
+    return ExitStatus.OK
 
 
 if __name__ == '__main__':

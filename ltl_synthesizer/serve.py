@@ -13,6 +13,8 @@ import contextlib
 import io
 import json
 
+from respec.errors import ExitStatus
+
 
 def serve(requests, answers) -> int:
     for line in requests:
@@ -32,15 +34,15 @@ def answer(line: str) -> dict:
         if not isinstance(argv, list) or not all(isinstance(item, str) for item in argv):
             raise ValueError('a request is a JSON list of strings')
     except ValueError as error:
-        return {'status': cli.EXIT_MALFORMED, 'stdout': '', 'stderr': f'gr1synth: error: {error}\n'}
+        return {'status': ExitStatus.FAILED, 'stdout': '', 'stderr': f'gr1synth: error: {error}\n'}
     with contextlib.redirect_stdout(stdout), contextlib.redirect_stderr(stderr):
         try:
             args = cli._arguments(argv)
             if args.serve:
                 print('gr1synth: error: --serve inside a request', file=stderr)
-                status = cli.EXIT_MALFORMED
+                status = ExitStatus.FAILED
             else:
                 status = cli.run_with_deep_stack(cli._run, args)
         except SystemExit as exit_:  # argparse's usage errors
-            status = exit_.code if isinstance(exit_.code, int) else cli.EXIT_MALFORMED
+            status = exit_.code if isinstance(exit_.code, int) else ExitStatus.FAILED
     return {'status': status, 'stdout': stdout.getvalue(), 'stderr': stderr.getvalue()}

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import enum
 import reprlib
+import textwrap
 
 #: How much of a user's value any message quotes: a refused value may be megabytes long.
 QUOTED_CHARACTERS = 40
@@ -136,3 +137,48 @@ def quoted(value, length: int = QUOTED_CHARACTERS) -> str:
         return repr(value) if len(value) <= length else repr(value[:length]) + '...'
     shown = _SHORT_REPR.repr(value)
     return shown if len(shown) <= length else shown[:length] + '...'
+
+
+class ExitStatus(enum.IntEnum):
+    """The exit status of every command of the suite, one meaning per number (README, "Exit
+    status"); a command stopped by SIGINT or SIGTERM exits with 128 + the signal's number."""
+
+    def __new__(cls, number: int, meaning: str):
+        member = int.__new__(cls, number)
+        member._value_, member.meaning = number, meaning
+        return member
+
+    OK = 0, 'done as asked (`gr1synth`: realizable or not, as slugs)'
+    FAILED = 1, ('the input or the task was refused: an error code of the pipeline (printed with '
+                 'the item it names), a malformed specification (`gr1synth`, as slugs), a task that '
+                 'cannot be done (`compile --diagnose`)')
+    USAGE = 2, 'bad command line, or an argument file that cannot be read'
+    TIMED_OUT = 3, 'a time limit ran out (`--timeout`, a goal\'s time limit)'
+    OUT_OF_MEMORY = 4, 'a memory limit was exceeded (`gr1synth --memory-limit`)'
+    UNAVAILABLE = 5, 'a server, node or port the command needs is missing or busy'
+    OTHER_OUTCOME = 6, '`execute`: the behavior ended in another outcome than `--expect`'
+    VIOLATIONS = 7, '`execute`: the trace check found violations, or the robot fell'
+    NOT_FINISHED = 8, '`execute`: the run could not finish (robot-time limit, a state it cannot run)'
+
+    @classmethod
+    def for_error(cls, code: ErrorCode | str) -> ExitStatus:
+        """The exit status of a command whose request ended with ``code`` (an ErrorCode or the
+        name a server answered; one this suite does not know is a failure)."""
+        try:
+            code = ErrorCode(code)
+        except ValueError:
+            return cls.FAILED
+        if code == ErrorCode.SUCCESS:
+            return cls.OK
+        if code in (ErrorCode.TIMEOUT, ErrorCode.SYNTHESIS_TIMEOUT):
+            return cls.TIMED_OUT
+        if code in (ErrorCode.SERVICE_UNAVAILABLE, ErrorCode.BUSY):
+            return cls.UNAVAILABLE
+        return cls.FAILED
+
+
+def exit_status_help(*statuses: ExitStatus) -> str:
+    """The ``Exit status:`` paragraph of a command's help, for the statuses it can end with."""
+    lines = [textwrap.fill(f'{int(status)}  {status.meaning.replace("`", "")}', width=88,
+                           initial_indent='  ', subsequent_indent='     ') for status in statuses]
+    return '\n'.join(['Exit status:', *lines, '  130, 143  stopped by SIGINT (Ctrl-C) or SIGTERM'])

@@ -13,6 +13,7 @@ import argparse
 import sys
 from pathlib import Path
 
+from respec.errors import ExitStatus, exit_status_help
 from respec.naming import parse_names
 from sm_generation.automaton_io import load_automaton
 from sm_generation.errors import SMGenerationError
@@ -24,6 +25,7 @@ FORMATS = ('yaml', 'json', 'dot', *RENDER_FORMATS)
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.epilog = exit_status_help(ExitStatus.OK, ExitStatus.FAILED, ExitStatus.USAGE)
     parser.add_argument('--system', default='atlas', help='robot system (config/<system>.yaml); default atlas')
     parser.add_argument('--automaton', required=True, type=Path,
                         help='automaton file: our YAML/JSON format, or a slugs JSON strategy (needs --spec)')
@@ -40,7 +42,7 @@ def run(args: argparse.Namespace) -> int:
     fmt = args.format or _format_from_suffix(args.output) or 'yaml'
     if fmt in RENDER_FORMATS and args.output is None:
         print(f'error: --format {fmt} needs -o FILE', file=sys.stderr)
-        return 2
+        return ExitStatus.USAGE
     initial_conditions = None
     if args.initial_conditions is not None:
         initial_conditions = parse_names(args.initial_conditions)
@@ -49,25 +51,25 @@ def run(args: argparse.Namespace) -> int:
         states = generate_state_machine(automaton, args.system, args.config_dir, initial_conditions, args.reduce)
     except SMGenerationError as error:
         print(f'error: {error.code}: {error} (item: {error.item})', file=sys.stderr)
-        return 1
+        return ExitStatus.FAILED
     problems = validate_state_machine(states)
     if problems:  # would be a bug in this package; report rather than write a broken file
         print('error: SM_GENERATION_FAILED: generated machine is inconsistent:\n  ' + '\n  '.join(problems),
               file=sys.stderr)
-        return 1
+        return ExitStatus.FAILED
     if fmt in RENDER_FORMATS:
         try:
             render(to_dot(states), args.output, fmt)
         except RenderError as error:
             print(f'error: {error} (item: {error.item})', file=sys.stderr)
-            return 1
-        return 0
+            return ExitStatus.FAILED
+        return ExitStatus.OK
     text = {'yaml': to_yaml, 'json': to_json, 'dot': to_dot}[fmt](states)
     if args.output is None:
         sys.stdout.write(text)
     else:
         args.output.write_text(text)
-    return 0
+    return ExitStatus.OK
 
 
 def _format_from_suffix(path: Path | None) -> str | None:

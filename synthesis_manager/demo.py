@@ -10,6 +10,7 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
+from respec.errors import ExitStatus, exit_status_help
 from sm_generation import StateInstantiation
 from sm_generation.export import render, to_dot, to_json, to_yaml
 from synthesis_manager.send_goal import ProgressBar, add_goal_arguments, goal_from_args, print_summary
@@ -17,6 +18,7 @@ from synthesis_manager.suite import SuiteUnavailable, add_suite_arguments, in_pr
 
 
 def add_arguments(parser):
+    parser.epilog = exit_status_help(ExitStatus.OK, ExitStatus.FAILED, ExitStatus.TIMED_OUT, ExitStatus.UNAVAILABLE)
     add_goal_arguments(parser, with_options=False)
     parser.set_defaults(name='demo')
     add_suite_arguments(parser)
@@ -54,14 +56,14 @@ def run(args) -> int:
             progress.close()
     except SuiteUnavailable as error:
         print(f'demo: {error}', file=sys.stderr)
-        return 1
+        return ExitStatus.UNAVAILABLE
     print_summary(outcome)
     if not outcome.succeeded:
-        return 1
+        return ExitStatus.for_error(outcome.error_name)
     print('realizable: yes')
     written = write_artifacts(outcome, directory)
     byproducts = sorted(directory.glob(f'{args.name}.*'))
     print(f'artifacts in {directory}:')
     for path in byproducts + written:
         print(f'  {path.name}')
-    return 0
+    return ExitStatus.OK

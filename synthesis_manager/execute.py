@@ -28,16 +28,8 @@ With ``--engine flexbe`` the machine is exported as a FlexBE behavior and run by
 FlexBE engine (``synthesis_manager.ros.flexbe_engine``), its states driving the simulator
 node over ROS; the report is the same.
 
-Exit status:
-  0  the run ended in the expected SM outcome (``--expect``, default ``finished``), the
-     trace check found no violation and the robot did not fall;
-  1  the run ended in another SM outcome (trace clean, robot standing);
-  2  bad command line (e.g. a malformed ``--fail-first``);
-  3  synthesis failed (the action's error code is printed);
-  4  the trace check found violations, or the robot fell;
-  5  the run could not finish (robot-time limit, a state the executive cannot run, ...);
-  130, 143  stopped by SIGINT (Ctrl-C) or SIGTERM.
-A mission stops at the first batch with status 3, 4 or 5 and exits with it; otherwise it
+Exit status: see the table below (from respec.errors.ExitStatus). A mission stops at the first
+batch that ends with anything but 0 or 6 (another SM outcome) and exits with it; otherwise it
 exits with the status of its last batch (earlier batches may end in any SM outcome).
 """
 
@@ -50,14 +42,14 @@ from pathlib import Path
 
 from atlas_sim.closed_loop import DeferredEvents, run_and_check
 from atlas_sim.machine import ExecutionError
+from respec.errors import ExitStatus, exit_status_help
 from respec.parsing import spec_from_text_sections
 from synthesis_manager.send_goal import ProgressBar, add_goal_arguments, goal_from_args, print_summary
 from synthesis_manager.suite import SuiteUnavailable, add_suite_arguments, in_process_suite
 
-EXIT_OK, EXIT_OTHER_OUTCOME, EXIT_USAGE, EXIT_SYNTHESIS, EXIT_VIOLATIONS, EXIT_EXECUTION = 0, 1, 2, 3, 4, 5
-
-
-EXIT_STATUS_HELP = __doc__[__doc__.index('Exit status:'):]
+EXIT_STATUS_HELP = exit_status_help(ExitStatus.OK, ExitStatus.FAILED, ExitStatus.USAGE, ExitStatus.TIMED_OUT,
+                                    ExitStatus.UNAVAILABLE, ExitStatus.OTHER_OUTCOME, ExitStatus.VIOLATIONS,
+                                    ExitStatus.NOT_FINISHED)
 
 
 def add_arguments(parser):
@@ -104,7 +96,7 @@ def run(args) -> int:
         problem = _flexbe_usage_problem(args)
         if problem:
             print(f'execute: {problem}', file=sys.stderr)
-            return EXIT_USAGE
+            return ExitStatus.USAGE
     if args.record:
         os.environ.setdefault('MUJOCO_GL', 'egl')  # before anything imports mujoco
     initial_conditions = parse_names(args.initial_conditions)
@@ -115,7 +107,7 @@ def run(args) -> int:
         simulator = make_simulator(args.system, args.config_dir or None, start, faults, args.seed)
     except (FaultSpecError, InitialConditionError, InvalidInitialConditionsError, SystemConfigError) as error:
         print(f'execute: {error}', file=sys.stderr)
-        return EXIT_USAGE
+        return ExitStatus.USAGE
     log = sys.stderr if args.json else sys.stdout
     report = {'system': args.system, 'faults': faults}
     code = _synthesize_and_execute(args, simulator, initial_conditions, batches, report, log)
@@ -146,7 +138,7 @@ def _synthesize_and_execute(args, simulator, initial_conditions, batches, report
             return session.run_mission(initial_conditions, batches, report)
     except SuiteUnavailable as error:
         print(f'execute: {error}', file=sys.stderr)
-        return EXIT_SYNTHESIS
+        return ExitStatus.UNAVAILABLE
 
 
 class _Session:
@@ -182,7 +174,7 @@ class _Session:
             code = self.run_batch(initial_conditions if index == 0 else [CURRENT], goals, batch, record,
                                   self.args.expect if last else 'finished')
             batch['exit_code'] = code
-            if code in (EXIT_SYNTHESIS, EXIT_VIOLATIONS, EXIT_EXECUTION):
+            if code not in (ExitStatus.OK, ExitStatus.OTHER_OUTCOME):
                 break
         return code
 
@@ -217,7 +209,7 @@ class _Session:
             print_summary(outcome, stream=self.log)
         if not outcome.succeeded:
             print(f'execute: synthesis failed: {outcome.error_name}: {outcome.message}', file=sys.stderr)
-            return EXIT_SYNTHESIS
+            return ExitStatus.for_error(outcome.error_name)
         robot, sim_node = self.robot()
         return _execute(self.args, outcome, robot, self.simulator, goals, report, self.log, sim_node,
                         record, expect, self.ros.domain_id)
@@ -280,7 +272,7 @@ def _execute(args, outcome, robot, simulator, goals, report, log, sim_node, reco
         report.update(outcome=None, error={'code': error.code, 'item': error.item, 'message': str(error)},
                       trace=error.trace.to_dict() if error.trace else None, fallen=simulator.has_fallen())
         print(f'execute: {error}', file=sys.stderr)
-        return EXIT_EXECUTION
+        return ExitStatus.NOT_FINISHED
     result, check = run.result, run.check
     fallen = result.fallen or simulator.has_fallen()
     report.update(outcome=result.outcome, trace=result.trace.to_dict(), trace_check=check.to_dict(),
@@ -294,8 +286,8 @@ def _execute(args, outcome, robot, simulator, goals, report, log, sim_node, reco
         if record:
             print(f'recorded {len(run.frames)} frames and {report["timeline"]}', file=log)
     if check.violations or fallen:
-        return EXIT_VIOLATIONS
-    return EXIT_OK if result.outcome == expect else EXIT_OTHER_OUTCOME
+        return ExitStatus.VIOLATIONS
+    return ExitStatus.OK if result.outcome == expect else ExitStatus.OTHER_OUTCOME
 
 
 def print_run(run, check, fallen: bool, wall: float, stream=sys.stdout) -> None:

@@ -20,15 +20,17 @@ import sys
 import time
 from pathlib import Path
 
+from respec.errors import ExitStatus, exit_status_help
 from synthesis_manager.send_goal import ProgressBar, add_goal_arguments, goal_from_args
 from synthesis_manager.suite import SuiteUnavailable, add_suite_arguments, in_process_suite
 
-EXIT_OK, EXIT_USAGE, EXIT_SYNTHESIS = 0, 2, 3
+EXIT_STATUSES = (ExitStatus.OK, ExitStatus.FAILED, ExitStatus.USAGE, ExitStatus.TIMED_OUT, ExitStatus.UNAVAILABLE)
 
 
 def add_arguments(parser):
     from sm_generation.flexbe_behavior import DEFAULT_PACKAGE
 
+    parser.epilog = exit_status_help(*EXIT_STATUSES)
     add_goal_arguments(parser, with_options=False)
     add_suite_arguments(parser)
     parser.add_argument('--package', default=DEFAULT_PACKAGE, help=f'ROS package name (default {DEFAULT_PACKAGE})')
@@ -51,19 +53,19 @@ def run(args) -> int:
         config = load_flexbe_config(args.system, args.config_dir or None)
     except SMGenerationError as error:
         print(f'export-behavior: {error.code}: {error}', file=sys.stderr)
-        return EXIT_USAGE
+        return ExitStatus.USAGE
     progress = ProgressBar(stream=sys.stderr)  # the stream of now (the default is the one at import)
     try:
         with in_process_suite(args, 'export_behavior_client') as (_, client):
             outcome = client.run(goal_from_args(args), feedback=progress)
     except SuiteUnavailable as error:
         print(f'export-behavior: {error}', file=sys.stderr)
-        return EXIT_SYNTHESIS
+        return ExitStatus.UNAVAILABLE
     finally:
         progress.close()
     if not outcome.succeeded:
         print(f'export-behavior: synthesis failed: {outcome.error_name}: {outcome.message}', file=sys.stderr)
-        return EXIT_SYNTHESIS
+        return ExitStatus.for_error(outcome.error_name)
     states = [StateInstantiation.from_dict(s) for s in outcome.states]
     description = (args.description or f'Synthesized for {args.system}: from {", ".join(initial_conditions)}, '
                    f'achieve {", ".join(goals)}.')
@@ -72,7 +74,7 @@ def run(args) -> int:
                                    date=time.strftime('%a %b %d %Y'))
     except SMGenerationError as error:
         print(f'export-behavior: {error.code}: {error}', file=sys.stderr)
-        return EXIT_USAGE
+        return ExitStatus.FAILED
     folder = package.write(Path(args.output))
     print(f'wrote behavior "{behavior_name}" ({package.class_name}) as package {package.package}: {folder}')
-    return EXIT_OK
+    return ExitStatus.OK

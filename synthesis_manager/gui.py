@@ -19,7 +19,7 @@ import time
 import uvicorn
 from rclpy.node import Node
 
-from respec.errors import ErrorCode
+from respec.errors import ErrorCode, ExitStatus, exit_status_help
 from synthesis_manager.client import SynthesisClient, SynthesisOutcome, make_goal
 from synthesis_manager.ros.harness import RosHarness, environment_domain_id
 from synthesis_manager.suite import add_suite_arguments, suite_node_factories
@@ -31,6 +31,7 @@ LOOPBACK_HOSTS = ('127.0.0.1', 'localhost', '::1')
 
 
 def add_arguments(parser):
+    parser.epilog = exit_status_help(ExitStatus.OK, ExitStatus.USAGE, ExitStatus.UNAVAILABLE)
     parser.add_argument('--port', type=int, default=DEFAULT_PORT,
                         help=f'TCP port of the page (default {DEFAULT_PORT}; 0 picks a free one)')
     parser.add_argument('--host', default='127.0.0.1',
@@ -155,7 +156,7 @@ def run(args) -> int:
         sock = listening_socket(args.host, args.port)
     except OSError as error:
         print(f'gui: cannot listen on {args.host}:{args.port}: {error.strerror}', file=sys.stderr)
-        return 1
+        return ExitStatus.UNAVAILABLE
     with sock:
         try:
             with ros_backend(args, connect=args.connect) as backend:
@@ -167,4 +168,4 @@ def run(args) -> int:
                 server.run(sockets=[sock])
         except KeyboardInterrupt:
             pass
-    return 0
+    return ExitStatus.OK

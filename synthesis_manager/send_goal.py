@@ -9,7 +9,7 @@ from pathlib import Path
 
 from rclpy.node import Node
 
-from respec.errors import CodedError
+from respec.errors import CodedError, ExitStatus, exit_status_help
 from respec.naming import parse_names
 from respec.parsing import parse_structuredslugs
 from sm_generation.instantiation import count_states
@@ -43,6 +43,8 @@ def add_goal_arguments(parser, with_options: bool = True):
 
 
 def add_arguments(parser):
+    parser.epilog = exit_status_help(ExitStatus.OK, ExitStatus.FAILED, ExitStatus.USAGE, ExitStatus.TIMED_OUT,
+                                     ExitStatus.UNAVAILABLE)
     add_goal_arguments(parser)
     parser.add_argument('--action', choices=('behavior_synthesis', 'flexbe_synthesis'),
                         default='behavior_synthesis',
@@ -132,7 +134,7 @@ def run(args) -> int:
         goal = goal_from_args(args)
     except (OSError, ValueError, CodedError) as error:
         print(f'send-goal: cannot read the request: {error}', file=sys.stderr)
-        return 2
+        return ExitStatus.USAGE
 
     print(f'send-goal: waiting for /{args.action}…', file=sys.stderr, flush=True)
     with RosHarness(domain_id=environment_domain_id()) as ros:
@@ -140,7 +142,7 @@ def run(args) -> int:
         if not client.wait_for_server(timeout=SERVER_WAIT):
             print(f'send-goal: no /{args.action} action server after {SERVER_WAIT:g} s (start one with '
                   '`behavior-synthesis serve` or `behavior-synthesis gui`)', file=sys.stderr)
-            return 1
+            return ExitStatus.UNAVAILABLE
         progress = None if args.json else ProgressBar()
         cancel = threading.Event()
         outcome_box = {}
@@ -180,5 +182,5 @@ def run(args) -> int:
     if interrupted:
         raise KeyboardInterrupt  # the command line exits with 128 + the signal's number
     if outcome is None:
-        return 1
-    return 0 if outcome.succeeded else 1
+        return ExitStatus.FAILED
+    return ExitStatus.for_error(outcome.error_name)

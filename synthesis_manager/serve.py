@@ -2,12 +2,16 @@
 
 from __future__ import annotations
 
+import sys
+
+from respec.errors import ExitStatus, exit_status_help
 from respec.naming import parse_names
 from synthesis_manager.ros.node_main import run_nodes
 from synthesis_manager.suite import SUITE_NODE_NAMES, add_suite_arguments, suite_node_factories
 
 
 def add_arguments(parser):
+    parser.epilog = exit_status_help(ExitStatus.OK, ExitStatus.USAGE)
     add_suite_arguments(parser)
     parser.add_argument('--nodes', default=','.join(SUITE_NODE_NAMES),
                         help=f'comma-separated subset of: {", ".join(SUITE_NODE_NAMES)}')
@@ -17,8 +21,8 @@ def run(args) -> int:
     names = parse_names(args.nodes)
     unknown = sorted(set(names) - set(SUITE_NODE_NAMES))
     if unknown:
-        print(f'behavior-synthesis serve: unknown node {unknown[0]!r}')
-        return 2
+        print(f'behavior-synthesis serve: unknown node {unknown[0]!r}', file=sys.stderr)
+        return ExitStatus.USAGE
     return run_nodes(*suite_node_factories(args, names),
                      ready_message=f'behavior synthesis suite up: {", ".join(names)} '
                                    '(actions /behavior_synthesis and /flexbe_synthesis); Ctrl-C to stop')

@@ -17,6 +17,7 @@ from respec.parsing import spec_from_text_sections
 from synthesis_manager.cli import main as cli_main
 from synthesis_manager.client import SynthesisClient, make_goal
 from synthesis_manager.suite import suite_node_factories
+from respec.errors import ExitStatus
 
 
 def synthesize_over_ros(ros, initial_conditions, goals, sm_outcomes=('finished', 'failed')):
@@ -65,7 +66,7 @@ def test_cli_runs_a_task_and_prints_json(capsys):
 def test_cli_exit_codes_follow_the_expected_outcome_and_records_frames(capsys, tmp_path):
     arguments = ['--goals', 'look_down,pickup_object', '--fail', 'pickup_object']
     code, report = run_cli(capsys, *arguments)
-    assert code == 1 and report['outcome'] == 'failed' and report['trace_check']['ok']
+    assert code == ExitStatus.OTHER_OUTCOME and report['outcome'] == 'failed' and report['trace_check']['ok']
     code, report = run_cli(capsys, *arguments, '--expect', 'failed', '--record', str(tmp_path))
     assert code == 0
     frames = sorted((tmp_path / 'frames').glob('*.png'))
@@ -96,6 +97,6 @@ def test_cli_rejects_bad_faults_and_starts_before_synthesis(capsys, arguments, i
 
 def test_cli_reports_a_failed_synthesis(capsys):
     code, report = run_cli(capsys, '--goals', 'fly')
-    assert code == 3
+    assert code == ExitStatus.FAILED
     assert report['synthesis']['error_name'] != 'SUCCESS' and 'fly' in report['synthesis']['message']
     assert 'trace' not in report

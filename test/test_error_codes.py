@@ -115,3 +115,13 @@ def test_a_relayed_answer_keeps_its_code_and_an_unknown_number_is_named():
     assert known.code is ErrorCode.SPEC_UNSYNTHESIZABLE and str(known) == 'no way'
     unknown = StageFailed(SynthesisErrorCodes(value=777, message='odd'))
     assert unknown.code is ErrorCode.BEHAVIOR_SYNTHESIS_FAILED and 'unknown error code 777: odd' in str(unknown)
+
+
+def test_the_readme_lists_every_exit_status_with_its_meaning():
+    from respec.errors import ExitStatus
+
+    readme = (ROOT / 'README.md').read_text()
+    assert all(f'| {int(status)} | {status.meaning} |' in readme for status in ExitStatus)
+    assert ExitStatus.for_error('SPEC_UNSYNTHESIZABLE') == ExitStatus.FAILED == ExitStatus.for_error('777')
+    assert ExitStatus.for_error(ErrorCode.SYNTHESIS_TIMEOUT) == ExitStatus.TIMED_OUT
+    assert ExitStatus.for_error(ErrorCode.BUSY) == ExitStatus.UNAVAILABLE

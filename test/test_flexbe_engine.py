@@ -111,7 +111,7 @@ def run_cli(capsys, *arguments):
 
 @pytest.mark.parametrize('arguments, code, outcome', [
     ((), 0, 'finished'),
-    (('--fail', 'pickup_object'), 1, 'failed'),
+    (('--fail', 'pickup_object'), 6, 'failed'),  # ExitStatus.OTHER_OUTCOME
     (('--sm-outcomes', 'finished', '--fail-first', 'pickup_object:2'), 0, 'finished')],
     ids=['finished', 'failed', 'retry'])
 def test_execute_on_the_flexbe_engine_prints_the_usual_report(capsys, arguments, code, outcome):

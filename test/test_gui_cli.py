@@ -74,7 +74,7 @@ def test_gui_reports_a_port_in_use():
         port = wait_for_line(first, URL_LINE).group(1).rsplit(':', 1)[1].strip('/')
         second = subprocess.run([sys.executable, '-m', 'synthesis_manager', 'gui', '--port', port],
                                 capture_output=True, text=True, timeout=60)
-        assert second.returncode == 1
+        assert second.returncode == 5  # ExitStatus.UNAVAILABLE
         assert f'cannot listen on 127.0.0.1:{port}' in second.stderr
     finally:
         assert stop(first) == 0

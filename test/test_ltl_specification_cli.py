@@ -60,9 +60,9 @@ def test_custom_ltl_file_and_explain(tmp_path):
      'INVALID_INITIAL_CONDITIONS', "'walk'"),
     (['--system', 'atlas', '--goals', 'walk', '--sm-outcomes', 'failed'], 'INVALID_SM_OUTCOMES', "'failed'"),
 ])
-def test_bad_input_exits_2_with_one_line_naming_the_item(args, code, item):
+def test_bad_input_exits_1_with_one_line_naming_the_item(args, code, item):
     result = cli(*args)
-    assert result.returncode == 2 and result.stdout == ''
+    assert result.returncode == 1 and result.stdout == ''
     lines = result.stderr.strip().splitlines()
     assert len(lines) == 1
     assert lines[0].startswith(f'error: {code}: ') and f'[item: {item}]' in lines[0]
@@ -70,7 +70,7 @@ def test_bad_input_exits_2_with_one_line_naming_the_item(args, code, item):
 
 def test_unreadable_custom_ltl_file():
     result = cli('--system', 'atlas', '--goals', 'walk', '--custom-ltl', '/nonexistent/custom.yaml')
-    assert result.returncode == 2 and 'INVALID_FORMULA' in result.stderr
+    assert result.returncode == 1 and 'INVALID_FORMULA' in result.stderr
 
 
 def test_add_arguments_and_run_in_process(tmp_path, capsys):
@@ -80,7 +80,7 @@ def test_add_arguments_and_run_in_process(tmp_path, capsys):
     assert run(parser.parse_args(['--system', 'atlas', '--goals', 'walk', '--format', 'slugsin',
                                   '-o', str(target)])) == 0
     assert target.read_text() == compile_task('atlas', [], ['walk']).to_slugsin()
-    assert run(parser.parse_args(['--system', 'atlas', '--goals', ''])) == 2
+    assert run(parser.parse_args(['--system', 'atlas', '--goals', ''])) == 1  # ExitStatus.FAILED
     assert 'INVALID_GOALS' in capsys.readouterr().err
 
 

@@ -149,7 +149,7 @@ def test_mission_recovers_after_a_failed_batch(capsys):
                                '--then', 'pickup_object')
     assert code == 0, report
     failed, recovered = report['batches']
-    assert failed['outcome'] == 'failed' and failed['trace_check']['ok'] and failed['exit_code'] == 1
+    assert failed['outcome'] == 'failed' and failed['trace_check']['ok'] and failed['exit_code'] == 6  # ExitStatus.OTHER_OUTCOME
     # the next batch starts from the failed state: in manipulate, the pickup not completed
     assert recovered['initial_conditions'][0] == 'manipulate'
     assert 'pickup_object' not in recovered['initial_conditions']

@@ -12,7 +12,8 @@ from respec.spec import GR1Specification
 from ltl_synthesizer.explain import explain_unrealizable
 from ltl_synthesizer.gr1 import solve_environment_game, solve_system_game
 from ltl_synthesizer.strategy import extract_counterstrategy, extract_strategy, streamed_strategy
-from ltl_synthesizer.symbolic import Interrupt, Options, SymbolicGame, memory_exceeded
+from ltl_synthesizer.interrupt import Interrupt, memory_exceeded
+from ltl_synthesizer.symbolic import Options, SymbolicGame
 
 # Default memory limit of one synthesis: BDD memory, in bytes.
 DEFAULT_MEMORY_LIMIT = 2 * 2**30

@@ -23,7 +23,8 @@ from respec.spec import FORMULA_SECTIONS, GR1Specification
 
 from ltl_synthesizer.gr1 import solve_environment_game, solve_system_game
 from ltl_synthesizer.strategy import extract_counterstrategy
-from ltl_synthesizer.symbolic import Interrupt, SymbolicGame
+from ltl_synthesizer.interrupt import Interrupt
+from ltl_synthesizer.symbolic import SymbolicGame
 from ltl_synthesizer.synthesizer import initial_positions_win
 
 T = TypeVar('T')

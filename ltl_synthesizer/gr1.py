@@ -39,9 +39,9 @@ class AttractorStep:
         step's position sets there, and renamed back: swapping the variables of a small set
         is cheap, priming the large position sets is not.
         """
-        swapped = game.swap_steps(moves)  # the moves' targets are now current variables
-        into_closer = game.swap_steps(swapped & self.closer)
-        into_waiting = game.swap_steps(swapped & self.waiting) & ~self.assumption
+        reversed_moves = game.prime(moves)  # the moves' targets are now current variables
+        into_closer = game.prime(reversed_moves & self.closer)
+        into_waiting = game.prime(reversed_moves & self.waiting) & ~self.assumption
         return (moves & self.goal_transitions) | into_closer | into_waiting
 
 

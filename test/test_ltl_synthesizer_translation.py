@@ -58,11 +58,11 @@ def test_next_maps_to_the_primed_copy_and_distributes():
     assert g.bdd.support(u) == {"a'", "b'"}
 
 
-def test_prime_and_unprime_are_inverse():
+def test_priming_twice_is_the_identity():
     g = game()
     u = g.translator.translate(disj([a, conj([b, neg(c)])]), 'sys_trans')
     assert g.bdd.support(g.prime(u)) == {"a'", "b'", "c'"}
-    assert g.unprime(g.prime(u)) == u
+    assert g.prime(g.prime(u)) == u
 
 
 def test_unknown_proposition_is_named():

@@ -15,10 +15,12 @@ in each of its loops, so a synthesis stops within a few milliseconds plus one BD
 ``Interrupt(cancel, deadline, memory_limit)`` is the same check as one object: pass it to
 ``respec.parsing.parse_structuredslugs(text, check=interrupt)`` to bound parsing too.
 
-Modules: symbolic (formulas to BDDs, enforceable predecessors, the Interrupt), gr1 (fixpoints),
-strategy (explicit strategies, counter-strategies, slugs JSON), explain (why unrealizable),
-unrealizable_core (minimal unrealizable subsets of guarantees, by delta debugging), cli
-(``gr1synth``). Imports are lazy, so ``gr1synth --help`` starts without loading CUDD.
+Modules: interrupt (cancel, deadline, memory limit), symbolic (the game: formulas to BDDs,
+enforceable predecessors), policy (Options and the automatic plan), gr1 (the solver and its
+fixpoints), strategy (explicit strategies, counter-strategies, slugs JSON), explain (why
+unrealizable), unrealizable_core (minimal unrealizable subsets of guarantees, by delta
+debugging), cli (``gr1synth``). Imports are lazy, so ``gr1synth --help`` starts without
+loading CUDD.
 """
 
 import importlib
@@ -27,7 +29,7 @@ _EXPORTS = {
     'synthesize': 'ltl_synthesizer.synthesizer', 'is_realizable': 'ltl_synthesizer.synthesizer',
     'SynthesisResult': 'ltl_synthesizer.synthesizer',
     'DEFAULT_MEMORY_LIMIT': 'ltl_synthesizer.synthesizer',
-    'Options': 'ltl_synthesizer.symbolic', 'Interrupt': 'ltl_synthesizer.symbolic',
+    'Options': 'ltl_synthesizer.policy', 'Interrupt': 'ltl_synthesizer.interrupt',
     'SynthesisCancelled': 'ltl_synthesizer.errors', 'SynthesisError': 'ltl_synthesizer.errors',
     'SynthesisMemoryExceeded': 'ltl_synthesizer.errors',
     'UndeclaredPropositionError': 'ltl_synthesizer.errors',

@@ -218,7 +218,7 @@ def _run(args) -> int:
     from respec.parsing import ParseError
     from ltl_synthesizer.errors import (SynthesisCancelled, SynthesisError,
                                         SynthesisMemoryExceeded)
-    from ltl_synthesizer.symbolic import Interrupt
+    from ltl_synthesizer.interrupt import Interrupt
 
     deadline = time.monotonic() + args.timeout if args.timeout else None
     memory_limit = int(args.memory_limit * 2**20) if args.memory_limit > 0 else None

@@ -47,7 +47,7 @@ def _initial_conditions(game, system, environment, robotics_semantics) -> list[s
         return ['No initial state satisfies both ENV_INIT and SYS_INIT '
                 '(the system initial conditions contradict the environment ones).']
     if system.complete and system.winning == game.false:
-        where = 'reachable ' if game.reachable_only else ''
+        where = 'reachable ' if system.reachable_only else ''
         header = f'No {where}position is winning for the system (the environment wins from everywhere).'
     else:
         header = None

@@ -15,8 +15,65 @@ from __future__ import annotations
 
 import itertools
 from dataclasses import dataclass, field
+from functools import cached_property
 
+from ltl_synthesizer.cudd_import import cudd
+from ltl_synthesizer.policy import Options, ReorderingSwitch, plan
 from ltl_synthesizer.symbolic import SymbolicGame
+
+
+class Solver:
+    """What the solver keeps while it works on one game (the game itself stays stateless):
+    the plan chosen for it (``policy.plan``), the positions that matter (``care``), the
+    reordering switch, and a memo of the system's predecessors of recent position sets."""
+
+    def __init__(self, game: SymbolicGame, options: Options | None = None):
+        self.game = game
+        self.options = options or Options()
+        self.plan = plan(game, self.options)
+        if self.plan.sift_once:
+            game.bdd.reorder()
+        self.reordering = ReorderingSwitch(game, self.plan.reordering)
+        self._moves_into = {}
+        self._previous_moves_into = {}
+
+    @cached_property
+    def care(self):
+        """The positions the solver must decide: all, or those reachable from the initial ones.
+
+        Every legal move (env_trans and sys_trans) from a reachable position leads to a
+        reachable one, so the game restricted to them has the same winner there; the
+        solver's sets then stay within them, and targets are simplified outside them.
+        """
+        return self.game.reachable_positions() if self.plan.reachable_only else self.game.true
+
+    def enforce(self, responses):
+        """``game.enforce``, with the reordering switch watching the BDDs grow."""
+        self.reordering.observe()
+        return self.game.enforce(responses)
+
+    def system_can_move_into(self, positions, remember: bool = True):
+        """``exists y'. sys_trans & positions'``, memoized: the assumptions' inner fixpoints
+        share start sets, and each outer iteration restarts them from the previous one's
+        results (see ``start_outer_iteration``). Sets that never recur (``remember=False``)
+        stay out of the memo: kept alive, they would slow every garbage collection and
+        reordering (the safety fixpoint of moving obstacle 24x24: 2.5x slower)."""
+        key = int(positions)
+        found = self._moves_into.get(key) or self._previous_moves_into.get(key)
+        if found is None or found[0] != positions:
+            # Only moves from relevant positions matter, and they lead to relevant positions:
+            # the target may take any values elsewhere, so take CUDD's simplest such BDD.
+            care = self.care
+            target = positions if care == self.game.true else cudd.restrict(positions, care)
+            found = (positions, self.game.system_can_respond(self.game.prime(target)))
+        if remember:
+            self._moves_into[key] = found
+        return found[1]
+
+    def start_outer_iteration(self):
+        """Keep the memo of the previous outer (Z) iteration only: older sets do not recur."""
+        self._previous_moves_into = self._moves_into
+        self._moves_into = {}
 
 
 @dataclass
@@ -39,9 +96,9 @@ class AttractorStep:
         step's position sets there, and renamed back: swapping the variables of a small set
         is cheap, priming the large position sets is not.
         """
-        swapped = game.swap_steps(moves)  # the moves' targets are now current variables
-        into_closer = game.swap_steps(swapped & self.closer)
-        into_waiting = game.swap_steps(swapped & self.waiting) & ~self.assumption
+        reversed_moves = game.prime(moves)  # the moves' targets are now current variables
+        into_closer = game.prime(reversed_moves & self.closer)
+        into_waiting = game.prime(reversed_moves & self.waiting) & ~self.assumption
         return (moves & self.goal_transitions) | into_closer | into_waiting
 
 
@@ -54,6 +111,7 @@ class SystemSolution:
     winning: object
     attractor_steps: list = field(default_factory=list)
     complete: bool = True  # False when the solver stopped early because the initial check failed
+    reachable_only: bool = False  # decided on the reachable positions only (Solver.care)
 
 
 class WarmStarts:
@@ -85,7 +143,7 @@ class WarmStarts:
         self._current, self._current_last = {}, {}
 
 
-def solve_system_game(game: SymbolicGame, stop_when_losing=None) -> SystemSolution:
+def solve_system_game(solver: Solver, stop_when_losing=None) -> SystemSolution:
     """The system's winning positions: the greatest fixpoint Z over all goals,
 
         nu Z. /\\_j mu Y. \\/_i nu X. cox( (G_j & Z') | Y' | (!A_i & X') ).
@@ -97,42 +155,44 @@ def solve_system_game(game: SymbolicGame, stop_when_losing=None) -> SystemSoluti
     # to the same greatest fixpoint). The safety game's winning positions are one, and cheap;
     # on typical specifications they are exactly the winning positions, so the first Z
     # iteration is already the confirming one (instead of two or three full iterations).
-    Z = safe = _safe_positions(game, game.relevant_positions(), stop_when_losing)
+    game = solver.game
+    reachable_only = solver.plan.reachable_only
+    Z = safe = _safe_positions(solver, solver.care, stop_when_losing)
     if stop_when_losing is not None and not stop_when_losing(safe):
-        return SystemSolution(safe, [], complete=False)
+        return SystemSolution(safe, [], complete=False, reachable_only=reachable_only)
     warm_starts = WarmStarts()
     while True:
-        game.start_outer_iteration()
+        solver.start_outer_iteration()
         attractor_steps = []
         next_Z = game.true
         for goal_index, goal in enumerate(game.sys_goals):
-            attracted, steps = _attract_to_goal(game, goal_index, goal, Z, warm_starts)
+            attracted, steps = _attract_to_goal(solver, goal_index, goal, Z, warm_starts)
             attractor_steps += steps
             next_Z &= attracted
             if next_Z == game.false:
                 break
         if next_Z == Z:
-            return SystemSolution(Z, attractor_steps)
+            return SystemSolution(Z, attractor_steps, reachable_only=reachable_only)
         Z = next_Z
         warm_starts.next_outer_iteration()
         if stop_when_losing is not None and not stop_when_losing(Z):
-            return SystemSolution(Z, [], complete=False)
+            return SystemSolution(Z, [], complete=False, reachable_only=reachable_only)
 
 
-def _safe_positions(game: SymbolicGame, within, stop_when_losing=None):
+def _safe_positions(solver: Solver, within, stop_when_losing=None):
     """``nu Z. within & cox(Z')``: positions (among ``within``) from which the system can keep
     both safety sections forever. Every winning position is one (a winning strategy stays
     among them). Stops early (returning the current Z) once ``stop_when_losing`` says the
     initial positions are lost: Z only shrinks."""
     Z = within
     while True:
-        next_Z = Z & game.enforce(game.system_can_move_into(Z, remember=False))
+        next_Z = Z & solver.enforce(solver.system_can_move_into(Z, remember=False))
         if next_Z == Z or (stop_when_losing is not None and not stop_when_losing(next_Z)):
             return next_Z
         Z = next_Z
 
 
-def _attract_to_goal(game: SymbolicGame, goal_index: int, goal, winning, warm_starts: WarmStarts):
+def _attract_to_goal(solver: Solver, goal_index: int, goal, winning, warm_starts: WarmStarts):
     """Middle least fixpoint Y: positions that can force goal ``goal`` (into Z = ``winning``)
     or keep some environment goal false forever while staying safe.
 
@@ -141,7 +201,8 @@ def _attract_to_goal(game: SymbolicGame, goal_index: int, goal, winning, warm_st
     Gauss-Seidel iteration: the same least fixpoint, reached in far fewer sweeps, and each
     step's ``closer`` set still only holds positions of lower rank).
     """
-    chained = game.options.chained_sweeps
+    game = solver.game
+    chained = solver.options.chained_sweeps
     goal_transitions = goal & game.prime(winning)
     reach_goal = game.system_can_respond(goal_transitions)
     Y = game.false
@@ -152,7 +213,7 @@ def _attract_to_goal(game: SymbolicGame, goal_index: int, goal, winning, warm_st
         for assumption_index, assumption in enumerate(game.env_goals):
             start = warm_starts.upper_bound(goal_index, sweep, assumption_index, winning)
             X, responses = _wait_for_assumption(
-                game, can_move_towards_goal, assumption, start,
+                solver, can_move_towards_goal, assumption, start,
                 game.env_goal_ignores_outputs[assumption_index])
             warm_starts.record(goal_index, sweep, assumption_index, X)
             closer = Y if chained else Y_before_sweep
@@ -163,16 +224,16 @@ def _attract_to_goal(game: SymbolicGame, goal_index: int, goal, winning, warm_st
             Y |= X
             if chained and new_positions:
                 # The product distributes over the union, and X's own product is memoized.
-                can_move_towards_goal |= game.system_can_move_into(X)
+                can_move_towards_goal |= solver.system_can_move_into(X)
         # Y never leaves Z (every X starts inside it): once Y is Z, the next sweep could
         # only confirm it, at the price of all the inner fixpoints.
         if Y == Y_before_sweep or Y == winning:
             return Y, steps
         if not chained:
-            can_move_towards_goal = reach_goal | game.system_can_move_into(Y)
+            can_move_towards_goal = reach_goal | solver.system_can_move_into(Y)
 
 
-def _wait_for_assumption(game: SymbolicGame, can_move_towards_goal, assumption, start,
+def _wait_for_assumption(solver: Solver, can_move_towards_goal, assumption, start,
                          system_independent: bool):
     """Inner greatest fixpoint X: positions that can move towards the goal, or else stay in X
     on transitions that violate environment goal ``assumption``.
@@ -183,14 +244,15 @@ def _wait_for_assumption(game: SymbolicGame, can_move_towards_goal, assumption, 
     any upper bound. Returns X and the system's responses (over current variables and next
     inputs) that keep to these transitions.
     """
+    game = solver.game
     X = start
     while True:
         if system_independent:
             # The assumption constrains no next output, so it factors out of exists y'.
-            responses = can_move_towards_goal | (~assumption & game.system_can_move_into(X))
+            responses = can_move_towards_goal | (~assumption & solver.system_can_move_into(X))
         else:
             responses = can_move_towards_goal | game.system_can_respond(game.prime(X) & ~assumption)
-        next_X = X & game.enforce(responses)
+        next_X = X & solver.enforce(responses)
         if next_X == X:
             return X, responses
         X = next_X
@@ -218,11 +280,14 @@ class EnvironmentSolution:
     levels: list = field(default_factory=list)
 
 
-def solve_environment_game(game: SymbolicGame) -> EnvironmentSolution:
+def solve_environment_game(solver: Solver) -> EnvironmentSolution:
     """The dual (counter-strategy) game, as slugs' ``--counterStrategy``:
 
         mu Z. \\/_j nu Y. /\\_i mu X. env_cox( (Z' | !G_j) & Y' & (X' | A_i) )
+
+    (The solver's memo and care set are the system's: this game uses only its plan.)
     """
+    game = solver.game
     winning = game.false
     levels = []
     while True:

@@ -10,9 +10,6 @@ remaining conjunct mentions it (early quantification), which keeps intermediate 
 
 from __future__ import annotations
 
-import os
-import threading
-import time
 import warnings
 from dataclasses import dataclass, field
 from functools import cached_property
@@ -21,108 +18,14 @@ from ltl_synthesizer.cudd_import import cudd
 
 from respec.spec import GR1Specification
 
-from ltl_synthesizer.errors import SynthesisCancelled, SynthesisMemoryExceeded
+from ltl_synthesizer.interrupt import Interrupt
+from ltl_synthesizer.policy import Options
 from ltl_synthesizer.translation import Translator, check_declarations, primed, variable_order
-
-# Conjuncts are merged into clusters while the cluster's BDD stays below this many nodes: fewer,
-# larger relational products are faster than many tiny ones, up to a point (see bench/): 1000
-# rather than 2500 makes multi-goal ATLAS tasks 20-40% faster and leaves the chain family as is.
-DEFAULT_CLUSTER_LIMIT = 1000
 
 # CUDD's cache and unique tables grow on demand; starting small keeps tiny specs fast (dd's
 # default cache of 262,144 slots alone costs 5-6 ms to set up, a tenth of a paper-size task).
 MEMORY_ESTIMATE = 64 * 2**20
 INITIAL_CACHE_SLOTS = 2**14
-
-# Up to this many propositions a game solves in a few tens of milliseconds, and neither the
-# sifting pass nor the reachability search pays for itself (bench/bench_synthesizer.py
-# --compare: paper tasks 35-45% faster without them, 5-goal ATLAS tasks and 12-action chains
-# 10-45% slower); 'automatic' options switch them on above it.
-SMALL_GAME_PROPOSITIONS = 36
-
-# Automatic dynamic reordering. Sifting from the start, as slugs does, is 2-5x faster on
-# games with several system goals (a Y/X family per goal stays alive and one order must suit
-# them all: AMBA) and on small pure safety games over wide integers (moving obstacle: few
-# variables, large BDDs). Elsewhere it starts on the static order and switches sifting on only
-# once this many BDD nodes are alive: ATLAS tasks (one goal, an assumption per action) would
-# lose up to 2x to sifting, cinderella (many variables, small BDDs) 4x
-# (bench/bench_gr1_families.py, bench_goals.py). A node count, not a time: the same request
-# always takes the same path.
-DYNAMIC_REORDERING_FROM_NODES = 100_000
-REORDERING_CHECK_PERIOD = 4
-# ... and the sifting pass also runs on smaller games whose safety relations have this many nodes.
-SIFTED_RELATION_NODES = 1000
-
-
-@dataclass
-class Options:
-    """Tuning switches of the symbolic engine (defaults are the measured best; see bench/)."""
-
-    # Dynamic reordering (CUDD's automatic sifting); None = automatic: from the start with
-    # several system goals or on small safety games, else past DYNAMIC_REORDERING_FROM_NODES.
-    reordering: bool | None = None
-    # None = automatic: on for games of more than SMALL_GAME_PROPOSITIONS propositions
-    # (reachable_only: and with some liveness goal; see SymbolicGame).
-    sift_once: bool | None = None  # one sifting pass after the relations are built (see SymbolicGame)
-    cluster_limit: int = DEFAULT_CLUSTER_LIMIT
-    variable_order: str = 'affinity'  # 'affinity' (co-occurrence) or 'declared'
-    reachable_only: bool | None = None  # solve only on positions reachable from the initial ones
-    chained_sweeps: bool = True  # Gauss-Seidel Y sweeps (see gr1._attract_to_goal)
-
-
-class Interrupt:
-    """Stops a synthesis on request: a cancel flag, a deadline (a ``time.monotonic()``
-    instant) and a memory limit in bytes. Every long loop of the synthesizer (translation,
-    fixpoints, reachability, extraction, explanation, parsing) calls ``check()``, so a
-    synthesis stops within a few milliseconds of the request, beyond the duration of one BDD
-    operation. The object is also a plain callable (for respec's parser).
-
-    The memory limit bounds the BDDs (CUDD's own limit, set by the game, fails the operation
-    that would exceed it) and the process's growth in resident memory since this object was
-    made (the explicit strategy and the rest), polled every ``MEMORY_CHECK_SECONDS``.
-    """
-
-    MEMORY_CHECK_SECONDS = 0.1
-
-    def __init__(self, cancel: threading.Event | None = None, deadline: float | None = None,
-                 memory_limit: int | None = None):
-        self.cancel = cancel
-        self.deadline = deadline
-        self.memory_limit = memory_limit
-        self._baseline_memory = _resident_memory() if memory_limit is not None else 0
-        self._memory_checked_at = time.monotonic()
-
-    def check(self) -> None:
-        if self.cancel is not None and self.cancel.is_set():
-            raise SynthesisCancelled('cancelled')
-        now = time.monotonic()
-        if self.deadline is not None and now >= self.deadline:
-            raise SynthesisCancelled('timeout')
-        if self.memory_limit is not None and now - self._memory_checked_at >= self.MEMORY_CHECK_SECONDS:
-            self._memory_checked_at = now
-            if _resident_memory() - self._baseline_memory > self.memory_limit:
-                raise memory_exceeded(self.memory_limit)
-
-    __call__ = check
-
-
-def _resident_memory() -> int:
-    """This process's resident memory in bytes (Linux; elsewhere its peak so far)."""
-    try:
-        with open('/proc/self/statm') as statm:
-            return int(statm.read().split()[1]) * _PAGE_SIZE
-    except OSError:
-        import resource
-        return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
-
-
-_PAGE_SIZE = os.sysconf('SC_PAGE_SIZE') if hasattr(os, 'sysconf') else 4096
-
-
-def memory_exceeded(limit: int) -> SynthesisMemoryExceeded:
-    return SynthesisMemoryExceeded(
-        f'synthesis needs more than its memory limit of {limit / 2**20:.0f} MB '
-        '(memory_limit); simplify the specification or raise the limit', item='memory_limit')
 
 
 @dataclass
@@ -135,25 +38,29 @@ class _Partition:
 
 
 class SymbolicGame:
-    """BDD encoding of a GR(1) game; the current-step variables are the game positions."""
+    """BDD encoding of a GR(1) game; the current-step variables are the game positions.
+
+    The game holds the specification's BDDs and stateless operators on them; whatever a
+    solver keeps while it works (care set, memo, reordering progress) is the solver's
+    (gr1.Solver). ``options`` choose the encoding: variable order and cluster size.
+    """
 
     def __init__(self, spec: GR1Specification, options: Options | None = None,
                  interrupt: Interrupt | None = None):
         self.spec = spec
-        self.options = options or Options()
+        options = options or Options()
         self.interrupt = interrupt or Interrupt(None, None)
         self.inputs = list(spec.env_props)
         self.outputs = list(spec.sys_props)
         check_declarations(spec)
         self.variables = self.inputs + self.outputs
-        large = len(self.variables) > SMALL_GAME_PROPOSITIONS
         self.bdd = cudd.BDD(memory_estimate=MEMORY_ESTIMATE, initial_cache_size=INITIAL_CACHE_SLOTS)
         self.bdd.configure(reordering=False)
         if self.interrupt.memory_limit is not None:
             # CUDD fails an operation that would go beyond this (synthesize reports it);
             # the interrupt's own check catches slower growth between operations.
             self.bdd.configure(max_memory=self.interrupt.memory_limit)
-        for name in variable_order(spec, self.options.variable_order):
+        for name in variable_order(spec, options.variable_order):
             self.bdd.declare(name, primed(name))
             self.bdd.group({name: 2})  # reordering keeps each pair adjacent (cheap renaming)
         self.to_next = {name: primed(name) for name in self.variables}
@@ -162,8 +69,6 @@ class SymbolicGame:
         self.next_outputs = [primed(name) for name in self.outputs]
         self.true = self.bdd.true
         self.false = self.bdd.false
-        self._moves_into = {}
-        self._previous_moves_into = {}
 
         self.translator = Translator(self.bdd, self.inputs, self.outputs, self.interrupt.check)
         translate = self.translator.translate
@@ -174,54 +79,27 @@ class SymbolicGame:
         # slugs treats an empty liveness section as the single goal TRUE.
         self.env_goals = [translate(f, 'env_liveness') for f in spec.env_liveness] or [self.true]
         self.sys_goals = [translate(f, 'sys_liveness') for f in spec.sys_liveness] or [self.true]
+        self.has_liveness = any(goal != self.true for goal in self.env_goals + self.sys_goals)
         # Assumptions that constrain no next output factor out of exists y' (see gr1).
         self.env_goal_ignores_outputs = [not self.mentions_next_outputs(goal)
                                          for goal in self.env_goals]
-        # A pure safety game is solved by one greatest fixpoint, no dearer than the
-        # reachability search itself (cinderella: 0.01 s solving after 2.5 s of search).
-        has_liveness = any(goal != self.true for goal in self.env_goals + self.sys_goals)
-        self.reachable_only = (large and has_liveness) if self.options.reachable_only is None \
-            else self.options.reachable_only
-        self.env_partition = self._partition(self.env_trans_parts, set(self.next_inputs))
-        self.sys_partition = self._partition(self.sys_trans_parts, set(self.next_outputs))
-        # Few propositions but wide integers (grids, counters) also make large relations,
-        # whose bits the static order cannot place well (moving obstacle 16x16: 3x faster).
-        relation_nodes = sum(len(cluster) for cluster in
-                             self.env_partition.clusters + self.sys_partition.clusters)
-        self.sift_once = (large or relation_nodes >= SIFTED_RELATION_NODES) \
-            if self.options.sift_once is None else self.options.sift_once
-        if self.sift_once:
-            # The static order cannot know that e.g. a memory proposition belongs next to its
-            # action's activation and outcomes; one sifting pass on the relations finds such
-            # placements (3x faster multi-goal solving) for a few milliseconds.
-            self.bdd.reorder()
-        sift_from_start = len(self.sys_goals) > 1 or not (large or has_liveness)
-        self.reordering = sift_from_start if self.options.reordering is None \
-            else self.options.reordering
-        self._enforce_calls = 0
-        self._order_frozen = False
-        if self.reordering:
-            self.bdd.configure(reordering=True)
-        # Positions outside this set never matter (see relevant_positions); set by the solver.
-        self.care = self.true
+        self.env_partition = self._partition(self.env_trans_parts, set(self.next_inputs), options)
+        self.sys_partition = self._partition(self.sys_trans_parts, set(self.next_outputs), options)
+        # The size of the safety relations in the static order (before any reordering).
+        self.relation_nodes = sum(len(cluster) for cluster in
+                                  self.env_partition.clusters + self.sys_partition.clusters)
 
     # --- renaming and quantification ------------------------------------------------------
 
-    def swap_steps(self, u):
-        """``u`` with current and next-step variables exchanged (any set of transitions).
+    def prime(self, u):
+        """``u`` with every variable exchanged with its next-step copy (x <-> x').
 
-        The one place that uses dd's ``_swap``: swapping each pair is exact for any ``u`` and
-        much cheaper than dd's general renaming, which composes a substitution vector.
+        A set of positions Z becomes Z' (the same set, on the next step), a condition on the
+        next step becomes a set of positions, and a set of transitions is reversed in time;
+        ``prime(prime(u)) == u``. Swapping each pair is exact for any ``u`` and much cheaper
+        than dd's general renaming, which composes a substitution vector.
         """
         return self.bdd._swap(u, self.to_next)
-
-    def prime(self, u):
-        """The set ``u`` of positions (current variables only) as a condition on the next step."""
-        return self.swap_steps(u)
-
-    def unprime(self, u):
-        """A condition on next-step variables only, as a set of current positions."""
-        return self.swap_steps(u)
 
     def env_trans(self):
         """The monolithic environment safety relation (for explicit extraction and explanations)."""
@@ -230,8 +108,8 @@ class SymbolicGame:
     def sys_trans(self):
         return _conjoin(self.true, self.sys_partition.clusters, self.interrupt)
 
-    def _partition(self, parts, quantified: set[str]) -> _Partition:
-        clusters = _cluster(self.bdd, parts, self.options.cluster_limit, self.interrupt)
+    def _partition(self, parts, quantified: set[str], options: Options) -> _Partition:
+        clusters = _cluster(self.bdd, parts, options.cluster_limit, self.interrupt)
         supports = [self.bdd.support(c) & quantified for c in clusters]
         partition = _Partition(clusters=clusters)
         for index, support in enumerate(supports):
@@ -254,53 +132,11 @@ class SymbolicGame:
         """``exists y'. sys_trans & target``: the system has a legal move into ``target``."""
         return self._relational_product(target, self.sys_partition)
 
-    def system_can_move_into(self, positions, remember: bool = True):
-        """``exists y'. sys_trans & positions'``, memoized: the assumptions' inner fixpoints
-        share start sets, and each outer iteration restarts them from the previous one's
-        results (see ``start_outer_iteration``). Sets that never recur (``remember=False``)
-        stay out of the memo: kept alive, they would slow every garbage collection and
-        reordering (the safety fixpoint of moving obstacle 24x24: 2.5x slower)."""
-        key = int(positions)
-        found = self._moves_into.get(key) or self._previous_moves_into.get(key)
-        if found is None or found[0] != positions:
-            # Only moves from relevant positions matter, and they lead to relevant positions:
-            # the target may take any values elsewhere, so take CUDD's simplest such BDD.
-            target = positions if self.care == self.true else cudd.restrict(positions, self.care)
-            found = (positions, self.system_can_respond(self.prime(target)))
-        if remember:
-            self._moves_into[key] = found
-        return found[1]
-
-    def start_outer_iteration(self):
-        """Keep the memo of the previous outer (Z) iteration only: older sets do not recur."""
-        self._previous_moves_into = self._moves_into
-        self._moves_into = {}
-
     def enforce(self, responses):
         """Positions where every next input allowed by env_trans has a response:
         ``forall x'. env_trans -> responses`` (``responses`` over current vars and next inputs)."""
         self.interrupt.check()
-        self._reorder_when_large()
         return ~self._relational_product(~responses, self.env_partition)
-
-    def freeze_order(self) -> None:
-        """No more reordering: after the solve, the work is many small operations on BDDs
-        already built, which a late sifting pass (seconds) would not repay (slugs also stops
-        reordering before extracting strategies)."""
-        self.bdd.configure(reordering=False)
-        self._order_frozen = True
-
-    def _reorder_when_large(self) -> None:
-        """Automatic reordering: switch CUDD's sifting on once the BDDs have grown large."""
-        if self.reordering or self.options.reordering is not None or self._order_frozen:
-            return
-        # Reading CUDD's statistics scans its unique table: look every few operations only.
-        self._enforce_calls += 1
-        if self._enforce_calls % REORDERING_CHECK_PERIOD:
-            return
-        if self._cudd_statistics()['n_nodes'] > DYNAMIC_REORDERING_FROM_NODES:
-            self.reordering = True
-            self.bdd.configure(reordering=True)
 
     def cox(self, target):
         """Enforceable predecessor of a set of transitions (slugs' "cox").
@@ -320,18 +156,7 @@ class SymbolicGame:
         """The positions one legal move away from ``positions``."""
         # The whole relation at once: measured 2x faster than its clusters with early
         # quantification here, where every current variable is quantified.
-        return self.unprime(cudd.and_exists(positions, self.legal_moves, self.variables))
-
-    def relevant_positions(self):
-        """The positions the solver must decide: all, or those reachable from the initial ones.
-
-        Every legal move (env_trans and sys_trans) from a reachable position leads to a
-        reachable one, so the game restricted to them has the same winner there; the
-        solver's sets then stay within them, and targets are simplified outside them.
-        """
-        if self.reachable_only:
-            self.care = self.reachable_positions()
-        return self.care
+        return self.prime(cudd.and_exists(positions, self.legal_moves, self.variables))
 
     def reachable_positions(self):
         """Positions reachable from the initial ones (env_init & sys_init, either semantics)
@@ -400,13 +225,10 @@ class SymbolicGame:
             return False
         raise ValueError('assignment does not fix every variable of the function')
 
-    def _cudd_statistics(self) -> dict:
+    def statistics(self) -> dict:
         with warnings.catch_warnings():  # dd warns that 'mem' is now in bytes; we know
             warnings.simplefilter('ignore')
-            return self.bdd.statistics()
-
-    def statistics(self) -> dict:
-        stats = self._cudd_statistics()
+            stats = self.bdd.statistics()
         return {'bdd_nodes': stats.get('n_nodes'), 'peak_bdd_nodes': stats.get('peak_nodes'),
                 'reorderings': stats.get('n_reorderings'), 'bdd_memory_bytes': stats.get('mem')}
 

@@ -10,9 +10,11 @@ from dataclasses import dataclass, field
 from respec.spec import GR1Specification
 
 from ltl_synthesizer.explain import explain_unrealizable
-from ltl_synthesizer.gr1 import solve_environment_game, solve_system_game
+from ltl_synthesizer.gr1 import Solver, solve_environment_game, solve_system_game
 from ltl_synthesizer.strategy import extract_counterstrategy, extract_strategy, streamed_strategy
-from ltl_synthesizer.symbolic import Interrupt, Options, SymbolicGame, memory_exceeded
+from ltl_synthesizer.interrupt import Interrupt, memory_exceeded
+from ltl_synthesizer.policy import Options
+from ltl_synthesizer.symbolic import SymbolicGame
 
 # Default memory limit of one synthesis: BDD memory, in bytes.
 DEFAULT_MEMORY_LIMIT = 2 * 2**30
@@ -89,15 +91,16 @@ def _synthesize(spec, robotics_semantics, interrupt, counterstrategy, explain, o
     start = time.perf_counter()
     interrupt.check()
     game = SymbolicGame(spec, options, interrupt)
+    solver = Solver(game, options)
     built = time.perf_counter()
 
     def still_possible(winning):
         return initial_positions_win(game, winning, robotics_semantics)
 
-    solution = solve_system_game(game, stop_when_losing=still_possible)
+    solution = solve_system_game(solver, stop_when_losing=still_possible)
     realizable = solution.complete and still_possible(solution.winning)
     if realizable:  # the counter-game of an unrealizable one is another solve: it may sift
-        game.freeze_order()
+        solver.reordering.stop()
     solved = time.perf_counter()
     result = SynthesisResult(realizable=realizable)
     if realizable:
@@ -109,7 +112,7 @@ def _synthesize(spec, robotics_semantics, interrupt, counterstrategy, explain, o
             result.stats['warnings'] = ['ENV_INIT and SYS_INIT are contradictory: realizable '
                                         'vacuously, the strategy has no initial state']
     elif counterstrategy or explain:
-        environment = solve_environment_game(game)
+        environment = solve_environment_game(solver)
         if counterstrategy:
             result.counterstrategy = extract_counterstrategy(game, environment, robotics_semantics)
         if explain:

@@ -21,9 +21,10 @@ from typing import Callable, Sequence, TypeVar
 
 from respec.spec import FORMULA_SECTIONS, GR1Specification
 
-from ltl_synthesizer.gr1 import solve_environment_game, solve_system_game
+from ltl_synthesizer.gr1 import Solver, solve_environment_game, solve_system_game
 from ltl_synthesizer.strategy import extract_counterstrategy
-from ltl_synthesizer.symbolic import Interrupt, SymbolicGame
+from ltl_synthesizer.interrupt import Interrupt
+from ltl_synthesizer.symbolic import SymbolicGame
 from ltl_synthesizer.synthesizer import initial_positions_win
 
 T = TypeVar('T')
@@ -42,7 +43,7 @@ def is_realizable(spec: GR1Specification, robotics_semantics: bool = True,
     def still_possible(winning) -> bool:
         return initial_positions_win(game, winning, robotics_semantics)
 
-    solution = solve_system_game(game, stop_when_losing=still_possible)
+    solution = solve_system_game(Solver(game), stop_when_losing=still_possible)
     return solution.complete and still_possible(solution.winning)
 
 
@@ -151,7 +152,7 @@ def environment_play(spec: GR1Specification, robotics_semantics: bool = True, le
     value (0/1).
     """
     game = SymbolicGame(spec, None, Interrupt(cancel, deadline))
-    environment = solve_environment_game(game)
+    environment = solve_environment_game(Solver(game))
     nodes = extract_counterstrategy(game, environment, robotics_semantics)['nodes']
     if '0' not in nodes:
         return []

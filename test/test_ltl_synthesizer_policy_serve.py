@@ -12,7 +12,9 @@ import pytest
 
 from ltl_synthesizer import Options, synthesize
 from ltl_synthesizer.strategy import strategy_json_chunks, strategy_to_json
-from ltl_synthesizer.symbolic import SMALL_GAME_PROPOSITIONS, SymbolicGame
+from ltl_synthesizer.gr1 import Solver
+from ltl_synthesizer.policy import SMALL_GAME_PROPOSITIONS
+from ltl_synthesizer.symbolic import SymbolicGame
 from respec.parsing import ParseError, parse_slugsin, parse_structuredslugs
 
 REPOSITORY = Path(__file__).resolve().parents[1]
@@ -92,14 +94,14 @@ def test_streamed_json_is_the_same_text_in_pieces():
 
 def test_pure_safety_games_skip_the_reachability_search():
     spec = parse_structuredslugs(gr1_families.cinderella(6, 3, 11, 6))
-    game = SymbolicGame(spec)
-    assert len(game.variables) > SMALL_GAME_PROPOSITIONS
-    assert not game.reachable_only and not game.reordering
+    solver = Solver(SymbolicGame(spec))
+    assert len(solver.game.variables) > SMALL_GAME_PROPOSITIONS
+    assert not solver.plan.reachable_only and not solver.reordering.on
 
 
 def test_several_system_goals_sift_from_the_start():
-    game = SymbolicGame(parse_structuredslugs(gr1_families.amba(2)))
-    assert len(game.sys_goals) > 1 and game.reordering
+    solver = Solver(SymbolicGame(parse_structuredslugs(gr1_families.amba(2))))
+    assert len(solver.game.sys_goals) > 1 and solver.plan.reordering and solver.reordering.on
 
 
 @pytest.mark.parametrize('family, arguments, realizable', [
@@ -117,15 +119,17 @@ def test_families_verdicts_are_the_same_under_every_engine_choice(family, argume
 
 
 def test_automatic_reordering_switches_on_past_the_node_threshold(monkeypatch):
-    from ltl_synthesizer import symbolic
-    monkeypatch.setattr(symbolic, 'DYNAMIC_REORDERING_FROM_NODES', 10)
-    monkeypatch.setattr(symbolic, 'REORDERING_CHECK_PERIOD', 1)
+    from ltl_synthesizer import policy
+    monkeypatch.setattr(policy, 'DYNAMIC_REORDERING_FROM_NODES', 10)
+    monkeypatch.setattr(policy, 'REORDERING_CHECK_PERIOD', 1)
     spec = parse_structuredslugs(gr1_families.evasion(24, 8).replace(
         '!requestPending2\n', ''))  # one system goal and an (implicit) assumption
-    game = SymbolicGame(spec)
-    assert not game.reordering and len(game.sys_goals) == 1
-    game.cox(game.true)
-    assert game.reordering
+    solver = Solver(SymbolicGame(spec))
+    assert not solver.reordering.on and len(solver.game.sys_goals) == 1
+    solver.enforce(solver.game.true)
+    assert solver.reordering.on
+    solver.reordering.stop()
+    assert not solver.reordering.on
 
 
 def test_strategies_of_family_instances_pass_the_independent_check():

@@ -13,7 +13,7 @@ from hypothesis import strategies as st
 
 from gr1_oracle import Oracle, formulas
 from ltl_synthesizer import Options, synthesize
-from ltl_synthesizer.gr1 import solve_system_game
+from ltl_synthesizer.gr1 import Solver, solve_system_game
 from ltl_synthesizer.symbolic import SymbolicGame
 from respec.ltl import implies, neg, next_, var
 from respec.spec import GR1Specification
@@ -91,8 +91,9 @@ def test_symbolic_winning_region_equals_the_oracles_winning_states(spec):
     oracle = Oracle(spec)
     explicit = oracle.game
     for reachable_only in (False, True):
-        game = SymbolicGame(spec, Options(reachable_only=reachable_only))
-        solution = solve_system_game(game)  # no early stop: the whole region
+        game = SymbolicGame(spec)
+        solution = solve_system_game(Solver(game, Options(reachable_only=reachable_only)))
+        assert solution.reachable_only == reachable_only  # no early stop: the whole region
         symbolic = np.array([game.evaluate(solution.winning, dict(zip(explicit.names, explicit.valuation(s))))
                              for s in range(explicit.S)])
         expected = oracle.winning & explicit_reachable(explicit) if reachable_only else oracle.winning

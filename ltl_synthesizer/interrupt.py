@@ -1,0 +1,65 @@
+"""Stopping a synthesis on request (a process concern, kept out of the game and the solver):
+a cancel flag, a deadline and a memory limit, checked by every long loop."""
+
+from __future__ import annotations
+
+import os
+import threading
+import time
+
+from ltl_synthesizer.errors import SynthesisCancelled, SynthesisMemoryExceeded
+
+
+class Interrupt:
+    """Stops a synthesis on request: a cancel flag, a deadline (a ``time.monotonic()``
+    instant) and a memory limit in bytes. Every long loop of the synthesizer (translation,
+    fixpoints, reachability, extraction, explanation, parsing) calls ``check()``, so a
+    synthesis stops within a few milliseconds of the request, beyond the duration of one BDD
+    operation. The object is also a plain callable (for respec's parser).
+
+    The memory limit bounds the BDDs (CUDD's own limit, set by the game, fails the operation
+    that would exceed it) and the process's growth in resident memory since this object was
+    made (the explicit strategy and the rest), polled every ``MEMORY_CHECK_SECONDS``.
+    """
+
+    MEMORY_CHECK_SECONDS = 0.1
+
+    def __init__(self, cancel: threading.Event | None = None, deadline: float | None = None,
+                 memory_limit: int | None = None):
+        self.cancel = cancel
+        self.deadline = deadline
+        self.memory_limit = memory_limit
+        self._baseline_memory = _resident_memory() if memory_limit is not None else 0
+        self._memory_checked_at = time.monotonic()
+
+    def check(self) -> None:
+        if self.cancel is not None and self.cancel.is_set():
+            raise SynthesisCancelled('cancelled')
+        now = time.monotonic()
+        if self.deadline is not None and now >= self.deadline:
+            raise SynthesisCancelled('timeout')
+        if self.memory_limit is not None and now - self._memory_checked_at >= self.MEMORY_CHECK_SECONDS:
+            self._memory_checked_at = now
+            if _resident_memory() - self._baseline_memory > self.memory_limit:
+                raise memory_exceeded(self.memory_limit)
+
+    __call__ = check
+
+
+def _resident_memory() -> int:
+    """This process's resident memory in bytes (Linux; elsewhere its peak so far)."""
+    try:
+        with open('/proc/self/statm') as statm:
+            return int(statm.read().split()[1]) * _PAGE_SIZE
+    except OSError:
+        import resource
+        return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
+
+
+_PAGE_SIZE = os.sysconf('SC_PAGE_SIZE') if hasattr(os, 'sysconf') else 4096
+
+
+def memory_exceeded(limit: int) -> SynthesisMemoryExceeded:
+    return SynthesisMemoryExceeded(
+        f'synthesis needs more than its memory limit of {limit / 2**20:.0f} MB '
+        '(memory_limit); simplify the specification or raise the limit', item='memory_limit')

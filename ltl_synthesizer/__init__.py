@@ -7,7 +7,7 @@
 Limits (every phase -- parsing, BDD building, solving, extraction, explanation -- checks them
 in each of its loops, so a synthesis stops within a few milliseconds plus one BDD operation)::
 
-    synthesize(spec, deadline=time.monotonic() + 60,   # -> SynthesisCancelled, code SYNTHESIS_TIMEOUT
+    synthesize(spec, deadline=time.monotonic() + 60,   # -> SynthesisTimedOut, code SYNTHESIS_TIMEOUT
                cancel=threading.Event(),               # set() -> SynthesisCancelled, code PREEMPTED
                memory_limit=2 * 2**30)                 # BDD bytes -> SynthesisMemoryExceeded
     is_realizable(spec, ...)                           # the verdict only, same limits
@@ -31,7 +31,7 @@ _EXPORTS = {
     'DEFAULT_MEMORY_LIMIT': 'ltl_synthesizer.synthesizer',
     'Options': 'ltl_synthesizer.policy', 'Interrupt': 'ltl_synthesizer.interrupt',
     'SynthesisCancelled': 'ltl_synthesizer.errors', 'SynthesisError': 'ltl_synthesizer.errors',
-    'SynthesisMemoryExceeded': 'ltl_synthesizer.errors',
+    'SynthesisMemoryExceeded': 'ltl_synthesizer.errors', 'SynthesisTimedOut': 'ltl_synthesizer.errors',
     'UndeclaredPropositionError': 'ltl_synthesizer.errors',
     'NotGR1FormulaError': 'ltl_synthesizer.errors',
 }

@@ -107,7 +107,7 @@ def _read_text(path: str, deadline: float | None) -> str:
     if deadline is None:
         return Path(path).read_text()
     import threading
-    from ltl_synthesizer.errors import SynthesisCancelled
+    from ltl_synthesizer.errors import SynthesisTimedOut
     outcome = {}
 
     def read():  # opening a FIFO blocks until a writer comes: in a thread the process may leave
@@ -120,7 +120,7 @@ def _read_text(path: str, deadline: float | None) -> str:
     reader.start()
     reader.join(max(0.0, deadline - time.monotonic()))
     if reader.is_alive():
-        raise SynthesisCancelled(f'timeout: {path} was still being read')
+        raise SynthesisTimedOut(f'timeout: {path} was still being read')
     if 'error' in outcome:
         raise outcome['error']
     return outcome['text']

@@ -24,18 +24,9 @@ class NotGR1FormulaError(SynthesisError):
 
 
 class SynthesisCancelled(SynthesisError):
-    """Synthesis was stopped by the cancel flag (``reason='cancelled'``) or the deadline ('timeout').
-
-    ``SynthesisCancelled('timeout')`` makes a :class:`SynthesisTimedOut`, so that each code
-    belongs to a class.
-    """
+    """Synthesis was stopped by its cancel flag (``reason`` 'cancelled')."""
 
     code = ErrorCode.PREEMPTED
-
-    def __new__(cls, reason: str = 'cancelled'):
-        if cls is SynthesisCancelled and reason == 'timeout':
-            cls = SynthesisTimedOut
-        return super().__new__(cls, reason)
 
     def __init__(self, reason: str = 'cancelled'):
         super().__init__(f'synthesis {reason}', item=reason)
@@ -43,7 +34,7 @@ class SynthesisCancelled(SynthesisError):
 
 
 class SynthesisTimedOut(SynthesisCancelled):
-    """Synthesis passed its deadline."""
+    """Synthesis passed its deadline (``reason`` 'timeout', or what was going on then)."""
 
     code = ErrorCode.SYNTHESIS_TIMEOUT
 

@@ -17,7 +17,7 @@ import threading
 import time
 from pathlib import Path
 
-from ltl_synthesizer.errors import SynthesisCancelled, SynthesisError
+from ltl_synthesizer.errors import SynthesisCancelled, SynthesisError, SynthesisTimedOut
 from respec.errors import ErrorCode
 
 REALIZABLE_LINE = 'RESULT: Specification is realizable.'
@@ -99,7 +99,7 @@ def _wait(process: subprocess.Popen, executable: str, timeout: float | None,
             raise SynthesisCancelled('cancelled')
         if deadline is not None and time.monotonic() >= deadline:
             _kill(process)
-            raise SynthesisCancelled('timeout')
+            raise SynthesisTimedOut()
 
 
 def _kill(process: subprocess.Popen) -> None:

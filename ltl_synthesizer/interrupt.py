@@ -7,7 +7,7 @@ import os
 import threading
 import time
 
-from ltl_synthesizer.errors import SynthesisCancelled, SynthesisMemoryExceeded
+from ltl_synthesizer.errors import SynthesisCancelled, SynthesisMemoryExceeded, SynthesisTimedOut
 
 
 class Interrupt:
@@ -37,7 +37,7 @@ class Interrupt:
             raise SynthesisCancelled('cancelled')
         now = time.monotonic()
         if self.deadline is not None and now >= self.deadline:
-            raise SynthesisCancelled('timeout')
+            raise SynthesisTimedOut()
         if self.memory_limit is not None and now - self._memory_checked_at >= self.MEMORY_CHECK_SECONDS:
             self._memory_checked_at = now
             if _resident_memory() - self._baseline_memory > self.memory_limit:

@@ -33,7 +33,7 @@ import threading
 import time
 import traceback
 
-from ltl_synthesizer.errors import SynthesisCancelled, SynthesisError
+from ltl_synthesizer.errors import SynthesisCancelled, SynthesisError, SynthesisTimedOut
 
 # How often the caller looks at its cancel flag and deadline while a child works.
 POLL_SECONDS = 0.02
@@ -155,7 +155,7 @@ class SynthesisProcesses:
                 if cancel is not None and cancel.is_set():
                     raise SynthesisCancelled('cancelled')
                 if deadline is not None and time.monotonic() >= deadline:
-                    raise SynthesisCancelled('timeout')
+                    raise SynthesisTimedOut()
                 if not child.alive():
                     raise self._ended(child)
             answer = child.receive()

@@ -55,7 +55,7 @@ def synthesize(spec: GR1Specification, robotics_semantics: bool = True,
 
     Limits (all optional, checked in every long loop of every phase): ``cancel`` (a
     threading.Event) raises ``SynthesisCancelled`` (code PREEMPTED), ``deadline`` (a
-    ``time.monotonic()`` instant) raises ``SynthesisCancelled`` (code SYNTHESIS_TIMEOUT),
+    ``time.monotonic()`` instant) raises ``SynthesisTimedOut`` (code SYNTHESIS_TIMEOUT),
     ``memory_limit`` (bytes of BDD memory, default 2 GiB) raises ``SynthesisMemoryExceeded``.
     ``UndeclaredPropositionError`` / ``NotGR1FormulaError`` for formulas outside the declared
     propositions or GR(1).

@@ -33,18 +33,23 @@ import re
 import string
 from collections import deque
 from contextlib import contextmanager
-from dataclasses import dataclass, field
 from functools import lru_cache
 from operator import add
 from typing import NamedTuple
 
-from respec.errors import CodedError, ErrorCode, quoted
+from respec.errors import quoted
 from respec.ltl import (
     FALSE, FIELD_SETTERS, TRUE, And, Const, Formula, Iff, Implies, Next, Not, Or, Var, conj, disj, iff,
     implies, neg, next_, var, variables,
 )
 from respec.nesting import MAX_FORMULA_NESTING, too_deep
 from respec.spec import FORMULA_SECTIONS, PROPOSITION_SECTIONS, SLUGS_HEADERS, GR1Specification
+from respec.parsing.errors import ParseError, UnknownVariableError
+from respec.parsing.integers import COMPARATORS as _COMPARATORS, IntegerVariable, compare
+from respec.parsing.scope import (
+    ANY as _ANY, KEYWORDS as _KEYWORDS, NAME as _NAME, Scope as _Scope, Source as _Source,
+    scope_problem as _scope_problem, section_scopes as _scopes,
+)
 
 __all__ = [
     'ParseError', 'UnknownVariableError', 'parse_formula', 'parse_structuredslugs',
@@ -52,31 +57,7 @@ __all__ = [
 ]
 
 _SECTION_OF_HEADER = {header: section for section, header in SLUGS_HEADERS.items()}
-_NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_.@]*")
-_NUMBER = re.compile(r"[0-9]+")
 _INTEGER_DECLARATION = re.compile(r"^([A-Za-z_][A-Za-z0-9_]*)\s*:\s*(-?[0-9]+)\s*\.\.\.\s*(-?[0-9]+)$")
-_KEYWORDS = {'TRUE', 'FALSE', 'next'}
-
-
-class ParseError(CodedError):
-    """A syntax or naming error at ``filename:line:column``; ``item`` is the offending token."""
-
-    code = ErrorCode.INVALID_FORMULA
-
-    def __init__(self, problem: str, token: str, filename: str = '<string>', line: int = 1,
-                 column: int = 1):
-        self.problem = problem
-        self.filename = filename
-        self.line = line
-        self.column = column
-        self.token = token
-        super().__init__(f'{filename}:{line}:{column}: {problem} near {quoted(token)}', item=token)
-
-
-class UnknownVariableError(ParseError):
-    """A formula mentions a proposition that no [INPUT] / [OUTPUT] section declares."""
-
-    code = ErrorCode.UNKNOWN_PROPOSITION
 
 
 class _Token(NamedTuple):
@@ -84,34 +65,6 @@ class _Token(NamedTuple):
     text: str
     line: int
     column: int
-
-
-@dataclass(frozen=True)
-class _Source:
-    """Where a formula's text comes from: for error positions."""
-
-    filename: str = '<string>'
-    line: int = 1
-    column: int = 1
-
-    def error(self, problem: str, token: str, line: int, column: int, kind=ParseError):
-        # Positions inside the text are relative to its first character.
-        absolute_column = column + self.column - 1 if line == 1 else column
-        return kind(problem, token, self.filename, self.line + line - 1, absolute_column)
-
-
-@dataclass(frozen=True)
-class _Scope:
-    """Which propositions a formula may use, and which of them in the next step."""
-
-    names: frozenset[str] | None        # None: any name (parse_formula without declarations)
-    current: frozenset[str] | None
-    next_step: frozenset[str] | None
-    section: str = ''
-    integers: dict = field(default_factory=dict)   # name -> IntegerVariable (structured slugs)
-
-
-_ANY = _Scope(None, None, None)
 
 
 # --- infix (structured slugs) -------------------------------------------------------------
@@ -132,11 +85,6 @@ _INFIX_TOKEN = re.compile(
     r"|(?P<op>" + '|'.join(re.escape(spelling) for spelling in
                            sorted(_INFIX_OPERATORS, key=len, reverse=True)) + r")"
     r"|(?P<bad>.)")
-_COMPARATORS = {
-    '=': lambda a, b: a == b, '!=': lambda a, b: a != b, '<': lambda a, b: a < b,
-    '<=': lambda a, b: a <= b, '>': lambda a, b: a > b, '>=': lambda a, b: a >= b,
-}
-_MAX_EXPANSION = 1 << 16   # valuations enumerated to expand one integer comparison
 # Binary operators by binding strength, loosest first (all left associative).
 _BINARY_LEVEL = {'<->': 0, '->': 1, '^': 2, '|': 3, '&': 4}
 
@@ -348,73 +296,6 @@ def _combine(operator: str, left: Formula, right: Formula) -> Formula:
 def xor(left: Formula, right: Formula) -> Formula:
     """Exclusive or, which respec.ltl spells as a negated biimplication."""
     return neg(iff(left, right))
-
-
-@dataclass(frozen=True)
-class IntegerVariable:
-    """A structured-slugs integer ``name: low...high``, stored as slugs stores it: the bits of
-    ``value - low``, least significant first, named ``name@0.low.high``, ``name@1``, ..."""
-
-    name: str
-    low: int
-    high: int
-
-    @property
-    def bits(self) -> list[str]:
-        count = 0
-        while 2 ** count <= self.high - self.low:
-            count += 1
-        return [f'{self.name}@0.{self.low}.{self.high}' if k == 0 else f'{self.name}@{k}' for k in range(count)]
-
-    def equals(self, value: int, next_step: bool) -> Formula:
-        """The bits spelling ``value`` (which must lie in the range)."""
-        offset = value - self.low
-        literals = [var(bit) if offset >> k & 1 else neg(var(bit)) for k, bit in enumerate(self.bits)]
-        return conj(next_(literal) if next_step else literal for literal in literals)
-
-    def in_range(self, next_step: bool) -> Formula:
-        """slugs' "variable limits" constraint; TRUE when every bit pattern is a value."""
-        if 2 ** len(self.bits) == self.high - self.low + 1:
-            return TRUE
-        return compare([(self, next_step)], '<=', [self.high])
-
-
-def compare(left: list, operator: str, right: list) -> Formula:
-    """Expand ``sum(left) <operator> sum(right)`` to a disjunction over the valuations of the
-    integer variables involved (terms: ints, or (IntegerVariable, next_step) pairs)."""
-    unknowns = sorted({term for term in left + right if not isinstance(term, int)},
-                      key=lambda term: (term[0].name, term[1]))
-    ranges = [range(variable.low, variable.high + 1) for variable, _ in unknowns]
-    size = 1
-    for values in ranges:
-        size *= len(values)
-    if size > _MAX_EXPANSION:
-        raise ValueError(f'integer comparison over {size} valuations is too large to expand')
-    holds = _COMPARATORS[operator]
-    cases = []
-    for values in itertools.product(*ranges):
-        value_of = dict(zip(unknowns, values))
-
-        def total(terms):
-            return sum(term if isinstance(term, int) else value_of[term] for term in terms)
-
-        if holds(total(left), total(right)):
-            cases.append(conj(variable.equals(value, next_step)
-                              for (variable, next_step), value in value_of.items()))
-    return disj(cases)
-
-
-def _scope_problem(scope: _Scope, name: str, next_step: bool) -> str:
-    if scope.names is None:
-        return ''
-    where = f' in {scope.section}' if scope.section else ''
-    if name not in scope.names:
-        return f'unknown variable {quoted(name)}{where}'
-    allowed = scope.next_step if next_step else scope.current
-    if name not in allowed:
-        step = 'next-step' if next_step else 'current'
-        return f'{step} variable {quoted(name)} is not allowed{where}'
-    return ''
 
 
 # --- infix lines without the token objects ------------------------------------------------
@@ -660,24 +541,6 @@ def _parse(text: str, syntax: str, scope: _Scope, source: _Source) -> Formula:
     if syntax == 'prefix':
         return _PrefixParser(text, scope, source).parse()
     raise ValueError(f"unknown formula syntax {syntax!r} (expected 'infix' or 'prefix')")
-
-
-def _scopes(env_props: list[str], sys_props: list[str], integers=None) -> dict[str, _Scope]:
-    """slugs' rules for which variables each formula section may read (synthesisContextBasics.cpp)."""
-    inputs, outputs = frozenset(env_props), frozenset(env_props) | frozenset(sys_props)
-    nothing = frozenset()
-
-    def scope(section, current, next_step):
-        return _Scope(outputs, current, next_step, f'[{SLUGS_HEADERS[section]}]', integers or {})
-
-    return {
-        'env_init': scope('env_init', inputs, nothing),
-        'sys_init': scope('sys_init', outputs, nothing),
-        'env_trans': scope('env_trans', outputs, inputs),
-        'sys_trans': scope('sys_trans', outputs, outputs),
-        'env_liveness': scope('env_liveness', outputs, outputs),
-        'sys_liveness': scope('sys_liveness', outputs, outputs),
-    }
 
 
 def parse_structuredslugs(text: str, filename: str = '<string>', check=None) -> GR1Specification:

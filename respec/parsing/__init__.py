@@ -36,15 +36,15 @@ from contextlib import contextmanager
 from operator import add
 
 from respec.ltl import (
-    FALSE, FIELD_SETTERS, TRUE, And, Const, Formula, Iff, Implies, Next, Not, Or, Var, conj, disj, neg, next_, var, variables,
+    FALSE, FIELD_SETTERS, TRUE, And, Const, Formula, Iff, Implies, Next, Not, Or, Var, variables,
 )
-from respec.nesting import MAX_FORMULA_NESTING
 from respec.spec import FORMULA_SECTIONS, PROPOSITION_SECTIONS, SLUGS_HEADERS, GR1Specification
 from respec.parsing.errors import ParseError, UnknownVariableError
 from respec.parsing.integers import IntegerVariable
 from respec.parsing.grammar import (
-    combine as _combine, parse_formula, parse_in_scope as _parse, xor,
+    parse_formula, parse_in_scope as _parse, xor,
 )
+from respec.parsing.quick import quick_infix as _quick_infix, quick_prefix as _quick_prefix
 from respec.parsing.scope import (
     ANY as _ANY, KEYWORDS as _KEYWORDS, NAME as _NAME, Scope as _Scope, Source as _Source,
     section_scopes as _scopes,
@@ -57,133 +57,6 @@ __all__ = [
 
 _SECTION_OF_HEADER = {header: section for section, header in SLUGS_HEADERS.items()}
 _INTEGER_DECLARATION = re.compile(r"^([A-Za-z_][A-Za-z0-9_]*)\s*:\s*(-?[0-9]+)\s*\.\.\.\s*(-?[0-9]+)$")
-
-
-# --- infix lines without the token objects ------------------------------------------------
-#
-# A file's lines that no shape covers are read by a shunting-yard loop over plain strings
-# (about three times faster than the parser above, which keeps every token's position for its
-# messages). It builds the parser's very tree with the same constructors, and it gives up
-# (None) on anything it does not expect, so that the parser reads that line and explains any
-# error: non-ASCII text, integers, numbers, a bad character, a misplaced operator, a
-# proposition the section does not allow, a nested next.
-
-_QUICK_LINE = re.compile(r"[A-Za-z0-9_.@' \t&|^!~()<>/\\-]*")
-# Each operator spelled with several characters becomes one mark of its own (longest first,
-# as the parser's scanner reads them), which then stands apart like the one-character ones.
-_QUICK_SPELLINGS = (('<-->', '\x10'), ('<->', '\x10'), ('-->', '\x11'), ('->', '\x11'),
-                    ('&&', '\x12'), ('/\\', '\x12'), ('||', '\x13'), ('\\/', '\x13'))
-_QUICK_PADDED = ('(', ')', '!', '~', '&', '|', '^', '\x10', '\x11', '\x12', '\x13')
-# Binding strength of each binary operator, as _BINARY_LEVEL.
-_QUICK_LEVEL = {'&': 4, '\x12': 4, '|': 3, '\x13': 3, '^': 2, '\x11': 1, '\x10': 0}
-_QUICK_NAME_START = frozenset(string.ascii_letters + '_')
-# Besides the binary operators' levels (0-4), the operator stack holds these marks.
-_OPEN, _NOT, _NEXT = -1, -2, -3
-_QUICK_KIND = {**_QUICK_LEVEL, '(': _OPEN, '!': _NOT, '~': _NOT, 'next': _NEXT, ')': 5, 'TRUE': 6, 'FALSE': 7}
-_CLOSE, _TRUE, _FALSE = 5, 6, 7
-
-
-def _quick_infix(line: str, scope: _Scope, variables: dict[str, Var] | None = None) -> Formula | None:
-    """The formula of one infix line of a specification file, or None (see above).
-    ``variables``: the file's proposition nodes by name (shared, and added to)."""
-    variables = {} if variables is None else variables
-    if not line.isascii() or scope.integers or _QUICK_LINE.fullmatch(line) is None:
-        return None
-    if line.count('(') + line.count('!') + line.count('~') + line.count('next') > MAX_FORMULA_NESTING:
-        return None  # perhaps nested too deeply: the parser counts the levels
-    for spelling, mark in _QUICK_SPELLINGS:
-        if spelling in line:
-            line = line.replace(spelling, mark)
-    if '-' in line or '<' in line or '>' in line or '/' in line or '\\' in line:
-        return None  # a comparison, or a broken operator
-    for operator in _QUICK_PADDED:
-        if operator in line:
-            line = line.replace(operator, f' {operator} ')
-    known, now, following = scope.names, scope.current, scope.next_step
-    operands, operators, counts = [], [], []
-    push, push_operator = operands.append, operators.append
-    kinds = _QUICK_KIND
-    in_next = False
-    expect_operand = True
-    for token in line.split():
-        kind = kinds.get(token)
-        if expect_operand:
-            if kind is None:  # a proposition
-                if token[0] not in _QUICK_NAME_START:
-                    return None  # a number, or a word starting with '.', '@' or a prime
-                if "'" in token:
-                    name = token[:-1]
-                    if in_next or "'" in name or (known is not None and name not in following):
-                        return None
-                    operand = variables.get(name) or variables.setdefault(name, var(name))
-                    operand = next_(operand)
-                elif known is None or token in (following if in_next else now):
-                    operand = variables.get(token) or variables.setdefault(token, var(token))
-                else:
-                    return None
-            elif kind < 0:  # '(', '!' or next
-                if kind == _NEXT:
-                    if in_next:
-                        return None
-                    in_next = True
-                push_operator(kind)
-                continue
-            elif kind == _TRUE:
-                operand = TRUE
-            elif kind == _FALSE:
-                operand = FALSE
-            else:
-                return None  # a binary operator or ')' where an operand belongs
-            expect_operand = False
-        elif kind is None or kind < 0 or kind > _CLOSE:
-            return None  # an operand or a unary operator after an operand
-        elif kind == _CLOSE:
-            while operators and operators[-1] >= 0:
-                _quick_reduce(operands, operators, counts)
-            if not operators or operators.pop() != _OPEN:
-                return None
-            operand = operands.pop()
-        else:  # a binary operator; kind is its level
-            while operators and operators[-1] > kind:
-                _quick_reduce(operands, operators, counts)
-            if operators and operators[-1] == kind:
-                if kind >= 3:  # a run of & or |: one node for the whole run, as the parser makes
-                    counts[-1] += 1
-                    expect_operand = True
-                    continue
-                _quick_reduce(operands, operators, counts)  # left associative
-            push_operator(kind)
-            counts.append(2)
-            expect_operand = True
-            continue
-        # An operand is complete: the unary operators just before it apply.
-        while operators and operators[-1] < _OPEN:
-            if operators.pop() == _NOT:
-                operand = neg(operand)
-            else:
-                operand = next_(operand)
-                in_next = False
-        push(operand)
-    if expect_operand:
-        return None
-    while operators:
-        if operators[-1] < 0:
-            return None  # an unclosed '('
-        _quick_reduce(operands, operators, counts)
-    return operands[0]
-
-
-def _quick_reduce(operands: list, operators: list, counts: list) -> None:
-    """Replace the operands of the operator on top of the stack by its formula."""
-    level, count = operators.pop(), counts.pop()
-    arguments = operands[-count:]
-    del operands[-count:]
-    if level == 4:
-        operands.append(conj(arguments))
-    elif level == 3:
-        operands.append(disj(arguments))
-    else:
-        operands.append(_combine(('<->', '->', '^')[level], *arguments))
 
 
 # --- public API ---------------------------------------------------------------------------
@@ -388,63 +261,6 @@ def _parse_line(line: str, syntax: str, scope: _Scope, source: _Source) -> Formu
             return _parse(line, 'prefix', scope, source)
         except ParseError:
             raise infix_error from None
-
-
-def _quick_prefix(line: str, scope: _Scope, variables: dict[str, Var]) -> Formula | None:
-    """The formula of one slugsin line of a specification file, read right to left over plain
-    strings (the parser's very tree), or None for the parser to read: memory buffers,
-    undeclared or misplaced propositions, malformed lines. ``variables``: the file's
-    proposition nodes by name (shared, and added to)."""
-    now, following = scope.current, scope.next_step
-    if scope.names is None or '$' in line or '?' in line:
-        return None
-    if len(line) > 2 * MAX_FORMULA_NESTING and line.count(' ') > MAX_FORMULA_NESTING:
-        return None  # perhaps nested too deeply: the parser counts the levels
-    operands = []
-    push, pop = operands.append, operands.pop
-    for token in reversed(line.split()):
-        kind = _QUICK_PREFIX_KIND.get(token)
-        if kind is None:  # a proposition: declared ones are well-formed names
-            if token[-1] == "'":
-                name = token[:-1]
-                if name not in following:
-                    return None
-                push(next_(variables.get(name) or variables.setdefault(name, var(name))))
-            elif token in now:
-                push(variables.get(token) or variables.setdefault(token, var(token)))
-            else:
-                return None
-        elif kind == '1' or kind == '0':
-            push(TRUE if kind == '1' else FALSE)
-        elif kind == '!':
-            if not operands:
-                return None
-            operand = pop()
-            push(neg(operand if operand.__class__ is not list else _finished(operand)))
-        elif len(operands) < 2:
-            return None
-        else:
-            left, right = pop(), pop()
-            if left.__class__ is list:
-                left = _finished(left)
-            if right.__class__ is list:
-                if right[0] == kind:
-                    right.append(left)  # "& a & b c": one node for the run, as the parser makes
-                    push(right)
-                    continue
-                right = _finished(right)
-            push([kind, right, left] if kind == '&' or kind == '|' else _combine(kind, left, right))
-    return _finished(operands[0]) if len(operands) == 1 else None
-
-
-def _finished(operand):
-    """A formula, from a formula or a run: [operator, operands last first] (_quick_prefix)."""
-    if operand.__class__ is not list:
-        return operand
-    return conj(operand[:0:-1]) if operand[0] == '&' else disj(operand[:0:-1])
-
-
-_QUICK_PREFIX_KIND = {token: token for token in ('!', '&', '|', '^', '1', '0')}
 
 
 # --- lines by shape ---------------------------------------------------------------------------

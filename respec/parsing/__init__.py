@@ -30,14 +30,9 @@ import gc
 import itertools
 from bisect import bisect_right
 import re
-import string
-from collections import deque
 from contextlib import contextmanager
-from operator import add
 
-from respec.ltl import (
-    FALSE, FIELD_SETTERS, TRUE, And, Const, Formula, Iff, Implies, Next, Not, Or, Var, variables,
-)
+from respec.ltl import TRUE, Formula, variables
 from respec.spec import FORMULA_SECTIONS, PROPOSITION_SECTIONS, SLUGS_HEADERS, GR1Specification
 from respec.parsing.errors import ParseError, UnknownVariableError
 from respec.parsing.integers import IntegerVariable
@@ -45,8 +40,12 @@ from respec.parsing.grammar import (
     parse_formula, parse_in_scope as _parse, xor,
 )
 from respec.parsing.quick import quick_infix as _quick_infix, quick_prefix as _quick_prefix
+from respec.parsing.shapes import (
+    LINES_BETWEEN_CHECKS as _LINES_BETWEEN_CHECKS, LeafNodes as _LeafNodes,
+    parse_section_by_shapes as _parse_section_by_shapes,
+)
 from respec.parsing.scope import (
-    ANY as _ANY, KEYWORDS as _KEYWORDS, NAME as _NAME, Scope as _Scope, Source as _Source,
+    KEYWORDS as _KEYWORDS, NAME as _NAME, Scope as _Scope, Source as _Source,
     section_scopes as _scopes,
 )
 
@@ -74,9 +73,6 @@ def parse_structuredslugs(text: str, filename: str = '<string>', check=None) -> 
 def parse_slugsin(text: str, filename: str = '<string>', check=None) -> GR1Specification:
     """Parse a ``.slugsin`` file: one prefix conjunct per non-empty line (``check``: as above)."""
     return _parse_slugs_file(text, filename, 'prefix', check)
-
-
-_LINES_BETWEEN_CHECKS = 1024
 
 
 class _SectionText:
@@ -251,184 +247,6 @@ def _column(content: str) -> int:
     return len(content) - len(content.lstrip()) + 1
 
 
-def _parse_line(line: str, syntax: str, scope: _Scope, source: _Source) -> Formula:
-    try:
-        return _parse(line, syntax, scope, source)
-    except ParseError as infix_error:
-        if syntax != 'infix' or isinstance(infix_error, UnknownVariableError):
-            raise
-        try:
-            return _parse(line, 'prefix', scope, source)
-        except ParseError:
-            raise infix_error from None
-
-
-# --- lines by shape ---------------------------------------------------------------------------
-#
-# Large specifications repeat a few line shapes with different propositions ("a & next(b) ->
-# !c", "| ! a | b' c'" ...). A shape is the line with every proposition replaced by a
-# placeholder; it is parsed once, by the parser above, and compiled into a function that builds
-# the formulas of all lines of that shape together, a node column at a time. The result is the
-# very tree the parser would build (a proposition never changes how operators group or fold).
-# Lines whose propositions break the section's rules, and unusual lines (very long or deeply
-# nested, or whose template folds a proposition away), go through the parser, which explains
-# errors.
-
-_PROPOSITION = re.compile(
-    r"(?<![A-Za-z0-9_.@])(?!(?:TRUE|FALSE|next)(?![A-Za-z0-9_.@]))[A-Za-z_][A-Za-z0-9_.@]*")
-_WORD = re.compile(r"([A-Za-z_][A-Za-z0-9_.@]*)")
-_PLACEHOLDER = '\x00'
-_NEXT_MARK = '\x01'
-# Outlines (see _shapes_by_translation): each character of a word becomes one of these.
-_DIGIT_MARK, _DOT_MARK = '\x02', '\x03'
-_MARKS = (_PLACEHOLDER, _NEXT_MARK, _DIGIT_MARK, _DOT_MARK)
-_NAME_START = string.ascii_letters + '_'
-_OUTLINE = str.maketrans({**dict.fromkeys(_NAME_START, _PLACEHOLDER), **dict.fromkeys(string.digits, _DIGIT_MARK),
-                          '.': _DOT_MARK, '@': _DOT_MARK})
-_WORDS_ONLY = str.maketrans({chr(code): ' ' for code in range(128)
-                             if chr(code) not in _NAME_START + string.digits + '.@'})
-_OUTLINE_WORD = re.compile('[\x00\x02\x03]+')
-_OUTLINE_NON_NAME = re.compile('(?<![\x00\x02\x03])[\x02\x03]')  # a number, or a word starting with . or @
-_MAX_SHAPE_PLACEHOLDERS = 64
-_MAX_SHAPE_NESTING = 32
-_SHAPES: dict[str, dict[str, object]] = {}  # syntax -> shape -> compiled (or False)
-_MAX_SHAPES = 1 << 14
-_LINES_WORTH_COMPILING = 8     # lines sharing a shape before it is compiled
-_LINES_WORTH_GROUPING = 1000   # sections this large may be left to the parser whole
-
-
-def _parse_section_by_shapes(lines: list[str], syntax: str, scope: _Scope, leaves: _LeafNodes,
-                             check=None) -> list:
-    """The formula of each line, or None where the parser must handle the line.
-
-    The shapes and propositions of all lines are found at once (a few passes of str.translate
-    over the joined text, not a scan per line), and the lines of each shape are built together.
-    A shape not compiled yet is compiled only when enough lines share it (compiling costs as
-    much as parsing a dozen lines); a large section whose lines are mostly unlike each other is
-    left to the parser whole.
-    """
-    joined = '\n'.join(lines)
-    if not lines or any(mark in joined for mark in _MARKS):
-        return [None] * len(lines)
-    # 'next(' is marked first, so that every word left is a proposition or a keyword.
-    marked = joined.replace('next(', _NEXT_MARK + '(')
-    names, starts, lines_of_shape = _shapes_by_translation(marked) or _shapes_by_expression(marked)
-    # Lines are checked against the section's rules, for each step only if some proposition
-    # of the section may not appear in it.
-    check_now = scope.names is not None and not scope.current.issuperset(names)
-    check_next = scope.names is not None and not scope.next_step.issuperset(names)
-    compiled_shapes = _SHAPES.setdefault(syntax, {})
-    formulas = [None] * len(lines)
-    for shape, indices in lines_of_shape.items():
-        compiled = compiled_shapes.get(shape)
-        if compiled is None:
-            if len(indices) < _LINES_WORTH_COMPILING:
-                continue
-            compiled = _compiled_shape(compiled_shapes, shape, syntax, starts[indices[0] + 1] - starts[indices[0]])
-        if compiled is False:
-            continue
-        build, read_now, read_next = compiled
-        count = len(read_now) + len(read_next)
-        read_now, read_next = read_now if check_now else (), read_next if check_next else ()
-        for first in range(0, len(indices), _LINES_BETWEEN_CHECKS):
-            if check is not None:
-                check()
-            chosen = indices[first:first + _LINES_BETWEEN_CHECKS]
-            columns = _columns(names, [starts[index] for index in chosen], count)
-            if (read_now or read_next) and not _within(scope, columns, read_now, read_next):
-                # Some line breaks the rules: the parser names the problem.
-                keep = [row for row in range(len(chosen))
-                        if _within(scope, [[column[row]] for column in columns], read_now, read_next)]
-                chosen = [chosen[row] for row in keep]
-                columns = [[column[row] for row in keep] for column in columns]
-            for index, formula in zip(chosen, build(columns, len(chosen), leaves)):
-                formulas[index] = formula
-    return formulas
-
-
-def _shapes_by_translation(marked: str):
-    """(names, starts, lines_of_shape): every proposition in order, where each line's
-    propositions start in it, and the lines of each shape. Found with str.translate (a few
-    times faster than a regular expression); None when the text needs the expression
-    (non-ASCII text, numbers, TRUE / FALSE or a spaced 'next (')."""
-    if not marked.isascii():
-        return None
-    names = marked.translate(_WORDS_ONLY).split()
-    if _KEYWORDS.intersection(names):
-        return None
-    # In a line's outline each word is a run of marks as long as the word; lines are grouped
-    # by outline, then outlines by shape (one placeholder per word).
-    outline_of_line = marked.translate(_OUTLINE).split('\n')
-    lines_of_outline = _positions(outline_of_line)
-    if _mostly_unlike(lines_of_outline, len(outline_of_line)):
-        return [], [], {}
-    word_counts, lines_of_shape = {}, {}
-    for outline, indices in lines_of_outline.items():
-        if _OUTLINE_NON_NAME.search(outline):
-            return None
-        shape = _OUTLINE_WORD.sub(_PLACEHOLDER, outline)
-        word_counts[outline] = shape.count(_PLACEHOLDER)
-        lines_of_shape.setdefault(shape, []).extend(indices)
-    return names, list(itertools.accumulate(map(word_counts.__getitem__, outline_of_line), initial=0)), lines_of_shape
-
-
-def _shapes_by_expression(marked: str):
-    """What _shapes_by_translation finds, for any text."""
-    parts = _WORD.split(marked)
-    names = parts[1::2]
-    if _KEYWORDS.intersection(names):  # the slower expression that skips keywords
-        names = _PROPOSITION.findall(marked)
-        shapes = _PROPOSITION.sub(_PLACEHOLDER, marked)
-    else:
-        shapes = _PLACEHOLDER.join(parts[0::2])
-    shape_of_line = shapes.split('\n')
-    lines_of_shape = _positions(shape_of_line)
-    if _mostly_unlike(lines_of_shape, len(shape_of_line)):
-        return [], [], {}
-    starts = list(itertools.accumulate(map(str.count, shape_of_line, itertools.repeat(_PLACEHOLDER)), initial=0))
-    return names, starts, lines_of_shape
-
-
-def _mostly_unlike(groups: dict, lines: int) -> bool:
-    """Whether a large section's lines fall into more groups than half their number."""
-    return lines >= _LINES_WORTH_GROUPING and 2 * len(groups) > lines
-
-
-def _positions(items: list[str]) -> dict[str, list[int]]:
-    """Each distinct item -> the indices where it occurs."""
-    positions: dict[str, list[int]] = {}
-    for index, item in enumerate(items):
-        found = positions.get(item)
-        if found is None:
-            positions[item] = [index]
-        else:
-            found.append(index)
-    return positions
-
-
-def _columns(names: list[str], line_starts: list[int], count: int) -> list[list[str]]:
-    """Column i: the i-th proposition of each line (its propositions start at ``line_starts``)."""
-    return [list(map(names.__getitem__, map(add, line_starts, itertools.repeat(offset)))) for offset in range(count)]
-
-
-def _within(scope: _Scope, columns: list[list[str]], read_now: tuple, read_next: tuple) -> bool:
-    """Whether lines read only what the section allows (``read_now``, ``read_next``: the
-    columns read in the current and in the next step)."""
-    return (scope.current.issuperset(itertools.chain.from_iterable(columns[i] for i in read_now))
-            and scope.next_step.issuperset(itertools.chain.from_iterable(columns[i] for i in read_next)))
-
-
-def _compiled_shape(compiled_shapes: dict, shape: str, syntax: str, count: int):
-    """A shape's compiled form (see _compile_shape), kept; False for unusual lines (very long
-    or deeply nested), which the parser handles."""
-    if count > _MAX_SHAPE_PLACEHOLDERS or shape.count('(') > _MAX_SHAPE_NESTING:
-        return False
-    if len(compiled_shapes) >= _MAX_SHAPES:
-        compiled_shapes.clear()
-    compiled = compiled_shapes[shape] = _compile_shape(shape, syntax, count)
-    return compiled
-
-
 @contextmanager
 def _collector_paused():
     """Python's cyclic garbage collector off while a file's formula trees are built: trees
@@ -442,125 +260,16 @@ def _collector_paused():
             gc.enable()
 
 
-def _compile_shape(shape: str, syntax: str, count: int):
-    """(build, read_now, read_next), or False when the shape is not a formula (the parser then
-    reports the line's error). ``build(columns, n)`` makes the formulas of n lines of the shape,
-    where ``columns[i]`` holds each line's i-th proposition; ``read_now`` / ``read_next`` are the
-    columns read in the current / in the next step."""
-    if syntax == 'prefix' and '$' in shape:
-        return False  # memory buffers share subformulas, which a template would copy out
-    pieces = shape.replace(_NEXT_MARK, 'next').split(_PLACEHOLDER)
-    text = ''.join(piece + (f'_{index}' if index < count else '') for index, piece in enumerate(pieces))
+def _parse_line(line: str, syntax: str, scope: _Scope, source: _Source) -> Formula:
     try:
-        template = _parse(text, syntax, _ANY, _Source())
-    except ParseError:
-        return False
-    if variables(template) != {f'_{index}' for index in range(count)}:
-        return False  # folded away (e.g. '& 0 a'): the parser still checks the proposition
-    in_next = [False] * count
-    namespace = dict(_BUILDER_NAMES)
-    exec(_builder_source(template, in_next), namespace)  # noqa: S102 -- our own generated code
-    return (namespace['build'], tuple(i for i in range(count) if not in_next[i]),
-            tuple(i for i in range(count) if in_next[i]))
-
-
-_consume = deque(maxlen=0).extend  # runs an iterator to its end
-
-
-class _LeafNodes:
-    """The leaf nodes of one file's compiled lines: one node per proposition for each of a,
-    !a, next(a), next(!a) and !next(a), made a column at a time."""
-
-    def __init__(self):
-        self._made: dict[str, dict[str, Formula]] = {factory: {} for factory in _LEAF_PARTS}
-        self.variables: dict[str, Var] = self._made['Var']  # name -> its Var node
-
-    def __call__(self, factory: str, names: list[str]) -> list[Formula]:
-        """The ``factory`` leaf ('Var', 'NotVar', ...) of each of ``names``."""
-        made = self._made[factory]
+        return _parse(line, syntax, scope, source)
+    except ParseError as infix_error:
+        if syntax != 'infix' or isinstance(infix_error, UnknownVariableError):
+            raise
         try:
-            return list(map(made.__getitem__, names))
-        except KeyError:  # some are new
-            pass
-        missing = list(set(names).difference(made))
-        kind, inner = _LEAF_PARTS[factory]
-        nodes = list(map(object.__new__, itertools.repeat(kind, len(missing))))
-        if inner is None:
-            _consume(map(FIELD_SETTERS[Var]['name'], nodes, missing))
-        else:
-            _consume(map(FIELD_SETTERS[kind]['arg'], nodes, self(inner, missing)))
-        made.update(zip(missing, nodes))
-        return list(map(made.__getitem__, names))
-
-
-# Each leaf factory: the node's class, and the leaf factory of its argument.
-_LEAF_PARTS = {'Var': (Var, None), 'NotVar': (Not, 'Var'), 'NextVar': (Next, 'Var'),
-               'NextNotVar': (Next, 'NotVar'), 'NotNextVar': (Not, 'NextVar')}
-
-
-# What a compiled shape's code may use: the shared leaf nodes, and for every other node the
-# allocation and the field setters, applied a column at a time with map() (no Python code
-# runs per line: about five times faster than calling the dataclass's __init__ per node,
-# which matters for the millions of nodes of a large file; the nodes are the same).
-_BUILDER_NAMES = {
-    'TRUE': TRUE, 'FALSE': FALSE, 'new': object.__new__, 'repeat': itertools.repeat, 'consume': _consume,
-    **{f'{kind.__name__}_{name}': setter
-       for kind in (Not, Next, And, Or, Implies, Iff) for name, setter in FIELD_SETTERS[kind].items()},
-    **{kind.__name__: kind for kind in (Not, Next, And, Or, Implies, Iff)},
-}
-
-
-def _leaf(formula: Formula) -> tuple[str, Var] | None:
-    """(the shared-leaf factory, its variable) if ``formula`` is a leaf the parser shares."""
-    match formula:
-        case Var():
-            return 'Var', formula
-        case Not(arg=Var() as variable):
-            return 'NotVar', variable
-        case Next(arg=Var() as variable):
-            return 'NextVar', variable
-        case Next(arg=Not(arg=Var() as variable)):
-            return 'NextNotVar', variable
-        case Not(arg=Next(arg=Var() as variable)):
-            return 'NotNextVar', variable
-    return None
-
-
-def _builder_source(template: Formula, in_next: list) -> str:
-    """Python source of ``build(columns, n, leaves)``: ``template`` for n lines, its placeholder
-    ``_i`` replaced by the propositions of ``columns[i]`` (their leaf nodes from ``leaves``, a
-    _LeafNodes), one node column (a list over the lines) at a time (``in_next[i]`` is set if
-    ``_i`` is read in the next step)."""
-    statements = []
-
-    def column(formula: Formula, under_next: bool) -> str:
-        """The name of a list holding ``formula``'s node for each line, after the statements making it."""
-        leaf = _leaf(formula)
-        if leaf is not None:
-            factory, variable = leaf
-            index = int(variable.name[1:])
-            in_next[index] = under_next or factory.startswith('Next') or factory == 'NotNextVar'
-            return new_column(f'leaves({factory!r}, columns[{index}])')
-        if isinstance(formula, Const):
-            return new_column('[TRUE] * n' if formula.value else '[FALSE] * n')
-        kind = type(formula).__name__
-        if isinstance(formula, (Not, Next)):
-            fields = {'arg': column(formula.arg, under_next or isinstance(formula, Next))}
-        elif isinstance(formula, (And, Or)):
-            fields = {'args': 'zip(' + ', '.join(column(arg, under_next) for arg in formula.args) + ')'}
-        else:
-            fields = {'left': column(formula.left, under_next), 'right': column(formula.right, under_next)}
-        nodes = new_column(f'list(map(new, repeat({kind}, n)))')
-        statements.extend(f'consume(map({kind}_{field}, {nodes}, {values}))' for field, values in fields.items())
-        return nodes
-
-    def new_column(expression: str) -> str:
-        name = f'c{len(statements)}'
-        statements.append(f'{name} = {expression}')
-        return name
-
-    result = column(template, False)
-    return '\n'.join(['def build(columns, n, leaves):', *(f'    {line}' for line in statements), f'    return {result}'])
+            return _parse(line, 'prefix', scope, source)
+        except ParseError:
+            raise infix_error from None
 
 
 def _check_proposition_name(name: str, seen: set[str], syntax: str, source: _Source) -> None:

@@ -252,14 +252,14 @@ def test_parsing_by_line_shapes_gives_what_the_parser_gives_line_by_line(text):
     """The same specification or the same first error (with its position) as parsing every
     line with the parser (no shapes, no quick reading), whichever shapes earlier files left
     compiled."""
-    import respec.parsing
+    from respec.parsing import specifications
 
     for parse_file in (parse_structuredslugs, parse_slugsin):
         by_shapes = parse_outcome(parse_file, text)
         with pytest.MonkeyPatch.context() as patch:
-            patch.setattr(respec.parsing, '_parse_section_by_shapes', lambda lines, *_: [None] * len(lines))
-            patch.setattr(respec.parsing, '_quick_infix', lambda *_: None)
-            patch.setattr(respec.parsing, '_quick_prefix', lambda *_: None)
+            patch.setattr(specifications, 'parse_section_by_shapes', lambda lines, *_: [None] * len(lines))
+            patch.setattr(specifications, 'quick_infix', lambda *_: None)
+            patch.setattr(specifications, 'quick_prefix', lambda *_: None)
             assert by_shapes == parse_outcome(parse_file, text)
 
 
@@ -273,13 +273,15 @@ TOKENS = ['a', 'b', 'c', "a'", "c'", 'x.y', 'TRUE', 'FALSE', 'next', 'next(', '(
 def test_the_quick_infix_reading_gives_the_parsers_tree_or_leaves_the_line_to_it(pieces, section):
     """Any sequence of tokens, valid or not: the quick reading either declines or agrees with
     the parser (which then does not fail)."""
-    from respec.parsing import _parse, _quick_infix, _scopes, _Source
+    from respec.parsing.grammar import parse_in_scope
+    from respec.parsing.quick import quick_infix
+    from respec.parsing.scope import Source, section_scopes
 
     line = ''.join(token + space for token, space in pieces).strip()
-    scope = _scopes(['a', 'x.y', 'a@1'], ['b', 'c'])[section]
-    quick = _quick_infix(line, scope)
+    scope = section_scopes(['a', 'x.y', 'a@1'], ['b', 'c'])[section]
+    quick = quick_infix(line, scope)
     if quick is not None:
-        assert quick == _parse(line, 'infix', scope, _Source())
+        assert quick == parse_in_scope(line, 'infix', scope, Source())
 
 
 PREFIX_TOKENS = ['a', 'b', 'c', "a'", "c'", "b'", 'x.y', '!', '&', '|', '^', '1', '0', '2', "'", 'a@1', 'zz', '$',
@@ -290,23 +292,26 @@ PREFIX_TOKENS = ['a', 'b', 'c', "a'", "c'", "b'", 'x.y', '!', '&', '|', '^', '1'
 @given(st.lists(st.sampled_from(PREFIX_TOKENS), min_size=1, max_size=12),
        st.sampled_from(['sys_trans', 'env_trans', 'sys_init']))
 def test_the_quick_prefix_reading_gives_the_parsers_tree_or_leaves_the_line_to_it(tokens, section):
-    from respec.parsing import _parse, _quick_prefix, _scopes, _Source
+    from respec.parsing.grammar import parse_in_scope
+    from respec.parsing.quick import quick_prefix
+    from respec.parsing.scope import Source, section_scopes
 
     line = ' '.join(tokens)
-    scope = _scopes(['a', 'x.y', 'a@1'], ['b', 'c'])[section]
-    quick = _quick_prefix(line, scope, {})
+    scope = section_scopes(['a', 'x.y', 'a@1'], ['b', 'c'])[section]
+    quick = quick_prefix(line, scope, {})
     if quick is not None:
-        assert quick == _parse(line, 'prefix', scope, _Source())
+        assert quick == parse_in_scope(line, 'prefix', scope, Source())
 
 
 @settings(max_examples=300, deadline=None, database=None)
 @given(formulas(NAMES))
 def test_the_quick_readings_read_every_printed_formula(formula):
-    from respec.parsing import _quick_infix, _quick_prefix, _scopes
+    from respec.parsing.quick import quick_infix, quick_prefix
+    from respec.parsing.scope import section_scopes
 
-    scope = _scopes(['a', 'b'], ['c', 'x_1', 'y.2'])['sys_trans']
-    assert _quick_infix(to_infix(formula), scope) == parse_formula(to_infix(formula))
-    assert _quick_prefix(to_prefix(formula), scope, {}) == parse_formula(to_prefix(formula), 'prefix')
+    scope = section_scopes(['a', 'b'], ['c', 'x_1', 'y.2'])['sys_trans']
+    assert quick_infix(to_infix(formula), scope) == parse_formula(to_infix(formula))
+    assert quick_prefix(to_prefix(formula), scope, {}) == parse_formula(to_prefix(formula), 'prefix')
 
 
 @settings(max_examples=150, deadline=None, database=None)

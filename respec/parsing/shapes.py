@@ -49,7 +49,7 @@ _LINES_WORTH_GROUPING = 1000   # sections this large may be left whole to the li
 
 
 def parse_section_by_shapes(lines: list[str], syntax: str, scope: Scope, leaves: LeafNodes,
-                             check=None) -> list:
+                            check=None) -> list:
     """The formula of each line, or None where the grammar must handle the line.
 
     The shapes and propositions of all lines are found at once (a few passes of str.translate

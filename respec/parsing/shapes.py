@@ -54,8 +54,8 @@ def parse_section_by_shapes(lines: list[str], syntax: str, scope: Scope, leaves:
 
     The shapes and propositions of all lines are found at once (a few passes of str.translate
     over the joined text, not a scan per line), and the lines of each shape are built together.
-    A shape not compiled yet is compiled only when enough lines share it (compiling costs as
-    much as parsing a dozen lines); a large section whose lines are mostly unlike each other is
+    A shape not compiled yet is compiled only when enough lines share it (compiling costs
+    more than parsing a few lines); a large section whose lines are mostly unlike each other is
     left whole to the line readers (respec.parsing.quick, then the grammar).
     """
     joined = '\n'.join(lines)
@@ -99,8 +99,8 @@ def parse_section_by_shapes(lines: list[str], syntax: str, scope: Scope, leaves:
 
 def _shapes_by_translation(marked: str):
     """(names, starts, lines_of_shape): every proposition in order, where each line's
-    propositions start in it, and the lines of each shape. Found with str.translate (a few
-    times faster than a regular expression); None when the text needs the expression
+    propositions start in it, and the lines of each shape. Found with str.translate (faster
+    than a regular expression); None when the text needs the expression
     (non-ASCII text, numbers, TRUE / FALSE or a spaced 'next (')."""
     if not marked.isascii():
         return None
@@ -237,9 +237,9 @@ _LEAF_PARTS = {'Var': (Var, None), 'NotVar': (Not, 'Var'), 'NextVar': (Next, 'Va
 
 
 # What a compiled shape's code may use: the shared leaf nodes, and for every other node the
-# allocation and the field setters, applied a column at a time with map() (no Python code
-# runs per line: about five times faster than calling the dataclass's __init__ per node,
-# which matters for the millions of nodes of a large file; the nodes are the same).
+# allocation and the field setters, applied a column at a time with map(): no Python code runs
+# per line, which matters for the millions of nodes of a large file (docs/parsing.md); the
+# nodes are those the dataclass's __init__ makes.
 _BUILDER_NAMES = {
     'TRUE': TRUE, 'FALSE': FALSE, 'new': object.__new__, 'repeat': itertools.repeat, 'consume': _consume,
     **{f'{kind.__name__}_{name}': setter

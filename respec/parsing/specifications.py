@@ -134,7 +134,7 @@ def _integer_variable(declaration: re.Match, seen: set[str], source: Source) -> 
 @contextmanager
 def _collector_paused():
     """Python's cyclic garbage collector off while a file's formula trees are built: trees
-    have no cycles, and its passes over millions of new nodes cost a third of a large parse."""
+    have no cycles, and its passes over millions of new nodes are slow (docs/parsing.md)."""
     was_enabled = gc.isenabled()
     gc.disable()
     try:

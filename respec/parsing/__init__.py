@@ -16,7 +16,10 @@ Modules, each importing only those above it:
     errors          ParseError, UnknownVariableError
     scope           proposition names, each section's scope, error positions
     integers        structured slugs' integer variables, bit-blasted
-    grammar         the reference readers of one formula (infix and prefix), which explain errors
+    operators       the binary operators: how tightly each binds, the nodes each makes
+    infix           the reference reader of infix formulas
+    prefix          the reference reader of prefix (slugsin) formulas
+    grammar         one formula in either syntax, read by its reference reader (which explains errors)
     quick           quick readers of one file line over plain strings (infix and slugsin)
     shapes          the lines of a section that share a shape, built together
     files           cutting a file into its sections
@@ -26,8 +29,9 @@ How large files are read fast, and why the fast paths give the grammar's trees: 
 """
 
 from respec.parsing.errors import ParseError, UnknownVariableError
-from respec.parsing.grammar import parse_formula, xor
+from respec.parsing.grammar import parse_formula
 from respec.parsing.integers import IntegerVariable
+from respec.parsing.operators import xor
 from respec.parsing.specifications import parse_slugsin, parse_structuredslugs, spec_from_text_sections
 
 __all__ = [

@@ -13,7 +13,7 @@ import string
 
 from respec.ltl import FALSE, TRUE, Formula, Var, conj, disj, neg, next_, var
 from respec.nesting import MAX_FORMULA_NESTING
-from respec.parsing.grammar import BINDING, Binding, combine
+from respec.parsing.operators import BINDING, Binding, combine
 from respec.parsing.scope import Scope
 
 

@@ -298,4 +298,5 @@ def _builder_source(template: Formula, in_next: list) -> str:
         return name
 
     result = column(template, False)
-    return '\n'.join(['def build(columns, n, leaves):', *(f'    {line}' for line in statements), f'    return {result}'])
+    return '\n'.join(['def build(columns, n, leaves):', *(f'    {line}' for line in statements),
+                      f'    return {result}'])

@@ -39,9 +39,11 @@ class SectionText:
         return [part[1] for part in self._parts]
 
     def source(self, index: int, filename: str) -> Source:
+        """Where the section's line ``index`` is in the file."""
+        # The last part starting at or before the line (1 << 62: beyond any file line).
         start, first_line, contents, kept = self._parts[bisect_right(self._parts, (index, 1 << 62)) - 1]
         position = index - start if kept is None else kept[index - start]
-        return Source(filename, first_line + position, column(contents[position]))
+        return Source(filename, first_line + position, _column(contents[position]))
 
 
 # Line breaks other than '\n' that str.splitlines() also honours.
@@ -67,7 +69,7 @@ def sections_of(text: str, filename: str) -> dict[str, SectionText]:
             for offset, content in enumerate(body):
                 if content.strip():
                     raise ParseError('text before the first section header', content.strip(), filename,
-                                     line + offset, column(content))
+                                     line + offset, _column(content))
         if header is None:
             break
         line += chunk.count('\n')
@@ -77,7 +79,7 @@ def sections_of(text: str, filename: str) -> dict[str, SectionText]:
         if name not in _SECTION_OF_HEADER:
             raise ParseError('unknown section header (expected one of '
                              + ', '.join(f'[{h}]' for h in SLUGS_HEADERS.values()) + ')',
-                             stripped, filename, line, column(content))
+                             stripped, filename, line, _column(content))
         section, line, position = _SECTION_OF_HEADER[name], line + 1, header[1] + 1
     return sections
 
@@ -96,6 +98,6 @@ def _header_lines(text: str):
             at = text.find('[', at + 1)
 
 
-def column(content: str) -> int:
+def _column(content: str) -> int:
     """The column of a line's first non-blank character."""
     return len(content) - len(content.lstrip()) + 1

@@ -28,8 +28,8 @@ def parse_structuredslugs(text: str, filename: str = '<string>', check=None) -> 
     """Parse a ``.structuredslugs`` file: one infix conjunct per non-empty line.
 
     Like slugs' structured compiler, a line that is not infix but is a valid slugsin prefix
-    formula is accepted as prefix. ``check``, if given, is called every few hundred lines
-    (e.g. a synthesizer's Interrupt, which raises to stop a long parse).
+    formula is accepted as prefix. ``check``, if given, is called every 1,024 lines (e.g. a
+    synthesizer's Interrupt, which raises to stop a long parse).
     """
     return _parse_slugs_file(text, filename, 'infix', check)
 
@@ -37,6 +37,42 @@ def parse_structuredslugs(text: str, filename: str = '<string>', check=None) -> 
 def parse_slugsin(text: str, filename: str = '<string>', check=None) -> GR1Specification:
     """Parse a ``.slugsin`` file: one prefix conjunct per non-empty line (``check``: as above)."""
     return _parse_slugs_file(text, filename, 'prefix', check)
+
+
+def spec_from_text_sections(sections: dict[str, list[str]]) -> GR1Specification:
+    """Build a specification from the LTLSpecification message shape.
+
+    ``sections`` maps 'env_props' / 'sys_props' to proposition names and the six formula
+    sections to lists of infix strings (missing sections are empty). Errors name the
+    section and index, e.g. ``sys_trans[2]:1:5: unknown variable 'foo' near 'foo'``.
+    """
+    if not isinstance(sections, dict):
+        raise ParseError('expected a mapping of section names to lists of strings', repr(sections), '<sections>')
+    for key in sections:
+        if key not in PROPOSITION_SECTIONS + FORMULA_SECTIONS:
+            raise ParseError('unknown specification section', str(key), '<sections>')
+    for key, entries in sections.items():
+        if isinstance(entries, str) or not hasattr(entries, '__iter__'):
+            raise ParseError('a section must be a list of strings', repr(entries), key)
+        for index, entry in enumerate(entries):
+            if not isinstance(entry, str):
+                raise ParseError('expected a string', repr(entry), f'{key}[{index}]')
+
+    seen: set[str] = set()
+    declared = {}
+    for section in PROPOSITION_SECTIONS:
+        declared[section] = []
+        for index, name in enumerate(sections.get(section, [])):
+            _check_proposition_name(name.strip(), seen, 'message', Source(f'{section}[{index}]'))
+            declared[section].append(name.strip())
+            seen.add(name.strip())
+
+    scopes = section_scopes(declared['env_props'], declared['sys_props'])
+    formulas = {
+        section: [parse_in_scope(text, 'infix', scopes[section], Source(f'{section}[{index}]'))
+                  for index, text in enumerate(sections.get(section, []))]
+        for section in FORMULA_SECTIONS}
+    return GR1Specification(**declared, **formulas)
 
 
 def _parse_slugs_file(text: str, filename: str, syntax: str, check=None) -> GR1Specification:
@@ -164,39 +200,3 @@ def _check_proposition_name(name: str, seen: set[str], syntax: str, source: Sour
         raise source.error('invalid proposition name', name, 1, 1)
     if name in seen:
         raise source.error('proposition declared twice', name, 1, 1)
-
-
-def spec_from_text_sections(sections: dict[str, list[str]]) -> GR1Specification:
-    """Build a specification from the LTLSpecification message shape.
-
-    ``sections`` maps 'env_props' / 'sys_props' to proposition names and the six formula
-    sections to lists of infix strings (missing sections are empty). Errors name the
-    section and index, e.g. ``sys_trans[2]:1:5: unknown variable 'foo' near 'foo'``.
-    """
-    if not isinstance(sections, dict):
-        raise ParseError('expected a mapping of section names to lists of strings', repr(sections), '<sections>')
-    for key in sections:
-        if key not in PROPOSITION_SECTIONS + FORMULA_SECTIONS:
-            raise ParseError('unknown specification section', str(key), '<sections>')
-    for key, entries in sections.items():
-        if isinstance(entries, str) or not hasattr(entries, '__iter__'):
-            raise ParseError('a section must be a list of strings', repr(entries), key)
-        for index, entry in enumerate(entries):
-            if not isinstance(entry, str):
-                raise ParseError('expected a string', repr(entry), f'{key}[{index}]')
-
-    seen: set[str] = set()
-    declared = {}
-    for section in PROPOSITION_SECTIONS:
-        declared[section] = []
-        for index, name in enumerate(sections.get(section, [])):
-            _check_proposition_name(name.strip(), seen, 'message', Source(f'{section}[{index}]'))
-            declared[section].append(name.strip())
-            seen.add(name.strip())
-
-    scopes = section_scopes(declared['env_props'], declared['sys_props'])
-    formulas = {
-        section: [parse_in_scope(text, 'infix', scopes[section], Source(f'{section}[{index}]'))
-                  for index, text in enumerate(sections.get(section, []))]
-        for section in FORMULA_SECTIONS}
-    return GR1Specification(**declared, **formulas)

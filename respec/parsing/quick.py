@@ -24,11 +24,12 @@ from respec.parsing.scope import Scope
 
 _READABLE_LINE = re.compile(r"[A-Za-z0-9_.@' \t&|^!~()<>/\\-]*")
 # Operators spelled with several characters become one mark each (longest spellings first, as
-# the grammar's scanner reads them), which then stands apart like the one-character ones.
-_SPELLINGS = (('<-->', '\x10'), ('<->', '\x10'), ('-->', '\x11'), ('->', '\x11'),
-              ('&&', '\x12'), ('/\\', '\x12'), ('||', '\x13'), ('\\/', '\x13'))
-_OPERATOR_OF_MARK = {'\x10': '<->', '\x11': '->', '\x12': '&', '\x13': '|'}
-_PADDED = ('(', ')', '!', '~', '&', '|', '^', *_OPERATOR_OF_MARK)
+# the infix reader's scanner reads them), which then stands apart like the one-character ones.
+_MARK_OF_OPERATOR = {'<->': '\x10', '->': '\x11', '&': '\x12', '|': '\x13'}
+_SPELLINGS = tuple((spelling, _MARK_OF_OPERATOR[operator]) for spelling, operator in (
+    ('<-->', '<->'), ('<->', '<->'), ('-->', '->'), ('->', '->'),
+    ('&&', '&'), ('/\\', '&'), ('||', '|'), ('\\/', '|')))
+_PADDED = ('(', ')', '!', '~', '&', '|', '^', *_MARK_OF_OPERATOR.values())
 _NAME_START = frozenset(string.ascii_letters + '_')
 # A token's kind: a binary operator's Binding; below the bindings, the marks the operator stack
 # holds besides them ('(' and the unary operators); above them, the other tokens.
@@ -36,7 +37,7 @@ _OPEN, _NOT, _NEXT = -1, -2, -3
 _CLOSE, _TRUE, _FALSE = range(len(Binding), len(Binding) + 3)
 _KIND = {
     **{operator: BINDING[operator] for operator in ('&', '|', '^')},
-    **{mark: BINDING[operator] for mark, operator in _OPERATOR_OF_MARK.items()},
+    **{mark: BINDING[operator] for operator, mark in _MARK_OF_OPERATOR.items()},
     '(': _OPEN, '!': _NOT, '~': _NOT, 'next': _NEXT, ')': _CLOSE, 'TRUE': _TRUE, 'FALSE': _FALSE,
 }
 _OPERATOR_OF_BINDING = {binding: operator for operator, binding in BINDING.items()}

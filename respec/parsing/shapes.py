@@ -38,8 +38,9 @@ _OUTLINE = str.maketrans({**dict.fromkeys(_NAME_START, _PLACEHOLDER), **dict.fro
                           '.': _DOT_MARK, '@': _DOT_MARK})
 _WORDS_ONLY = str.maketrans({chr(code): ' ' for code in range(128)
                              if chr(code) not in _NAME_START + string.digits + '.@'})
-_OUTLINE_WORD = re.compile('[\x00\x02\x03]+')
-_OUTLINE_NON_NAME = re.compile('(?<![\x00\x02\x03])[\x02\x03]')  # a number, or a word starting with . or @
+_OUTLINE_WORD = re.compile(f'[{_PLACEHOLDER}{_DIGIT_MARK}{_DOT_MARK}]+')
+# A number, or a word starting with . or @.
+_OUTLINE_NON_NAME = re.compile(f'(?<![{_PLACEHOLDER}{_DIGIT_MARK}{_DOT_MARK}])[{_DIGIT_MARK}{_DOT_MARK}]')
 _MAX_SHAPE_PLACEHOLDERS = 64
 _MAX_SHAPE_NESTING = 32
 _SHAPES: dict[str, dict[str, object]] = {}  # syntax -> shape -> compiled (or False)

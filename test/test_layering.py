@@ -140,6 +140,23 @@ def test_the_cores_sit_below_the_shell():
     assert SHELL not in {target for core in CORES for target in graph[core]}
 
 
+
+def test_respec_parsing_modules_import_only_those_listed_before_them():
+    """respec/parsing/__init__.py lists its modules in import order: each one imports only
+    modules listed above it, and every module is listed."""
+    package = ROOT / 'respec' / 'parsing'
+    docstring = ast.get_docstring(ast.parse((package / '__init__.py').read_text()))
+    listed = [line.split()[0] for line in docstring.split('Modules, each importing only those above it:')[1]
+              .split('\n\n')[1].splitlines()]
+    assert sorted(listed) == sorted(path.stem for path in package.glob('*.py') if path.stem != '__init__')
+    later_imports = [f'{name}.py:{line} imports {module}'
+                     for position, name in enumerate(listed)
+                     for module, line in imported_modules(package / f'{name}.py', ROOT)
+                     if module.startswith('respec.parsing')
+                     and module.removeprefix('respec.parsing.').split('.')[0] not in listed[:position]]
+    assert later_imports == []
+
+
 # --- the checker itself, on small made-up trees ------------------------------------------
 
 def _write(root: Path, files: dict[str, str]) -> Path:

@@ -28,52 +28,8 @@ Modules (MuJoCo is imported only by ``physics``, ``simulator``, ``rendering``)
 ``trace_check`` checks an executed trace against the specification and the goal order.
 ``closed_loop`` ``run_and_check``: execute, record key frames, check, draw the timeline.
 
-Typical use
------------
-::
-
-    from atlas_sim import AtlasSimulator, FaultSpec
-
-    sim = AtlasSimulator()                    # config/atlas.yaml, mode stand_prep
-    sim.execute("stand")                      # -> RequestResult(outcome="completed", ...)
-    sim.execute("pickup_object").reason       # 'preconditions of pickup_object not met: ...'
-
-    # Step-by-step driving, as a state-machine executor does:
-    requests = sim.start_concurrently(["manipulate", "object_template"])
-    while not all(r.done for r in requests):
-        sim.step()                            # one control period (0.01 s sim time)
-        print(sim.snapshot())                 # mode, completed actions, head tilt, ...
-    outcomes = {r.name: r.result.outcome for r in requests}
-
-    sim.inject_fault("pickup_object", FaultSpec(fail_first=1))
-    sim.has_fallen()
-
-``AtlasSimulator`` API
-----------------------
-``AtlasSimulator(config=None, model_path=MODEL_PATH)``  config: SystemConfig, path or None.
-``start(name) -> Request``                      start one request (may be failed already).
-``start_concurrently(names) -> [Request]``      start several; checks use the state before.
-``step(duration=None) -> [RequestResult]``      advance one control period (or duration).
-``poll(request) -> RequestResult | None``       result once finished.
-``execute(name, timeout=60) -> RequestResult``  start and step until finished.
-``execute_concurrently(names, timeout=60) -> {name: RequestResult}``.
-``run_until_idle(timeout=60)``, ``hold(seconds)``  let sim time pass.
-``snapshot() -> dict``                          time, mode, pending_mode, completed_actions,
-                                                running, head_tilt, base_xy, base_yaw,
-                                                pelvis_height, arm_pose, gripper_closed,
-                                                holding_object, sensors, fallen.
-``RequestResult``: name, outcome, reason, started_at, finished_at, completed,
-                proposition ("stand_c" / "look_down_f").
-``has_fallen() -> bool``, ``mode``, ``time``, ``completed_actions()``, ``head_tilt()``.
-``inject_fault(name, FaultSpec | None)``, ``set_operator_input(name, bool)``,
-``set_sensor(name, bool)``, ``push(force, duration, body="torso")``.
-``add_listener(fn(event, request))`` / ``remove_listener(fn)``; events "started"/"finished".
-``reset()``                                     back to the initial mode, counters cleared.
-``physics`` (HumanoidPhysics), ``state`` (DiscreteState), ``outputs`` (dict),
-``history`` (all RequestResults in finishing order).
-
-Requests cannot be cancelled: a running request always ends with its own
-outcome (an executor that no longer needs it simply ignores the result).
+How to drive the simulator from Python (a typical session and the AtlasSimulator API):
+docs/simulation.md, "The simulator from Python".
 """
 
 from __future__ import annotations

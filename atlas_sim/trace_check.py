@@ -1,51 +1,9 @@
 """Execution traces and their check against the synthesized GR(1) specification (ROS-free).
 
-A **trace** records one executed run of a state machine: one :class:`TraceStep` per
-executed top-level state, with the activation propositions ``<p>_a`` of the state, the
-outcome propositions true when the state was entered and when it ended, the state name,
-the robot's control mode and the robot clock. JSON shape (``Trace.to_dict``)::
-
-    {"outcome": "finished",                       # SM outcome, or null if the run broke off
-     "sm_outcome_propositions": {"finished": "finished", "failed": "failed"},
-     "steps": [{"index": 0, "state": "/look_down", "state_class": "TiltHeadState",
-                "activated": ["look_down_a"], "capabilities": ["look_down"],
-                "entered_at": 1.8, "ended_at": 2.68, "mode_at_entry": "stand", "mode_at_exit": "stand",
-                "outcomes_at_entry": ["object_template_c", "stand_c"],
-                "outcomes_at_exit": ["look_down_c", "object_template_c", "stand_c"],
-                "results": [{"capability": "look_down", "outcome": "completed", "reason": "...",
-                             "time": 2.68, "abandoned": false}],
-                "state_outcome": "done", "transition": "manipulate"}, ...]}
-
-**Environment valuations** come from what the robot reported, with the paper's
-activation–outcome semantics (:class:`OutcomeTracker`): an outcome proposition
-``<p>_<o>`` becomes true when capability ``p`` reports outcome ``o`` and stays true until
-``p`` is activated again (eqs. (5), (6), (12)); for control modes ``<m>_c`` is true for
-the current mode (eq. (10)). Sensors are true while the robot reads them true.
-
-**The check** (:func:`check_trace`) walks the positions of the run::
-
-    start: (outcomes at entry of step 0, nothing activated)       -- the automaton's initial state
-    step k: (outcomes at entry of step k, activations of step k)
-    end:   (outcomes at exit of the last step, activations unknown, SM outcome proposition true)
-
-(A run that broke off after a state ended gets an end position with no SM outcome; one
-that broke off inside a state ends with that state.) The system valuation of a position
-is its activations; the other system propositions (goal memory ``<g>_m``) are hidden, so
-the checker tracks the *set* of hidden valuations consistent with SYS_INIT and SYS_TRANS
-so far (a subset construction, exact because there are few of them). The end position's
-activations are hidden too: the machine stops before activating anything there.
-SM-outcome propositions are false while the machine runs and at the end exactly the
-reached outcome's is true. Each step must satisfy SYS_TRANS (ENV_TRANS) from one position
-to the next, and each position the formulas without ``next`` (so the end is checked too).
-Between two positions the automaton may pass silently through states that activate
-nothing (the state machine generator skips them), so such idle positions are allowed in
-between. Reported:
-
-* ``env_init`` / ``env_trans``: the robot broke an assumption (formula and step);
-* ``sys_init`` / ``sys_trans``: the state machine broke a guarantee (formula and step);
-* ``goal_order``: with ordered goals each goal counts only once the previous one counted
-  (eq. (20)); a run ending in ``finished`` must have counted every goal.
-Liveness is not checked (a finite run ending in an SM outcome satisfies eq. (19)).
+A trace is one executed run (one TraceStep per top-level state); check_trace walks its
+positions against the specification's safety formulas and the goal order. The trace's JSON
+shape, how environment valuations are read and why the check is exact: docs/simulation.md,
+"How a run is checked".
 """
 
 from __future__ import annotations

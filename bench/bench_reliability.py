@@ -205,17 +205,22 @@ def idle_release(client, server_pid: int, idle_seconds: float = 35.0) -> dict:
 
 
 SECTIONS = ('burst', 'soak', 'gui', 'attacks', 'idle')
+#: The parts of 'attacks', each also selectable alone.
+ATTACKS = ('hostile', 'limits', 'qos', 'simulations')
 
 
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument('--sections', default=','.join(SECTIONS), help=f'comma-separated subset of {SECTIONS}')
+    parser.add_argument('--sections', default=','.join(SECTIONS),
+                        help=f'comma-separated subset of {SECTIONS} (attacks: all of {ATTACKS}, each selectable)')
     parser.add_argument('--goals', type=int, default=2000, help='goals in the soak')
     parser.add_argument('--in-flight', type=int, default=4, help='soak goals in progress at once')
     parser.add_argument('--warmup', type=int, default=600, help='soak goals before the RSS slope counts')
     parser.add_argument('--flood', type=int, default=10_000, help='goals of the default-QoS flood')
     args = parser.parse_args(argv)
     sections = args.sections.split(',')
+    if 'attacks' in sections:
+        sections += ATTACKS
 
     from rclpy.node import Node
 
@@ -239,14 +244,18 @@ def main(argv=None) -> int:
                     if 'burst' in sections:
                         print('burst: 50 goals at once to serve', flush=True)
                         report['burst'] = burst(client)
-                    if 'attacks' in sections:
-                        print('attacks: hostile goals, limits under load, default-QoS clients', flush=True)
+                    if 'hostile' in sections:
+                        print('attacks: hostile goals', flush=True)
                         flexbe_client = SynthesisClient(ros.add_node(Node, 'bench_flexbe_client'), 'flexbe_synthesis')
                         assert flexbe_client.wait_for_server(timeout=60.0)
                         report['hostile goals'] = attacks.hostile_goals(client, flexbe_client, serve.process.pid, rss_kib)
+                    if 'limits' in sections:
+                        print('attacks: time limits under load', flush=True)
                         runaway = make_goal('atlas', [], [], option='ltl_synthesis_only', timeout=30.0, ltl_specification={
                             'sys_props': [f'p{i}' for i in range(200)], 'env_props': ['e'], 'sys_liveness': ['p0']})
                         report['time limits under load'] = attacks.limits_under_load(client, runaway)
+                    if 'qos' in sections:
+                        print('attacks: default-QoS clients', flush=True)
                         plain = attacks.default_qos_client(ros.add_node(Node, 'bench_default_qos_client'))
                         report['default-QoS client, 200 goals'] = attacks.default_qos_burst(plain, 200)
                         report[f'default-QoS client, {args.flood} goals'] = attacks.default_qos_burst(plain, args.flood)
@@ -255,12 +264,12 @@ def main(argv=None) -> int:
                         report['soak'] = soak(client, serve.process.pid, args.goals, args.in_flight, args.warmup)
             finally:
                 serve.stop()
-        if 'gui' in sections or 'attacks' in sections:
+        if 'gui' in sections or 'simulations' in sections:
             with reserve_domain_id() as domain, gui_process(domain, byproducts) as (url, gui_pid):
                 if 'gui' in sections:
                     print('gui: 20 jobs at once', flush=True)
                     report['gui'] = gui_burst(url)
-                if 'attacks' in sections:
+                if 'simulations' in sections:
                     print('gui: 40 simulations at once', flush=True)
                     report['gui simulations at once'] = attacks.gui_simulation_flood(url, gui_pid, rss_kib)
 

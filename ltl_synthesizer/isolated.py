@@ -37,8 +37,11 @@ from ltl_synthesizer.errors import SynthesisCancelled, SynthesisError, Synthesis
 
 # How often the caller looks at its cancel flag and deadline while a child works.
 POLL_SECONDS = 0.02
-#: How much lower the children's CPU priority is than their parent's.
+#: How much lower the children's CPU priority is than their parent's (by default).
 CHILD_NICENESS = 5
+#: The same for a server running many syntheses at once: eight CPU-bound children at +5 on two
+#: cores outweighed their parent (it got under half a core), so its answers came late.
+SERVER_CHILD_NICENESS = 15
 #: How long an idle child is kept for the next synthesis.
 IDLE_SECONDS = 30.0
 _LENGTH_BYTES = 8
@@ -56,10 +59,11 @@ class _Child:
     and stdout: length-prefixed pickles, a request ('module:function', args, kwargs) in, an
     answer ('result', value) or ('error', exception) out."""
 
-    def __init__(self):
+    def __init__(self, niceness: int):
         self.idle_since = time.monotonic()
         self.fresh = True  # has served nothing yet: its RSS is the baseline
-        self.process = subprocess.Popen([sys.executable, '-m', 'ltl_synthesizer.isolated', str(os.getpid())],
+        self.process = subprocess.Popen([sys.executable, '-m', 'ltl_synthesizer.isolated', str(os.getpid()),
+                                         str(niceness)],
                                         stdin=subprocess.PIPE, stdout=subprocess.PIPE)
 
     def send(self, message) -> None:
@@ -96,10 +100,11 @@ def _read_exactly(stream, size: int) -> bytes:
 
 
 class SynthesisProcesses:
-    """A pool of synthesis child processes, one per synthesis running at the same time."""
+    """A pool of synthesis child processes, one per synthesis running at the same time, each
+    ``niceness`` below its parent's CPU priority."""
 
-    def __init__(self, idle_seconds: float = IDLE_SECONDS):
-        self.idle_seconds = idle_seconds
+    def __init__(self, idle_seconds: float = IDLE_SECONDS, niceness: int = CHILD_NICENESS):
+        self.idle_seconds, self.niceness = idle_seconds, niceness
         self._lock = threading.Lock()
         self._idle: list[_Child] = []
         self._busy: set[_Child] = set()
@@ -114,7 +119,7 @@ class SynthesisProcesses:
         with self._lock:
             self._prepared = count
             while len(self._idle) < count and not self._closed:
-                self._idle.append(_Child())
+                self._idle.append(_Child(self.niceness))
 
     @property
     def idle_count(self) -> int:
@@ -130,7 +135,7 @@ class SynthesisProcesses:
                 stale = [child for child in self._idle if now - child.idle_since >= self.idle_seconds
                          and not child.fresh]
                 self._idle = [child for child in self._idle if child not in stale]
-                self._idle += [_Child() for _ in range(min(len(stale), self._prepared - len(self._idle)))]
+                self._idle += [_Child(self.niceness) for _ in range(min(len(stale), self._prepared - len(self._idle)))]
                 next_check = min((child.idle_since + self.idle_seconds for child in self._idle
                                   if not child.fresh), default=None)
             for child in stale:
@@ -192,7 +197,7 @@ class SynthesisProcesses:
         if child is None or not child.alive():
             if child is not None:
                 child.kill()
-            child = _Child()
+            child = _Child(self.niceness)
         with self._lock:
             self._busy.add(child)
         return child
@@ -211,7 +216,7 @@ class SynthesisProcesses:
                 self._wake_reaper.set()
             elif not self._closed and not self._idle:
                 # A replacement starts now, while the caller reports the stop.
-                self._idle.append(_Child())
+                self._idle.append(_Child(self.niceness))
         if not keep:
             child.kill()
 
@@ -267,7 +272,7 @@ def _die_with_parent(parent_pid: int) -> None:
 if __name__ == '__main__':
     # Below the parent's priority: syntheses filling every core must not delay the parent's
     # answers (time limits, cancels, BUSY) on a loaded machine.
-    os.nice(CHILD_NICENESS)
+    os.nice(int(sys.argv[2]))
     from respec.nesting import allow_deep_formulas
     allow_deep_formulas()  # requests are served in a thread with room for any formula accepted
     server = threading.Thread(target=_serve, args=(int(sys.argv[1]),), name='synthesis-process')

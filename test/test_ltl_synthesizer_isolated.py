@@ -175,3 +175,16 @@ def test_a_child_outlives_the_thread_that_started_it():
         assert processes.call('os:getpid') == child  # the same child serves the next call
     finally:
         processes.close()
+
+
+def test_children_run_at_the_niceness_asked_below_their_parent():
+    """A server's syntheses must leave their parent the CPU to answer on time."""
+    processes = SynthesisProcesses(niceness=7)
+    try:
+        processes.synthesize(GR1Specification(sys_props=['y'], sys_liveness=[var('y')]))  # the child is up
+        (child,) = children_of_this_process()
+        with open(f'/proc/{child}/stat') as stat:
+            niceness = int(stat.read().rsplit(')', 1)[1].split()[16])
+        assert niceness == min(19, os.nice(0) + 7)
+    finally:
+        processes.close()

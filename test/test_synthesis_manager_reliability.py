@@ -283,18 +283,18 @@ def test_a_yaml_bomb_in_synthesis_options_is_refused_at_once(ros, tmp_path):
 
 
 def test_goal_time_limits_hold_under_load(ros, tmp_path):
-    """Behind syntheses that fill every worker, a goal's limit counts its queue wait: it is
-    answered within a second of its limit; an invalid limit is refused at once."""
+    """Behind syntheses that fill every worker, a goal's limit counts its queue wait: each is
+    answered within a second of its limit (counted from sending); an invalid limit is refused
+    at once."""
     client = start_suite(ros, tmp_path, synthesis_parameters=[Parameter('parallel_syntheses', value=2)])
     with slow_goals_running(client, 2):
         started = time.monotonic()
         invalid = client.run(make_goal(**PAPER_TASK, timeout=-1.0), timeout=30)
         assert invalid.error_name == 'INVALID_REQUEST' and time.monotonic() - started < 1.0
-        limited = run_all(client, [make_goal(**PAPER_TASK, name=f'limited{i}', timeout=2.0) for i in range(3)])
-        seconds = time.monotonic() - started
-        assert names(limited) == Counter({'SYNTHESIS_TIMEOUT': 3}), [o.message for o in limited]
-        assert all('2 s' in outcome.message for outcome in limited)
-        assert seconds < 2.0 + 1.0 + 1.0  # the invalid goal's second included
+        limited = run_all(client, [make_goal(**PAPER_TASK, name=f'limited{i}', timeout=2.0) for i in range(6)])
+        assert names(limited) == Counter({'SYNTHESIS_TIMEOUT': 6}), [o.message for o in limited]
+        assert all("time limit of 2 s passed" in outcome.message for outcome in limited)
+        assert max(outcome.seconds for outcome in limited) < 2.0 + 1.0
 
 
 def test_a_flood_is_rejected_on_arrival_and_reported_busy(ros, tmp_path):

@@ -17,7 +17,7 @@ from rclpy.node import Node
 
 from ltl_synthesizer import SynthesisCancelled
 from ltl_synthesizer.external import run_external_synthesizer
-from ltl_synthesizer.isolated import SynthesisProcesses
+from ltl_synthesizer.isolated import SERVER_CHILD_NICENESS, SynthesisProcesses
 from ltl_synthesizer.strategy import strategy_to_json
 from respec.automaton import automaton_from_strategy
 from respec.errors import ErrorCode
@@ -72,7 +72,7 @@ class LTLSynthesisNode(Node):
         self._lock = threading.Lock()
         self.workers = WorkerPool(self.parameter('parallel_syntheses'), self.parameter('queued_syntheses'),
                                   name='synthesis')
-        self.synthesis_processes = SynthesisProcesses()
+        self.synthesis_processes = SynthesisProcesses(niceness=SERVER_CHILD_NICENESS)
         if self.parameter('backend') == 'builtin':
             self.synthesis_processes.prepare()
         group = ReentrantCallbackGroup()

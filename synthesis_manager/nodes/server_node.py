@@ -30,10 +30,10 @@ from ltl_specification.errors import InvalidInitialConditionsError
 from ltl_specification.initial_conditions import (detected_status, initial_conditions_from_robot_state,
                                                   reads_robot_state)
 from ltl_synthesizer.errors import SynthesisError
-from ltl_synthesizer.isolated import SynthesisProcesses
+from ltl_synthesizer.isolated import SERVER_CHILD_NICENESS, SynthesisProcesses
 from respec.errors import INTERNAL_ERROR, CodedError, ErrorCode
 from sm_generation.instantiation import count_states
-from synthesis_manager.limits import BusyError, GoalDeadline, check_message, check_timeout
+from synthesis_manager.limits import BusyError, GoalDeadline, GoalTimedOut, check_message, check_timeout
 from synthesis_manager.nodes.atlas_sim_node import STATE_TOPIC
 from synthesis_manager.requests import (InvalidRequest, SynthesisTask, task_from_behavior_synthesis,
                                         task_from_flexbe_synthesis)
@@ -55,7 +55,8 @@ from synthesis_msgs.srv import (CancelSynthesis, GenerateFlexBESM, GenerateLTLSp
 # tests can put a stand-in there).
 DIAGNOSIS = 'ltl_specification.diagnosis:explain_unsynthesizable'
 DIAGNOSIS_GRACE = 1.0  # seconds past diagnosis_timeout before the diagnosis process is killed
-SYNTHESIS_ANSWER_GRACE = 1.0  # seconds past its time limit the synthesis node has to answer SYNTHESIS_TIMEOUT
+# Seconds past synthesis_timeout the synthesis node has to answer (a goal's own limit gets none).
+SYNTHESIS_ANSWER_GRACE = 1.0
 
 
 @dataclass
@@ -169,7 +170,7 @@ class BehaviorSynthesisServer(Node):
         self.diagnoses = WorkerPool(workers=2, max_waiting=self.parameter('max_active_goals'), name='diagnosis')
         # Diagnoses run syntheses too: in child processes that a cancel, the time limit or
         # shutdown ends at once (one CUDD operation can hold the GIL for seconds).
-        self.diagnosis_processes = SynthesisProcesses()
+        self.diagnosis_processes = SynthesisProcesses(niceness=SERVER_CHILD_NICENESS)
         self.log_to_flexbe = flexbe_log_publisher(self, self.parameter('flexbe_log_topic'))
         group = ReentrantCallbackGroup()
 
@@ -319,13 +320,18 @@ class BehaviorSynthesisServer(Node):
                 return
 
         feedback('Synthesizing an automaton', 0.4)
-        # The synthesizer gets what is left of the goal's time and answers SYNTHESIS_TIMEOUT then.
-        timeout = deadline.stage_limit(task.timeout, 'LTL synthesis') if task.timeout else \
-            self.parameter('synthesis_timeout')
-        synthesized = await self.call(goal_handle, self.synthesizer, SynthesizeAutomaton.Request(
-            ltl_specification=outcome.ltl_specification, spec_name=spec_name,
-            timeout=float(timeout), request_id=goal_id),
-            'LTL synthesis', timeout + SYNTHESIS_ANSWER_GRACE, on_cancel=lambda: self.cancel_synthesis(goal_id))
+        try:
+            # The synthesizer gets what is left of the goal's time and answers SYNTHESIS_TIMEOUT
+            # then; but its clock starts on receipt, later: the goal's limit ends the wait itself.
+            timeout = deadline.stage_limit(task.timeout, 'LTL synthesis') if task.timeout else \
+                self.parameter('synthesis_timeout')
+            synthesized = await self.call(goal_handle, self.synthesizer, SynthesizeAutomaton.Request(
+                ltl_specification=outcome.ltl_specification, spec_name=spec_name,
+                timeout=float(timeout), request_id=goal_id),
+                'LTL synthesis', timeout + SYNTHESIS_ANSWER_GRACE, on_cancel=lambda: self.cancel_synthesis(goal_id),
+                deadline=deadline)
+        except GoalTimedOut as passed:  # the synthesis stage's code, whoever saw the limit pass
+            raise StageFailed(error_code(ErrorCode.SYNTHESIS_TIMEOUT, str(passed))) from None
         if task.timeout and error_name(synthesized.error_code.value) == ErrorCode.SYNTHESIS_TIMEOUT:
             # Name the goal's limit, not the time that was left of it.
             synthesized.error_code.message = str(deadline.timed_out('LTL synthesis'))

@@ -1,8 +1,8 @@
 """A launch-free harness for running ROS 2 nodes in-process (tests, benchmarks, demo, clients).
 
-``RosHarness`` owns a private rclpy context on a reserved ROS_DOMAIN_ID and a
-MultiThreadedExecutor spinning in a background thread, so several test runs on one machine
-never talk to each other and nothing is left running afterwards::
+``RosHarness`` owns a private rclpy context on a reserved ROS_DOMAIN_ID and the entry points'
+executor (ros/executor.py) spinning in a background thread, so several test runs on one
+machine never talk to each other and nothing is left running afterwards::
 
     with RosHarness() as ros:
         server = ros.add_node(MyServer)        # node classes take a ``context`` keyword
@@ -43,16 +43,16 @@ class RosHarness:
             self.domain_id = self._stack.enter_context(reserve_domain_id())
         prepare_ros_environment(self.domain_id)
         import rclpy
-        from rclpy.executors import MultiThreadedExecutor
-
         from rclpy.signals import SignalHandlerOptions
+
+        from synthesis_manager.ros.executor import SuiteExecutor
 
         self.context = rclpy.utilities.get_default_context() if self._default_context else rclpy.Context()
         # No rclpy signal handlers: Ctrl-C stays a KeyboardInterrupt for the code using the
         # harness (a client cancels its goal, then leaves the block).
         rclpy.init(context=self.context, domain_id=self.domain_id,
                    signal_handler_options=SignalHandlerOptions.NO)
-        self.executor = MultiThreadedExecutor(num_threads=self._num_threads, context=self.context)
+        self.executor = SuiteExecutor(num_threads=self._num_threads, context=self.context)
         self._thread = threading.Thread(target=self._spin, name='ros-harness-executor', daemon=True)
         self._thread.start()
         return self

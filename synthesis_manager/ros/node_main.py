@@ -9,13 +9,15 @@ from synthesis_manager.ros.env import init_ros
 
 
 def run_nodes(*node_factories, argv: list[str] | None = None, ready_message: str = '') -> int:
-    """Create each node in one process, spin them on a MultiThreadedExecutor, shut down cleanly."""
-    from rclpy.executors import ExternalShutdownException, MultiThreadedExecutor
+    """Create each node in one process, spin them on a SuiteExecutor, shut down cleanly."""
+    from rclpy.executors import ExternalShutdownException
+
+    from synthesis_manager.ros.executor import SuiteExecutor
 
     # rclpy's own signal handlers (installed by init) turn SIGINT and SIGTERM into a
     # context shutdown, which ends the spin loop below.
     context = init_ros(args=argv)
-    executor = MultiThreadedExecutor(num_threads=16, context=context)
+    executor = SuiteExecutor(num_threads=16, context=context)
     nodes = []
     try:
         for factory in node_factories:

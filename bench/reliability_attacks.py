@@ -105,18 +105,28 @@ def limits_under_load(client, slow_goal, count: int = 20) -> dict:
             '3 s limits: answered after the limit, s (median)': sorted(limited)[len(limited) // 2]}
 
 
-def default_qos_client(node):
+def plain_client(node, deep_queues: bool = False):
+    """A plain rclpy ActionClient: rclpy's default depth-10 queues (as the ros2 CLI and FlexBE
+    WebUI make it), or the queues docs/limits.md asks of a client sending bursts."""
     from rclpy.action import ActionClient
+
+    from synthesis_manager.ros.qos import action_client_qos
     from synthesis_msgs.action import BehaviorSynthesis
-    client = ActionClient(node, BehaviorSynthesis, 'behavior_synthesis')  # rclpy's default depth-10 queues
+    client = ActionClient(node, BehaviorSynthesis, 'behavior_synthesis', **(action_client_qos() if deep_queues else {}))
     assert client.wait_for_server(timeout_sec=60)
     return client
 
 
-def default_qos_burst(client, count: int, wait: float = 120.0) -> dict:
-    """``count`` compile-only goals sent at once by a plain rclpy client, each result asked
-    for when its goal is accepted (as the ros2 CLI does); what the client hears."""
-    from synthesis_manager.client import make_goal
+def plain_client_burst(client, count: int, wait: float = 120.0) -> dict:
+    """``count`` compile-only goals sent at once by a plain rclpy client (:func:`plain_client`), each result asked
+    for when its goal is accepted (as the ros2 CLI does); exact counts of what the client hears.
+
+    A result with status UNKNOWN is rclpy's answer for a goal the server does not know (its
+    result expired after ``result_retention``, or it was never accepted): an empty result whose
+    error code is 0, no code of ours; it is counted apart, not as a code."""
+    from action_msgs.msg import GoalStatus
+
+    from synthesis_manager.client import GOAL_STATUS_NAMES, make_goal
     from synthesis_manager.ros.conversions import error_name
 
     started = time.monotonic()
@@ -137,10 +147,17 @@ def default_qos_burst(client, count: int, wait: float = 120.0) -> dict:
                                                and all(f.done() for f in list(results))):
         time.sleep(0.1)
     responses = [f.result() for f in sent if f.done()]
-    codes = Counter(error_name(f.result().result.error_code.value) for f in list(results) if f.done())
+    heard = [f.result() for f in list(results) if f.done()]
+    known = [response for response in heard if response.status != GoalStatus.STATUS_UNKNOWN]
     return {'goals': count, 'goal responses heard': len(responses),
+            'goals never answered': count - len(responses),
+            'accepted': sum(1 for handle in responses if handle.accepted),
             'rejected (flood)': sum(1 for handle in responses if not handle.accepted),
-            'results heard': sum(codes.values()), 'codes': codes, 'seconds': time.monotonic() - started}
+            'results heard': len(heard), 'results never heard': len(results) - len(heard),
+            'results for goals the server no longer knew (status UNKNOWN)': len(heard) - len(known),
+            'statuses': Counter(GOAL_STATUS_NAMES.get(response.status, str(response.status)) for response in known),
+            'codes': Counter(error_name(response.result.error_code.value) for response in known),
+            'seconds': time.monotonic() - started}
 
 
 def gui_simulation_flood(url: str, gui_pid: int, rss_kib, attempts: int = 40) -> dict:

@@ -12,7 +12,7 @@ from respec.errors import ErrorCode
 from respec.naming import DEFAULT_SM_OUTCOMES
 from synthesis_manager.ros.action_client import RaceFreeActionClient
 from synthesis_manager.ros.cnu_interface import load_flexbe_synthesis_interface
-from synthesis_manager.ros.conversions import error_name, msg_to_sections, msg_to_state_dict
+from synthesis_manager.ros.conversions import error_code, error_name, msg_to_sections, msg_to_state_dict
 from synthesis_manager.ros.harness import wait_for
 from synthesis_msgs.action import BehaviorSynthesis
 from synthesis_msgs.msg import BehaviorSynthesisRequest, LTLSpecification, SynthesisOptions
@@ -31,6 +31,9 @@ def action_type(action_name: str):
 
 
 GOAL_STATUS_NAMES = {4: 'SUCCEEDED', 5: 'CANCELED', 6: 'ABORTED'}
+GOAL_STATUS_UNKNOWN = 0
+RESULT_EXPIRED = ('the server no longer knows this goal: its result was asked for after its result_retention, '
+                  'or the server restarted; send the goal again')
 
 
 @dataclass
@@ -113,6 +116,17 @@ def outcome_from_result(result, seconds: float) -> SynthesisOutcome:
         automaton=automaton_to_dict(result.automaton), seconds=seconds)
 
 
+def outcome_from_response(response, seconds: float) -> SynthesisOutcome:
+    """A result request's answer; TIMEOUT when the server no longer knew the goal (rclpy then
+    answers status UNKNOWN with an empty result, whose error code 0 is no code of ours)."""
+    if response.status == GOAL_STATUS_UNKNOWN:
+        return SynthesisOutcome(error_code('TIMEOUT').value, 'TIMEOUT', RESULT_EXPIRED, seconds=seconds,
+                                goal_status='UNKNOWN')
+    outcome = outcome_from_result(response.result, seconds)
+    outcome.goal_status = GOAL_STATUS_NAMES.get(response.status, str(response.status))
+    return outcome
+
+
 # Goal states after which the server has a result to give.
 _FINISHED_STATES = tuple(GOAL_STATUS_NAMES)
 # Ask for a result again this long after the status said the goal finished (or anyway
@@ -175,7 +189,6 @@ class SynthesisClient:
                 request_result()
         # Requests still pending are left to complete: dropping them would make their late
         # responses "unexpected".
-        response = next(future.result() for future, _ in requests if future.done())
-        outcome = outcome_from_result(response.result, time.monotonic() - started)
-        outcome.goal_status = GOAL_STATUS_NAMES.get(response.status, str(response.status))
-        return outcome
+        answers = [future.result() for future, _ in requests if future.done()]
+        response = next((answer for answer in answers if answer.status != GOAL_STATUS_UNKNOWN), answers[0])
+        return outcome_from_response(response, time.monotonic() - started)

@@ -336,3 +336,18 @@ def test_a_default_qos_client_hears_every_answer_of_a_bounded_burst(ros, tmp_pat
             assert time.monotonic() < deadline, 'a result was lost'
             time.sleep(0.01)
     assert Counter(error_name(f.result().result.error_code.value) for f in results) == {'SUCCESS': 30}
+
+
+def test_a_result_asked_for_after_its_retention_is_a_timeout_not_a_success(ros, tmp_path):
+    """rclpy answers a result request for a goal its server forgot with status UNKNOWN and an
+    empty result (error code 0): our client reports TIMEOUT saying why."""
+    from synthesis_manager.client import outcome_from_response
+    from synthesis_manager.ros.harness import wait_for
+    start_suite(ros, tmp_path, server_parameters=[Parameter('result_retention', value=1.0)])
+    client = default_qos_client(ros)
+    handle = wait_for(client.send_goal_async(make_goal(**PAPER_TASK, option='ltl_compilation_only')), 30)
+    assert outcome_from_response(wait_for(handle.get_result_async(), 30), 0.0).error_name == 'SUCCESS'
+    time.sleep(3.0)  # the result is forgotten 1 s after the goal finished
+    late = outcome_from_response(wait_for(handle.get_result_async(), 30), 0.0)
+    assert (late.error_name, late.goal_status) == ('TIMEOUT', 'UNKNOWN')
+    assert 'result_retention' in late.message

@@ -1,8 +1,10 @@
-"""QoS of the suite's services and actions: queues deep enough that a burst is never dropped.
+"""QoS of the suite's services and actions: queues deep enough for bursts of up to QUEUE_DEPTH.
 
 rclpy's defaults keep the last 10 requests (and responses) per endpoint, so the 11th of a
 burst of goals silently overwrote an earlier one and its client waited forever. Every
 service, service client, action server and action client of the suite uses these instead.
+A burst deeper than a queue still loses its excess in DDS, unseen by either side (10,000
+goals at once from a client with these queues: about 1,100 reached the server).
 """
 
 from __future__ import annotations

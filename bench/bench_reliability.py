@@ -49,10 +49,11 @@ TASK = ('atlas', ['stand_prep'], ['look_down', 'pickup_object'])
 GUI_TASK = {'system': 'atlas', 'initial_conditions': ['stand_prep'], 'goals': ['look_down', 'pickup_object']}
 
 
-def rss_kib(pid: int) -> int:
-    """Resident memory of ``pid`` and its child processes (the synthesis processes)."""
+def rss_kib(pid: int, with_children: bool = True) -> int:
+    """Resident memory of ``pid`` and (``with_children``) its child processes (the synthesis
+    processes, the GUI's simulations)."""
     total = 0
-    for process in [pid, *_children(pid)]:
+    for process in [pid, *(_children(pid) if with_children else [])]:
         try:
             status = Path(f'/proc/{process}/status').read_text()
         except OSError:  # ended meanwhile

@@ -182,10 +182,15 @@ def gui_simulation_flood(url: str, gui_pid: int, rss_kib, attempts: int = 40) ->
                     return
             time.sleep(0.5)
 
-    # One run first: MuJoCo, its renderer and their libraries load once per process.
-    with peak_rss_growth(gui_pid, rss_kib) as first:
+    def gui_alone(pid):
+        return rss_kib(pid, with_children=False)
+
+    # One run alone first (when simulations ran in the GUI process, MuJoCo and its renderer
+    # loaded there on the first run); the GUI process alone, and with its simulation processes.
+    before = gui_alone(gui_pid)
+    with peak_rss_growth(gui_pid, gui_alone) as first, peak_rss_growth(gui_pid, rss_kib) as first_all:
         finish(post(f'api/jobs/{job["id"]}/simulations', b'{}')[2]['id'])
-    with peak_rss_growth(gui_pid, rss_kib) as rss:
+    with peak_rss_growth(gui_pid, gui_alone) as rss, peak_rss_growth(gui_pid, rss_kib) as rss_all:
         started = time.monotonic()
         with ThreadPoolExecutor(attempts) as pool:
             answers = list(pool.map(lambda _: post(f'api/jobs/{job["id"]}/simulations', b'{}'), range(attempts)))
@@ -197,6 +202,11 @@ def gui_simulation_flood(url: str, gui_pid: int, rss_kib, attempts: int = 40) ->
     retry = sorted({headers.get('Retry-After') for status, headers, _ in answers if status == 429})
     return {'requests at once': attempts, 'statuses': Counter(status for status, _, _ in answers),
             'all answered after s': answered, 'Retry-After': ', '.join(map(str, retry)),
-            'accepted runs finished after s': all_done, 'GUI peak RSS growth, first run alone MiB': first['MiB'],
-            'GUI peak RSS growth, the 40 requests MiB': rss['MiB'],
+            'accepted runs finished after s': all_done,
+            'GUI process RSS before MiB': before / 1024,
+            'GUI process peak RSS growth, first run MiB': first['MiB'],
+            'GUI process peak RSS growth, the 40 requests MiB': rss['MiB'],
+            'with its simulation processes, first run MiB': first_all['MiB'],
+            'with its simulation processes, the 40 requests MiB': rss_all['MiB'],
+            'GUI process RSS after them MiB': gui_alone(gui_pid) / 1024,
             'form-encoded POST status': form}

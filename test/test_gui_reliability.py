@@ -2,6 +2,8 @@
 
 import http.client
 import json
+import os
+import signal
 import time
 import urllib.parse
 from concurrent.futures import ThreadPoolExecutor
@@ -192,6 +194,51 @@ def test_simulations_are_bounded_at_once_and_per_job(gui):
     while request(url, 'GET', f"/api/simulations/{run['id']}")[1]['state'] != 'finished':
         assert time.monotonic() < deadline
         time.sleep(0.5)
+
+
+
+def simulation_processes() -> set[int]:
+    """This process's simulation children (web/simulation_process.py)."""
+    found = set()
+    for entry in filter(str.isdigit, os.listdir('/proc')):
+        try:
+            with open(f'/proc/{entry}/stat') as stat:
+                parent = int(stat.read().rsplit(')', 1)[1].split()[1])
+            with open(f'/proc/{entry}/cmdline', 'rb') as cmdline:
+                if parent == os.getpid() and b'synthesis_manager.web.simulation_process' in cmdline.read():
+                    found.add(int(entry))
+        except (OSError, IndexError):  # ended meanwhile
+            pass
+    return found
+
+
+def test_a_crashed_simulation_is_reported_and_the_gui_keeps_serving(gui):
+    """Each simulation runs in a child process: killing it (as a crash in MuJoCo would) ends
+    that run with an error naming the process; the GUI and the next run are unharmed."""
+    _, url = gui
+    job = wait_until_finished(url, request(url, 'POST', '/api/jobs', PAPER_TASK)[1]['id'])
+
+    def finished(simulation_id):
+        deadline = time.monotonic() + 300
+        while (run := request(url, 'GET', f'/api/simulations/{simulation_id}')[1])['state'] != 'finished':
+            assert time.monotonic() < deadline
+            time.sleep(0.2)
+        return run
+
+    status, _, run = post_raw(url, f"/api/jobs/{job['id']}/simulations", b'{}', 'application/json')
+    assert status == 202
+    deadline = time.monotonic() + 60
+    while not (children := simulation_processes()):
+        assert time.monotonic() < deadline, 'no simulation process'
+        time.sleep(0.05)
+    os.kill(children.pop(), signal.SIGKILL)
+    crashed = finished(run['id'])
+    assert crashed['error']['code'] == 'FAILURE' and crashed['error']['item'] == 'simulation process'
+    assert 'ended (exit code -9) without a result' in crashed['error']['message']
+    assert request(url, 'GET', '/api/info')[0] == 200
+    status, _, run = post_raw(url, f"/api/jobs/{job['id']}/simulations", b'{}', 'application/json')
+    assert finished(run['id'])['outcome'] == 'finished'
+    assert not simulation_processes()  # none left behind
 
 
 @pytest.mark.parametrize('path, body', [

@@ -5,7 +5,6 @@ from __future__ import annotations
 import dataclasses
 import itertools
 import logging
-import os
 import shutil
 import tempfile
 import threading
@@ -15,19 +14,17 @@ from collections import OrderedDict
 from pathlib import Path
 from typing import Callable
 
-from atlas_sim.closed_loop import run_and_check
-from atlas_sim.robot import SimulatedRobot, make_simulator, parse_faults
 from ltl_specification.diagnosis import goal_findings, impossible_next_goals
 from respec.abstraction import load_abstraction
 from respec.errors import INTERNAL_ERROR, CodedError, ErrorCode, quoted
 from respec.naming import DEFAULT_SM_OUTCOMES, FINISHED
-from respec.parsing import spec_from_text_sections
 from respec.systems import SystemConfigError, available_systems, load_section
 from synthesis_manager.limits import BusyError
 from synthesis_manager.web.artifacts import ARTIFACTS, Artifact
 from synthesis_manager.web.errors import (ArtifactFailedError, InvalidJobRequestError, NotAvailableError,
                                           NotFoundError)
 from synthesis_manager.web.jobs import JOB_OPTIONS, Job, JobRequest, local_outcome, names_field
+from synthesis_manager.web.simulation_process import SimulationProcess
 from synthesis_manager.web.simulations import Simulation, simulation_available
 
 logger = logging.getLogger(__name__)
@@ -68,6 +65,7 @@ class SynthesisBackend:
         self._artifacts: dict[tuple[str, str], Artifact] = {}
         self._counter = itertools.count(1)
         self._simulations: dict[str, Simulation] = {}
+        self._simulation_processes: set[SimulationProcess] = set()
         self._simulation_dir = tempfile.TemporaryDirectory(prefix='behavior-synthesis-gui-')
         self.can_simulate = simulation_available()
 
@@ -129,12 +127,17 @@ class SynthesisBackend:
     # jobs ------------------------------------------------------------------------------
 
     def stop(self):
-        """The server is stopping: cancel every unfinished job (its goal too) and end the event streams."""
+        """The server is stopping: cancel every unfinished job (its goal too), end the running
+        simulations and the event streams."""
         self.stopping.set()
         with self._lock:
             unfinished = [job for job in self._jobs.values() if not job.finished]
         for job in unfinished:
             job.cancel_requested.set()
+        with self._lock:
+            running = list(self._simulation_processes)
+        for child in running:
+            child.stop()
 
     def start_job(self, body) -> dict:
         if self.stopping.is_set():
@@ -264,36 +267,38 @@ class SynthesisBackend:
         return simulation
 
     def _simulate(self, simulation: Simulation, job: Job):
-        os.environ.setdefault('MUJOCO_GL', 'egl')  # off-screen rendering, before mujoco loads
+        """Run ``simulation`` in its child process (web/simulation_process.py), following it."""
         request, started = job.request, time.monotonic()
-        simulator = None
+        child = SimulationProcess({
+            'states': job.outcome['states'], 'ltl_specification': job.outcome['ltl_specification'],
+            'system': request.system, 'config_dir': str(self.config_dir) if self.config_dir else None,
+            'initial_conditions': list(request.initial_conditions), 'goals': list(request.goals),
+            'ordered': not request.unordered, 'fail_first': list(simulation.fail_first),
+            'record_dir': str(self._record_dir(simulation.id)), 'max_robot_time': 300.0, 'max_wall_time': 300.0})
+        with self._lock:
+            self._simulation_processes.add(child)
+        if self.stopping.is_set():
+            child.stop()
 
-        def progress(steps, frames):  # every control tick: publish only when a step or frame was added
-            simulation.robot_time = simulator.time
-            if len(steps) != len(simulation.steps) or len(frames) != len(simulation.frames):
-                self._update(simulation, steps=[dataclasses.asdict(step) for step in steps], frames=frames)
+        def progress(update):
+            simulation.robot_time = update['robot_time']
+            self._update(simulation, steps=update['steps'], frames=[Path(path) for path in update['frames']])
 
         try:
-            simulator = make_simulator(request.system, self.config_dir, request.initial_conditions,
-                                       faults=parse_faults(fail_first=[f'{c}:1' for c in simulation.fail_first]))
-            run = run_and_check(job.outcome['states'], SimulatedRobot(simulator), simulator, request.system,
-                                spec_from_text_sections(job.outcome['ltl_specification']), list(request.goals),
-                                ordered=not request.unordered, config_dir=self.config_dir,
-                                record_dir=self._record_dir(simulation.id),
-                                max_robot_time=300.0, max_wall_time=300.0, on_progress=progress)
-            self._update(simulation, outcome=run.result.outcome, check=run.check.to_dict(),
-                         timeline_png=run.timeline, frames=run.frames,
-                         steps=[dataclasses.asdict(step) for step in run.result.trace.steps])
-        except Exception as error:  # ExecutionError, bad faults, rendering: report, keep serving
-            if not isinstance(error, CodedError):
-                logger.exception('simulation %s failed', simulation.id)
-            trace = getattr(error, 'trace', None)
-            self._update(simulation, error={
-                'code': error.code if isinstance(error, CodedError) else INTERNAL_ERROR,
-                'item': getattr(error, 'item', ''), 'message': str(error)},
-                steps=[dataclasses.asdict(step) for step in trace.steps] if trace else simulation.steps)
+            final = child.run(progress)
         finally:
-            self._update(simulation, state='finished', wall_seconds=time.monotonic() - started)
+            with self._lock:
+                self._simulation_processes.discard(child)
+        if 'result' in final:
+            result = final['result']
+            simulation.robot_time = result['robot_time']
+            self._update(simulation, outcome=result['outcome'], check=result['check'], steps=result['steps'],
+                         timeline_png=Path(result['timeline']) if result['timeline'] else None,
+                         frames=[Path(path) for path in result['frames']])
+        else:
+            self._update(simulation, error=final['error'],
+                         steps=simulation.steps if final['steps'] is None else final['steps'])
+        self._update(simulation, state='finished', wall_seconds=time.monotonic() - started)
 
     def _job(self, job_id: str) -> Job:
         with self._lock:

@@ -54,6 +54,10 @@ def save_png(path: PathLike, image: np.ndarray) -> Path:
     return path
 
 
+#: Side of the shadow map in pixels (MuJoCo's default 4096).
+SHADOW_MAP_SIZE = 2048
+
+
 class FrameRenderer:
     """Renders the current frame of a simulator (or ``HumanoidPhysics``).
 
@@ -67,7 +71,17 @@ class FrameRenderer:
 
         self.physics = getattr(simulator, "physics", simulator)
         self.camera = camera
-        self._renderer = mujoco.Renderer(self.physics.model, height=height, width=width)
+        # In software GL the model's offscreen buffer (1280x960, multisampled) and MuJoCo's
+        # 4096^2 shadow map took ~110 MiB; a buffer of the frame's size renders the same
+        # pixels, and a 2048^2 shadow map looks the same at these sizes. The model is left as it was.
+        visual = self.physics.model.vis
+        kept = (visual.global_.offwidth, visual.global_.offheight, visual.quality.shadowsize)
+        visual.global_.offwidth, visual.global_.offheight = width, height
+        visual.quality.shadowsize = min(visual.quality.shadowsize, SHADOW_MAP_SIZE)
+        try:
+            self._renderer = mujoco.Renderer(self.physics.model, height=height, width=width)
+        finally:
+            visual.global_.offwidth, visual.global_.offheight, visual.quality.shadowsize = kept
 
     def render(self) -> np.ndarray:
         """The current frame as an ``(height, width, 3)`` uint8 array."""

@@ -63,10 +63,14 @@ def rss_kib(pid: int, with_children: bool = True) -> int:
 
 
 def _children(pid: int) -> list[int]:
-    try:
-        return [int(child) for child in Path(f'/proc/{pid}/task/{pid}/children').read_text().split()]
-    except OSError:
-        return []
+    """The child processes of every thread of ``pid`` (each thread's children are its own)."""
+    children = []
+    for task in Path(f'/proc/{pid}/task').glob('*'):
+        try:
+            children += [int(child) for child in (task / 'children').read_text().split()]
+        except OSError:  # the thread ended meanwhile
+            pass
+    return children
 
 
 def slope(points: list[tuple[float, float]]) -> float:

@@ -189,7 +189,9 @@ def gui_simulation_flood(url: str, gui_pid: int, rss_kib, attempts: int = 40) ->
     # loaded there on the first run); the GUI process alone, and with its simulation processes.
     before = gui_alone(gui_pid)
     with peak_rss_growth(gui_pid, gui_alone) as first, peak_rss_growth(gui_pid, rss_kib) as first_all:
-        finish(post(f'api/jobs/{job["id"]}/simulations', b'{}')[2]['id'])
+        answer = post(f'api/jobs/{job["id"]}/simulations', b'{}')
+        assert answer[0] == 202, (answer, job.get('outcome', {}).get('error_name'), job.get('outcome', {}).get('message'))
+        finish(answer[2]['id'])
     with peak_rss_growth(gui_pid, gui_alone) as rss, peak_rss_growth(gui_pid, rss_kib) as rss_all:
         started = time.monotonic()
         with ThreadPoolExecutor(attempts) as pool:

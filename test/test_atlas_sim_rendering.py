@@ -29,6 +29,11 @@ sim.execute("stand")
 sim.execute("look_down")
 recorder.capture("final")
 recorder.close()
+# a renderer sizes its buffers to its frames but leaves the model as it was: a bigger one still fits
+from atlas_sim import FrameRenderer
+assert (sim.physics.model.vis.global_.offwidth, sim.physics.model.vis.global_.offheight) == (1280, 960)
+with FrameRenderer(sim, 640, 480) as big:
+    big.save(sys.argv[1] + "/big.png")
 """
 
 
@@ -76,7 +81,7 @@ def render_with_any_backend(directory: Path) -> str:
 
 def test_key_frames_are_rendered_to_png(tmp_path):
     backend = render_with_any_backend(tmp_path)
-    frames = sorted((tmp_path / backend).glob("*.png"))
+    frames = sorted(path for path in (tmp_path / backend).glob("*.png") if path.name != "big.png")
     names = [f.name for f in frames]
     # started + finished for stand and look_down, plus the manual capture
     assert len(frames) == 5, names
@@ -86,3 +91,4 @@ def test_key_frames_are_rendered_to_png(tmp_path):
     assert image.std() > 10  # a real scene, not a blank frame
     first = decode_png(frames[0].read_bytes())
     assert np.abs(first.astype(int) - image.astype(int)).mean() > 1  # the robot moved
+    assert decode_png((tmp_path / backend / "big.png").read_bytes()).shape == (480, 640, 3)

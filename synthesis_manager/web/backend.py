@@ -52,8 +52,8 @@ class SynthesisBackend:
         self.config_dir = config_dir or None
         self.max_jobs = max_jobs
         self.max_unfinished_jobs = max_unfinished_jobs
-        # A simulation takes ~0.5 GB and a core for up to minutes: only a few run at once, and
-        # a job keeps only its newest few runs (frames included).
+        # A simulation takes a process of ~225 MiB and a core for up to minutes: only a few run
+        # at once, and a job keeps only its newest few runs (frames included).
         self.max_running_simulations = max_running_simulations
         self.max_simulations_per_job = max_simulations_per_job
         self.description = description

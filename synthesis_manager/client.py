@@ -12,7 +12,7 @@ from respec.errors import ErrorCode
 from respec.naming import DEFAULT_SM_OUTCOMES
 from synthesis_manager.ros.action_client import RaceFreeActionClient
 from synthesis_manager.ros.cnu_interface import load_flexbe_synthesis_interface
-from synthesis_manager.ros.conversions import error_code, error_name, msg_to_sections, msg_to_state_dict
+from synthesis_manager.ros.conversions import error_name, msg_to_sections, msg_to_state_dict
 from synthesis_manager.ros.harness import wait_for
 from synthesis_msgs.action import BehaviorSynthesis
 from synthesis_msgs.msg import BehaviorSynthesisRequest, LTLSpecification, SynthesisOptions
@@ -120,7 +120,7 @@ def outcome_from_response(response, seconds: float) -> SynthesisOutcome:
     """A result request's answer; TIMEOUT when the server no longer knew the goal (rclpy then
     answers status UNKNOWN with an empty result, whose error code 0 is no code of ours)."""
     if response.status == GOAL_STATUS_UNKNOWN:
-        return SynthesisOutcome(error_code('TIMEOUT').value, 'TIMEOUT', RESULT_EXPIRED, seconds=seconds,
+        return SynthesisOutcome(ErrorCode.TIMEOUT.number, ErrorCode.TIMEOUT, RESULT_EXPIRED, seconds=seconds,
                                 goal_status='UNKNOWN')
     outcome = outcome_from_result(response.result, seconds)
     outcome.goal_status = GOAL_STATUS_NAMES.get(response.status, str(response.status))

@@ -263,9 +263,11 @@ def main(argv=None) -> int:
                         print('attacks: default-QoS clients', flush=True)
                         plain = attacks.plain_client(ros.add_node(Node, 'bench_default_qos_client'))
                         report['default-QoS client, 200 goals'] = attacks.plain_client_burst(plain, 200)
-                        report[f'default-QoS client, {args.flood} goals'] = attacks.plain_client_burst(plain, args.flood)
+                        report[f'default-QoS client, {args.flood} goals'] = attacks.plain_client_burst(
+                            plain, args.flood)
                         deep = attacks.plain_client(ros.add_node(Node, 'bench_deep_qos_client'), deep_queues=True)
-                        report[f'client with deep queues, {args.flood} goals'] = attacks.plain_client_burst(deep, args.flood)
+                        report[f'client with deep queues, {args.flood} goals'] = attacks.plain_client_burst(
+                            deep, args.flood)
                     if 'soak' in sections:
                         print(f'soak: {args.goals} goals, {args.in_flight} in flight', flush=True)
                         report['soak'] = soak(client, serve.process.pid, args.goals, args.in_flight, args.warmup)

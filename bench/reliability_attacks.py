@@ -155,7 +155,8 @@ def plain_client_burst(client, count: int, wait: float = 120.0) -> dict:
             'rejected (flood)': sum(1 for handle in responses if not handle.accepted),
             'results heard': len(heard), 'results never heard': len(results) - len(heard),
             'results for goals the server no longer knew (status UNKNOWN)': len(heard) - len(known),
-            'statuses': Counter(GOAL_STATUS_NAMES.get(response.status, str(response.status)) for response in known),
+            'statuses': Counter(GOAL_STATUS_NAMES.get(response.status, str(response.status))
+                                for response in known),
             'codes': Counter(error_name(response.result.error_code.value) for response in known),
             'seconds': time.monotonic() - started}
 
@@ -190,7 +191,7 @@ def gui_simulation_flood(url: str, gui_pid: int, rss_kib, attempts: int = 40) ->
     before = gui_alone(gui_pid)
     with peak_rss_growth(gui_pid, gui_alone) as first, peak_rss_growth(gui_pid, rss_kib) as first_all:
         answer = post(f'api/jobs/{job["id"]}/simulations', b'{}')
-        assert answer[0] == 202, (answer, job.get('outcome', {}).get('error_name'), job.get('outcome', {}).get('message'))
+        assert answer[0] == 202, (answer, job.get('outcome'))
         finish(answer[2]['id'])
     with peak_rss_growth(gui_pid, gui_alone) as rss, peak_rss_growth(gui_pid, rss_kib) as rss_all:
         started = time.monotonic()

@@ -135,7 +135,8 @@ class SynthesisProcesses:
                 stale = [child for child in self._idle if now - child.idle_since >= self.idle_seconds
                          and not child.fresh]
                 self._idle = [child for child in self._idle if child not in stale]
-                self._idle += [_Child(self.niceness) for _ in range(min(len(stale), self._prepared - len(self._idle)))]
+                replacements = min(len(stale), self._prepared - len(self._idle))
+                self._idle += [_Child(self.niceness) for _ in range(replacements)]
                 next_check = min((child.idle_since + self.idle_seconds for child in self._idle
                                   if not child.fresh), default=None)
             for child in stale:

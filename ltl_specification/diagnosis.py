@@ -26,7 +26,7 @@ from respec.naming import DEFAULT_SM_OUTCOMES, activation, memory, outcome_propo
 from respec.components import (SOURCE_ACTIONS, SOURCE_CONTROL_MODES, SOURCE_CUSTOM, SOURCE_GOALS,
                                SOURCE_INITIAL_CONDITIONS, SOURCE_SM_OUTCOMES, FormulaGroup)
 from respec.ltl import Formula, evaluate, mentions_next, to_infix, variables
-from ltl_synthesizer.errors import SynthesisCancelled
+from ltl_synthesizer.errors import SynthesisCancelledError
 from ltl_synthesizer.unrealizable_core import environment_play, unrealizable_core
 
 from ltl_specification.compiler import CompiledSpecification, compile_task, load_task_abstraction
@@ -245,7 +245,7 @@ def diagnose(spec: CompiledSpecification, robotics_semantics: bool = True, confi
                                     [to_infix(f) for f in g.formulas]) for g in core.groups]
         steps = environment_play(spec, robotics_semantics, PLAY_LENGTH, cancel, deadline)
         diagnosis.play = play_in_words(steps, provenance, abstraction)
-    except SynthesisCancelled as stopped:
+    except SynthesisCancelledError as stopped:
         diagnosis.note = f'(The unrealizable core was not computed: {stopped.reason}.)'
     if not diagnosis.sentence:
         diagnosis.sentence = _core_sentence(diagnosis.core)

@@ -7,9 +7,9 @@
 Limits (every phase -- parsing, BDD building, solving, extraction, explanation -- checks them
 in each of its loops, so a synthesis stops within a few milliseconds plus one BDD operation)::
 
-    synthesize(spec, deadline=time.monotonic() + 60,   # -> SynthesisTimedOut, code SYNTHESIS_TIMEOUT
-               cancel=threading.Event(),               # set() -> SynthesisCancelled, code PREEMPTED
-               memory_limit=2 * 2**30)                 # BDD bytes -> SynthesisMemoryExceeded
+    synthesize(spec, deadline=time.monotonic() + 60,   # -> SynthesisTimeoutError, code SYNTHESIS_TIMEOUT
+               cancel=threading.Event(),               # set() -> SynthesisCancelledError, code PREEMPTED
+               memory_limit=2 * 2**30)                 # BDD bytes -> SynthesisMemoryError
     is_realizable(spec, ...)                           # the verdict only, same limits
 
 ``Interrupt(cancel, deadline, memory_limit)`` is the same check as one object: pass it to
@@ -30,8 +30,8 @@ _EXPORTS = {
     'SynthesisResult': 'ltl_synthesizer.synthesizer',
     'DEFAULT_MEMORY_LIMIT': 'ltl_synthesizer.synthesizer',
     'Options': 'ltl_synthesizer.policy', 'Interrupt': 'ltl_synthesizer.interrupt',
-    'SynthesisCancelled': 'ltl_synthesizer.errors', 'SynthesisError': 'ltl_synthesizer.errors',
-    'SynthesisMemoryExceeded': 'ltl_synthesizer.errors', 'SynthesisTimedOut': 'ltl_synthesizer.errors',
+    'SynthesisCancelledError': 'ltl_synthesizer.errors', 'SynthesisError': 'ltl_synthesizer.errors',
+    'SynthesisMemoryError': 'ltl_synthesizer.errors', 'SynthesisTimeoutError': 'ltl_synthesizer.errors',
     'UndeclaredPropositionError': 'ltl_synthesizer.errors',
     'NotGR1FormulaError': 'ltl_synthesizer.errors',
 }

@@ -92,7 +92,7 @@ def _arguments(argv):
 def read_specification(path: str, check=None, deadline: float | None = None):
     """Parse a .slugsin or .structuredslugs file (by extension) into a GR1Specification;
     ``check`` (e.g. an ltl_synthesizer Interrupt) is called regularly while parsing. Reading
-    that has not ended by ``deadline`` (a FIFO no one writes to) raises SynthesisCancelled."""
+    that has not ended by ``deadline`` (a FIFO no one writes to) raises SynthesisCancelledError."""
     from respec.parsing import parse_slugsin, parse_structuredslugs
     if path.endswith('.structuredslugs'):
         parse = parse_structuredslugs
@@ -107,7 +107,7 @@ def _read_text(path: str, deadline: float | None) -> str:
     if deadline is None:
         return Path(path).read_text()
     import threading
-    from ltl_synthesizer.errors import SynthesisTimedOut
+    from ltl_synthesizer.errors import SynthesisTimeoutError
     outcome = {}
 
     def read():  # opening a FIFO blocks until a writer comes: in a thread the process may leave
@@ -120,7 +120,7 @@ def _read_text(path: str, deadline: float | None) -> str:
     reader.start()
     reader.join(max(0.0, deadline - time.monotonic()))
     if reader.is_alive():
-        raise SynthesisTimedOut(f'timeout: {path} was still being read')
+        raise SynthesisTimeoutError(f'timeout: {path} was still being read')
     if 'error' in outcome:
         raise outcome['error']
     return outcome['text']
@@ -216,8 +216,8 @@ def run_with_deep_stack(function, *args):
 
 def _run(args) -> int:
     from respec.parsing import ParseError
-    from ltl_synthesizer.errors import (SynthesisCancelled, SynthesisError,
-                                        SynthesisMemoryExceeded)
+    from ltl_synthesizer.errors import (SynthesisCancelledError, SynthesisError,
+                                        SynthesisMemoryError)
     from ltl_synthesizer.interrupt import Interrupt
 
     deadline = time.monotonic() + args.timeout if args.timeout else None
@@ -225,10 +225,10 @@ def _run(args) -> int:
     interrupt = Interrupt(None, deadline, memory_limit)
     try:
         spec = read_specification(args.input, check=interrupt, deadline=deadline)
-    except SynthesisCancelled as error:
+    except SynthesisCancelledError as error:
         print(f'gr1synth: error: {error}', file=sys.stderr)
         return ExitStatus.TIMED_OUT
-    except (SynthesisMemoryExceeded, MemoryError) as error:
+    except (SynthesisMemoryError, MemoryError) as error:
         print(f'gr1synth: error: memory limit: {error or "out of memory"} (while parsing {args.input})',
               file=sys.stderr)
         return ExitStatus.OUT_OF_MEMORY
@@ -256,10 +256,10 @@ def _run(args) -> int:
                             explain=args.explain,
                             strategy='stream' if stream else args.explicitStrategy,
                             memory_limit=memory_limit)
-    except SynthesisCancelled as error:
+    except SynthesisCancelledError as error:
         print(f'gr1synth: error: {error}', file=sys.stderr)
         return ExitStatus.TIMED_OUT
-    except SynthesisMemoryExceeded as error:
+    except SynthesisMemoryError as error:
         print(f'gr1synth: error: {error}', file=sys.stderr)
         return ExitStatus.OUT_OF_MEMORY
     except SynthesisError as error:
@@ -283,7 +283,7 @@ def _run(args) -> int:
             _write_chunks(strategy_json_chunks(strategy), args.output)
         else:
             _write(strategy_to_text(strategy), args.output)
-    except SynthesisMemoryExceeded as error:  # a streamed strategy is extracted while written
+    except SynthesisMemoryError as error:  # a streamed strategy is extracted while written
         print(f'gr1synth: error: {error}', file=sys.stderr)
         return ExitStatus.OUT_OF_MEMORY
     return ExitStatus.OK

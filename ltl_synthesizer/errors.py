@@ -23,7 +23,7 @@ class NotGR1FormulaError(SynthesisError):
     code = ErrorCode.INVALID_FORMULA
 
 
-class SynthesisCancelled(SynthesisError):
+class SynthesisCancelledError(SynthesisError):
     """Synthesis was stopped by its cancel flag (``reason`` 'cancelled')."""
 
     code = ErrorCode.PREEMPTED
@@ -33,7 +33,7 @@ class SynthesisCancelled(SynthesisError):
         self.reason = reason
 
 
-class SynthesisTimedOut(SynthesisCancelled):
+class SynthesisTimeoutError(SynthesisCancelledError):
     """Synthesis passed its deadline (``reason`` 'timeout', or what was going on then)."""
 
     code = ErrorCode.SYNTHESIS_TIMEOUT
@@ -42,5 +42,5 @@ class SynthesisTimedOut(SynthesisCancelled):
         super().__init__(reason)
 
 
-class SynthesisMemoryExceeded(SynthesisError):
+class SynthesisMemoryError(SynthesisError):
     """The synthesis needed more memory than its limit (``item`` is 'memory_limit')."""

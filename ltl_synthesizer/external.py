@@ -17,7 +17,7 @@ import threading
 import time
 from pathlib import Path
 
-from ltl_synthesizer.errors import SynthesisCancelled, SynthesisError, SynthesisTimedOut
+from ltl_synthesizer.errors import SynthesisCancelledError, SynthesisError, SynthesisTimeoutError
 from respec.errors import ErrorCode
 
 REALIZABLE_LINE = 'RESULT: Specification is realizable.'
@@ -38,7 +38,7 @@ def run_external_synthesizer(executable: str, slugsin_path, output_path,
 
     Raises ExternalSynthesizerError (code SYNTHESIZER_BACKEND_FAILED) when the executable
     cannot be started, exits abnormally, prints neither RESULT line, or claims realizability
-    without a readable strategy; SynthesisCancelled with reason 'timeout' (code
+    without a readable strategy; SynthesisCancelledError with reason 'timeout' (code
     SYNTHESIS_TIMEOUT) after ``timeout`` seconds or 'cancelled' (code PREEMPTED) when
     ``cancel`` is set. The process (and its process group) is killed in both cases.
     """
@@ -96,10 +96,10 @@ def _wait(process: subprocess.Popen, executable: str, timeout: float | None,
             pass
         if cancel is not None and cancel.is_set():
             _kill(process)
-            raise SynthesisCancelled('cancelled')
+            raise SynthesisCancelledError('cancelled')
         if deadline is not None and time.monotonic() >= deadline:
             _kill(process)
-            raise SynthesisTimedOut()
+            raise SynthesisTimeoutError()
 
 
 def _kill(process: subprocess.Popen) -> None:

@@ -7,7 +7,7 @@ import os
 import threading
 import time
 
-from ltl_synthesizer.errors import SynthesisCancelled, SynthesisMemoryExceeded, SynthesisTimedOut
+from ltl_synthesizer.errors import SynthesisCancelledError, SynthesisMemoryError, SynthesisTimeoutError
 
 
 class Interrupt:
@@ -34,10 +34,10 @@ class Interrupt:
 
     def check(self) -> None:
         if self.cancel is not None and self.cancel.is_set():
-            raise SynthesisCancelled('cancelled')
+            raise SynthesisCancelledError('cancelled')
         now = time.monotonic()
         if self.deadline is not None and now >= self.deadline:
-            raise SynthesisTimedOut()
+            raise SynthesisTimeoutError()
         if self.memory_limit is not None and now - self._memory_checked_at >= self.MEMORY_CHECK_SECONDS:
             self._memory_checked_at = now
             if _resident_memory() - self._baseline_memory > self.memory_limit:
@@ -59,7 +59,7 @@ def _resident_memory() -> int:
 _PAGE_SIZE = os.sysconf('SC_PAGE_SIZE') if hasattr(os, 'sysconf') else 4096
 
 
-def memory_exceeded(limit: int) -> SynthesisMemoryExceeded:
-    return SynthesisMemoryExceeded(
+def memory_exceeded(limit: int) -> SynthesisMemoryError:
+    return SynthesisMemoryError(
         f'synthesis needs more than its memory limit of {limit / 2**20:.0f} MB '
         '(memory_limit); simplify the specification or raise the limit', item='memory_limit')

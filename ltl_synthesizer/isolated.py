@@ -18,7 +18,7 @@ idle children held 2.6x the baseline RSS), and as many fresh ones as were prepar
 
 ``synthesize`` has the arguments, results and exceptions of :func:`ltl_synthesizer.synthesize`;
 ``call`` runs any importable function. A child that dies (killed from outside, crashed) raises
-:class:`SynthesisProcessDied`; a cancel or the deadline raises SynthesisCancelled.
+:class:`SynthesisProcessDiedError`; a cancel or the deadline raises SynthesisCancelledError.
 """
 
 from __future__ import annotations
@@ -33,7 +33,7 @@ import threading
 import time
 import traceback
 
-from ltl_synthesizer.errors import SynthesisCancelled, SynthesisError, SynthesisTimedOut
+from ltl_synthesizer.errors import SynthesisCancelledError, SynthesisError, SynthesisTimeoutError
 
 # How often the caller looks at its cancel flag and deadline while a child works.
 POLL_SECONDS = 0.02
@@ -47,7 +47,7 @@ IDLE_SECONDS = 30.0
 _LENGTH_BYTES = 8
 
 
-class SynthesisProcessDied(SynthesisError):
+class SynthesisProcessDiedError(SynthesisError):
     """The process running the synthesis ended without an answer."""
 
 
@@ -159,9 +159,9 @@ class SynthesisProcesses:
             child.send((target, tuple(args), dict(kwargs or {})))
             while not child.answered(POLL_SECONDS):
                 if cancel is not None and cancel.is_set():
-                    raise SynthesisCancelled('cancelled')
+                    raise SynthesisCancelledError('cancelled')
                 if deadline is not None and time.monotonic() >= deadline:
-                    raise SynthesisTimedOut()
+                    raise SynthesisTimeoutError()
                 if not child.alive():
                     raise self._ended(child)
             answer = child.receive()
@@ -176,8 +176,8 @@ class SynthesisProcesses:
 
     def _ended(self, child: _Child) -> SynthesisError:
         if self._closed:
-            return SynthesisCancelled('cancelled')
-        return SynthesisProcessDied(f'the synthesis process ended (exit code {child.process.poll()}) '
+            return SynthesisCancelledError('cancelled')
+        return SynthesisProcessDiedError(f'the synthesis process ended (exit code {child.process.poll()}) '
                                     'without an answer', item='synthesis process')
 
     def close(self) -> None:
@@ -193,7 +193,7 @@ class SynthesisProcesses:
     def _take(self) -> _Child:
         with self._lock:
             if self._closed:
-                raise SynthesisCancelled('cancelled')
+                raise SynthesisCancelledError('cancelled')
             child = self._idle.pop() if self._idle else None
         if child is None or not child.alive():
             if child is not None:

@@ -54,9 +54,9 @@ def synthesize(spec: GR1Specification, robotics_semantics: bool = True,
     (``strategy_json_chunks`` writes them out; memory holds no edges).
 
     Limits (all optional, checked in every long loop of every phase): ``cancel`` (a
-    threading.Event) raises ``SynthesisCancelled`` (code PREEMPTED), ``deadline`` (a
-    ``time.monotonic()`` instant) raises ``SynthesisTimedOut`` (code SYNTHESIS_TIMEOUT),
-    ``memory_limit`` (bytes of BDD memory, default 2 GiB) raises ``SynthesisMemoryExceeded``.
+    threading.Event) raises ``SynthesisCancelledError`` (code PREEMPTED), ``deadline`` (a
+    ``time.monotonic()`` instant) raises ``SynthesisTimeoutError`` (code SYNTHESIS_TIMEOUT),
+    ``memory_limit`` (bytes of BDD memory, default 2 GiB) raises ``SynthesisMemoryError``.
     ``UndeclaredPropositionError`` / ``NotGR1FormulaError`` for formulas outside the declared
     propositions or GR(1).
     """

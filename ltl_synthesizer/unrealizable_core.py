@@ -36,7 +36,7 @@ def is_realizable(spec: GR1Specification, robotics_semantics: bool = True,
                   cancel: threading.Event | None = None, deadline: float | None = None) -> bool:
     """Whether ``spec`` is realizable (no strategy is extracted).
 
-    Raises ``SynthesisCancelled`` when ``cancel`` is set or ``deadline`` passes.
+    Raises ``SynthesisCancelledError`` when ``cancel`` is set or ``deadline`` passes.
     """
     game = SymbolicGame(spec, None, Interrupt(cancel, deadline))
 
@@ -121,7 +121,7 @@ def unrealizable_core(spec: GR1Specification, groups: Sequence, robotics_semanti
 
     ``groups`` are objects with ``section`` and ``formulas`` covering the specification
     (e.g. ``respec.components.FormulaGroup``); only those of ``droppable_sections`` are candidates.
-    Returns None when ``spec`` is realizable. Raises ``SynthesisCancelled`` on cancel/deadline.
+    Returns None when ``spec`` is realizable. Raises ``SynthesisCancelledError`` on cancel/deadline.
     """
     sections = droppable_sections(robotics_semantics)
     guarantees = [group for group in groups if group.section in sections]

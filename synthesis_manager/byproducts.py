@@ -38,7 +38,7 @@ _MARKER_SIGNATURE = 'behavior synthesis byproducts; retention may delete: '
 _MARKER_FILE = re.compile(r'^\.(?P<stem>.+)' + re.escape(_MARKER_SUFFIX) + '$')
 
 
-class InvalidSpecName(CodedError):
+class InvalidSpecNameError(CodedError):
     code = ErrorCode.INVALID_SPEC_NAME
 
 
@@ -50,7 +50,7 @@ def checked_spec_name(spec_name: str) -> str:
     """``spec_name`` (or the default), refusing names that could leave the directory."""
     name = spec_name or DEFAULT_SPEC_NAME
     if not is_spec_name(name):
-        raise InvalidSpecName(f'invalid spec_name {quoted(spec_name)}: use letters, digits, "_", "-" and "." '
+        raise InvalidSpecNameError(f'invalid spec_name {quoted(spec_name)}: use letters, digits, "_", "-" and "." '
                               '(at most 100, no path separators or "..")', 'spec_name')
     return name
 

@@ -14,7 +14,7 @@ from respec.errors import ExitStatus, exit_status_help
 from sm_generation import StateInstantiation
 from sm_generation.export import render, to_dot, to_json, to_yaml
 from synthesis_manager.send_goal import ProgressBar, add_goal_arguments, goal_from_args, print_summary
-from synthesis_manager.suite import SuiteUnavailable, add_suite_arguments, in_process_suite
+from synthesis_manager.suite import SuiteUnavailableError, add_suite_arguments, in_process_suite
 
 
 def add_arguments(parser):
@@ -54,7 +54,7 @@ def run(args) -> int:
             progress = ProgressBar()
             outcome = client.run(goal_from_args(args), feedback=progress)
             progress.close()
-    except SuiteUnavailable as error:
+    except SuiteUnavailableError as error:
         print(f'demo: {error}', file=sys.stderr)
         return ExitStatus.UNAVAILABLE
     print_summary(outcome)

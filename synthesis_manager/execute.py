@@ -45,7 +45,7 @@ from atlas_sim.machine import ExecutionError
 from respec.errors import ExitStatus, exit_status_help
 from respec.parsing import spec_from_text_sections
 from synthesis_manager.send_goal import ProgressBar, add_goal_arguments, goal_from_args, print_summary
-from synthesis_manager.suite import SuiteUnavailable, add_suite_arguments, in_process_suite
+from synthesis_manager.suite import SuiteUnavailableError, add_suite_arguments, in_process_suite
 
 EXIT_STATUS_HELP = exit_status_help(ExitStatus.OK, ExitStatus.FAILED, ExitStatus.USAGE, ExitStatus.TIMED_OUT,
                                     ExitStatus.UNAVAILABLE, ExitStatus.OTHER_OUTCOME, ExitStatus.VIOLATIONS,
@@ -136,7 +136,7 @@ def _synthesize_and_execute(args, simulator, initial_conditions, batches, report
                 report.update(goals=batches[0])
                 return session.run_batch(initial_conditions, batches[0], report, args.record, args.expect)
             return session.run_mission(initial_conditions, batches, report)
-    except SuiteUnavailable as error:
+    except SuiteUnavailableError as error:
         print(f'execute: {error}', file=sys.stderr)
         return ExitStatus.UNAVAILABLE
 

@@ -22,7 +22,7 @@ from pathlib import Path
 
 from respec.errors import ExitStatus, exit_status_help
 from synthesis_manager.send_goal import ProgressBar, add_goal_arguments, goal_from_args
-from synthesis_manager.suite import SuiteUnavailable, add_suite_arguments, in_process_suite
+from synthesis_manager.suite import SuiteUnavailableError, add_suite_arguments, in_process_suite
 
 EXIT_STATUSES = (ExitStatus.OK, ExitStatus.FAILED, ExitStatus.USAGE, ExitStatus.TIMED_OUT, ExitStatus.UNAVAILABLE)
 
@@ -58,7 +58,7 @@ def run(args) -> int:
     try:
         with in_process_suite(args, 'export_behavior_client') as (_, client):
             outcome = client.run(goal_from_args(args), feedback=progress)
-    except SuiteUnavailable as error:
+    except SuiteUnavailableError as error:
         print(f'export-behavior: {error}', file=sys.stderr)
         return ExitStatus.UNAVAILABLE
     finally:

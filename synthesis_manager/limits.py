@@ -12,7 +12,7 @@ import math
 import time
 
 from respec.errors import CodedError, ErrorCode, quoted
-from synthesis_manager.requests import InvalidRequest
+from synthesis_manager.requests import InvalidRequestError
 
 #: Longest string accepted in any request field, in UTF-8 bytes.
 MAX_STRING_BYTES = 64 * 1024
@@ -25,9 +25,9 @@ def check_timeout(value, item: str = 'timeout') -> float:
     try:
         seconds = float(value)
     except (TypeError, ValueError):
-        raise InvalidRequest(f'{item} must be a number of seconds, got {quoted(value)}') from None
+        raise InvalidRequestError(f'{item} must be a number of seconds, got {quoted(value)}') from None
     if not math.isfinite(seconds) or seconds < 0:
-        raise InvalidRequest(f'{item} must be a finite number of seconds >= 0 (0: the default), '
+        raise InvalidRequestError(f'{item} must be a finite number of seconds >= 0 (0: the default), '
                              f'got {quoted(value)}')
     return seconds
 
@@ -65,7 +65,7 @@ def oversized_strings(message, path: str = 'request', limit: int = MAX_STRING_BY
 def check_message(message, path: str = 'request', limit: int = MAX_STRING_BYTES):
     """Refuse a message with an oversized string field, naming the first such field."""
     for field_path, value in oversized_strings(message, path, limit):
-        raise InvalidRequest(too_long(field_path, value, limit))
+        raise InvalidRequestError(too_long(field_path, value, limit))
 
 
 def too_long(field_path: str, value: str, limit: int = MAX_STRING_BYTES) -> str:
@@ -86,7 +86,7 @@ class BusyError(CodedError):
         self.retry_after = retry_after
 
 
-class GoalTimedOut(CodedError):
+class GoalTimeoutError(CodedError):
     """The goal's own time limit passed (its whole pipeline, queues included)."""
 
     code = ErrorCode.TIMEOUT
@@ -105,7 +105,7 @@ class GoalDeadline:
 
     def stage_limit(self, stage_limit: float, stage: str) -> float:
         """Seconds ``stage`` may take: its own limit, cut to what is left of the goal's;
-        GoalTimedOut when nothing is left."""
+        GoalTimeoutError when nothing is left."""
         if self.deadline is None:
             return stage_limit
         left = self.deadline - time.monotonic()
@@ -116,6 +116,6 @@ class GoalDeadline:
     def passed(self) -> bool:
         return self.deadline is not None and time.monotonic() >= self.deadline
 
-    def timed_out(self, stage: str) -> GoalTimedOut:
-        return GoalTimedOut(f'the goal\'s time limit of {self.limit:g} s passed ({stage}; the limit counts '
+    def timed_out(self, stage: str) -> GoalTimeoutError:
+        return GoalTimeoutError(f'the goal\'s time limit of {self.limit:g} s passed ({stage}; the limit counts '
                             'the whole pipeline, waiting included)', 'timeout')

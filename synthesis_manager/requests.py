@@ -17,7 +17,7 @@ from respec.naming import DEFAULT_SM_OUTCOMES, parse_names
 OPTION_NAMES = ('ltl_compilation_only', 'ltl_synthesis_only', 'ltl_steps_only')
 
 
-class InvalidRequest(CodedError):
+class InvalidRequestError(CodedError):
     """A request the server cannot run (contradictory or malformed options)."""
 
     code = ErrorCode.INVALID_REQUEST
@@ -27,7 +27,7 @@ def selected_option(options) -> str | None:
     """The one SynthesisOptions flag that is set, or None; several flags is an error."""
     chosen = [name for name in OPTION_NAMES if getattr(options, name)]
     if len(chosen) > 1:
-        raise InvalidRequest(f'synthesis options are mutually exclusive, got {" and ".join(chosen)}')
+        raise InvalidRequestError(f'synthesis options are mutually exclusive, got {" and ".join(chosen)}')
     return chosen[0] if chosen else None
 
 
@@ -113,11 +113,11 @@ class _RequestYamlLoader(yaml.SafeLoader):
     def compose_node(self, parent, index):
         if self.check_event(yaml.AliasEvent):
             mark = self.peek_event().start_mark
-            raise InvalidRequest(f'{self.item}: YAML aliases (*name) are not accepted '
+            raise InvalidRequestError(f'{self.item}: YAML aliases (*name) are not accepted '
                                  f'(line {mark.line + 1}, column {mark.column + 1})', self.item)
         self.depth += 1
         if self.depth > MAX_YAML_DEPTH:
-            raise InvalidRequest(f'{self.item}: YAML nested deeper than {MAX_YAML_DEPTH} levels', self.item)
+            raise InvalidRequestError(f'{self.item}: YAML nested deeper than {MAX_YAML_DEPTH} levels', self.item)
         try:
             return super().compose_node(parent, index)
         finally:
@@ -125,7 +125,7 @@ class _RequestYamlLoader(yaml.SafeLoader):
 
 
 def load_request_yaml(text: str, item: str):
-    """The value of a request's YAML field ``item``; an InvalidRequest naming it if it is not
+    """The value of a request's YAML field ``item``; an InvalidRequestError naming it if it is not
     valid YAML, uses aliases or nests too deeply. The message quotes none of the text."""
     loader = _RequestYamlLoader(text, item)
     try:
@@ -134,7 +134,7 @@ def load_request_yaml(text: str, item: str):
         mark = getattr(error, 'problem_mark', None)
         where = f' (line {mark.line + 1}, column {mark.column + 1})' if mark is not None else ''
         problem = getattr(error, 'problem', None) or 'malformed'
-        raise InvalidRequest(f'{item} is not valid YAML: {quoted(problem, 80)}{where}', item) from None
+        raise InvalidRequestError(f'{item} is not valid YAML: {quoted(problem, 80)}{where}', item) from None
     finally:
         loader.dispose()
 
@@ -144,7 +144,7 @@ def parse_synthesis_options(text: str) -> dict:
 
     Empty text means the defaults. Accepted: one option name (``ltl_compilation_only``), or a
     mapping of option flags, ``timeout`` (seconds) and ``unordered_goals``. Anything else is an
-    InvalidRequest naming the bad item (quoting at most the start of a value).
+    InvalidRequestError naming the bad item (quoting at most the start of a value).
     """
     options = load_request_yaml(text or '', 'synthesis_options')
     if options is None:
@@ -152,20 +152,20 @@ def parse_synthesis_options(text: str) -> dict:
     if isinstance(options, str):
         options = {options: True}
     if not isinstance(options, dict):
-        raise InvalidRequest(f'synthesis_options must be a YAML mapping, got {quoted(options)}',
+        raise InvalidRequestError(f'synthesis_options must be a YAML mapping, got {quoted(options)}',
                              'synthesis_options')
     known = (*OPTION_NAMES, 'timeout', 'unordered_goals')
     for key, value in options.items():
         if key not in known:
-            raise InvalidRequest(f'unknown synthesis option {quoted(key)} (known: {", ".join(known)})',
+            raise InvalidRequestError(f'unknown synthesis option {quoted(key)} (known: {", ".join(known)})',
                                  'synthesis_options')
         if key == 'timeout':
             if (isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value)
                     or value < 0):
-                raise InvalidRequest(f'synthesis option timeout must be a finite number >= 0, '
+                raise InvalidRequestError(f'synthesis option timeout must be a finite number >= 0, '
                                      f'got {quoted(value)}', 'timeout')
         elif not isinstance(value, bool):
-            raise InvalidRequest(f'synthesis option {key} must be true or false, got {quoted(value)}', key)
+            raise InvalidRequestError(f'synthesis option {key} must be true or false, got {quoted(value)}', key)
     flags = SimpleNamespace(**{name: bool(options.get(name, False)) for name in OPTION_NAMES})
     return {'option': selected_option(flags), 'timeout': float(options.get('timeout', 0.0)),
             'unordered_goals': bool(options.get('unordered_goals', False))}
@@ -197,11 +197,11 @@ def task_from_flexbe_synthesis(goal, default_system: str) -> SynthesisTask:
     """A FlexBESynthesis goal (CNU's interface); ``synthesis_options`` is YAML."""
     request = goal.request
     if request.specification_file_name:
-        raise InvalidRequest(f'specification_file_name {quoted(request.specification_file_name)}: this server '
+        raise InvalidRequestError(f'specification_file_name {quoted(request.specification_file_name)}: this server '
                              'compiles specifications itself; leave it empty')
     options = parse_synthesis_options(goal.synthesis_options)
     if options['option'] == 'ltl_synthesis_only':
-        raise InvalidRequest('synthesis option ltl_synthesis_only needs a complete specification, '
+        raise InvalidRequestError('synthesis option ltl_synthesis_only needs a complete specification, '
                              'which FlexBESynthesis goals cannot carry; send it with BehaviorSynthesis')
     return make_task(system=request.system_name, initial_conditions=list(request.initial_conditions),
                      goals=list(request.goals), sm_outcomes=request.sm_outcomes, name=request.spec_name,

@@ -14,7 +14,7 @@ from respec.naming import parse_names
 from respec.parsing import parse_structuredslugs
 from sm_generation.instantiation import count_states
 from synthesis_manager.client import SynthesisClient, make_flexbe_goal, make_goal
-from synthesis_manager.requests import InvalidRequest
+from synthesis_manager.requests import InvalidRequestError
 from synthesis_manager.ros.harness import RosHarness, environment_domain_id
 from synthesis_manager.summary import spec_size, state_machine_tree
 
@@ -74,7 +74,7 @@ def goal_from_args(args):
         option, spec = 'ltl_synthesis_only', read_spec_file(args.synthesis_only)
     if getattr(args, 'action', '') == 'flexbe_synthesis':
         if spec is not None:
-            raise InvalidRequest('--synthesis-only needs --action behavior_synthesis (FlexBESynthesis '
+            raise InvalidRequestError('--synthesis-only needs --action behavior_synthesis (FlexBESynthesis '
                                  'goals carry no specification)')
         return make_flexbe_goal(args.system, parse_names(args.initial_conditions), parse_names(args.goals),
                                 parse_names(args.sm_outcomes), option=option, name=args.name,

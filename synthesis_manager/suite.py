@@ -68,7 +68,7 @@ def suite_node_factories(args=None, names=SUITE_NODE_NAMES):
             for name in names]
 
 
-class SuiteUnavailable(CodedError):
+class SuiteUnavailableError(CodedError):
     """The in-process suite's action server did not come up."""
 
     code = ErrorCode.SERVICE_UNAVAILABLE
@@ -85,5 +85,5 @@ def in_process_suite(args=None, client_name: str = 'suite_client'):
             ros.add_node(factory)
         client = SynthesisClient(ros.add_node(Node, client_name))
         if not client.wait_for_server(timeout=10.0):
-            raise SuiteUnavailable('the /behavior_synthesis action server did not come up')
+            raise SuiteUnavailableError('the /behavior_synthesis action server did not come up')
         yield ros, client

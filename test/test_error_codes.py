@@ -80,7 +80,7 @@ def test_exceptions_with_a_code_are_coded_errors():
 
 
 # The one error relaying another node's answer: its code is that answer's.
-RELAYS = {'StageFailed'}
+RELAYS = {'StageFailedError'}
 
 
 def test_no_error_sets_its_code_per_instance():
@@ -108,12 +108,12 @@ def test_no_exception_class_name_is_used_twice():
 
 
 def test_a_relayed_answer_keeps_its_code_and_an_unknown_number_is_named():
-    from synthesis_manager.ros.stage_calls import StageFailed
+    from synthesis_manager.ros.stage_calls import StageFailedError
     from synthesis_msgs.msg import SynthesisErrorCodes
 
-    known = StageFailed(SynthesisErrorCodes(value=SynthesisErrorCodes.SPEC_UNSYNTHESIZABLE, message='no way'))
+    known = StageFailedError(SynthesisErrorCodes(value=SynthesisErrorCodes.SPEC_UNSYNTHESIZABLE, message='no way'))
     assert known.code is ErrorCode.SPEC_UNSYNTHESIZABLE and str(known) == 'no way'
-    unknown = StageFailed(SynthesisErrorCodes(value=777, message='odd'))
+    unknown = StageFailedError(SynthesisErrorCodes(value=777, message='odd'))
     assert unknown.code is ErrorCode.BEHAVIOR_SYNTHESIS_FAILED and 'unknown error code 777: odd' in str(unknown)
 
 
@@ -125,3 +125,14 @@ def test_the_readme_lists_every_exit_status_with_its_meaning():
     assert ExitStatus.for_error('SPEC_UNSYNTHESIZABLE') == ExitStatus.FAILED == ExitStatus.for_error('777')
     assert ExitStatus.for_error(ErrorCode.SYNTHESIS_TIMEOUT) == ExitStatus.TIMED_OUT
     assert ExitStatus.for_error(ErrorCode.BUSY) == ExitStatus.UNAVAILABLE
+
+
+def test_errors_end_in_error_and_every_other_exception_is_a_documented_control_flow_signal():
+    from respec.errors import ControlFlowSignal
+
+    exceptions = {cls for module in MODULES for cls in vars(module).values()
+                  if isinstance(cls, type) and issubclass(cls, BaseException) and cls.__module__ == module.__name__}
+    assert [c.__name__ for c in CODED if not c.__name__.endswith('Error')] == []
+    signals = {c for c in exceptions if not c.__name__.endswith('Error')}
+    assert signals and all(issubclass(c, ControlFlowSignal) and 'not an error' in c.__doc__.lower()
+                           for c in signals), signals

@@ -12,7 +12,7 @@ from respec.errors import QUOTED_CHARACTERS, quoted
 from respec.ltl import var
 from respec.nesting import MAX_FORMULA_NESTING
 from respec.parsing import ParseError, UnknownVariableError, parse_formula, parse_structuredslugs
-from synthesis_manager.requests import MAX_YAML_DEPTH, InvalidRequest, parse_synthesis_options
+from synthesis_manager.requests import MAX_YAML_DEPTH, InvalidRequestError, parse_synthesis_options
 
 
 def alias_bomb(levels: int) -> str:
@@ -30,7 +30,7 @@ def test_a_yaml_alias_bomb_is_refused_before_it_expands():
     bomb = alias_bomb(9)  # 9**9 = 387 million strings if expanded
     assert len(bomb) < 1000
     before, started = peak_rss_mib(), time.process_time()
-    with pytest.raises(InvalidRequest, match='aliases') as raised:
+    with pytest.raises(InvalidRequestError, match='aliases') as raised:
         parse_synthesis_options(bomb)
     assert time.process_time() - started < 1.0
     assert peak_rss_mib() - before < 50
@@ -39,20 +39,20 @@ def test_a_yaml_alias_bomb_is_refused_before_it_expands():
 
 
 def test_a_single_alias_is_refused_too():
-    with pytest.raises(InvalidRequest, match='aliases'):
+    with pytest.raises(InvalidRequestError, match='aliases'):
         parse_synthesis_options('timeout: &t 3\nunordered_goals: *t')
 
 
 @pytest.mark.parametrize('text', ['[' * 5000 + ']' * 5000, '{a: ' * 3000 + '1' + '}' * 3000,
                                   '\n'.join(' ' * level + 'a:' for level in range(200)) + ' 1'])
 def test_deeply_nested_options_are_a_short_invalid_request(text):
-    with pytest.raises(InvalidRequest, match=f'deeper than {MAX_YAML_DEPTH}') as raised:
+    with pytest.raises(InvalidRequestError, match=f'deeper than {MAX_YAML_DEPTH}') as raised:
         parse_synthesis_options(text)
     assert len(str(raised.value)) < 100
 
 
 def test_yaml_errors_quote_no_input():
-    with pytest.raises(InvalidRequest, match='not valid YAML') as raised:
+    with pytest.raises(InvalidRequestError, match='not valid YAML') as raised:
         parse_synthesis_options('timeout: [' + 'x' * 10_000)
     assert 'x' * 50 not in str(raised.value) and len(str(raised.value)) < 200
 
@@ -60,7 +60,7 @@ def test_yaml_errors_quote_no_input():
 @pytest.mark.parametrize('text', ['x' * 10_000 + ': 1', 'timeout: ' + '9' * 5000 + '.5e' + '9' * 3,
                                   'ltl_steps_only: ' + 'y' * 10_000])
 def test_refused_option_values_are_quoted_by_their_start(text):
-    with pytest.raises(InvalidRequest) as raised:
+    with pytest.raises(InvalidRequestError) as raised:
         parse_synthesis_options(text)
     assert len(str(raised.value)) < 250
 

@@ -17,7 +17,7 @@ from pathlib import Path
 import pytest
 
 from gr1_oracle import Oracle
-from ltl_synthesizer import SynthesisCancelled, synthesize
+from ltl_synthesizer import SynthesisCancelledError, synthesize
 from ltl_synthesizer.external import ExternalSynthesizerError, run_external_synthesizer
 from respec.parsing import parse_slugsin, parse_structuredslugs
 
@@ -256,7 +256,7 @@ def assert_killed(tmp_path):
 
 def test_timeout_kills_the_process(tmp_path):
     started = time.monotonic()
-    with pytest.raises(SynthesisCancelled) as caught:
+    with pytest.raises(SynthesisCancelledError) as caught:
         run_external_synthesizer(sleeper(tmp_path), write_slugsin(tmp_path, 'copy_safety.structuredslugs'),
                                  tmp_path / 'o.json', timeout=0.5)
     assert (caught.value.reason, caught.value.code) == ('timeout', 'SYNTHESIS_TIMEOUT')
@@ -267,7 +267,7 @@ def test_timeout_kills_the_process(tmp_path):
 def test_cancel_kills_the_process(tmp_path):
     cancel = threading.Event()
     threading.Timer(0.5, cancel.set).start()
-    with pytest.raises(SynthesisCancelled) as caught:
+    with pytest.raises(SynthesisCancelledError) as caught:
         run_external_synthesizer(sleeper(tmp_path), write_slugsin(tmp_path, 'copy_safety.structuredslugs'),
                                  tmp_path / 'o.json', cancel=cancel)
     assert caught.value.reason == 'cancelled'

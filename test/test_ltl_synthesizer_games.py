@@ -10,7 +10,7 @@ import pytest
 
 import gr1_oracle
 
-from ltl_synthesizer import Options, SynthesisCancelled, synthesize
+from ltl_synthesizer import Options, SynthesisCancelledError, synthesize
 from respec.automaton import automaton_from_strategy
 from ltl_synthesizer.strategy import strategy_to_json
 from respec.ltl import (TRUE, conj, disj, evaluate, iff,
@@ -289,7 +289,7 @@ def atlas_chain(tmp_path_factory):
 
 def test_deadline_stops_a_long_synthesis(atlas_chain):
     game = atlas_chain
-    with pytest.raises(SynthesisCancelled) as raised:
+    with pytest.raises(SynthesisCancelledError) as raised:
         synthesize(game, deadline=time.monotonic() + 0.2)
     assert raised.value.reason == 'timeout' and raised.value.code == 'SYNTHESIS_TIMEOUT'
 
@@ -300,7 +300,7 @@ def test_cancel_flag_stops_a_long_synthesis(atlas_chain):
     timer = threading.Timer(0.2, cancel.set)
     timer.start()
     try:
-        with pytest.raises(SynthesisCancelled) as raised:
+        with pytest.raises(SynthesisCancelledError) as raised:
             synthesize(game, cancel=cancel)
     finally:
         timer.cancel()
@@ -310,7 +310,7 @@ def test_cancel_flag_stops_a_long_synthesis(atlas_chain):
 def test_already_cancelled_request_does_no_work():
     cancel = threading.Event()
     cancel.set()
-    with pytest.raises(SynthesisCancelled):
+    with pytest.raises(SynthesisCancelledError):
         synthesize(copy_game(), cancel=cancel)
 
 

@@ -9,9 +9,9 @@ from concurrent.futures import ThreadPoolExecutor
 import pytest
 
 from ltl_specification import compile_task
-from ltl_synthesizer import SynthesisCancelled, synthesize
-from ltl_synthesizer.errors import SynthesisMemoryExceeded, UndeclaredPropositionError
-from ltl_synthesizer.isolated import SynthesisProcessDied, SynthesisProcesses
+from ltl_synthesizer import SynthesisCancelledError, synthesize
+from ltl_synthesizer.errors import SynthesisMemoryError, UndeclaredPropositionError
+from ltl_synthesizer.isolated import SynthesisProcessDiedError, SynthesisProcesses
 from respec.ltl import var
 from respec.spec import GR1Specification
 
@@ -68,7 +68,7 @@ def test_errors_come_back_as_the_synthesizers_own(processes):
     with pytest.raises(UndeclaredPropositionError) as error:
         processes.synthesize(bad)
     assert error.value.item == 'nowhere' and error.value.code == 'UNKNOWN_PROPOSITION'
-    with pytest.raises(SynthesisMemoryExceeded) as error:
+    with pytest.raises(SynthesisMemoryError) as error:
         processes.synthesize(RUNAWAY, memory_limit=16 * 2**20, deadline=time.monotonic() + 120)
     assert error.value.item == 'memory_limit'
 
@@ -76,7 +76,7 @@ def test_errors_come_back_as_the_synthesizers_own(processes):
 def test_a_cancel_kills_the_child_at_once_and_the_next_synthesis_works(processes):
     cancel = threading.Event()
     threading.Timer(1.0, cancel.set).start()
-    with pytest.raises(SynthesisCancelled) as error:
+    with pytest.raises(SynthesisCancelledError) as error:
         processes.synthesize(RUNAWAY, cancel=cancel)
     stopped = time.monotonic()
     assert error.value.code == 'PREEMPTED'
@@ -88,7 +88,7 @@ def test_a_cancel_kills_the_child_at_once_and_the_next_synthesis_works(processes
 
 def test_the_deadline_stops_the_synthesis_within_a_poll(processes):
     started = time.monotonic()
-    with pytest.raises(SynthesisCancelled) as error:
+    with pytest.raises(SynthesisCancelledError) as error:
         processes.synthesize(RUNAWAY, deadline=started + 1.0)
     assert error.value.code == 'SYNTHESIS_TIMEOUT'
     assert time.monotonic() - started < 1.5
@@ -110,7 +110,7 @@ def test_a_child_killed_from_outside_is_reported_and_replaced(processes):
     for pid in children_of_this_process():
         os.kill(pid, signal.SIGKILL)
     worker.join(timeout=10)
-    assert isinstance(outcome.get('error'), SynthesisProcessDied)
+    assert isinstance(outcome.get('error'), SynthesisProcessDiedError)
     assert outcome['error'].code == 'SYNTHESIS_FAILED'
     assert processes.synthesize(compile_task('atlas', ['stand_prep'], ['look_down'])).realizable
 
@@ -118,7 +118,7 @@ def test_a_child_killed_from_outside_is_reported_and_replaced(processes):
 def test_close_kills_busy_and_idle_children():
     processes = SynthesisProcesses()
     processes.prepare(2)
-    worker = threading.Thread(target=lambda: pytest.raises(SynthesisCancelled, processes.synthesize, RUNAWAY))
+    worker = threading.Thread(target=lambda: pytest.raises(SynthesisCancelledError, processes.synthesize, RUNAWAY))
     worker.start()
     time.sleep(1.0)
     assert len(children_of_this_process()) >= 2

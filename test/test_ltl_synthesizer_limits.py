@@ -5,7 +5,7 @@ import time
 
 import pytest
 
-from ltl_synthesizer import (Interrupt, SynthesisCancelled, SynthesisMemoryExceeded, is_realizable,
+from ltl_synthesizer import (Interrupt, SynthesisCancelledError, SynthesisMemoryError, is_realizable,
                              synthesize)
 from respec.ltl import conj, disj, iff, neg, next_, var
 from respec.parsing import parse_structuredslugs
@@ -31,7 +31,7 @@ def exponential_spec(pairs=20):
 @pytest.mark.parametrize('robotics_semantics', [True, False])
 def test_the_deadline_stops_strategy_extraction_within_a_second(robotics_semantics):
     started = time.monotonic()
-    with pytest.raises(SynthesisCancelled) as raised:
+    with pytest.raises(SynthesisCancelledError) as raised:
         synthesize(runaway_spec(), robotics_semantics=robotics_semantics, deadline=started + 1.0)
     assert raised.value.code == 'SYNTHESIS_TIMEOUT'
     assert time.monotonic() - started < 2.0
@@ -41,7 +41,7 @@ def test_cancel_stops_a_runaway_within_a_second():
     cancel = threading.Event()
     threading.Timer(0.5, cancel.set).start()
     started = time.monotonic()
-    with pytest.raises(SynthesisCancelled) as raised:
+    with pytest.raises(SynthesisCancelledError) as raised:
         synthesize(runaway_spec(), cancel=cancel)
     assert raised.value.code == 'PREEMPTED'
     assert time.monotonic() - started < 1.5
@@ -55,7 +55,7 @@ def test_the_verdict_alone_of_the_runaway_is_immediate():
 
 def test_the_memory_limit_ends_a_blow_up_with_a_clear_error():
     limit = 48 * 2**20
-    with pytest.raises(SynthesisMemoryExceeded) as raised:
+    with pytest.raises(SynthesisMemoryError) as raised:
         synthesize(exponential_spec(), memory_limit=limit)
     assert raised.value.code == 'SYNTHESIS_FAILED' and raised.value.item == 'memory_limit'
     assert 'memory limit of 48 MB' in str(raised.value)
@@ -79,6 +79,6 @@ def test_parsing_checks_the_interrupt(lines):
     text = '[INPUT]\nx\n\n[OUTPUT]\ny\n\n[SYS_TRANS]\n' + '\n'.join(lines) + '\n'
     cancel = threading.Event()
     cancel.set()
-    with pytest.raises(SynthesisCancelled):
+    with pytest.raises(SynthesisCancelledError):
         parse_structuredslugs(text, check=Interrupt(cancel))
     assert len(parse_structuredslugs(text, check=Interrupt()).sys_trans) == len(lines)

@@ -5,7 +5,7 @@ import time
 
 import pytest
 
-from synthesis_manager.byproducts import ByproductStore, InvalidSpecName
+from synthesis_manager.byproducts import ByproductStore, InvalidSpecNameError
 
 
 def write_set(store, name):
@@ -61,7 +61,7 @@ def test_keep_none_leaves_nothing(tmp_path):
 
 @pytest.mark.parametrize('name', ['../escape', '/abs', '.hidden', 'a/b', 'x' * 101])
 def test_names_that_could_leave_the_directory_are_refused(tmp_path, name):
-    with pytest.raises(InvalidSpecName):
+    with pytest.raises(InvalidSpecNameError):
         write_set(ByproductStore(tmp_path), name)
     assert not list(tmp_path.iterdir())
 

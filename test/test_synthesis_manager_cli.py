@@ -12,7 +12,7 @@ from types import SimpleNamespace
 import pytest
 
 from respec.naming import parse_names
-from synthesis_manager.requests import InvalidRequest, selected_option
+from synthesis_manager.requests import InvalidRequestError, selected_option
 from synthesis_manager.ros.env import prepare_ros_environment
 
 CLI = [str(Path(sys.executable).parent / 'behavior-synthesis')]
@@ -34,7 +34,7 @@ def test_synthesis_options_are_mutually_exclusive():
     options = SimpleNamespace(ltl_compilation_only=False, ltl_synthesis_only=False, ltl_steps_only=True)
     assert selected_option(options) == 'ltl_steps_only'
     options.ltl_compilation_only = True
-    with pytest.raises(InvalidRequest, match='mutually exclusive'):
+    with pytest.raises(InvalidRequestError, match='mutually exclusive'):
         selected_option(options)
 
 

@@ -5,12 +5,12 @@ import math
 import pytest
 
 from synthesis_manager.limits import MAX_STRING_BYTES, check_message, check_timeout, oversized_strings
-from synthesis_manager.requests import InvalidRequest
+from synthesis_manager.requests import InvalidRequestError
 
 
 @pytest.mark.parametrize('value', [-1, -0.001, math.nan, math.inf, -math.inf, 'soon'])
 def test_bad_time_limits_are_invalid_requests(value):
-    with pytest.raises(InvalidRequest, match='timeout') as raised:
+    with pytest.raises(InvalidRequestError, match='timeout') as raised:
         check_timeout(value)
     assert raised.value.code == 'INVALID_REQUEST'
 
@@ -26,7 +26,7 @@ def test_an_oversized_nested_string_is_named_and_not_echoed():
     goal = BehaviorSynthesis.Goal()
     goal.request.name = 'ok'
     goal.request.ltl_specification.sys_trans = ['x', 'y' * (MAX_STRING_BYTES + 1)]
-    with pytest.raises(InvalidRequest) as raised:
+    with pytest.raises(InvalidRequestError) as raised:
         check_message(goal, 'goal')
     message = str(raised.value)
     assert 'goal.request.ltl_specification.sys_trans[1]' in message

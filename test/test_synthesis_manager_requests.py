@@ -5,8 +5,8 @@ from types import SimpleNamespace
 import pytest
 from hypothesis import given, settings, strategies as st
 
-from synthesis_manager.byproducts import InvalidSpecName, checked_spec_name
-from synthesis_manager.requests import (InvalidRequest, behavior_name, byproduct_file_stem,
+from synthesis_manager.byproducts import InvalidSpecNameError, checked_spec_name
+from synthesis_manager.requests import (InvalidRequestError, behavior_name, byproduct_file_stem,
                                         parse_synthesis_options, resolve_system,
                                         task_from_behavior_synthesis, task_from_flexbe_synthesis)
 
@@ -83,13 +83,13 @@ def test_synthesis_options_yaml(text, expected):
     ('{ltl_steps_only: true, ltl_compilation_only: true}', 'mutually exclusive'),
 ])
 def test_bad_synthesis_options_are_invalid_requests(text, named):
-    with pytest.raises(InvalidRequest, match=named):
+    with pytest.raises(InvalidRequestError, match=named):
         parse_synthesis_options(text)
 
 
 def test_the_synthesizer_still_refuses_names_that_leave_its_directory():
     for name in ('../escape', 'a/b', '.hidden', 'a..b'):
-        with pytest.raises(InvalidSpecName, match='invalid spec_name'):
+        with pytest.raises(InvalidSpecNameError, match='invalid spec_name'):
             checked_spec_name(name)
 
 
@@ -129,5 +129,5 @@ def test_flexbe_timeout_field_wins_over_the_options_timeout():
 def test_flexbe_requests_this_server_cannot_serve_are_invalid(fields, options, named):
     goal = flexbe_goal(**fields)
     goal.synthesis_options = options
-    with pytest.raises(InvalidRequest, match=named):
+    with pytest.raises(InvalidRequestError, match=named):
         task_from_flexbe_synthesis(goal, 'atlas')

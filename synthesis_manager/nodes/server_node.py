@@ -33,9 +33,9 @@ from ltl_synthesizer.errors import SynthesisError
 from ltl_synthesizer.isolated import SERVER_CHILD_NICENESS, SynthesisProcesses
 from respec.errors import INTERNAL_ERROR, CodedError, ErrorCode
 from sm_generation.instantiation import count_states
-from synthesis_manager.limits import BusyError, GoalDeadline, GoalTimedOut, check_message, check_timeout
+from synthesis_manager.limits import BusyError, GoalDeadline, GoalTimeoutError, check_message, check_timeout
 from synthesis_manager.nodes.atlas_sim_node import STATE_TOPIC
-from synthesis_manager.requests import (InvalidRequest, SynthesisTask, task_from_behavior_synthesis,
+from synthesis_manager.requests import (InvalidRequestError, SynthesisTask, task_from_behavior_synthesis,
                                         task_from_flexbe_synthesis)
 from synthesis_manager.ros.cnu_interface import load_flexbe_synthesis_interface
 from synthesis_manager.ros.conversions import error_code, error_name, is_empty_spec, msg_to_sections
@@ -43,7 +43,8 @@ from synthesis_manager.ros.errors import log_internal_error
 from synthesis_manager.ros.node_main import node_main
 from synthesis_manager.ros.qos import action_server_qos, service_qos
 from synthesis_manager.ros.robot_state import RobotStateListener
-from synthesis_manager.ros.stage_calls import Preempted, ServerStopping, StageCaller, StageFailed, StageTimedOut
+from synthesis_manager.ros.stage_calls import (Preempted, ServerStoppingError, StageCaller, StageFailedError,
+                                              StageTimeoutError)
 from synthesis_manager.ros.worker_pool import WorkerPool
 from synthesis_msgs.action import BehaviorSynthesis
 from synthesis_msgs.msg import FSAutomaton, LTLSpecification
@@ -302,7 +303,7 @@ class BehaviorSynthesisServer(Node):
 
         if task.option == 'ltl_synthesis_only':
             if task.custom_ltl is None or is_empty_spec(task.custom_ltl):
-                raise InvalidRequest('ltl_synthesis_only needs the complete LTL specification '
+                raise InvalidRequestError('ltl_synthesis_only needs the complete LTL specification '
                                      'in request.ltl_specification')
             outcome.ltl_specification = task.custom_ltl
         else:
@@ -330,8 +331,8 @@ class BehaviorSynthesisServer(Node):
                 timeout=float(timeout), request_id=goal_id),
                 'LTL synthesis', timeout + SYNTHESIS_ANSWER_GRACE, on_cancel=lambda: self.cancel_synthesis(goal_id),
                 deadline=deadline)
-        except GoalTimedOut as passed:  # the synthesis stage's code, whoever saw the limit pass
-            raise StageFailed(error_code(ErrorCode.SYNTHESIS_TIMEOUT, str(passed))) from None
+        except GoalTimeoutError as passed:  # the synthesis stage's code, whoever saw the limit pass
+            raise StageFailedError(error_code(ErrorCode.SYNTHESIS_TIMEOUT, str(passed))) from None
         if task.timeout and error_name(synthesized.error_code.value) == ErrorCode.SYNTHESIS_TIMEOUT:
             # Name the goal's limit, not the time that was left of it.
             synthesized.error_code.message = str(deadline.timed_out('LTL synthesis'))
@@ -367,7 +368,7 @@ class BehaviorSynthesisServer(Node):
         if goal_handle.is_cancel_requested:
             raise Preempted()
         if self._stopping.is_set():
-            raise ServerStopping('reading the robot state: the server is shutting down', topic)
+            raise ServerStoppingError('reading the robot state: the server is shutting down', topic)
         if state is None:
             raise InvalidInitialConditionsError(
                 f'no initial conditions given and no robot state on {topic!r} within {timeout:g} s: '
@@ -380,7 +381,7 @@ class BehaviorSynthesisServer(Node):
     @staticmethod
     def check(code):
         if code.value != code.SUCCESS:
-            raise StageFailed(code)
+            raise StageFailedError(code)
 
     async def call(self, goal_handle, client, request, stage: str, timeout: float, on_cancel=None,
                    deadline: GoalDeadline | None = None):
@@ -390,7 +391,7 @@ class BehaviorSynthesisServer(Node):
         try:
             return await self.stages.call(client, request, stage, limit, self.parameter('service_timeout'),
                                           cancelled=lambda: goal_handle.is_cancel_requested, on_cancel=on_cancel)
-        except StageTimedOut:
+        except StageTimeoutError:
             if deadline is not None and deadline.passed():
                 raise deadline.timed_out(stage) from None
             raise
@@ -422,7 +423,7 @@ class BehaviorSynthesisServer(Node):
         if goal_handle.is_cancel_requested:
             raise Preempted()
         if self._stopping.is_set():
-            raise ServerStopping('diagnosis: the server is shutting down', 'diagnosis')
+            raise ServerStoppingError('diagnosis: the server is shutting down', 'diagnosis')
         return message
 
     def _diagnosis(self, arguments: dict, deadline: float, stop: threading.Event, details: str) -> str:

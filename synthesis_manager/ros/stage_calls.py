@@ -7,9 +7,9 @@ the very services they waited for). Each wait ends with the response, or as soon
 these happens (checked at least every WATCH_PERIOD seconds):
 
 - the client cancels the goal              -> Preempted
-- the stage's time limit passes            -> StageTimedOut (TIMEOUT)
-- the server shuts down                    -> ServerStopping (BEHAVIOR_SYNTHESIS_FAILED)
-- the node serving the stage goes away     -> StageUnavailable (SERVICE_UNAVAILABLE) naming it
+- the stage's time limit passes            -> StageTimeoutError (TIMEOUT)
+- the server shuts down                    -> ServerStoppingError (BEHAVIOR_SYNTHESIS_FAILED)
+- the node serving the stage goes away     -> StageUnavailableError (SERVICE_UNAVAILABLE) naming it
 
 How the waiting works: rclpy's executor resumes every pending coroutine each time it wakes,
 and a node-wide watchdog timer wakes it every WATCH_PERIOD seconds; a coroutine waits by
@@ -29,7 +29,7 @@ from respec.errors import CodedError, ControlFlowSignal, ErrorCode
 WATCH_PERIOD = 0.1
 
 
-class StageFailed(CodedError):
+class StageFailedError(CodedError):
     """A pipeline service answered with an error code: the goal ends with that answer, relayed.
     The one error whose code is per instance (it is the stage's); an answer whose number this
     suite does not know keeps the class's code and names the number."""
@@ -46,19 +46,19 @@ class StageFailed(CodedError):
             super().__init__(answer.message or self.code.name)
 
 
-class StageUnavailable(CodedError):
+class StageUnavailableError(CodedError):
     """A pipeline service is not there, or its node went away while working."""
 
     code = ErrorCode.SERVICE_UNAVAILABLE
 
 
-class StageTimedOut(CodedError):
+class StageTimeoutError(CodedError):
     """A pipeline service did not answer in time."""
 
     code = ErrorCode.TIMEOUT
 
 
-class ServerStopping(CodedError):
+class ServerStoppingError(CodedError):
     """The server shuts down while a goal waits on a stage."""
 
     code = ErrorCode.BEHAVIOR_SYNTHESIS_FAILED
@@ -104,15 +104,15 @@ class StageCaller:
         while not future.done():
             failure = None
             if self._stopping.is_set():
-                failure = ServerStopping(f'{stage}: the server is shutting down', stage)
+                failure = ServerStoppingError(f'{stage}: the server is shutting down', stage)
             elif cancelled():
                 failure = Preempted()
             elif time.monotonic() > deadline:
-                failure = StageTimedOut(f'{stage}: no answer from {client.srv_name!r} within {timeout:g} s',
+                failure = StageTimeoutError(f'{stage}: no answer from {client.srv_name!r} within {timeout:g} s',
                                         client.srv_name)
             elif not client.service_is_ready():
                 self._providers.pop(client.srv_name, None)
-                failure = StageUnavailable(f'{stage}: node {provider!r} (service '
+                failure = StageUnavailableError(f'{stage}: node {provider!r} (service '
                                            f'{self.node.resolve_service_name(client.srv_name)!r}) went '
                                            'away before answering', provider)
             if failure is not None:
@@ -127,11 +127,11 @@ class StageCaller:
         deadline = time.monotonic() + service_timeout
         while not client.service_is_ready():
             if self._stopping.is_set():
-                raise ServerStopping(f'{stage}: the server is shutting down', stage)
+                raise ServerStoppingError(f'{stage}: the server is shutting down', stage)
             if cancelled():
                 raise Preempted()
             if time.monotonic() > deadline:
-                raise StageUnavailable(f'{stage}: service {client.srv_name!r} is not available '
+                raise StageUnavailableError(f'{stage}: service {client.srv_name!r} is not available '
                                        f'(waited {service_timeout:g} s)', client.srv_name)
             await next_executor_turn()
 

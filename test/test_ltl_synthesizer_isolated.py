@@ -5,6 +5,7 @@ import signal
 import threading
 import time
 from concurrent.futures import ThreadPoolExecutor
+from pathlib import Path
 
 import pytest
 
@@ -74,14 +75,18 @@ def test_errors_come_back_as_the_synthesizers_own(processes):
 
 
 def test_a_cancel_kills_the_child_at_once_and_the_next_synthesis_works(processes):
-    cancel = threading.Event()
-    threading.Timer(1.0, cancel.set).start()
+    cancel, working = threading.Event(), set()
+
+    def cancel_it():
+        working.update(children_of_this_process())
+        cancel.set()
+    threading.Timer(1.0, cancel_it).start()
     with pytest.raises(SynthesisCancelledError) as error:
         processes.synthesize(RUNAWAY, cancel=cancel)
     stopped = time.monotonic()
     assert error.value.code == 'PREEMPTED'
-    running = children_of_this_process()
-    assert len(running) == 1  # only the replacement, started idle
+    assert len(working) == 1 and not Path(f'/proc/{working.pop()}').exists()  # killed and reaped
+    assert len(children_of_this_process()) <= 1  # at most the replacement, started idle
     assert processes.synthesize(compile_task('atlas', ['stand_prep'], ['look_down'])).realizable
     assert time.monotonic() - stopped < 30
 

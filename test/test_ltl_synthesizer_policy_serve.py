@@ -12,8 +12,9 @@ import pytest
 
 from ltl_synthesizer import Options, synthesize
 from ltl_synthesizer.strategy import strategy_json_chunks, strategy_to_json
-from ltl_synthesizer.gr1 import Solver
-from ltl_synthesizer.policy import SMALL_GAME_PROPOSITIONS
+from ltl_synthesizer.gr1 import Solver, solve_system_game
+from ltl_synthesizer.policy import (BETWEEN_ITERATIONS, FROM_START, ONCE_LARGE,
+                                    SMALL_GAME_PROPOSITIONS)
 from ltl_synthesizer.symbolic import SymbolicGame
 from respec.parsing import ParseError, parse_slugsin, parse_structuredslugs
 
@@ -96,12 +97,27 @@ def test_pure_safety_games_skip_the_reachability_search():
     spec = parse_structuredslugs(gr1_families.cinderella(6, 3, 11, 6))
     solver = Solver(SymbolicGame(spec))
     assert len(solver.game.variables) > SMALL_GAME_PROPOSITIONS
-    assert not solver.plan.reachable_only and not solver.reordering.on
+    assert not solver.plan.reachable_only and solver.plan.reordering == ONCE_LARGE
+    assert not solver.reordering.on
+
+
+def test_small_safety_games_sift_between_iterations_only():
+    """Moving obstacle: sifting passes happen, but never inside a BDD operation."""
+    spec = parse_structuredslugs(gr1_families.moving_obstacle(16, 4))
+    solver = Solver(SymbolicGame(spec))
+    assert solver.plan.reordering == BETWEEN_ITERATIONS and solver.plan.sift_once
+    assert not solver.game.bdd.configure()['reordering']  # no automatic (mid-operation) sifting
+    sifted_once = solver.game.statistics()['reorderings']
+    solution = solve_system_game(solver, stop_when_losing=None)
+    assert solver.game.statistics()['reorderings'] > sifted_once
+    assert not solver.game.bdd.configure()['reordering']
+    assert solution.winning != solver.game.false
 
 
 def test_several_system_goals_sift_from_the_start():
     solver = Solver(SymbolicGame(parse_structuredslugs(gr1_families.amba(2))))
-    assert len(solver.game.sys_goals) > 1 and solver.plan.reordering and solver.reordering.on
+    assert len(solver.game.sys_goals) > 1 and solver.plan.reordering == FROM_START
+    assert solver.reordering.on
 
 
 @pytest.mark.parametrize('family, arguments, realizable', [

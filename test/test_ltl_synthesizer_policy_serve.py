@@ -13,6 +13,7 @@ import pytest
 from ltl_synthesizer import Options, synthesize
 from ltl_synthesizer.strategy import strategy_json_chunks, strategy_to_json
 from ltl_synthesizer.gr1 import Solver, solve_system_game
+from ltl_synthesizer.strategy import symbolic_strategy
 from ltl_synthesizer.policy import (BETWEEN_ITERATIONS, FROM_START, ONCE_LARGE,
                                     SMALL_GAME_PROPOSITIONS)
 from ltl_synthesizer.symbolic import SymbolicGame
@@ -22,7 +23,7 @@ REPOSITORY = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPOSITORY / 'bench'))
 
 import gr1_families  # noqa: E402
-from strategy_check import check_strategy  # noqa: E402
+from strategy_check import check_strategy, check_symbolic_strategy  # noqa: E402
 
 REALIZABLE = '[INPUT]\nx\n[OUTPUT]\ny\n[SYS_TRANS]\nnext(y) <-> next(x)\n[SYS_LIVENESS]\ny | !x\n'
 
@@ -164,6 +165,42 @@ def test_the_independent_check_catches_a_broken_strategy():
     for node in broken['nodes'].values():
         node['state'][1] = 1 - node['state'][1]  # y no longer follows x
     assert check_strategy(spec, broken)
+
+
+def solved(spec):
+    """The game of ``spec``, its solution and our strategy as relations."""
+    game = SymbolicGame(spec)
+    solution = solve_system_game(Solver(game))
+    return game, solution, symbolic_strategy(game, solution)
+
+
+def test_symbolic_strategies_of_family_instances_pass_the_independent_check():
+    for generator, arguments in ((gr1_families.amba, (2,)), (gr1_families.factory, (4, 3, 1, 1)),
+                                 (gr1_families.moving_obstacle, (8, 0)),
+                                 (gr1_families.cinderella, (5, 2, 7, 4))):
+        spec = parse_structuredslugs(generator(*arguments))
+        game, _, relations = solved(spec)
+        assert check_symbolic_strategy(spec, relations, game.bdd) == []
+
+
+# A system that must raise y infinitely often, free to choose it every step.
+FREE_GOAL = '[INPUT]\nx\n[OUTPUT]\ny\n[SYS_LIVENESS]\ny\n[ENV_LIVENESS]\nx\n'
+
+
+def test_the_symbolic_check_catches_broken_strategies():
+    spec = parse_structuredslugs(FREE_GOAL)
+    game, solution, relations = solved(spec)
+    assert check_symbolic_strategy(spec, relations, game.bdd) == []
+    y_next = game.bdd.var("y'")
+    may_idle = [relation | ~y_next for relation in relations]  # may keep y low forever
+    assert check_symbolic_strategy(spec, may_idle, game.bdd) == [
+        'goal 0: a reachable cycle meets every assumption and never the goal']
+    assert 'no answered initial state' in check_symbolic_strategy(spec, [game.false], game.bdd)[0]
+    spec = parse_structuredslugs(REALIZABLE)
+    game, solution, relations = solved(spec)
+    assert check_symbolic_strategy(spec, relations, game.bdd) == []
+    disobedient = [solution.winning & ~game.sys_trans()]  # y' differs from x'
+    assert 'violates SYS_TRANS' in check_symbolic_strategy(spec, disobedient, game.bdd)[0]
 
 
 # --- start-up -------------------------------------------------------------------------------

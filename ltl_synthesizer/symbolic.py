@@ -25,9 +25,9 @@ from ltl_synthesizer.translation import Translator, check_declarations, declare_
 # CUDD's cache and unique tables grow on demand; starting small keeps tiny specs fast (dd's
 # default cache of 262,144 slots alone costs 5-6 ms to set up, a tenth of a paper-size task).
 # The memory estimate bounds that growth: past 90% of it CUDD stops enlarging its unique
-# table and collects garbage at every chance, and its cache stays below a third of it
-# (64 MiB made moving obstacle 48x48 2x slower); 256 MiB costs under a millisecond to set
-# up (1 GiB: a 16 MB allocation, 2-6 ms) and is as fast on the largest families.
+# table and collects garbage at every chance (64 MiB made moving obstacle 48x48 2x and
+# factory 7x5 e10 2x slower); 256 MiB costs under a millisecond to set up (1 GiB: a 16 MB
+# allocation, 2-6 ms) and is as fast on the largest family instances.
 MEMORY_ESTIMATE = 256 * 2**20
 INITIAL_CACHE_SLOTS = 2**14
 

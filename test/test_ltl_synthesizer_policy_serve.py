@@ -14,7 +14,7 @@ from ltl_synthesizer import Options, synthesize
 from ltl_synthesizer.strategy import strategy_json_chunks, strategy_to_json
 from ltl_synthesizer.gr1 import Solver, solve_system_game
 from ltl_synthesizer.strategy import symbolic_strategy
-from ltl_synthesizer.policy import (BETWEEN_ITERATIONS, FROM_START, ONCE_LARGE,
+from ltl_synthesizer.policy import (BETWEEN_ITERATIONS, FROM_START, NEVER, ONCE_LARGE,
                                     SMALL_GAME_PROPOSITIONS)
 from ltl_synthesizer.symbolic import SymbolicGame
 from respec.parsing import ParseError, parse_slugsin, parse_structuredslugs
@@ -94,11 +94,11 @@ def test_streamed_json_is_the_same_text_in_pieces():
 
 # --- automatic policy -----------------------------------------------------------------------
 
-def test_pure_safety_games_skip_the_reachability_search():
+def test_large_safety_games_skip_the_reachability_search_and_dynamic_sifting():
     spec = parse_structuredslugs(gr1_families.cinderella(6, 3, 11, 6))
     solver = Solver(SymbolicGame(spec))
     assert len(solver.game.variables) > SMALL_GAME_PROPOSITIONS
-    assert not solver.plan.reachable_only and solver.plan.reordering == ONCE_LARGE
+    assert not solver.plan.reachable_only and solver.plan.reordering == NEVER
     assert not solver.reordering.on
 
 
@@ -142,7 +142,8 @@ def test_automatic_reordering_switches_on_past_the_node_threshold(monkeypatch):
     spec = parse_structuredslugs(gr1_families.evasion(24, 8).replace(
         '!requestPending2\n', ''))  # one system goal and an (implicit) assumption
     solver = Solver(SymbolicGame(spec))
-    assert not solver.reordering.on and len(solver.game.sys_goals) == 1
+    assert solver.plan.reordering == ONCE_LARGE and not solver.reordering.on
+    assert len(solver.game.sys_goals) == 1
     solver.enforce(solver.game.true)
     assert solver.reordering.on
     solver.reordering.stop()

@@ -12,6 +12,19 @@ here, in a manager of its own, and the strategy graph is checked directly:
    holds a play that meets the assumptions and misses goal j forever).
 
 Scales to strategies of hundreds of thousands of nodes (one BDD evaluation per edge).
+
+Explicit strategies grow beyond that on the larger family instances, so
+``check_symbolic_strategy`` checks the same three properties on the strategy as relations
+(``ltl_synthesizer.strategy.symbolic_strategy``: per goal j, the moves allowed from each
+position and environment move), with other algorithms than the synthesizer's fixpoints: a
+forward reachability of the closed loop (positions x goal counters, the counter advancing on
+each goal-j transition), then on the reachable part: every move obeys SYS_TRANS, every
+environment move allowed by ENV_TRANS is answered, and an Emerson-Lei fair-cycle search finds
+no cycle at one counter value (missing its goal forever) that meets every assumption.
+The relations are copied into this checker's own BDD manager; every formula is translated
+here. Run on a specification file:
+
+    python bench/strategy_check.py FILE.slugsin    # synthesize, then check symbolically
 """
 
 from __future__ import annotations
@@ -22,9 +35,9 @@ from respec.ltl import And, Const, Iff, Implies, Next, Not, Or, Var
 
 
 class _Formulas:
-    def __init__(self, spec):
+    def __init__(self, spec, reordering: bool = False):
         self.bdd = cudd.BDD()
-        self.bdd.configure(reordering=False)
+        self.bdd.configure(reordering=reordering)
         self.variables = list(spec.env_props) + list(spec.sys_props)
         for name in self.variables:
             self.bdd.declare(name, name + "'")
@@ -186,3 +199,125 @@ def _components(graph: dict) -> list[set]:
                 parent = work[-1][0]
                 low[parent] = min(low[parent], low[node])
     return components
+
+
+def check_symbolic_strategy(spec, relations: list, source: cudd.BDD) -> list[str]:
+    """Problems found (empty when the strategy is winning, standard initial semantics).
+
+    ``relations[j]`` (a BDD of manager ``source`` over x, y, x', y') holds the moves the
+    strategy allows while it pursues system goal j; any choice among them must win.
+    """
+    formulas = _Formulas(spec, reordering=True)
+    bdd = formulas.bdd
+    current = list(spec.env_props) + list(spec.sys_props)
+    next_inputs = [name + "'" for name in spec.env_props]
+    next_outputs = [name + "'" for name in spec.sys_props]
+    next_variables = [name + "'" for name in current]
+    to_current = dict(zip(next_variables, current))
+    env_init = formulas.conjunction(spec.env_init)
+    sys_init = formulas.conjunction(spec.sys_init)
+    env_trans = formulas.conjunction(spec.env_trans)
+    sys_trans = formulas.conjunction(spec.sys_trans)
+    assumptions = [formulas.translate(f) for f in spec.env_liveness] or [bdd.true]
+    goals = [formulas.translate(f) for f in spec.sys_liveness] or [bdd.true]
+    if len(relations) != len(goals):
+        return [f'{len(relations)} strategy relations for {len(goals)} system goals']
+    # The relations are copied in the synthesizer's variable order, without sifting meanwhile
+    # (copying into another order can take far longer than the check); the order is no part
+    # of the logic.
+    cudd.reorder(bdd, {name: source.level_of_var(name) for name in bdd.vars})
+    bdd.configure(reordering=False)
+    moves = [source.copy(relation, bdd) & env_trans for relation in relations]
+    bdd.configure(reordering=True)
+    problems = [f'goal {j}: a move violates SYS_TRANS' for j, m in enumerate(moves)
+                if m & ~sys_trans != bdd.false]
+    # Positions where every environment move allowed by ENV_TRANS has an answer.
+    answered = [~bdd.exist(next_inputs, env_trans & ~bdd.exist(next_outputs, m)) for m in moves]
+    initial = env_init & sys_init & answered[0]
+    if env_init & ~bdd.exist(list(spec.sys_props), initial) != bdd.false:
+        problems.append('some initial input valuation has no answered initial state')
+
+    def successors(positions, transitions):
+        return bdd.let(to_current, cudd.and_exists(positions, transitions, current))
+
+    # Forward reachability of (position, goal counter), one position set per counter.
+    reached = [initial if j == 0 else bdd.false for j in range(len(goals))]
+    changed = True
+    while changed:
+        changed = False
+        for j, goal in enumerate(goals):
+            following = (j + 1) % len(goals)
+            for target, transitions in ((j, moves[j] & ~goal), (following, moves[j] & goal)):
+                grown = reached[target] | successors(reached[j], transitions)
+                if grown != reached[target]:
+                    reached[target], changed = grown, True
+    for j in range(len(goals)):
+        if reached[j] & ~answered[j] != bdd.false:
+            problems.append(f'goal {j}: a reachable position leaves some environment move unanswered')
+        if _fair_cycle(bdd, reached[j], moves[j] & ~goals[j], assumptions, current, next_variables):
+            problems.append(f'goal {j}: a reachable cycle meets every assumption and never the goal')
+    return problems
+
+
+def _fair_cycle(bdd, positions, transitions, assumptions, current, next_variables) -> bool:
+    """Whether ``transitions`` (over current and next variables) have, among ``positions``,
+    an infinite path that takes a transition of every assumption infinitely often: the
+    Emerson-Lei greatest fixpoint of positions that can reach, within it, a transition of
+    each assumption into it."""
+    to_next = dict(zip(current, next_variables))
+    within = positions & transitions
+    fair = positions
+    while True:
+        shrunk = fair
+        for assumption in assumptions:
+            fair_next = bdd.let(to_next, fair)
+            reach = bdd.false
+            while True:
+                step = cudd.and_exists(within, fair_next & (assumption | bdd.let(to_next, reach)),
+                                       next_variables)
+                if step == reach:
+                    break
+                reach = step
+            shrunk &= reach
+        if shrunk == fair:
+            return fair != bdd.false
+        fair = shrunk
+
+
+def main(argv=None) -> int:
+    """Synthesize FILE (ours) and check its strategy symbolically: exit 0 ok, 1 problems,
+    2 unrealizable; prints one line."""
+    import argparse
+    import time
+    parser = argparse.ArgumentParser(description='check our strategy for a specification symbolically')
+    parser.add_argument('specification', help='.slugsin or .structuredslugs file')
+    args = parser.parse_args(argv)
+    from ltl_synthesizer.cli import read_specification
+    from ltl_synthesizer.gr1 import Solver, solve_system_game
+    from ltl_synthesizer.strategy import symbolic_strategy
+    from ltl_synthesizer.symbolic import SymbolicGame
+    from ltl_synthesizer.synthesizer import initial_positions_win
+    spec = read_specification(args.specification)
+    start = time.process_time()
+    game = SymbolicGame(spec)
+    solver = Solver(game)
+    solution = solve_system_game(solver)
+    if not initial_positions_win(game, solution.winning, robotics_semantics=False):
+        print('unrealizable')
+        return 2
+    solver.reordering.stop()
+    relations = symbolic_strategy(game, solution)
+    built = time.process_time()
+    problems = check_symbolic_strategy(spec, relations, game.bdd)
+    checked = time.process_time()
+    del relations
+    print(f"{'ok' if not problems else 'FAILED: ' + problems[0]} (strategy relations "
+          f'{built - start:.1f} s, check {checked - built:.1f} s)')
+    return 1 if problems else 0
+
+
+if __name__ == '__main__':
+    import sys
+    from pathlib import Path
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+    sys.exit(main())

@@ -49,7 +49,7 @@ class Solver:
 
     def enforce(self, responses):
         """``game.enforce``, with the reordering switch watching the BDDs grow."""
-        self.reordering.observe()
+        self.reordering.observe(responses)
         return self.game.enforce(responses)
 
     def system_can_move_into(self, positions, remember: bool = True):

@@ -23,13 +23,28 @@ SIFTED_RELATION_NODES = 1000
 
 # Automatic dynamic reordering. Sifting from the start, as slugs does, is 2-5x faster on
 # games with several system goals (a Y/X family per goal stays alive and one order must suit
-# them all: AMBA) and on small pure safety games over wide integers (moving obstacle: few
-# variables, large BDDs). Elsewhere it starts on the static order and switches sifting on only
+# them all: AMBA). Elsewhere it starts on the static order and switches sifting on only
 # once this many BDD nodes are alive: ATLAS tasks (one goal, an assumption per action) would
 # lose up to 2x to sifting, cinderella (many variables, small BDDs) 4x
 # (bench/bench_gr1_families.py, bench_goals.py).
 DYNAMIC_REORDERING_FROM_NODES = 100_000
 REORDERING_CHECK_PERIOD = 4
+# Small pure safety games over wide integers (moving obstacle: few variables, large BDDs) need
+# sifting too, but CUDD's automatic sifting strikes in the middle of a relational product,
+# when its intermediate results (7x the fixpoint iterate) are alive, and so costs the most
+# and may even strike during the confirming last iteration (48x48: 17 s of 55). They sift
+# between iterations instead, whenever the BDD an iteration is about to quantify (the
+# system's responses, which sifting then fits) has grown by this factor since the last
+# sifting, from CUDD's own first threshold: moving obstacle 24x24 2x and 48x48 1.7x faster.
+SIFT_BETWEEN_ITERATIONS_GROWTH = 2
+SIFT_BETWEEN_ITERATIONS_FROM_NODES = 4004
+# Large pure safety games (cinderella: many variables) need few iterations over large BDDs,
+# after the one sifting pass: further sifting never pays (n7c1 b20: 7 s without, 13 s once
+# large, 8 s between iterations; n7c2 b16: 29, 41, 36 s).
+
+# The reordering modes of a plan.
+NEVER, FROM_START, ONCE_LARGE, BETWEEN_ITERATIONS = 'never', 'from start', 'once large', \
+    'between iterations'
 
 
 @dataclass
@@ -56,8 +71,7 @@ class Plan:
 
     sift_once: bool
     reachable_only: bool
-    # True: dynamic reordering from the start; False: never; None: once the BDDs grow large.
-    reordering: bool | None
+    reordering: str  # NEVER, FROM_START, ONCE_LARGE or BETWEEN_ITERATIONS
 
 
 def plan(game, options: Options) -> Plan:
@@ -72,41 +86,53 @@ def plan(game, options: Options) -> Plan:
     # wide integers (grids, counters) also make large relations, whose bits the static order
     # cannot place well (moving obstacle 16x16: 3x faster).
     sift_once = large or game.relation_nodes >= SIFTED_RELATION_NODES
-    sift_from_start = len(game.sys_goals) > 1 or not (large or game.has_liveness)
+    if options.reordering is not None:
+        reordering = FROM_START if options.reordering else NEVER
+    elif len(game.sys_goals) > 1:
+        reordering = FROM_START
+    elif not game.has_liveness:
+        reordering = NEVER if large else BETWEEN_ITERATIONS
+    else:
+        reordering = ONCE_LARGE
     return Plan(
         sift_once=sift_once if options.sift_once is None else options.sift_once,
         reachable_only=reachable_only if options.reachable_only is None else options.reachable_only,
-        reordering=(True if sift_from_start else None) if options.reordering is None
-        else options.reordering)
+        reordering=reordering)
 
 
 class ReorderingSwitch:
-    """CUDD's dynamic reordering during a solve, as planned: on from the start, never, or
-    (``None``) switched on once more than DYNAMIC_REORDERING_FROM_NODES BDD nodes are alive,
-    which ``observe()`` (called before every enforceable-predecessor step) looks at."""
+    """Variable reordering during a solve, as planned (``Plan.reordering``): CUDD's dynamic
+    sifting from the start or never; switched on once more than DYNAMIC_REORDERING_FROM_NODES
+    BDD nodes are alive (ONCE_LARGE); or one sifting pass between fixpoint iterations when
+    the BDDs have grown (BETWEEN_ITERATIONS). ``observe(responses)`` is called before every
+    enforceable-predecessor step with the BDD it is about to quantify."""
 
-    def __init__(self, game, planned: bool | None):
+    def __init__(self, game, planned: str):
         self.game = game
-        self.on = planned is True
-        self._watching = planned is None
+        self.planned = planned
+        self.on = planned in (FROM_START, BETWEEN_ITERATIONS)
         self._observed = 0
-        if self.on:
+        self._sifted_at = SIFT_BETWEEN_ITERATIONS_FROM_NODES
+        if planned == FROM_START:
             game.bdd.configure(reordering=True)
 
-    def observe(self) -> None:
-        if not self._watching:
-            return
-        # Reading CUDD's statistics scans its unique table: look every few operations only.
-        self._observed += 1
-        if self._observed % REORDERING_CHECK_PERIOD:
-            return
-        if self.game.statistics()['bdd_nodes'] > DYNAMIC_REORDERING_FROM_NODES:
-            self.on, self._watching = True, False
-            self.game.bdd.configure(reordering=True)
+    def observe(self, responses) -> None:
+        if not self.on and self.planned == ONCE_LARGE:
+            # Reading CUDD's statistics scans its unique table: look every few steps only.
+            self._observed += 1
+            if self._observed % REORDERING_CHECK_PERIOD == 0 and \
+                    self.game.statistics()['bdd_nodes'] > DYNAMIC_REORDERING_FROM_NODES:
+                self.on = True
+                self.game.bdd.configure(reordering=True)
+        elif self.on and self.planned == BETWEEN_ITERATIONS:
+            # The DAG size of one BDD, not the manager's node count (a scan of its tables).
+            if len(responses) > SIFT_BETWEEN_ITERATIONS_GROWTH * self._sifted_at:
+                self.game.bdd.reorder()
+                self._sifted_at = max(len(responses), SIFT_BETWEEN_ITERATIONS_FROM_NODES)
 
     def stop(self) -> None:
         """No more reordering: after the solve, the work is many small operations on BDDs
         already built, which a late sifting pass (seconds) would not repay (slugs also stops
         reordering before extracting strategies)."""
         self.game.bdd.configure(reordering=False)
-        self.on = self._watching = False
+        self.on, self.planned = False, NEVER

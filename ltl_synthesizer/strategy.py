@@ -55,6 +55,32 @@ def goal_moves(game: SymbolicGame, steps, env_moves, legal):
     return moves
 
 
+def symbolic_strategy(game: SymbolicGame, solution: SystemSolution) -> list:
+    """The strategy as relations, one per system goal j, over (position, next input, next
+    output): from each winning position, for each environment move, the moves allowed by
+    sys_trans of the first attractor step (lowest rank) that offers one -- the moves
+    ``goal_moves`` chooses among, at every position at once. Every such move reaches the
+    goal, a lower rank, or stays at its rank on a transition that violates the step's
+    assumption, so any choice among them wins (checked independently by
+    bench/strategy_check.py). Building it costs BDD work on all positions: for analysis
+    and checks, not for extraction."""
+    sys_trans = game.sys_trans()
+    relations = []
+    for steps in goal_steps(game, solution):
+        answered = relation = game.false
+        for step in steps:
+            game.interrupt.check()
+            first_offered = step.responses & ~answered
+            if first_offered == game.false:
+                continue
+            transitions = step.goal_transitions | game.prime(step.closer) | \
+                (game.prime(step.waiting) & ~step.assumption)
+            relation |= first_offered & transitions & sys_trans
+            answered |= step.responses
+        relations.append(relation & solution.winning)
+    return relations
+
+
 def enumerate_states(game: SymbolicGame, states, names, limit: int | None = None):
     """The assignments to ``names`` in ``states`` (all, or the first ``limit``), smallest first
     (``states`` must depend only on names)."""

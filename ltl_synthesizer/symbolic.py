@@ -20,11 +20,15 @@ from respec.spec import GR1Specification
 
 from ltl_synthesizer.interrupt import Interrupt
 from ltl_synthesizer.policy import Options
-from ltl_synthesizer.translation import Translator, check_declarations, primed, variable_order
+from ltl_synthesizer.translation import Translator, check_declarations, declare_pair, primed
 
 # CUDD's cache and unique tables grow on demand; starting small keeps tiny specs fast (dd's
 # default cache of 262,144 slots alone costs 5-6 ms to set up, a tenth of a paper-size task).
-MEMORY_ESTIMATE = 64 * 2**20
+# The memory estimate bounds that growth: past 90% of it CUDD stops enlarging its unique
+# table and collects garbage at every chance (64 MiB made moving obstacle 48x48 2x and
+# factory 7x5 e10 2x slower); 256 MiB costs under a millisecond to set up (1 GiB: a 16 MB
+# allocation, 2-6 ms) and is as fast on the largest family instances.
+MEMORY_ESTIMATE = 256 * 2**20
 INITIAL_CACHE_SLOTS = 2**14
 
 
@@ -60,9 +64,6 @@ class SymbolicGame:
             # CUDD fails an operation that would go beyond this (synthesize reports it);
             # the interrupt's own check catches slower growth between operations.
             self.bdd.configure(max_memory=self.interrupt.memory_limit)
-        for name in variable_order(spec, options.variable_order):
-            self.bdd.declare(name, primed(name))
-            self.bdd.group({name: 2})  # reordering keeps each pair adjacent (cheap renaming)
         self.to_next = {name: primed(name) for name in self.variables}
         self.to_current = {primed(name): name for name in self.variables}
         self.next_inputs = [primed(name) for name in self.inputs]
@@ -70,15 +71,26 @@ class SymbolicGame:
         self.true = self.bdd.true
         self.false = self.bdd.false
 
+        # The static variable order: 'declared', or 'affinity': propositions in order of first
+        # use in the safety formulas, then the goals and initial conditions (variables are
+        # declared as the translator meets them), so that propositions used together (an
+        # action's activation and its outcomes) sit together and the relations stay small.
+        if options.variable_order == 'declared':
+            for name in self.variables:
+                declare_pair(self.bdd, name)
+        elif options.variable_order != 'affinity':
+            raise ValueError(f'unknown variable order {options.variable_order!r}')
         self.translator = Translator(self.bdd, self.inputs, self.outputs, self.interrupt.check)
         translate = self.translator.translate
+        self.sys_trans_parts = [translate(f, 'sys_trans') for f in spec.sys_trans]
+        self.env_trans_parts = [translate(f, 'env_trans') for f in spec.env_trans]
+        # slugs treats an empty liveness section as the single goal TRUE.
+        self.sys_goals = [translate(f, 'sys_liveness') for f in spec.sys_liveness] or [self.true]
+        self.env_goals = [translate(f, 'env_liveness') for f in spec.env_liveness] or [self.true]
         self.env_init = self.translator.conjunction(spec.env_init, 'env_init')
         self.sys_init = self.translator.conjunction(spec.sys_init, 'sys_init')
-        self.env_trans_parts = [translate(f, 'env_trans') for f in spec.env_trans]
-        self.sys_trans_parts = [translate(f, 'sys_trans') for f in spec.sys_trans]
-        # slugs treats an empty liveness section as the single goal TRUE.
-        self.env_goals = [translate(f, 'env_liveness') for f in spec.env_liveness] or [self.true]
-        self.sys_goals = [translate(f, 'sys_liveness') for f in spec.sys_liveness] or [self.true]
+        for name in self.variables:  # the propositions no formula uses
+            declare_pair(self.bdd, name)
         self.has_liveness = any(goal != self.true for goal in self.env_goals + self.sys_goals)
         # Assumptions that constrain no next output factor out of exists y' (see gr1).
         self.env_goal_ignores_outputs = [not self.mentions_next_outputs(goal)

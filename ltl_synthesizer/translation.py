@@ -23,8 +23,19 @@ def primed(name: str) -> str:
     return name + "'"
 
 
+def declare_pair(bdd: cudd.BDD, name: str) -> None:
+    """Declare proposition ``name`` and its next-step copy (once), next to each other."""
+    if name not in bdd.vars:
+        bdd.declare(name, primed(name))
+        bdd.group({name: 2})  # reordering keeps each pair adjacent (cheap renaming)
+
+
 class Translator:
-    """Translates formulas over the declared propositions into BDDs of ``bdd``."""
+    """Translates formulas over the declared propositions into BDDs of ``bdd``.
+
+    Each proposition's BDD variables are declared (``declare_pair``) when a formula first uses
+    it, so translating the formulas in some order places the variables in order of first use.
+    """
 
     def __init__(self, bdd: cudd.BDD, inputs: list[str], outputs: list[str], check=None):
         self.bdd = bdd
@@ -36,17 +47,6 @@ class Translator:
         """The BDD of a formula over current and next-step variables; slugs' rules of the
         section (no next step in initial conditions, no next output in env_trans) apply."""
         self.check()
-        if section in INIT_SECTIONS and any(under_next for _, under_next in walk(formula)):
-            raise NotGR1FormulaError(
-                f'{section}: initial conditions cannot refer to the next step: {to_infix(formula)}',
-                item=to_infix(formula))
-        if section == 'env_trans':
-            bad = next_outputs(formula, self.outputs)
-            if bad:
-                # slugs rejects this too: the environment moves first and cannot see the system's move.
-                raise NotGR1FormulaError(
-                    f"env_trans: environment assumption refers to the next value of output '{bad[0]}': "
-                    f'{to_infix(formula)}', item=bad[0])
         return self._translate(formula, section)
 
     def conjunction(self, formulas, section: str) -> cudd.Function:
@@ -56,24 +56,44 @@ class Translator:
         return result
 
     def _translate(self, root: Formula, section: str) -> cudd.Function:
-        """Post-order evaluation with an explicit stack of (node, under next, children done)."""
-        results = []
+        """Post-order evaluation with an explicit stack of (node, under next, children done),
+        checking the section's rules on the way (one pass over the formula).
+
+        Formulas may share subformulas (slugsin's memory buffers make a DAG smaller than its
+        tree): each (subformula, under next) is translated once.
+        """
+        done: dict[tuple[int, bool], cudd.Function] = {}
+        next_outputs = set()
         stack = [(root, False, False)]
         while stack:
             formula, under_next, expanded = stack.pop()
-            if isinstance(formula, Next) and under_next:
-                raise NotGR1FormulaError(f'{section}: nested next is not GR(1): {to_infix(formula)}',
-                                          item=to_infix(formula))
+            key = (id(formula), under_next)
+            if key in done:
+                continue
+            if isinstance(formula, Next):
+                if under_next:
+                    raise NotGR1FormulaError(f'{section}: nested next is not GR(1): {to_infix(formula)}',
+                                              item=to_infix(formula))
+                if section in INIT_SECTIONS:
+                    raise NotGR1FormulaError(
+                        f'{section}: initial conditions cannot refer to the next step: {to_infix(root)}',
+                        item=to_infix(root))
             inner = under_next or isinstance(formula, Next)
             if not expanded and children(formula):
                 stack.append((formula, under_next, True))
                 stack.extend((child, inner, False) for child in reversed(children(formula)))
                 continue
-            arity = len(children(formula))
-            args = results[len(results) - arity:] if arity else []
-            del results[len(results) - arity:]
-            results.append(self._node(formula, args, under_next, section))
-        return results[0]
+            if under_next and isinstance(formula, Var) and formula.name in self.outputs:
+                next_outputs.add(formula.name)
+            args = [done[(id(child), inner)] for child in children(formula)]
+            done[key] = self._node(formula, args, under_next, section)
+        if section == 'env_trans' and next_outputs:
+            # slugs rejects this too: the environment moves first and cannot see the system's move.
+            bad = min(next_outputs)
+            raise NotGR1FormulaError(
+                f"env_trans: environment assumption refers to the next value of output '{bad}': "
+                f'{to_infix(root)}', item=bad)
+        return done[(id(root), False)]
 
     def _node(self, formula: Formula, args: list, under_next: bool, section: str) -> cudd.Function:
         bdd = self.bdd
@@ -84,6 +104,7 @@ class Translator:
                 raise UndeclaredPropositionError(
                     f"{section}: unknown proposition {quoted(formula.name)} (declare it as an input or output)",
                     item=formula.name)
+            declare_pair(bdd, formula.name)
             return bdd.var(primed(formula.name) if under_next else formula.name)
         if isinstance(formula, Next):
             return args[0]
@@ -106,22 +127,6 @@ class Translator:
         raise NotGR1FormulaError(f'{section}: not a formula: {formula!r}', item=repr(formula))
 
 
-def walk(formula: Formula):
-    """Every node of ``formula`` (pre-order) with whether it lies under a next operator."""
-    stack = [(formula, False)]
-    while stack:
-        node, under_next = stack.pop()
-        yield node, under_next
-        inner = under_next or isinstance(node, Next)
-        stack.extend((child, inner) for child in reversed(children(node)))
-
-
-def next_outputs(formula: Formula, outputs: set[str]) -> list[str]:
-    """The outputs whose next value ``formula`` reads, sorted."""
-    return sorted({node.name for node, under_next in walk(formula)
-                   if under_next and isinstance(node, Var) and node.name in outputs})
-
-
 def check_declarations(spec: GR1Specification) -> None:
     seen = set()
     for name in list(spec.env_props) + list(spec.sys_props):
@@ -130,24 +135,3 @@ def check_declarations(spec: GR1Specification) -> None:
         if name in seen:
             raise UndeclaredPropositionError(f"proposition '{name}' is declared twice", item=name)
         seen.add(name)
-
-
-def variable_order(spec: GR1Specification, strategy: str) -> list[str]:
-    """Static variable order: declared, or 'affinity' (first appearance in the safety formulas).
-
-    Propositions used together (an action's activation and its outcomes) then sit together,
-    which keeps the transition relations small.
-    """
-    declared = list(spec.env_props) + list(spec.sys_props)
-    if strategy == 'declared':
-        return declared
-    if strategy != 'affinity':
-        raise ValueError(f'unknown variable order {strategy!r}')
-    known = set(declared)
-    found = {}  # an ordered set
-    for formula in list(spec.sys_trans) + list(spec.env_trans) + list(spec.sys_liveness) \
-            + list(spec.env_liveness) + list(spec.env_init) + list(spec.sys_init):
-        for node, _ in walk(formula):
-            if isinstance(node, Var) and node.name in known:
-                found.setdefault(node.name)
-    return list(found) + [name for name in declared if name not in found]

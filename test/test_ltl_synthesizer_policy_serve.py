@@ -12,8 +12,10 @@ import pytest
 
 from ltl_synthesizer import Options, synthesize
 from ltl_synthesizer.strategy import strategy_json_chunks, strategy_to_json
-from ltl_synthesizer.gr1 import Solver
-from ltl_synthesizer.policy import SMALL_GAME_PROPOSITIONS
+from ltl_synthesizer.gr1 import Solver, solve_system_game
+from ltl_synthesizer.strategy import symbolic_strategy
+from ltl_synthesizer.policy import (BETWEEN_ITERATIONS, FROM_START, NEVER, ONCE_LARGE,
+                                    SMALL_GAME_PROPOSITIONS)
 from ltl_synthesizer.symbolic import SymbolicGame
 from respec.parsing import ParseError, parse_slugsin, parse_structuredslugs
 
@@ -21,7 +23,7 @@ REPOSITORY = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPOSITORY / 'bench'))
 
 import gr1_families  # noqa: E402
-from strategy_check import check_strategy  # noqa: E402
+from strategy_check import check_strategy, check_symbolic_strategy  # noqa: E402
 
 REALIZABLE = '[INPUT]\nx\n[OUTPUT]\ny\n[SYS_TRANS]\nnext(y) <-> next(x)\n[SYS_LIVENESS]\ny | !x\n'
 
@@ -92,16 +94,31 @@ def test_streamed_json_is_the_same_text_in_pieces():
 
 # --- automatic policy -----------------------------------------------------------------------
 
-def test_pure_safety_games_skip_the_reachability_search():
+def test_large_safety_games_skip_the_reachability_search_and_dynamic_sifting():
     spec = parse_structuredslugs(gr1_families.cinderella(6, 3, 11, 6))
     solver = Solver(SymbolicGame(spec))
     assert len(solver.game.variables) > SMALL_GAME_PROPOSITIONS
-    assert not solver.plan.reachable_only and not solver.reordering.on
+    assert not solver.plan.reachable_only and solver.plan.reordering == NEVER
+    assert not solver.reordering.on
+
+
+def test_small_safety_games_sift_between_iterations_only():
+    """Moving obstacle: sifting passes happen, but never inside a BDD operation."""
+    spec = parse_structuredslugs(gr1_families.moving_obstacle(16, 4))
+    solver = Solver(SymbolicGame(spec))
+    assert solver.plan.reordering == BETWEEN_ITERATIONS and solver.plan.sift_once
+    assert not solver.game.bdd.configure()['reordering']  # no automatic (mid-operation) sifting
+    sifted_once = solver.game.statistics()['reorderings']
+    solution = solve_system_game(solver, stop_when_losing=None)
+    assert solver.game.statistics()['reorderings'] > sifted_once
+    assert not solver.game.bdd.configure()['reordering']
+    assert solution.winning != solver.game.false
 
 
 def test_several_system_goals_sift_from_the_start():
     solver = Solver(SymbolicGame(parse_structuredslugs(gr1_families.amba(2))))
-    assert len(solver.game.sys_goals) > 1 and solver.plan.reordering and solver.reordering.on
+    assert len(solver.game.sys_goals) > 1 and solver.plan.reordering == FROM_START
+    assert solver.reordering.on
 
 
 @pytest.mark.parametrize('family, arguments, realizable', [
@@ -125,7 +142,8 @@ def test_automatic_reordering_switches_on_past_the_node_threshold(monkeypatch):
     spec = parse_structuredslugs(gr1_families.evasion(24, 8).replace(
         '!requestPending2\n', ''))  # one system goal and an (implicit) assumption
     solver = Solver(SymbolicGame(spec))
-    assert not solver.reordering.on and len(solver.game.sys_goals) == 1
+    assert solver.plan.reordering == ONCE_LARGE and not solver.reordering.on
+    assert len(solver.game.sys_goals) == 1
     solver.enforce(solver.game.true)
     assert solver.reordering.on
     solver.reordering.stop()
@@ -148,6 +166,42 @@ def test_the_independent_check_catches_a_broken_strategy():
     for node in broken['nodes'].values():
         node['state'][1] = 1 - node['state'][1]  # y no longer follows x
     assert check_strategy(spec, broken)
+
+
+def solved(spec):
+    """The game of ``spec``, its solution and our strategy as relations."""
+    game = SymbolicGame(spec)
+    solution = solve_system_game(Solver(game))
+    return game, solution, symbolic_strategy(game, solution)
+
+
+def test_symbolic_strategies_of_family_instances_pass_the_independent_check():
+    for generator, arguments in ((gr1_families.amba, (2,)), (gr1_families.factory, (4, 3, 1, 1)),
+                                 (gr1_families.moving_obstacle, (8, 0)),
+                                 (gr1_families.cinderella, (5, 2, 7, 4))):
+        spec = parse_structuredslugs(generator(*arguments))
+        game, _, relations = solved(spec)
+        assert check_symbolic_strategy(spec, relations, game.bdd) == []
+
+
+# A system that must raise y infinitely often, free to choose it every step.
+FREE_GOAL = '[INPUT]\nx\n[OUTPUT]\ny\n[SYS_LIVENESS]\ny\n[ENV_LIVENESS]\nx\n'
+
+
+def test_the_symbolic_check_catches_broken_strategies():
+    spec = parse_structuredslugs(FREE_GOAL)
+    game, solution, relations = solved(spec)
+    assert check_symbolic_strategy(spec, relations, game.bdd) == []
+    y_next = game.bdd.var("y'")
+    may_idle = [relation | ~y_next for relation in relations]  # may keep y low forever
+    assert check_symbolic_strategy(spec, may_idle, game.bdd) == [
+        'goal 0: a reachable cycle meets every assumption and never the goal']
+    assert 'no answered initial state' in check_symbolic_strategy(spec, [game.false], game.bdd)[0]
+    spec = parse_structuredslugs(REALIZABLE)
+    game, solution, relations = solved(spec)
+    assert check_symbolic_strategy(spec, relations, game.bdd) == []
+    disobedient = [solution.winning & ~game.sys_trans()]  # y' differs from x'
+    assert 'violates SYS_TRANS' in check_symbolic_strategy(spec, disobedient, game.bdd)[0]
 
 
 # --- start-up -------------------------------------------------------------------------------

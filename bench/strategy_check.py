@@ -43,6 +43,14 @@ class _Formulas:
             self.bdd.declare(name, name + "'")
         self._memo = {}
 
+    def game(self, spec):
+        """The specification's initial conditions, safety relations and liveness lists as BDDs."""
+        true = self.bdd.true
+        return (self.conjunction(spec.env_init), self.conjunction(spec.sys_init),
+                self.conjunction(spec.env_trans), self.conjunction(spec.sys_trans),
+                [self.translate(f) for f in spec.env_liveness] or [true],
+                [self.translate(f) for f in spec.sys_liveness] or [true])
+
     def translate(self, formula, in_next=False):
         key = (id(formula), in_next)
         if key in self._memo:
@@ -85,12 +93,7 @@ def check_strategy(spec, strategy: dict, limit: int = 20) -> list[str]:
     if sorted(names) != sorted(formulas.variables):
         return [f'strategy variables {names} are not the specification\'s']
     inputs = list(spec.env_props)
-    env_init = formulas.conjunction(spec.env_init)
-    sys_init = formulas.conjunction(spec.sys_init)
-    env_trans = formulas.conjunction(spec.env_trans)
-    sys_trans = formulas.conjunction(spec.sys_trans)
-    assumptions = [formulas.translate(f) for f in spec.env_liveness] or [bdd.true]
-    goals = [formulas.translate(f) for f in spec.sys_liveness] or [bdd.true]
+    env_init, sys_init, env_trans, sys_trans, assumptions, goals = formulas.game(spec)
     nodes = strategy['nodes']
     problems = []
 
@@ -214,12 +217,7 @@ def check_symbolic_strategy(spec, relations: list, source: cudd.BDD) -> list[str
     next_outputs = [name + "'" for name in spec.sys_props]
     next_variables = [name + "'" for name in current]
     to_current = dict(zip(next_variables, current))
-    env_init = formulas.conjunction(spec.env_init)
-    sys_init = formulas.conjunction(spec.sys_init)
-    env_trans = formulas.conjunction(spec.env_trans)
-    sys_trans = formulas.conjunction(spec.sys_trans)
-    assumptions = [formulas.translate(f) for f in spec.env_liveness] or [bdd.true]
-    goals = [formulas.translate(f) for f in spec.sys_liveness] or [bdd.true]
+    env_init, sys_init, env_trans, sys_trans, assumptions, goals = formulas.game(spec)
     if len(relations) != len(goals):
         return [f'{len(relations)} strategy relations for {len(goals)} system goals']
     # The relations are copied in the synthesizer's variable order, without sifting meanwhile

@@ -61,6 +61,8 @@ _CAPABILITY_KEYS = ('interface', 'parameters', 'preconditions', 'postconditions'
                     'autonomy', 'outcomes')
 _FILE_KEYS = ('name', 'capabilities', 'variable_mappings', 'state_outcome_mappings', 'memory')
 _SPEC_SECTIONS = ('INPUT', 'OUTPUT', 'ENV_INIT', 'SYS_INIT')
+# CNU's files may spell a memory proposition with their suffix; ours is added by respec.naming.
+CNU_MEMORY_SUFFIX = '_m'
 # YAML reads `true`/`false` keys as booleans; CNU's mappings quote them, but be lenient.
 _YAML_WORDS = {True: 'true', False: 'false'}
 
@@ -339,7 +341,7 @@ def _memory(raw, system: str) -> dict[str, bool]:
             raise CapabilityConfigError(f'{system}: memory may only hold sys_props: name -> initial value',
                                         item=f'memory.{side}')
         for name, initial in names.items():
-            name = str(name).removesuffix('_m')
+            name = str(name).removesuffix(CNU_MEMORY_SUFFIX)
             if not _NAME.match(name) or not isinstance(initial, bool):
                 raise CapabilityConfigError(f'{system}: memory entry {name!r} needs a name and true/false',
                                             item=f'memory.sys_props.{name}')

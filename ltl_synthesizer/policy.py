@@ -11,6 +11,14 @@ from dataclasses import dataclass
 # larger relational products are faster than many tiny ones, up to a point (see bench/): 1000
 # rather than 2500 makes multi-goal ATLAS tasks 20-40% faster and leaves the chain family as is.
 DEFAULT_CLUSTER_LIMIT = 1000
+# Pure safety games (no liveness) only ever compute the enforceable predecessor of the whole
+# safe set, quantifying every next-step variable at once; there fewer, larger products win
+# (bench/bench_gr1_families.py: moving obstacle 48x48 20.3 -> 16.4 s, whose environment
+# relation becomes one BDD of 1,559 nodes; cinderella n8c3 b15 40 -> 27 s, n7c1 b20 7.7 ->
+# 4.8 s; factory 7x5 as fast). Games with liveness goals keep the smaller limit: their inner
+# fixpoints and strategies take many products of small sets, and AMBA's solve times jump
+# 20x on some larger limits.
+SAFETY_GAME_CLUSTER_LIMIT = 3000
 
 # Up to this many propositions a game solves in a few tens of milliseconds, and neither the
 # sifting pass nor the reachability search pays for itself (bench/bench_synthesizer.py
@@ -57,7 +65,9 @@ class Options:
     # One sifting pass after the relations are built; None = automatic: on for games of more
     # than SMALL_GAME_PROPOSITIONS propositions or with large safety relations.
     sift_once: bool | None = None
-    cluster_limit: int = DEFAULT_CLUSTER_LIMIT
+    # Most BDD nodes in a cluster of conjoined safety formulas; None = automatic:
+    # SAFETY_GAME_CLUSTER_LIMIT for pure safety games, else DEFAULT_CLUSTER_LIMIT.
+    cluster_limit: int | None = None
     variable_order: str = 'affinity'  # 'affinity' (co-occurrence) or 'declared'
     # Solve only on positions reachable from the initial ones; None = automatic: on for games
     # of more than SMALL_GAME_PROPOSITIONS propositions with some liveness goal.
@@ -72,6 +82,13 @@ class Plan:
     sift_once: bool
     reachable_only: bool
     reordering: str  # NEVER, FROM_START, ONCE_LARGE or BETWEEN_ITERATIONS
+
+
+def cluster_limit(has_liveness: bool, options: Options) -> int:
+    """The cluster limit for a game with or without liveness goals (see SAFETY_GAME_CLUSTER_LIMIT)."""
+    if options.cluster_limit is not None:
+        return options.cluster_limit
+    return DEFAULT_CLUSTER_LIMIT if has_liveness else SAFETY_GAME_CLUSTER_LIMIT
 
 
 def plan(game, options: Options) -> Plan:

@@ -19,7 +19,7 @@ from ltl_synthesizer.cudd_import import cudd
 from respec.spec import GR1Specification
 
 from ltl_synthesizer.interrupt import Interrupt
-from ltl_synthesizer.policy import Options
+from ltl_synthesizer.policy import Options, cluster_limit
 from ltl_synthesizer.translation import Translator, check_declarations, declare_pair, primed
 
 # CUDD's cache and unique tables grow on demand; starting small keeps tiny specs fast (dd's
@@ -121,7 +121,8 @@ class SymbolicGame:
         return _conjoin(self.true, self.sys_partition.clusters, self.interrupt)
 
     def _partition(self, parts, quantified: set[str], options: Options) -> _Partition:
-        clusters = _cluster(self.bdd, parts, options.cluster_limit, self.interrupt)
+        clusters = _cluster(self.bdd, parts, cluster_limit(self.has_liveness, options),
+                            self.interrupt)
         supports = [self.bdd.support(c) & quantified for c in clusters]
         partition = _Partition(clusters=clusters)
         for index, support in enumerate(supports):

@@ -100,7 +100,7 @@ def test_bad_requests_get_specific_codes_and_the_server_keeps_serving(suite):
     assert no_goals.error_name == 'INVALID_GOALS'
     malformed = run(suite, system='atlas', initial_conditions=[], goals=[], option='ltl_synthesis_only',
                     ltl_specification={'sys_props': ['x'], 'sys_trans': ['x &']})
-    assert malformed.error_name == 'SYNTHESIS_FAILED'
+    assert malformed.error_name == 'INVALID_FORMULA'
     assert 'sys_trans[0]' in malformed.message
     unrealizable = run(suite, system='atlas', initial_conditions=[], goals=[], option='ltl_synthesis_only',
                        ltl_specification={'env_props': ['door_open'], 'sys_props': ['inside'],

@@ -265,6 +265,11 @@ def test_deeply_nested_custom_ltl_gets_its_specific_code_at_once(ros, tmp_path):
         assert time.monotonic() - started < 5
         assert outcome.error_name == 'INVALID_FORMULA', outcome.message[:300]
         assert f'nested deeper than {MAX_FORMULA_NESTING}' in outcome.message and len(outcome.message) < 300
+        # The same code from the ltl_synthesis service, which parses a whole specification.
+        direct = client.run(make_goal('atlas', [], [], option='ltl_synthesis_only', ltl_specification={
+            'sys_props': ['look_down_a'], 'sys_trans': [formula]}), timeout=60)
+        assert direct.error_name == 'INVALID_FORMULA', direct.message[:300]
+        assert f'nested deeper than {MAX_FORMULA_NESTING}' in direct.message and len(direct.message) < 300
 
 
 def test_a_yaml_bomb_in_synthesis_options_is_refused_at_once(ros, tmp_path):

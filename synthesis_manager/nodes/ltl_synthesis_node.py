@@ -131,9 +131,9 @@ class LTLSynthesisNode(Node):
                                        give_up=lambda: cancel.is_set() or time.monotonic() > deadline)
             except Abandoned:  # stopped while waiting for a worker
                 self._stopped(response, 'cancelled' if cancel.is_set() else 'timeout', timeout)
-        except ParseError as error:  # the original's code for a malformed specification
+        except ParseError as error:  # the parsers' own code, as in every other stage
             response.synthesizable = False
-            response.error_code = error_code(ErrorCode.SYNTHESIS_FAILED, f'malformed specification: {error}')
+            response.error_code = error_code(error.code, f'malformed specification: {error}')
         except Exception as error:  # every failure becomes an error code; the node keeps serving
             response.synthesizable = False
             response.error_code = reported_error(error, self.get_logger(), 'synthesis failed')

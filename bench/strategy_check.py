@@ -14,13 +14,14 @@ here, in a manager of its own, and the strategy graph is checked directly:
 Scales to strategies of hundreds of thousands of nodes (one BDD evaluation per edge).
 
 Explicit strategies grow beyond that on the larger family instances, so
-``check_symbolic_strategy`` checks the same three properties on the strategy as relations
-(``ltl_synthesizer.strategy.symbolic_strategy``: per goal j, the moves allowed from each
-position and environment move), with other algorithms than the synthesizer's fixpoints: a
-forward reachability of the closed loop (positions x goal counters, the counter advancing on
-each goal-j transition), then on the reachable part: every move obeys SYS_TRANS, every
-environment move allowed by ENV_TRANS is answered, and an Emerson-Lei fair-cycle search finds
-no cycle at one counter value (missing its goal forever) that meets every assumption.
+``check_symbolic_strategy`` checks the strategy as relations
+(``ltl_synthesizer.strategy.symbolic_strategy``: its positions and, per goal j, the pieces of
+moves it allows), with other algorithms than the synthesizer's fixpoints, on all of the
+strategy's positions at once (so on every position a play can reach): the initial positions
+are among them, every environment move allowed by ENV_TRANS is answered by a move allowed
+by SYS_TRANS, no move leaves them, and an Emerson-Lei fair-path search finds no path of
+goal-j moves that misses goal j forever and meets every assumption infinitely often.
+Relations stay in parts (clusters of conjuncts) and every product quantifies early.
 The relations are copied into this checker's own BDD manager; every formula is translated
 here. Run on a specification file:
 
@@ -35,9 +36,9 @@ from respec.ltl import And, Const, Iff, Implies, Next, Not, Or, Var
 
 
 class _Formulas:
-    def __init__(self, spec, reordering: bool = False):
+    def __init__(self, spec):
         self.bdd = cudd.BDD()
-        self.bdd.configure(reordering=reordering)
+        self.bdd.configure(reordering=False)
         self.variables = list(spec.env_props) + list(spec.sys_props)
         for name in self.variables:
             self.bdd.declare(name, name + "'")
@@ -204,66 +205,100 @@ def _components(graph: dict) -> list[set]:
     return components
 
 
-def check_symbolic_strategy(spec, relations: list, source: cudd.BDD) -> list[str]:
+def check_symbolic_strategy(spec, strategy, source: cudd.BDD) -> list[str]:
     """Problems found (empty when the strategy is winning, standard initial semantics).
 
-    ``relations[j]`` (a BDD of manager ``source`` over x, y, x', y') holds the moves the
-    strategy allows while it pursues system goal j; any choice among them must win.
+    ``strategy`` (an ``ltl_synthesizer.strategy.SymbolicStrategy`` of manager ``source``)
+    claims: on its positions ``winning``, while pursuing system goal j the system may take
+    any move allowed by SYS_TRANS into the target of a piece of ``pieces[j]`` whose
+    ``offered`` set holds the position and the environment's move. Checked here, for every
+    goal j and on all of its positions (so on every position a play can reach): each
+    environment move allowed by ENV_TRANS has such a move, no such move leaves the
+    positions, the initial positions are among them, and no path of goal-j moves that never
+    meets goal j meets every assumption infinitely often (an Emerson-Lei greatest fixpoint).
+    Then every play of the strategy from an initial position satisfies the specification.
+    Relations stay in parts (clusters of conjuncts): each product is one image or preimage
+    computed with early quantification, never the strategy's whole relation.
     """
-    formulas = _Formulas(spec, reordering=True)
+    formulas = _Formulas(spec)
     bdd = formulas.bdd
-    current = list(spec.env_props) + list(spec.sys_props)
-    next_inputs = [name + "'" for name in spec.env_props]
-    next_outputs = [name + "'" for name in spec.sys_props]
-    next_variables = [name + "'" for name in current]
-    to_current = dict(zip(next_variables, current))
-    env_init, sys_init, env_trans, sys_trans, assumptions, goals = formulas.game(spec)
-    if len(relations) != len(goals):
-        return [f'{len(relations)} strategy relations for {len(goals)} system goals']
-    # The relations are copied in the synthesizer's variable order, without sifting meanwhile
-    # (copying into another order can take far longer than the check); the order is no part
-    # of the logic.
+    # The check works in the synthesizer's final variable order, sifted for these very
+    # relations, without sifting of its own: translating and copying into another order, or
+    # sifting during the check, can take far longer than the check (moving obstacle 24x24:
+    # 14 s of sifting for a 0.2 s check). The order is no part of the logic.
     cudd.reorder(bdd, {name: source.level_of_var(name) for name in bdd.vars})
-    bdd.configure(reordering=False)
-    moves = [source.copy(relation, bdd) & env_trans for relation in relations]
-    bdd.configure(reordering=True)
-    problems = [f'goal {j}: a move violates SYS_TRANS' for j, m in enumerate(moves)
-                if m & ~sys_trans != bdd.false]
-    # Positions where every environment move allowed by ENV_TRANS has an answer.
-    answered = [~bdd.exist(next_inputs, env_trans & ~bdd.exist(next_outputs, m)) for m in moves]
-    initial = env_init & sys_init & answered[0]
-    if env_init & ~bdd.exist(list(spec.sys_props), initial) != bdd.false:
-        problems.append('some initial input valuation has no answered initial state')
+    current = list(spec.env_props) + list(spec.sys_props)
+    next_inputs = {name + "'" for name in spec.env_props}
+    next_outputs = {name + "'" for name in spec.sys_props}
+    to_next = {name: name + "'" for name in current}
+    env_init, sys_init = formulas.conjunction(spec.env_init), formulas.conjunction(spec.sys_init)
+    env_trans = _clusters(bdd, [formulas.translate(f) for f in spec.env_trans])
+    sys_trans = _clusters(bdd, [formulas.translate(f) for f in spec.sys_trans])
+    assumptions = [formulas.translate(f) for f in spec.env_liveness] or [bdd.true]
+    goals = [formulas.translate(f) for f in spec.sys_liveness] or [bdd.true]
+    if len(strategy.pieces) != len(goals):
+        return [f'{len(strategy.pieces)} strategy relations for {len(goals)} system goals']
+    winning = source.copy(strategy.winning, bdd)
+    pieces = [[(source.copy(piece.offered, bdd), source.copy(piece.target, bdd)) for piece in goal]
+              for goal in strategy.pieces]
+    problems = []
+    if env_init & ~bdd.exist(list(spec.sys_props), env_init & sys_init & winning) != bdd.false:
+        problems.append('some initial input valuation has no initial position in the strategy')
+    leaving = ~bdd.let(to_next, winning)
+    for j, goal_pieces in enumerate(pieces):
+        responses = bdd.false
+        for offered, target in goal_pieces:
+            responses |= offered & _product(bdd, [target] + sys_trans, next_outputs)
+        if winning & _product(bdd, [~responses] + env_trans, next_inputs) != bdd.false:
+            problems.append(f'goal {j}: some environment move allowed at a position of the '
+                            f'strategy has no answer')
+        moves = [(winning & offered, target) for offered, target in goal_pieces]
 
-    def successors(positions, transitions):
-        return bdd.let(to_current, cudd.and_exists(positions, transitions, current))
-
-    # Forward reachability of (position, goal counter), one position set per counter.
-    reached = [initial if j == 0 else bdd.false for j in range(len(goals))]
-    changed = True
-    while changed:
-        changed = False
-        for j, goal in enumerate(goals):
-            following = (j + 1) % len(goals)
-            for target, transitions in ((j, moves[j] & ~goal), (following, moves[j] & goal)):
-                grown = reached[target] | successors(reached[j], transitions)
-                if grown != reached[target]:
-                    reached[target], changed = grown, True
-    for j in range(len(goals)):
-        if reached[j] & ~answered[j] != bdd.false:
-            problems.append(f'goal {j}: a reachable position leaves some environment move unanswered')
-        if _fair_cycle(bdd, reached[j], moves[j] & ~goals[j], assumptions, current, next_variables):
-            problems.append(f'goal {j}: a reachable cycle meets every assumption and never the goal')
+        def preimage(targets, moves=moves):
+            """Positions with a move (of these pieces) that is a transition of ``targets``."""
+            found = bdd.false
+            for offered, target in moves:
+                found |= _product(bdd, [offered, target & targets] + env_trans + sys_trans,
+                                  next_inputs | next_outputs)
+            return found
+        if preimage(leaving) != bdd.false:
+            problems.append(f'goal {j}: a move leaves the positions of the strategy')
+        if goals[j] != bdd.true and _fair_path(bdd, winning, preimage, ~goals[j], assumptions, to_next):
+            problems.append(f'goal {j}: a path of the strategy meets every assumption and never the goal')
     return problems
 
 
-def _fair_cycle(bdd, positions, transitions, assumptions, current, next_variables) -> bool:
-    """Whether ``transitions`` (over current and next variables) have, among ``positions``,
-    an infinite path that takes a transition of every assumption infinitely often: the
+def _clusters(bdd, parts: list, limit: int = 2000) -> list:
+    """Consecutive conjuncts merged while the merged BDD stays under ``limit`` nodes."""
+    clusters = []
+    for part in parts:
+        if clusters and len(merged := clusters[-1] & part) <= limit:
+            clusters[-1] = merged
+        else:
+            clusters.append(part)
+    return clusters
+
+
+def _product(bdd, parts: list, quantified: set):
+    """``exists quantified. /\\ parts``, each variable quantified right after the last part
+    that mentions it (the parts' conjunction is never built)."""
+    last = {}
+    for index, part in enumerate(parts):
+        for name in bdd.support(part) & quantified:
+            last[name] = index
+    result = bdd.true
+    for index, part in enumerate(parts):
+        now = [name for name, at in last.items() if at == index]
+        result = cudd.and_exists(result, part, now) if now else result & part
+    return result
+
+
+def _fair_path(bdd, positions, preimage, avoid_goal, assumptions, to_next) -> bool:
+    """Whether some position of ``positions`` starts an infinite path of moves (``preimage``
+    of a set of transitions: the positions with a move among them) that all lie in
+    ``avoid_goal`` and take a transition of every assumption infinitely often: the
     Emerson-Lei greatest fixpoint of positions that can reach, within it, a transition of
     each assumption into it."""
-    to_next = dict(zip(current, next_variables))
-    within = positions & transitions
     fair = positions
     while True:
         shrunk = fair
@@ -271,8 +306,7 @@ def _fair_cycle(bdd, positions, transitions, assumptions, current, next_variable
             fair_next = bdd.let(to_next, fair)
             reach = bdd.false
             while True:
-                step = cudd.and_exists(within, fair_next & (assumption | bdd.let(to_next, reach)),
-                                       next_variables)
+                step = preimage(avoid_goal & fair_next & (assumption | bdd.let(to_next, reach)))
                 if step == reach:
                     break
                 reach = step
@@ -304,11 +338,11 @@ def main(argv=None) -> int:
         print('unrealizable')
         return 2
     solver.reordering.stop()
-    relations = symbolic_strategy(game, solution)
+    strategy = symbolic_strategy(game, solution)
     built = time.process_time()
-    problems = check_symbolic_strategy(spec, relations, game.bdd)
+    problems = check_symbolic_strategy(spec, strategy, game.bdd)
     checked = time.process_time()
-    del relations
+    del strategy
     print(f"{'ok' if not problems else 'FAILED: ' + problems[0]} (strategy relations "
           f'{built - start:.1f} s, check {checked - built:.1f} s)')
     return 1 if problems else 0

@@ -13,6 +13,7 @@ result is deterministic.
 from __future__ import annotations
 
 from collections import deque
+from dataclasses import dataclass
 
 from ltl_synthesizer.gr1 import EnvironmentSolution, SystemSolution
 from ltl_synthesizer.symbolic import SymbolicGame
@@ -55,30 +56,51 @@ def goal_moves(game: SymbolicGame, steps, env_moves, legal):
     return moves
 
 
-def symbolic_strategy(game: SymbolicGame, solution: SystemSolution) -> list:
-    """The strategy as relations, one per system goal j, over (position, next input, next
-    output): from each winning position, for each environment move, the moves allowed by
-    sys_trans of the first attractor step (lowest rank) that offers one -- the moves
-    ``goal_moves`` chooses among, at every position at once. Every such move reaches the
-    goal, a lower rank, or stays at its rank on a transition that violates the step's
-    assumption, so any choice among them wins (checked independently by
-    bench/strategy_check.py). Building it costs BDD work on all positions: for analysis
-    and checks, not for extraction."""
-    sys_trans = game.sys_trans()
-    relations = []
+@dataclass
+class StrategyPiece:
+    """The moves of one attractor step: at the positions and environment moves of ``offered``
+    (over current variables and next inputs; those no step of lower rank offers), every
+    system move allowed by sys_trans into ``target`` (transitions, over current and next
+    variables)."""
+
+    offered: object
+    target: object
+
+
+@dataclass
+class SymbolicStrategy:
+    """The strategy as relations: on the positions ``winning``, while it pursues system goal
+    j, the system may take any move of the pieces ``pieces[j]`` (their union, with sys_trans).
+    Kept as pieces: their union conjoined with sys_trans is a far larger BDD than all of
+    them together (factory 5x5: 7.3 million nodes), and nothing needs it whole."""
+
+    winning: object
+    pieces: list
+
+
+def symbolic_strategy(game: SymbolicGame, solution: SystemSolution) -> SymbolicStrategy:
+    """The strategy as relations, one list of pieces per system goal j: from each winning
+    position, for each environment move, the moves allowed by sys_trans of the first
+    attractor step (lowest rank) that offers one -- the moves ``goal_moves`` chooses among,
+    at every position at once. Every such move reaches the goal, a lower rank, or stays at
+    its rank on a transition that violates the step's assumption, so any choice among them
+    wins (checked independently by bench/strategy_check.py). For analysis and checks, not
+    for extraction."""
+    pieces = []
     for steps in goal_steps(game, solution):
-        answered = relation = game.false
+        answered = game.false
+        goal_pieces = []
         for step in steps:
             game.interrupt.check()
-            first_offered = step.responses & ~answered
-            if first_offered == game.false:
+            offered = step.responses & ~answered
+            if offered == game.false:
                 continue
-            transitions = step.goal_transitions | game.prime(step.closer) | \
+            target = step.goal_transitions | game.prime(step.closer) | \
                 (game.prime(step.waiting) & ~step.assumption)
-            relation |= first_offered & transitions & sys_trans
+            goal_pieces.append(StrategyPiece(offered, target))
             answered |= step.responses
-        relations.append(relation & solution.winning)
-    return relations
+        pieces.append(goal_pieces)
+    return SymbolicStrategy(solution.winning, pieces)
 
 
 def enumerate_states(game: SymbolicGame, states, names, limit: int | None = None):

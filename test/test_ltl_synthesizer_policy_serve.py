@@ -13,7 +13,8 @@ import pytest
 from ltl_synthesizer import Options, synthesize
 from ltl_synthesizer.strategy import strategy_json_chunks, strategy_to_json
 from ltl_synthesizer.gr1 import Solver, solve_system_game
-from ltl_synthesizer.strategy import symbolic_strategy
+from ltl_synthesizer.strategy import StrategyPiece, SymbolicStrategy, symbolic_strategy
+from ltl_synthesizer.synthesizer import initial_positions_win
 from ltl_synthesizer.policy import (BETWEEN_ITERATIONS, FROM_START, NEVER, ONCE_LARGE,
                                     SMALL_GAME_PROPOSITIONS)
 from ltl_synthesizer.symbolic import SymbolicGame
@@ -180,8 +181,9 @@ def test_symbolic_strategies_of_family_instances_pass_the_independent_check():
                                  (gr1_families.moving_obstacle, (8, 0)),
                                  (gr1_families.cinderella, (5, 2, 7, 4))):
         spec = parse_structuredslugs(generator(*arguments))
-        game, _, relations = solved(spec)
-        assert check_symbolic_strategy(spec, relations, game.bdd) == []
+        game, solution, strategy = solved(spec)
+        assert initial_positions_win(game, solution.winning, robotics_semantics=False)
+        assert check_symbolic_strategy(spec, strategy, game.bdd) == []
 
 
 # A system that must raise y infinitely often, free to choose it every step.
@@ -190,18 +192,28 @@ FREE_GOAL = '[INPUT]\nx\n[OUTPUT]\ny\n[SYS_LIVENESS]\ny\n[ENV_LIVENESS]\nx\n'
 
 def test_the_symbolic_check_catches_broken_strategies():
     spec = parse_structuredslugs(FREE_GOAL)
-    game, solution, relations = solved(spec)
-    assert check_symbolic_strategy(spec, relations, game.bdd) == []
+    game, solution, strategy = solved(spec)
+    assert check_symbolic_strategy(spec, strategy, game.bdd) == []
     y_next = game.bdd.var("y'")
-    may_idle = [relation | ~y_next for relation in relations]  # may keep y low forever
+    # May keep y low forever: one more piece per goal, offering every move into !y.
+    may_idle = SymbolicStrategy(strategy.winning, [pieces + [StrategyPiece(game.true, ~y_next)]
+                                                   for pieces in strategy.pieces])
     assert check_symbolic_strategy(spec, may_idle, game.bdd) == [
-        'goal 0: a reachable cycle meets every assumption and never the goal']
-    assert 'no answered initial state' in check_symbolic_strategy(spec, [game.false], game.bdd)[0]
+        'goal 0: a path of the strategy meets every assumption and never the goal']
+    nowhere = SymbolicStrategy(game.false, strategy.pieces)
+    assert 'no initial position' in check_symbolic_strategy(spec, nowhere, game.bdd)[0]
+    silent = SymbolicStrategy(strategy.winning, [[]])
+    assert check_symbolic_strategy(spec, silent, game.bdd) == [
+        'goal 0: some environment move allowed at a position of the strategy has no answer']
+
     spec = parse_structuredslugs(REALIZABLE)
-    game, solution, relations = solved(spec)
-    assert check_symbolic_strategy(spec, relations, game.bdd) == []
-    disobedient = [solution.winning & ~game.sys_trans()]  # y' differs from x'
-    assert 'violates SYS_TRANS' in check_symbolic_strategy(spec, disobedient, game.bdd)[0]
+    game, solution, strategy = solved(spec)
+    assert check_symbolic_strategy(spec, strategy, game.bdd) == []
+    # Claims only the position x = y = 1, but the environment may then lower x.
+    x, y = game.bdd.var('x'), game.bdd.var('y')
+    narrowed = SymbolicStrategy(x & y, strategy.pieces)
+    assert 'goal 0: a move leaves the positions of the strategy' in \
+        check_symbolic_strategy(spec, narrowed, game.bdd)
 
 
 # --- start-up -------------------------------------------------------------------------------

@@ -81,9 +81,8 @@ class FrameRenderer:
         visual.global_.offwidth, visual.global_.offheight = width, height
         visual.quality.shadowsize = min(visual.quality.shadowsize, SHADOW_MAP_SIZE)
         try:
-            # No text is drawn, so the smallest font scale (its bitmaps are made per context).
             self._renderer = mujoco.Renderer(self.physics.model, height=height, width=width,
-                                             max_geom=MAX_SCENE_GEOMS, font_scale=mujoco.mjtFontScale.mjFONTSCALE_50)
+                                             max_geom=MAX_SCENE_GEOMS)
         finally:
             visual.global_.offwidth, visual.global_.offheight, visual.quality.shadowsize = kept
 

@@ -43,6 +43,35 @@ def peak_rss_growth(pid: int, rss_kib):
         figures['MiB'] = max(0, peak[0] - baseline) / 1024
 
 
+@contextmanager
+def simulation_process_peak(gui_pid: int, children):
+    """Yields a dict whose 'MiB' is, afterwards, the highest peak RSS (VmHWM) one of the GUI's
+    simulation processes (web/simulation_process.py) reached: a run's own peak, read until it ends."""
+    peaks, done = {}, threading.Event()
+
+    def sample():
+        while not done.wait(0.02):
+            for child in children(gui_pid):
+                try:
+                    with open(f'/proc/{child}/cmdline', 'rb') as cmdline:
+                        if b'simulation_process' not in cmdline.read():
+                            continue
+                    with open(f'/proc/{child}/status') as status:
+                        hwm = next(int(line.split()[1]) for line in status if line.startswith('VmHWM:'))
+                except (OSError, StopIteration):  # ended meanwhile
+                    continue
+                peaks[child] = max(peaks.get(child, 0), hwm)
+    sampler = threading.Thread(target=sample, daemon=True)
+    sampler.start()
+    figures = {}
+    try:
+        yield figures
+    finally:
+        done.set()
+        sampler.join()
+        figures['MiB'] = max(peaks.values(), default=0) / 1024
+
+
 def timed(run, goal, timeout=120.0):
     started = time.monotonic()
     try:
@@ -161,7 +190,7 @@ def plain_client_burst(client, count: int, wait: float = 120.0) -> dict:
             'seconds': time.monotonic() - started}
 
 
-def gui_simulation_flood(url: str, gui_pid: int, rss_kib, attempts: int = 40) -> dict:
+def gui_simulation_flood(url: str, gui_pid: int, rss_kib, children, attempts: int = 40) -> dict:
     """40 simulations requested at once for one finished job; then a cross-site-style form POST."""
     def post(path, body, content_type='application/json'):
         request = urllib.request.Request(url + path, method='POST', data=body, headers={'Content-Type': content_type})
@@ -189,11 +218,13 @@ def gui_simulation_flood(url: str, gui_pid: int, rss_kib, attempts: int = 40) ->
     # One run alone first (when simulations ran in the GUI process, MuJoCo and its renderer
     # loaded there on the first run); the GUI process alone, and with its simulation processes.
     before = gui_alone(gui_pid)
-    with peak_rss_growth(gui_pid, gui_alone) as first, peak_rss_growth(gui_pid, rss_kib) as first_all:
+    with peak_rss_growth(gui_pid, gui_alone) as first, peak_rss_growth(gui_pid, rss_kib) as first_all, \
+            simulation_process_peak(gui_pid, children) as first_child:
         answer = post(f'api/jobs/{job["id"]}/simulations', b'{}')
         assert answer[0] == 202, (answer, job.get('outcome'))
         finish(answer[2]['id'])
-    with peak_rss_growth(gui_pid, gui_alone) as rss, peak_rss_growth(gui_pid, rss_kib) as rss_all:
+    with peak_rss_growth(gui_pid, gui_alone) as rss, peak_rss_growth(gui_pid, rss_kib) as rss_all, \
+            simulation_process_peak(gui_pid, children) as child:
         started = time.monotonic()
         with ThreadPoolExecutor(attempts) as pool:
             answers = list(pool.map(lambda _: post(f'api/jobs/{job["id"]}/simulations', b'{}'), range(attempts)))
@@ -211,5 +242,7 @@ def gui_simulation_flood(url: str, gui_pid: int, rss_kib, attempts: int = 40) ->
             'GUI process peak RSS growth, the 40 requests MiB': rss['MiB'],
             'with its simulation processes, first run MiB': first_all['MiB'],
             'with its simulation processes, the 40 requests MiB': rss_all['MiB'],
+            'simulation process peak RSS, first run MiB': first_child['MiB'],
+            'simulation process peak RSS, the 40 requests (highest) MiB': child['MiB'],
             'GUI process RSS after them MiB': gui_alone(gui_pid) / 1024,
             'form-encoded POST status': form}

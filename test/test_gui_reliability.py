@@ -279,9 +279,12 @@ def test_a_simulation_process_gets_the_lean_rendering_environment(monkeypatch):
         monkeypatch.delenv(name, raising=False)
     monkeypatch.setenv('LP_NUM_THREADS', '2')
     run = SimulationProcess({'max_wall_time': 1.0})
-    try:  # Popen returns once the child has exec'd, so this is the child's environment
-        with open(f'/proc/{run.process.pid}/environ', 'rb') as environ:
-            variables = dict(entry.split(b'=', 1) for entry in environ.read().split(b'\0') if b'=' in entry)
+    try:  # empty while the child is between exec's (the ROS wheels' .pth may re-exec it); it waits on stdin
+        deadline, variables = time.monotonic() + 30, {}
+        while not variables:
+            assert time.monotonic() < deadline and run.process.poll() is None
+            with open(f'/proc/{run.process.pid}/environ', 'rb') as environ:
+                variables = dict(entry.split(b'=', 1) for entry in environ.read().split(b'\0') if b'=' in entry)
     finally:
         run.stop()
         run.process.wait()

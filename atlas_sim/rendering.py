@@ -56,6 +56,8 @@ def save_png(path: PathLike, image: np.ndarray) -> Path:
 
 #: Side of the shadow map in pixels (MuJoCo's default 4096).
 SHADOW_MAP_SIZE = 2048
+#: Geoms one frame can draw: the scene has ~25 (MuJoCo's default room for 10,000 took ~9 MiB).
+MAX_SCENE_GEOMS = 1000
 
 
 class FrameRenderer:
@@ -79,7 +81,8 @@ class FrameRenderer:
         visual.global_.offwidth, visual.global_.offheight = width, height
         visual.quality.shadowsize = min(visual.quality.shadowsize, SHADOW_MAP_SIZE)
         try:
-            self._renderer = mujoco.Renderer(self.physics.model, height=height, width=width)
+            self._renderer = mujoco.Renderer(self.physics.model, height=height, width=width,
+                                             max_geom=MAX_SCENE_GEOMS)
         finally:
             visual.global_.offwidth, visual.global_.offheight, visual.quality.shadowsize = kept
 

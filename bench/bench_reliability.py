@@ -13,7 +13,8 @@
   in ``synthesis_options``, custom LTL nested 5,000 and 30,000 deep, negative/NaN and 3 s
   time limits in a burst behind slow syntheses, a plain rclpy client with the default depth-10
   queues sending 200 goals and then a 10,000-goal flood, and 40 GUI simulations at once. Each
-  says what came back, how long after its limit, and the server's peak RSS growth.
+  says what came back, how long after its limit, and the server's peak RSS growth; the
+  simulations also the peak RSS of a simulation process itself (VmHWM).
 - idle: the server's RSS (with its synthesis processes) after a burst and after they idled.
 
 The server and GUI run as their real console entry points in separate processes on a
@@ -280,7 +281,7 @@ def main(argv=None) -> int:
                     report['gui'] = gui_burst(url)
                 if 'simulations' in sections:
                     print('gui: 40 simulations at once', flush=True)
-                    report['gui simulations at once'] = attacks.gui_simulation_flood(url, gui_pid, rss_kib)
+                    report['gui simulations at once'] = attacks.gui_simulation_flood(url, gui_pid, rss_kib, _children)
 
     kept = _sections(RESULTS.read_text()) if RESULTS.exists() else {}
     lines = ['# Reliability under load', '',

@@ -25,13 +25,13 @@ def alias_bomb(levels: int = 9) -> str:
 
 
 @contextmanager
-def peak_rss_growth(pid: int, rss_kib):
-    """Yields a dict whose 'MiB' is, afterwards, the peak RSS growth of ``pid`` (with children)."""
-    baseline, peak, done = rss_kib(pid), [0], threading.Event()
+def sampled_maximum(read):
+    """Yields a dict whose 'KiB' is, afterwards, the largest value ``read()`` gave (every 20 ms)."""
+    peak, done = [read()], threading.Event()
 
     def sample():
         while not done.wait(0.02):
-            peak[0] = max(peak[0], rss_kib(pid))
+            peak[0] = max(peak[0], read())
     sampler = threading.Thread(target=sample, daemon=True)
     sampler.start()
     figures = {}
@@ -40,7 +40,31 @@ def peak_rss_growth(pid: int, rss_kib):
     finally:
         done.set()
         sampler.join()
-        figures['MiB'] = max(0, peak[0] - baseline) / 1024
+        figures['KiB'] = peak[0]
+
+
+@contextmanager
+def peak_rss_growth(pid: int, rss_kib):
+    """Yields a dict whose 'MiB' is, afterwards, the peak RSS growth of ``pid`` (with children)."""
+    baseline, figures = rss_kib(pid), {}
+    with sampled_maximum(lambda: rss_kib(pid)) as peak:
+        yield figures
+    figures['MiB'] = max(0, peak['KiB'] - baseline) / 1024
+
+
+def simulation_processes_peak_kib(gui_pid: int, children) -> int:
+    """The highest peak RSS (VmHWM) of the GUI's running simulation processes (web/simulation_process.py)."""
+    peak = 0
+    for child in children(gui_pid):
+        try:
+            with open(f'/proc/{child}/cmdline', 'rb') as cmdline:
+                if b'simulation_process' not in cmdline.read():
+                    continue
+            with open(f'/proc/{child}/status') as status:
+                peak = max(peak, next(int(line.split()[1]) for line in status if line.startswith('VmHWM:')))
+        except (OSError, StopIteration):  # ended meanwhile
+            continue
+    return peak
 
 
 def timed(run, goal, timeout=120.0):
@@ -161,7 +185,7 @@ def plain_client_burst(client, count: int, wait: float = 120.0) -> dict:
             'seconds': time.monotonic() - started}
 
 
-def gui_simulation_flood(url: str, gui_pid: int, rss_kib, attempts: int = 40) -> dict:
+def gui_simulation_flood(url: str, gui_pid: int, rss_kib, children, attempts: int = 40) -> dict:
     """40 simulations requested at once for one finished job; then a cross-site-style form POST."""
     def post(path, body, content_type='application/json'):
         request = urllib.request.Request(url + path, method='POST', data=body, headers={'Content-Type': content_type})
@@ -189,11 +213,16 @@ def gui_simulation_flood(url: str, gui_pid: int, rss_kib, attempts: int = 40) ->
     # One run alone first (when simulations ran in the GUI process, MuJoCo and its renderer
     # loaded there on the first run); the GUI process alone, and with its simulation processes.
     before = gui_alone(gui_pid)
-    with peak_rss_growth(gui_pid, gui_alone) as first, peak_rss_growth(gui_pid, rss_kib) as first_all:
+    def simulation_peak():  # a run's own peak: VmHWM, read until the process ends
+        return simulation_processes_peak_kib(gui_pid, children)
+
+    with peak_rss_growth(gui_pid, gui_alone) as first, peak_rss_growth(gui_pid, rss_kib) as first_all, \
+            sampled_maximum(simulation_peak) as first_child:
         answer = post(f'api/jobs/{job["id"]}/simulations', b'{}')
         assert answer[0] == 202, (answer, job.get('outcome'))
         finish(answer[2]['id'])
-    with peak_rss_growth(gui_pid, gui_alone) as rss, peak_rss_growth(gui_pid, rss_kib) as rss_all:
+    with peak_rss_growth(gui_pid, gui_alone) as rss, peak_rss_growth(gui_pid, rss_kib) as rss_all, \
+            sampled_maximum(simulation_peak) as child:
         started = time.monotonic()
         with ThreadPoolExecutor(attempts) as pool:
             answers = list(pool.map(lambda _: post(f'api/jobs/{job["id"]}/simulations', b'{}'), range(attempts)))
@@ -211,5 +240,7 @@ def gui_simulation_flood(url: str, gui_pid: int, rss_kib, attempts: int = 40) ->
             'GUI process peak RSS growth, the 40 requests MiB': rss['MiB'],
             'with its simulation processes, first run MiB': first_all['MiB'],
             'with its simulation processes, the 40 requests MiB': rss_all['MiB'],
+            'simulation process peak RSS, first run MiB': first_child['KiB'] / 1024,
+            'simulation process peak RSS, the 40 requests (highest) MiB': child['KiB'] / 1024,
             'GUI process RSS after them MiB': gui_alone(gui_pid) / 1024,
             'form-encoded POST status': form}

@@ -7,8 +7,6 @@ the graph, so the same machine always gets the same positions.
 
 from __future__ import annotations
 
-import networkx as nx
-
 LAYER_SPACING = 140.0
 COLUMN_SPACING = 260.0
 MARGIN = 60.0
@@ -18,6 +16,8 @@ INNER_SPACING = 230.0
 
 def layered_positions(edges: dict[str, list[str]], initial: str, outcomes: list[str]) -> dict[str, list[float]]:
     """Positions [x, y] of states (``edges``: state -> targets in order) and outcomes."""
+    import networkx as nx  # here: networkx is ~22 MiB, and running a machine (atlas_sim) needs no layout
+
     graph = nx.DiGraph()
     graph.add_nodes_from(edges)
     for source, targets in edges.items():

@@ -14,6 +14,7 @@ from synthesis_manager.cli import build_parser
 from synthesis_manager.gui import background_server, ros_backend
 from synthesis_manager.limits import MAX_BODY_BYTES
 from synthesis_manager.web.routes import create_app
+from synthesis_manager.web.simulation_process import CHILD_ENVIRONMENT, SimulationProcess
 
 PAPER_TASK = {'system': 'atlas', 'initial_conditions': ['stand_prep'], 'goals': ['look_down', 'pickup_object']}
 
@@ -269,3 +270,26 @@ def test_a_job_naming_a_huge_unknown_goal_is_answered_briefly(gui):
     assert status == 202
     outcome = wait_until_finished(url, job['id'])['outcome']
     assert outcome['error_name'] == 'UNKNOWN_PROPOSITION' and len(outcome['message']) < 600
+
+
+def test_a_simulation_process_gets_the_lean_rendering_environment(monkeypatch):
+    """The child renders with llvmpipe in its own thread and returns freed buffers at once
+    (its peak RSS); what the GUI's own environment sets wins."""
+    for name in CHILD_ENVIRONMENT:
+        monkeypatch.delenv(name, raising=False)
+    monkeypatch.setenv('LP_NUM_THREADS', '2')
+    run = SimulationProcess({'max_wall_time': 1.0})
+    try:  # empty while the child is between exec's (the ROS wheels' .pth may re-exec it); it waits on stdin
+        deadline, variables = time.monotonic() + 30, {}
+        while not variables:
+            assert time.monotonic() < deadline and run.process.poll() is None
+            with open(f'/proc/{run.process.pid}/environ', 'rb') as environ:
+                variables = dict(entry.split(b'=', 1) for entry in environ.read().split(b'\0') if b'=' in entry)
+    finally:
+        run.stop()
+        run.process.wait()
+        run.process.stdin.close()
+        run.process.stdout.close()
+    assert variables[b'LP_NUM_THREADS'] == b'2'
+    assert variables[b'MALLOC_TRIM_THRESHOLD_'] == b'131072'
+    assert variables[b'MUJOCO_GL'] == b'egl'

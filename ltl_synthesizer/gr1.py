@@ -157,7 +157,9 @@ def solve_system_game(solver: Solver, stop_when_losing=None) -> SystemSolution:
     # iteration is already the confirming one (instead of two or three full iterations).
     game = solver.game
     reachable_only = solver.plan.reachable_only
-    Z = safe = _safe_positions(solver, solver.care, stop_when_losing)
+    # Every set below stays within the positions not lost at once, where the system's
+    # responses need not repeat its invariant (see SymbolicGame.system_can_respond).
+    Z = safe = _safe_positions(solver, solver.care & game.not_lost_at_once, stop_when_losing)
     if stop_when_losing is not None and not stop_when_losing(safe):
         return SystemSolution(safe, [], complete=False, reachable_only=reachable_only)
     warm_starts = WarmStarts()

@@ -73,6 +73,9 @@ class Options:
     # of more than SMALL_GAME_PROPOSITIONS propositions with some liveness goal.
     reachable_only: bool | None = None
     chained_sweeps: bool = True  # Gauss-Seidel Y sweeps (see gr1._attract_to_goal)
+    # sys_trans's formulas over current inputs only stay out of the relational products
+    # (SymbolicGame.sys_invariant): moving obstacle 48x48 2x, evasion 48x16 3x faster.
+    invariant_apart: bool = True
 
 
 @dataclass(frozen=True)

@@ -171,7 +171,7 @@ def _moves_from(game: SymbolicGame, state: dict[str, bool]):
     env_moves = game.cube(state)
     for cluster in game.env_partition.clusters:
         env_moves &= cluster
-    legal = env_moves
+    legal = env_moves & game.sys_invariant
     for cluster in game.sys_partition.clusters:
         legal &= cluster
     return env_moves, legal

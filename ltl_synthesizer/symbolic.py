@@ -96,10 +96,22 @@ class SymbolicGame:
         self.env_goal_ignores_outputs = [not self.mentions_next_outputs(goal)
                                          for goal in self.env_goals]
         self.env_partition = self._partition(self.env_trans_parts, set(self.next_inputs), options)
-        self.sys_partition = self._partition(self.sys_trans_parts, set(self.next_outputs), options)
+        # The system's safety formulas over current inputs only ("never next to the
+        # obstacle": a condition the system meets only through its earlier moves) form its
+        # invariant, kept out of its relational products (see system_can_respond). Formulas
+        # that mention outputs stay in: they prune the responses (ATLAS tasks: 2x slower out).
+        current_inputs = set(self.inputs)
+        moving_parts = []
+        self.sys_invariant = self.true
+        for part in self.sys_trans_parts:
+            if not options.invariant_apart or not self.bdd.support(part) <= current_inputs:
+                moving_parts.append(part)
+            else:
+                self.sys_invariant &= part
+        self.sys_partition = self._partition(moving_parts, set(self.next_outputs), options)
         # The size of the safety relations in the static order (before any reordering).
-        self.relation_nodes = sum(len(cluster) for cluster in
-                                  self.env_partition.clusters + self.sys_partition.clusters)
+        self.relation_nodes = len(self.sys_invariant) + sum(
+            len(cluster) for cluster in self.env_partition.clusters + self.sys_partition.clusters)
 
     # --- renaming and quantification ------------------------------------------------------
 
@@ -118,7 +130,7 @@ class SymbolicGame:
         return _conjoin(self.true, self.env_partition.clusters, self.interrupt)
 
     def sys_trans(self):
-        return _conjoin(self.true, self.sys_partition.clusters, self.interrupt)
+        return _conjoin(self.sys_invariant, self.sys_partition.clusters, self.interrupt)
 
     def _partition(self, parts, quantified: set[str], options: Options) -> _Partition:
         clusters = _cluster(self.bdd, parts, cluster_limit(self.has_liveness, options),
@@ -142,7 +154,15 @@ class SymbolicGame:
         return result
 
     def system_can_respond(self, target):
-        """``exists y'. sys_trans & target``: the system has a legal move into ``target``."""
+        """``exists y'. sys_trans & target``: the system has a legal move into ``target``, at
+        the positions that satisfy ``sys_invariant`` (elsewhere the system has no legal move).
+
+        The invariant is left out: conjoined into the result, a relation between integers
+        (moving obstacle: robot and obstacle positions) multiplies its size by 7 and the cost
+        of the products that follow alike (48x48: 11.4 s of products -> 1.5 s). The solver
+        only asks at positions that are not lost at once (``not_lost_at_once``), where the
+        answer is the same; ``cox``, ``env_cox``, ``sys_trans`` and ``legal_moves`` are exact.
+        """
         return self._relational_product(target, self.sys_partition)
 
     def enforce(self, responses):
@@ -158,12 +178,26 @@ class SymbolicGame:
         output allowed by sys_trans such that the transition lies in ``target``:
         ``forall x'. env_trans -> exists y'. sys_trans & target``.
         """
-        return self.enforce(self.system_can_respond(target))
+        return self.enforce(self.system_can_respond(target)) & self.not_lost_at_once
+
+    @cached_property
+    def not_lost_at_once(self):
+        """Positions where sys_invariant holds or env_trans allows no next input at all.
+
+        Elsewhere the system has no legal move while the environment has one: no
+        enforceable predecessor holds there. Since sys_invariant does not depend on the
+        next step, ``cox(T) = not_lost_at_once & enforce(system_can_respond(T))``.
+        """
+        if self.sys_invariant == self.true:
+            return self.true
+        environment_can_move = self._relational_product(self.true, self.env_partition)
+        return self.sys_invariant | ~environment_can_move
 
     @cached_property
     def legal_moves(self):
         """env_trans & sys_trans as one BDD (built on first use, after the sifting pass)."""
-        return _conjoin(self.env_trans(), self.sys_partition.clusters, self.interrupt)
+        return _conjoin(self.env_trans() & self.sys_invariant, self.sys_partition.clusters,
+                        self.interrupt)
 
     def successors(self, positions):
         """The positions one legal move away from ``positions``."""
@@ -196,7 +230,7 @@ class SymbolicGame:
         Returned over current variables and next inputs (the environment's choice).
         """
         self.interrupt.check()
-        system_escapes = self._relational_product(~target, self.sys_partition)
+        system_escapes = self.sys_invariant & self._relational_product(~target, self.sys_partition)
         return _conjoin(~system_escapes, self.env_partition.clusters, self.interrupt)
 
     def exist_next_inputs(self, u):

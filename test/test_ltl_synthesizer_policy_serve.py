@@ -105,7 +105,7 @@ def test_large_safety_games_skip_the_reachability_search_and_dynamic_sifting():
 
 def test_small_safety_games_sift_between_iterations_only():
     """Moving obstacle: sifting passes happen, but never inside a BDD operation."""
-    spec = parse_structuredslugs(gr1_families.moving_obstacle(16, 4))
+    spec = parse_structuredslugs(gr1_families.moving_obstacle(24, 7))
     solver = Solver(SymbolicGame(spec))
     assert solver.plan.reordering == BETWEEN_ITERATIONS and solver.plan.sift_once
     assert not solver.game.bdd.configure()['reordering']  # no automatic (mid-operation) sifting
@@ -134,6 +134,26 @@ def test_families_verdicts_are_the_same_under_every_engine_choice(family, argume
                 for options in (Options(), Options(reordering=True), Options(reordering=False),
                                 Options(reachable_only=True), Options(sift_once=True))}
     assert verdicts == {realizable}
+
+
+@pytest.mark.parametrize('family, arguments', [
+    ('moving_obstacle', (16, 3)), ('moving_obstacle', (16, 4)), ('evasion', (24, 8)),
+])
+def test_the_invariant_kept_apart_changes_nothing_but_the_work(family, arguments):
+    """Moving obstacle and evasion have invariants over inputs only (the robot never meets
+    the obstacle): the same winning positions with the invariant in or out of the products,
+    and the strategy solved with it out passes the independent check."""
+    spec = parse_structuredslugs(getattr(gr1_families, family)(*arguments))
+    apart = SymbolicGame(spec, options=Options(invariant_apart=True))
+    kept_in = SymbolicGame(spec, options=Options(invariant_apart=False))
+    assert apart.sys_invariant != apart.true and kept_in.sys_invariant == kept_in.true
+    won = [solve_system_game(Solver(game, Options(invariant_apart=flag))).winning
+           for game, flag in ((apart, True), (kept_in, False))]
+    assert kept_in.bdd.copy(won[1], apart.bdd) == won[0]
+    solution = solve_system_game(Solver(apart))
+    if initial_positions_win(apart, solution.winning, robotics_semantics=False):
+        strategy = symbolic_strategy(apart, solution)
+        assert check_symbolic_strategy(spec, strategy, apart.bdd) == []
 
 
 def test_automatic_reordering_switches_on_past_the_node_threshold(monkeypatch):

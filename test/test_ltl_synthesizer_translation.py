@@ -114,3 +114,31 @@ def test_partitioned_product_equals_monolithic(cluster_limit):
     target = g.translator.translate(disj([next_(c), conj([a, neg(next_(b))])]), 'sys_trans')
     monolithic = ~g.bdd.exist(["a'"], g.env_trans() & ~g.bdd.exist(["b'", "c'"], g.sys_trans() & target))
     assert g.cox(target) == monolithic
+
+
+def test_the_invariant_stays_out_of_the_products_and_the_operators_stay_exact():
+    """sys_trans's formulas over current inputs only form the system's invariant: the
+    responses leave it out, and cox, env_cox, sys_trans and legal_moves stay exact, also
+    where the environment has no legal move (there the system wins by default)."""
+    sections = dict(env_trans=[implies(conj([a, b]), FALSE), iff(next_(a), neg(a))],
+                    sys_trans=[neg(conj([a, var('d')])), implies(next_(c), next_(b)),
+                               implies(a, next_(c))])
+    spec = GR1Specification(env_props=['a', 'd'], sys_props=['b', 'c'], **sections)
+    apart, kept_in = (SymbolicGame(spec, options=Options(invariant_apart=flag)) for flag in (True, False))
+    assert apart.sys_invariant == apart.translator.translate(neg(conj([a, var('d')])), 'sys_trans')
+    assert kept_in.sys_invariant == kept_in.true
+    for g in (apart, kept_in):
+        env_trans, sys_trans = g.env_trans(), g.sys_trans()
+        assert sys_trans == g.translator.conjunction(sections['sys_trans'], 'sys_trans')
+        assert g.legal_moves == env_trans & sys_trans
+        for target_formula in (next_(c), disj([next_(c), conj([a, neg(next_(b))])]), neg(next_(b))):
+            target = g.translator.translate(target_formula, 'sys_trans')
+            monolithic = ~g.bdd.exist(["a'", "d'"], env_trans & ~g.bdd.exist(
+                ["b'", "c'"], sys_trans & target))
+            assert g.cox(target) == monolithic
+            escapes = g.bdd.exist(["b'", "c'"], sys_trans & ~target)
+            assert g.env_cox(target) == env_trans & ~escapes
+    # Where a and b hold the environment has no move: not lost, although a & d breaks sys_trans.
+    stuck = apart.bdd.cube({'a': True, 'b': True, 'd': True})
+    assert stuck & ~apart.not_lost_at_once == apart.false
+    assert apart.cox(apart.false) & stuck == stuck

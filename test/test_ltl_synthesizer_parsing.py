@@ -303,6 +303,73 @@ def test_the_quick_prefix_reading_gives_the_parsers_tree_or_leaves_the_line_to_i
         assert quick == parse_in_scope(line, 'prefix', scope, Source())
 
 
+@st.composite
+def buffered_prefix_lines(draw, depth=4, memory=0):
+    """Token lists of slugsin formulas with memory buffers and recalls (``memory``: how many
+    elements of the innermost buffer a recall may name)."""
+    choices = ['leaf', '!', '&', '|', '^', '$'] + (['?'] if memory else [])
+    kind = draw(st.sampled_from(choices if depth > 0 else ['leaf'] + (['?'] if memory else [])))
+    if kind == 'leaf':
+        return [draw(st.sampled_from(['a', 'b', "a'", "b'", 'c', '1', '0']))]
+    if kind == '?':
+        return ['?', str(draw(st.integers(0, memory - 1)))]
+    if kind == '!':
+        return ['!'] + draw(buffered_prefix_lines(depth - 1, memory))
+    if kind == '$':
+        size = draw(st.integers(1, 3))
+        tokens = ['$', str(size)]
+        for index in range(size):
+            tokens += draw(buffered_prefix_lines(depth - 1, index))
+        return tokens
+    return [kind] + draw(buffered_prefix_lines(depth - 1, memory)) + draw(buffered_prefix_lines(depth - 1, memory))
+
+
+@settings(max_examples=1500, deadline=None, database=None)
+@given(buffered_prefix_lines(), st.data(), st.sampled_from(['sys_trans', 'env_trans', 'sys_init']))
+def test_the_quick_prefix_reading_of_memory_buffers_gives_the_parsers_tree(tokens, data, section):
+    """Lines with memory buffers, whole or with one token dropped or replaced: the quick
+    reader gives the grammar's tree, or leaves the line to the grammar."""
+    from respec.parsing.grammar import parse_in_scope
+    from respec.parsing.quick import quick_prefix
+    from respec.parsing.scope import Source, section_scopes
+
+    scope = section_scopes(['a', 'x.y'], ['b', 'c'])[section]
+    change = data.draw(st.sampled_from(['none', 'drop', 'replace']))
+    if change != 'none' and len(tokens) > 1:
+        index = data.draw(st.integers(0, len(tokens) - 1))
+        replacement = [data.draw(st.sampled_from(['$', '?', '0', '2', '&', "c'", 'zz']))]
+        tokens = tokens[:index] + (replacement if change == 'replace' else []) + tokens[index + 1:]
+    line = ' '.join(tokens)
+    quick = quick_prefix(line, scope, {})
+    try:
+        expected = parse_in_scope(line, 'prefix', scope, Source())
+    except ParseError:
+        assert quick is None
+    else:
+        assert quick == expected
+        if change == 'none' and section == 'sys_trans':
+            assert quick is not None  # a well-formed line with buffers is read quickly
+
+
+def test_long_slugsin_lines_are_read_quickly_up_to_the_nesting_limit():
+    """Lines long enough to be nested too deeply are read left to right, counting levels: a
+    long run of & is one level (the grammar's tree, quickly); 10,001 nested ! are left to
+    the grammar, which reports them."""
+    from respec.nesting import MAX_FORMULA_NESTING
+    from respec.parsing.grammar import parse_in_scope
+    from respec.parsing.quick import quick_prefix
+    from respec.parsing.scope import Source, section_scopes
+
+    scope = section_scopes(['a', 'x.y'], ['b', 'c'])['sys_trans']
+    run = ' '.join(["& ! a & | b' c"] * 4000) + ' x.y'
+    assert len(run) > 2 * MAX_FORMULA_NESTING
+    assert quick_prefix(run, scope, {}) == parse_in_scope(run, 'prefix', scope, Source())
+    too_deep = '! ' * (MAX_FORMULA_NESTING + 1) + 'a ' + ' ' * 2 * MAX_FORMULA_NESTING
+    assert quick_prefix(too_deep, scope, {}) is None
+    with pytest.raises(ParseError, match='nested'):
+        parse_in_scope(too_deep, 'prefix', scope, Source())
+
+
 @settings(max_examples=300, deadline=None, database=None)
 @given(formulas(NAMES))
 def test_the_quick_readings_read_every_printed_formula(formula):

@@ -156,14 +156,18 @@ _PREFIX_KIND = {token: token for token in ('!', '&', '|', '^', '1', '0')}
 
 def quick_prefix(line: str, scope: Scope, variables: dict[str, Var]) -> Formula | None:
     """The formula of one slugsin line of a specification file, read right to left over plain
-    strings (the grammar's tree), or None for the grammar to read: memory buffers,
-    undeclared or misplaced propositions, malformed lines. ``variables``: the file's
-    proposition nodes by name (shared, and added to)."""
+    strings (the grammar's tree), or None for the grammar to read: undeclared or misplaced
+    propositions, malformed lines. ``variables``: the file's proposition nodes by name
+    (shared, and added to). Lines with memory buffers (a recall names an element to its left)
+    and very long lines are read left to right."""
     now, following = scope.current, scope.next_step
-    if scope.names is None or '$' in line or '?' in line:
+    if scope.names is None:
         return None
-    if len(line) > 2 * MAX_FORMULA_NESTING and line.count(' ') > MAX_FORMULA_NESTING:
-        return None  # perhaps nested too deeply: the grammar counts the levels
+    if '$' in line or '?' in line or (
+            len(line) > 2 * MAX_FORMULA_NESTING and line.count(' ') > MAX_FORMULA_NESTING):
+        # Memory buffers, or a line long enough to be nested too deeply: read left to right,
+        # which resolves recalls and counts the nesting levels as the grammar does.
+        return _quick_prefix_left_to_right(line, now, following, variables)
     operands = []
     push, pop = operands.append, operands.pop
     for token in reversed(line.split()):
@@ -206,3 +210,83 @@ def _finished(operand):
     if operand.__class__ is not list:
         return operand
     return conj(operand[:0:-1]) if operand[0] == '&' else disj(operand[:0:-1])
+
+
+# Left to right, a token's kind: the operands an operator takes, or a mark for the others.
+_BUFFER, _RECALL, _ONE, _ZERO = 0, -1, -2, -3
+_LEFT_TO_RIGHT_KIND = {'!': 1, '&': 2, '|': 2, '^': 2, '$': _BUFFER, '?': _RECALL, '1': _ONE, '0': _ZERO}
+
+
+def _quick_prefix_left_to_right(line: str, now, following, variables: dict[str, Var]) -> Formula | None:
+    """A slugsin line, with memory buffers ``$ n f0 ... fn-1`` and recalls ``? i``, read left
+    to right with a stack of open operators, each ``[operator, operands wanted, operands]``.
+    A recall reads the innermost open buffer, as the grammar's ``memory``; the operators
+    open at once are the grammar's nesting levels; a run ``& a & b c`` is one node, as the
+    grammar gathers it. Anything unexpected is left to the grammar (None)."""
+    tokens = iter(line.split())
+    open_operators = []
+    push, pop = open_operators.append, open_operators.pop
+    kinds = _LEFT_TO_RIGHT_KIND
+    for token in tokens:
+        kind = kinds.get(token)
+        if kind is None:  # a proposition
+            if token[-1] == "'":
+                name = token[:-1]
+                if name not in following:
+                    return None
+                value = next_(variables.get(name) or variables.setdefault(name, var(name)))
+            elif token in now:
+                value = variables.get(token) or variables.setdefault(token, var(token))
+            else:
+                return None
+        elif kind > 0 or kind == _BUFFER:  # an operator
+            if kind == _BUFFER:
+                kind = _count(next(tokens, ''))
+                if not kind:
+                    return None
+            elif open_operators:
+                top = open_operators[-1]
+                if top[0] == token and kind == 2 and token != '^' and len(top[2]) == top[1] - 1:
+                    top[1] += 1  # one more operand of the same run
+                    continue
+            if len(open_operators) >= MAX_FORMULA_NESTING:
+                return None  # the grammar reports the nesting
+            push([token, kind, []])
+            continue
+        elif kind == _RECALL:
+            index = _count(next(tokens, ''))
+            memory = next((operator[2] for operator in reversed(open_operators)
+                           if operator[0] == '$'), None)
+            if index is None or memory is None or index >= len(memory):
+                return None
+            value = memory[index]
+        else:
+            value = TRUE if kind == _ONE else FALSE
+        # The value completes operators: each finished one is a value for the one below it.
+        while open_operators:
+            operator, wanted, operands = open_operators[-1]
+            operands.append(value)
+            if len(operands) < wanted:
+                break
+            pop()
+            value = _applied(operator, operands)
+        else:
+            return value if next(tokens, None) is None else None
+    return None
+
+
+def _count(token: str) -> int | None:
+    """The number a buffer or recall takes, or None."""
+    return int(token) if token.isascii() and token.isdigit() else None
+
+
+def _applied(operator: str, operands: list) -> Formula:
+    if operator == '$':
+        return operands[-1]  # a buffer's value is its last element
+    if operator == '!':
+        return neg(operands[0])
+    if operator == '&':
+        return conj(operands)
+    if operator == '|':
+        return disj(operands)
+    return combine(operator, operands[0], operands[1])

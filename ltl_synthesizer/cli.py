@@ -271,7 +271,6 @@ def _run(args) -> int:
     print(REALIZABLE_LINE if result.realizable else UNREALIZABLE_LINE, file=sys.stderr)
     if not result.realizable and args.explain and result.explanation:
         print(result.explanation, file=sys.stderr)
-    from ltl_synthesizer.strategy import strategy_json_chunks
     if result.realizable and args.explicitStrategy:
         strategy = result.strategy
     elif not result.realizable and args.counterStrategy:
@@ -280,6 +279,7 @@ def _run(args) -> int:
         return ExitStatus.OK
     try:
         if args.jsonOutput:
+            from ltl_synthesizer.strategy import strategy_json_chunks
             _write_chunks(strategy_json_chunks(strategy), args.output)
         else:
             _write(strategy_to_text(strategy), args.output)

@@ -24,6 +24,7 @@ from synthesis_manager.client import SynthesisClient, SynthesisOutcome, make_goa
 from synthesis_manager.ros.harness import RosHarness, environment_domain_id
 from synthesis_manager.suite import add_suite_arguments, suite_node_factories
 from synthesis_manager.web.backend import SynthesisBackend
+from synthesis_manager.web.outcome import JobOutcome
 from synthesis_manager.web.routes import create_app
 
 DEFAULT_PORT = 8080
@@ -44,21 +45,24 @@ def add_arguments(parser):
 
 
 class RosGoalRunner:
-    """``run_goal`` for SynthesisBackend: sends each job to ``/behavior_synthesis``."""
+    """``run_goal`` for SynthesisBackend: sends each job to ``/behavior_synthesis`` and hands the
+    action's SynthesisOutcome to the (ROS-free) web layer as a JobOutcome."""
 
     def __init__(self, client, server_timeout: float = 5.0, goal_timeout: float = 600.0):
         self.client = client
         self.server_timeout = server_timeout
         self.goal_timeout = goal_timeout
 
-    def __call__(self, request, feedback, cancel) -> dict:
+    def __call__(self, request, feedback, cancel) -> JobOutcome:
         if not self.client.wait_for_server(timeout=self.server_timeout):
-            return SynthesisOutcome(
+            outcome = SynthesisOutcome(
                 ErrorCode.SERVICE_UNAVAILABLE.number, ErrorCode.SERVICE_UNAVAILABLE, 'no /behavior_synthesis action server answered within '
-                f'{self.server_timeout:g} s (start one with `behavior-synthesis serve`)').to_dict()
-        goal = make_goal(request.system, request.initial_conditions, request.goals, request.sm_outcomes,
-                         option=request.option, name=request.name, unordered=request.unordered)
-        return self.client.run(goal, feedback=feedback, cancel=cancel, timeout=self.goal_timeout).to_dict()
+                f'{self.server_timeout:g} s (start one with `behavior-synthesis serve`)')
+        else:
+            goal = make_goal(request.system, request.initial_conditions, request.goals, request.sm_outcomes,
+                             option=request.option, name=request.name, unordered=request.unordered)
+            outcome = self.client.run(goal, feedback=feedback, cancel=cancel, timeout=self.goal_timeout)
+        return JobOutcome.from_dict(outcome.to_dict())
 
 
 @contextlib.contextmanager

@@ -276,3 +276,54 @@ def test_a_forgotten_download_is_json_for_programs_and_a_page_for_browsers(clien
     assert client.get(url).json()['error'] == 'NOT_FOUND'
     page = client.get(url, headers={'accept': 'text/html,application/xhtml+xml'})
     assert page.status_code == 404 and 'This download is no longer available' in page.text
+
+
+def test_vocabulary_is_served_from_the_python_constants(client):
+    from respec.spec import SECTIONS
+    from sm_generation.export import AUTONOMY_NAMES
+    from sm_generation.instantiation import StateInstantiation
+
+    names = client.get('/api/vocabulary').json()
+    assert names['state_classes']['outcome'] == StateInstantiation.CLASS_OUTCOME
+    assert names['state_classes']['concurrency'] == StateInstantiation.CLASS_CONCURRENCY
+    assert names['autonomy_levels'] == list(AUTONOMY_NAMES)
+    assert names['job_results'] == {'succeeded': 'SUCCESS', 'cancelled': 'PREEMPTED'}
+    assert names['error_codes']['SPEC_UNSYNTHESIZABLE'] == -21
+    assert [section['name'] for section in names['specification_sections']] == list(SECTIONS)
+    assert names['sm_outcomes'] == {'finished': 'finished', 'failed': 'failed'}
+
+
+def walk(node):
+    """The tree's nodes, parents first."""
+    yield node
+    for child in node['children']:
+        yield from walk(child)
+
+
+def test_the_state_machine_is_served_as_a_tree_of_the_listed_states(client):
+    _, job = run_job(client, PAPER_TASK)
+    tree = client.get(f"/api/jobs/{job['id']}/state-machine").json()
+    assert tree['name'] == '/' and tree['state_path'] == '/'
+    flat = [{key: value for key, value in node.items() if key not in ('name', 'children')} for node in walk(tree)]
+    assert sorted(flat, key=lambda s: s['state_path']) == sorted(job['outcome']['states'], key=lambda s: s['state_path'])
+    kinds = [child['state_class'] == ':OUTCOME' for child in tree['children']]
+    assert kinds == sorted(kinds) and kinds[-2:] == [True, True]  # the states, then the machine's outcomes
+    assert all(node['name'] == node['state_path'].rsplit('/', 1)[-1] for node in walk(tree) if node is not tree)
+
+    _, compiled = run_job(client, {**PAPER_TASK, 'option': 'ltl_compilation_only'})
+    missing = client.get(f"/api/jobs/{compiled['id']}/state-machine")
+    assert missing.status_code == 409 and missing.json()['item'] == compiled['id']
+
+
+def test_a_concurrency_container_holds_its_states_in_the_tree():
+    from pathlib import Path
+
+    from sm_generation import generate_state_machine, load_automaton
+    from synthesis_manager.web.machine_tree import state_machine_tree
+
+    states = generate_state_machine(load_automaton(Path(__file__).parent / 'automata' / 'concurrent.yaml'), 'atlas')
+    tree = state_machine_tree(states)
+    container = next(node for node in tree['children'] if node['state_class'] == ':CONCURRENCY')
+    inner = [s.state_path for s in states if s.state_path.startswith(container['state_path'] + '/')]
+    assert [child['state_path'] for child in container['children']] == inner and inner
+    assert all(child['children'] == [] for child in container['children'])

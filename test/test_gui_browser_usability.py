@@ -16,6 +16,7 @@ from PIL import Image
 
 from synthesis_manager.gui import listening_socket, make_server
 from synthesis_manager.web.backend import SynthesisBackend
+from synthesis_manager.web.outcome import JobOutcome
 from synthesis_manager.web.routes import create_app
 from test_gui_browser import browser_context, choose_task, gui_server, open_page, result_code  # noqa: F401
 
@@ -227,8 +228,7 @@ class Server:
 def never_finishing(request, feedback, cancel):
     feedback('Synthesizing an automaton', 0.4)
     cancel.wait(60)
-    return {'error_code': -9, 'error_name': 'PREEMPTED', 'message': 'cancelled', 'states': [],
-            'ltl_specification': {}, 'automaton': {}, 'seconds': 0.0}
+    return JobOutcome(-9, 'PREEMPTED', 'cancelled')
 
 
 def test_server_restart_mid_job_is_said_plainly_and_the_page_reconnects(browser_context):  # noqa: F811

@@ -1,4 +1,4 @@
-"""The downloads of a finished job, built on demand from its outcome (and request, config dir)."""
+"""The downloads of a finished job, built on demand from its JobOutcome (and request, config dir)."""
 
 from __future__ import annotations
 
@@ -10,10 +10,11 @@ from pathlib import Path
 from typing import Callable
 
 from respec.parsing import spec_from_text_sections
-from sm_generation import SMGenerationError, StateInstantiation, export
+from sm_generation import SMGenerationError, export
 from sm_generation.config import load_flexbe_config
 from sm_generation.export import render, to_dot
 from sm_generation.flexbe_behavior import behavior_package, check_behavior_name, default_behavior_name
+from synthesis_manager.web.outcome import JobOutcome
 
 
 @dataclass(frozen=True)
@@ -23,34 +24,30 @@ class Artifact:
     filename: str
 
 
-def _state_list(outcome):
-    return [StateInstantiation.from_dict(s) for s in outcome['states']]
-
-
 def _export(kind):
     def build(outcome, *_) -> bytes:
-        return getattr(export, kind)(_state_list(outcome)).encode()
+        return getattr(export, kind)(list(outcome.states)).encode()
     return build
 
 
 def _picture(fmt):
     def build(outcome, *_) -> bytes:
         with tempfile.TemporaryDirectory(prefix='behavior-synthesis-gui-') as directory:
-            path = render(to_dot(_state_list(outcome)), Path(directory) / f'state_machine.{fmt}')
+            path = render(to_dot(list(outcome.states)), Path(directory) / f'state_machine.{fmt}')
             return path.read_bytes()
     return build
 
 
 def _specification(method):
     def build(outcome, *_) -> bytes:
-        return getattr(spec_from_text_sections(outcome['ltl_specification']), method)().encode()
+        return getattr(spec_from_text_sections(outcome.ltl_specification), method)().encode()
     return build
 
 
 def _flexbe_behavior(outcome, request, config_dir) -> bytes:
     """The behavior package FlexBE's editor would save (as ``behavior-synthesis export-behavior``)."""
     name = request.name if request.name and check_name(request.name) else default_behavior_name(request.goals)
-    package = behavior_package(_state_list(outcome), load_flexbe_config(request.system, config_dir), name,
+    package = behavior_package(list(outcome.states), load_flexbe_config(request.system, config_dir), name,
                                date=time.strftime('%a %b %d %Y'))
     return package.zip_bytes()
 
@@ -64,16 +61,20 @@ def check_name(name: str) -> bool:
     return True
 
 
-def _has_states(outcome):
-    return bool(outcome.get('states'))
+def _has_states(outcome: JobOutcome) -> bool:
+    return bool(outcome.states)
 
 
-def _has_specification(outcome):
-    return bool(outcome.get('ltl_specification'))
+def _has_specification(outcome: JobOutcome) -> bool:
+    return bool(outcome.ltl_specification)
 
 
-def _has_automaton(outcome):
-    return bool((outcome.get('automaton') or {}).get('states'))
+def _has_automaton(outcome: JobOutcome) -> bool:
+    return bool(outcome.automaton_states)
+
+
+def _json_file(data) -> bytes:
+    return (json.dumps(data, indent=1) + '\n').encode()
 
 
 @dataclass(frozen=True)
@@ -82,7 +83,7 @@ class ArtifactKind:
 
     label: str
     media_type: str
-    present: Callable[[dict], bool]
+    present: Callable[[JobOutcome], bool]
     build: Callable[..., bytes]  # (outcome, job request, config_dir) -> bytes
 
 
@@ -100,15 +101,15 @@ ARTIFACTS = {
     'specification.slugsin': ArtifactKind('Specification (.slugsin)', 'text/plain',
                                           _has_specification, _specification('to_slugsin')),
     'automaton.json': ArtifactKind('Automaton (JSON)', 'application/json', _has_automaton,
-                                   lambda outcome, *_: (json.dumps(outcome['automaton'], indent=1) + '\n').encode()),
+                                   lambda outcome, *_: _json_file(outcome.automaton)),
     'result.json': ArtifactKind('Whole result (JSON)', 'application/json', lambda outcome: True,
-                                lambda outcome, *_: (json.dumps(outcome, indent=1) + '\n').encode()),
+                                lambda outcome, *_: _json_file(outcome.to_dict())),
     'flexbe_behavior.zip': ArtifactKind('FlexBE behavior package (.zip, as export-behavior writes it)',
                                         'application/zip', _has_states, _flexbe_behavior),
 }
 
 
-def available_artifacts(outcome: dict) -> list[str]:
+def available_artifacts(outcome: JobOutcome) -> list[str]:
     return [name for name, kind in ARTIFACTS.items() if kind.present(outcome)]
 
 

@@ -23,7 +23,9 @@ from synthesis_manager.limits import BusyError
 from synthesis_manager.web.artifacts import ARTIFACTS, Artifact
 from synthesis_manager.web.errors import (ArtifactFailedError, InvalidJobRequestError, NotAvailableError,
                                           NotFoundError)
-from synthesis_manager.web.jobs import JOB_OPTIONS, Job, JobRequest, local_outcome, names_field
+from synthesis_manager.web.jobs import JOB_OPTIONS, Job, JobRequest, ProgressNote, names_field
+from synthesis_manager.web.machine_tree import state_machine_tree
+from synthesis_manager.web.outcome import JobOutcome
 from synthesis_manager.web.simulation_process import SimulationProcess
 from synthesis_manager.web.simulations import Simulation, simulation_available
 
@@ -32,14 +34,17 @@ logger = logging.getLogger(__name__)
 
 SIMULATION_RETRY_AFTER = 10  # seconds: a short simulation's run time
 
-GoalRunner = Callable[[JobRequest, Callable[[str, float], None], threading.Event], dict]
+GoalRunner = Callable[[JobRequest, Callable[[str, float], None], threading.Event], JobOutcome]
 
 
 class SynthesisBackend:
-    """Jobs run by ``run_goal(request, feedback, cancel) -> outcome dict`` in worker threads.
+    """Jobs run by ``run_goal(request, feedback, cancel) -> JobOutcome`` in worker threads.
 
     ``run_goal`` calls ``feedback(status, progress)`` as the pipeline advances and stops
     (returning a PREEMPTED outcome) once ``cancel`` is set.
+
+    Jobs and simulations are returned as their records (Job, Simulation); the routes turn
+    them into JSON.
 
     Test hook: ``job_gate`` is a set Event; while a test clears it, new jobs wait in the
     ``queued`` state before anything is sent, which makes cancelling them deterministic.
@@ -139,7 +144,7 @@ class SynthesisBackend:
         for child in running:
             child.stop()
 
-    def start_job(self, body) -> dict:
+    def start_job(self, body) -> Job:
         if self.stopping.is_set():
             raise BusyError('the server is stopping', 'jobs')
         request = JobRequest.from_json(body, self.systems())
@@ -152,19 +157,19 @@ class SynthesisBackend:
             self._jobs[job.id] = job
             self._forget_old_jobs()
         threading.Thread(target=self._work, args=(job,), name=f'gui-job-{job.id}', daemon=True).start()
-        return job.to_dict()
+        return job
 
-    def cancel_job(self, job_id: str) -> dict:
+    def cancel_job(self, job_id: str) -> Job:
         job = self._job(job_id)
         if job.finished:
             raise NotAvailableError(f'job {quoted(job_id)} has already finished '
-                                    f'({job.outcome["error_name"]})', job_id)
+                                    f'({job.outcome.error_name})', job_id)
         job.cancel_requested.set()
         self._note(job, 'Cancel requested', job.progress)
-        return job.to_dict()
+        return job
 
-    def job_status(self, job_id: str) -> dict:
-        return self._job(job_id).to_dict()
+    def job_status(self, job_id: str) -> Job:
+        return self._job(job_id)
 
     def job_revision(self, job_id: str) -> int:
         return self._job(job_id).revision
@@ -178,7 +183,7 @@ class SynthesisBackend:
         kind = ARTIFACTS[name]
         if not kind.present(job.outcome):
             raise NotAvailableError(
-                f'job {quoted(job_id)} ({job.outcome["error_name"]}) has no {name}', name)
+                f'job {quoted(job_id)} ({job.outcome.error_name}) has no {name}', name)
         key = (job_id, name)
         if key not in self._artifacts:
             try:
@@ -191,9 +196,18 @@ class SynthesisBackend:
             self._artifacts[key] = Artifact(content, kind.media_type, f'{job.request.name or "behavior"}_{name}')
         return self._artifacts[key]
 
+    def state_machine(self, job_id: str) -> dict:
+        """The job's state machine as a tree (its JSON: see web.machine_tree)."""
+        job = self._job(job_id)
+        if not job.finished:
+            raise NotAvailableError(f'job {quoted(job_id)} has not finished yet', job_id)
+        if not job.outcome.states:
+            raise NotAvailableError(f'job {quoted(job_id)} ({job.outcome.error_name}) has no state machine', job_id)
+        return state_machine_tree(job.outcome.states)
+
     # simulations ------------------------------------------------------------------------
 
-    def start_simulation(self, job_id: str, body) -> dict:
+    def start_simulation(self, job_id: str, body) -> Simulation:
         """Run the state machine of a finished job on atlas_sim's simulated robot."""
         job = self._job(job_id)
         body = {} if body is None else body
@@ -206,7 +220,7 @@ class SynthesisBackend:
         if not self.can_simulate:
             raise NotAvailableError('simulation needs atlas_sim and MuJoCo, which are not installed',
                                     'atlas_sim')
-        if not (job.finished and job.outcome.get('states')):
+        if not (job.finished and job.outcome.states):
             raise NotAvailableError(f'job {quoted(job_id)} has no state machine to simulate', job_id)
         support = self.simulation_support(job.request.system)
         if not support['available']:
@@ -217,7 +231,7 @@ class SynthesisBackend:
             self._simulations[simulation.id] = simulation
         threading.Thread(target=self._simulate, args=(simulation, job), name=f'gui-{simulation.id}',
                          daemon=True).start()
-        return simulation.to_dict()
+        return simulation
 
     def _admit_simulation(self, job_id: str):
         """Refuse a run beyond max_running_simulations (429); make room for it among the job's
@@ -240,8 +254,8 @@ class SynthesisBackend:
     def _record_dir(self, simulation_id: str) -> Path:
         return Path(self._simulation_dir.name) / simulation_id
 
-    def simulation_status(self, simulation_id: str) -> dict:
-        return self._simulation(simulation_id).to_dict()
+    def simulation_status(self, simulation_id: str) -> Simulation:
+        return self._simulation(simulation_id)
 
     def simulation_revision(self, simulation_id: str) -> int:
         return self._simulation(simulation_id).revision
@@ -270,7 +284,8 @@ class SynthesisBackend:
         """Run ``simulation`` in its child process (web/simulation_process.py), following it."""
         request, started = job.request, time.monotonic()
         child = SimulationProcess({
-            'states': job.outcome['states'], 'ltl_specification': job.outcome['ltl_specification'],
+            'states': [state.to_dict() for state in job.outcome.states],
+            'ltl_specification': job.outcome.ltl_specification,
             'system': request.system, 'config_dir': str(self.config_dir) if self.config_dir else None,
             'initial_conditions': list(request.initial_conditions), 'goals': list(request.goals),
             'ordered': not request.unordered, 'fail_first': list(simulation.fail_first),
@@ -328,7 +343,8 @@ class SynthesisBackend:
             if job.cancel_requested.is_set():
                 break
         if job.cancel_requested.is_set():  # never sent: nothing to cancel downstream
-            self._finish(job, local_outcome(ErrorCode.PREEMPTED, 'cancelled before it was sent', job))
+            self._finish(job, JobOutcome.local(ErrorCode.PREEMPTED, 'cancelled before it was sent',
+                                               job.seconds_since_created()))
             return
         self._update(job, state='running', status='sending the goal')
 
@@ -337,18 +353,18 @@ class SynthesisBackend:
                                     job.cancel_requested)
         except Exception as error:  # the GUI keeps serving whatever the runner does
             logger.exception('job %s failed', job.id)
-            outcome = local_outcome(INTERNAL_ERROR, f'the GUI could not run the goal: {error}', job)
+            outcome = JobOutcome.local(INTERNAL_ERROR, f'the GUI could not run the goal: {error}',
+                                       job.seconds_since_created())
         self._finish(job, outcome)
 
     def _note(self, job: Job, status: str, progress: float):
         """A new status of ``job``: shown now and kept in its timeline."""
-        entry = {'seconds': round(time.monotonic() - job.created, 4), 'status': status,
-                 'progress': round(float(progress), 4)}
-        self._update(job, status=status, progress=float(progress), timeline=job.timeline + [entry])
+        note = ProgressNote(job.seconds_since_created(), status, round(float(progress), 4))
+        self._update(job, status=status, progress=float(progress), timeline=job.timeline + [note])
 
-    def _finish(self, job: Job, outcome: dict):
-        if outcome['error_name'] == ErrorCode.PREEMPTED:
+    def _finish(self, job: Job, outcome: JobOutcome):
+        if outcome.cancelled:
             self._note(job, 'Cancelled', job.progress)
-        self._update(job, state='finished', outcome=outcome, status=outcome['error_name'],
-                     finished_after=round(time.monotonic() - job.created, 4),
-                     progress=1.0 if outcome['error_name'] == ErrorCode.SUCCESS else job.progress)
+        self._update(job, state='finished', outcome=outcome, status=outcome.error_name,
+                     finished_after=job.seconds_since_created(),
+                     progress=1.0 if outcome.succeeded else job.progress)

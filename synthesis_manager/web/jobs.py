@@ -13,6 +13,7 @@ from sm_generation.instantiation import StateInstantiation, count_states
 from synthesis_manager.limits import oversized_strings, too_long
 from synthesis_manager.web.artifacts import available_artifacts, download_labels
 from synthesis_manager.web.errors import InvalidJobRequestError, NotFoundError
+from synthesis_manager.web.outcome import JobOutcome
 
 # The stop-early options the page offers (ltl_synthesis_only needs a whole specification).
 JOB_OPTIONS = ('ltl_compilation_only', 'ltl_steps_only')
@@ -88,6 +89,63 @@ def names_field(body: dict, key: str) -> tuple[str, ...]:
 
 # --- jobs ---------------------------------------------------------------------------------
 
+@dataclass(frozen=True)
+class ProgressNote:
+    """One status of a running job, as the timeline shows it."""
+
+    seconds: float    # since the job was created
+    status: str
+    progress: float   # 0..1, as the pipeline's feedback says
+
+
+@dataclass(frozen=True)
+class StageTiming:
+    """How long one pipeline stage took."""
+
+    stage: str
+    seconds: float
+
+
+@dataclass(frozen=True)
+class ResultSummary:
+    """Realizability and sizes of a finished job, as the result page shows them."""
+
+    succeeded: bool
+    realizable: bool | None    # None: synthesis did not run (compile only, or an earlier failure)
+    input_propositions: int
+    output_propositions: int
+    formulas: int
+    automaton_states: int
+    state_machine_states: int
+    state_instantiations: int
+    concurrency_containers: int
+    seconds: float
+
+    @classmethod
+    def of(cls, outcome: JobOutcome) -> 'ResultSummary':
+        sections = outcome.ltl_specification
+        automaton_states = len(outcome.automaton_states)
+        if outcome.error_name == ErrorCode.SPEC_UNSYNTHESIZABLE:
+            realizable = False
+        elif automaton_states:
+            realizable = True
+        else:
+            realizable = None
+        return cls(
+            succeeded=outcome.succeeded,
+            realizable=realizable,
+            input_propositions=len(sections.get('env_props', [])),
+            output_propositions=len(sections.get('sys_props', [])),
+            formulas=sum(len(lines) for name, lines in sections.items() if not name.endswith('_props')),
+            automaton_states=automaton_states,
+            state_machine_states=count_states(outcome.states),
+            state_instantiations=len(outcome.states),
+            concurrency_containers=sum(1 for s in outcome.states
+                                       if s.state_class == StateInstantiation.CLASS_CONCURRENCY),
+            seconds=round(outcome.seconds, 4),
+        )
+
+
 @dataclass
 class Job:
     """One synthesis request and everything that happened to it."""
@@ -97,8 +155,8 @@ class Job:
     state: str = 'queued'              # queued -> running -> finished
     status: str = 'waiting to be sent'
     progress: float = 0.0
-    timeline: list[dict] = field(default_factory=list)  # {'seconds', 'status', 'progress'}
-    outcome: dict | None = None        # SynthesisOutcome.to_dict() once finished
+    timeline: list[ProgressNote] = field(default_factory=list)
+    outcome: JobOutcome | None = None  # once finished
     cancel_requested: threading.Event = field(default_factory=threading.Event, repr=False)
     created: float = field(default_factory=time.monotonic, repr=False)
     revision: int = 0                  # bumped on every change, so streams send only news
@@ -108,60 +166,35 @@ class Job:
     def finished(self) -> bool:
         return self.state == 'finished'
 
+    def seconds_since_created(self) -> float:
+        return round(time.monotonic() - self.created, 4)
+
     def to_dict(self) -> dict:
-        artifacts = available_artifacts(self.outcome) if self.outcome else []
+        """The job's JSON (the routes' answer and event data)."""
+        outcome = self.outcome
+        artifacts = available_artifacts(outcome) if outcome else []
         return {'id': self.id, 'revision': self.revision, 'state': self.state, 'status': self.status,
                 'progress': round(self.progress, 4), 'request': asdict(self.request),
                 'cancel_requested': self.cancel_requested.is_set(),
-                'timeline': list(self.timeline), 'outcome': self.outcome,
-                'summary': result_summary(self.outcome) if self.outcome else None,
-                'stages': stage_timings(self.timeline, self.finished_after) if self.outcome else [],
+                'timeline': [asdict(note) for note in self.timeline],
+                'outcome': outcome.to_dict() if outcome else None,
+                'summary': asdict(ResultSummary.of(outcome)) if outcome else None,
+                'stages': [asdict(stage) for stage in stage_timings(self.timeline, self.finished_after)]
+                if outcome else [],
                 'artifacts': artifacts, 'download_labels': download_labels(artifacts)}
 
 
-def local_outcome(error_name: str, message: str, job: Job) -> dict:
-    """An outcome (SynthesisOutcome.to_dict() shape) for a job that never got a result."""
-    return {'error_code': ErrorCode(error_name).number, 'error_name': error_name, 'message': message,
-            'states': [], 'ltl_specification': {}, 'automaton': {},
-            'seconds': round(time.monotonic() - job.created, 4)}
-
-
-def result_summary(outcome: dict) -> dict:
-    """Realizability and sizes of a finished job, as the result page shows them."""
-    sections = outcome.get('ltl_specification') or {}
-    automaton_states = len((outcome.get('automaton') or {}).get('states') or [])
-    states = outcome.get('states') or []
-    if outcome.get('error_name') == ErrorCode.SPEC_UNSYNTHESIZABLE:
-        realizable = False
-    elif automaton_states:
-        realizable = True
-    else:
-        realizable = None  # synthesis did not run (compile only, or an earlier failure)
-    return {
-        'succeeded': outcome.get('error_name') == ErrorCode.SUCCESS,
-        'realizable': realizable,
-        'input_propositions': len(sections.get('env_props', [])),
-        'output_propositions': len(sections.get('sys_props', [])),
-        'formulas': sum(len(lines) for name, lines in sections.items() if not name.endswith('_props')),
-        'automaton_states': automaton_states,
-        'state_machine_states': count_states(states),
-        'state_instantiations': len(states),
-        'concurrency_containers': sum(1 for s in states if s['state_class'] == StateInstantiation.CLASS_CONCURRENCY),
-        'seconds': outcome.get('seconds', 0.0),
-    }
-
-
-def stage_timings(timeline: list[dict], total_seconds: float) -> list[dict]:
+def stage_timings(timeline: list[ProgressNote], total_seconds: float) -> list[StageTiming]:
     """How long each pipeline stage took, from the feedback timeline.
 
     A stage starts with a status whose first word is a gerund ("Compiling ...",
     "Synthesizing ...") and lasts until the next status (or the end of the job).
     """
     stages = []
-    for index, entry in enumerate(timeline):
-        first_word = entry['status'].split(' ', 1)[0]
+    for index, note in enumerate(timeline):
+        first_word = note.status.split(' ', 1)[0]
         if not first_word.endswith('ing'):
             continue
-        end = timeline[index + 1]['seconds'] if index + 1 < len(timeline) else total_seconds
-        stages.append({'stage': entry['status'], 'seconds': round(max(0.0, end - entry['seconds']), 4)})
+        end = timeline[index + 1].seconds if index + 1 < len(timeline) else total_seconds
+        stages.append(StageTiming(note.status, round(max(0.0, end - note.seconds), 4)))
     return stages

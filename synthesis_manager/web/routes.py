@@ -3,11 +3,13 @@
 ``create_app(backend)`` serves ``static/`` and these routes::
 
     GET  /                                   the page (static/index.html; app.js, style.css under /static)
+    GET  /api/vocabulary                     the Python names the page needs (web.vocabulary)
     GET  /api/systems                        {"systems": [...]}
     GET  /api/systems/{system}               what a request may name: control modes, actions
     POST /api/jobs                           start a synthesis job -> 202 {"id": ..., ...}
     GET  /api/jobs/{id}                      its status, progress timeline, result and summary
     GET  /api/jobs/{id}/events               the same as server-sent events until the job ends
+    GET  /api/jobs/{id}/state-machine        its state machine as a tree of states (web.machine_tree)
     POST /api/jobs/{id}/cancel               cancel it (the result becomes PREEMPTED)
     GET  /api/jobs/{id}/artifacts/{name}     a download (see ARTIFACTS); ?inline=1 to display it
                                              (a browser asking for a forgotten one gets a page saying so)
@@ -22,6 +24,9 @@ names the offending system, field, job or artifact; the server keeps serving. Re
 a foreign Host header (421), a body over 1 MB (413) or a POST whose body is not declared JSON
 (415: what a cross-site form can send) are refused first (web.guards); a new job while too many
 are unfinished is 503 BUSY, a simulation while too many run is 429 BUSY with Retry-After.
+
+The backend returns records (Job, Simulation, the outcome typed as web.outcome.JobOutcome);
+the routes turn them into JSON with their ``to_dict``.
 
 The backend does the work: :class:`synthesis_manager.web.backend.SynthesisBackend` keeps
 the jobs, validates requests and builds the downloads; the synthesis itself is a
@@ -46,6 +51,7 @@ from synthesis_manager.web.artifacts import Artifact
 from synthesis_manager.limits import BusyError
 from synthesis_manager.web.errors import GuiRequestError, InvalidJobRequestError, NotFoundError, http_answer
 from synthesis_manager.web.guards import RequestGuard
+from synthesis_manager.web.vocabulary import vocabulary
 
 STATIC_DIR = Path(__file__).with_name('static')
 
@@ -79,6 +85,10 @@ def create_app(backend) -> FastAPI:
         return {'description': getattr(backend, 'description', ''),
                 'simulation': bool(getattr(backend, 'can_simulate', False))}
 
+    @app.get('/api/vocabulary')
+    def names():
+        return vocabulary()
+
     @app.get('/api/systems')
     def systems():
         return {'systems': backend.systems()}
@@ -89,21 +99,25 @@ def create_app(backend) -> FastAPI:
 
     @app.post('/api/jobs', status_code=202)
     def start_job(body=Body(None)):
-        return backend.start_job(body)
+        return backend.start_job(body).to_dict()
 
     @app.get('/api/jobs/{job_id}')
     def job_status(job_id: str):
-        return backend.job_status(job_id)
+        return backend.job_status(job_id).to_dict()
 
     @app.post('/api/jobs/{job_id}/cancel', status_code=202)
     def cancel_job(job_id: str):
-        return backend.cancel_job(job_id)
+        return backend.cancel_job(job_id).to_dict()
 
     @app.get('/api/jobs/{job_id}/events')
     async def job_events(job_id: str, request: Request):
         backend.job_status(job_id)  # unknown job: 404 now rather than an empty stream
         return _event_stream(request, lambda: backend.job_revision(job_id),
-                             lambda: backend.job_status(job_id), _stopping(backend))
+                             lambda: backend.job_status(job_id).to_dict(), _stopping(backend))
+
+    @app.get('/api/jobs/{job_id}/state-machine')
+    def state_machine(job_id: str):
+        return backend.state_machine(job_id)
 
     @app.get('/api/jobs/{job_id}/artifacts/{name}')
     def artifact(job_id: str, name: str, request: Request, inline: bool = False):
@@ -120,17 +134,17 @@ def create_app(backend) -> FastAPI:
 
     @app.post('/api/jobs/{job_id}/simulations', status_code=202)
     def start_simulation(job_id: str, body=Body(None)):
-        return backend.start_simulation(job_id, body)
+        return backend.start_simulation(job_id, body).to_dict()
 
     @app.get('/api/simulations/{simulation_id}')
     def simulation_status(simulation_id: str):
-        return backend.simulation_status(simulation_id)
+        return backend.simulation_status(simulation_id).to_dict()
 
     @app.get('/api/simulations/{simulation_id}/events')
     async def simulation_events(simulation_id: str, request: Request):
         backend.simulation_status(simulation_id)
         return _event_stream(request, lambda: backend.simulation_revision(simulation_id),
-                             lambda: backend.simulation_status(simulation_id), _stopping(backend))
+                             lambda: backend.simulation_status(simulation_id).to_dict(), _stopping(backend))
 
     @app.get('/api/simulations/{simulation_id}/frames/{index}')
     def simulation_frame(simulation_id: str, index: int):

@@ -327,3 +327,25 @@ def test_a_concurrency_container_holds_its_states_in_the_tree():
     inner = [s.state_path for s in states if s.state_path.startswith(container['state_path'] + '/')]
     assert [child['state_path'] for child in container['children']] == inner and inner
     assert all(child['children'] == [] for child in container['children'])
+
+
+def test_the_page_is_es_modules_served_as_javascript(client):
+    from synthesis_manager.web.routes import STATIC_DIR
+
+    assert '<script type="module" src="/static/app.js"></script>' in client.get('/').text
+    modules = sorted(path.name for path in STATIC_DIR.glob('*.js'))
+    assert 'app.js' in modules and 'drawing.js' in modules
+    for name in modules:
+        response = client.get(f'/static/{name}')
+        assert response.status_code == 200 and response.headers['content-type'].startswith('text/javascript')
+
+
+def test_the_page_keeps_no_copies_of_the_served_vocabulary(client):
+    from synthesis_manager.web.routes import STATIC_DIR
+
+    names = client.get('/api/vocabulary').json()
+    served = [*names['state_classes'].values(), *names['autonomy_levels'], *names['error_codes'],
+              *(section['name'] for section in names['specification_sections']), names['preferred_system']]
+    copies = [f'{path.name}: {name}' for path in sorted(STATIC_DIR.glob('*.js')) for name in served
+              for quote in '\'"`' if f'{quote}{name}{quote}' in path.read_text()]
+    assert copies == []

@@ -2,9 +2,13 @@
 
     routes        the FastAPI app: page, JSON API, server-sent event streams, downloads
     backend       SynthesisBackend: jobs, simulations and downloads behind the routes
-    jobs          what the page asks for (JobRequest), a job's record and summary
+    jobs          what the page asks for (JobRequest), a job's record, progress and summary
+    outcome       JobOutcome: what a job ended with, typed until a route makes JSON of it
+    machine_tree  stand-in: a machine's tree JSON until sm_generation.state_machine lands
+    vocabulary    the Python names the page needs (GET /api/vocabulary)
     simulations   a closed-loop run's record
     artifacts     the downloads built from a finished job
     errors        request errors answered as 4xx/5xx JSON
-    static/       index.html, app.js, style.css
+    guards        what is refused before any route (foreign Host, large body, non-JSON POST)
+    static/       index.html, style.css and the page's ES modules (app.js first)
 """

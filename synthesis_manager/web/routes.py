@@ -2,7 +2,7 @@
 
 ``create_app(backend)`` serves ``static/`` and these routes::
 
-    GET  /                                   the page (static/index.html; app.js, style.css under /static)
+    GET  /                                   the page (static/index.html; its ES modules, style.css under /static)
     GET  /api/vocabulary                     the Python names the page needs (web.vocabulary)
     GET  /api/systems                        {"systems": [...]}
     GET  /api/systems/{system}               what a request may name: control modes, actions
@@ -39,6 +39,7 @@ from __future__ import annotations
 import asyncio
 import html
 import json
+import mimetypes
 from pathlib import Path
 from typing import Callable
 
@@ -54,6 +55,9 @@ from synthesis_manager.web.guards import RequestGuard
 from synthesis_manager.web.vocabulary import vocabulary
 
 STATIC_DIR = Path(__file__).with_name('static')
+# The page is ES modules, which a browser runs only when served with a JavaScript media type;
+# the host's mime.types (which StaticFiles reads) might map .js to something else.
+mimetypes.add_type('text/javascript', '.js')
 
 
 def create_app(backend) -> FastAPI:

@@ -1,0 +1,143 @@
+// The request form: the system's own names to choose from, the ordered goal list with the
+// server's live goal check, and the request it makes. It owns the chosen system's choices.
+import { api } from './api.js';
+import { $, element } from './dom.js';
+import { vocabulary } from './vocabulary.js';
+
+let choices = null;      // the current system's control modes and actions (GET /api/systems/{system})
+let canSimulate = false; // the server can run atlas_sim (GET /api/info)
+let goalChecks = 0;      // replies can overtake each other: only the newest check's is shown
+
+export async function loadSystems() {
+  const [{ systems }, info] = await Promise.all([api('GET', '/api/systems'), api('GET', '/api/info')]);
+  $('backend-description').textContent = info.description || '';
+  canSimulate = info.simulation;
+  const select = $('system');
+  select.replaceChildren(...systems.map((name) => element('option', { value: name, text: name })));
+  const preferred = vocabulary().preferred_system;
+  if (systems.includes(preferred)) select.value = preferred;
+  await loadChoices();
+}
+
+export async function loadChoices() {
+  choices = await api('GET', `/api/systems/${encodeURIComponent($('system').value)}`);
+  // The robot starts in one control mode (radio buttons); any actions may be completed already.
+  const choice = (type, group, name, hint, checked) => {
+    const box = element('input', { type, value: name, name: group });
+    box.checked = checked;
+    return element('label', { className: 'choice', title: hint }, box, ` ${name}`);
+  };
+  const defaults = new Set(choices.default_initial_conditions);
+  $('initial-control-modes').replaceChildren(
+    element('span', { className: 'group-title', text: 'Control mode (one)' }),
+    ...choices.control_modes.map((m) => choice('radio', 'initial-mode', m.name, `next: ${m.next.join(', ') || '—'}`,
+      defaults.has(m.name))));
+  $('initial-actions').replaceChildren(
+    element('span', { className: 'group-title', text: 'Actions (already completed)' }),
+    ...choices.actions.map((a) => choice('checkbox', 'initial-condition', a.name,
+      `needs: ${a.preconditions.join(', ') || 'nothing'}`, defaults.has(a.name))));
+
+  const group = (label, items, hint) => element('optgroup', { label },
+    ...items.map((item) => element('option', { value: item.name, title: hint(item), text: item.name })));
+  $('goal-choice').replaceChildren(
+    group('Actions', choices.actions, (a) => `needs: ${a.preconditions.join(', ') || 'nothing'}`),
+    group('Control modes', choices.control_modes, (m) => `reached from: ${predecessors(m.name).join(', ') || 'no other mode'}`));
+  $('goals').replaceChildren();
+  updateGoalsHint();
+}
+
+// The names a simulation can make fail first: the system's actions, then its control modes.
+export function capabilityNames() {
+  return [...choices.actions, ...choices.control_modes].map((c) => c.name);
+}
+
+// Whether the simulated robot can run the chosen system's machines, and if not, why.
+export function simulationSupport() {
+  return choices.simulation || { available: canSimulate, note: '' };
+}
+
+// Ask the server which goals cannot come next (and which chosen goals can never be
+// achieved) and say so in the picker and the list, before anything is synthesized.
+export async function checkGoals() {
+  const request = currentRequest();
+  const number = ++goalChecks;
+  let check;
+  try {
+    check = await api('POST', '/api/goal-check', { system: request.system, initial_conditions: request.initial_conditions,
+      goals: request.goals, unordered: request.unordered });
+  } catch (error) {
+    return;  // the synthesis itself will report what is wrong
+  }
+  if (number !== goalChecks) return;
+  for (const option of $('goal-choice').options) {
+    const why = check.impossible_next[option.value];
+    option.textContent = why ? `${option.value} (impossible here)` : option.value;
+    option.classList.toggle('impossible', Boolean(why));
+    option.dataset.impossible = why || '';
+    if (why) option.title = why;
+  }
+  for (const item of $('goals').children) {
+    const finding = check.findings.find((f) => f.item === item.dataset.goal);
+    item.classList.toggle('impossible', Boolean(finding));
+    item.querySelector('.goal-warning').textContent = finding ? finding.sentence : '';
+  }
+}
+
+// The control modes that can change to ``mode`` (its own self-loop aside).
+function predecessors(mode) {
+  return choices.control_modes.filter((m) => m.name !== mode && m.next.includes(mode)).map((m) => m.name);
+}
+
+function goalItem(name) {
+  const button = (text, label, action) => {
+    const b = element('button', { type: 'button', className: 'small', title: label, 'aria-label': `${label} ${name}`, text });
+    b.addEventListener('click', action);
+    return b;
+  };
+  const item = element('li', { 'data-goal': name }, element('span', { className: 'goal-name', text: name }));
+  item.append(
+    button('↑', 'move up', () => { if (item.previousElementSibling) item.previousElementSibling.before(item); updateGoalsHint(); }),
+    button('↓', 'move down', () => { if (item.nextElementSibling) item.nextElementSibling.after(item); updateGoalsHint(); }),
+    button('×', 'remove', () => { item.remove(); updateGoalsHint(); }),
+    element('span', { className: 'goal-warning', role: 'note' }));
+  return item;
+}
+
+export function addGoal() {
+  const name = $('goal-choice').value;
+  if (!name) return;
+  $('goals').append(goalItem(name));
+  updateGoalsHint();
+}
+
+function updateGoalsHint() {
+  $('goals-empty').hidden = $('goals').children.length > 0;
+  checkGoals();
+}
+
+export function currentRequest() {
+  const checked = (selector) => document.querySelector(selector).value;
+  return {
+    system: $('system').value,
+    initial_conditions: [...document.querySelectorAll('input[name="initial-mode"]:checked, input[name="initial-condition"]:checked')]
+      .map((b) => b.value),
+    goals: [...$('goals').children].map((item) => item.dataset.goal),
+    sm_outcomes: checked('input[name="sm-outcomes"]:checked').split(','),
+    option: checked('input[name="option"]:checked') || null,
+    unordered: $('unordered').checked,
+    name: $('behavior-name').value.trim(),
+  };
+}
+
+// What the form can tell before asking the server: no goals (every option the page offers
+// needs them), a behavior name it would refuse.
+export function requestProblem(request) {
+  if (!request.goals.length) {
+    return { field: 'goal-choice', message: 'Add at least one goal: pick it in the list and press “Add goal”.' };
+  }
+  const name = $('behavior-name');
+  if (!name.checkValidity()) {
+    return { field: 'behavior-name', message: `Behavior name “${name.value}”: ${$('behavior-name-hint').textContent.trim()}` };
+  }
+  return null;
+}

@@ -1,0 +1,133 @@
+// The closed-loop simulation of a finished job's machine on atlas_sim: offer it, run it,
+// follow its steps on the drawing and in a table, show its key frames and trace check.
+import { api, streamEvents } from './api.js';
+import * as drawing from './drawing.js';
+import { $, element } from './dom.js';
+import { capabilityNames, simulationSupport } from './form.js';
+import { resetFrames, showFrames } from './frames.js';
+import { vocabulary } from './vocabulary.js';
+
+let offeredJob = null;        // the job whose machine the Simulate button runs
+let simulationEvents = null;  // the EventSource of the run being followed
+
+export function offerSimulation(job) {
+  offeredJob = job;
+  if (!job.artifacts.includes('state_machine.yaml')) return;
+  const support = simulationSupport();
+  $('simulation-note').textContent = support.note;
+  $('simulation-note').hidden = support.available;
+  $('simulation-controls').hidden = !support.available;
+  if (!support.available) {
+    $('simulation-section').hidden = false;
+    return;
+  }
+  $('fail-first').replaceChildren(element('option', { value: '', text: 'nothing (no faults)' }),
+    ...capabilityNames().map((name) => element('option', { value: name, text: name })));
+  $('simulation-section').hidden = false;
+}
+
+// A new job is on its way: no run of the old one stays on the page.
+export function withdrawSimulation() {
+  offeredJob = null;
+  resetSimulation();
+}
+
+function resetSimulation() {
+  if (simulationEvents) simulationEvents.close();
+  simulationEvents = null;
+  $('simulate').disabled = false;
+  $('simulation-status').textContent = '';
+  $('simulation-live').textContent = '';
+  $('simulation-view').hidden = true;
+  $('robot-view').hidden = true;
+  $('graph-layout').classList.remove('simulating');
+  $('simulation-steps').replaceChildren();
+  resetFrames();
+  drawing.markRun([], false);
+  $('simulation-check').textContent = '';
+  $('simulation-timeline').hidden = true;
+}
+
+export async function simulate() {
+  if (!offeredJob) return;
+  resetSimulation();
+  $('simulate').disabled = true;
+  const failing = $('fail-first').value;
+  let simulation;
+  try {
+    simulation = await api('POST', `/api/jobs/${offeredJob.id}/simulations`, { fail_first: failing ? [failing] : [] });
+  } catch (error) {
+    $('simulation-status').textContent = `${error.code}: ${error.message}`;
+    $('simulate').disabled = false;
+    return;
+  }
+  showSimulation(simulation);
+  // Follow the robot: the drawing and the robot side by side, in view.
+  $('graph-section').scrollIntoView({ block: 'start', behavior: 'instant' });
+  const end = () => {
+    simulationEvents = null;
+    $('simulate').disabled = false;
+  };
+  simulationEvents = streamEvents(`/api/simulations/${simulation.id}/events`, {
+    progress: showSimulation,
+    finished: (last) => { end(); showSimulation(last); },
+    // The stream broke (e.g. the server restarted): show what the server still knows, once.
+    broken: () => api('GET', `/api/simulations/${simulation.id}`).then(
+      (last) => { end(); showSimulation(last); },
+      (error) => { end(); $('simulation-status').textContent = `${error.code}: ${error.message}`; }),
+  });
+}
+
+function showSimulation(simulation) {
+  const base = `/api/simulations/${simulation.id}`;
+  const running = simulation.state !== 'finished';
+  let status = simulation.steps.length === 0 ? 'Starting the simulator…'
+    : `Running: ${simulation.steps.length} states, robot time ${simulation.robot_time.toFixed(2)} s`;
+  let outcomeClass = '';
+  if (!running) {
+    status = simulation.error
+      ? `Stopped: ${simulation.error.code}: ${simulation.error.message}`
+      : `Outcome: ${simulation.outcome} after ${simulation.steps.length} states ` +
+        `(robot time ${simulation.robot_time.toFixed(2)} s, wall time ${simulation.wall_seconds.toFixed(2)} s)`;
+    outcomeClass = simulation.error ? 'bad' : `outcome-${simulation.outcome}`;
+  }
+  $('simulation-status').textContent = status;
+  $('simulation-status').className = `status ${outcomeClass}`;
+  $('simulation-live').textContent = status;
+  $('simulation-live').className = `status ${outcomeClass}`;
+  $('simulation-view').hidden = false;
+  $('robot-view').hidden = false;
+  if (!$('graph-layout').classList.contains('simulating')) {
+    $('graph-layout').classList.add('simulating');
+    drawing.refit();  // the drawing just got narrower
+  }
+  const machineOutcomes = Object.values(vocabulary().sm_outcomes);
+  const outcomeCell = (step) => {
+    if (!step.state_outcome) return element('td', { text: '…' });
+    const ends = machineOutcomes.includes(step.transition) ? ` outcome-${step.transition}` : '';
+    return element('td', { className: `outcome${ends}`, text: `${step.state_outcome} → ${step.transition}` });
+  };
+  $('simulation-steps').replaceChildren(
+    element('tr', {}, ...['#', 'state', 'activated', 'results', 'outcome', 'robot time (s)'].map((h) => element('th', { text: h }))),
+    ...simulation.steps.map((step) => element('tr', { 'data-state': step.state },
+      element('td', { text: String(step.index) }),
+      element('td', { text: step.state.replace(/^\//, '') }),
+      element('td', { text: step.capabilities.join(', ') }),
+      element('td', { text: step.results.map((r) => `${r.capability} ${r.outcome}`).join(', ') }),
+      outcomeCell(step),
+      element('td', { text: `${step.entered_at.toFixed(2)}–${step.ended_at.toFixed(2)}` }))));
+  drawing.markRun(simulation.steps, running);
+  showFrames(base, simulation.frames);
+  if (simulation.check) {
+    const check = simulation.check;
+    $('simulation-check').textContent = check.ok
+      ? `Trace check against the specification: ok (${check.positions} positions)`
+      : `Trace check: ${check.violations.length} violation(s): ` +
+        check.violations.map((v) => v.message || JSON.stringify(v)).join('; ');
+    $('simulation-check').className = check.ok ? 'good' : 'bad';
+  }
+  if (simulation.timeline) {
+    $('simulation-timeline').src = `${base}/timeline.png`;
+    $('simulation-timeline').hidden = false;
+  }
+}

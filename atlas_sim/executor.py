@@ -45,7 +45,7 @@ from atlas_sim.machine import (BEHAVIOR, CONCURRENCY, DECISION_STATE, LOG_STATE,
                                UndeclaredOutcomeError, load_machine)
 from atlas_sim.robot import CapabilityResult, Robot
 from atlas_sim.trace_check import OutcomeTracker, Trace, TraceStep
-from respec.abstraction import load_abstraction
+from respec.robot.abstraction import load_abstraction
 from respec.errors import ErrorCode
 from respec.naming import activated, is_activation, outcome_proposition
 from sm_generation.config import load_flexbe_config

@@ -44,13 +44,13 @@ from dataclasses import dataclass, field, fields
 from pathlib import Path
 from typing import Mapping, Sequence
 
-from respec.abstraction import AbstractionConfigError, RobotAbstraction, load_abstraction
+from respec.robot.abstraction import AbstractionConfigError, RobotAbstraction, load_abstraction
 from respec.components import (
     SOURCE_CUSTOM, FormulaGroup, action_groups, action_specification, control_mode_groups,
     control_mode_specification, goal_groups, goal_specification, initial_conditions_groups,
     initial_conditions_specification,
 )
-from respec.capabilities import CapabilitySystem, capability_system_of
+from respec.robot.cnu import CapabilitySystem, capability_system_of
 from respec.errors import quoted
 from respec.ltl import variables
 from respec.naming import (DEFAULT_SM_OUTCOMES, FAILED, FINISHED, activation, did_you_mean, outcome_proposition,
@@ -60,8 +60,8 @@ from respec.spec import (
     FORMULA_SECTIONS, PROPOSITION_SECTIONS, SECTIONS, GR1Specification, PropositionConflictError,
     merge_specifications,
 )
-from respec.state_library import StateClass, workspace_state_library
-from respec.systems import ConfigFileInvalidError, SystemNotFoundError
+from respec.robot.state_library import StateClass, workspace_state_library
+from respec.robot.files import ConfigFileInvalidError, SystemNotFoundError
 
 from ltl_specification.capabilities import compile_capability_task
 from ltl_specification.errors import (
@@ -106,7 +106,7 @@ def compile_task(system: str, initial_conditions: Sequence[str] | str, goals: Se
                  state_library: Mapping[str, StateClass] | None = None) -> CompiledSpecification:
     """Compile the GR(1) specification of reaching ``goals`` from ``initial_conditions``.
 
-    A system described by CNU capability files (``respec.capabilities``) is compiled by
+    A system described by CNU capability files (``respec.robot.cnu``) is compiled by
     ``ltl_specification.capabilities``; its state classes are checked against
     ``state_library`` (default: the FlexBE state packages on ``AMENT_PREFIX_PATH``), and
     ``sm_outcomes`` and ``strict_order`` do not apply (its mappings name its outcomes).

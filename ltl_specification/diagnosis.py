@@ -21,7 +21,7 @@ import itertools
 import threading
 from dataclasses import asdict, dataclass, field
 
-from respec.abstraction import RobotAbstraction
+from respec.robot.abstraction import RobotAbstraction
 from respec.naming import DEFAULT_SM_OUTCOMES, activation, memory, outcome_proposition
 from respec.components import (SOURCE_ACTIONS, SOURCE_CONTROL_MODES, SOURCE_CUSTOM, SOURCE_GOALS,
                                SOURCE_INITIAL_CONDITIONS, SOURCE_SM_OUTCOMES, FormulaGroup)

@@ -48,7 +48,7 @@ def reads_robot_state(initial_conditions: Sequence[str], system: str, config_dir
     A robot described by CNU's capability files keeps CNU's meaning of no initial conditions:
     its specification already gives them (``current`` still asks the robot).
     """
-    from respec.capabilities import capability_system_of
+    from respec.robot.cnu import capability_system_of
     from respec.errors import CodedError
 
     if not asks_for_robot_state(initial_conditions):

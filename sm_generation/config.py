@@ -39,7 +39,7 @@ from pathlib import Path
 
 from respec.naming import activated
 from sm_generation.instantiation import StateInstantiation
-from respec.systems import ConfigFileInvalidError, SystemNotFoundError, load_section
+from respec.robot.files import ConfigFileInvalidError, SystemNotFoundError, load_section
 from sm_generation.errors import (AutonomyConfigInvalidError, FlexBEConfigInvalidError, NoSystemConfigError,
                                   SMGenerationError, StateConfigInvalidError, SystemConfigNotFoundError,
                                   UserdataConfigInvalidError)

@@ -30,9 +30,9 @@ from __future__ import annotations
 import logging
 from pathlib import Path
 
-from respec.capabilities import CapabilitySystem, capability_system_of
-from respec.state_library import workspace_state_library
-from respec.systems import ConfigFileInvalidError, SystemNotFoundError
+from respec.robot.cnu import CapabilitySystem, capability_system_of
+from respec.robot.state_library import workspace_state_library
+from respec.robot.files import ConfigFileInvalidError, SystemNotFoundError
 from sm_generation.config import FlexBEConfig, StateConfig, load_flexbe_config
 from sm_generation.errors import (FlexBEConfigInvalidError, NoSystemConfigError, SMGenerationError,
                                   SystemConfigNotFoundError)

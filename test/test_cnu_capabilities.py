@@ -13,9 +13,9 @@ import yaml
 from ltl_specification import compile_task
 from ltl_synthesizer import synthesize
 from respec.automaton import automaton_from_strategy
-from respec.capabilities import CapabilityConfigError, capability_system_of
+from respec.robot.cnu import CapabilityConfigError, capability_system_of
 from respec.ltl import conj, evaluate
-from respec.state_library import StateClass, StateClassError, workspace_state_library
+from respec.robot.state_library import StateClass, StateClassError, workspace_state_library
 from sm_generation import generate_state_machine, validate_state_machine
 
 # CNU's request defaults (flexbe_synthesis_examples/request_*.py) and the state counts

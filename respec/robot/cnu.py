@@ -38,7 +38,7 @@ import yaml
 
 from respec.errors import ErrorCode
 from respec.naming import COMPLETED, FINISHED
-from respec.systems import SystemConfigError, load_system_file, system_config_path
+from respec.robot.files import SystemConfigError, load_system_file, system_config_path
 
 CAPABILITIES_KEY, SPEC_KEY, MAPPINGS_KEY = 'cnu_capabilities', 'cnu_spec', 'cnu_mappings'
 SYSTEM_FILE_KEYS = ('system', CAPABILITIES_KEY, SPEC_KEY, MAPPINGS_KEY, 'reduce')

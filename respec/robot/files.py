@@ -43,7 +43,7 @@ def default_config_dir() -> Path:
     override = os.environ.get(CONFIG_DIR_ENV)
     if override:
         return Path(override)
-    return Path(__file__).resolve().parent.parent / 'config'
+    return Path(__file__).resolve().parents[2] / 'config'
 
 
 def available_systems(config_dir: str | Path | None = None) -> list[str]:

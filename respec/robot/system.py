@@ -1,0 +1,113 @@
+"""``RobotSystem``: one robot system, loaded once from its file(s), validated, immutable.
+
+A robot system is one YAML file, ``<config_dir>/<name>.yaml``, in one of two kinds:
+
+``abstraction``   our own format (ATLAS-style): an ``abstraction:`` section with control modes,
+                  actions, outcomes and sensors (``respec.robot.abstraction``), a ``flexbe:``
+                  section mapping propositions to FlexBE states, and optionally ``simulation:``.
+``capabilities``  a robot described by CNU's capability files, which the system file points at
+                  (``respec.robot.cnu``); its FlexBE mapping comes from the capabilities and the
+                  workspace's state classes.
+
+Every stage takes a ``RobotSystem`` (or a name resolved once at the edge with
+``robot_system``), so a request reads the system's files once, and the kind is decided here,
+once, when the file is read.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+from types import MappingProxyType
+from typing import Mapping
+
+from respec.robot.abstraction import RobotAbstraction, abstraction_from_document
+from respec.robot.cnu import CapabilitySystem, is_capability_document, load_capability_system
+from respec.robot.files import (ConfigFileInvalidError, available_systems, default_config_dir, read_config_file,
+                                system_config_path)
+
+ABSTRACTION_KIND = 'abstraction'
+CAPABILITIES_KIND = 'capabilities'
+
+
+@dataclass(frozen=True)
+class RobotSystem:
+    """A validated robot system: its name, file, kind and descriptions.
+
+    Exactly one of ``abstraction`` (kind ``abstraction``) and ``capabilities`` (kind
+    ``capabilities``) is set. ``sections`` holds the file's other top-level sections as read
+    (``flexbe``, ``simulation``); the package that uses a section validates it
+    (``sm_generation.config``, ``atlas_sim``).
+    """
+
+    name: str
+    path: Path
+    abstraction: RobotAbstraction | None = None
+    capabilities: CapabilitySystem | None = None
+    sections: Mapping[str, object] = field(default_factory=dict, compare=False, repr=False)
+
+    @property
+    def kind(self) -> str:
+        return CAPABILITIES_KIND if self.capabilities is not None else ABSTRACTION_KIND
+
+    @property
+    def is_capability_system(self) -> bool:
+        return self.capabilities is not None
+
+    @property
+    def config_file(self) -> str:
+        """The file as users know it, e.g. 'config/atlas.yaml'."""
+        return f'{self.path.parent.name}/{self.path.name}'
+
+    def section(self, name: str) -> dict:
+        """One top-level section of the system file; raises ConfigFileInvalidError if missing."""
+        content = self.sections.get(name)
+        if not isinstance(content, Mapping):
+            raise ConfigFileInvalidError(f'{self.name}.yaml: missing or invalid section {name!r}', item=name)
+        return dict(content)
+
+    def has_section(self, name: str) -> bool:
+        return isinstance(self.sections.get(name), Mapping)
+
+
+def robot_system_from_file(path: str | Path, name: str | None = None) -> RobotSystem:
+    """The robot system of one system file (its kind told by its content)."""
+    path = Path(path)
+    name = name or path.stem
+    document = read_config_file(path)
+    if is_capability_document(document):
+        return RobotSystem(name, path, capabilities=load_capability_system(document, name, path.parent),
+                           sections=MappingProxyType(dict(document)))
+    return RobotSystem(name, path, abstraction=abstraction_from_document(document, name),
+                       sections=MappingProxyType(dict(document)))
+
+
+def robot_system(system: RobotSystem | str, config_dir: str | Path | None = None) -> RobotSystem:
+    """``system`` itself, or the system of that name in ``config_dir`` (default: ``config/``).
+
+    The edge where a name becomes a RobotSystem: raises SystemNotFoundError for an unknown
+    name and a SystemConfigError subclass (naming the entry) for an invalid file.
+    """
+    if isinstance(system, RobotSystem):
+        return system
+    return robot_system_from_file(system_config_path(system, config_dir), system)
+
+
+@dataclass(frozen=True)
+class SystemCatalog:
+    """The robot systems of a config directory: their names, and each one loaded on request.
+
+    Loading reads the files afresh, so a request sees a system file as it is when it arrives.
+    """
+
+    config_dir: Path | None = None
+
+    @property
+    def directory(self) -> Path:
+        return Path(self.config_dir) if self.config_dir else default_config_dir()
+
+    def names(self) -> list[str]:
+        return available_systems(self.directory)
+
+    def load(self, name: RobotSystem | str) -> RobotSystem:
+        return robot_system(name, self.directory)

@@ -34,8 +34,8 @@ CAPABILITIES_KIND = 'capabilities'
 class RobotSystem:
     """A validated robot system: its name, file, kind and descriptions.
 
-    Exactly one of ``abstraction`` (kind ``abstraction``) and ``capabilities`` (kind
-    ``capabilities``) is set. ``sections`` holds the file's other top-level sections as read
+    ``capabilities`` is set for kind ``capabilities``; otherwise ``abstraction`` holds the
+    validated ``abstraction:`` section (None when the file has none). ``sections`` holds the file's other top-level sections as read
     (``flexbe``, ``simulation``); the package that uses a section validates it
     (``sm_generation.config``, ``atlas_sim``).
     """
@@ -78,8 +78,10 @@ def robot_system_from_file(path: str | Path, name: str | None = None) -> RobotSy
     if is_capability_document(document):
         return RobotSystem(name, path, capabilities=load_capability_system(document, name, path.parent),
                            sections=MappingProxyType(dict(document)))
-    return RobotSystem(name, path, abstraction=abstraction_from_document(document, name),
-                       sections=MappingProxyType(dict(document)))
+    # A file without an abstraction: section may still serve generation alone (its flexbe:
+    # section); compiling a task on it reports the missing section.
+    abstraction = abstraction_from_document(document, name) if 'abstraction' in document else None
+    return RobotSystem(name, path, abstraction=abstraction, sections=MappingProxyType(dict(document)))
 
 
 def robot_system(system: RobotSystem | str, config_dir: str | Path | None = None) -> RobotSystem:

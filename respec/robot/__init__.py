@@ -9,7 +9,7 @@ Modules:
 """
 
 from respec.robot.system import (ABSTRACTION_KIND, CAPABILITIES_KIND, RobotSystem, SystemCatalog, robot_system,
-                                 robot_system_from_file)
+                                 robot_system_from_file, robot_system_from_files)
 
 __all__ = ['ABSTRACTION_KIND', 'CAPABILITIES_KIND', 'RobotSystem', 'SystemCatalog', 'robot_system',
-           'robot_system_from_file']
+           'robot_system_from_file', 'robot_system_from_files']

@@ -73,9 +73,13 @@ def load_system_file(system: str, config_dir: str | Path | None = None) -> dict:
 
 def read_config_file(path: str | Path) -> dict:
     """A system configuration file as a dict (raises ConfigFileInvalidError naming the file)."""
-    path = Path(path)
+    return parse_config_text(Path(path).read_text(), path)
+
+
+def parse_config_text(text: str, path: str | Path) -> dict:
+    """The text of the system configuration file ``path`` as a dict (errors name the file)."""
     try:
-        document = yaml.load(path.read_text(), Loader=_SAFE_LOADER)
+        document = yaml.load(text, Loader=_SAFE_LOADER)
     except yaml.YAMLError as error:
         raise ConfigFileInvalidError(f'{path}: not valid YAML: {error}', item=str(path)) from error
     if not isinstance(document, dict):

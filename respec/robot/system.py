@@ -16,14 +16,16 @@ once, when the file is read.
 
 from __future__ import annotations
 
+import errno
+import os
 from dataclasses import dataclass, field
 from pathlib import Path
 from types import MappingProxyType
-from typing import Mapping
+from typing import Callable, Mapping
 
 from respec.robot.abstraction import RobotAbstraction, abstraction_from_document
 from respec.robot.cnu import CapabilitySystem, is_capability_document, load_capability_system
-from respec.robot.files import (ConfigFileInvalidError, available_systems, default_config_dir, read_config_file,
+from respec.robot.files import (ConfigFileInvalidError, available_systems, default_config_dir, parse_config_text,
                                 system_config_path)
 
 ABSTRACTION_KIND = 'abstraction'
@@ -41,10 +43,12 @@ class RobotSystem:
     """
 
     name: str
-    path: Path
+    path: Path = field(compare=False)  # where it was read from: the same system may be read elsewhere
     abstraction: RobotAbstraction | None = None
     capabilities: CapabilitySystem | None = None
     sections: Mapping[str, object] = field(default_factory=dict, compare=False, repr=False)
+    # The text of every file read, by its path relative to the system file's folder.
+    files: Mapping[str, str] = field(default_factory=dict, compare=False, repr=False)
 
     @property
     def kind(self) -> str:
@@ -73,15 +77,37 @@ class RobotSystem:
 def robot_system_from_file(path: str | Path, name: str | None = None) -> RobotSystem:
     """The robot system of one system file (its kind told by its content)."""
     path = Path(path)
-    name = name or path.stem
-    document = read_config_file(path)
+    return _robot_system(name or path.stem, path, lambda relative: (path.parent / relative).read_text())
+
+
+def robot_system_from_files(name: str, files: Mapping[str, str], config_file: str | None = None) -> RobotSystem:
+    """A robot system rebuilt from the texts of its files (``RobotSystem.files``), e.g. as a
+    suite serves them to a GUI that runs elsewhere: the same system as the one read from disk."""
+    def read(relative: str) -> str:
+        if relative not in files:
+            raise FileNotFoundError(errno.ENOENT, os.strerror(errno.ENOENT), relative)
+        return files[relative]
+
+    return _robot_system(name, Path(config_file or f'config/{name}.yaml'), read)
+
+
+def _robot_system(name: str, path: Path, read: Callable[[str], str]) -> RobotSystem:
+    files: dict[str, str] = {}
+
+    def read_and_keep(relative: str) -> str:
+        files[relative] = read(relative)
+        return files[relative]
+
+    document = parse_config_text(read_and_keep(path.name), path)
     if is_capability_document(document):
-        return RobotSystem(name, path, capabilities=load_capability_system(document, name, path.parent),
-                           sections=MappingProxyType(dict(document)))
+        capabilities = load_capability_system(document, name, read_and_keep)
+        return RobotSystem(name, path, capabilities=capabilities, sections=MappingProxyType(dict(document)),
+                           files=MappingProxyType(files))
     # A file without an abstraction: section may still serve generation alone (its flexbe:
     # section); compiling a task on it reports the missing section.
     abstraction = abstraction_from_document(document, name) if 'abstraction' in document else None
-    return RobotSystem(name, path, abstraction=abstraction, sections=MappingProxyType(dict(document)))
+    return RobotSystem(name, path, abstraction=abstraction, sections=MappingProxyType(dict(document)),
+                       files=MappingProxyType(files))
 
 
 def robot_system(system: RobotSystem | str, config_dir: str | Path | None = None) -> RobotSystem:

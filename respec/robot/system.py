@@ -17,6 +17,7 @@ once, when the file is read.
 from __future__ import annotations
 
 import errno
+import json
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -25,8 +26,8 @@ from typing import Callable, Mapping
 
 from respec.robot.abstraction import RobotAbstraction, abstraction_from_document
 from respec.robot.cnu import CapabilitySystem, is_capability_document, load_capability_system
-from respec.robot.files import (ConfigFileInvalidError, available_systems, default_config_dir, parse_config_text,
-                                system_config_path)
+from respec.robot.files import (ConfigFileInvalidError, SystemConfigError, SystemNotFoundError, available_systems,
+                                default_config_dir, parse_config_text, system_config_path)
 
 ABSTRACTION_KIND = 'abstraction'
 CAPABILITIES_KIND = 'capabilities'
@@ -139,3 +140,47 @@ class SystemCatalog:
 
     def load(self, name: RobotSystem | str) -> RobotSystem:
         return robot_system(name, self.directory)
+
+
+# --- a catalog as text: how a suite serves its systems to a GUI running elsewhere ---------------
+
+def catalog_to_json(catalog: SystemCatalog) -> str:
+    """Every system of ``catalog`` as JSON (deterministic): name, config file and the text of
+    each file it reads; a system that cannot be loaded is listed with its error instead."""
+    from respec.errors import CodedError
+
+    entries = []
+    for name in catalog.names():
+        try:
+            system = catalog.load(name)
+        except CodedError as error:
+            entries.append({'name': name, 'error': {'code': error.code.name, 'message': str(error),
+                                                    'item': error.item}})
+            continue
+        entries.append({'name': name, 'config_file': system.config_file, 'files': dict(system.files)})
+    return json.dumps({'systems': entries}, sort_keys=True)
+
+
+@dataclass(frozen=True)
+class ServedCatalog:
+    """The systems a suite serves (``catalog_to_json``), with SystemCatalog's ``names``/``load``."""
+
+    entries: Mapping[str, Mapping]
+
+    @classmethod
+    def from_json(cls, text: str) -> ServedCatalog:
+        return cls({entry['name']: entry for entry in json.loads(text)['systems']})
+
+    def names(self) -> list[str]:
+        return sorted(self.entries)
+
+    def load(self, name: RobotSystem | str) -> RobotSystem:
+        if isinstance(name, RobotSystem):
+            return name
+        entry = self.entries.get(name)
+        if entry is None:
+            raise SystemNotFoundError(f'unknown system {name!r}: the suite serves no such system '
+                                      f'(known systems: {", ".join(self.names()) or "none"})', item=str(name))
+        if 'error' in entry:
+            raise SystemConfigError(entry['error']['message'], item=entry['error']['item'])
+        return robot_system_from_files(name, entry['files'], entry['config_file'])

@@ -36,7 +36,7 @@ from respec.systems import ConfigFileInvalidError, SystemNotFoundError
 from sm_generation.config import FlexBEConfig, StateConfig, load_flexbe_config
 from sm_generation.errors import (FlexBEConfigInvalidError, NoSystemConfigError, SMGenerationError,
                                   SystemConfigNotFoundError)
-from sm_generation.instantiation import OutcomeCondition, StateInstantiation
+from sm_generation.instantiation import DECISION_CLASS, NOTHING_CLASS, OutcomeCondition, StateInstantiation
 from sm_generation.layout import inner_positions, layered_positions
 from sm_generation.machine import (
     DECISION, NOTHING_TO_DO, AutomatonView, Machine, MachineState, Target, build_machine)
@@ -47,12 +47,10 @@ _LOG = logging.getLogger(__name__)
 NAME_SEPARATOR = '_and_'
 CONDITION_SEPARATOR = '__'
 SENSOR_EVENT_SUFFIX = '_true'
-# Helper states from flexbe_states, used where the automaton itself has no state.
+# The helper states' names (their classes: instantiation.DECISION_CLASS, NOTHING_CLASS).
 DECISION_NAME = 'choose_initial_state'
-DECISION_CLASS = 'OperatorDecisionState'
 DECISION_AUTONOMY = 3  # Full: the operator confirms where to start unless in full autonomy
 NOTHING_NAME = 'nothing_to_do'
-NOTHING_CLASS = 'LogState'
 
 
 def generate_state_machine(automaton, system: str, config_dir: str | Path | None = None,

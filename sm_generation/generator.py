@@ -32,7 +32,7 @@ import logging
 
 from sm_generation.config import FlexBEConfig, StateConfig
 from sm_generation.errors import SMGenerationError
-from sm_generation.instantiation import OutcomeCondition, StateInstantiation
+from sm_generation.instantiation import DECISION_CLASS, NOTHING_CLASS, OutcomeCondition, StateInstantiation
 from sm_generation.layout import inner_positions, layered_positions
 from sm_generation.machine import (
     DECISION, NOTHING_TO_DO, AutomatonView, Machine, MachineState, Target, build_machine)
@@ -43,12 +43,10 @@ _LOG = logging.getLogger(__name__)
 NAME_SEPARATOR = '_and_'
 CONDITION_SEPARATOR = '__'
 SENSOR_EVENT_SUFFIX = '_true'
-# Helper states from flexbe_states, used where the automaton itself has no state.
+# The helper states' names (their classes: instantiation.DECISION_CLASS, NOTHING_CLASS).
 DECISION_NAME = 'choose_initial_state'
-DECISION_CLASS = 'OperatorDecisionState'
 DECISION_AUTONOMY = 3  # Full: the operator confirms where to start unless in full autonomy
 NOTHING_NAME = 'nothing_to_do'
-NOTHING_CLASS = 'LogState'
 
 
 def generate_from_config(automaton, config: FlexBEConfig, initial_conditions: list[str] | None = None,

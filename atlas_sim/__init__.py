@@ -23,7 +23,7 @@ Modules (MuJoCo is imported only by ``physics``, ``simulator``, ``rendering``)
 ``operator_data`` the data operator inputs provide (template id, target pose) and its checks.
 ``rendering``   ``FrameRenderer``, ``KeyFrameRecorder``, ``save_png``.
 ``robot``       the ``Robot`` protocol, ``SimulatedRobot``, ``make_simulator``, ``parse_faults``.
-``machine``     a StateInstantiation list as a validated tree (``load_machine``).
+``machine``     the executive's errors; ``load_machine`` (the shared ``sm_generation`` tree).
 ``executor``    runs a synthesized state machine on a robot (``execute_state_machine``).
 ``trace_check`` checks an executed trace against the specification and the goal order.
 ``closed_loop`` ``run_and_check``: execute, record key frames, check, draw the timeline.

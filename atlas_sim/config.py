@@ -3,7 +3,7 @@
 Two sections matter here:
 
 ``abstraction``  the discrete model shared with the specification compiler, read and
-                 validated by ``respec.abstraction`` (``RobotAbstraction``).
+                 validated by ``respec.robot.abstraction`` (``RobotAbstraction``).
 ``simulation``   how atlas_sim emulates the system (all keys optional)::
 
     simulation:
@@ -46,9 +46,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Dict, Mapping, Optional, Tuple
 
-from respec.abstraction import RobotAbstraction, abstraction_from_document
+from respec.robot.abstraction import RobotAbstraction, abstraction_from_document
 from respec.errors import CodedError, ErrorCode
-from respec.systems import read_config_file, system_config_path
+from respec.robot.files import read_config_file, system_config_path
 
 class SimulationConfigError(CodedError, ValueError):
     """The ``simulation:`` section is invalid; ``item`` names the offending key or capability."""

@@ -31,7 +31,7 @@ from dataclasses import dataclass, field
 from typing import Dict, Iterable, List, Mapping, Optional, Set
 
 from .config import SimulationConfigError
-from respec.abstraction import RobotAbstraction
+from respec.robot.abstraction import RobotAbstraction
 from respec.naming import COMPLETED, FAILED
 
 

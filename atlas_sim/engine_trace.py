@@ -30,7 +30,7 @@ import contextlib
 import threading
 
 from atlas_sim.executor import ExecutionResult, StateMapping, entered_step
-from atlas_sim.machine import load_machine
+from atlas_sim.machine import load_machine, next_target
 from atlas_sim.trace_check import OutcomeTracker, Trace, TraceStep
 
 
@@ -42,9 +42,9 @@ class EngineTraceRecorder:
         self.mapping = StateMapping(system, config_dir)
         self.simulator = simulator
         self.simulator_lock = simulator_lock or contextlib.nullcontext()
-        self.states = {child.name: child for child in self.root.children}
-        self.parts = {child.name: [self.mapping.part(node) for node in (child.children or [child])]
-                      for child in self.root.children}
+        self.states = {child.name: child for child in self.root.states}
+        self.parts = {child.name: [self.mapping.part(node) for node in (child.states or (child,))]
+                      for child in self.root.states}
         self.trace = Trace(sm_outcome_propositions=self.mapping.sm_outcome_propositions())
         self._lock = threading.Lock()
         snapshot = self._snapshot()
@@ -76,7 +76,7 @@ class EngineTraceRecorder:
 
     def returned(self, name: str, outcome: str) -> None:
         """Top-level state ``name`` returned ``outcome``."""
-        target = self.states[name].next_target(outcome)
+        target = next_target(self.states[name], outcome)
         snapshot = self._snapshot()
         with self._lock:
             self._observe(snapshot)

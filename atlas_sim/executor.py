@@ -26,7 +26,8 @@ whatever it still reports is recorded, so the trace check sees it.
 
 The robot is anything with the :class:`atlas_sim.robot.Robot` protocol: ``SimulatedRobot`` drives
 an ``AtlasSimulator`` directly; ``synthesis_manager.nodes.atlas_sim_robot.RosRobot`` drives the
-simulator node. The machine is read and validated by :mod:`atlas_sim.machine`.
+simulator node. The machine is the tree of :mod:`sm_generation.state_machine`, loaded by
+:mod:`atlas_sim.machine`.
 
     sim = make_simulator('atlas', initial_conditions=['stand_prep'])
     run = execute_state_machine(states, SimulatedRobot(sim), system='atlas')
@@ -41,14 +42,17 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Callable
 
-from atlas_sim.machine import (BEHAVIOR, CONCURRENCY, DECISION_STATE, LOG_STATE, ExecutionError, StateNode,
-                               UndeclaredOutcomeError, load_machine)
+from atlas_sim.machine import ExecutionError, UndeclaredOutcomeError, load_machine, next_target
 from atlas_sim.robot import CapabilityResult, Robot
 from atlas_sim.trace_check import OutcomeTracker, Trace, TraceStep
-from respec.abstraction import load_abstraction
+from respec.robot.abstraction import load_abstraction
 from respec.errors import ErrorCode
 from respec.naming import activated, is_activation, outcome_proposition
 from sm_generation.config import load_flexbe_config
+from sm_generation.instantiation import DECISION_CLASS, HELPER_STATE_CLASSES, StateInstantiation
+from sm_generation.state_machine import State
+
+BEHAVIOR = StateInstantiation.CLASS_BEHAVIOR
 
 # --- errors -----------------------------------------------------------------------------------
 
@@ -70,7 +74,7 @@ class ExecutionLimitError(ExecutionError):
 class Part:
     """A primitive state being run: on the robot (capability), a sensor, or a helper."""
 
-    node: StateNode
+    node: State
     kind: str                      # 'capability', 'sensor', 'helper'
     proposition: str = ''          # activation proposition or sensor name
     output_mapping: dict | None = None
@@ -99,8 +103,8 @@ class StateMapping:
             return (BEHAVIOR, behavior_class)
         return (state_class, tuple(parameter_values))
 
-    def part(self, node: StateNode) -> Part:
-        if node.state_class in (LOG_STATE, DECISION_STATE):
+    def part(self, node: State) -> Part:
+        if node.state_class in HELPER_STATE_CLASSES:
             return Part(node, 'helper')
         matches = self._by_key.get(self._key(node.state_class, node.behavior_class, node.parameter_values), [])
         if len(matches) > 1:  # same class and parameters: the state's name ('stand_2') says which
@@ -109,8 +113,8 @@ class StateMapping:
         if not matches:
             what = node.behavior_class if node.state_class == BEHAVIOR else \
                 f'{node.state_class}({", ".join(node.parameter_values)})'
-            raise UnmappedStateError(f'state {node.path!r} ({what}) matches no entry of flexbe.states of '
-                                     f'{self.flexbe.system!r}', item=node.path)
+            raise UnmappedStateError(f'state {node.state_path!r} ({what}) matches no entry of flexbe.states of '
+                                     f'{self.flexbe.system!r}', item=node.state_path)
         config = matches[0]
         kind = 'capability' if is_activation(config.proposition) else 'sensor'
         return Part(node, kind, config.proposition, dict(config.output_mapping))
@@ -144,10 +148,10 @@ class ExecutionResult:
                 'ticks': self.ticks}
 
 
-def entered_step(trace: Trace, state: StateNode, parts: list[Part], snapshot: dict,
+def entered_step(trace: Trace, state: State, parts: list[Part], snapshot: dict,
                  tracker: OutcomeTracker) -> TraceStep:
     """Append the step of top-level ``state`` (run as ``parts``) entered now to ``trace``."""
-    step = TraceStep(index=len(trace.steps), state=state.path, state_class=state.state_class,
+    step = TraceStep(index=len(trace.steps), state=state.state_path, state_class=state.state_class,
                      activated=sorted(p.proposition for p in parts if p.kind == 'capability'),
                      capabilities=[p.capability for p in parts if p.kind == 'capability'],
                      entered_at=snapshot['time'], mode_at_entry=snapshot['mode'],
@@ -179,8 +183,8 @@ class Executive:
         self.wall_deadline = None if max_wall_time is None else time.monotonic() + max_wall_time
         self.decide = decide or (lambda path, outcomes: outcomes[0])
         self.on_tick = on_tick
-        self.parts = {node.path: mapping.part(node) for state in self.root.children
-                      for node in (state.children or [state])}
+        self.parts = {node.state_path: mapping.part(node) for state in self.root.states
+                      for node in (state.states or (state,))}
         self.trace = Trace(sm_outcome_propositions=mapping.sm_outcome_propositions())
         self.running: dict[str, _Running] = {}   # capability -> latest request
         self.abandoned: list[_Running] = []
@@ -200,14 +204,14 @@ class Executive:
             raise
 
     def _run(self) -> ExecutionResult:
-        states = {child.name: child for child in self.root.children}
+        states = {child.name: child for child in self.root.states}
         current = states[self.root.initial_state_name]
         while True:
             if len(self.trace.steps) >= self.max_states:
-                raise ExecutionLimitError(f'no SM outcome after {self.max_states} states', item=current.path,
+                raise ExecutionLimitError(f'no SM outcome after {self.max_states} states', item=current.state_path,
                                           trace=self.trace)
             state_outcome = self._run_state(current)
-            target = current.next_target(state_outcome)
+            target = next_target(current, state_outcome)
             self.trace.steps[-1].state_outcome, self.trace.steps[-1].transition = state_outcome, target
             if target in self.root.outcomes:
                 self.trace.outcome = target
@@ -218,18 +222,18 @@ class Executive:
 
     # one top-level state ------------------------------------------------------------------------
 
-    def _run_state(self, state: StateNode) -> str:
-        parts = [self.parts[node.path] for node in (state.children or [state])]
+    def _run_state(self, state: State) -> str:
+        parts = [self.parts[node.state_path] for node in (state.states or (state,))]
         step = entered_step(self.trace, state, parts, self.robot.snapshot(), self.tracker)
         self._activate(step.capabilities)
         sensors_at_entry = dict(self.tracker.sensors)
         returned: dict[str, str] = {}          # part path -> state outcome returned
         while True:
             for part in parts:
-                if part.node.path not in returned:
+                if part.node.state_path not in returned:
                     outcome = self._returned(part, sensors_at_entry)
                     if outcome is not None:
-                        returned[part.node.path] = outcome
+                        returned[part.node.state_path] = outcome
             outcome = self._state_outcome(state, returned)
             if outcome is not None:
                 break
@@ -256,8 +260,8 @@ class Executive:
 
     def _returned(self, part: Part, sensors_at_entry: dict) -> str | None:
         if part.kind == 'helper':
-            if part.node.state_class == DECISION_STATE:
-                return self.decide(part.node.path, list(part.node.outcomes))
+            if part.node.state_class == DECISION_CLASS:
+                return self.decide(part.node.state_path, list(part.node.outcomes))
             return part.node.outcomes[0] if part.node.outcomes else None
         if part.kind == 'sensor':  # sensors are events: the reading turns true
             if self.tracker.sensors.get(part.proposition) and not sensors_at_entry.get(part.proposition):
@@ -269,18 +273,18 @@ class Executive:
         proposition = outcome_proposition(part.capability, result.outcome)
         outcomes = part.output_mapping.get(proposition)
         if not outcomes:
-            raise UndeclaredOutcomeError(f'state {part.node.path!r} has no outcome for {proposition!r} in '
-                                         'flexbe.states', item=part.node.path, trace=self.trace)
+            raise UndeclaredOutcomeError(f'state {part.node.state_path!r} has no outcome for {proposition!r} in '
+                                         'flexbe.states', item=part.node.state_path, trace=self.trace)
         if outcomes[0] not in part.node.outcomes:
             raise UndeclaredOutcomeError(
-                f'state {part.node.path!r} returned {outcomes[0]!r} ({proposition}: {result.reason}), which '
-                f'is not one of its outcomes {part.node.outcomes}', item=part.node.path, trace=self.trace)
+                f'state {part.node.state_path!r} returned {outcomes[0]!r} ({proposition}: {result.reason}), which '
+                f'is not one of its outcomes {part.node.outcomes}', item=part.node.state_path, trace=self.trace)
         return outcomes[0]
 
     @staticmethod
-    def _state_outcome(state: StateNode, returned: dict[str, str]) -> str | None:
-        if state.state_class != CONCURRENCY:
-            return returned.get(state.path)
+    def _state_outcome(state: State, returned: dict[str, str]) -> str | None:
+        if state.state_class != StateInstantiation.CLASS_CONCURRENCY:
+            return returned.get(state.state_path)
         by_name = {path.rsplit('/', 1)[-1]: outcome for path, outcome in returned.items()}
         for outcome, condition in state.conditions:  # FlexBE returns the first that holds
             if all(by_name.get(name) == wanted for name, wanted in condition):

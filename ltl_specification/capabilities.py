@@ -1,6 +1,6 @@
 """GR(1) specifications for robots described by capabilities (CNU's flexbe_synthesis format).
 
-Our encoding of a capability system (see ``respec.capabilities`` for the file format). For
+Our encoding of a capability system (see ``respec.robot.cnu`` for the file format). For
 each capability ``c``: a system proposition ``c_a`` (c runs) and one environment proposition
 per transition outcome its FlexBE outcomes mean (``c_c`` completed, ``c_f`` failure).
 
@@ -32,12 +32,12 @@ from __future__ import annotations
 
 from typing import Mapping, Sequence
 
-from respec.capabilities import CapabilityConfigError, CapabilitySystem, Literal, parse_literal
+from respec.robot.cnu import CapabilityConfigError, CapabilitySystem, Literal, parse_literal
 from respec.ltl import TRUE, Formula, conj, disj, iff, implies, neg, next_, var
 from respec.naming import COMPLETED, FAILED, activation, did_you_mean, memory
 from respec.parsing import IntegerVariable
 from respec.spec import FORMULA_SECTIONS, GR1Specification
-from respec.state_library import StateClass, capability_outcomes
+from respec.robot.state_library import StateClass, capability_outcomes
 
 from ltl_specification.errors import (InvalidFormulaError, InvalidGoalsError, InvalidInitialConditionsError,
                                       UnknownPropositionError)

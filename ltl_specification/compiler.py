@@ -44,13 +44,13 @@ from dataclasses import dataclass, field, fields
 from pathlib import Path
 from typing import Mapping, Sequence
 
-from respec.abstraction import AbstractionConfigError, RobotAbstraction, load_abstraction
+from respec.robot import RobotSystem, robot_system
+from respec.robot.abstraction import AbstractionConfigError, RobotAbstraction, abstraction_from_document
 from respec.components import (
     SOURCE_CUSTOM, FormulaGroup, action_groups, action_specification, control_mode_groups,
     control_mode_specification, goal_groups, goal_specification, initial_conditions_groups,
     initial_conditions_specification,
 )
-from respec.capabilities import CapabilitySystem, capability_system_of
 from respec.errors import quoted
 from respec.ltl import variables
 from respec.naming import (DEFAULT_SM_OUTCOMES, FAILED, FINISHED, activation, did_you_mean, outcome_proposition,
@@ -60,8 +60,8 @@ from respec.spec import (
     FORMULA_SECTIONS, PROPOSITION_SECTIONS, SECTIONS, GR1Specification, PropositionConflictError,
     merge_specifications,
 )
-from respec.state_library import StateClass, workspace_state_library
-from respec.systems import ConfigFileInvalidError, SystemNotFoundError
+from respec.robot.state_library import StateClass, workspace_state_library
+from respec.robot.files import ConfigFileInvalidError, SystemNotFoundError
 
 from ltl_specification.capabilities import compile_capability_task
 from ltl_specification.errors import (
@@ -69,7 +69,7 @@ from ltl_specification.errors import (
     InvalidSmOutcomesError, UnknownPropositionError, UnknownSystemError,
 )
 from ltl_specification.pertinence import Pertinence, infer_pertinence
-from ltl_specification.reachability import config_file, unreachable_goal_modes
+from ltl_specification.reachability import unreachable_goal_modes
 
 SUPPORTED_SM_OUTCOMES = (DEFAULT_SM_OUTCOMES, (FINISHED,))
 
@@ -99,14 +99,15 @@ class CompiledSpecification(GR1Specification):
         return explain(self)
 
 
-def compile_task(system: str, initial_conditions: Sequence[str] | str, goals: Sequence[str] | str,
+def compile_task(system: RobotSystem | str, initial_conditions: Sequence[str] | str, goals: Sequence[str] | str,
                  sm_outcomes: Sequence[str] = DEFAULT_SM_OUTCOMES, strict_order: bool = True,
                  custom_ltl: Mapping[str, Sequence[str]] | None = None,
                  config_dir: str | Path | None = None,
                  state_library: Mapping[str, StateClass] | None = None) -> CompiledSpecification:
     """Compile the GR(1) specification of reaching ``goals`` from ``initial_conditions``.
 
-    A system described by CNU capability files (``respec.capabilities``) is compiled by
+    ``system`` is a RobotSystem, or the name of one in ``config_dir`` (default ``config/``).
+    A system described by CNU capability files (``respec.robot.cnu``) is compiled by
     ``ltl_specification.capabilities``; its state classes are checked against
     ``state_library`` (default: the FlexBE state packages on ``AMENT_PREFIX_PATH``), and
     ``sm_outcomes`` and ``strict_order`` do not apply (its mappings name its outcomes).
@@ -118,20 +119,20 @@ def compile_task(system: str, initial_conditions: Sequence[str] | str, goals: Se
     env_props / sys_props, new proposition names) that are conjoined to the result.
     Raises a ``SpecificationError`` subclass naming the offending item.
     """
-    capability_system = load_capability_system(system, config_dir)
-    if capability_system is not None:
+    system = load_task_system(system, config_dir)
+    if system.is_capability_system:
         library = workspace_state_library() if state_library is None else state_library
         return CompiledSpecification(**_spec_fields(compile_capability_task(
-            capability_system, library, _names(initial_conditions, 'initial conditions', InvalidInitialConditionsError),
+            system.capabilities, library, _names(initial_conditions, 'initial conditions', InvalidInitialConditionsError),
             _names(goals, 'goals', InvalidGoalsError), custom_ltl)))
-    abstraction = load_task_abstraction(system, config_dir)
+    abstraction = load_task_abstraction(system)
     sm_outcomes = _check_sm_outcomes(sm_outcomes)
     goals = _check_goals(abstraction, goals)
     initial_conditions = _check_initial_conditions(abstraction, initial_conditions)
     initial_mode = _initial_mode(abstraction, initial_conditions)
     custom_formulas = _parse_custom_ltl(custom_ltl)
     mentioned, sensors = _items_mentioned(abstraction, custom_formulas)
-    _check_goal_modes_reachable(abstraction, goals, initial_mode, config_file(system, config_dir))
+    _check_goal_modes_reachable(abstraction, goals, initial_mode, system.config_file)
 
     pertinence = infer_pertinence(abstraction, initial_mode, initial_conditions, goals, mentioned)
     parts, groups = _sub_specifications(abstraction, pertinence, initial_conditions, goals, sm_outcomes,
@@ -145,7 +146,7 @@ def compile_task(system: str, initial_conditions: Sequence[str] | str, goals: Se
         raise InvalidFormulaError(
             f'custom LTL declares {quoted(error.item)} with the wrong kind: {error}', item=error.item) from error
     _check_custom_scopes(spec, custom_ltl)
-    provenance = Provenance(system, tuple(initial_conditions), tuple(goals), sm_outcomes, strict_order,
+    provenance = Provenance(system.name, tuple(initial_conditions), tuple(goals), sm_outcomes, strict_order,
                             pertinence, tuple(s for s in SECTIONS if custom_ltl and custom_ltl.get(s)),
                             tuple(groups))
     return CompiledSpecification(**_spec_fields(spec), provenance=provenance)
@@ -214,22 +215,25 @@ def explain(spec: CompiledSpecification) -> str:
 
 # --- request validation ---------------------------------------------------------------------
 
-def load_capability_system(system: str, config_dir) -> CapabilitySystem | None:
+def load_task_system(system: RobotSystem | str, config_dir=None) -> RobotSystem:
+    """The task's robot system, with the compiler's codes for an unknown or invalid one."""
     try:
-        return capability_system_of(system, config_dir)
-    except SystemNotFoundError as error:
-        raise UnknownSystemError(str(error), item=error.item) from error
-    except ConfigFileInvalidError as error:
-        raise InvalidAbstractionError(str(error), item=error.item) from error
-
-
-def load_task_abstraction(system: str, config_dir) -> RobotAbstraction:
-    try:
-        return load_abstraction(system, config_dir)
+        return robot_system(system, config_dir)
     except SystemNotFoundError as error:
         raise UnknownSystemError(str(error), item=error.item) from error
     except (AbstractionConfigError, ConfigFileInvalidError) as error:
         raise InvalidAbstractionError(str(error), item=error.item) from error
+
+
+def load_task_abstraction(system: RobotSystem | str, config_dir=None) -> RobotAbstraction:
+    """The abstraction of an abstraction-kind system (as ``load_task_system``)."""
+    system = load_task_system(system, config_dir)
+    if system.abstraction is None:
+        try:
+            abstraction_from_document(system.sections, system.name)  # names what is missing
+        except AbstractionConfigError as error:
+            raise InvalidAbstractionError(str(error), item=error.item) from error
+    return system.abstraction
 
 
 def _names(value: Sequence[str] | str | None, what: str, error) -> list[str]:

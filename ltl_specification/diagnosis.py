@@ -21,7 +21,7 @@ import itertools
 import threading
 from dataclasses import asdict, dataclass, field
 
-from respec.abstraction import RobotAbstraction
+from respec.robot.abstraction import RobotAbstraction
 from respec.naming import DEFAULT_SM_OUTCOMES, activation, memory, outcome_proposition
 from respec.components import (SOURCE_ACTIONS, SOURCE_CONTROL_MODES, SOURCE_CUSTOM, SOURCE_GOALS,
                                SOURCE_INITIAL_CONDITIONS, SOURCE_SM_OUTCOMES, FormulaGroup)
@@ -29,7 +29,7 @@ from respec.ltl import Formula, evaluate, mentions_next, to_infix, variables
 from ltl_synthesizer.errors import SynthesisCancelledError
 from ltl_synthesizer.unrealizable_core import environment_play, unrealizable_core
 
-from ltl_specification.compiler import CompiledSpecification, compile_task, load_task_abstraction
+from ltl_specification.compiler import CompiledSpecification, compile_task, load_task_abstraction, load_task_system
 from ltl_specification.reachability import Finding, config_file, unreachable_goal_modes
 
 PLAY_LENGTH = 8
@@ -105,30 +105,32 @@ def precheck(spec: CompiledSpecification, config_dir=None) -> list[Finding]:
     return findings
 
 
-def goal_findings(system: str, initial_conditions, goals, strict_order: bool = True,
+def goal_findings(system, initial_conditions, goals, strict_order: bool = True,
                   config_dir=None) -> list[Finding]:
     """The goal part of the pre-check, without compiling (cheap enough to run as a form changes).
 
-    Names that are not actions or modes of ``system`` are skipped (compilation reports them).
+    ``system`` is a RobotSystem or its name. Names that are not actions or modes of it are
+    skipped (compilation reports them).
     """
-    abstraction = load_task_abstraction(system, config_dir)
+    system = load_task_system(system, config_dir)
+    abstraction = load_task_abstraction(system)
     modes = [i for i in initial_conditions if abstraction.kind_of(i) == 'control_mode']
     initial_mode = modes[0] if modes else abstraction.initial_mode
     if initial_mode is None:
         return []
     known = [g for g in goals if abstraction.kind_of(g) is not None]
-    return unreachable_goal_modes(abstraction, known, initial_mode, strict_order, config_file(system, config_dir))
+    return unreachable_goal_modes(abstraction, known, initial_mode, strict_order, system.config_file)
 
 
-def impossible_next_goals(system: str, initial_conditions, goals, strict_order: bool = True,
+def impossible_next_goals(system, initial_conditions, goals, strict_order: bool = True,
                           config_dir=None) -> dict[str, str]:
     """For every action or mode that is not a goal yet: why it cannot be the next goal (if so)."""
-    abstraction = load_task_abstraction(system, config_dir)
+    system = load_task_system(system, config_dir)
     impossible = {}
-    for candidate in abstraction.items():
+    for candidate in load_task_abstraction(system).items():
         if candidate in goals:
             continue
-        findings = goal_findings(system, initial_conditions, [*goals, candidate], strict_order, config_dir)
+        findings = goal_findings(system, initial_conditions, [*goals, candidate], strict_order)
         last = [f for f in findings if f.item == candidate]
         if last:
             impossible[candidate] = last[0].sentence

@@ -42,21 +42,22 @@ def asks_for_robot_state(initial_conditions: Sequence[str]) -> bool:
     return True
 
 
-def reads_robot_state(initial_conditions: Sequence[str], system: str, config_dir=None) -> bool:
+def reads_robot_state(initial_conditions: Sequence[str], system, config_dir=None) -> bool:
     """Whether the server must read the robot's state for this request (``asks_for_robot_state``).
 
-    A robot described by CNU's capability files keeps CNU's meaning of no initial conditions:
-    its specification already gives them (``current`` still asks the robot).
+    ``system`` is a RobotSystem or its name. A robot described by CNU's capability files keeps
+    CNU's meaning of no initial conditions: its specification already gives them (``current``
+    still asks the robot).
     """
-    from respec.capabilities import capability_system_of
     from respec.errors import CodedError
+    from respec.robot import robot_system
 
     if not asks_for_robot_state(initial_conditions):
         return False
     if CURRENT in initial_conditions:
         return True
     try:
-        return capability_system_of(system, config_dir) is None
+        return not robot_system(system, config_dir).is_capability_system
     except CodedError:  # an unknown or broken system: compiling the task reports it
         return True
 

@@ -27,7 +27,7 @@ from collections import deque
 from dataclasses import dataclass, field
 from typing import Sequence
 
-from respec.abstraction import RobotAbstraction
+from respec.robot.abstraction import RobotAbstraction
 
 from ltl_specification.errors import InvalidGoalsError
 

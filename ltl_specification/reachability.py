@@ -11,8 +11,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
-from respec.abstraction import RobotAbstraction
-from respec.systems import system_config_path
+from respec.robot.abstraction import RobotAbstraction
+from respec.robot.files import system_config_path
 
 from ltl_specification.pertinence import mode_distances
 

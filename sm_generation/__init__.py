@@ -12,17 +12,19 @@ Modules:
     machine        automaton -> abstract machine (observations, pass-through, exits)
     reduction      merging bisimilar states
     layout         positions for the FlexBE editor
-    generator      generate_state_machine
-    validation     validate_state_machine
+    generator      the engine: automaton + FlexBE mapping -> StateInstantiation list
+    for_system     generate_state_machine: the front door, the mapping chosen by the system's kind
+    capabilities   the FlexBE mapping of a CNU capability system
+    state_machine  StateMachine (the list as a validated tree), validate_state_machine
     export         YAML, JSON, Graphviz DOT, SVG/PNG
     cli            ``behavior-synthesis generate-sm`` / ``python -m sm_generation``
 """
 
 from sm_generation.automaton_io import Automaton, AutomatonState, load_automaton
 from sm_generation.errors import SMGenerationError
-from sm_generation.generator import generate_state_machine
+from sm_generation.for_system import generate_state_machine
 from sm_generation.instantiation import OutcomeCondition, StateInstantiation, count_states
-from sm_generation.validation import validate_state_machine
+from sm_generation.state_machine import StateMachine, validate_state_machine
 
 __all__ = ['Automaton', 'AutomatonState', 'OutcomeCondition', 'count_states', 'SMGenerationError', 'StateInstantiation',
-           'generate_state_machine', 'load_automaton', 'validate_state_machine']
+           'StateMachine', 'generate_state_machine', 'load_automaton', 'validate_state_machine']

@@ -17,10 +17,10 @@ import re
 from typing import Mapping
 
 from respec.automaton import Automaton, AutomatonState
-from respec.capabilities import CapabilitySystem
+from respec.robot.cnu import CapabilitySystem
 from respec.naming import activation
 from respec.parsing import IntegerVariable
-from respec.state_library import StateClass, capability_outcomes
+from respec.robot.state_library import StateClass, capability_outcomes
 from sm_generation.config import FlexBEConfig, StateConfig
 from sm_generation.generator import generate_from_config
 from sm_generation.instantiation import StateInstantiation

@@ -18,8 +18,8 @@ from respec.naming import parse_names
 from sm_generation.automaton_io import load_automaton
 from sm_generation.errors import SMGenerationError
 from sm_generation.export import RENDER_FORMATS, RenderError, render, to_dot, to_json, to_yaml
-from sm_generation.generator import generate_state_machine
-from sm_generation.validation import validate_state_machine
+from sm_generation.for_system import generate_state_machine
+from sm_generation.state_machine import validate_state_machine
 
 FORMATS = ('yaml', 'json', 'dot', *RENDER_FORMATS)
 

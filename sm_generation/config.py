@@ -39,7 +39,8 @@ from pathlib import Path
 
 from respec.naming import activated
 from sm_generation.instantiation import StateInstantiation
-from respec.systems import ConfigFileInvalidError, SystemNotFoundError, load_section
+from respec.robot import RobotSystem, robot_system
+from respec.robot.files import ConfigFileInvalidError, SystemNotFoundError
 from sm_generation.errors import (AutonomyConfigInvalidError, FlexBEConfigInvalidError, NoSystemConfigError,
                                   SMGenerationError, StateConfigInvalidError, SystemConfigNotFoundError,
                                   UserdataConfigInvalidError)
@@ -122,18 +123,33 @@ def input_request_capabilities(config: FlexBEConfig) -> dict[int, str]:
     return capabilities
 
 
-def load_flexbe_config(system: str, config_dir: str | Path | None = None) -> FlexBEConfig:
-    """Load and validate the ``flexbe:`` section of ``config/<system>.yaml``."""
+def generation_system(system: RobotSystem | str, config_dir: str | Path | None = None) -> RobotSystem:
+    """``system``, or the system of that name, with sm_generation's codes when it cannot be found."""
+    if isinstance(system, RobotSystem):
+        return system
     if config_dir is not None and not Path(config_dir).is_dir():
         raise SystemConfigNotFoundError(f'configuration directory {config_dir} does not exist',
                                         str(config_dir))
     try:
-        section = load_section(system, 'flexbe', config_dir)
+        return robot_system(system, config_dir)
     except SystemNotFoundError as error:
         raise NoSystemConfigError(str(error), error.item or system) from error
     except ConfigFileInvalidError as error:
         raise FlexBEConfigInvalidError(str(error), error.item) from error
-    return parse_flexbe_config(section, system)
+
+
+def flexbe_config(system: RobotSystem) -> FlexBEConfig:
+    """The validated ``flexbe:`` section of an abstraction-kind system."""
+    try:
+        section = system.section('flexbe')
+    except ConfigFileInvalidError as error:
+        raise FlexBEConfigInvalidError(str(error), error.item) from error
+    return parse_flexbe_config(section, system.name)
+
+
+def load_flexbe_config(system: RobotSystem | str, config_dir: str | Path | None = None) -> FlexBEConfig:
+    """Load and validate the ``flexbe:`` section of ``config/<system>.yaml``."""
+    return flexbe_config(generation_system(system, config_dir))
 
 
 def parse_flexbe_config(section: dict, system: str = '') -> FlexBEConfig:

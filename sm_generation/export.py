@@ -20,6 +20,7 @@ import yaml
 from respec.errors import CodedError, ErrorCode
 from respec.naming import FINISHED
 from sm_generation.instantiation import StateInstantiation
+from sm_generation.state_machine import State, StateMachine
 
 RENDER_FORMATS = ('svg', 'png')
 # The machine's success outcome is drawn green, its other outcomes (and arrows to them) red.
@@ -86,12 +87,11 @@ def to_dot(states: list[StateInstantiation]) -> str:
     SVG elements get ids ``state:<name>``, ``outcome:<name>`` (copies: ``outcome:<name>:<column>``)
     and ``edge:<state>-><target>``, so a page can find, highlight and explain them.
     """
-    root = next((s for s in states if s.state_path == '/'), None)
-    top = [s for s in states if s.parent_path == '/' and s.state_class != StateInstantiation.CLASS_OUTCOME]
-    inner = {s.state_path: [c for c in states if c.parent_path == s.state_path] for s in top}
-    machine_outcomes = root.outcomes if root else []
+    machine = StateMachine.from_instantiations(states)
+    top = list(machine.states)
+    machine_outcomes = machine.outcomes
     names = {s.name for s in top}
-    columns = _grid(top, root.initial_state_name if root else '')
+    columns = _grid(top, machine.initial_state_name)
     lines = ['digraph state_machine {', '  rankdir=TB;', '  nodesep=0.35;', f'  ranksep={0.3 if columns else 0.55};',
              '  graph [fontname="Helvetica", bgcolor="transparent"];',
              '  node [shape=plain, fontname="Helvetica", fontsize=14];',
@@ -99,8 +99,7 @@ def to_dot(states: list[StateInstantiation]) -> str:
     column_of = {state: index for index, column in enumerate(columns) for state in column}
     for state in top:
         failing = _failing_groups(state, names)
-        label = (_container_label(state, inner[state.state_path], failing) if inner[state.state_path] else
-                 _state_label(state, failing))
+        label = _container_label(state, failing) if state.states else _state_label(state, failing)
         css = f'state column-{column_of[state.name]}' if columns else 'state'  # its failure outcome's copy
         lines.append(f'  {_quote("state:" + state.name)} [id={_quote("state:" + state.name)}, '
                      f'class="{css}", label=<{label}>];')
@@ -116,9 +115,8 @@ def to_dot(states: list[StateInstantiation]) -> str:
     lines.append('  }')
     if columns:
         lines += _grid_lines(columns, copies, FINISHED in machine_outcomes)
-    if root and root.initial_state_name:
-        lines.append('  "start" [id="start", shape=circle, style=filled, fillcolor="#4a5560", label="", width=0.18];')
-        lines.append(f'  "start" -> {_quote("state:" + root.initial_state_name)}:n [id="edge:start", label=" initial"];')
+    lines.append('  "start" [id="start", shape=circle, style=filled, fillcolor="#4a5560", label="", width=0.18];')
+    lines.append(f'  "start" -> {_quote("state:" + machine.initial_state_name)}:n [id="edge:start", label=" initial"];')
     for state in top:
         for index, (target, outcomes) in enumerate(outcome_groups(state)):
             head = ('state:' + target if target in names else
@@ -171,7 +169,7 @@ def _outcome_node(outcome: str, column: int) -> str:
     return f'outcome:{outcome}' if column == 0 else f'outcome:{outcome}:{column}'
 
 
-def _grid(top: list[StateInstantiation], initial: str) -> list[list[str]]:
+def _grid(top: list[State], initial: str) -> list[list[str]]:
     """The top-level states in reading order (the main path from ``initial`` along each state's
     first transition to another state, then the rest in list order), cut into columns about as
     tall as the grid is wide in boxes; [] for a machine short enough for one column."""
@@ -223,14 +221,13 @@ def _state_label(state: StateInstantiation, failing: set[int] = frozenset()) -> 
             f'</FONT></TD></TR><TR>{_outcome_cells(state, failing)}</TR></TABLE>')
 
 
-def _container_label(state: StateInstantiation, children: list[StateInstantiation],
-                     failing: set[int] = frozenset()) -> str:
+def _container_label(state: StateMachine, failing: set[int] = frozenset()) -> str:
     columns = max(1, len(outcome_groups(state)))
     boxes = ''.join(
         f'<TD><TABLE BORDER="1" CELLBORDER="0" CELLSPACING="0" CELLPADDING="4" STYLE="ROUNDED" BGCOLOR="white">'
         f'<TR><TD><B>{_html(child.name)}</B></TD></TR><TR><TD><FONT POINT-SIZE="11" COLOR="#5a6570">'
         f'{_html(_class_label(child))}</FONT></TD></TR><TR><TD><FONT POINT-SIZE="10" COLOR="#5a6570">'
-        f'{_html(", ".join(child.outcomes))}</FONT></TD></TR></TABLE></TD>' for child in children)
+        f'{_html(", ".join(child.outcomes))}</FONT></TD></TR></TABLE></TD>' for child in state.states)
     return (f'<TABLE BORDER="1" CELLBORDER="0" CELLSPACING="0" CELLPADDING="5" STYLE="ROUNDED" BGCOLOR="#f4f0fa">'
             f'<TR><TD COLSPAN="{columns}"><B>{_html(state.name)}</B> <FONT POINT-SIZE="11" COLOR="#5a6570">'
             f'(concurrency container)</FONT></TD></TR>'

@@ -31,12 +31,11 @@ from pathlib import Path
 
 from sm_generation.config import FlexBEConfig
 from sm_generation.errors import SMGenerationError, StateConfigInvalidError
-from sm_generation.generator import DECISION_CLASS, NOTHING_CLASS
-from sm_generation.instantiation import StateInstantiation
+from sm_generation.instantiation import HELPER_STATE_CLASSES, StateInstantiation
 from sm_generation.layout import container_outcome_positions
+from sm_generation.state_machine import State, StateMachine
 
-FLEXBE_STATES_PACKAGE = 'flexbe_states'
-HELPER_STATE_CLASSES = (DECISION_CLASS, NOTHING_CLASS)  # the generator's, from flexbe_states
+FLEXBE_STATES_PACKAGE = 'flexbe_states'  # where the generator's helper states come from
 AUTONOMY_NAMES = {0: 'Autonomy.Off', 1: 'Autonomy.Low', 2: 'Autonomy.High', 3: 'Autonomy.Full'}
 DEFAULT_PACKAGE = 'synthesized_flexbe_behaviors'
 ZIP_DATE = (2020, 1, 1, 0, 0, 0)  # same machine, same archive bytes
@@ -119,7 +118,7 @@ def behavior_package(states: list[StateInstantiation], config: FlexBEConfig, beh
     """The behavior package for ``states`` (a generated StateInstantiation list)."""
     check_package_name(package)
     check_behavior_name(behavior_name)
-    machine = _Machine(states)
+    machine = StateMachine.from_instantiations(states)
     description = description or f'Synthesized for {config.system}.'
     module = behavior_module_name(behavior_name)
     class_name = behavior_class_name(behavior_name)
@@ -136,53 +135,6 @@ def behavior_package(states: list[StateInstantiation], config: FlexBEConfig, beh
     }
     return BehaviorPackage(package=package, behavior_name=behavior_name, class_name=class_name,
                            module=module, files=files)
-
-
-class _Machine:
-    """The StateInstantiation list, indexed: root, containers and their children."""
-
-    def __init__(self, states: list[StateInstantiation]):
-        roots = [s for s in states if s.state_path == '/']
-        if len(roots) != 1:
-            raise SMGenerationError('the state machine needs exactly one root entry '
-                                    f"(state_path '/'), found {len(roots)}", '/')
-        self.root = roots[0]
-        self.children: dict[str, list[StateInstantiation]] = {}
-        self.outcome_entries = []
-        for state in states:
-            if state is self.root:
-                continue
-            if state.state_class == StateInstantiation.CLASS_OUTCOME:
-                self.outcome_entries.append(state)
-                continue
-            self.children.setdefault(state.parent_path, []).append(state)
-        unsupported = [s for s in states if s.state_class in (StateInstantiation.CLASS_STATEMACHINE,
-                                                             StateInstantiation.CLASS_PRIORITY) and s is not self.root]
-        if unsupported:
-            raise SMGenerationError(f'{unsupported[0].state_class} containers inside '
-                                    'the machine are not exported', unsupported[0].state_path)
-
-    def containers(self) -> list[StateInstantiation]:
-        return [s for group in self.children.values() for s in group
-                if s.state_class == StateInstantiation.CLASS_CONCURRENCY]
-
-    def primitives(self) -> list[StateInstantiation]:
-        return [s for group in self.children.values() for s in group
-                if s.state_class not in (StateInstantiation.CLASS_CONCURRENCY, StateInstantiation.CLASS_BEHAVIOR)]
-
-    def behaviors(self) -> list[StateInstantiation]:
-        return sorted((s for group in self.children.values() for s in group
-                       if s.state_class == StateInstantiation.CLASS_BEHAVIOR), key=lambda s: s.state_path)
-
-    def userdata_keys(self) -> list[str]:
-        """Every key some state remaps to: the root machine holds them all."""
-        return sorted({key for group in self.children.values() for s in group for key in s.userdata_remapping})
-
-    def ordered_children(self, container: StateInstantiation) -> list[StateInstantiation]:
-        """Initial state first, then by name (the editor's order)."""
-        children = sorted(self.children.get(container.state_path, []), key=lambda s: s.name)
-        initial = [s for s in children if s.name == container.initial_state_name]
-        return initial + [s for s in children if s not in initial]
 
 
 # --- behavior code -------------------------------------------------------------------------------
@@ -207,7 +159,7 @@ def _behavior_import(state: StateInstantiation, config: FlexBEConfig) -> str:
             f'import {behavior_class_name(state.behavior_class)}')
 
 
-def _behavior_code(machine: _Machine, config: FlexBEConfig, behavior_name: str, class_name: str,
+def _behavior_code(machine: StateMachine, config: FlexBEConfig, behavior_name: str, class_name: str,
                    description: str, author: str, date: str) -> str:
     state_classes = sorted({s.state_class for s in machine.primitives()})
     imports = sorted({f'from flexbe_core import {name}' for name in CORE_IMPORTS}
@@ -241,7 +193,7 @@ def _behavior_code(machine: _Machine, config: FlexBEConfig, behavior_name: str, 
         *(f'{INDENT * 2}{name}.initialize_ros(node)' for name in state_classes), '',
         f'{INDENT * 2}# references to used behaviors',
         *(f"{INDENT * 2}self.add_behavior({behavior_class_name(s.behavior_class)}, '{s.state_path[1:]}', node)"
-          for s in machine.behaviors()), '',
+          for s in sorted(machine.behaviors(), key=lambda s: s.state_path)), '',
         f'{INDENT * 2}# Additional initialization code can be added inside the following tags',
         f'{INDENT * 2}# [MANUAL_INIT]', '', f'{INDENT * 2}# [/MANUAL_INIT]', '',
         f'{INDENT * 2}# Behavior comments:', '',
@@ -256,37 +208,35 @@ def _positions(entries) -> str:
     return ', '.join(f'x:{round(e.position[0])} y:{round(e.position[1])}' for e in entries)
 
 
-def _container_variables(machine: _Machine) -> dict[str, str]:
+def _container_variables(machine: StateMachine) -> dict[str, str]:
     return {c.state_path: f'_sm_{c.name.lower()}_{index}' for index, c in enumerate(machine.containers())}
 
 
-def _create_method(machine: _Machine, defaults: dict[str, str]) -> list[str]:
+def _create_method(machine: StateMachine, defaults: dict[str, str]) -> list[str]:
     body = INDENT * 2
-    root = machine.root
     outcome_entries = {e.name: e for e in machine.outcome_entries}
-    placed = [outcome_entries[o] for o in root.outcomes if o in outcome_entries]
+    placed = [outcome_entries[o] for o in machine.outcomes if o in outcome_entries]
     lines = [f'{INDENT}def create(self):', f'{body}"""Create state machine."""', f'{body}# Root state machine']
     if placed:
         lines.append(f'{body}# {_positions(placed)}')
     # The root's input keys come from outside (the behavior's userdata, with the configured
     # defaults); the other keys are written by states before they are read.
-    keys = f', input_keys={_list(root.input_keys)}' if root.input_keys else ''
-    lines.append(f'{body}_state_machine = OperatableStateMachine(outcomes={_list(root.outcomes)}{keys})')
-    lines += [f'{body}_state_machine.userdata.{key} = {defaults.get(key, "None")}' for key in machine.userdata_keys()]
+    keys = f', input_keys={_list(machine.input_keys)}' if machine.input_keys else ''
+    lines.append(f'{body}_state_machine = OperatableStateMachine(outcomes={_list(machine.outcomes)}{keys})')
+    lines += [f'{body}_state_machine.userdata.{key} = {defaults.get(key, "None")}' for key in machine.remapped_keys()]
     lines += ['', f'{body}# Additional creation code can be added inside the following tags',
               f'{body}# [MANUAL_CREATE]', '', f'{body}# [/MANUAL_CREATE]', '']
     variables = _container_variables(machine)
     for container in machine.containers():
-        lines += _container_definition(container, variables[container.state_path], machine, variables)
+        lines += _container_definition(container, variables[container.state_path], variables)
     lines.append(f'{body}with _state_machine:')
-    for state in machine.ordered_children(root):
+    for state in machine.ordered_states():
         lines += _add_state(state, variables)
     lines += [f'{body}return _state_machine', '']
     return lines
 
 
-def _container_definition(container: StateInstantiation, variable: str, machine: _Machine,
-                          variables: dict[str, str]) -> list[str]:
+def _container_definition(container: StateMachine, variable: str, variables: dict[str, str]) -> list[str]:
     body = INDENT * 2
     head = f'{body}{variable} = ConcurrencyContainer('
     pad = ' ' * len(head)
@@ -308,12 +258,12 @@ def _container_definition(container: StateInstantiation, variable: str, machine:
     lines += [f'{condition_pad}{condition},' for condition in conditions[:-1]]
     lines += [f'{condition_pad}{conditions[-1]}', f'{condition_pad}])', '']
     lines.append(f'{body}with {variable}:')
-    for child in machine.ordered_children(container):
+    for child in container.ordered_states():
         lines += _add_state(child, variables)
     return lines
 
 
-def _add_state(state: StateInstantiation, variables: dict[str, str]) -> list[str]:
+def _add_state(state: State, variables: dict[str, str]) -> list[str]:
     pad = STATE_INDENT + ' ' * len(ADD_CALL)
     if state.state_class == StateInstantiation.CLASS_CONCURRENCY:
         implementation = variables[state.state_path]
@@ -348,7 +298,7 @@ def _list(names) -> str:
 
 # --- package files -------------------------------------------------------------------------------
 
-def _package_xml(package: str, machine: _Machine, config: FlexBEConfig, description: str) -> str:
+def _package_xml(package: str, machine: StateMachine, config: FlexBEConfig, description: str) -> str:
     depends = sorted({'flexbe_core', FLEXBE_STATES_PACKAGE}
                      | {config.state_package(s.state_class) or FLEXBE_STATES_PACKAGE for s in machine.primitives()
                         if s.state_class not in HELPER_STATE_CLASSES}
@@ -378,7 +328,7 @@ def _setup_py(package: str) -> str:
         '    ],', "    install_requires=['setuptools'],", '    zip_safe=True,', ')', ''])
 
 
-def _manifest(package: str, module: str, class_name: str, behavior_name: str, machine: _Machine,
+def _manifest(package: str, module: str, class_name: str, behavior_name: str, machine: StateMachine,
               author: str, date: str, description: str) -> str:
     contained = sorted({s.behavior_class for s in machine.behaviors()})
     return '\n'.join([

@@ -107,6 +107,13 @@ class StateInstantiation:
 
 FIELD_NAMES = tuple(f.name for f in fields(StateInstantiation))
 
+# The helper states the generator adds where the automaton itself has no state (flexbe_states'
+# classes): an operator decision between several starts, and a state that only logs that there
+# is nothing to do. The FlexBE code generation and the executive recognise them by class.
+DECISION_CLASS = 'OperatorDecisionState'
+NOTHING_CLASS = 'LogState'
+HELPER_STATE_CLASSES = (DECISION_CLASS, NOTHING_CLASS)
+
 
 def count_states(entries) -> int:
     """How many states a machine has: every entry but the machine itself ('/') and its outcomes.

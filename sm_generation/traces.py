@@ -10,6 +10,7 @@ set of runs up to ``depth`` cannot be told apart by any sequence of that many ou
 from __future__ import annotations
 
 from sm_generation.instantiation import StateInstantiation
+from sm_generation.state_machine import State, StateMachine
 
 Part = tuple[str, str, tuple[str, ...]]  # (state class, behavior class, parameter values)
 Step = tuple[tuple[Part, ...], tuple[tuple[Part, str], ...]]
@@ -20,12 +21,12 @@ def _part(state: StateInstantiation) -> Part:
     return (state.state_class, state.behavior_class, tuple(state.parameter_values))
 
 
-def _moves(state: StateInstantiation, inner: list[StateInstantiation]) -> tuple[tuple, list[tuple]]:
+def _moves(state: State) -> tuple[tuple, list[tuple]]:
     """What ``state`` runs, and its possible (report, target) moves."""
     if state.state_class != StateInstantiation.CLASS_CONCURRENCY:
         part = _part(state)
         return (part,), [(((part, outcome),), target) for outcome, target in zip(state.outcomes, state.transitions)]
-    parts = {child.name: _part(child) for child in inner}
+    parts = {child.name: _part(child) for child in state.states}
     target_of = dict(zip(state.outcomes, state.transitions))
     moves = []
     for outcome, condition in zip(state.cond_outcome, state.cond_transition):
@@ -37,10 +38,9 @@ def _moves(state: StateInstantiation, inner: list[StateInstantiation]) -> tuple[
 
 def runs(states: list[StateInstantiation], depth: int) -> set[tuple]:
     """All runs of at most ``depth`` steps: tuples of steps, then ('exit', outcome) or TRUNCATED."""
-    root = states[0]
-    top = {s.name: s for s in states if s.parent_path == '/' and s.state_class != StateInstantiation.CLASS_OUTCOME}
-    inner = {name: [s for s in states if s.parent_path == f'/{name}'] for name in top}
-    moves = {name: _moves(state, inner[name]) for name, state in top.items()}
+    root = StateMachine.from_instantiations(states)
+    top = {s.name: s for s in root.states}
+    moves = {name: _moves(state) for name, state in top.items()}
     result: set[tuple] = set()
 
     def walk(name: str, prefix: tuple) -> None:

@@ -89,7 +89,7 @@ def run(args) -> int:
     from atlas_sim.robot import FaultSpecError, InitialConditionError, make_simulator, parse_faults
     from ltl_specification.errors import InvalidInitialConditionsError
     from ltl_specification.initial_conditions import asks_for_robot_state
-    from respec.systems import SystemConfigError
+    from respec.robot.files import SystemConfigError
     from respec.naming import parse_names
 
     if args.engine == 'flexbe':

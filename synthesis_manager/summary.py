@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from sm_generation.instantiation import StateInstantiation
+from sm_generation.state_machine import State, StateMachine
 
 
 def state_machine_tree(states: list[dict]) -> str:
@@ -10,28 +11,31 @@ def state_machine_tree(states: list[dict]) -> str:
 
         /  (:STATEMACHINE, initial: stand, outcomes: finished, failed)
           stand  [ChangeControlModeActionState]  changed -> look_down, failed -> failed
+
+    ``states``: the StateInstantiation list (dicts or objects).
     """
     lines = []
-    for state in states:  # the generator's order is deterministic and lists parents first
-        path = state['state_path']
-        depth = 0 if path == '/' else path.count('/')
-        indent = '  ' * depth
-        name = '/' if path == '/' else path.rsplit('/', 1)[-1]
-        kind = state['state_class']
+
+    def show(node: State, depth: int) -> None:
+        kind = node.state_class
         if kind == StateInstantiation.CLASS_BEHAVIOR:
-            kind = f"{kind} {state['behavior_class']}"
+            kind = f'{kind} {node.behavior_class}'
         details = []
-        if state.get('initial_state_name'):
-            details.append(f"initial: {state['initial_state_name']}")
-        edges = ', '.join(f'{o} -> {t}' for o, t in zip(state['outcomes'], state['transitions']))
-        if path == '/':
-            details.append(f"outcomes: {', '.join(state['outcomes'])}")
+        if node.initial_state_name:
+            details.append(f'initial: {node.initial_state_name}')
+        edges = ', '.join(f'{o} -> {t}' for o, t in zip(node.outcomes, node.transitions))
+        if depth == 0:
+            details.append(f"outcomes: {', '.join(node.outcomes)}")
             edges = ''
-        for outcome, condition in zip(state.get('cond_outcome', []), state.get('cond_transition', [])):
-            pairs = ' & '.join(f'{n}={o}' for n, o in zip(condition['state_name'], condition['state_outcome']))
+        for outcome, condition in zip(node.cond_outcome, node.cond_transition):
+            pairs = ' & '.join(f'{n}={o}' for n, o in zip(condition.state_name, condition.state_outcome))
             details.append(f'{outcome} if {pairs}')
         suffix = f"  ({'; '.join(details)})" if details else ''
-        lines.append(f'{indent}{name}  [{kind}]{suffix}' + (f'  {edges}' if edges else ''))
+        lines.append(f"{'  ' * depth}{node.name or '/'}  [{kind}]{suffix}" + (f'  {edges}' if edges else ''))
+        for child in node.children:
+            show(child, depth + 1)
+
+    show(StateMachine.from_instantiations(states), 0)
     return '\n'.join(lines)
 
 

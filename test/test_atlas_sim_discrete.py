@@ -8,7 +8,7 @@ from pathlib import Path
 import pytest
 
 from atlas_sim.config import DEFAULT_CONFIG, SystemConfig, load_system_config
-from respec.abstraction import AbstractionConfigError
+from respec.robot.abstraction import AbstractionConfigError
 from atlas_sim.discrete import COMPLETED, FAILED, DiscreteSemantics
 from atlas_sim.faults import FaultInjector, FaultSpec
 from atlas_sim.kinematics import LegGeometry, POSTURES, sagittal_leg_ik

@@ -13,9 +13,10 @@ import yaml
 from ltl_specification import compile_task
 from ltl_synthesizer import synthesize
 from respec.automaton import automaton_from_strategy
-from respec.capabilities import CapabilityConfigError, capability_system_of
+from respec.robot import robot_system
+from respec.robot.cnu import CapabilityConfigError
 from respec.ltl import conj, evaluate
-from respec.state_library import StateClass, StateClassError, workspace_state_library
+from respec.robot.state_library import StateClass, StateClassError, workspace_state_library
 from sm_generation import generate_state_machine, validate_state_machine
 
 # CNU's request defaults (flexbe_synthesis_examples/request_*.py) and the state counts
@@ -131,7 +132,7 @@ def test_cnu_example_requests_succeed_with_at_most_cnus_state_count(name, cnu, l
     assert validate_state_machine(states) == never_exits
     assert len(top_level_states(states)) <= example['cnu_states']
     # Every capability state is the capability's own FlexBE class with its parameters.
-    capabilities = capability_system_of(name, tmp_path).capabilities
+    capabilities = robot_system(name, tmp_path).capabilities.capabilities
     for state in top_level_states(states):
         capability = capabilities[state.name]
         assert state.state_class == capability.interface
@@ -258,7 +259,7 @@ def test_cnu_behaviors_run_on_the_real_flexbe_engine(cnu, library, tmp_path):
     for name in ('vending_demo', 'vending_demo_extended', 'hello_world'):
         example_system(tmp_path, cnu, name)
         _, _, states = synthesized(tmp_path, name, library)
-        config = capability_flexbe_config(capability_system_of(name, tmp_path), library)
+        config = capability_flexbe_config(robot_system(name, tmp_path).capabilities, library)
         package = behavior_package(states, config, f'CNU {name.replace("_", " ")}')
         behavior_class, checksum = load_behavior_class(package, tmp_path / name)
         with RosHarness(default_context=True) as ros:  # flexbe_core uses rclpy's global context

@@ -140,6 +140,57 @@ def test_the_cores_sit_below_the_shell():
     assert SHELL not in {target for core in CORES for target in graph[core]}
 
 
+# --- modules: no import circle between two files either ----------------------------------
+
+def module_name(path: Path, root: Path) -> str:
+    """The dotted module a source file is (a package's ``__init__.py`` is the package)."""
+    parts = list(path.relative_to(root).with_suffix('').parts)
+    if parts[-1] == '__init__':
+        parts.pop()
+    return '.'.join(parts)
+
+
+def module_graph(root: Path = ROOT) -> dict[str, dict[str, str]]:
+    """module -> {project module it imports: first 'file:line'}, function-local imports included.
+
+    ``from a.b import c`` is an edge to ``a.b.c`` when that is a module, else to ``a.b``.
+    """
+    paths = {module_name(path, root): path for package in PACKAGES for path in (root / package).rglob('*.py')}
+    graph: dict[str, dict[str, str]] = {}
+    for name, path in sorted(paths.items()):
+        edges = graph.setdefault(name, {})
+        tree = ast.parse(path.read_text(), filename=str(path))
+        imported = dict(imported_modules(path, root))
+        for node in ast.walk(tree):
+            if isinstance(node, ast.ImportFrom):
+                base = next((m for m, line in imported.items() if line == node.lineno), None)
+                for alias in node.names:
+                    if base is not None and f'{base}.{alias.name}' in paths:
+                        imported.setdefault(f'{base}.{alias.name}', node.lineno)
+        for target, line in imported.items():
+            if target in paths and target != name and not name.startswith(target + '.'):
+                edges.setdefault(target, f'{path.relative_to(root).as_posix()}:{line}')
+    return graph
+
+
+def test_modules_import_each_other_without_circles():
+    graph = module_graph()
+    cycle = find_cycle(graph)
+    assert cycle == [], ' -> '.join(cycle) + ': ' + ', '.join(
+        graph[a][b] for a, b in zip(cycle, cycle[1:]))
+
+
+def test_checker_finds_a_circle_between_two_modules_of_one_package(tmp_path):
+    root = _write(tmp_path, {
+        'ltl_synthesizer/__init__.py': '',
+        'ltl_synthesizer/cli.py': 'from ltl_synthesizer.serve import serve\n',
+        'ltl_synthesizer/serve.py': 'def f():\n    from ltl_synthesizer import cli\n',
+    })
+    assert find_cycle(module_graph(root)) in (
+        ['ltl_synthesizer.cli', 'ltl_synthesizer.serve', 'ltl_synthesizer.cli'],
+        ['ltl_synthesizer.serve', 'ltl_synthesizer.cli', 'ltl_synthesizer.serve'])
+
+
 
 def test_respec_parsing_modules_import_only_those_listed_before_them():
     """respec/parsing/__init__.py lists its modules in import order: each one imports only

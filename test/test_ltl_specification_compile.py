@@ -12,7 +12,7 @@ from ltl_specification import (
     explain,
 )
 from ltl_specification.pertinence import infer_pertinence
-from respec.abstraction import abstraction_from_dict
+from respec.robot.abstraction import abstraction_from_dict
 
 
 def text(spec):

@@ -2,8 +2,8 @@
 
 import pytest
 
-from respec.abstraction import AbstractionConfigError, abstraction_from_dict, load_abstraction
-from respec.systems import SystemNotFoundError
+from respec.robot.abstraction import AbstractionConfigError, abstraction_from_dict, load_abstraction
+from respec.robot.files import SystemNotFoundError
 
 
 def section(**overrides):

@@ -5,13 +5,17 @@ from __future__ import annotations
 from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.node import Node
 
+from std_msgs.msg import String
+
 from ltl_specification import compile_task
+from respec.robot import SystemCatalog, catalog_to_json
 from respec.naming import DEFAULT_SM_OUTCOMES
 from synthesis_manager.ros.conversions import error_code, msg_to_sections, spec_to_msg
 from synthesis_manager.limits import check_message
 from synthesis_manager.ros.errors import reported_error
 from synthesis_manager.ros.node_main import node_main
 from synthesis_manager.ros.qos import service_qos
+from synthesis_manager.ros.robot_systems import create_systems_publisher
 from synthesis_msgs.srv import GenerateLTLSpecification
 
 
@@ -19,13 +23,35 @@ class LTLCompilationNode(Node):
     """Compiles partial tasks into complete GR(1) specifications.
 
     Parameters: ``config_dir`` (robot system configurations; empty = the packaged config/).
+    Publishes the systems of ``config_dir`` on ``robot_systems`` (latched; checked for edits
+    every ``SYSTEMS_PERIOD`` seconds), so clients elsewhere see the systems it compiles for.
     """
+
+    SYSTEMS_PERIOD = 2.0
 
     def __init__(self, **kwargs):
         super().__init__('ltl_compilation', **kwargs)
         self.declare_parameter('config_dir', '')
         self.create_service(GenerateLTLSpecification, 'ltl_compilation', self.on_request,
                             callback_group=ReentrantCallbackGroup(), qos_profile=service_qos())
+        self._systems_publisher = create_systems_publisher(self)
+        self._published_systems = None
+        self.publish_systems()
+        self.create_timer(self.SYSTEMS_PERIOD, self.publish_systems)
+
+    def catalog(self) -> SystemCatalog:
+        return SystemCatalog(self.get_parameter('config_dir').value or None)
+
+    def publish_systems(self) -> None:
+        """Publish the systems when they changed (a system file edited, added or removed)."""
+        try:
+            text = catalog_to_json(self.catalog())
+        except OSError as error:  # e.g. the config directory vanished: keep serving the last list
+            self.get_logger().warning(f'cannot read the robot systems: {error}')
+            return
+        if text != self._published_systems:
+            self._systems_publisher.publish(String(data=text))
+            self._published_systems = text
 
     def on_request(self, request, response):
         try:

@@ -35,3 +35,9 @@ def action_client_qos() -> dict:
     return dict(goal_service_qos_profile=service_qos(), result_service_qos_profile=service_qos(),
                 cancel_service_qos_profile=service_qos(),
                 feedback_sub_qos_profile=QoSProfile(depth=FEEDBACK_DEPTH))
+
+
+def latched_qos() -> QoSProfile:
+    """For a topic whose last message a late subscriber still gets (transient local, depth 1)."""
+    return QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=1,
+                      reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.TRANSIENT_LOCAL)

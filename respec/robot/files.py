@@ -43,7 +43,7 @@ def default_config_dir() -> Path:
     override = os.environ.get(CONFIG_DIR_ENV)
     if override:
         return Path(override)
-    return Path(__file__).resolve().parent.parent / 'config'
+    return Path(__file__).resolve().parents[2] / 'config'
 
 
 def available_systems(config_dir: str | Path | None = None) -> list[str]:
@@ -73,9 +73,13 @@ def load_system_file(system: str, config_dir: str | Path | None = None) -> dict:
 
 def read_config_file(path: str | Path) -> dict:
     """A system configuration file as a dict (raises ConfigFileInvalidError naming the file)."""
-    path = Path(path)
+    return parse_config_text(Path(path).read_text(), path)
+
+
+def parse_config_text(text: str, path: str | Path) -> dict:
+    """The text of the system configuration file ``path`` as a dict (errors name the file)."""
     try:
-        document = yaml.load(path.read_text(), Loader=_SAFE_LOADER)
+        document = yaml.load(text, Loader=_SAFE_LOADER)
     except yaml.YAMLError as error:
         raise ConfigFileInvalidError(f'{path}: not valid YAML: {error}', item=str(path)) from error
     if not isinstance(document, dict):

@@ -20,7 +20,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Mapping
 
-from respec.capabilities import CapabilityConfigError, CapabilitySystem
+from respec.robot.cnu import CapabilityConfigError, CapabilitySystem
 from respec.errors import ErrorCode
 
 FLEXBE_STATES_EXPORT = '<flexbe_states'

@@ -26,7 +26,7 @@ from pathlib import Path
 
 from respec.errors import ErrorCode
 from respec.naming import COMPLETED, DEFAULT_SM_OUTCOMES, FAILED, activation, memory, outcome_proposition
-from respec.systems import SystemConfigError, load_system_file
+from respec.robot.files import SystemConfigError, load_system_file
 
 _NAME = re.compile(r'^[A-Za-z][A-Za-z0-9_]*$')
 DEFAULT_OUTCOMES = (COMPLETED, FAILED)

@@ -32,13 +32,13 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass, field
-from pathlib import Path
+from typing import Callable
 
 import yaml
 
 from respec.errors import ErrorCode
 from respec.naming import COMPLETED, FINISHED
-from respec.systems import SystemConfigError, load_system_file, system_config_path
+from respec.robot.files import SystemConfigError
 
 CAPABILITIES_KEY, SPEC_KEY, MAPPINGS_KEY = 'cnu_capabilities', 'cnu_spec', 'cnu_mappings'
 SYSTEM_FILE_KEYS = ('system', CAPABILITIES_KEY, SPEC_KEY, MAPPINGS_KEY, 'reduce')
@@ -153,17 +153,9 @@ def is_capability_document(document: dict) -> bool:
     return isinstance(document, dict) and CAPABILITIES_KEY in document
 
 
-def capability_system_of(system: str, config_dir: str | Path | None = None) -> CapabilitySystem | None:
-    """The capability system ``config/<system>.yaml`` points at, or None for a system of our own format."""
-    path = system_config_path(system, config_dir)
-    document = load_system_file(system, config_dir)
-    if not is_capability_document(document):
-        return None
-    return load_capability_system(document, system, path.parent)
-
-
-def load_capability_system(document: dict, system: str, base_dir: str | Path) -> CapabilitySystem:
-    """The capability system a system file (``document``, found in ``base_dir``) points at."""
+def load_capability_system(document: dict, system: str, read: Callable[[str], str]) -> CapabilitySystem:
+    """The capability system a system file (``document``) points at; ``read`` gives the text of a
+    file named relative to the system file (raising OSError when it cannot)."""
     for key in document:
         if key not in SYSTEM_FILE_KEYS:
             raise CapabilityConfigError(f'{system}.yaml: unknown key {key!r} next to {CAPABILITIES_KEY} '
@@ -171,9 +163,9 @@ def load_capability_system(document: dict, system: str, base_dir: str | Path) ->
     reduce = document.get('reduce', True)
     if not isinstance(reduce, bool):
         raise CapabilityConfigError(f'{system}.yaml: reduce must be true or false', item='reduce')
-    capabilities = _read_yaml(document, CAPABILITIES_KEY, base_dir, system, required=True)
-    spec = _read_yaml(document, SPEC_KEY, base_dir, system) or {}
-    mappings = _read_yaml(document, MAPPINGS_KEY, base_dir, system)
+    capabilities = _read_yaml(document, CAPABILITIES_KEY, read, system, required=True)
+    spec = _read_yaml(document, SPEC_KEY, read, system) or {}
+    mappings = _read_yaml(document, MAPPINGS_KEY, read, system)
     return capability_system_from_dicts(capabilities, spec, mappings, system, reduce,
                                         source=str(document[CAPABILITIES_KEY]))
 
@@ -217,7 +209,7 @@ def capability_system_from_dicts(capabilities: object, spec: object = None, mapp
 
 # --- files ----------------------------------------------------------------------------------
 
-def _read_yaml(document: dict, key: str, base_dir, system: str, required: bool = False):
+def _read_yaml(document: dict, key: str, read: Callable[[str], str], system: str, required: bool = False):
     value = document.get(key)
     if value is None:
         if required:
@@ -225,9 +217,8 @@ def _read_yaml(document: dict, key: str, base_dir, system: str, required: bool =
         return None
     if not isinstance(value, str) or not value:
         raise CapabilityConfigError(f'{system}.yaml: {key} must be a path, got {value!r}', item=key)
-    path = Path(base_dir) / value
     try:
-        text = path.read_text()
+        text = read(value)
     except OSError as error:
         raise CapabilityConfigError(f'{system}.yaml: {key} {value!r} cannot be read ({error.strerror})',
                                     item=key) from None

@@ -1,0 +1,186 @@
+"""``RobotSystem``: one robot system, loaded once from its file(s), validated, immutable.
+
+A robot system is one YAML file, ``<config_dir>/<name>.yaml``, in one of two kinds:
+
+``abstraction``   our own format (ATLAS-style): an ``abstraction:`` section with control modes,
+                  actions, outcomes and sensors (``respec.robot.abstraction``), a ``flexbe:``
+                  section mapping propositions to FlexBE states, and optionally ``simulation:``.
+``capabilities``  a robot described by CNU's capability files, which the system file points at
+                  (``respec.robot.cnu``); its FlexBE mapping comes from the capabilities and the
+                  workspace's state classes.
+
+Every stage takes a ``RobotSystem`` (or a name resolved once at the edge with
+``robot_system``), so a request reads the system's files once, and the kind is decided here,
+once, when the file is read.
+"""
+
+from __future__ import annotations
+
+import errno
+import json
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+from types import MappingProxyType
+from typing import Callable, Mapping
+
+from respec.robot.abstraction import RobotAbstraction, abstraction_from_document
+from respec.robot.cnu import CapabilitySystem, is_capability_document, load_capability_system
+from respec.robot.files import (ConfigFileInvalidError, SystemConfigError, SystemNotFoundError, available_systems,
+                                default_config_dir, parse_config_text, system_config_path)
+
+ABSTRACTION_KIND = 'abstraction'
+CAPABILITIES_KIND = 'capabilities'
+
+
+@dataclass(frozen=True)
+class RobotSystem:
+    """A validated robot system: its name, file, kind and descriptions.
+
+    ``capabilities`` is set for kind ``capabilities``; otherwise ``abstraction`` holds the
+    validated ``abstraction:`` section (None when the file has none). ``sections`` holds the file's other top-level sections as read
+    (``flexbe``, ``simulation``); the package that uses a section validates it
+    (``sm_generation.config``, ``atlas_sim``).
+    """
+
+    name: str
+    path: Path = field(compare=False)  # where it was read from: the same system may be read elsewhere
+    abstraction: RobotAbstraction | None = None
+    capabilities: CapabilitySystem | None = None
+    sections: Mapping[str, object] = field(default_factory=dict, compare=False, repr=False)
+    # The text of every file read, by its path relative to the system file's folder.
+    files: Mapping[str, str] = field(default_factory=dict, compare=False, repr=False)
+
+    @property
+    def kind(self) -> str:
+        return CAPABILITIES_KIND if self.capabilities is not None else ABSTRACTION_KIND
+
+    @property
+    def is_capability_system(self) -> bool:
+        return self.capabilities is not None
+
+    @property
+    def config_file(self) -> str:
+        """The file as users know it, e.g. 'config/atlas.yaml'."""
+        return f'{self.path.parent.name}/{self.path.name}'
+
+    def section(self, name: str) -> dict:
+        """One top-level section of the system file; raises ConfigFileInvalidError if missing."""
+        content = self.sections.get(name)
+        if not isinstance(content, Mapping):
+            raise ConfigFileInvalidError(f'{self.name}.yaml: missing or invalid section {name!r}', item=name)
+        return dict(content)
+
+    def has_section(self, name: str) -> bool:
+        return isinstance(self.sections.get(name), Mapping)
+
+
+def robot_system_from_file(path: str | Path, name: str | None = None) -> RobotSystem:
+    """The robot system of one system file (its kind told by its content)."""
+    path = Path(path)
+    return _robot_system(name or path.stem, path, lambda relative: (path.parent / relative).read_text())
+
+
+def robot_system_from_files(name: str, files: Mapping[str, str], config_file: str | None = None) -> RobotSystem:
+    """A robot system rebuilt from the texts of its files (``RobotSystem.files``), e.g. as a
+    suite serves them to a GUI that runs elsewhere: the same system as the one read from disk."""
+    def read(relative: str) -> str:
+        if relative not in files:
+            raise FileNotFoundError(errno.ENOENT, os.strerror(errno.ENOENT), relative)
+        return files[relative]
+
+    return _robot_system(name, Path(config_file or f'config/{name}.yaml'), read)
+
+
+def _robot_system(name: str, path: Path, read: Callable[[str], str]) -> RobotSystem:
+    files: dict[str, str] = {}
+
+    def read_and_keep(relative: str) -> str:
+        files[relative] = read(relative)
+        return files[relative]
+
+    document = parse_config_text(read_and_keep(path.name), path)
+    if is_capability_document(document):
+        capabilities = load_capability_system(document, name, read_and_keep)
+        return RobotSystem(name, path, capabilities=capabilities, sections=MappingProxyType(dict(document)),
+                           files=MappingProxyType(files))
+    # A file without an abstraction: section may still serve generation alone (its flexbe:
+    # section); compiling a task on it reports the missing section.
+    abstraction = abstraction_from_document(document, name) if 'abstraction' in document else None
+    return RobotSystem(name, path, abstraction=abstraction, sections=MappingProxyType(dict(document)),
+                       files=MappingProxyType(files))
+
+
+def robot_system(system: RobotSystem | str, config_dir: str | Path | None = None) -> RobotSystem:
+    """``system`` itself, or the system of that name in ``config_dir`` (default: ``config/``).
+
+    The edge where a name becomes a RobotSystem: raises SystemNotFoundError for an unknown
+    name and a SystemConfigError subclass (naming the entry) for an invalid file.
+    """
+    if isinstance(system, RobotSystem):
+        return system
+    return robot_system_from_file(system_config_path(system, config_dir), system)
+
+
+@dataclass(frozen=True)
+class SystemCatalog:
+    """The robot systems of a config directory: their names, and each one loaded on request.
+
+    Loading reads the files afresh, so a request sees a system file as it is when it arrives.
+    """
+
+    config_dir: Path | None = None
+
+    @property
+    def directory(self) -> Path:
+        return Path(self.config_dir) if self.config_dir else default_config_dir()
+
+    def names(self) -> list[str]:
+        return available_systems(self.directory)
+
+    def load(self, name: RobotSystem | str) -> RobotSystem:
+        return robot_system(name, self.directory)
+
+
+# --- a catalog as text: how a suite serves its systems to a GUI running elsewhere ---------------
+
+def catalog_to_json(catalog: SystemCatalog) -> str:
+    """Every system of ``catalog`` as JSON (deterministic): name, config file and the text of
+    each file it reads; a system that cannot be loaded is listed with its error instead."""
+    from respec.errors import CodedError
+
+    entries = []
+    for name in catalog.names():
+        try:
+            system = catalog.load(name)
+        except CodedError as error:
+            entries.append({'name': name, 'error': {'code': error.code.name, 'message': str(error),
+                                                    'item': error.item}})
+            continue
+        entries.append({'name': name, 'config_file': system.config_file, 'files': dict(system.files)})
+    return json.dumps({'systems': entries}, sort_keys=True)
+
+
+@dataclass(frozen=True)
+class ServedCatalog:
+    """The systems a suite serves (``catalog_to_json``), with SystemCatalog's ``names``/``load``."""
+
+    entries: Mapping[str, Mapping]
+
+    @classmethod
+    def from_json(cls, text: str) -> ServedCatalog:
+        return cls({entry['name']: entry for entry in json.loads(text)['systems']})
+
+    def names(self) -> list[str]:
+        return sorted(self.entries)
+
+    def load(self, name: RobotSystem | str) -> RobotSystem:
+        if isinstance(name, RobotSystem):
+            return name
+        entry = self.entries.get(name)
+        if entry is None:
+            raise SystemNotFoundError(f'unknown system {name!r}: the suite serves no such system '
+                                      f'(known systems: {", ".join(self.names()) or "none"})', item=str(name))
+        if 'error' in entry:
+            raise SystemConfigError(entry['error']['message'], item=entry['error']['item'])
+        return robot_system_from_files(name, entry['files'], entry['config_file'])

@@ -315,20 +315,6 @@ def test_the_state_machine_is_served_as_a_tree_of_the_listed_states(client):
     assert missing.status_code == 409 and missing.json()['item'] == compiled['id']
 
 
-def test_a_concurrency_container_holds_its_states_in_the_tree():
-    from pathlib import Path
-
-    from sm_generation import generate_state_machine, load_automaton
-    from synthesis_manager.web.machine_tree import state_machine_tree
-
-    states = generate_state_machine(load_automaton(Path(__file__).parent / 'automata' / 'concurrent.yaml'), 'atlas')
-    tree = state_machine_tree(states)
-    container = next(node for node in tree['children'] if node['state_class'] == ':CONCURRENCY')
-    inner = [s.state_path for s in states if s.state_path.startswith(container['state_path'] + '/')]
-    assert [child['state_path'] for child in container['children']] == inner and inner
-    assert all(child['children'] == [] for child in container['children'])
-
-
 def test_the_page_is_es_modules_served_as_javascript(client):
     from synthesis_manager.web.routes import STATIC_DIR
 

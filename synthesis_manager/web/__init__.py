@@ -4,7 +4,6 @@
     backend       SynthesisBackend: jobs, simulations and downloads behind the routes
     jobs          what the page asks for (JobRequest), a job's record, progress and summary
     outcome       JobOutcome: what a job ended with, typed until a route makes JSON of it
-    machine_tree  stand-in: a machine's tree JSON until sm_generation.state_machine lands
     vocabulary    the Python names the page needs (GET /api/vocabulary)
     simulations   a closed-loop run's record
     artifacts     the downloads built from a finished job

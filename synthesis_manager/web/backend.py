@@ -18,13 +18,13 @@ from ltl_specification.diagnosis import goal_findings, impossible_next_goals
 from respec.robot.abstraction import load_abstraction
 from respec.errors import INTERNAL_ERROR, CodedError, ErrorCode, quoted
 from respec.naming import DEFAULT_SM_OUTCOMES, FINISHED
+from sm_generation.state_machine import StateMachine
 from respec.robot.files import SystemConfigError, available_systems, load_section
 from synthesis_manager.limits import BusyError
 from synthesis_manager.web.artifacts import ARTIFACTS, Artifact
 from synthesis_manager.web.errors import (ArtifactFailedError, InvalidJobRequestError, NotAvailableError,
                                           NotFoundError)
 from synthesis_manager.web.jobs import JOB_OPTIONS, Job, JobRequest, ProgressNote, names_field
-from synthesis_manager.web.machine_tree import state_machine_tree
 from synthesis_manager.web.outcome import JobOutcome
 from synthesis_manager.web.simulation_process import SimulationProcess
 from synthesis_manager.web.simulations import Simulation, simulation_available
@@ -196,14 +196,14 @@ class SynthesisBackend:
             self._artifacts[key] = Artifact(content, kind.media_type, f'{job.request.name or "behavior"}_{name}')
         return self._artifacts[key]
 
-    def state_machine(self, job_id: str) -> dict:
-        """The job's state machine as a tree (its JSON: see web.machine_tree)."""
+    def state_machine(self, job_id: str) -> StateMachine:
+        """The job's state machine as the tree sm_generation builds from its list."""
         job = self._job(job_id)
         if not job.finished:
             raise NotAvailableError(f'job {quoted(job_id)} has not finished yet', job_id)
         if not job.outcome.states:
             raise NotAvailableError(f'job {quoted(job_id)} ({job.outcome.error_name}) has no state machine', job_id)
-        return state_machine_tree(job.outcome.states)
+        return StateMachine.from_instantiations(job.outcome.states)
 
     # simulations ------------------------------------------------------------------------
 

@@ -9,7 +9,7 @@
     POST /api/jobs                           start a synthesis job -> 202 {"id": ..., ...}
     GET  /api/jobs/{id}                      its status, progress timeline, result and summary
     GET  /api/jobs/{id}/events               the same as server-sent events until the job ends
-    GET  /api/jobs/{id}/state-machine        its state machine as a tree of states (web.machine_tree)
+    GET  /api/jobs/{id}/state-machine        its state machine as a tree (sm_generation.StateMachine.to_dict)
     POST /api/jobs/{id}/cancel               cancel it (the result becomes PREEMPTED)
     GET  /api/jobs/{id}/artifacts/{name}     a download (see ARTIFACTS); ?inline=1 to display it
                                              (a browser asking for a forgotten one gets a page saying so)
@@ -25,8 +25,8 @@ a foreign Host header (421), a body over 1 MB (413) or a POST whose body is not 
 (415: what a cross-site form can send) are refused first (web.guards); a new job while too many
 are unfinished is 503 BUSY, a simulation while too many run is 429 BUSY with Retry-After.
 
-The backend returns records (Job, Simulation, the outcome typed as web.outcome.JobOutcome);
-the routes turn them into JSON with their ``to_dict``.
+The backend returns records (Job with its web.outcome.JobOutcome, Simulation, the job's
+sm_generation StateMachine); the routes turn them into JSON with their ``to_dict``.
 
 The backend does the work: :class:`synthesis_manager.web.backend.SynthesisBackend` keeps
 the jobs, validates requests and builds the downloads; the synthesis itself is a
@@ -121,7 +121,7 @@ def create_app(backend) -> FastAPI:
 
     @app.get('/api/jobs/{job_id}/state-machine')
     def state_machine(job_id: str):
-        return backend.state_machine(job_id)
+        return backend.state_machine(job_id).to_dict()
 
     @app.get('/api/jobs/{job_id}/artifacts/{name}')
     def artifact(job_id: str, name: str, request: Request, inline: bool = False):

@@ -256,6 +256,32 @@ def test_server_restart_mid_job_is_said_plainly_and_the_page_reconnects(browser_
         page.close()
 
 
+def concurrent_machine(request, feedback, cancel):
+    """A runner answering every job with the machine of test/automata/concurrent.yaml (a
+    concurrency container: no GUI request of the configs makes one)."""
+    from sm_generation import generate_state_machine, load_automaton
+
+    automaton = load_automaton(Path(__file__).resolve().parent / 'automata' / 'concurrent.yaml')
+    return JobOutcome(1, 'SUCCESS', '', states=tuple(generate_state_machine(automaton, 'atlas')))
+
+
+def test_a_concurrency_container_names_its_states_when_clicked(browser_context):  # noqa: F811
+    server = Server(SynthesisBackend(concurrent_machine), free_port())
+    try:
+        with open_page(browser_context, f'http://127.0.0.1:{server.sock.getsockname()[1]}/') as page:
+            choose_task(page, ['look_down'])
+            page.click('#synthesize')
+            assert result_code(page) == 'SUCCESS'
+            page.wait_for_selector('g[id="state:object_template_and_stand"]')
+            page.focus('g[id="state:object_template_and_stand"]')
+            page.keyboard.press('Enter')
+            details = page.inner_text('#state-details')
+            assert 'concurrency container' in details
+            assert 'Contains\tobject_template (InputState), stand (ChangeControlModeActionState)' in details
+    finally:
+        server.kill()
+
+
 # --- 4. simulation view ----------------------------------------------------------------------
 
 def test_simulation_colours_outcomes_marks_the_drawing_and_captions_frames(page):

@@ -18,8 +18,8 @@ from ltl_specification.diagnosis import goal_findings, impossible_next_goals
 from respec.robot.abstraction import load_abstraction
 from respec.errors import INTERNAL_ERROR, CodedError, ErrorCode, quoted
 from respec.naming import DEFAULT_SM_OUTCOMES, FINISHED
-from sm_generation.state_machine import StateMachine
 from respec.robot.files import SystemConfigError, available_systems, load_section
+from sm_generation.state_machine import StateMachine
 from synthesis_manager.limits import BusyError
 from synthesis_manager.web.artifacts import ARTIFACTS, Artifact
 from synthesis_manager.web.errors import (ArtifactFailedError, InvalidJobRequestError, NotAvailableError,

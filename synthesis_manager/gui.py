@@ -22,6 +22,7 @@ from rclpy.node import Node
 from respec.errors import ErrorCode, ExitStatus, exit_status_help
 from synthesis_manager.client import SynthesisClient, SynthesisOutcome, make_goal
 from synthesis_manager.ros.harness import RosHarness, environment_domain_id
+from synthesis_manager.ros.robot_systems import SuiteSystems
 from synthesis_manager.suite import add_suite_arguments, suite_node_factories
 from synthesis_manager.web.backend import SynthesisBackend
 from synthesis_manager.web.outcome import JobOutcome
@@ -72,12 +73,16 @@ def ros_backend(args=None, connect: bool = False):
         if not connect:
             for factory in suite_node_factories(args):
                 ros.add_node(factory)
-        client = SynthesisClient(ros.add_node(Node, 'behavior_synthesis_gui'))
+        client_node = ros.add_node(Node, 'behavior_synthesis_gui')
+        client = SynthesisClient(client_node)
         where = (f'the suite on ROS_DOMAIN_ID {ros.domain_id}' if connect
                  else f'an in-process suite (private ROS domain {ros.domain_id})')
+        # Attached to a running suite, the page shows and checks the suite's systems (served on
+        # robot_systems), never config files of this machine.
         yield SynthesisBackend(
             RosGoalRunner(client, goal_timeout=getattr(args, 'goal_timeout', 600.0)),
-            config_dir=getattr(args, 'config_dir', '') or None, description=f'synthesizing with {where}')
+            config_dir=getattr(args, 'config_dir', '') or None,
+            systems=SuiteSystems(client_node) if connect else None, description=f'synthesizing with {where}')
 
 
 def listening_socket(host: str, port: int) -> socket.socket:

@@ -2,16 +2,19 @@
 
 import os
 import re
+import shutil
 import signal
 import subprocess
 import sys
 import time
+from pathlib import Path
 
 import httpx
 import pytest
 
 from synthesis_manager.ros.env import prepare_ros_environment
 
+REPOSITORY = Path(__file__).resolve().parents[1]
 URL_LINE = re.compile(r'behavior synthesis GUI: (http://\S+/)')
 
 
@@ -88,15 +91,26 @@ def reserved_domain():
         yield domain
 
 
-def test_connect_joins_a_running_suite(reserved_domain):
+def test_connect_joins_a_running_suite(reserved_domain, tmp_path):
+    # The suite's systems, not this machine's: the GUI reads none of config/ itself.
+    shutil.copy(REPOSITORY / 'config' / 'atlas.yaml', tmp_path / 'atlas.yaml')
+    (tmp_path / 'arm_only.yaml').write_text(
+        'abstraction:\n  control_modes: {rest: [reach], reach: [rest]}\n  actions: {wave: [reach]}\n'
+        'flexbe:\n  states: {}\n')
     env = prepare_ros_environment(reserved_domain, dict(os.environ))
-    suite = start('serve', env=env)
+    suite = start('serve', '--config-dir', str(tmp_path), env=env)
     gui = None
     try:
         wait_for_line(suite, r'suite up')
         gui = start('gui', '--connect', '--port', '0', env=env)
         url = wait_for_line(gui, URL_LINE).group(1)
         assert f'ROS_DOMAIN_ID {reserved_domain}' in httpx.get(f'{url}api/info').json()['description']
+        assert httpx.get(f'{url}api/systems').json()['systems'] == ['arm_only', 'atlas']
+        arm = httpx.get(f'{url}api/systems/arm_only').json()
+        assert [mode['name'] for mode in arm['control_modes']] == ['rest', 'reach']
+        check = httpx.post(f'{url}api/goal-check', json={'system': 'arm_only', 'initial_conditions': ['rest'],
+                                                          'goals': ['wave']}).json()
+        assert check['findings'] == []
         job = httpx.post(f'{url}api/jobs', json={
             'system': 'atlas', 'initial_conditions': 'stand_prep', 'goals': 'look_down',
             'option': 'ltl_compilation_only'}).json()

@@ -11,7 +11,7 @@ from typing import Callable
 
 from respec.parsing import spec_from_text_sections
 from sm_generation import SMGenerationError, export
-from sm_generation.config import load_flexbe_config
+from sm_generation.config import flexbe_config
 from sm_generation.export import render, to_dot
 from sm_generation.flexbe_behavior import behavior_package, check_behavior_name, default_behavior_name
 from synthesis_manager.web.outcome import JobOutcome
@@ -44,10 +44,10 @@ def _specification(method):
     return build
 
 
-def _flexbe_behavior(outcome, request, config_dir) -> bytes:
+def _flexbe_behavior(outcome, request, systems) -> bytes:
     """The behavior package FlexBE's editor would save (as ``behavior-synthesis export-behavior``)."""
     name = request.name if request.name and check_name(request.name) else default_behavior_name(request.goals)
-    package = behavior_package(list(outcome.states), load_flexbe_config(request.system, config_dir), name,
+    package = behavior_package(list(outcome.states), flexbe_config(systems.load(request.system)), name,
                                date=time.strftime('%a %b %d %Y'))
     return package.zip_bytes()
 
@@ -84,7 +84,7 @@ class ArtifactKind:
     label: str
     media_type: str
     present: Callable[[JobOutcome], bool]
-    build: Callable[..., bytes]  # (outcome, job request, config_dir) -> bytes
+    build: Callable[..., bytes]  # (outcome, job request, the robot systems' catalog) -> bytes
 
 
 ARTIFACTS = {

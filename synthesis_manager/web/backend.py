@@ -15,10 +15,11 @@ from pathlib import Path
 from typing import Callable
 
 from ltl_specification.diagnosis import goal_findings, impossible_next_goals
-from respec.robot.abstraction import load_abstraction
+from ltl_specification.compiler import load_task_abstraction
 from respec.errors import INTERNAL_ERROR, CodedError, ErrorCode, quoted
 from respec.naming import DEFAULT_SM_OUTCOMES, FINISHED
-from respec.robot.files import SystemConfigError, available_systems, load_section
+from respec.robot import RobotSystem, SystemCatalog
+from respec.robot.files import SystemConfigError
 from sm_generation.state_machine import StateMachine
 from synthesis_manager.limits import BusyError
 from synthesis_manager.web.artifacts import ARTIFACTS, Artifact
@@ -50,11 +51,14 @@ class SynthesisBackend:
     ``queued`` state before anything is sent, which makes cancelling them deterministic.
     """
 
-    def __init__(self, run_goal: GoalRunner, config_dir: str | Path | None = None,
+    def __init__(self, run_goal: GoalRunner, config_dir: str | Path | None = None, systems=None,
                  max_jobs: int = 100, max_unfinished_jobs: int = 50, description: str = '',
                  max_running_simulations: int = 2, max_simulations_per_job: int = 5):
         self.run_goal = run_goal
         self.config_dir = config_dir or None
+        # Where the robot systems come from: the suite's own (SuiteSystems, served over ROS)
+        # when attached to a running suite, else the config directory's (SystemCatalog).
+        self.catalog = systems if systems is not None else SystemCatalog(self.config_dir)
         self.max_jobs = max_jobs
         self.max_unfinished_jobs = max_unfinished_jobs
         # A simulation takes a process of ~225 MiB and a core for up to minutes: only a few run
@@ -77,16 +81,23 @@ class SynthesisBackend:
     # systems ---------------------------------------------------------------------------
 
     def systems(self) -> list[str]:
-        return available_systems(self.config_dir)
+        return self.catalog.names()
+
+    def robot_system(self, system: str) -> RobotSystem:
+        """The robot system of a request, as the suite synthesizes for it (NotFoundError if unknown)."""
+        names = self.systems()
+        if system not in names:
+            raise NotFoundError(f'unknown system {quoted(system)} (known systems: {", ".join(names)})', str(system))
+        return self.catalog.load(system)
 
     def choices(self, system: str) -> dict:
         """The control modes and actions of ``system``, in file order, with their relations."""
-        if system not in self.systems():
-            raise NotFoundError(f'unknown system {quoted(system)} (known systems: {", ".join(self.systems())})',
-                                system)
         try:
-            abstraction = load_abstraction(system, self.config_dir)
-        except SystemConfigError as error:
+            robot = self.robot_system(system)
+            abstraction = load_task_abstraction(robot)
+        except NotFoundError:
+            raise
+        except CodedError as error:
             raise NotAvailableError(str(error), error.item or system) from error
         modes, actions = abstraction.control_modes, abstraction.actions
         return {
@@ -96,19 +107,19 @@ class SynthesisBackend:
             'default_initial_conditions': list(modes)[:1],
             'sm_outcome_choices': [list(DEFAULT_SM_OUTCOMES), [FINISHED]],
             'options': list(JOB_OPTIONS),
-            'simulation': self.simulation_support(system),
+            'simulation': self.simulation_support(robot),
         }
 
-    def simulation_support(self, system: str) -> dict:
-        """Whether atlas_sim can run ``system``'s machines, and if not, why (in plain words)."""
+    def simulation_support(self, robot: RobotSystem) -> dict:
+        """Whether atlas_sim can run the system's machines, and if not, why (in plain words)."""
         if not self.can_simulate:
             return {'available': False, 'note': 'Simulation needs atlas_sim and MuJoCo, which are not installed.'}
         try:
-            section = load_section(system, 'simulation', self.config_dir)
+            section = robot.section('simulation')
         except SystemConfigError:
-            return {'available': False, 'note': f'{system} has no simulation section: atlas_sim cannot run it.'}
+            return {'available': False, 'note': f'{robot.name} has no simulation section: atlas_sim cannot run it.'}
         if section.get('stand_in'):
-            return {'available': False, 'note': f'No simulation for {system}: {" ".join(str(section["stand_in"]).split())}'}
+            return {'available': False, 'note': f'No simulation for {robot.name}: {" ".join(str(section["stand_in"]).split())}'}
         return {'available': True, 'note': ''}
 
     def goal_check(self, body) -> dict:
@@ -123,8 +134,9 @@ class SynthesisBackend:
         goals = names_field(body, 'goals')
         strict_order = not body.get('unordered', False)
         try:
-            findings = goal_findings(system, initial_conditions, goals, strict_order, self.config_dir)
-            impossible = impossible_next_goals(system, initial_conditions, goals, strict_order, self.config_dir)
+            robot = self.catalog.load(system)
+            findings = goal_findings(robot, initial_conditions, goals, strict_order)
+            impossible = impossible_next_goals(robot, initial_conditions, goals, strict_order)
         except CodedError as error:  # e.g. an invalid abstraction: the synthesis will say it
             raise NotAvailableError(str(error), error.item or system) from error
         return {'findings': [dataclasses.asdict(f) for f in findings], 'impossible_next': impossible}
@@ -187,7 +199,7 @@ class SynthesisBackend:
         key = (job_id, name)
         if key not in self._artifacts:
             try:
-                content = kind.build(job.outcome, job.request, self.config_dir)
+                content = kind.build(job.outcome, job.request, self.catalog)
             except Exception as error:  # e.g. RenderError when Graphviz is missing; keep serving
                 if not isinstance(error, CodedError):
                     logger.exception('building %s of job %s failed', name, job_id)
@@ -222,7 +234,11 @@ class SynthesisBackend:
                                     'atlas_sim')
         if not (job.finished and job.outcome.states):
             raise NotAvailableError(f'job {quoted(job_id)} has no state machine to simulate', job_id)
-        support = self.simulation_support(job.request.system)
+        try:
+            robot = self.catalog.load(job.request.system)
+        except CodedError as error:
+            raise NotAvailableError(str(error), error.item or job.request.system) from error
+        support = self.simulation_support(robot)
         if not support['available']:
             raise NotAvailableError(support['note'], job.request.system)
         simulation = Simulation(id=f'{job_id}-sim{next(self._counter)}', job_id=job_id, fail_first=fail_first)

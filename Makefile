@@ -26,7 +26,7 @@ FLEXBE_SYNTHESIS_MSGS_BUILD := build/flexbe_synthesis_msgs
 # folder of its own that only the WebUI's process (test/test_flexbe_webui.py) puts on its path.
 WEBUI_SITE := build/flexbe_webui_site
 # Our FlexBE packages (colcon packages; here used from source through the venv's path).
-FLEXBE_PACKAGES := atlas_sim/atlas_sim_flexbe_states atlas_sim/atlas_sim_flexbe_behaviors
+FLEXBE_PACKAGES := atlas_sim/flexbe/atlas_sim_flexbe_states atlas_sim/flexbe/atlas_sim_flexbe_behaviors
 # The ament prefix in which the WebUI and flexbe_core's BehaviorLibrary find FlexBE packages
 # (AMENT_PREFIX_PATH). Separate from the venv so that tools which walk a behavior package's
 # prefix for manifests walk only these few files.

@@ -1,64 +1,18 @@
-"""atlas_sim: a MuJoCo humanoid that emulates ATLAS for synthesized behaviors.
+"""atlas_sim: a MuJoCo humanoid that emulates ATLAS, and the executive that runs synthesized
+behaviors on a robot (ROS-free). One job per sub-package:
 
-The simulator executes the *capabilities* of a robot-system config
-(``config/atlas.yaml``): control modes (``stand_prep``, ``stand``,
-``manipulate``, ``step``, ``walk``) and actions (``look_down``,
-``pickup_object``, ``object_template``, ...).  Each request ends with outcome
-``completed`` or ``failed`` plus a reason, following the config's discrete
-abstraction (mode transition system, action preconditions) and the
-``simulation:`` section (motions, scenario, faults).  ROS-free.
+``atlas_sim.simulator``  the MuJoCo simulator of a robot-system config's capabilities (control
+                         modes, actions, sensors), robot-agnostic of the state machine.
+``atlas_sim.executive``  the FlexBE-compatible executive that runs a synthesized state machine
+                         on any robot with the ``Robot`` protocol, and the trace check
+                         (robot-agnostic; reads ``sm_generation``'s StateMachine tree).
+``simulated_robot``      the simulator as the executive's robot (``SimulatedRobot``).
+``closed_loop``          ``run_and_check``: execute on the simulator, record key frames, check,
+                         draw the timeline.
 
-Modules (MuJoCo is imported only by ``physics``, ``simulator``, ``rendering``)
-------------------------------------------------------------------------------
-``config``      ``load_system_config(path) -> SystemConfig`` (abstraction +
-                simulation sections; the schema is documented there).
-``discrete``    ``DiscreteState``, ``DiscreteSemantics``: the
-                mode/precondition/validity rules, testable without physics.
-``faults``      ``FaultSpec(always, fail_first, probability)``, ``FaultInjector``.
-``kinematics``  joint groups, arm poses, whole-body ``POSTURES``, leg IK.
-``motions``     ``build_motion(entry, geometry)``: posture, gait, head_tilt,
-                arm_sequence, compute, operator_input.
-``physics``     ``HumanoidPhysics``: model loading, targets, fall detection.
-``simulator``   ``AtlasSimulator``, ``Request``, ``RequestResult``.
-``operator_data`` the data operator inputs provide (template id, target pose) and its checks.
-``rendering``   ``FrameRenderer``, ``KeyFrameRecorder``, ``save_png``.
-``robot``       the ``Robot`` protocol, ``SimulatedRobot``, ``make_simulator``, ``parse_faults``.
-``machine``     the executive's errors; ``load_machine`` (the shared ``sm_generation`` tree).
-``executor``    runs a synthesized state machine on a robot (``execute_state_machine``).
-``trace_check`` checks an executed trace against the specification and the goal order.
-``closed_loop`` ``run_and_check``: execute, record key frames, check, draw the timeline.
+``atlas_sim/flexbe/`` holds the FlexBE state and behavior packages for the simulator node
+(ROS packages of their own, not part of this Python package).
 
 How to drive the simulator from Python (a typical session and the AtlasSimulator API):
 docs/simulation.md, "The simulator from Python".
 """
-
-from __future__ import annotations
-
-import importlib
-
-# Lazy exports keep ``import atlas_sim.discrete`` free of the MuJoCo import.
-_EXPORTS = {
-    "AtlasSimulator": "simulator",
-    "Request": "simulator",
-    "RequestResult": "simulator",
-    "HumanoidPhysics": "physics",
-    "MODEL_PATH": "physics",
-    "FrameRenderer": "rendering",
-    "KeyFrameRecorder": "rendering",
-    "save_png": "rendering",
-    "FaultSpec": "faults",
-    "FaultInjector": "faults",
-    "DiscreteSemantics": "discrete",
-    "DiscreteState": "discrete",
-    "SystemConfig": "config",
-    "load_system_config": "config",
-}
-
-__all__ = sorted(_EXPORTS)
-
-
-def __getattr__(name: str):
-    module_name = _EXPORTS.get(name)
-    if module_name is None:
-        raise AttributeError(f"module 'atlas_sim' has no attribute {name!r}")
-    return getattr(importlib.import_module(f".{module_name}", __name__), name)

@@ -8,15 +8,15 @@ from __future__ import annotations
 
 import collections
 import contextlib
-import time
 from dataclasses import dataclass, field
 from pathlib import Path
+import time
 from typing import Callable
 
-from atlas_sim.executor import ExecutionResult, Executive, StateMapping
-from atlas_sim.rendering import KeyFrameRecorder
-from atlas_sim.timeline import plot_timeline
-from atlas_sim.trace_check import TraceCheckReport, TraceStep, check_trace
+from atlas_sim.executive.executor import ExecutionResult, Executive, StateMapping
+from atlas_sim.executive.timeline import plot_timeline
+from atlas_sim.executive.trace_check import TraceCheckReport, TraceStep, check_trace
+from atlas_sim.simulator.rendering import KeyFrameRecorder
 from respec.spec import GR1Specification
 
 FRAME_WIDTH, FRAME_HEIGHT = 480, 360

@@ -37,8 +37,9 @@ def synthesized_machine(initial_conditions, goals, sm_outcomes):
 
 
 def run_direct(states, initial_conditions, faults):
-    from atlas_sim.executor import execute_state_machine
-    from atlas_sim.robot import SimulatedRobot, make_simulator, parse_faults
+    from atlas_sim.executive.executor import execute_state_machine
+    from atlas_sim.simulated_robot import SimulatedRobot
+    from atlas_sim.simulator.factory import make_simulator, parse_faults
 
     simulator = make_simulator('atlas', initial_conditions=initial_conditions, faults=parse_faults(**faults))
     started = time.perf_counter()
@@ -50,8 +51,8 @@ def run_over_ros(states, initial_conditions, faults, speed):
     from rclpy.node import Node
     from rclpy.parameter import Parameter
 
-    from atlas_sim.executor import execute_state_machine
-    from atlas_sim.robot import make_simulator, parse_faults
+    from atlas_sim.executive.executor import execute_state_machine
+    from atlas_sim.simulator.factory import make_simulator, parse_faults
     from synthesis_manager.nodes.atlas_sim_node import AtlasSimNode
     from synthesis_manager.nodes.atlas_sim_robot import RosRobot
     from synthesis_manager.ros.harness import RosHarness
@@ -72,7 +73,7 @@ def run_on_flexbe_engine(states, initial_conditions, faults, speed):
     """The real FlexBE engine (flexbe_core from `make flexbe`) drives the simulator node."""
     from rclpy.parameter import Parameter
 
-    from atlas_sim.robot import make_simulator, parse_faults
+    from atlas_sim.simulator.factory import make_simulator, parse_faults
     from synthesis_manager.nodes.atlas_sim_node import AtlasSimNode
     from synthesis_manager.ros.flexbe_engine import run_on_flexbe
     from synthesis_manager.ros.harness import RosHarness
@@ -96,7 +97,7 @@ def flexbe_available() -> bool:
 
 
 def main() -> int:
-    from atlas_sim.trace_check import check_trace
+    from atlas_sim.executive.trace_check import check_trace
 
     print(f"{'task':<14}{'path':<12}{'robot s':>9}{'wall s':>9}{'x real':>8}  outcome, trace check")
     for name, initial, goals, sm_outcomes, faults in TASKS:

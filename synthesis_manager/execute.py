@@ -41,7 +41,7 @@ import sys
 from pathlib import Path
 
 from atlas_sim.closed_loop import DeferredEvents, run_and_check
-from atlas_sim.machine import ExecutionError
+from atlas_sim.executive.machine import ExecutionError
 from respec.errors import ExitStatus, exit_status_help
 from respec.parsing import spec_from_text_sections
 from synthesis_manager.send_goal import ProgressBar, add_goal_arguments, goal_from_args, print_summary
@@ -86,7 +86,7 @@ def add_arguments(parser):
 
 
 def run(args) -> int:
-    from atlas_sim.robot import FaultSpecError, InitialConditionError, make_simulator, parse_faults
+    from atlas_sim.simulator.factory import FaultSpecError, InitialConditionError, make_simulator, parse_faults
     from ltl_specification.errors import InvalidInitialConditionsError
     from ltl_specification.initial_conditions import asks_for_robot_state
     from respec.robot.files import SystemConfigError
@@ -155,7 +155,7 @@ class _Session:
             if self.uses_ros_sim:
                 self._robot = _ros_robot(self.ros, self.args, self.simulator)
             else:
-                from atlas_sim.robot import SimulatedRobot
+                from atlas_sim.simulated_robot import SimulatedRobot
 
                 self._robot = SimulatedRobot(self.simulator), None
         return self._robot

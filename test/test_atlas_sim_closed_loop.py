@@ -9,9 +9,10 @@ import math
 
 import pytest
 
-from atlas_sim.executor import execute_state_machine
-from atlas_sim.robot import SimulatedRobot, make_simulator, parse_faults
-from atlas_sim.trace_check import check_trace
+from atlas_sim.executive.executor import execute_state_machine
+from atlas_sim.executive.trace_check import check_trace
+from atlas_sim.simulated_robot import SimulatedRobot
+from atlas_sim.simulator.factory import make_simulator, parse_faults
 from ltl_specification import compile_task
 from ltl_synthesizer import synthesize
 from respec.automaton import automaton_from_strategy

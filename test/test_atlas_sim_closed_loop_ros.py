@@ -9,15 +9,15 @@ import pytest
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 
-from atlas_sim.executor import execute_state_machine
-from synthesis_manager.nodes.atlas_sim_node import AtlasSimNode
-from synthesis_manager.nodes.atlas_sim_robot import RosRobot
-from atlas_sim.trace_check import check_trace
+from atlas_sim.executive.executor import execute_state_machine
+from atlas_sim.executive.trace_check import check_trace
+from respec.errors import ExitStatus
 from respec.parsing import spec_from_text_sections
 from synthesis_manager.cli import main as cli_main
 from synthesis_manager.client import SynthesisClient, make_goal
+from synthesis_manager.nodes.atlas_sim_node import AtlasSimNode
+from synthesis_manager.nodes.atlas_sim_robot import RosRobot
 from synthesis_manager.suite import suite_node_factories
-from respec.errors import ExitStatus
 
 
 def synthesize_over_ros(ros, initial_conditions, goals, sm_outcomes=('finished', 'failed')):

@@ -7,12 +7,12 @@ from pathlib import Path
 
 import pytest
 
-from atlas_sim.config import DEFAULT_CONFIG, SystemConfig, load_system_config
+from atlas_sim.simulator.config import DEFAULT_CONFIG, SystemConfig, load_system_config
 from respec.robot.abstraction import AbstractionConfigError
-from atlas_sim.discrete import COMPLETED, FAILED, DiscreteSemantics
-from atlas_sim.faults import FaultInjector, FaultSpec
-from atlas_sim.kinematics import LegGeometry, POSTURES, sagittal_leg_ik
-from atlas_sim.motions import GaitMotion, KeyframeMotion, OperatorInputMotion, build_motion
+from atlas_sim.simulator.discrete import COMPLETED, FAILED, DiscreteSemantics
+from atlas_sim.simulator.faults import FaultInjector, FaultSpec
+from atlas_sim.simulator.kinematics import LegGeometry, POSTURES, sagittal_leg_ik
+from atlas_sim.simulator.motions import GaitMotion, KeyframeMotion, OperatorInputMotion, build_motion
 
 REPO = Path(__file__).resolve().parent.parent
 
@@ -64,7 +64,7 @@ def test_unknown_motion_kind_is_rejected():
 
 def test_discrete_modules_do_not_import_mujoco():
     code = (
-        "import sys, atlas_sim, atlas_sim.discrete, atlas_sim.faults, atlas_sim.motions;"
+        "import sys, atlas_sim, atlas_sim.simulator.discrete, atlas_sim.simulator.faults, atlas_sim.simulator.motions;"
         "print('mujoco' in sys.modules)"
     )
     out = subprocess.run([sys.executable, "-c", code], cwd=REPO, capture_output=True, text=True, check=True)
@@ -205,7 +205,7 @@ def test_crouch_is_lower_than_stand():
 
 
 def test_simulation_section_typos_are_rejected():
-    from atlas_sim.config import SimulationConfig
+    from atlas_sim.simulator.config import SimulationConfig
 
     with pytest.raises(ValueError, match="unknown keys"):
         SimulationConfig.from_dict({"fautls": {}})

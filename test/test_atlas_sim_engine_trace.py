@@ -5,10 +5,11 @@ starts their capabilities on the simulator as FlexBE's states would and reports 
 outcomes; the recorded trace must check clean and match what our executive records.
 """
 
-from atlas_sim.engine_trace import EngineTraceRecorder
-from atlas_sim.executor import execute_state_machine
-from atlas_sim.robot import SimulatedRobot, make_simulator
-from atlas_sim.trace_check import check_trace
+from atlas_sim.executive.engine_trace import EngineTraceRecorder
+from atlas_sim.executive.executor import execute_state_machine
+from atlas_sim.executive.trace_check import check_trace
+from atlas_sim.simulated_robot import SimulatedRobot
+from atlas_sim.simulator.factory import make_simulator
 from ltl_specification import compile_task
 from ltl_synthesizer import synthesize
 from respec.automaton import automaton_from_strategy

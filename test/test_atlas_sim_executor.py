@@ -2,11 +2,12 @@
 
 import pytest
 
-from atlas_sim.executor import ExecutionLimitError, UnmappedStateError, execute_state_machine
-from atlas_sim.machine import MachineInvalidError, UndeclaredOutcomeError, load_machine
-from atlas_sim.robot import (CapabilityResult, FaultSpecError, InitialConditionError, SimulatedRobot, make_simulator,
-                             parse_faults)
-from atlas_sim.trace_check import check_trace
+from atlas_sim.executive.executor import ExecutionLimitError, UnmappedStateError, execute_state_machine
+from atlas_sim.executive.machine import MachineInvalidError, UndeclaredOutcomeError, load_machine
+from atlas_sim.executive.robot import CapabilityResult
+from atlas_sim.executive.trace_check import check_trace
+from atlas_sim.simulated_robot import SimulatedRobot
+from atlas_sim.simulator.factory import FaultSpecError, InitialConditionError, make_simulator, parse_faults
 from ltl_specification import compile_task
 from sm_generation import StateInstantiation
 from sm_generation.config import load_flexbe_config

@@ -9,8 +9,8 @@ import copy
 import pytest
 import yaml
 
-from atlas_sim.config import DEFAULT_CONFIG, SimulationConfigError, SystemConfig
-from atlas_sim.simulator import AtlasSimulator
+from atlas_sim.simulator.atlas_simulator import AtlasSimulator
+from atlas_sim.simulator.config import DEFAULT_CONFIG, SimulationConfigError, SystemConfig
 
 
 def atlas_document():
@@ -121,7 +121,7 @@ def test_answers_are_pickled_as_flexbe_input_does_and_read_back_as_input_state_d
     import ast
     import pickle
 
-    from atlas_sim.operator_data import flexbe_input_data
+    from atlas_sim.simulator.operator_data import flexbe_input_data
 
     for value in (1, [0.6, 0.0, 0.0]):
         assert pickle.loads(ast.literal_eval(flexbe_input_data(value))) == value
@@ -137,7 +137,7 @@ def test_the_configured_operator_answers_by_request_type():
 @pytest.mark.parametrize('entries, item', [
     (['0'], '0'), (['x=1'], 'x'), (['300=1'], '300'), (['0=[1,'], '0=[1,'), ({'zero': 1}, 'zero')])
 def test_bad_answers_name_the_entry(entries, item):
-    from atlas_sim.operator_data import parse_answers
+    from atlas_sim.simulator.operator_data import parse_answers
 
     with pytest.raises(SimulationConfigError) as raised:
         parse_answers(entries, '--answer')
@@ -145,7 +145,7 @@ def test_bad_answers_name_the_entry(entries, item):
 
 
 def test_answers_from_text_and_files():
-    from atlas_sim.operator_data import parse_answers
+    from atlas_sim.simulator.operator_data import parse_answers
 
     assert parse_answers(['0=7', '3=[1, 2, 0.5]'], '--answer') == {0: 7, 3: [1, 2, 0.5]}
     assert parse_answers({0: 2}, 'scenario.yaml') == {0: 2}

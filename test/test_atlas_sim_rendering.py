@@ -15,14 +15,14 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from atlas_sim.rendering import encode_png
+from atlas_sim.simulator.rendering import encode_png
 
 REPO = Path(__file__).resolve().parent.parent
 WIDTH, HEIGHT = 320, 240
 
 RENDER_SCRIPT = f"""
 import sys
-from atlas_sim import AtlasSimulator, KeyFrameRecorder
+from atlas_sim.simulator import AtlasSimulator, KeyFrameRecorder
 sim = AtlasSimulator()
 recorder = KeyFrameRecorder(sim, sys.argv[1], width={WIDTH}, height={HEIGHT})
 sim.execute("stand")
@@ -30,7 +30,7 @@ sim.execute("look_down")
 recorder.capture("final")
 recorder.close()
 # a renderer sizes its buffers to its frames but leaves the model as it was: a bigger one still fits
-from atlas_sim import FrameRenderer
+from atlas_sim.simulator import FrameRenderer
 assert (sim.physics.model.vis.global_.offwidth, sim.physics.model.vis.global_.offheight) == (1280, 960)
 with FrameRenderer(sim, 640, 480) as big:
     big.save(sys.argv[1] + "/big.png")

@@ -1,16 +1,16 @@
 """Behaviour of the simulated humanoid: modes, actions, faults, falls, concurrency."""
 
+from collections import deque
 import dataclasses
 import json
 import random
-from collections import deque
 
 import numpy as np
 import pytest
 
-from atlas_sim.config import CONFIG_DIR, load_system_config
-from atlas_sim.faults import FaultSpec
-from atlas_sim.simulator import AtlasSimulator
+from atlas_sim.simulator.atlas_simulator import AtlasSimulator
+from atlas_sim.simulator.config import CONFIG_DIR, load_system_config
+from atlas_sim.simulator.faults import FaultSpec
 
 CONFIG = load_system_config()
 MODES = CONFIG.abstraction.control_modes

@@ -4,7 +4,7 @@ import json
 
 import pytest
 
-from atlas_sim.trace_check import (OutcomeTracker, Trace, TraceError, TraceStep, check_trace,
+from atlas_sim.executive.trace_check import (OutcomeTracker, Trace, TraceError, TraceStep, check_trace,
                                    least_violating_assignments, partial_evaluate, valuations_of_trace)
 from ltl_specification import compile_task
 from respec.ltl import var

@@ -10,15 +10,15 @@ import pytest
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 
-from atlas_sim.robot import make_simulator, parse_faults
-from synthesis_manager.nodes.atlas_sim_node import AtlasSimNode
-from atlas_sim.trace_check import check_trace
+from atlas_sim.executive.trace_check import check_trace
+from atlas_sim.simulator.factory import make_simulator, parse_faults
 from ltl_specification import compile_task
 from ltl_synthesizer import synthesize
 from respec.automaton import automaton_from_strategy
 from sm_generation import generate_state_machine
 from sm_generation.config import load_flexbe_config
 from sm_generation.flexbe_behavior import behavior_package
+from synthesis_manager.nodes.atlas_sim_node import AtlasSimNode
 
 pytestmark = pytest.mark.usefixtures('flexbe')
 

@@ -109,7 +109,7 @@ def test_the_editor_parser_reads_the_paper_task_and_atlas_sim_behaviors(parser):
     assert answer['warnings'] == []
     top = [s.name for s in states if s.parent_path == '/' and s.state_class != ':OUTCOME']
     assert sorted(reading_of(answer['result'])['_state_machine']) == sorted(top)
-    folder = ROOT / 'atlas_sim' / 'atlas_sim_flexbe_behaviors' / 'atlas_sim_flexbe_behaviors'
+    folder = ROOT / 'atlas_sim' / 'flexbe' / 'atlas_sim_flexbe_behaviors' / 'atlas_sim_flexbe_behaviors'
     for source in sorted(folder.glob('*_sm.py')):
         answer = parser(source.read_text())
         assert answer['warnings'] == [], source.name

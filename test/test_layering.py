@@ -4,9 +4,11 @@ Read with ``ast`` (nothing is imported), so a forbidden import is found even ins
 function or behind a try. Every import counts, function-local ones included: a cycle cannot
 be hidden by importing late.
 
-A ROS package folder (a directory with a ``package.xml``, e.g. a FlexBE state package inside
-``atlas_sim/``) is its own package: it may import flexbe_core and rclpy, and the core modules
-around it must not import it.
+A Python package is the files reachable from its folder through ``__init__.py`` files. A ROS
+package folder (a directory with a ``package.xml``, e.g. the FlexBE state package in
+``atlas_sim/flexbe/``, which no ``__init__.py`` joins to ``atlas_sim``) is a package of its own:
+it may import flexbe_core and rclpy, and no core may import it. Every Python file in the
+packages' folders belongs to exactly one of them, so none escapes the checks.
 """
 
 from __future__ import annotations
@@ -28,12 +30,22 @@ def ros_package_folders(root: Path = ROOT) -> list[Path]:
     return sorted(path.parent for package in PACKAGES for path in (root / package).rglob('package.xml'))
 
 
-def owner(path: Path, root: Path, ros_folders: list[Path]) -> str:
-    """The package a source file belongs to: a ROS package folder, else its top-level package."""
-    for folder in ros_folders:
-        if folder in path.parents:
-            return folder.relative_to(root).as_posix()
-    return path.relative_to(root).parts[0]
+def package_modules(folder: Path) -> list[Path]:
+    """The Python files of the package in ``folder``: those reached through ``__init__.py`` files."""
+    if not (folder / '__init__.py').exists():
+        return []
+    files = sorted(folder.glob('*.py'))
+    for child in sorted(path for path in folder.iterdir() if path.is_dir()):
+        files += package_modules(child)
+    return files
+
+
+def packages(root: Path = ROOT) -> dict[str, list[Path]]:
+    """Every package (a Python package or a ROS package folder) and its Python files."""
+    found = {package: package_modules(root / package) for package in PACKAGES}
+    for folder in ros_package_folders(root):
+        found[folder.relative_to(root).as_posix()] = sorted(folder.rglob('*.py'))
+    return found
 
 
 def imported_modules(path: Path, root: Path) -> list[tuple[str, int]]:
@@ -63,6 +75,13 @@ def ros_python_names(folder: Path) -> set[str]:
     return {child.name for child in folder.iterdir() if (child / '__init__.py').exists()}
 
 
+def unowned_files(root: Path = ROOT) -> list[str]:
+    """Python files in the packages' folders that belong to no package (no check would see them)."""
+    owned = {path for files in packages(root).values() for path in files}
+    return sorted(path.relative_to(root).as_posix() for package in PACKAGES
+                  for path in (root / package).rglob('*.py') if path not in owned)
+
+
 def import_graph(root: Path = ROOT):
     """(package -> {imported project package: first 'file:line'}, forbidden imports of the cores)."""
     ros_folders = ros_package_folders(root)
@@ -70,10 +89,9 @@ def import_graph(root: Path = ROOT):
                  for folder in ros_folders for name in ros_python_names(folder)}
     graph: dict[str, dict[str, str]] = {}
     forbidden = []
-    for package in PACKAGES:
-        for path in sorted((root / package).rglob('*.py')):
-            source = owner(path, root, ros_folders)
-            edges = graph.setdefault(source, {})
+    for source, files in packages(root).items():
+        edges = graph.setdefault(source, {})
+        for path in files:
             for module, line in imported_modules(path, root):
                 where = f'{path.relative_to(root).as_posix()}:{line}'
                 target = _target(module, ros_folders, ros_names, root)
@@ -119,6 +137,11 @@ def find_cycle(graph: dict[str, dict[str, str]]) -> list[str]:
             if cycle:
                 return cycle
     return []
+
+
+def test_every_python_file_belongs_to_one_package():
+    assert unowned_files() == []
+    assert {'atlas_sim/flexbe/atlas_sim_flexbe_states', 'atlas_sim/flexbe/atlas_sim_flexbe_behaviors'} <= set(packages())
 
 
 def test_cores_import_neither_the_shell_nor_ros_nor_the_web_stack():
@@ -232,6 +255,7 @@ def test_checker_reports_a_core_importing_rclpy_or_the_shell(tmp_path):
     root = _write(tmp_path, {
         'atlas_sim/__init__.py': '',
         'atlas_sim/node.py': 'import rclpy\n',
+        'ltl_synthesizer/__init__.py': '',
         'ltl_synthesizer/cli.py': 'try:\n    from synthesis_manager.ros import env\nexcept ImportError:\n    pass\n',
         'synthesis_manager/__init__.py': 'import rclpy\nimport fastapi\n',
     })
@@ -243,12 +267,25 @@ def test_checker_reports_a_core_importing_rclpy_or_the_shell(tmp_path):
 def test_checker_lets_a_ros_package_folder_import_flexbe_but_not_the_cores_import_it(tmp_path):
     root = _write(tmp_path, {
         'atlas_sim/__init__.py': '',
-        'atlas_sim/flexbe_states/package.xml': '<package/>',
-        'atlas_sim/flexbe_states/flexbe_states/__init__.py': '',
-        'atlas_sim/flexbe_states/flexbe_states/mode_state.py':
+        'atlas_sim/flexbe/flexbe_states/package.xml': '<package/>',
+        'atlas_sim/flexbe/flexbe_states/flexbe_states/__init__.py': '',
+        'atlas_sim/flexbe/flexbe_states/flexbe_states/mode_state.py':
             'from flexbe_core import EventState\nimport rclpy\nfrom atlas_sim import executor\n',
         'atlas_sim/executor.py': 'from flexbe_states.mode_state import ModeState\n',
     })
     graph, forbidden = import_graph(root)
     assert forbidden == ['atlas_sim/executor.py:1: atlas_sim imports flexbe_states.mode_state']
-    assert graph['atlas_sim/flexbe_states'] == {'atlas_sim': 'atlas_sim/flexbe_states/flexbe_states/mode_state.py:3'}
+    assert graph['atlas_sim/flexbe/flexbe_states'] == {'atlas_sim': 'atlas_sim/flexbe/flexbe_states/flexbe_states/mode_state.py:3'}
+
+
+def test_a_folder_without_init_is_no_part_of_the_package_around_it(tmp_path):
+    root = _write(tmp_path, {
+        'atlas_sim/__init__.py': '',
+        'atlas_sim/flexbe/flexbe_states/package.xml': '<package/>',
+        'atlas_sim/flexbe/flexbe_states/flexbe_states/__init__.py': 'import rclpy\n',
+        'atlas_sim/scripts/tool.py': 'import rclpy\n',
+    })
+    assert {name: [p.relative_to(root).as_posix() for p in files] for name, files in packages(root).items()
+            if files} == {'atlas_sim': ['atlas_sim/__init__.py'],
+                          'atlas_sim/flexbe/flexbe_states': ['atlas_sim/flexbe/flexbe_states/flexbe_states/__init__.py']}
+    assert unowned_files(root) == ['atlas_sim/scripts/tool.py']

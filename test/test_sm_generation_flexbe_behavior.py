@@ -183,7 +183,7 @@ def test_package_manifests_are_valid_for_colcon():
 
     _, package = export()
     manifests = [package.files['package.xml']] + [
-        (ROOT / 'atlas_sim' / name / 'package.xml').read_text()
+        (ROOT / 'atlas_sim' / 'flexbe' / name / 'package.xml').read_text()
         for name in ('atlas_sim_flexbe_states', 'atlas_sim_flexbe_behaviors')]
     for text in manifests:
         parsed = parse_package_string(text)

@@ -4,23 +4,23 @@ The suite's nodes, the simulator node and the clients run in one harness (or in 
 ``behavior-synthesis execute`` command, which starts them in-process the same way).
 """
 
+from argparse import Namespace
 import json
 import threading
 import time
-from argparse import Namespace
 
 import pytest
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 
-from atlas_sim.executor import execute_state_machine
-from synthesis_manager.nodes.atlas_sim_node import AtlasSimNode
-from synthesis_manager.nodes.atlas_sim_robot import RosRobot
-from atlas_sim.trace_check import check_trace
+from atlas_sim.executive.executor import execute_state_machine
+from atlas_sim.executive.trace_check import check_trace
 from ltl_specification.initial_conditions import initial_conditions_in_status
 from respec.parsing import spec_from_text_sections
 from synthesis_manager.cli import main as cli_main
 from synthesis_manager.client import SynthesisClient, make_flexbe_goal, make_goal
+from synthesis_manager.nodes.atlas_sim_node import AtlasSimNode
+from synthesis_manager.nodes.atlas_sim_robot import RosRobot
 from synthesis_manager.suite import suite_node_factories
 
 TASK_1 = ['look_down', 'pickup_object']

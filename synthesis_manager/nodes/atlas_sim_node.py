@@ -3,7 +3,7 @@
 * action server ``atlas_sim/execute`` (synthesis_msgs/action/ExecuteCapability): the goal
   names one capability (control mode or action) and may carry the requesting state's
   userdata (e.g. the operator's ``template_id``), which the simulator checks as the robot
-  would (atlas_sim.operator_data); the result is ``completed``/``failed``,
+  would (atlas_sim.simulator.operator_data); the result is ``completed``/``failed``,
   the simulator's reason and the sim time it ended. Goals may overlap, as concurrency
   containers need: goals arriving within ``batch_window`` wall seconds of each other start
   in the same sim instant (``AtlasSimulator.start_concurrently``). Requests cannot be
@@ -37,8 +37,9 @@ from rclpy.action import ActionServer, CancelResponse, GoalResponse
 from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.node import Node
 
-from atlas_sim.robot import make_simulator, parse_faults
-from atlas_sim.operator_data import decode_userdata
+from atlas_sim.simulator.factory import make_simulator, parse_faults
+from atlas_sim.simulator.node_names import ACTION_NAME, CAPABILITY_ACTION_PREFIX, NODE_NAME, STATE_TOPIC
+from atlas_sim.simulator.operator_data import decode_userdata
 from respec.errors import quoted
 from respec.naming import parse_names
 from synthesis_manager.ros.errors import log_internal_error
@@ -46,10 +47,6 @@ from synthesis_manager.ros.node_main import node_main
 from synthesis_msgs.action import ExecuteCapability
 from synthesis_msgs.msg import RobotState
 
-NODE_NAME = 'atlas_sim'
-ACTION_NAME = 'atlas_sim/execute'
-CAPABILITY_ACTION_PREFIX = 'atlas_sim/capabilities/'
-STATE_TOPIC = 'atlas_sim/state'
 
 
 def robot_state_message(snapshot: dict) -> RobotState:

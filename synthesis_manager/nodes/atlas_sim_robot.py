@@ -1,4 +1,4 @@
-"""The executive's :class:`~atlas_sim.robot.Robot` protocol over ROS: drives ``atlas_sim``.
+"""The executive's :class:`~atlas_sim.executive.robot.Robot` protocol over ROS: drives ``atlas_sim``.
 
 One ``atlas_sim/execute`` goal (synthesis_msgs/action/ExecuteCapability) per activated
 capability, the robot state from ``atlas_sim/state`` (synthesis_msgs/msg/RobotState).
@@ -20,7 +20,7 @@ import time
 
 from rclpy.action import ActionClient
 
-from atlas_sim.robot import CapabilityResult
+from atlas_sim.executive.robot import CapabilityResult
 from respec.errors import CodedError, ErrorCode
 from synthesis_manager.nodes.atlas_sim_node import ACTION_NAME, STATE_TOPIC
 from synthesis_msgs.action import ExecuteCapability

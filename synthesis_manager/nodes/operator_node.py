@@ -23,8 +23,8 @@ from pathlib import Path
 
 import yaml
 
-from atlas_sim.config import SimulationConfigError, system_config
-from atlas_sim.operator_data import answers_by_request_type, flexbe_input_data, parse_answers, quoted
+from atlas_sim.simulator.config import SimulationConfigError, system_config
+from atlas_sim.simulator.operator_data import answers_by_request_type, flexbe_input_data, parse_answers, quoted
 from sm_generation.config import input_request_capabilities, load_flexbe_config
 
 NODE_NAME = 'atlas_sim_operator'

@@ -9,7 +9,7 @@ capability); :class:`SimulatedOperator` answers InputState's ``flexbe/behavior_i
 requests by running the operator-input capability the request stands for on the simulator.
 
 The trace for the specification check comes from
-:class:`atlas_sim.engine_trace.EngineTraceRecorder`: the top-level states of the running
+:class:`atlas_sim.executive.engine_trace.EngineTraceRecorder`: the top-level states of the running
 machine are observed by wrapping their ``execute`` (the engine itself is not changed), the
 robot's reports come from the simulator's events.
 
@@ -29,9 +29,10 @@ import time
 import zlib
 from pathlib import Path
 
-from atlas_sim.engine_trace import EngineTraceRecorder
-from atlas_sim.executor import ExecutionLimitError
-from atlas_sim.operator_data import answers_by_request_type, flexbe_input_data
+from atlas_sim.executive.engine_trace import EngineTraceRecorder
+from atlas_sim.executive.executor import ExecutionLimitError
+from atlas_sim.simulator.node_names import CAPABILITY_ACTION_PREFIX
+from atlas_sim.simulator.operator_data import answers_by_request_type, flexbe_input_data
 from sm_generation.config import input_request_capabilities, load_flexbe_config
 from sm_generation.flexbe_behavior import behavior_package
 from sm_generation.instantiation import StateInstantiation
@@ -49,7 +50,6 @@ class SimulatedOperator:
         from rclpy.action import ActionClient, ActionServer
         from rclpy.callback_groups import ReentrantCallbackGroup
 
-        from synthesis_manager.nodes.atlas_sim_node import CAPABILITY_ACTION_PREFIX
         from synthesis_msgs.action import ExecuteCapability
 
         self._types = (BehaviorInput, ExecuteCapability)

@@ -90,7 +90,8 @@ def _simulate(settings: dict, send: Callable[[dict], None]) -> None:
     from pathlib import Path
 
     from atlas_sim.closed_loop import run_and_check
-    from atlas_sim.robot import SimulatedRobot, make_simulator, parse_faults
+    from atlas_sim.simulated_robot import SimulatedRobot
+    from atlas_sim.simulator.factory import make_simulator, parse_faults
     from respec.parsing import spec_from_text_sections
 
     simulator, sent = None, [0, 0]

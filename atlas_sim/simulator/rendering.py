@@ -2,11 +2,11 @@
 
 MuJoCo picks its OpenGL backend from ``MUJOCO_GL`` when it is *first
 imported*, so headless programs must set it before importing anything that
-imports mujoco (``atlas_sim.physics``, ``atlas_sim.simulator``)::
+imports mujoco (``atlas_sim.simulator.physics``, ``atlas_sim.simulator.atlas_simulator``)::
 
     import os
     os.environ.setdefault("MUJOCO_GL", "egl")   # or "osmesa"
-    from atlas_sim import AtlasSimulator, FrameRenderer
+    from atlas_sim.simulator import AtlasSimulator, FrameRenderer
 
 The PNG encoder below is a small self-contained writer (zlib + CRC chunks), so
 no imaging library is needed.

@@ -20,7 +20,7 @@ compute         no motion, just ``duration`` (planning steps)
 operator_input  no motion; completes iff the scenario provides the input
 ==============  ===============================================================
 
-``physics`` is duck-typed (see ``atlas_sim.physics.HumanoidPhysics``), so this
+``physics`` is duck-typed (see ``atlas_sim.simulator.physics.HumanoidPhysics``), so this
 module needs numpy only.
 """
 

@@ -1,17 +1,13 @@
-"""The robot the executive drives (ROS-free): the :class:`Robot` protocol, the in-process
-:class:`SimulatedRobot` and the simulator factory.
-
-``synthesis_manager.nodes.atlas_sim_robot.RosRobot`` is the same protocol over ROS 2.
+"""An :class:`AtlasSimulator` for a robot system, started in given initial conditions and with
+given faults (``make_simulator``, ``parse_faults``), and the errors naming a bad one.
 """
 
 from __future__ import annotations
 
 import dataclasses
-from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Protocol, Sequence
 
-from atlas_sim.config import system_config
+from atlas_sim.simulator.config import system_config
 from respec.errors import CodedError, ErrorCode
 from respec.naming import COMPLETED
 
@@ -26,52 +22,6 @@ class FaultSpecError(CodedError, ValueError):
     """A malformed fault ('capability:k') or one naming an unknown capability; ``item`` names it."""
 
     code = ErrorCode.INVALID_REQUEST
-
-
-@dataclass(frozen=True)
-class CapabilityResult:
-    """How one activation of a capability ended, on the robot's clock."""
-
-    capability: str
-    outcome: str  # 'completed' or 'failed'
-    reason: str
-    time: float
-
-
-class Robot(Protocol):
-    """What the executive needs from a robot (or its simulator)."""
-
-    def start_concurrently(self, capabilities: Sequence[str]) -> list[Any]:
-        """Start capabilities in one instant; returns one opaque handle per capability."""
-
-    def step(self) -> None:
-        """Let the robot run for a short while (one control period)."""
-
-    def result(self, handle) -> CapabilityResult | None:
-        """The result of a started capability, or None while it runs."""
-
-    def snapshot(self) -> dict:
-        """Robot state: at least time, mode, completed_actions, sensors, pelvis_height, fallen."""
-
-
-class SimulatedRobot:
-    """The :class:`Robot` protocol on an in-process ``AtlasSimulator`` (fast: no ROS)."""
-
-    def __init__(self, simulator):
-        self.simulator = simulator
-
-    def start_concurrently(self, capabilities):
-        return self.simulator.start_concurrently(list(capabilities))
-
-    def step(self) -> None:
-        self.simulator.step()
-
-    def result(self, handle) -> CapabilityResult | None:
-        done = handle.result
-        return None if done is None else CapabilityResult(done.name, done.outcome, done.reason, done.finished_at)
-
-    def snapshot(self) -> dict:
-        return self.simulator.snapshot()
 
 
 def parse_faults(fail=(), fail_first=(), probability=()) -> dict:
@@ -102,7 +52,7 @@ def make_simulator(system: str = 'atlas', config_dir: str | Path | None = None, 
     config's) and actions that have already completed. ``faults`` (capability -> entry of
     ``simulation.faults``) are added to the config's, ``seed`` replaces its seed.
     """
-    from atlas_sim.simulator import AtlasSimulator  # here: importing the executor needs no MuJoCo
+    from atlas_sim.simulator.atlas_simulator import AtlasSimulator  # here: parse_faults needs no MuJoCo
 
     config = system_config(system, config_dir)
     modes = [c for c in initial_conditions if c in config.abstraction.control_modes]

@@ -19,7 +19,7 @@ LEG_JOINTS = ("hip_yaw", "hip_roll", "hip_pitch", "knee", "ankle_pitch", "ankle_
 ARM_JOINTS = ("shoulder_pitch", "shoulder_roll", "elbow", "wrist")
 
 #: Joint groups a motion can claim.  Two motions that claim a common group
-#: cannot run at the same time (see ``atlas_sim.simulator``).
+#: cannot run at the same time (see ``atlas_sim.simulator.atlas_simulator``).
 JOINT_GROUPS: Dict[str, tuple] = {
     "legs": tuple(f"{side}_{joint}" for side in SIDES for joint in LEG_JOINTS),
     "torso": ("back_pitch",),
@@ -57,7 +57,7 @@ class LegGeometry:
 
     ``hip_offset_y``/``hip_offset_z`` locate the hip joints in the pelvis frame,
     ``ankle_height`` is the height of the ankle joint above the foot sole.
-    The defaults match ``models/humanoid.xml``; ``atlas_sim.physics`` re-reads
+    The defaults match ``models/humanoid.xml``; ``atlas_sim.simulator.physics`` re-reads
     them from the loaded model.
     """
 

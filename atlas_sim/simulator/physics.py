@@ -1,7 +1,7 @@
 """MuJoCo wrapper for the humanoid: loading, position targets, measurements.
 
 This is the only module (besides ``rendering``) that imports MuJoCo; the
-discrete semantics in ``atlas_sim.discrete`` stay importable without it.
+discrete semantics in ``atlas_sim.simulator.discrete`` stay importable without it.
 """
 
 from __future__ import annotations

@@ -2,7 +2,7 @@
 
 When FlexBE's engine runs a synthesized behavior, its states drive the simulator node and
 our executive is not involved; to check the run against the specification
-(:func:`atlas_sim.trace_check.check_trace`) the same :class:`~atlas_sim.trace_check.Trace`
+(:func:`atlas_sim.executive.trace_check.check_trace`) the same :class:`~atlas_sim.executive.trace_check.Trace`
 is built from two event streams:
 
 * the engine's top-level states: the runner calls :meth:`EngineTraceRecorder.entered`
@@ -13,7 +13,7 @@ is built from two event streams:
   still running joins it, so no new request starts: its outcome proposition stays as it
   is, as in our executive); a ``finished`` request is the robot's report.
 
-Steps, activations and outcome propositions follow :class:`atlas_sim.executor.Executive`:
+Steps, activations and outcome propositions follow :class:`atlas_sim.executive.executor.Executive`:
 a step's ``activated`` are the activation propositions of the state (or of the children
 of a concurrency container), a report of a capability the current step does not activate
 is recorded as ``abandoned``.
@@ -29,9 +29,9 @@ from __future__ import annotations
 import contextlib
 import threading
 
-from atlas_sim.executor import ExecutionResult, StateMapping, entered_step
-from atlas_sim.machine import load_machine, next_target
-from atlas_sim.trace_check import OutcomeTracker, Trace, TraceStep
+from atlas_sim.executive.executor import ExecutionResult, StateMapping, entered_step
+from atlas_sim.executive.machine import load_machine, next_target
+from atlas_sim.executive.trace_check import OutcomeTracker, Trace, TraceStep
 
 
 class EngineTraceRecorder:

@@ -11,11 +11,10 @@ import json
 from flexbe_core import Logger
 from flexbe_core.proxy import ProxyActionClient
 
+from atlas_sim.simulator.node_names import CAPABILITY_ACTION_PREFIX
+from respec.naming import COMPLETED  # the ExecuteCapability result outcome meaning success
 from synthesis_msgs.action import ExecuteCapability
 
-# Must match the simulator node's CAPABILITY_ACTION_PREFIX (checked by the project's tests).
-CAPABILITY_ACTION_PREFIX = 'atlas_sim/capabilities/'
-COMPLETED = 'completed'  # ExecuteCapability result outcome meaning success
 # How long on_enter waits for the simulator's action server the first time (discovery).
 SERVER_WAIT = 5.0
 

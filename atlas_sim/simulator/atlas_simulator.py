@@ -5,7 +5,7 @@ A *request* names one capability of the robot config (a control mode such as
 
 1. ``start(name, data)`` checks, in order: the robot has not fallen; the data
    the request carries (or the simulator's own operator answers) is valid and the
-   object it names is within reach (``atlas_sim.operator_data``); the discrete
+   object it names is within reach (``atlas_sim.simulator.operator_data``); the discrete
    rules allow it (``DiscreteSemantics.refusal``); its motion's joint groups
    are free.  A refused request is finished at once with outcome ``failed``
    and does not change the discrete state.  Otherwise the request *runs*; an

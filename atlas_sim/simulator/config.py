@@ -15,7 +15,7 @@ Two sections matter here:
       fault_delay: 0.1              # sim time before an injected fault is reported (s)
       settle: {timeout: 3.0, position_tolerance: 0.15, velocity_tolerance: 0.2}
       fall: {min_pelvis_height: 0.45, max_torso_tilt_deg: 40.0}
-      modes:                        # control mode -> motion (see atlas_sim.motions)
+      modes:                        # control mode -> motion (see atlas_sim.simulator.motions)
         stand: {motion: posture, posture: stand, duration: 1.5}
         walk:  {motion: gait, steps: 4, step_length: 0.15}
       actions:                      # action -> motion
@@ -27,10 +27,10 @@ Two sections matter here:
         operator_inputs: {object_template: true, target_pose: true}
         operator_answers: {object_template: 1}   # what the operator answers (default: by kind)
         sensors: {obj_detected: true}
-      scene:                        # objects by template id, reach (see atlas_sim.operator_data)
+      scene:                        # objects by template id, reach (see atlas_sim.simulator.operator_data)
         objects: {1: pickup_object}
         reach: 1.0
-      faults:                       # capability -> fault (see atlas_sim.faults)
+      faults:                       # capability -> fault (see atlas_sim.simulator.faults)
         pickup_object: {fail_first: 1}
       stand_in: "..."               # set when the humanoid does not model this robot but only
                                     # stands in for it (says how); the GUI then offers no simulation
@@ -56,8 +56,8 @@ class SimulationConfigError(CodedError, ValueError):
     code = ErrorCode.CONFIG_FILE_INVALID
 
 
-#: config/ next to the atlas_sim package (the repository layout).
-CONFIG_DIR = Path(__file__).resolve().parent.parent / "config"
+#: config/ next to the atlas_sim package (the repository layout: atlas_sim/simulator/config.py).
+CONFIG_DIR = Path(__file__).resolve().parents[2] / "config"
 DEFAULT_CONFIG = CONFIG_DIR / "atlas.yaml"
 
 
@@ -82,7 +82,7 @@ class ScenarioConfig:
 
 @dataclass(frozen=True)
 class SceneConfig:
-    """The objects the robot can act on, by template id (see atlas_sim.operator_data), and its reach (m)."""
+    """The objects the robot can act on, by template id (see atlas_sim.simulator.operator_data), and its reach (m)."""
 
     objects: Dict[int, str] = field(default_factory=lambda: {1: "pickup_object"})
     reach: float = 1.0

@@ -6,7 +6,7 @@ as :class:`MachineInvalidError`, an error of the run (with the trace so far, non
 
 from __future__ import annotations
 
-from atlas_sim.trace_check import Trace
+from atlas_sim.executive.trace_check import Trace
 from respec.errors import CodedError, ErrorCode
 from sm_generation.errors import SMGenerationError
 from sm_generation.state_machine import State, StateMachine

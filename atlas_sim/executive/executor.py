@@ -24,14 +24,14 @@ children did) keeps running, as its activation proposition stays true; a running
 that the next state does not activate is abandoned (the robot cannot cancel it) and
 whatever it still reports is recorded, so the trace check sees it.
 
-The robot is anything with the :class:`atlas_sim.robot.Robot` protocol: ``SimulatedRobot`` drives
+The robot is anything with the :class:`atlas_sim.executive.robot.Robot` protocol: ``SimulatedRobot`` drives
 an ``AtlasSimulator`` directly; ``synthesis_manager.nodes.atlas_sim_robot.RosRobot`` drives the
 simulator node. The machine is the tree of :mod:`sm_generation.state_machine`, loaded by
-:mod:`atlas_sim.machine`.
+:mod:`atlas_sim.executive.machine`.
 
     sim = make_simulator('atlas', initial_conditions=['stand_prep'])
     run = execute_state_machine(states, SimulatedRobot(sim), system='atlas')
-    run.outcome, run.trace                  # 'finished', Trace (see atlas_sim.trace_check)
+    run.outcome, run.trace                  # 'finished', Trace (see atlas_sim.executive.trace_check)
 """
 
 from __future__ import annotations
@@ -42,9 +42,9 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Callable
 
-from atlas_sim.machine import ExecutionError, UndeclaredOutcomeError, load_machine, next_target
-from atlas_sim.robot import CapabilityResult, Robot
-from atlas_sim.trace_check import OutcomeTracker, Trace, TraceStep
+from atlas_sim.executive.machine import ExecutionError, UndeclaredOutcomeError, load_machine, next_target
+from atlas_sim.executive.robot import CapabilityResult, Robot
+from atlas_sim.executive.trace_check import OutcomeTracker, Trace, TraceStep
 from respec.robot.abstraction import load_abstraction
 from respec.errors import ErrorCode
 from respec.naming import activated, is_activation, outcome_proposition

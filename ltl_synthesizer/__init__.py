@@ -19,7 +19,8 @@ Modules: interrupt (cancel, deadline, memory limit), symbolic (the game: formula
 enforceable predecessors), policy (Options and the automatic plan), gr1 (the solver and its
 fixpoints), strategy (explicit strategies, counter-strategies, slugs JSON), explain (why
 unrealizable), unrealizable_core (minimal unrealizable subsets of guarantees, by delta
-debugging), cli (``gr1synth``). Imports are lazy, so ``gr1synth --help`` starts without
+debugging), command (the ``gr1synth`` command: arguments, one run, outputs), cli
+(``gr1synth``) and serve (its resident mode), both on command. Imports are lazy, so ``gr1synth --help`` starts without
 loading CUDD.
 """
 

@@ -18,7 +18,6 @@ plain sentence; the details follow.
 from __future__ import annotations
 
 import itertools
-import threading
 from dataclasses import asdict, dataclass, field
 
 from respec.abstraction import RobotAbstraction
@@ -27,6 +26,7 @@ from respec.components import (SOURCE_ACTIONS, SOURCE_CONTROL_MODES, SOURCE_CUST
                                SOURCE_INITIAL_CONDITIONS, SOURCE_SM_OUTCOMES, FormulaGroup)
 from respec.ltl import Formula, evaluate, mentions_next, to_infix, variables
 from ltl_synthesizer.errors import SynthesisCancelledError
+from ltl_synthesizer.interrupt import Limits
 from ltl_synthesizer.unrealizable_core import environment_play, unrealizable_core
 
 from ltl_specification.compiler import CompiledSpecification, compile_task, load_task_abstraction
@@ -226,11 +226,11 @@ def origin_of(group: FormulaGroup, provenance, abstraction: RobotAbstraction, wh
 
 
 def diagnose(spec: CompiledSpecification, robotics_semantics: bool = True, config_dir=None,
-             cancel: threading.Event | None = None, deadline: float | None = None) -> Diagnosis | None:
+             limits: Limits = Limits()) -> Diagnosis | None:
     """Why ``spec`` (compiled with provenance) is unrealizable; None if it is realizable.
 
-    When the deadline passes during the core search, the pre-check's findings are still
-    returned and the note says the core was not computed.
+    When ``limits`` stop the core search (a cancel, the deadline), the pre-check's findings
+    are still returned and the note says the core was not computed.
     """
     provenance = spec.provenance
     abstraction = load_task_abstraction(provenance.system, config_dir)
@@ -238,12 +238,12 @@ def diagnose(spec: CompiledSpecification, robotics_semantics: bool = True, confi
     findings = precheck(spec, config_dir)
     diagnosis = Diagnosis(sentence=findings[0].sentence if findings else '', findings=findings)
     try:
-        core = unrealizable_core(spec, provenance.groups, robotics_semantics, cancel, deadline)
+        core = unrealizable_core(spec, provenance.groups, robotics_semantics, limits)
         if core is None:
             return None
         diagnosis.core = [CoreEntry(g.equation, g.title, g.item, origin_of(g, provenance, abstraction, where),
                                     [to_infix(f) for f in g.formulas]) for g in core.groups]
-        steps = environment_play(spec, robotics_semantics, PLAY_LENGTH, cancel, deadline)
+        steps = environment_play(spec, robotics_semantics, PLAY_LENGTH, limits)
         diagnosis.play = play_in_words(steps, provenance, abstraction)
     except SynthesisCancelledError as stopped:
         diagnosis.note = f'(The unrealizable core was not computed: {stopped.reason}.)'
@@ -296,14 +296,13 @@ def play_in_words(steps: list[dict], provenance, abstraction: RobotAbstraction) 
 
 def explain_unsynthesizable(details: str, system: str, initial_conditions, goals, sm_outcomes=DEFAULT_SM_OUTCOMES,
                             strict_order: bool = True, custom_ltl=None, robotics_semantics: bool = True,
-                            config_dir=None, deadline: float | None = None,
-                            cancel: threading.Event | None = None) -> str:
+                            config_dir=None, limits: Limits = Limits()) -> str:
     """The SPEC_UNSYNTHESIZABLE message for a task: the diagnosis first, then ``details``
     (the synthesizer's own explanation). Never raises: if the task cannot be diagnosed
     (e.g. it does not compile here), ``details`` are returned unchanged."""
     try:
         spec = compile_task(system, initial_conditions, goals, sm_outcomes, strict_order, custom_ltl, config_dir)
-        diagnosis = diagnose(spec, robotics_semantics, config_dir, cancel, deadline)
+        diagnosis = diagnose(spec, robotics_semantics, config_dir, limits)
     except Exception:  # the diagnosis is a help; the synthesizer's verdict stands without it
         return details
     if diagnosis is None:

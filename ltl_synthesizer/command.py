@@ -115,6 +115,24 @@ def _read_text(path: str, deadline: float | None) -> str:
     return outcome['text']
 
 
+def synthesis_outcome(spec, args, limits, stream: bool = False):
+    """What a run of ``args`` prints and writes, as a SynthesisResult: the verdict, and the
+    strategy, counter-strategy or explanation asked for. ``stream`` (in-process only): the
+    strategy is extracted while it is written (bounded memory)."""
+    from ltl_synthesizer.synthesizer import (SynthesisResult, counter_strategy, explain,
+                                             explicit_strategy, solve, stream_strategy)
+    solved = solve(spec, args.sysInitRoboticsSemantics, limits)
+    result = SynthesisResult(solved.realizable)
+    if solved.realizable and args.explicitStrategy:
+        result.strategy = stream_strategy(solved) if stream else explicit_strategy(solved)
+    elif not solved.realizable:
+        if args.counterStrategy:
+            result.counterstrategy = counter_strategy(solved)
+        if args.explain:
+            result.explanation = explain(solved)
+    return result
+
+
 def _write(text: str, output: str | None) -> None:
     _write_chunks([text], output)
 
@@ -196,13 +214,13 @@ def run(args) -> int:
     from respec.parsing import ParseError
     from ltl_synthesizer.errors import (SynthesisCancelledError, SynthesisError,
                                         SynthesisMemoryError)
-    from ltl_synthesizer.interrupt import Interrupt
+    from ltl_synthesizer.interrupt import Limits
 
     deadline = time.monotonic() + args.timeout if args.timeout else None
-    memory_limit = int(args.memory_limit * 2**20) if args.memory_limit > 0 else None
-    interrupt = Interrupt(None, deadline, memory_limit)
+    limits = Limits(deadline=deadline,
+                    memory_limit=int(args.memory_limit * 2**20) if args.memory_limit > 0 else None)
     try:
-        spec = read_specification(args.input, check=interrupt, deadline=deadline)
+        spec = read_specification(args.input, check=limits.interrupt(), deadline=deadline)
     except SynthesisCancelledError as error:
         print(f'gr1synth: error: {error}', file=sys.stderr)
         return ExitStatus.TIMED_OUT
@@ -218,22 +236,16 @@ def run(args) -> int:
         _write(spec.to_slugsin(), args.output)
         return ExitStatus.OK
 
-    if deadline is None:
-        from ltl_synthesizer.synthesizer import synthesize
-    else:
+    if deadline is not None:
         # With a time limit the synthesis runs in a child process, killed at the deadline even
         # in the middle of a long CUDD operation (checks between operations could be late).
         from ltl_synthesizer.isolated import SynthesisProcesses
         processes = SynthesisProcesses()
-        synthesize = processes.synthesize
     try:
-        # In-process JSON strategies are written while they are extracted (bounded memory).
-        stream = args.explicitStrategy and args.jsonOutput and deadline is None
-        result = synthesize(spec, robotics_semantics=args.sysInitRoboticsSemantics,
-                            deadline=deadline, counterstrategy=args.counterStrategy,
-                            explain=args.explain,
-                            strategy='stream' if stream else args.explicitStrategy,
-                            memory_limit=memory_limit)
+        if deadline is None:
+            result = synthesis_outcome(spec, args, limits, stream=args.jsonOutput)
+        else:
+            result = processes.call(synthesis_outcome, (spec, args, limits), deadline=deadline)
     except SynthesisCancelledError as error:
         print(f'gr1synth: error: {error}', file=sys.stderr)
         return ExitStatus.TIMED_OUT

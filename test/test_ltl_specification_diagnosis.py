@@ -7,7 +7,7 @@ import pytest
 from ltl_specification import compile_task
 from ltl_specification.diagnosis import (diagnose, explain_unsynthesizable, goal_findings, impossible_next_goals,
                                         precheck)
-from ltl_synthesizer import synthesize
+from ltl_synthesizer import Limits
 from ltl_synthesizer.unrealizable_core import (ddmin, droppable_sections, environment_play, is_realizable,
                                                restrict_guarantees, unrealizable_core)
 from respec.spec import FORMULA_SECTIONS
@@ -56,7 +56,7 @@ def test_precheck_names_forbidden_preconditions_and_contradictory_custom_ltl():
 
 def test_core_is_unrealizable_and_one_minimal():
     spec = compile_task(**IMPOSSIBLE)
-    assert not synthesize(spec, explain=False).realizable
+    assert not is_realizable(spec)
     core = unrealizable_core(spec, spec.provenance.groups)
     assert not is_realizable(core.specification)
     sections = droppable_sections(True)
@@ -122,7 +122,7 @@ def test_explain_unsynthesizable_keeps_the_details_and_never_raises():
 
 
 def test_deadline_keeps_the_precheck_sentence():
-    diagnosis = diagnose(compile_task(**IMPOSSIBLE), deadline=0.0)
+    diagnosis = diagnose(compile_task(**IMPOSSIBLE), limits=Limits(deadline=0.0))
     assert 'stand -> stand_prep' in diagnosis.sentence and 'not computed' in diagnosis.note
 
 

@@ -8,6 +8,7 @@ from pathlib import Path
 
 import pytest
 
+import endless_diagnosis as endless_diagnosis_module
 from synthesis_manager.client import SynthesisClient, make_goal
 from synthesis_manager.suite import suite_node_factories
 
@@ -171,7 +172,7 @@ def endless_diagnosis(suite, monkeypatch, tmp_path):
     monkeypatch.setenv('PYTHONPATH', os.pathsep.join(filter(None, [test_dir, os.environ.get('PYTHONPATH')])))
     pid_file = tmp_path / 'diagnosis.pid'
     monkeypatch.setenv('ENDLESS_DIAGNOSIS_PID_FILE', str(pid_file))
-    monkeypatch.setattr(server_node, 'DIAGNOSIS', 'endless_diagnosis:endless_diagnosis')
+    monkeypatch.setattr(server_node, 'DIAGNOSIS', endless_diagnosis_module.endless_diagnosis)
     return pid_file
 
 

@@ -15,7 +15,7 @@ from pathlib import Path
 from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.node import Node
 
-from ltl_synthesizer import SynthesisCancelledError
+from ltl_synthesizer import Limits, SynthesisCancelledError
 from ltl_synthesizer.external import run_external_synthesizer
 from ltl_synthesizer.isolated import SERVER_CHILD_NICENESS, SynthesisProcesses
 from ltl_synthesizer.strategy import strategy_to_json
@@ -160,9 +160,8 @@ class LTLSynthesisNode(Node):
             backend = self.parameter('backend')
             if backend == 'builtin':
                 try:
-                    result = self.synthesis_processes.synthesize(
-                        spec, robotics_semantics=robotics, cancel=cancel, deadline=deadline,
-                        memory_limit=self.parameter('memory_limit_mb') * 2**20)
+                    result = self.synthesis_processes.synthesize(spec, robotics, Limits(
+                        cancel, deadline, self.parameter('memory_limit_mb') * 2**20))
                 except SynthesisCancelledError as stopped:
                     return self._stopped(response, stopped.reason, timeout)
                 realizable, strategy, explanation = result.realizable, result.strategy, result.explanation

@@ -26,10 +26,12 @@ from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.node import Node
 from rclpy.time import Time
 
+from ltl_specification.diagnosis import explain_unsynthesizable
 from ltl_specification.errors import InvalidInitialConditionsError
 from ltl_specification.initial_conditions import (detected_status, initial_conditions_from_robot_state,
                                                   reads_robot_state)
 from ltl_synthesizer.errors import SynthesisError
+from ltl_synthesizer.interrupt import Limits
 from ltl_synthesizer.isolated import SERVER_CHILD_NICENESS, SynthesisProcesses
 from respec.errors import INTERNAL_ERROR, CodedError, ErrorCode
 from sm_generation.instantiation import count_states
@@ -54,7 +56,7 @@ from synthesis_msgs.srv import (CancelSynthesis, GenerateFlexBESM, GenerateLTLSp
 
 # What explains an unrealizable task (run in a child process; a module-level name so that
 # tests can put a stand-in there).
-DIAGNOSIS = 'ltl_specification.diagnosis:explain_unsynthesizable'
+DIAGNOSIS = explain_unsynthesizable
 DIAGNOSIS_GRACE = 1.0  # seconds past diagnosis_timeout before the diagnosis process is killed
 # Seconds past synthesis_timeout the synthesis node has to answer (a goal's own limit gets none).
 SYNTHESIS_ANSWER_GRACE = 1.0
@@ -429,8 +431,8 @@ class BehaviorSynthesisServer(Node):
     def _diagnosis(self, arguments: dict, deadline: float, stop: threading.Event, details: str) -> str:
         try:
             # The diagnosis keeps its own deadline; the child is killed only if it overruns.
-            return self.diagnosis_processes.call(DIAGNOSIS, (), {**arguments, 'deadline': deadline}, cancel=stop,
-                                                 deadline=deadline + DIAGNOSIS_GRACE)
+            return self.diagnosis_processes.call(DIAGNOSIS, (), {**arguments, 'limits': Limits(deadline=deadline)},
+                                                 cancel=stop, deadline=deadline + DIAGNOSIS_GRACE)
         except SynthesisError:  # stopped, out of time, or its process died: the verdict stands without it
             return details
 

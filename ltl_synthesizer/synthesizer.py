@@ -20,11 +20,11 @@ from respec.spec import GR1Specification
 
 from ltl_synthesizer.gr1 import (EnvironmentSolution, Solver, SystemSolution, solve_environment_game,
                                  solve_system_game)
-from ltl_synthesizer.interrupt import DEFAULT_MEMORY_LIMIT, Interrupt, Limits, memory_exceeded
+from ltl_synthesizer.interrupt import Interrupt, Limits, memory_exceeded
 from ltl_synthesizer.policy import Options
 from ltl_synthesizer.symbolic import SymbolicGame
 
-__all__ = ['DEFAULT_MEMORY_LIMIT', 'Limits', 'Solved', 'SynthesisResult', 'counter_strategy', 'explain',
+__all__ = ['Limits', 'Solved', 'SynthesisResult', 'counter_strategy', 'explain',
            'explicit_strategy', 'initial_positions_win', 'is_realizable', 'solve', 'stream_strategy',
            'synthesize']
 

@@ -7,9 +7,11 @@ import pytest
 from ltl_specification import compile_task
 from ltl_specification.diagnosis import (diagnose, explain_unsynthesizable, goal_findings, impossible_next_goals,
                                         precheck)
+from ltl_specification.provenance import provenance_from_json, provenance_to_json
 from ltl_synthesizer import Limits
 from ltl_synthesizer.unrealizable_core import (ddmin, droppable_sections, environment_play, is_realizable,
                                                restrict_guarantees, unrealizable_core)
+from respec.parsing import spec_from_text_sections
 from respec.spec import FORMULA_SECTIONS
 
 IMPOSSIBLE = dict(system='atlas', initial_conditions=[], goals=['look_down', 'stand_prep'])
@@ -115,10 +117,28 @@ def test_core_sentence_when_the_precheck_finds_nothing():
 
 
 def test_explain_unsynthesizable_keeps_the_details_and_never_raises():
-    message = explain_unsynthesizable('DETAILS', **IMPOSSIBLE)
+    impossible = compile_task(**IMPOSSIBLE)
+    message = explain_unsynthesizable('DETAILS', impossible, impossible.provenance)
     assert message.splitlines()[0].startswith('Goal 2 (stand_prep)') and message.endswith('DETAILS')
-    assert explain_unsynthesizable('DETAILS', 'no_such_system', [], ['x']) == 'DETAILS'
-    assert explain_unsynthesizable('DETAILS', 'atlas', [], ['look_down']) == 'DETAILS'  # realizable
+    assert explain_unsynthesizable('DETAILS', impossible, None) == 'DETAILS'  # no provenance: nothing to tell
+    realizable = compile_task('atlas', [], ['look_down'])
+    assert explain_unsynthesizable('DETAILS', realizable, realizable.provenance) == 'DETAILS'
+
+
+@pytest.mark.parametrize('task', [IMPOSSIBLE, dict(system='atlas', initial_conditions=[], goals=['look_down'],
+                                                   custom_ltl={'sys_trans': ['stand_c -> !look_down_a']})])
+def test_a_specification_sent_with_its_provenance_as_json_is_diagnosed_the_same(task):
+    """What the synthesis node receives: the specification as message sections and the
+    provenance as JSON, with no robot configuration at hand."""
+    compiled = compile_task(**task)
+    text = provenance_to_json(compiled.provenance)
+    assert text == provenance_to_json(compile_task(**task).provenance)  # deterministic
+    received = provenance_from_json(text)
+    assert provenance_to_json(received) == text
+    sent = spec_from_text_sections(compiled.to_text_sections())
+    assert diagnose(sent, provenance=received).message() == diagnose(compiled).message()
+    with pytest.raises(ValueError):
+        provenance_from_json('{"format": 0}')
 
 
 def test_deadline_keeps_the_precheck_sentence():

@@ -6,6 +6,7 @@ from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.node import Node
 
 from ltl_specification import compile_task
+from ltl_specification.provenance import provenance_to_json
 from respec.naming import DEFAULT_SM_OUTCOMES
 from synthesis_manager.ros.conversions import error_code, msg_to_sections, spec_to_msg
 from synthesis_manager.limits import check_message
@@ -41,6 +42,8 @@ class LTLCompilationNode(Node):
             self.get_logger().warning(response.error_code.message)
             return response
         response.ltl_specification = spec_to_msg(spec)
+        # CNU capability systems record none: their unrealizable specifications are not diagnosed.
+        response.provenance = provenance_to_json(spec.provenance) if spec.provenance is not None else ''
         response.error_code = error_code()
         return response
 

@@ -68,19 +68,13 @@ class SimulationProcess:
                 'steps': last_steps}
 
     def stop(self) -> None:
-        """End the child now (the GUI stops, or the run overran its wall-time limit)."""
+        """End the child now, from any thread (the GUI stops): run() returns the error message."""
         if self.process.poll() is None:
             self.process.kill()
 
 
 def simulate(settings: dict, progress: Callable[[dict], None]) -> dict:
     """In the child: run the machine on atlas_sim's robot, reporting ``progress``; the final message."""
-    from pathlib import Path
-
-    from atlas_sim.closed_loop import run_and_check
-    from atlas_sim.robot import SimulatedRobot, make_simulator, parse_faults
-    from respec.parsing import spec_from_text_sections
-
     simulator, sent = None, [0, 0]
 
     def step_added(steps, frames):  # every control tick: report only when a step or frame was added
@@ -90,6 +84,12 @@ def simulate(settings: dict, progress: Callable[[dict], None]) -> dict:
                       'frames': [str(path) for path in frames]})
 
     try:
+        from pathlib import Path
+
+        from atlas_sim.closed_loop import run_and_check
+        from atlas_sim.robot import SimulatedRobot, make_simulator, parse_faults
+        from respec.parsing import spec_from_text_sections
+
         simulator = make_simulator(settings['system'], settings['config_dir'], settings['initial_conditions'],
                                    faults=parse_faults(fail_first=[f'{c}:1' for c in settings['fail_first']]))
         run = run_and_check(settings['states'], SimulatedRobot(simulator), simulator, settings['system'],
@@ -101,7 +101,7 @@ def simulate(settings: dict, progress: Callable[[dict], None]) -> dict:
                            'timeline': str(run.timeline) if run.timeline else None,
                            'frames': [str(path) for path in run.frames], 'robot_time': simulator.time,
                            'steps': [dataclasses.asdict(step) for step in run.result.trace.steps]}}
-    except Exception as error:  # ExecutionError, bad faults, rendering: reported to the GUI
+    except Exception as error:  # ExecutionError, bad faults, rendering, a missing module: reported to the GUI
         if not isinstance(error, CodedError):
             logger.exception('simulation failed')
         trace = getattr(error, 'trace', None)

@@ -24,7 +24,7 @@ from respec.components import (SOURCE_ACTIONS, SOURCE_CONTROL_MODES, SOURCE_GOAL
                                SOURCE_SM_OUTCOMES, FormulaGroup)
 from respec.ltl import to_infix
 from respec.naming import activation, memory, outcome_proposition
-from respec.parsing import parse_formula
+from respec.parsing import ParseError, parse_formula
 
 from ltl_specification.pertinence import Pertinence
 from ltl_specification.reachability import Finding, unreachable_goal_modes
@@ -134,11 +134,16 @@ def provenance_to_json(provenance: Provenance) -> str:
 
 
 def provenance_from_json(text: str) -> Provenance:
-    """The provenance written by :func:`provenance_to_json`; ValueError (with KeyError and
-    TypeError, as json's own errors) for another text."""
-    data = json.loads(text)
-    if not isinstance(data, dict) or data.get('format') != FORMAT_VERSION:
-        raise ValueError(f'not a provenance of format {FORMAT_VERSION}')
+    """The provenance written by :func:`provenance_to_json`; ValueError for any other text."""
+    try:
+        return _provenance(json.loads(text))
+    except (KeyError, TypeError, ValueError, ParseError) as error:  # JSONDecodeError is a ValueError
+        raise ValueError(f'not a provenance of format {FORMAT_VERSION}: {error}') from error
+
+
+def _provenance(data) -> Provenance:
+    if data['format'] != FORMAT_VERSION:
+        raise ValueError(f'format {data["format"]!r}')
     pertinence = data['pertinence']
     return Provenance(
         data['system'], tuple(data['initial_conditions']), tuple(data['goals']), tuple(data['sm_outcomes']),

@@ -1,6 +1,7 @@
 """Diagnosis of impossible tasks: pre-check, unrealizable cores (delta debugging), plays in words."""
 
 import itertools
+import json
 
 import pytest
 
@@ -137,8 +138,11 @@ def test_a_specification_sent_with_its_provenance_as_json_is_diagnosed_the_same(
     assert provenance_to_json(received) == text
     sent = spec_from_text_sections(compiled.to_text_sections())
     assert diagnose(sent, provenance=received).message() == diagnose(compiled).message()
-    with pytest.raises(ValueError):
-        provenance_from_json('{"format": 0}')
+    bad_formula = json.loads(text)
+    bad_formula['groups'][0][5] = ['((']
+    for malformed in ('{"format": 0}', '[]', 'not json', json.dumps(bad_formula)):
+        with pytest.raises(ValueError):
+            provenance_from_json(malformed)
 
 
 def test_deadline_keeps_the_precheck_sentence():

@@ -212,7 +212,7 @@ class LTLSynthesisNode(Node):
             return details
         try:
             provenance = provenance_from_json(request.provenance)
-        except (ValueError, KeyError, TypeError) as error:
+        except ValueError as error:
             self.get_logger().warning(f'request.provenance ignored (no diagnosis): {error!r}'[:300])
             return details
         limit = request.diagnosis_timeout or self.parameter('diagnosis_timeout')

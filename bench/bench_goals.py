@@ -54,10 +54,10 @@ def task_spec(goals: int, ordered: bool):
 
 def run_one(goals: int, ordered: bool, options: dict) -> dict:
     """One synthesis in this process (the child side of ``measure``)."""
-    from ltl_synthesizer import Options, synthesize
+    from ltl_synthesizer import Limits, Options, synthesize
     spec = task_spec(goals, ordered)
     started = time.process_time()
-    result = synthesize(spec, options=Options(**options), memory_limit=None)
+    result = synthesize(spec, limits=Limits(memory_limit=None), options=Options(**options))
     cpu = time.process_time() - started
     return {'goals': goals, 'ordered': ordered, 'realizable': result.realizable,
             'cpu_seconds': cpu, 'variables': result.stats['variables'],

@@ -345,7 +345,7 @@ def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description='check our strategy for a specification symbolically')
     parser.add_argument('specification', help='.slugsin or .structuredslugs file')
     args = parser.parse_args(argv)
-    from ltl_synthesizer.cli import read_specification
+    from ltl_synthesizer.command import read_specification
     from ltl_synthesizer.gr1 import Solver, solve_system_game
     from ltl_synthesizer.strategy import symbolic_strategy
     from ltl_synthesizer.symbolic import SymbolicGame

@@ -3,15 +3,18 @@
     >>> spec = compile_task('atlas', ['stand_prep'], ['look_down', 'pickup_object'])
     >>> print(spec.to_structuredslugs())     # or to_slugsin(), to_text_sections()
 
-``ltl_specification.diagnosis`` says in plain words why a task cannot be done.
+``ltl_specification.diagnosis`` says in plain words why a task cannot be done, from the
+specification and its ``provenance`` alone (``ltl_specification.provenance``, which also
+carries it as JSON).
 """
 
-from ltl_specification.compiler import CompiledSpecification, Provenance, compile_task, explain
+from ltl_specification.compiler import CompiledSpecification, compile_task, explain
 from ltl_specification.errors import (
     InvalidAbstractionError, InvalidFormulaError, InvalidGoalsError, InvalidInitialConditionsError,
     InvalidSmOutcomesError, SpecificationError, UnknownPropositionError, UnknownSystemError,
 )
 from ltl_specification.pertinence import Pertinence, infer_pertinence
+from ltl_specification.provenance import Provenance
 
 __all__ = [
     'compile_task', 'explain', 'CompiledSpecification', 'Provenance', 'Pertinence', 'infer_pertinence',

@@ -73,7 +73,7 @@ def run(args: argparse.Namespace) -> int:
     if args.diagnose:
         from ltl_specification.diagnosis import diagnose
 
-        diagnosis = diagnose(spec, config_dir=args.config_dir)
+        diagnosis = diagnose(spec)
         if diagnosis is not None:
             print(f'SPEC_UNSYNTHESIZABLE: {diagnosis.message()}', file=sys.stderr)
             return ExitStatus.FAILED

@@ -69,24 +69,10 @@ from ltl_specification.errors import (
     InvalidSmOutcomesError, UnknownPropositionError, UnknownSystemError,
 )
 from ltl_specification.pertinence import Pertinence, infer_pertinence
+from ltl_specification.provenance import Provenance, task_provenance
 from ltl_specification.reachability import unreachable_goal_modes
 
 SUPPORTED_SM_OUTCOMES = (DEFAULT_SM_OUTCOMES, (FINISHED,))
-
-
-@dataclass
-class Provenance:
-    """What a compiled specification was made from, and why each item is in it."""
-
-    system: str
-    initial_conditions: tuple[str, ...]
-    goals: tuple[str, ...]
-    sm_outcomes: tuple[str, ...]
-    strict_order: bool
-    pertinence: Pertinence
-    custom_sections: tuple[str, ...] = ()
-    # Every formula's origin: paper equation, item and config section or request field.
-    groups: tuple[FormulaGroup, ...] = ()
 
 
 @dataclass
@@ -132,7 +118,8 @@ def compile_task(system: RobotSystem | str, initial_conditions: Sequence[str] | 
     initial_mode = _initial_mode(abstraction, initial_conditions)
     custom_formulas = _parse_custom_ltl(custom_ltl)
     mentioned, sensors = _items_mentioned(abstraction, custom_formulas)
-    _check_goal_modes_reachable(abstraction, goals, initial_mode, system.config_file)
+    where = system.config_file
+    _check_goal_modes_reachable(abstraction, goals, initial_mode, where)
 
     pertinence = infer_pertinence(abstraction, initial_mode, initial_conditions, goals, mentioned)
     parts, groups = _sub_specifications(abstraction, pertinence, initial_conditions, goals, sm_outcomes,
@@ -146,9 +133,9 @@ def compile_task(system: RobotSystem | str, initial_conditions: Sequence[str] | 
         raise InvalidFormulaError(
             f'custom LTL declares {quoted(error.item)} with the wrong kind: {error}', item=error.item) from error
     _check_custom_scopes(spec, custom_ltl)
-    provenance = Provenance(system.name, tuple(initial_conditions), tuple(goals), sm_outcomes, strict_order,
-                            pertinence, tuple(s for s in SECTIONS if custom_ltl and custom_ltl.get(s)),
-                            tuple(groups))
+    provenance = task_provenance(system.name, abstraction, where, initial_conditions, goals, sm_outcomes, strict_order,
+                                 pertinence, tuple(s for s in SECTIONS if custom_ltl and custom_ltl.get(s)),
+                                 groups)
     return CompiledSpecification(**_spec_fields(spec), provenance=provenance)
 
 

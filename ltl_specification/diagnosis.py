@@ -13,23 +13,29 @@ unrealizable core (``ltl_synthesizer.unrealizable_core``) over the specification
 groups, each mapped to its paper equation and the configuration entry or request field that
 produced it, and a short environment play told in words. ``Diagnosis.message`` leads with one
 plain sentence; the details follow.
+
+The pre-check and the diagnosis read only the specification and its provenance
+(``ltl_specification.provenance``: the compiler puts there everything that needs the robot
+configuration), so whoever holds a specification diagnoses it with its own settings: the
+synthesis node does, in the child process of the synthesis, and returns the diagnosis in its
+answer (``explain_unsynthesizable``).
 """
 
 from __future__ import annotations
 
 import itertools
-import threading
 from dataclasses import asdict, dataclass, field
 
-from respec.robot.abstraction import RobotAbstraction
-from respec.naming import DEFAULT_SM_OUTCOMES, activation, memory, outcome_proposition
-from respec.components import (SOURCE_ACTIONS, SOURCE_CONTROL_MODES, SOURCE_CUSTOM, SOURCE_GOALS,
-                               SOURCE_INITIAL_CONDITIONS, SOURCE_SM_OUTCOMES, FormulaGroup)
+from respec.components import SOURCE_CUSTOM, FormulaGroup
 from respec.ltl import Formula, evaluate, mentions_next, to_infix, variables
+from respec.naming import activation
+from respec.spec import GR1Specification
 from ltl_synthesizer.errors import SynthesisCancelledError
+from ltl_synthesizer.interrupt import Limits
 from ltl_synthesizer.unrealizable_core import environment_play, unrealizable_core
 
-from ltl_specification.compiler import CompiledSpecification, compile_task, load_task_abstraction, load_task_system
+from ltl_specification.compiler import load_task_abstraction, load_task_system
+from ltl_specification.provenance import Provenance
 from ltl_specification.reachability import Finding, config_file, unreachable_goal_modes
 
 PLAY_LENGTH = 8
@@ -90,15 +96,11 @@ class Diagnosis:
 
 # --- pre-check -------------------------------------------------------------------------------
 
-def precheck(spec: CompiledSpecification, config_dir=None) -> list[Finding]:
-    """Impossible requests that the abstraction and the request alone reveal (see module doc)."""
-    provenance = spec.provenance
-    abstraction = load_task_abstraction(provenance.system, config_dir)
-    where = config_file(provenance.system, config_dir)
-    findings = []
-    if provenance.pertinence.initial_mode is not None:
-        findings += unreachable_goal_modes(abstraction, provenance.goals, provenance.pertinence.initial_mode,
-                                            provenance.strict_order, where)
+def precheck(spec: GR1Specification, provenance: Provenance | None = None) -> list[Finding]:
+    """Impossible requests that the abstraction and the request alone reveal (see module doc);
+    ``provenance`` is what ``spec`` was compiled from (default: its own ``provenance``)."""
+    provenance = provenance or spec.provenance
+    findings = list(provenance.findings)  # what the abstraction shows, found when compiling
     custom = [g for g in provenance.groups if g.source == SOURCE_CUSTOM]
     findings += _forbidden_activations(custom, provenance)
     findings += _contradictory_custom_ltl(custom, provenance.groups)
@@ -206,47 +208,25 @@ def _exists(names: set[str], holds) -> bool | None:
 
 # --- after synthesis: core and play ----------------------------------------------------------
 
-def origin_of(group: FormulaGroup, provenance, abstraction: RobotAbstraction, where: str) -> str:
-    """The configuration entry or request field that produced ``group``, in words."""
-    if group.source == SOURCE_CONTROL_MODES:
-        if group.item:
-            targets = ', '.join(abstraction.control_modes.get(group.item, ())) or 'nothing'
-            return f'control_modes.{group.item} in {where}: {group.item} -> {targets}'
-        return f'control_modes in {where}'
-    if group.source == SOURCE_ACTIONS:
-        preconditions = ', '.join(abstraction.actions.get(group.item, ())) or 'none'
-        return f'actions.{group.item} in {where}: preconditions {preconditions}'
-    if group.source == SOURCE_GOALS:
-        order = 'in this order' if provenance.strict_order else 'in any order'
-        return f'request goals: {", ".join(provenance.goals)} ({order})'
-    if group.source == SOURCE_INITIAL_CONDITIONS:
-        named = ', '.join(provenance.initial_conditions) or f'initial_mode {provenance.pertinence.initial_mode}'
-        return f'request initial conditions: {named}'
-    if group.source == SOURCE_SM_OUTCOMES:
-        return f'request state-machine outcomes: {", ".join(provenance.sm_outcomes)}'
-    return 'request custom LTL'
+def diagnose(spec: GR1Specification, robotics_semantics: bool = True, limits: Limits = Limits(),
+             provenance: Provenance | None = None) -> Diagnosis | None:
+    """Why ``spec`` is unrealizable; None if it is realizable. ``provenance`` is what it was
+    compiled from (default: its own ``provenance``).
 
-
-def diagnose(spec: CompiledSpecification, robotics_semantics: bool = True, config_dir=None,
-             cancel: threading.Event | None = None, deadline: float | None = None) -> Diagnosis | None:
-    """Why ``spec`` (compiled with provenance) is unrealizable; None if it is realizable.
-
-    When the deadline passes during the core search, the pre-check's findings are still
-    returned and the note says the core was not computed.
+    When ``limits`` stop the core search (a cancel, the deadline), the pre-check's findings
+    are still returned and the note says the core was not computed.
     """
-    provenance = spec.provenance
-    abstraction = load_task_abstraction(provenance.system, config_dir)
-    where = config_file(provenance.system, config_dir)
-    findings = precheck(spec, config_dir)
+    provenance = provenance or spec.provenance
+    findings = precheck(spec, provenance)
     diagnosis = Diagnosis(sentence=findings[0].sentence if findings else '', findings=findings)
     try:
-        core = unrealizable_core(spec, provenance.groups, robotics_semantics, cancel, deadline)
+        core = unrealizable_core(spec, provenance.groups, robotics_semantics, limits)
         if core is None:
             return None
-        diagnosis.core = [CoreEntry(g.equation, g.title, g.item, origin_of(g, provenance, abstraction, where),
+        diagnosis.core = [CoreEntry(g.equation, g.title, g.item, provenance.origin(g),
                                     [to_infix(f) for f in g.formulas]) for g in core.groups]
-        steps = environment_play(spec, robotics_semantics, PLAY_LENGTH, cancel, deadline)
-        diagnosis.play = play_in_words(steps, provenance, abstraction)
+        steps = environment_play(spec, robotics_semantics, PLAY_LENGTH, limits)
+        diagnosis.play = play_in_words(steps, provenance)
     except SynthesisCancelledError as stopped:
         diagnosis.note = f'(The unrealizable core was not computed: {stopped.reason}.)'
     if not diagnosis.sentence:
@@ -263,19 +243,9 @@ def _core_sentence(core: list[CoreEntry]) -> str:
     return f'The task cannot be done as requested; these requirements are what makes it impossible: {named}.'
 
 
-def play_in_words(steps: list[dict], provenance, abstraction: RobotAbstraction) -> list[str]:
+def play_in_words(steps: list[dict], provenance: Provenance) -> list[str]:
     """Each step of an environment play as a sentence about what changed."""
-    meaning = {}
-    for item in [*provenance.pertinence.modes, *provenance.pertinence.actions]:
-        is_mode = item in provenance.pertinence.modes
-        meaning[activation(item)] = f'the robot starts {"changing to " if is_mode else ""}{item}'
-        for outcome in abstraction.outcomes:
-            meaning[outcome_proposition(item, outcome)] = (
-                f'now in {item}' if is_mode and outcome == abstraction.success_outcome else f'{item} {outcome}')
-    for goal in provenance.goals:
-        meaning[memory(goal)] = f'goal {goal} achieved'
-    for outcome in provenance.sm_outcomes:
-        meaning[outcome] = f'the state machine ends {outcome}'
+    meaning = provenance.meanings
     words = []
     previous: dict = {}
     for index, step in enumerate(steps):
@@ -296,16 +266,16 @@ def play_in_words(steps: list[dict], provenance, abstraction: RobotAbstraction) 
 
 # --- for the pipeline -------------------------------------------------------------------------
 
-def explain_unsynthesizable(details: str, system: str, initial_conditions, goals, sm_outcomes=DEFAULT_SM_OUTCOMES,
-                            strict_order: bool = True, custom_ltl=None, robotics_semantics: bool = True,
-                            config_dir=None, deadline: float | None = None,
-                            cancel: threading.Event | None = None) -> str:
-    """The SPEC_UNSYNTHESIZABLE message for a task: the diagnosis first, then ``details``
-    (the synthesizer's own explanation). Never raises: if the task cannot be diagnosed
-    (e.g. it does not compile here), ``details`` are returned unchanged."""
+def explain_unsynthesizable(details: str, spec: GR1Specification, provenance: Provenance | None,
+                            robotics_semantics: bool = True, limits: Limits = Limits()) -> str:
+    """The SPEC_UNSYNTHESIZABLE message for ``spec``: the diagnosis first, then ``details``
+    (the synthesizer's own explanation). Never raises: without a provenance (a specification
+    that was not compiled from a task), or if it cannot be diagnosed, ``details`` are returned
+    unchanged."""
+    if provenance is None:
+        return details
     try:
-        spec = compile_task(system, initial_conditions, goals, sm_outcomes, strict_order, custom_ltl, config_dir)
-        diagnosis = diagnose(spec, robotics_semantics, config_dir, cancel, deadline)
+        diagnosis = diagnose(spec, robotics_semantics, limits, provenance)
     except Exception:  # the diagnosis is a help; the synthesizer's verdict stands without it
         return details
     if diagnosis is None:

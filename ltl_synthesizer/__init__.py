@@ -2,33 +2,44 @@
 
     from ltl_synthesizer import synthesize
     result = synthesize(spec)            # spec: respec.spec.GR1Specification
-    result.realizable, result.strategy   # slugs --explicitStrategy --jsonOutput shape
+    result.realizable, result.strategy   # slugs --explicitStrategy --jsonOutput shape;
+    result.explanation                   # or why it is unrealizable
+
+The steps one at a time (a solved game holds BDDs: it stays in the process that solved it)::
+
+    solved = solve(spec, robotics_semantics=True, limits=Limits(...), options=None)
+    solved.realizable
+    explicit_strategy(solved), stream_strategy(solved)   # realizable
+    counter_strategy(solved), explain(solved)            # unrealizable
+    is_realizable(spec, ...)                             # the verdict alone
 
 Limits (every phase -- parsing, BDD building, solving, extraction, explanation -- checks them
 in each of its loops, so a synthesis stops within a few milliseconds plus one BDD operation)::
 
-    synthesize(spec, deadline=time.monotonic() + 60,   # -> SynthesisTimeoutError, code SYNTHESIS_TIMEOUT
-               cancel=threading.Event(),               # set() -> SynthesisCancelledError, code PREEMPTED
-               memory_limit=2 * 2**30)                 # BDD bytes -> SynthesisMemoryError
-    is_realizable(spec, ...)                           # the verdict only, same limits
+    Limits(deadline=time.monotonic() + 60,   # -> SynthesisTimeoutError, code SYNTHESIS_TIMEOUT
+           cancel=threading.Event(),         # set() -> SynthesisCancelledError, code PREEMPTED
+           memory_limit=2 * 2**30)           # bytes (the default; None: none) -> SynthesisMemoryError
 
-``Interrupt(cancel, deadline, memory_limit)`` is the same check as one object: pass it to
+``limits.interrupt()`` is their check as one callable object: pass it to
 ``respec.parsing.parse_structuredslugs(text, check=interrupt)`` to bound parsing too.
 
-Modules: interrupt (cancel, deadline, memory limit), symbolic (the game: formulas to BDDs,
-enforceable predecessors), policy (Options and the automatic plan), gr1 (the solver and its
-fixpoints), strategy (explicit strategies, counter-strategies, slugs JSON), explain (why
-unrealizable), unrealizable_core (minimal unrealizable subsets of guarantees, by delta
-debugging), cli (``gr1synth``). Imports are lazy, so ``gr1synth --help`` starts without
-loading CUDD.
+Modules: interrupt (Limits and their check), symbolic (the game: formulas to BDDs,
+enforceable predecessors), policy (Options and the automatic plan), synthesizer (the entry
+points above), gr1 (the solver and its fixpoints), strategy (explicit strategies,
+counter-strategies, slugs JSON), explain (why unrealizable), unrealizable_core (minimal
+unrealizable subsets of guarantees, by delta debugging), isolated (work in child processes
+that a cancel, a deadline or a shutdown ends at once), command (the ``gr1synth`` command:
+arguments, one run, outputs), cli (``gr1synth``) and serve (its resident mode), both on
+command. Imports are lazy, so ``gr1synth --help`` starts without loading CUDD.
 """
 
 import importlib
 
 _EXPORTS = {
-    'synthesize': 'ltl_synthesizer.synthesizer', 'is_realizable': 'ltl_synthesizer.synthesizer',
-    'SynthesisResult': 'ltl_synthesizer.synthesizer',
-    'DEFAULT_MEMORY_LIMIT': 'ltl_synthesizer.synthesizer',
+    **{name: 'ltl_synthesizer.synthesizer' for name in (
+        'solve', 'Solved', 'explicit_strategy', 'stream_strategy', 'counter_strategy', 'explain',
+        'synthesize', 'is_realizable', 'SynthesisResult')},
+    'Limits': 'ltl_synthesizer.interrupt', 'DEFAULT_MEMORY_LIMIT': 'ltl_synthesizer.interrupt',
     'Options': 'ltl_synthesizer.policy', 'Interrupt': 'ltl_synthesizer.interrupt',
     'SynthesisCancelledError': 'ltl_synthesizer.errors', 'SynthesisError': 'ltl_synthesizer.errors',
     'SynthesisMemoryError': 'ltl_synthesizer.errors', 'SynthesisTimeoutError': 'ltl_synthesizer.errors',

@@ -1,13 +1,42 @@
 """Stopping a synthesis on request (a process concern, kept out of the game and the solver):
-a cancel flag, a deadline and a memory limit, checked by every long loop."""
+a cancel flag, a deadline and a memory limit (``Limits``), checked by every long loop
+(``Interrupt``)."""
 
 from __future__ import annotations
 
 import os
+import dataclasses
 import threading
 import time
+from dataclasses import dataclass
 
 from ltl_synthesizer.errors import SynthesisCancelledError, SynthesisMemoryError, SynthesisTimeoutError
+
+# Default memory limit of one synthesis: BDD memory, in bytes.
+DEFAULT_MEMORY_LIMIT = 2 * 2**30
+
+
+@dataclass(frozen=True)
+class Limits:
+    """When a synthesis must stop: once ``cancel`` (a threading.Event) is set, at ``deadline``
+    (a ``time.monotonic()`` instant), or beyond ``memory_limit`` bytes (None: no limit).
+
+    Plain data, given to every entry point of the synthesizer; the process doing the work
+    makes the ``Interrupt`` that checks them.
+    """
+
+    cancel: threading.Event | None = None
+    deadline: float | None = None
+    memory_limit: int | None = DEFAULT_MEMORY_LIMIT
+
+    def interrupt(self) -> Interrupt:
+        """The check of these limits for this process (its memory counted from now)."""
+        return Interrupt(self.cancel, self.deadline, self.memory_limit)
+
+    def without_cancel(self) -> Limits:
+        """These limits for a child process (the flag stays with the parent, which ends the
+        child when it is set; an Event cannot be sent)."""
+        return dataclasses.replace(self, cancel=None)
 
 
 class Interrupt:

@@ -1,24 +1,36 @@
-"""Syntheses in child processes that a cancel, a deadline or a shutdown ends at once.
+"""Work in child processes that a cancel, a deadline or a shutdown ends at once: the one
+process runner of the project (syntheses, diagnoses, the GUI's simulations).
 
 The synthesizer checks its limits between BDD operations, but one CUDD operation on a large
 specification can run for seconds, holding Python's GIL: in the same process, nothing else
-runs meanwhile (not a cancel request, not a signal handler). Here each synthesis runs in a
-long-lived child process; the caller waits in short polls and kills the child when the
-synthesis must stop, so stopping takes milliseconds whatever CUDD is doing, and the CPU and
-memory are released with the process. Idle children are kept for the next synthesis (a new
-one costs the start of a Python interpreter, a fraction of a second), but not for long: a
-child idle for ``idle_seconds`` is ended (its heap grows with what it solved; after a burst,
-idle children held 2.6x the baseline RSS), and as many fresh ones as were prepared replace them.
+runs meanwhile (not a cancel request, not a signal handler). Native code (CUDD, MuJoCo and its
+renderer) may also crash or hold on to memory. So the work runs in a child process; the
+caller waits in short polls and kills the child when the work must stop, so stopping takes
+milliseconds whatever the child is doing, and the CPU and memory are released with the
+process. Each child runs ``niceness`` below its parent's CPU priority.
+
+    child = ChildProcess(preload='my.module', environment={'MUJOCO_GL': 'egl'})
+    value = child.call(my.module.function, (settings,), cancel=event, deadline=deadline,
+                       on_progress=print)   # function(settings, progress=...) reports as it goes
+    child.kill()
+
+``SynthesisProcesses`` is a pool of such children for syntheses and other solver work. Idle
+children are kept for the next call (a new one costs the start of a Python interpreter, a
+fraction of a second), but not for long: a child idle for ``idle_seconds`` is ended (its heap
+grows with what it solved; after a burst, idle children held 2.6x the baseline RSS), and as
+many fresh ones as were prepared replace them.
 
     processes = SynthesisProcesses()
-    result = processes.synthesize(spec, cancel=event, deadline=time.monotonic() + 60)
-    explanation = processes.call('ltl_specification.diagnosis:explain_unsynthesizable', args,
-                                 cancel=event, deadline=deadline)  # other solver work, the same way
+    result = processes.synthesize(spec, limits=Limits(cancel=event, deadline=time.monotonic() + 60))
+    value = processes.call(function, args, kwargs, cancel=event, deadline=deadline)
     processes.close()
 
-``synthesize`` has the arguments, results and exceptions of :func:`ltl_synthesizer.synthesize`;
-``call`` runs any importable function. A child that dies (killed from outside, crashed) raises
-:class:`SynthesisProcessDiedError`; a cancel or the deadline raises SynthesisCancelledError.
+Functions are passed as themselves (picklable: defined at the top level of a module), so the
+child imports what the caller already imports. Arguments and results travel as pickles; an
+exception raised in the child is raised in the caller. A child that dies (killed from outside,
+crashed) raises :class:`SynthesisProcessDiedError`; a cancel or the deadline raises
+SynthesisCancelledError (SynthesisTimeoutError). The memory limit is the work's own
+(``ltl_synthesizer.Limits``, checked in the child).
 """
 
 from __future__ import annotations
@@ -32,8 +44,10 @@ import sys
 import threading
 import time
 import traceback
+from typing import Callable
 
 from ltl_synthesizer.errors import SynthesisCancelledError, SynthesisError, SynthesisTimeoutError
+from ltl_synthesizer.interrupt import Limits
 
 # How often the caller looks at its cancel flag and deadline while a child works.
 POLL_SECONDS = 0.02
@@ -51,20 +65,59 @@ class SynthesisProcessDiedError(SynthesisError):
     """The process running the synthesis ended without an answer."""
 
 
-SYNTHESIZE = 'ltl_synthesizer.synthesizer:synthesize'
+#: What the pool's children import before their first request.
+SYNTHESIZER_MODULE = 'ltl_synthesizer.synthesizer'
 
 
-class _Child:
-    """One child process (``python -m ltl_synthesizer.isolated``), spoken to through its stdin
-    and stdout: length-prefixed pickles, a request ('module:function', args, kwargs) in, an
-    answer ('result', value) or ('error', exception) out."""
+class ChildProcess:
+    """One child process (``python -m ltl_synthesizer.isolated PARENT NICENESS PRELOAD``),
+    spoken to through its stdin and stdout: length-prefixed pickles, a request (function,
+    args, kwargs, whether progress is wanted) in; ('progress', value) messages and then an
+    answer ('result', value) or ('error', exception) out. ``preload`` is imported at its start,
+    so the first request need not wait for it; ``environment`` holds defaults for variables
+    the parent's environment does not set."""
 
-    def __init__(self, niceness: int):
+    def __init__(self, niceness: int = 0, preload: str = SYNTHESIZER_MODULE,
+                 environment: dict[str, str] | None = None):
         self.idle_since = time.monotonic()
         self.fresh = True  # has served nothing yet: its RSS is the baseline
-        self.process = subprocess.Popen([sys.executable, '-m', 'ltl_synthesizer.isolated', str(os.getpid()),
-                                         str(niceness)],
-                                        stdin=subprocess.PIPE, stdout=subprocess.PIPE)
+        self.process = subprocess.Popen(
+            [sys.executable, '-m', 'ltl_synthesizer.isolated', str(os.getpid()), str(niceness), preload],
+            stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+            env={**environment, **os.environ} if environment else None)
+
+    def call(self, function: Callable, args=(), kwargs=None, cancel: threading.Event | None = None,
+             deadline: float | None = None, on_progress: Callable | None = None):
+        """``function(*args, **kwargs)`` in this child; with ``on_progress``, ``function`` is
+        also given ``progress=`` a callable whose every value reaches ``on_progress`` here.
+        The child is killed once ``cancel`` is set or at ``deadline`` (time.monotonic());
+        one that dies raises SynthesisProcessDiedError."""
+        try:
+            self.send((function, tuple(args), dict(kwargs or {}), on_progress is not None))
+            while True:
+                while not self.answered(POLL_SECONDS):
+                    if cancel is not None and cancel.is_set():
+                        self.kill()
+                        raise SynthesisCancelledError('cancelled')
+                    if deadline is not None and time.monotonic() >= deadline:
+                        self.kill()
+                        raise SynthesisTimeoutError()
+                    if not self.alive():
+                        raise self.died()
+                kind, value = self.receive()
+                if kind != 'progress':
+                    break
+                on_progress(value)
+        except (EOFError, OSError, ValueError):  # the child died, or its pipes were closed
+            raise self.died() from None
+        if kind == 'error':
+            raise value
+        return value
+
+    def died(self) -> SynthesisProcessDiedError:
+        self.kill()
+        return SynthesisProcessDiedError(f'the synthesis process ended (exit code {self.process.poll()}) '
+                                         'without an answer', item='synthesis process')
 
     def send(self, message) -> None:
         data = pickle.dumps(message, protocol=pickle.HIGHEST_PROTOCOL)
@@ -82,6 +135,7 @@ class _Child:
         return self.process.poll() is None
 
     def kill(self) -> None:
+        """End the child now (from any thread) and release its pipes."""
         if self.alive():
             self.process.kill()
         self.process.wait()
@@ -105,9 +159,9 @@ class SynthesisProcesses:
 
     def __init__(self, idle_seconds: float = IDLE_SECONDS, niceness: int = CHILD_NICENESS):
         self.idle_seconds, self.niceness = idle_seconds, niceness
+        self._idle: list[ChildProcess] = []
+        self._busy: set[ChildProcess] = set()
         self._lock = threading.Lock()
-        self._idle: list[_Child] = []
-        self._busy: set[_Child] = set()
         self._closed = False
         self._prepared = 0
         self._wake_reaper = threading.Event()
@@ -119,7 +173,7 @@ class SynthesisProcesses:
         with self._lock:
             self._prepared = count
             while len(self._idle) < count and not self._closed:
-                self._idle.append(_Child(self.niceness))
+                self._idle.append(ChildProcess(self.niceness))
 
     @property
     def idle_count(self) -> int:
@@ -136,7 +190,7 @@ class SynthesisProcesses:
                          and not child.fresh]
                 self._idle = [child for child in self._idle if child not in stale]
                 replacements = min(len(stale), self._prepared - len(self._idle))
-                self._idle += [_Child(self.niceness) for _ in range(replacements)]
+                self._idle += [ChildProcess(self.niceness) for _ in range(replacements)]
                 next_check = min((child.idle_since + self.idle_seconds for child in self._idle
                                   if not child.fresh), default=None)
             for child in stale:
@@ -144,41 +198,24 @@ class SynthesisProcesses:
             self._wake_reaper.wait(None if next_check is None else max(0.05, next_check - time.monotonic()))
             self._wake_reaper.clear()
 
-    def synthesize(self, spec, cancel: threading.Event | None = None, deadline: float | None = None,
-                   **arguments):
-        """``ltl_synthesizer.synthesize(spec, cancel=..., deadline=..., **arguments)`` in a child."""
-        return self.call(SYNTHESIZE, (spec,), dict(arguments, deadline=deadline), cancel=cancel, deadline=deadline)
+    def synthesize(self, spec, robotics_semantics: bool = True, limits: Limits = Limits(), options=None):
+        """:func:`ltl_synthesizer.synthesize` in a child, killed once ``limits`` stop it."""
+        from ltl_synthesizer.synthesizer import synthesize
+        return self.call(synthesize, (spec, robotics_semantics, limits.without_cancel(), options),
+                         cancel=limits.cancel, deadline=limits.deadline)
 
-    def call(self, target: str, args=(), kwargs=None, cancel: threading.Event | None = None,
+    def call(self, function: Callable, args=(), kwargs=None, cancel: threading.Event | None = None,
              deadline: float | None = None):
-        """``function(*args, **kwargs)`` in a child, where ``target`` is 'module:function'.
-        The child is killed once ``cancel`` is set or at ``deadline`` (time.monotonic())."""
+        """``function(*args, **kwargs)`` in a child (:meth:`ChildProcess.call`)."""
         child = self._take()
-        answer = None
         try:
-            child.send((target, tuple(args), dict(kwargs or {})))
-            while not child.answered(POLL_SECONDS):
-                if cancel is not None and cancel.is_set():
-                    raise SynthesisCancelledError('cancelled')
-                if deadline is not None and time.monotonic() >= deadline:
-                    raise SynthesisTimeoutError()
-                if not child.alive():
-                    raise self._ended(child)
-            answer = child.receive()
-        except (EOFError, OSError, ValueError):  # the child died, or close() closed the pipes
-            raise self._ended(child) from None
+            return child.call(function, args, kwargs, cancel, deadline)
+        except SynthesisProcessDiedError:
+            if self._closed:  # close() killed it
+                raise SynthesisCancelledError('cancelled') from None
+            raise
         finally:
-            self._give_back(child, reusable=answer is not None)
-        kind, value = answer
-        if kind == 'error':
-            raise value
-        return value
-
-    def _ended(self, child: _Child) -> SynthesisError:
-        if self._closed:
-            return SynthesisCancelledError('cancelled')
-        return SynthesisProcessDiedError(f'the synthesis process ended (exit code {child.process.poll()}) '
-                                    'without an answer', item='synthesis process')
+            self._give_back(child, reusable=child.alive())  # stopped children were killed
 
     def close(self) -> None:
         """Kill every child, busy or idle (at shutdown)."""
@@ -190,7 +227,7 @@ class SynthesisProcesses:
         for child in children:
             child.kill()
 
-    def _take(self) -> _Child:
+    def _take(self) -> ChildProcess:
         with self._lock:
             if self._closed:
                 raise SynthesisCancelledError('cancelled')
@@ -198,12 +235,12 @@ class SynthesisProcesses:
         if child is None or not child.alive():
             if child is not None:
                 child.kill()
-            child = _Child(self.niceness)
+            child = ChildProcess(self.niceness)
         with self._lock:
             self._busy.add(child)
         return child
 
-    def _give_back(self, child: _Child, reusable: bool) -> None:
+    def _give_back(self, child: ChildProcess, reusable: bool) -> None:
         with self._lock:
             self._busy.discard(child)
             keep = reusable and not self._closed
@@ -217,40 +254,41 @@ class SynthesisProcesses:
                 self._wake_reaper.set()
             elif not self._closed and not self._idle:
                 # A replacement starts now, while the caller reports the stop.
-                self._idle.append(_Child(self.niceness))
+                self._idle.append(ChildProcess(self.niceness))
         if not keep:
             child.kill()
 
 
-def _serve(parent_pid: int) -> None:
+def _serve(parent_pid: int, preload: str) -> None:
     """The child: answer requests until stdin closes or the parent is gone."""
     _die_with_parent(parent_pid)
     requests = sys.stdin.buffer
     answers = os.fdopen(os.dup(sys.stdout.fileno()), 'wb')
     sys.stdout = sys.stderr  # stray prints must not corrupt the answers
-    _function(SYNTHESIZE)  # imported now: the first synthesis need not wait for it
-    while True:
+    importlib.import_module(preload)  # imported now: the first request need not wait for it
+
+    def send(message) -> None:
         try:
-            target, args, kwargs = pickle.loads(_read_exactly(requests, int.from_bytes(
-                _read_exactly(requests, _LENGTH_BYTES), 'little')))
-        except EOFError:
-            return
-        try:
-            answer = ('result', _function(target)(*args, **kwargs))
-        except Exception as error:  # noqa: BLE001 -- every failure goes back to the caller
-            error.add_note(f'in the synthesis process:\n{traceback.format_exc()}')
-            answer = ('error', error)
-        try:
-            data = pickle.dumps(answer, protocol=pickle.HIGHEST_PROTOCOL)
+            data = pickle.dumps(message, protocol=pickle.HIGHEST_PROTOCOL)
         except Exception as error:  # noqa: BLE001 -- e.g. an exception that cannot be pickled
             data = pickle.dumps(('error', SynthesisError(f'synthesis process: {error!r}')))
         answers.write(len(data).to_bytes(_LENGTH_BYTES, 'little') + data)
         answers.flush()
 
-
-def _function(target: str):
-    module, _, name = target.partition(':')
-    return getattr(importlib.import_module(module), name)
+    while True:
+        try:
+            function, args, kwargs, wants_progress = pickle.loads(_read_exactly(requests, int.from_bytes(
+                _read_exactly(requests, _LENGTH_BYTES), 'little')))
+        except EOFError:
+            return
+        if wants_progress:
+            kwargs['progress'] = lambda value: send(('progress', value))
+        try:
+            answer = ('result', function(*args, **kwargs))
+        except Exception as error:  # noqa: BLE001 -- every failure goes back to the caller
+            error.add_note(f'in the synthesis process:\n{traceback.format_exc()}')
+            answer = ('error', error)
+        send(answer)
 
 
 def _die_with_parent(parent_pid: int) -> None:
@@ -276,6 +314,6 @@ if __name__ == '__main__':
     os.nice(int(sys.argv[2]))
     from respec.nesting import allow_deep_formulas
     allow_deep_formulas()  # requests are served in a thread with room for any formula accepted
-    server = threading.Thread(target=_serve, args=(int(sys.argv[1]),), name='synthesis-process')
+    server = threading.Thread(target=_serve, args=(int(sys.argv[1]), sys.argv[3]), name='synthesis-process')
     server.start()
     server.join()

@@ -15,6 +15,8 @@ import json
 
 from respec.errors import ExitStatus
 
+from ltl_synthesizer.command import parse_arguments, run, run_with_deep_stack
+
 
 def serve(requests, answers) -> int:
     for line in requests:
@@ -27,7 +29,6 @@ def serve(requests, answers) -> int:
 
 def answer(line: str) -> dict:
     """The outcome of one request line (a malformed request is an answer, not a crash)."""
-    from ltl_synthesizer import cli
     stdout, stderr = io.StringIO(), io.StringIO()
     try:
         argv = json.loads(line)
@@ -37,12 +38,12 @@ def answer(line: str) -> dict:
         return {'status': ExitStatus.FAILED, 'stdout': '', 'stderr': f'gr1synth: error: {error}\n'}
     with contextlib.redirect_stdout(stdout), contextlib.redirect_stderr(stderr):
         try:
-            args = cli._arguments(argv)
+            args = parse_arguments(argv)
             if args.serve:
                 print('gr1synth: error: --serve inside a request', file=stderr)
                 status = ExitStatus.FAILED
             else:
-                status = cli.run_with_deep_stack(cli._run, args)
+                status = run_with_deep_stack(run, args)
         except SystemExit as exit_:  # argparse's usage errors
             status = exit_.code if isinstance(exit_.code, int) else ExitStatus.FAILED
     return {'status': status, 'stdout': stdout.getvalue(), 'stderr': stderr.getvalue()}

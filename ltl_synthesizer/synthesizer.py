@@ -1,30 +1,70 @@
-"""The synthesizer's entry point: specification in, strategy (or counter-strategy) out."""
+"""The synthesizer's entry points, one small function per product of a solved game.
+
+    solved = solve(spec, robotics_semantics, limits)   # the game and its verdict
+    explicit_strategy(solved)   stream_strategy(solved)  # when solved.realizable
+    counter_strategy(solved)    explain(solved)          # when not
+    synthesize(spec, ...)       # the common answer: the strategy, or why there is none
+
+as omega separates solving a game from making its transducer. A ``Solved`` game holds BDDs and
+lives in the process that solved it; ``synthesize`` returns a plain ``SynthesisResult`` that
+crosses process boundaries (``ltl_synthesizer.isolated``).
+"""
 
 from __future__ import annotations
 
-import threading
 import time
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 
 from respec.spec import GR1Specification
 
-from ltl_synthesizer.gr1 import Solver, solve_environment_game, solve_system_game
-from ltl_synthesizer.interrupt import Interrupt, memory_exceeded
+from ltl_synthesizer.gr1 import (EnvironmentSolution, Solver, SystemSolution, solve_environment_game,
+                                 solve_system_game)
+from ltl_synthesizer.interrupt import Interrupt, Limits, memory_exceeded
 from ltl_synthesizer.policy import Options
 from ltl_synthesizer.symbolic import SymbolicGame
 
-# Default memory limit of one synthesis: BDD memory, in bytes.
-DEFAULT_MEMORY_LIMIT = 2 * 2**30
+__all__ = ['Limits', 'Solved', 'SynthesisResult', 'counter_strategy', 'explain',
+           'explicit_strategy', 'initial_positions_win', 'is_realizable', 'solve', 'stream_strategy',
+           'synthesize']
 
 
 @dataclass
 class SynthesisResult:
+    """The answer of :func:`synthesize` (plain data: it may be pickled to another process)."""
+
     realizable: bool
     strategy: dict | None = None
     counterstrategy: dict | None = None
     explanation: str = ''
     stats: dict = field(default_factory=dict)
+
+
+@dataclass
+class Solved:
+    """A solved game: the verdict, and the solutions strategies and explanations are made of.
+
+    ``stats`` has the seconds spent building and solving, the number of variables and the
+    game's BDD statistics; ``warnings`` what a realizable verdict should be read with.
+    """
+
+    spec: GR1Specification
+    robotics_semantics: bool
+    game: SymbolicGame
+    solver: Solver
+    solution: SystemSolution
+    realizable: bool
+    interrupt: Interrupt
+    stats: dict = field(default_factory=dict)
+    warnings: list[str] = field(default_factory=list)
+    _environment: EnvironmentSolution | None = field(default=None, repr=False)
+
+    def environment(self) -> EnvironmentSolution:
+        """The environment's side of an unrealizable game (solved once, when first asked)."""
+        if self._environment is None:
+            with _memory_failures_reported(self.interrupt.memory_limit):
+                self._environment = solve_environment_game(self.solver)
+        return self._environment
 
 
 def initial_positions_win(game: SymbolicGame, winning, robotics_semantics: bool) -> bool:
@@ -40,37 +80,112 @@ def initial_positions_win(game: SymbolicGame, winning, robotics_semantics: bool)
     return game.env_init & ~good_outputs_exist == game.false
 
 
-def synthesize(spec: GR1Specification, robotics_semantics: bool = True,
-               cancel: threading.Event | None = None, deadline: float | None = None,
-               counterstrategy: bool = False, explain: bool = True,
-               options: Options | None = None, strategy: bool | str = True,
-               memory_limit: int | None = DEFAULT_MEMORY_LIMIT) -> SynthesisResult:
-    """Decide realizability of ``spec``; extract an explicit strategy (``strategy``), or a
-    counter-strategy (``counterstrategy``) and an explanation (``explain``) when unrealizable.
+def solve(spec: GR1Specification, robotics_semantics: bool = True, limits: Limits = Limits(),
+          options: Options | None = None) -> Solved:
+    """Build the game of ``spec`` and decide its realizability.
 
-    ``strategy='stream'``: the strategy's ``nodes`` are an iterator, made while it is read
-    (``strategy_json_chunks`` writes them out; memory holds no edges).
-
-    Limits (all optional, checked in every long loop of every phase): ``cancel`` (a
-    threading.Event) raises ``SynthesisCancelledError`` (code PREEMPTED), ``deadline`` (a
-    ``time.monotonic()`` instant) raises ``SynthesisTimeoutError`` (code SYNTHESIS_TIMEOUT),
-    ``memory_limit`` (bytes of BDD memory, default 2 GiB) raises ``SynthesisMemoryError``.
-    ``UndeclaredPropositionError`` / ``NotGR1FormulaError`` for formulas outside the declared
-    propositions or GR(1).
+    ``limits`` (checked in every long loop of every phase, here and in the products of the
+    result): a set ``cancel`` raises ``SynthesisCancelledError`` (code PREEMPTED), the
+    ``deadline`` ``SynthesisTimeoutError`` (code SYNTHESIS_TIMEOUT), the ``memory_limit``
+    ``SynthesisMemoryError``. ``UndeclaredPropositionError`` / ``NotGR1FormulaError`` for
+    formulas outside the declared propositions or GR(1).
     """
-    interrupt = Interrupt(cancel, deadline, memory_limit)
-    with _memory_failures_reported(memory_limit):
-        return _synthesize(spec, robotics_semantics, interrupt, counterstrategy, explain,
-                           options, strategy)
+    interrupt = limits.interrupt()
+    with _memory_failures_reported(interrupt.memory_limit):
+        start = time.perf_counter()
+        interrupt.check()
+        game = SymbolicGame(spec, options, interrupt)
+        solver = Solver(game, options)
+        built = time.perf_counter()
+
+        def still_possible(winning):
+            return initial_positions_win(game, winning, robotics_semantics)
+
+        solution = solve_system_game(solver, stop_when_losing=still_possible)
+        realizable = solution.complete and still_possible(solution.winning)
+        if realizable:  # the counter-game of an unrealizable one is another solve: it may sift
+            solver.reordering.stop()
+        solved = time.perf_counter()
+    warnings = []
+    if realizable and game.env_init & game.sys_init == game.false:
+        warnings.append('ENV_INIT and SYS_INIT are contradictory: realizable vacuously, the strategy '
+                        'has no initial state')
+    return Solved(spec, robotics_semantics, game, solver, solution, realizable, interrupt,
+                  {'build_seconds': built - start, 'solve_seconds': solved - built,
+                   'variables': len(game.variables)}, warnings)
 
 
-def is_realizable(spec: GR1Specification, robotics_semantics: bool = True,
-                  cancel: threading.Event | None = None, deadline: float | None = None,
-                  memory_limit: int | None = DEFAULT_MEMORY_LIMIT,
+def is_realizable(spec: GR1Specification, robotics_semantics: bool = True, limits: Limits = Limits(),
                   options: Options | None = None) -> bool:
-    """Only the verdict (no strategy, no explanation); same limits as ``synthesize``."""
-    return synthesize(spec, robotics_semantics, cancel, deadline, explain=False, options=options,
-                      strategy=False, memory_limit=memory_limit).realizable
+    """Only the verdict (no strategy, no explanation)."""
+    return solve(spec, robotics_semantics, limits, options).realizable
+
+
+# Strategies and explanations load only when asked: a verdict alone on a tiny specification is
+# mostly start-up (5 ms less of about 120).
+
+def explicit_strategy(solved: Solved) -> dict:
+    """The explicit-state strategy of a realizable game (slugs ``--explicitStrategy --jsonOutput`` shape)."""
+    from ltl_synthesizer.strategy import extract_strategy
+    with _memory_failures_reported(solved.interrupt.memory_limit):
+        return extract_strategy(solved.game, _realizable(solved).solution)
+
+
+def stream_strategy(solved: Solved) -> dict:
+    """The strategy with its ``nodes`` an iterator, made while it is read
+    (``strategy_json_chunks`` writes them out; memory holds no edges)."""
+    from ltl_synthesizer.strategy import streamed_strategy
+    with _memory_failures_reported(solved.interrupt.memory_limit):
+        return streamed_strategy(solved.game, _realizable(solved).solution)
+
+
+def counter_strategy(solved: Solved) -> dict:
+    """The environment's explicit counter-strategy of an unrealizable game."""
+    from ltl_synthesizer.strategy import extract_counterstrategy
+    environment = _unrealizable(solved).environment()
+    with _memory_failures_reported(solved.interrupt.memory_limit):
+        return extract_counterstrategy(solved.game, environment, solved.robotics_semantics)
+
+
+def explain(solved: Solved) -> str:
+    """Why an unrealizable game is lost: losing initial states, a blocked goal, a play."""
+    from ltl_synthesizer.explain import explain_unrealizable
+    environment = _unrealizable(solved).environment()
+    with _memory_failures_reported(solved.interrupt.memory_limit):
+        return explain_unrealizable(solved.game, solved.solution, environment, solved.robotics_semantics)
+
+
+def synthesize(spec: GR1Specification, robotics_semantics: bool = True, limits: Limits = Limits(),
+               options: Options | None = None) -> SynthesisResult:
+    """Solve ``spec``; its explicit strategy when realizable, else the explanation why not
+    (limits and errors as :func:`solve`)."""
+    start = time.perf_counter()
+    solved = solve(spec, robotics_semantics, limits, options)
+    extracting = time.perf_counter()
+    result = SynthesisResult(solved.realizable)
+    if solved.realizable:
+        result.strategy = explicit_strategy(solved)
+    else:
+        result.explanation = explain(solved)
+    if solved.warnings:
+        result.stats['warnings'] = solved.warnings
+    finished = time.perf_counter()
+    result.stats.update({
+        **solved.stats, 'extract_seconds': finished - extracting, 'total_seconds': finished - start,
+        'strategy_nodes': len(result.strategy['nodes']) if result.strategy else 0, **solved.game.statistics()})
+    return result
+
+
+def _realizable(solved: Solved) -> Solved:
+    if not solved.realizable:
+        raise ValueError('the specification is unrealizable: it has no strategy')
+    return solved
+
+
+def _unrealizable(solved: Solved) -> Solved:
+    if solved.realizable:
+        raise ValueError('the specification is realizable: it has no counter-strategy')
+    return solved
 
 
 @contextmanager
@@ -82,50 +197,3 @@ def _memory_failures_reported(memory_limit: int | None):
         if memory_limit is not None and 'NULL' in str(error):
             raise memory_exceeded(memory_limit) from error
         raise
-
-
-def _synthesize(spec, robotics_semantics, interrupt, counterstrategy, explain, options,
-                strategy) -> SynthesisResult:
-    start = time.perf_counter()
-    interrupt.check()
-    game = SymbolicGame(spec, options, interrupt)
-    solver = Solver(game, options)
-    built = time.perf_counter()
-
-    def still_possible(winning):
-        return initial_positions_win(game, winning, robotics_semantics)
-
-    solution = solve_system_game(solver, stop_when_losing=still_possible)
-    realizable = solution.complete and still_possible(solution.winning)
-    if realizable:  # the counter-game of an unrealizable one is another solve: it may sift
-        solver.reordering.stop()
-    solved = time.perf_counter()
-    result = SynthesisResult(realizable=realizable)
-    # Strategies and explanations load only when asked: a verdict alone on a tiny
-    # specification is mostly start-up (5 ms less of about 120).
-    if realizable:
-        if strategy:
-            from ltl_synthesizer.strategy import extract_strategy, streamed_strategy
-            result.strategy = streamed_strategy(game, solution) if strategy == 'stream' \
-                else extract_strategy(game, solution)
-        if game.env_init & game.sys_init == game.false:
-            result.stats['warnings'] = ['ENV_INIT and SYS_INIT are contradictory: realizable '
-                                        'vacuously, the strategy has no initial state']
-    elif counterstrategy or explain:
-        from ltl_synthesizer.explain import explain_unrealizable
-        from ltl_synthesizer.strategy import extract_counterstrategy
-        environment = solve_environment_game(solver)
-        if counterstrategy:
-            result.counterstrategy = extract_counterstrategy(game, environment, robotics_semantics)
-        if explain:
-            result.explanation = explain_unrealizable(game, solution, environment, robotics_semantics)
-    else:
-        result.explanation = 'Specification is unrealizable.'
-    finished = time.perf_counter()
-    result.stats.update({
-        'build_seconds': built - start, 'solve_seconds': solved - built,
-        'extract_seconds': finished - solved, 'total_seconds': finished - start,
-        'variables': len(game.variables), 'strategy_nodes':
-            len(result.strategy['nodes']) if result.strategy and strategy != 'stream' else 0,
-        **game.statistics()})
-    return result

@@ -15,36 +15,20 @@ Realizability of each candidate is decided by the synthesizer's own game (the sa
 
 from __future__ import annotations
 
-import threading
 from dataclasses import dataclass
 from typing import Callable, Sequence, TypeVar
 
 from respec.spec import FORMULA_SECTIONS, GR1Specification
 
-from ltl_synthesizer.gr1 import Solver, solve_environment_game, solve_system_game
+from ltl_synthesizer.gr1 import Solver, solve_environment_game
+from ltl_synthesizer.interrupt import Limits
 from ltl_synthesizer.strategy import extract_counterstrategy
-from ltl_synthesizer.interrupt import Interrupt
 from ltl_synthesizer.symbolic import SymbolicGame
-from ltl_synthesizer.synthesizer import initial_positions_win
+from ltl_synthesizer.synthesizer import is_realizable
 
 T = TypeVar('T')
 # Positions the search for a telling environment play may visit (it is only an illustration).
 MAX_PLAY_SEARCH = 20000
-
-
-def is_realizable(spec: GR1Specification, robotics_semantics: bool = True,
-                  cancel: threading.Event | None = None, deadline: float | None = None) -> bool:
-    """Whether ``spec`` is realizable (no strategy is extracted).
-
-    Raises ``SynthesisCancelledError`` when ``cancel`` is set or ``deadline`` passes.
-    """
-    game = SymbolicGame(spec, None, Interrupt(cancel, deadline))
-
-    def still_possible(winning) -> bool:
-        return initial_positions_win(game, winning, robotics_semantics)
-
-    solution = solve_system_game(Solver(game), stop_when_losing=still_possible)
-    return solution.complete and still_possible(solution.winning)
 
 
 def ddmin(candidates: Sequence[T], fails: Callable[[list[T]], bool]) -> list[T]:
@@ -116,12 +100,13 @@ def restrict_guarantees(spec: GR1Specification, groups: Sequence, sections: Sequ
 
 
 def unrealizable_core(spec: GR1Specification, groups: Sequence, robotics_semantics: bool = True,
-                      cancel: threading.Event | None = None, deadline: float | None = None) -> Core | None:
+                      limits: Limits = Limits()) -> Core | None:
     """A 1-minimal set of guarantee ``groups`` that, with all assumptions, is unrealizable.
 
     ``groups`` are objects with ``section`` and ``formulas`` covering the specification
     (e.g. ``respec.components.FormulaGroup``); only those of ``droppable_sections`` are candidates.
-    Returns None when ``spec`` is realizable. Raises ``SynthesisCancelledError`` on cancel/deadline.
+    Returns None when ``spec`` is realizable. Raises ``SynthesisCancelledError`` when ``limits``
+    stop it (each realizability check keeps to them).
     """
     sections = droppable_sections(robotics_semantics)
     guarantees = [group for group in groups if group.section in sections]
@@ -131,7 +116,7 @@ def unrealizable_core(spec: GR1Specification, groups: Sequence, robotics_semanti
         key = tuple(sorted(id(group) for group in subset))
         if key not in outcomes:
             outcomes[key] = not is_realizable(restrict_guarantees(spec, subset, sections), robotics_semantics,
-                                              cancel, deadline)
+                                              limits)
         return outcomes[key]
 
     if not unrealizable(guarantees):
@@ -141,7 +126,7 @@ def unrealizable_core(spec: GR1Specification, groups: Sequence, robotics_semanti
 
 
 def environment_play(spec: GR1Specification, robotics_semantics: bool = True, length: int = 8,
-                     cancel: threading.Event | None = None, deadline: float | None = None) -> list[dict]:
+                     limits: Limits = Limits()) -> list[dict]:
     """Up to ``length`` steps of a play the environment wins (``spec`` must be unrealizable).
 
     The environment follows its counter-strategy. The system plays its best: among the
@@ -151,7 +136,7 @@ def environment_play(spec: GR1Specification, robotics_semantics: bool = True, le
     an eager system gets and where it gets stuck. Each step maps every proposition to its
     value (0/1).
     """
-    game = SymbolicGame(spec, None, Interrupt(cancel, deadline))
+    game = SymbolicGame(spec, None, limits.interrupt())
     environment = solve_environment_game(Solver(game))
     nodes = extract_counterstrategy(game, environment, robotics_semantics)['nodes']
     if '0' not in nodes:

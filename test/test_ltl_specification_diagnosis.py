@@ -1,15 +1,18 @@
 """Diagnosis of impossible tasks: pre-check, unrealizable cores (delta debugging), plays in words."""
 
 import itertools
+import json
 
 import pytest
 
 from ltl_specification import compile_task
 from ltl_specification.diagnosis import (diagnose, explain_unsynthesizable, goal_findings, impossible_next_goals,
                                         precheck)
-from ltl_synthesizer import synthesize
+from ltl_specification.provenance import provenance_from_json, provenance_to_json
+from ltl_synthesizer import Limits
 from ltl_synthesizer.unrealizable_core import (ddmin, droppable_sections, environment_play, is_realizable,
                                                restrict_guarantees, unrealizable_core)
+from respec.parsing import spec_from_text_sections
 from respec.spec import FORMULA_SECTIONS
 
 IMPOSSIBLE = dict(system='atlas', initial_conditions=[], goals=['look_down', 'stand_prep'])
@@ -56,7 +59,7 @@ def test_precheck_names_forbidden_preconditions_and_contradictory_custom_ltl():
 
 def test_core_is_unrealizable_and_one_minimal():
     spec = compile_task(**IMPOSSIBLE)
-    assert not synthesize(spec, explain=False).realizable
+    assert not is_realizable(spec)
     core = unrealizable_core(spec, spec.provenance.groups)
     assert not is_realizable(core.specification)
     sections = droppable_sections(True)
@@ -115,14 +118,35 @@ def test_core_sentence_when_the_precheck_finds_nothing():
 
 
 def test_explain_unsynthesizable_keeps_the_details_and_never_raises():
-    message = explain_unsynthesizable('DETAILS', **IMPOSSIBLE)
+    impossible = compile_task(**IMPOSSIBLE)
+    message = explain_unsynthesizable('DETAILS', impossible, impossible.provenance)
     assert message.splitlines()[0].startswith('Goal 2 (stand_prep)') and message.endswith('DETAILS')
-    assert explain_unsynthesizable('DETAILS', 'no_such_system', [], ['x']) == 'DETAILS'
-    assert explain_unsynthesizable('DETAILS', 'atlas', [], ['look_down']) == 'DETAILS'  # realizable
+    assert explain_unsynthesizable('DETAILS', impossible, None) == 'DETAILS'  # no provenance: nothing to tell
+    realizable = compile_task('atlas', [], ['look_down'])
+    assert explain_unsynthesizable('DETAILS', realizable, realizable.provenance) == 'DETAILS'
+
+
+@pytest.mark.parametrize('task', [IMPOSSIBLE, dict(system='atlas', initial_conditions=[], goals=['look_down'],
+                                                   custom_ltl={'sys_trans': ['stand_c -> !look_down_a']})])
+def test_a_specification_sent_with_its_provenance_as_json_is_diagnosed_the_same(task):
+    """What the synthesis node receives: the specification as message sections and the
+    provenance as JSON, with no robot configuration at hand."""
+    compiled = compile_task(**task)
+    text = provenance_to_json(compiled.provenance)
+    assert text == provenance_to_json(compile_task(**task).provenance)  # deterministic
+    received = provenance_from_json(text)
+    assert provenance_to_json(received) == text
+    sent = spec_from_text_sections(compiled.to_text_sections())
+    assert diagnose(sent, provenance=received).message() == diagnose(compiled).message()
+    bad_formula = json.loads(text)
+    bad_formula['groups'][0][5] = ['((']
+    for malformed in ('{"format": 0}', '[]', 'not json', json.dumps(bad_formula)):
+        with pytest.raises(ValueError):
+            provenance_from_json(malformed)
 
 
 def test_deadline_keeps_the_precheck_sentence():
-    diagnosis = diagnose(compile_task(**IMPOSSIBLE), deadline=0.0)
+    diagnosis = diagnose(compile_task(**IMPOSSIBLE), limits=Limits(deadline=0.0))
     assert 'stand -> stand_prep' in diagnosis.sentence and 'not computed' in diagnosis.note
 
 

@@ -17,6 +17,7 @@ from pathlib import Path
 import pytest
 
 from gr1_oracle import Oracle
+from counterstrategies import synthesize_with_counterstrategy
 from ltl_synthesizer import SynthesisCancelledError, synthesize
 from ltl_synthesizer.external import ExternalSynthesizerError, run_external_synthesizer
 from respec.parsing import parse_slugsin, parse_structuredslugs
@@ -57,7 +58,7 @@ def test_oracle_decides_as_expected(name):
 def test_synthesizer_decides_as_expected_with_checked_strategies(name, robotics_semantics):
     spec = load(name)
     expected = EXPECTED[name][robotics_semantics]
-    result = synthesize(spec, robotics_semantics=robotics_semantics, counterstrategy=True)
+    result = synthesize_with_counterstrategy(spec, robotics_semantics)
     assert result.realizable == expected
     oracle = Oracle(spec)
     if expected:

@@ -10,7 +10,8 @@ import pytest
 
 import gr1_oracle
 
-from ltl_synthesizer import Options, SynthesisCancelledError, synthesize
+from counterstrategies import synthesize_with_counterstrategy
+from ltl_synthesizer import Limits, Options, SynthesisCancelledError, synthesize
 from respec.automaton import automaton_from_strategy
 from ltl_synthesizer.strategy import strategy_to_json
 from respec.ltl import (TRUE, conj, disj, evaluate, iff,
@@ -120,13 +121,13 @@ def test_unrealizable_only_in_the_outermost_fixpoint():
     game = spec(env_props=['x'], sys_props=['y'], env_init=[neg(x)], sys_init=[neg(y)],
                 env_trans=[implies(x, next_(x))],
                 sys_trans=[implies(x, iff(next_(y), y))], sys_liveness=[y, neg(y)])
-    result = synthesize(game, counterstrategy=True)
+    result = synthesize_with_counterstrategy(game)
     assert not result.realizable
 
 
 def test_blocked_goal_is_named_with_a_play():
     game = spec(env_props=['x'], sys_props=['y'], sys_liveness=[y, x])
-    result = synthesize(game, counterstrategy=True)
+    result = synthesize_with_counterstrategy(game)
     assert not result.realizable
     assert "system liveness #1 'x'" in result.explanation
     assert 'step 0: inputs {}' in result.explanation
@@ -137,7 +138,7 @@ def test_deadlock_explanation_names_the_conflicting_safety_formulas():
     game = spec(env_props=['x'], sys_props=['y'], env_init=[neg(x)], sys_init=[neg(y)],
                 sys_trans=[iff(next_(y), next_(x)), implies(y, next_(y)), neg(next_(y))],
                 sys_liveness=[neg(y)])
-    result = synthesize(game, counterstrategy=True)
+    result = synthesize_with_counterstrategy(game)
     assert not result.realizable
     text = result.explanation
     assert 'System deadlock' in text and 'inputs to {x}' in text
@@ -190,7 +191,7 @@ def check_counterstrategy(spec_, counter: dict) -> None:
 
 def test_counterstrategy_shape_and_soundness():
     game = spec(env_props=['x'], sys_props=['y'], sys_liveness=[x])
-    result = synthesize(game, counterstrategy=True)
+    result = synthesize_with_counterstrategy(game)
     assert result.counterstrategy['variables'] == ['x', 'y']
     node = result.counterstrategy['nodes']['0']
     assert node['rank'] == [0, 0]
@@ -207,7 +208,7 @@ def test_counterstrategy_shape_and_soundness():
     env_liveness=[var('z'), neg(x)], sys_liveness=[iff(y, x), neg(var('z'))])])
 def test_counterstrategies_of_unrealizable_games_are_winning_for_the_environment(make, robotics_semantics):
     game = make()
-    result = synthesize(game, robotics_semantics=robotics_semantics, counterstrategy=True)
+    result = synthesize_with_counterstrategy(game, robotics_semantics)
     if result.realizable:
         check_strategy(game, result.strategy, robotics_semantics)
         return
@@ -216,7 +217,7 @@ def test_counterstrategies_of_unrealizable_games_are_winning_for_the_environment
 
 
 def test_realizable_result_has_no_counterstrategy_and_unrealizable_no_strategy():
-    realizable = synthesize(copy_game(), counterstrategy=True)
+    realizable = synthesize_with_counterstrategy(copy_game())
     assert realizable.counterstrategy is None and realizable.strategy is not None
     unrealizable = synthesize(spec(env_props=['x'], sys_props=['y'], sys_liveness=[x]))
     assert unrealizable.strategy is None and unrealizable.counterstrategy is None
@@ -290,7 +291,7 @@ def atlas_chain(tmp_path_factory):
 def test_deadline_stops_a_long_synthesis(atlas_chain):
     game = atlas_chain
     with pytest.raises(SynthesisCancelledError) as raised:
-        synthesize(game, deadline=time.monotonic() + 0.2)
+        synthesize(game, limits=Limits(deadline=time.monotonic() + 0.2))
     assert raised.value.reason == 'timeout' and raised.value.code == 'SYNTHESIS_TIMEOUT'
 
 
@@ -301,7 +302,7 @@ def test_cancel_flag_stops_a_long_synthesis(atlas_chain):
     timer.start()
     try:
         with pytest.raises(SynthesisCancelledError) as raised:
-            synthesize(game, cancel=cancel)
+            synthesize(game, limits=Limits(cancel=cancel))
     finally:
         timer.cancel()
     assert raised.value.reason == 'cancelled' and raised.value.code == 'PREEMPTED'
@@ -311,7 +312,7 @@ def test_already_cancelled_request_does_no_work():
     cancel = threading.Event()
     cancel.set()
     with pytest.raises(SynthesisCancelledError):
-        synthesize(copy_game(), cancel=cancel)
+        synthesize(copy_game(), limits=Limits(cancel=cancel))
 
 
 # --- the automaton message shape ------------------------------------------------------------

@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 
 from ltl_specification import compile_task
-from ltl_synthesizer import SynthesisCancelledError, synthesize
+from ltl_synthesizer import Limits, SynthesisCancelledError, synthesize
 from ltl_synthesizer.errors import SynthesisMemoryError, UndeclaredPropositionError
 from ltl_synthesizer.isolated import SynthesisProcessDiedError, SynthesisProcesses
 from respec.ltl import var
@@ -70,7 +70,7 @@ def test_errors_come_back_as_the_synthesizers_own(processes):
         processes.synthesize(bad)
     assert error.value.item == 'nowhere' and error.value.code == 'UNKNOWN_PROPOSITION'
     with pytest.raises(SynthesisMemoryError) as error:
-        processes.synthesize(RUNAWAY, memory_limit=16 * 2**20, deadline=time.monotonic() + 120)
+        processes.synthesize(RUNAWAY, limits=Limits(deadline=time.monotonic() + 120, memory_limit=16 * 2**20))
     assert error.value.item == 'memory_limit'
 
 
@@ -82,7 +82,7 @@ def test_a_cancel_kills_the_child_at_once_and_the_next_synthesis_works(processes
         cancel.set()
     threading.Timer(1.0, cancel_it).start()
     with pytest.raises(SynthesisCancelledError) as error:
-        processes.synthesize(RUNAWAY, cancel=cancel)
+        processes.synthesize(RUNAWAY, limits=Limits(cancel=cancel))
     stopped = time.monotonic()
     assert error.value.code == 'PREEMPTED'
     assert len(working) == 1 and not Path(f'/proc/{working.pop()}').exists()  # killed and reaped
@@ -94,7 +94,7 @@ def test_a_cancel_kills_the_child_at_once_and_the_next_synthesis_works(processes
 def test_the_deadline_stops_the_synthesis_within_a_poll(processes):
     started = time.monotonic()
     with pytest.raises(SynthesisCancelledError) as error:
-        processes.synthesize(RUNAWAY, deadline=started + 1.0)
+        processes.synthesize(RUNAWAY, limits=Limits(deadline=started + 1.0))
     assert error.value.code == 'SYNTHESIS_TIMEOUT'
     assert time.monotonic() - started < 1.5
 
@@ -105,7 +105,7 @@ def test_a_child_killed_from_outside_is_reported_and_replaced(processes):
 
     def run():
         try:
-            processes.synthesize(RUNAWAY, deadline=time.monotonic() + 60)
+            processes.synthesize(RUNAWAY, limits=Limits(deadline=time.monotonic() + 60))
         except Exception as error:  # noqa: BLE001 -- inspected below
             outcome['error'] = error
 
@@ -152,7 +152,7 @@ def test_idle_children_are_released_and_fresh_prepared_ones_replace_them():
         spec = compile_task('atlas', ['stand_prep'], ['look_down', 'pickup_object'])
         with ThreadPoolExecutor(3) as pool:  # three at once: three children
             assert all(result.realizable for result in pool.map(lambda _: processes.synthesize(spec), range(6)))
-            list(pool.map(lambda _: processes.call('time:sleep', (0.5,)), range(3)))
+            list(pool.map(lambda _: processes.call(time.sleep, (0.5,)), range(3)))
         used = children_of_this_process()
         assert len(used) >= 2 and processes.idle_count >= 2
         deadline = time.monotonic() + 10
@@ -172,12 +172,12 @@ def test_a_child_outlives_the_thread_that_started_it():
     kernel's parent-death signal would kill it with its starting thread)."""
     processes = SynthesisProcesses()
     try:
-        starter = threading.Thread(target=lambda: processes.call('time:sleep', (0.0,)))
+        starter = threading.Thread(target=lambda: processes.call(time.sleep, (0.0,)))
         starter.start()
         starter.join()
         time.sleep(1.0)
         (child,) = children_of_this_process()
-        assert processes.call('os:getpid') == child  # the same child serves the next call
+        assert processes.call(os.getpid) == child  # the same child serves the next call
     finally:
         processes.close()
 

@@ -5,7 +5,7 @@ import time
 
 import pytest
 
-from ltl_synthesizer import (Interrupt, SynthesisCancelledError, SynthesisMemoryError, is_realizable,
+from ltl_synthesizer import (Interrupt, Limits, SynthesisCancelledError, SynthesisMemoryError, is_realizable,
                              synthesize)
 from respec.ltl import conj, disj, iff, neg, next_, var
 from respec.parsing import parse_structuredslugs
@@ -32,7 +32,7 @@ def exponential_spec(pairs=20):
 def test_the_deadline_stops_strategy_extraction_within_a_second(robotics_semantics):
     started = time.monotonic()
     with pytest.raises(SynthesisCancelledError) as raised:
-        synthesize(runaway_spec(), robotics_semantics=robotics_semantics, deadline=started + 1.0)
+        synthesize(runaway_spec(), robotics_semantics, Limits(deadline=started + 1.0))
     assert raised.value.code == 'SYNTHESIS_TIMEOUT'
     assert time.monotonic() - started < 2.0
 
@@ -42,21 +42,21 @@ def test_cancel_stops_a_runaway_within_a_second():
     threading.Timer(0.5, cancel.set).start()
     started = time.monotonic()
     with pytest.raises(SynthesisCancelledError) as raised:
-        synthesize(runaway_spec(), cancel=cancel)
+        synthesize(runaway_spec(), limits=Limits(cancel=cancel))
     assert raised.value.code == 'PREEMPTED'
     assert time.monotonic() - started < 1.5
 
 
 def test_the_verdict_alone_of_the_runaway_is_immediate():
     started = time.monotonic()
-    assert is_realizable(runaway_spec(), deadline=started + 30)
+    assert is_realizable(runaway_spec(), limits=Limits(deadline=started + 30))
     assert time.monotonic() - started < 5
 
 
 def test_the_memory_limit_ends_a_blow_up_with_a_clear_error():
     limit = 48 * 2**20
     with pytest.raises(SynthesisMemoryError) as raised:
-        synthesize(exponential_spec(), memory_limit=limit)
+        synthesize(exponential_spec(), limits=Limits(memory_limit=limit))
     assert raised.value.code == 'SYNTHESIS_FAILED' and raised.value.item == 'memory_limit'
     assert 'memory limit of 48 MB' in str(raised.value)
 
@@ -66,7 +66,7 @@ def test_unrealizable_runaway_explanation_is_bounded_too():
     # initial states loses. The explanation counts them symbolically instead of listing them.
     spec = runaway_spec()
     spec.sys_liveness = [var('x0')]
-    result = synthesize(spec, deadline=time.monotonic() + 30)
+    result = synthesize(spec, limits=Limits(deadline=time.monotonic() + 30))
     assert not result.realizable
     assert f'{2**200} initial state(s)' in result.explanation.replace('.0 initial', ' initial')
 

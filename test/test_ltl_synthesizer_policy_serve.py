@@ -10,7 +10,7 @@ from pathlib import Path
 
 import pytest
 
-from ltl_synthesizer import Options, synthesize
+from ltl_synthesizer import Options, is_realizable, solve, stream_strategy, synthesize
 from ltl_synthesizer.strategy import strategy_json_chunks, strategy_to_json
 from ltl_synthesizer.gr1 import Solver, solve_system_game
 from ltl_synthesizer.strategy import StrategyPiece, SymbolicStrategy, symbolic_strategy
@@ -88,7 +88,7 @@ def test_streamed_json_is_the_same_text_in_pieces():
     assert len(chunks) > 10 and ''.join(chunks) == strategy_to_json(strategy)
     assert json.loads(''.join(chunks))['nodes'].keys() == strategy['nodes'].keys()
     # Streamed: the nodes are made while the text is written, with the same bytes.
-    streamed = synthesize(spec, robotics_semantics=False, strategy='stream').strategy
+    streamed = stream_strategy(solve(spec, robotics_semantics=False))
     assert not isinstance(streamed['nodes'], dict)
     assert ''.join(strategy_json_chunks(streamed, nodes_per_chunk=5)) == strategy_to_json(strategy)
 
@@ -129,8 +129,7 @@ def test_several_system_goals_sift_from_the_start():
 ])
 def test_families_verdicts_are_the_same_under_every_engine_choice(family, arguments, realizable):
     spec = parse_structuredslugs(getattr(gr1_families, family)(*arguments))
-    verdicts = {synthesize(spec, robotics_semantics=False, strategy=False, explain=False,
-                           options=options).realizable
+    verdicts = {is_realizable(spec, robotics_semantics=False, options=options)
                 for options in (Options(), Options(reordering=True), Options(reordering=False),
                                 Options(reachable_only=True), Options(sift_once=True))}
     assert verdicts == {realizable}

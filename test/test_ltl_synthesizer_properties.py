@@ -12,7 +12,8 @@ from hypothesis import HealthCheck, event, given, settings
 from hypothesis import strategies as st
 
 from gr1_oracle import Oracle, formulas
-from ltl_synthesizer import Options, synthesize
+from counterstrategies import synthesize_with_counterstrategy
+from ltl_synthesizer import Options
 from ltl_synthesizer.gr1 import Solver, solve_system_game
 from ltl_synthesizer.symbolic import SymbolicGame
 from respec.ltl import implies, neg, next_, var
@@ -63,7 +64,7 @@ def test_synthesizer_agrees_with_oracle_and_its_strategies_check(spec):
     oracle = Oracle(spec)
     for robotics_semantics in (True, False):
         expected = oracle.realizable(robotics_semantics)
-        result = synthesize(spec, robotics_semantics=robotics_semantics, counterstrategy=True)
+        result = synthesize_with_counterstrategy(spec, robotics_semantics)
         semantics = 'robotics' if robotics_semantics else 'standard'
         event(f'{semantics}: {"realizable" if expected else "unrealizable"}')
         assert result.realizable == expected, f'{semantics} semantics\n{spec.to_structuredslugs()}'

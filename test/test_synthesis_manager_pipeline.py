@@ -8,6 +8,7 @@ from pathlib import Path
 
 import pytest
 
+import endless_diagnosis as endless_diagnosis_module
 from synthesis_manager.client import SynthesisClient, make_goal
 from synthesis_manager.suite import suite_node_factories
 
@@ -154,7 +155,6 @@ def test_impossible_goal_order_is_explained_in_plain_words_first(suite):
     assert 'stand -> stand_prep is not a transition in config/atlas.yaml' in first_line
     assert 'eq. (9) control-mode topology for stand' in outcome.message
     assert 'Details from the synthesizer:' in outcome.message  # the synthesizer's own account stays
-    assert 'Diagnosing why the task cannot be done' in feedback
 
 
 # --- the diagnosis of unrealizable tasks: a cancel and the time limit end it at once ---------
@@ -164,21 +164,32 @@ IMPOSSIBLE_TASK = dict(system='atlas', initial_conditions=['stand_prep'], goals=
 
 @pytest.fixture
 def endless_diagnosis(suite, monkeypatch, tmp_path):
-    """The suite's server diagnoses with test/endless_diagnosis.py; yields its pid file."""
-    from synthesis_manager.nodes import server_node
+    """The suite's synthesis node diagnoses with test/endless_diagnosis.py; yields its pid file."""
+    from ltl_synthesizer.isolated import SERVER_CHILD_NICENESS, SynthesisProcesses
+    from synthesis_manager.nodes import ltl_synthesis_node
 
     test_dir = str(Path(__file__).resolve().parent)
     monkeypatch.setenv('PYTHONPATH', os.pathsep.join(filter(None, [test_dir, os.environ.get('PYTHONPATH')])))
     pid_file = tmp_path / 'diagnosis.pid'
     monkeypatch.setenv('ENDLESS_DIAGNOSIS_PID_FILE', str(pid_file))
-    monkeypatch.setattr(server_node, 'DIAGNOSIS', 'endless_diagnosis:endless_diagnosis')
-    return pid_file
+    monkeypatch.setattr(ltl_synthesis_node, 'DIAGNOSIS', endless_diagnosis_module.endless_diagnosis)
+    # Children that import the stand-in: started from now on, with the test folder on their path.
+    processes = SynthesisProcesses(niceness=SERVER_CHILD_NICENESS)
+    monkeypatch.setattr(synthesis_node_of(suite), 'synthesis_processes', processes)
+    yield pid_file
+    processes.close()
 
 
 def server_of(suite):
     from synthesis_manager.nodes.server_node import BehaviorSynthesisServer
 
     return next(node for node in suite.nodes if isinstance(node, BehaviorSynthesisServer))
+
+
+def synthesis_node_of(suite):
+    from synthesis_manager.nodes.ltl_synthesis_node import LTLSynthesisNode
+
+    return next(node for node in suite.nodes if isinstance(node, LTLSynthesisNode))
 
 
 def process_gone(pid: int, within: float) -> bool:
@@ -198,7 +209,7 @@ def test_a_cancel_ends_the_diagnosis_at_once(suite, endless_diagnosis):
     cancel, cancelled_at = threading.Event(), []
 
     def on_feedback(status, _):
-        if status.startswith('Diagnosing') and not cancel.is_set():
+        if status.startswith('Synthesizing') and not cancel.is_set():
             deadline = time.monotonic() + 20  # the diagnosis process is busy once it wrote its pid
             while not endless_diagnosis.exists() and time.monotonic() < deadline:
                 time.sleep(0.05)
@@ -214,12 +225,12 @@ def test_a_cancel_ends_the_diagnosis_at_once(suite, endless_diagnosis):
 
 def test_the_diagnosis_time_limit_keeps_the_synthesizers_verdict(suite, endless_diagnosis):
     from rclpy.parameter import Parameter
-    from synthesis_manager.nodes.server_node import DIAGNOSIS_GRACE
+    from synthesis_manager.nodes.ltl_synthesis_node import DIAGNOSIS_GRACE
 
     server_of(suite).set_parameters([Parameter('diagnosis_timeout', value=1.0)])
     started = []
     outcome = suite.client.run(make_goal(**IMPOSSIBLE_TASK), timeout=60, feedback=lambda status, _: (
-        status.startswith('Diagnosing') and started.append(time.monotonic())))
+        status.startswith('Synthesizing') and started.append(time.monotonic())))
     assert outcome.error_name == 'SPEC_UNSYNTHESIZABLE'
     assert 'Details from the synthesizer' not in outcome.message  # no diagnosis: the synthesizer's account
     assert outcome.message.strip()

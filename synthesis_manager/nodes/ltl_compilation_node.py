@@ -8,6 +8,7 @@ from rclpy.node import Node
 from std_msgs.msg import String
 
 from ltl_specification import compile_task
+from ltl_specification.provenance import provenance_to_json
 from respec.robot import SystemCatalog, catalog_to_json
 from respec.naming import DEFAULT_SM_OUTCOMES
 from synthesis_manager.ros.conversions import error_code, msg_to_sections, spec_to_msg
@@ -67,6 +68,8 @@ class LTLCompilationNode(Node):
             self.get_logger().warning(response.error_code.message)
             return response
         response.ltl_specification = spec_to_msg(spec)
+        # CNU capability systems record none: their unrealizable specifications are not diagnosed.
+        response.provenance = provenance_to_json(spec.provenance) if spec.provenance is not None else ''
         response.error_code = error_code()
         return response
 

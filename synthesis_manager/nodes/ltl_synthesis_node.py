@@ -1,7 +1,9 @@
 """The ``ltl_synthesis`` service node (SynthesizeAutomaton): a thin adapter around the synthesizer.
 
 Like the original it writes the byproducts ``<spec_name>.structuredslugs``, ``.slugsin`` and
-``.json`` to a directory (see synthesis_manager.byproducts for names and retention).
+``.json`` to a directory (see synthesis_manager.byproducts for names and retention). An
+unrealizable specification that comes with its provenance is diagnosed here, with this node's
+settings, and the diagnosis leads the answer's message (ltl_specification.diagnosis).
 """
 
 from __future__ import annotations
@@ -15,7 +17,9 @@ from pathlib import Path
 from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.node import Node
 
-from ltl_synthesizer import SynthesisCancelledError
+from ltl_specification.diagnosis import explain_unsynthesizable
+from ltl_specification.provenance import provenance_from_json
+from ltl_synthesizer import Limits, SynthesisCancelledError, SynthesisError
 from ltl_synthesizer.external import run_external_synthesizer
 from ltl_synthesizer.isolated import SERVER_CHILD_NICENESS, SynthesisProcesses
 from ltl_synthesizer.strategy import strategy_to_json
@@ -33,6 +37,11 @@ from synthesis_msgs.srv import CancelSynthesis, SynthesizeAutomaton
 
 BACKENDS = ('builtin', 'slugs')
 
+# What explains an unrealizable specification (run in a synthesis child process; a module-level
+# name so that tests can put a stand-in there).
+DIAGNOSIS = explain_unsynthesizable
+DIAGNOSIS_GRACE = 1.0  # seconds past its own time limit before the diagnosis process is killed
+
 
 WAKE_PERIOD = 0.1  # seconds
 
@@ -46,7 +55,9 @@ class LTLSynthesisNode(Node):
     ``slugs_executable``, called the original way); ``timeout`` (seconds, used when a
     request gives none; time spent waiting for a worker counts); ``robotics_semantics``;
     ``memory_limit_mb`` (per synthesis; beyond it the synthesis ends with SYNTHESIS_FAILED
-    naming the limit, not an OOM kill); ``parallel_syntheses`` (run at once) and ``queued_syntheses`` (waiting beyond those;
+    naming the limit, not an OOM kill); ``diagnosis_timeout`` (seconds to find why an
+    unrealizable specification cannot be met, used when a request gives none; never past the
+    request's time limit); ``parallel_syntheses`` (run at once) and ``queued_syntheses`` (waiting beyond those;
     further requests are answered BUSY).
 
     Syntheses run in the node's own worker threads, awaited by an async service callback,
@@ -66,6 +77,7 @@ class LTLSynthesisNode(Node):
         self.declare_parameter('timeout', 60.0)
         self.declare_parameter('robotics_semantics', True)
         self.declare_parameter('memory_limit_mb', 2048)
+        self.declare_parameter('diagnosis_timeout', 20.0)
         self.declare_parameter('parallel_syntheses', 8)
         self.declare_parameter('queued_syntheses', 200)
         self._running: dict[str, threading.Event] = {}
@@ -123,6 +135,7 @@ class LTLSynthesisNode(Node):
         try:
             check_message(request)
             timeout = check_timeout(request.timeout, 'request.timeout') or self.parameter('timeout')
+            check_timeout(request.diagnosis_timeout, 'request.diagnosis_timeout')
             # The time limit starts now: waiting for a worker counts.
             deadline = time.monotonic() + timeout
             try:
@@ -160,9 +173,8 @@ class LTLSynthesisNode(Node):
             backend = self.parameter('backend')
             if backend == 'builtin':
                 try:
-                    result = self.synthesis_processes.synthesize(
-                        spec, robotics_semantics=robotics, cancel=cancel, deadline=deadline,
-                        memory_limit=self.parameter('memory_limit_mb') * 2**20)
+                    result = self.synthesis_processes.synthesize(spec, robotics, Limits(
+                        cancel, deadline, self.parameter('memory_limit_mb') * 2**20))
                 except SynthesisCancelledError as stopped:
                     return self._stopped(response, stopped.reason, timeout)
                 realizable, strategy, explanation = result.realizable, result.strategy, result.explanation
@@ -178,13 +190,45 @@ class LTLSynthesisNode(Node):
                 return
             response.synthesizable = realizable
             if not realizable:
-                response.error_code = error_code(
-                    ErrorCode.SPEC_UNSYNTHESIZABLE,
-                    f'specification {files.name!r} is unrealizable: {explanation}'.rstrip(': '))
+                details = f'specification {files.name!r} is unrealizable: {explanation}'.rstrip(': ')
+                try:
+                    message = self._diagnosed(details, spec, request, robotics, cancel, deadline)
+                except SynthesisCancelledError as stopped:
+                    return self._stopped(response, stopped.reason, timeout)
+                response.error_code = error_code(ErrorCode.SPEC_UNSYNTHESIZABLE, message)
                 return
             files.write('json', strategy_to_json(strategy))
         response.automaton = automaton_to_msg(automaton_from_strategy(strategy, spec))
         response.error_code = error_code()
+
+    def _diagnosed(self, details: str, spec, request, robotics_semantics: bool, cancel: threading.Event,
+                   deadline: float) -> str:
+        """``details`` (the synthesizer's explanation), led by why the task cannot be done when
+        the request carries the specification's provenance. The diagnosis runs in a synthesis
+        child process, with the memory limit, and ends by diagnosis_timeout and before the
+        request's time limit; without an answer by then the verdict stands with ``details``.
+        A cancel raises SynthesisCancelledError."""
+        if not request.provenance:
+            return details
+        try:
+            provenance = provenance_from_json(request.provenance)
+        except ValueError as error:
+            self.get_logger().warning(f'request.provenance ignored (no diagnosis): {error!r}'[:300])
+            return details
+        limit = request.diagnosis_timeout or self.parameter('diagnosis_timeout')
+        diagnosis_deadline = min(time.monotonic() + limit, deadline - DIAGNOSIS_GRACE)
+        if diagnosis_deadline <= time.monotonic():
+            return details
+        limits = Limits(deadline=diagnosis_deadline, memory_limit=self.parameter('memory_limit_mb') * 2**20)
+        try:
+            # The diagnosis keeps its own deadline; the child is killed only if it overruns.
+            return self.synthesis_processes.call(
+                DIAGNOSIS, (details, spec, provenance, robotics_semantics, limits),
+                cancel=cancel, deadline=diagnosis_deadline + DIAGNOSIS_GRACE)
+        except SynthesisError:
+            if cancel.is_set():
+                raise SynthesisCancelledError('cancelled') from None
+            return details  # out of time, or its process died: the verdict stands without it
 
     @staticmethod
     def _stopped(response, reason: str, timeout: float):

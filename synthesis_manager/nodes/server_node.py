@@ -29,33 +29,27 @@ from rclpy.time import Time
 from ltl_specification.errors import InvalidInitialConditionsError
 from ltl_specification.initial_conditions import (detected_status, initial_conditions_from_robot_state,
                                                   reads_robot_state)
-from ltl_synthesizer.errors import SynthesisError
-from ltl_synthesizer.isolated import SERVER_CHILD_NICENESS, SynthesisProcesses
 from respec.errors import INTERNAL_ERROR, CodedError, ErrorCode
 from sm_generation.instantiation import count_states
-from synthesis_manager.limits import BusyError, GoalDeadline, GoalTimeoutError, check_message, check_timeout
+from synthesis_manager.limits import (MAX_STRING_BYTES, BusyError, GoalDeadline, GoalTimeoutError, check_message,
+                                      check_timeout, utf8_length)
 from synthesis_manager.nodes.atlas_sim_node import STATE_TOPIC
 from synthesis_manager.requests import (InvalidRequestError, SynthesisTask, task_from_behavior_synthesis,
                                         task_from_flexbe_synthesis)
 from synthesis_manager.ros.cnu_interface import load_flexbe_synthesis_interface
-from synthesis_manager.ros.conversions import error_code, error_name, is_empty_spec, msg_to_sections
+from synthesis_manager.ros.conversions import error_code, error_name, is_empty_spec
 from synthesis_manager.ros.errors import log_internal_error
 from synthesis_manager.ros.node_main import node_main
 from synthesis_manager.ros.qos import action_server_qos, service_qos
 from synthesis_manager.ros.robot_state import RobotStateListener
 from synthesis_manager.ros.stage_calls import (Preempted, ServerStoppingError, StageCaller, StageFailedError,
                                               StageTimeoutError)
-from synthesis_manager.ros.worker_pool import WorkerPool
 from synthesis_msgs.action import BehaviorSynthesis
 from synthesis_msgs.msg import FSAutomaton, LTLSpecification
 from synthesis_msgs.srv import (CancelSynthesis, GenerateFlexBESM, GenerateLTLSpecification,
                                 SynthesizeAutomaton)
 
 
-# What explains an unrealizable task (run in a child process; a module-level name so that
-# tests can put a stand-in there).
-DIAGNOSIS = 'ltl_specification.diagnosis:explain_unsynthesizable'
-DIAGNOSIS_GRACE = 1.0  # seconds past diagnosis_timeout before the diagnosis process is killed
 # Seconds past synthesis_timeout the synthesis node has to answer (a goal's own limit gets none).
 SYNTHESIS_ANSWER_GRACE = 1.0
 
@@ -141,8 +135,9 @@ class BehaviorSynthesisServer(Node):
     Parameters: ``default_system`` (for requests naming none or ``system_wide``),
     ``flexbe_log_topic`` (FlexBE's operator log; '' disables it), ``service_timeout`` (seconds
     to wait for a service to appear), ``compilation_timeout``, ``synthesis_timeout`` and
-    ``generation_timeout`` (seconds per stage), ``diagnosis_timeout`` (seconds to find why an
-    unrealizable task cannot be done), ``robot_state_topic`` (synthesis_msgs/RobotState, default
+    ``generation_timeout`` (seconds per stage), ``diagnosis_timeout`` (seconds the synthesis node
+    may take, within the synthesis's limit, to find why an unrealizable task cannot be done: it
+    diagnoses the specification it holds, from the provenance the compilation gave), ``robot_state_topic`` (synthesis_msgs/RobotState, default
     the simulator's ``atlas_sim/state``), ``robot_state_timeout`` (seconds to wait for a state
     when a request names no initial conditions, or ``current``: synthesis on the fly),
     ``max_active_goals`` (goals in progress at once, both actions together; more are answered
@@ -168,10 +163,6 @@ class BehaviorSynthesisServer(Node):
         self._accepted_goals = 0  # accepted and not finished: running, or waiting for the executor
         self._lock = threading.Lock()
         self.stages = StageCaller(self)
-        self.diagnoses = WorkerPool(workers=2, max_waiting=self.parameter('max_active_goals'), name='diagnosis')
-        # Diagnoses run syntheses too: in child processes that a cancel, the time limit or
-        # shutdown ends at once (one CUDD operation can hold the GIL for seconds).
-        self.diagnosis_processes = SynthesisProcesses(niceness=SERVER_CHILD_NICENESS)
         self.log_to_flexbe = flexbe_log_publisher(self, self.parameter('flexbe_log_topic'))
         group = ReentrantCallbackGroup()
 
@@ -208,7 +199,6 @@ class BehaviorSynthesisServer(Node):
         """Make goals that are waiting on a stage give up (at shutdown)."""
         self._stopping.set()
         self.stages.stop()
-        self.diagnosis_processes.close()
 
     def _wake_executor(self):
         if self.executor is not None:
@@ -217,7 +207,6 @@ class BehaviorSynthesisServer(Node):
     def destroy_node(self):
         for action_server in self.action_servers:
             action_server.destroy()
-        self.diagnosis_processes.close()
         super().destroy_node()
 
     def parameter(self, name):
@@ -301,6 +290,7 @@ class BehaviorSynthesisServer(Node):
         goal_id = bytes(goal_handle.goal_id.uuid).hex()
         spec_name = task.byproduct_stem or f'{task.system or "behavior"}_{goal_id[:8]}'
 
+        provenance = ''  # what the specification was compiled from: the synthesizer diagnoses with it
         if task.option == 'ltl_synthesis_only':
             if task.custom_ltl is None or is_empty_spec(task.custom_ltl):
                 raise InvalidRequestError('ltl_synthesis_only needs the complete LTL specification '
@@ -316,6 +306,11 @@ class BehaviorSynthesisServer(Node):
                 'LTL compilation', self.parameter('compilation_timeout'), deadline=deadline)
             self.check(compiled.error_code)
             outcome.ltl_specification = compiled.ltl_specification
+            provenance = compiled.provenance
+            if utf8_length(provenance) > MAX_STRING_BYTES:  # the synthesizer would refuse the request
+                self.get_logger().warning(f'the provenance of {spec_name} ({utf8_length(provenance)} bytes) is '
+                                          'not sent: an unrealizable specification is not diagnosed')
+                provenance = ''
             feedback('Compiled the LTL specification', 1 / 3)
             if task.option == 'ltl_compilation_only':
                 return
@@ -328,7 +323,8 @@ class BehaviorSynthesisServer(Node):
                 self.parameter('synthesis_timeout')
             synthesized = await self.call(goal_handle, self.synthesizer, SynthesizeAutomaton.Request(
                 ltl_specification=outcome.ltl_specification, spec_name=spec_name,
-                timeout=float(timeout), request_id=goal_id),
+                timeout=float(timeout), request_id=goal_id, provenance=provenance,
+                diagnosis_timeout=float(self.parameter('diagnosis_timeout'))),
                 'LTL synthesis', timeout + SYNTHESIS_ANSWER_GRACE, on_cancel=lambda: self.cancel_synthesis(goal_id),
                 deadline=deadline)
         except GoalTimeoutError as passed:  # the synthesis stage's code, whoever saw the limit pass
@@ -336,10 +332,6 @@ class BehaviorSynthesisServer(Node):
         if task.timeout and error_name(synthesized.error_code.value) == ErrorCode.SYNTHESIS_TIMEOUT:
             # Name the goal's limit, not the time that was left of it.
             synthesized.error_code.message = str(deadline.timed_out('LTL synthesis'))
-        if task.option != 'ltl_synthesis_only' and error_name(synthesized.error_code.value) == ErrorCode.SPEC_UNSYNTHESIZABLE:
-            feedback('Diagnosing why the task cannot be done', 0.6)
-            synthesized.error_code.message = await self.diagnose(goal_handle, task, synthesized.error_code.message,
-                                                                 deadline)
         self.check(synthesized.error_code)
         outcome.automaton = synthesized.automaton
         feedback(f'Synthesized an automaton with {len(outcome.automaton.automaton)} states', 2 / 3)
@@ -395,44 +387,6 @@ class BehaviorSynthesisServer(Node):
             if deadline is not None and deadline.passed():
                 raise deadline.timed_out(stage) from None
             raise
-
-    async def diagnose(self, goal_handle, task: SynthesisTask, details: str,
-                       goal_deadline: GoalDeadline | None = None) -> str:
-        """Why ``task`` cannot be done, in plain words ahead of the synthesizer's ``details``
-        (``details`` alone when there is no diagnosis within diagnosis_timeout). A cancel or
-        shutdown ends the diagnosis at once."""
-        custom_ltl = msg_to_sections(task.custom_ltl) if task.custom_ltl is not None else None
-        # The same robot configuration as the compilation node's (config_dir), by keyword.
-        arguments = dict(details=details, system=task.system, initial_conditions=task.initial_conditions,
-                         goals=task.goals, sm_outcomes=task.sm_outcomes, strict_order=not task.unordered_goals,
-                         custom_ltl=custom_ltl or None, config_dir=self.parameter('config_dir') or None)
-        deadline = time.monotonic() + self.parameter('diagnosis_timeout')
-        if goal_deadline is not None and goal_deadline.deadline is not None:
-            deadline = min(deadline, goal_deadline.deadline)  # the verdict comes within the goal's limit
-            if deadline <= time.monotonic():
-                return details
-        stop = threading.Event()
-
-        def watch():
-            if goal_handle.is_cancel_requested or self._stopping.is_set():
-                stop.set()
-
-        # The worker only waits on the child process; the executor keeps serving.
-        message = await self.diagnoses.run(self._diagnosis, arguments, deadline, stop, details,
-                                           wake=self._wake_executor, each_turn=watch)
-        if goal_handle.is_cancel_requested:
-            raise Preempted()
-        if self._stopping.is_set():
-            raise ServerStoppingError('diagnosis: the server is shutting down', 'diagnosis')
-        return message
-
-    def _diagnosis(self, arguments: dict, deadline: float, stop: threading.Event, details: str) -> str:
-        try:
-            # The diagnosis keeps its own deadline; the child is killed only if it overruns.
-            return self.diagnosis_processes.call(DIAGNOSIS, (), {**arguments, 'deadline': deadline}, cancel=stop,
-                                                 deadline=deadline + DIAGNOSIS_GRACE)
-        except SynthesisError:  # stopped, out of time, or its process died: the verdict stands without it
-            return details
 
     def cancel_synthesis(self, goal_id: str):
         """Tell the synthesizer to stop this goal's synthesis (fire and forget)."""

@@ -1,12 +1,12 @@
 """A GUI simulation in a child process: the GUI stays small, and a crash stays in the child.
 
 MuJoCo with its off-screen renderer grew the GUI process by ~280 MiB on its first run, and a
-crash in native code would have ended the GUI with it. Each run is therefore
-``python -m synthesis_manager.web.simulation_process``: the run's settings go in as one JSON
-line on stdin, and JSON lines come back on stdout: ``{"progress": ...}`` as steps and key
-frames are added, then one ``{"result": ...}`` or ``{"error": ...}``. Frames and the timeline
-are files in the run's record directory, passed by path. The child ends when its stdin closes
-(the GUI stopped, or died), so no run outlives the GUI.
+crash in native code would have ended the GUI with it. Each run therefore has a child process
+of its own (``ltl_synthesizer.isolated.ChildProcess``, the project's one process runner, which
+preloads this module): the run's settings go in, progress comes back as steps and key frames
+are added, then one final message. Frames and the timeline are files in the run's record
+directory, passed by path. The child is killed when the GUI stops the run or it overruns its
+wall-time limit, and ends by itself when the GUI dies, so no run outlives the GUI.
 
     run = SimulationProcess(settings)       # in the GUI, one thread per run
     final = run.run(on_progress)            # run.stop() from another thread ends it
@@ -15,14 +15,12 @@ are files in the run's record directory, passed by path. The child ends when its
 from __future__ import annotations
 
 import dataclasses
-import json
 import logging
-import os
-import subprocess
-import sys
-import threading
+import time
 from typing import Callable
 
+from ltl_synthesizer.errors import SynthesisError
+from ltl_synthesizer.isolated import ChildProcess
 from respec.errors import INTERNAL_ERROR, CodedError
 
 #: Seconds past its own wall-time limit a child is given before it is killed.
@@ -39,108 +37,75 @@ logger = logging.getLogger(__name__)
 
 
 class SimulationProcess:
-    """One run in its child process (``settings``: see :func:`_simulate`)."""
+    """One run in its child process (``settings``: see :func:`simulate`)."""
 
     def __init__(self, settings: dict):
         self.settings = settings
-        self.process = subprocess.Popen([sys.executable, '-m', __name__], stdin=subprocess.PIPE,
-                                        stdout=subprocess.PIPE, env={**CHILD_ENVIRONMENT, **os.environ})
+        self.child = ChildProcess(preload=__name__, environment=CHILD_ENVIRONMENT)
+        self.process = self.child.process
 
     def run(self, on_progress: Callable[[dict], None]) -> dict:
         """Wait for the run, calling ``on_progress({'robot_time', 'steps', 'frames'})`` as it
         advances; return its final message, ``{'result': {...}}`` or ``{'error': {'code', 'item',
         'message'}, 'steps': [...] or None}``, also when the child dies or is stopped."""
         last_steps = None
-        watchdog = threading.Timer(self.settings['max_wall_time'] + KILL_GRACE, self.stop)
-        watchdog.daemon = True
-        watchdog.start()
+
+        def progress(update: dict):
+            nonlocal last_steps
+            last_steps = update['steps']
+            on_progress(update)
+
         try:
-            self.process.stdin.write(json.dumps(self.settings).encode() + b'\n')
-            self.process.stdin.flush()
-            for line in self.process.stdout:
-                message = json.loads(line)
-                if 'progress' not in message:
-                    return message
-                last_steps = message['progress']['steps']
-                on_progress(message['progress'])
-        except (OSError, ValueError):  # the child died mid-message
+            return self.child.call(simulate, (self.settings,), on_progress=progress,
+                                   deadline=time.monotonic() + self.settings['max_wall_time'] + KILL_GRACE)
+        except SynthesisError:  # the child died, was stopped or overran its time
             pass
         finally:
-            watchdog.cancel()
-            self.stop()
-            for stream in (self.process.stdin, self.process.stdout):
-                try:
-                    stream.close()  # a closed stdin is also the child's signal to end
-                except OSError:
-                    pass
-            self.process.wait()
+            self.child.kill()
         return {'error': {'code': INTERNAL_ERROR, 'item': 'simulation process',
                           'message': f'the simulation process ended (exit code {self.process.returncode}) '
                                      'without a result'},
                 'steps': last_steps}
 
     def stop(self) -> None:
-        """End the child now (the GUI stops, or the run overran its wall-time limit)."""
+        """End the child now, from any thread (the GUI stops): run() returns the error message."""
         if self.process.poll() is None:
             self.process.kill()
 
 
-def _simulate(settings: dict, send: Callable[[dict], None]) -> None:
-    """The child: run the machine on atlas_sim's robot, sending progress and the final message."""
-    from pathlib import Path
-
-    from atlas_sim.closed_loop import run_and_check
-    from atlas_sim.simulated_robot import SimulatedRobot
-    from atlas_sim.simulator.factory import make_simulator, parse_faults
-    from respec.parsing import spec_from_text_sections
-
+def simulate(settings: dict, progress: Callable[[dict], None]) -> dict:
+    """In the child: run the machine on atlas_sim's robot, reporting ``progress``; the final message."""
     simulator, sent = None, [0, 0]
 
-    def progress(steps, frames):  # every control tick: send only when a step or frame was added
+    def step_added(steps, frames):  # every control tick: report only when a step or frame was added
         if (len(steps), len(frames)) != tuple(sent):
             sent[:] = [len(steps), len(frames)]
-            send({'progress': {'robot_time': simulator.time, 'steps': [dataclasses.asdict(s) for s in steps],
-                               'frames': [str(path) for path in frames]}})
+            progress({'robot_time': simulator.time, 'steps': [dataclasses.asdict(s) for s in steps],
+                      'frames': [str(path) for path in frames]})
 
     try:
+        from pathlib import Path
+
+        from atlas_sim.closed_loop import run_and_check
+        from atlas_sim.simulated_robot import SimulatedRobot
+        from atlas_sim.simulator.factory import make_simulator, parse_faults
+        from respec.parsing import spec_from_text_sections
+
         simulator = make_simulator(settings['system'], settings['config_dir'], settings['initial_conditions'],
                                    faults=parse_faults(fail_first=[f'{c}:1' for c in settings['fail_first']]))
         run = run_and_check(settings['states'], SimulatedRobot(simulator), simulator, settings['system'],
                             spec_from_text_sections(settings['ltl_specification']), settings['goals'],
                             ordered=settings['ordered'], config_dir=settings['config_dir'],
                             record_dir=Path(settings['record_dir']), max_robot_time=settings['max_robot_time'],
-                            max_wall_time=settings['max_wall_time'], on_progress=progress)
-        send({'result': {'outcome': run.result.outcome, 'check': run.check.to_dict(),
-                         'timeline': str(run.timeline) if run.timeline else None,
-                         'frames': [str(path) for path in run.frames], 'robot_time': simulator.time,
-                         'steps': [dataclasses.asdict(step) for step in run.result.trace.steps]}})
-    except Exception as error:  # ExecutionError, bad faults, rendering: reported to the GUI
+                            max_wall_time=settings['max_wall_time'], on_progress=step_added)
+        return {'result': {'outcome': run.result.outcome, 'check': run.check.to_dict(),
+                           'timeline': str(run.timeline) if run.timeline else None,
+                           'frames': [str(path) for path in run.frames], 'robot_time': simulator.time,
+                           'steps': [dataclasses.asdict(step) for step in run.result.trace.steps]}}
+    except Exception as error:  # ExecutionError, bad faults, rendering, a missing module: reported to the GUI
         if not isinstance(error, CodedError):
             logger.exception('simulation failed')
         trace = getattr(error, 'trace', None)
-        send({'error': {'code': error.code if isinstance(error, CodedError) else INTERNAL_ERROR,
-                        'item': getattr(error, 'item', ''), 'message': str(error)},
-              'steps': [dataclasses.asdict(step) for step in trace.steps] if trace else None})
-
-
-def _serve() -> None:
-    answers = os.fdopen(os.dup(sys.stdout.fileno()), 'w')
-    sys.stdout = sys.stderr  # stray prints must not corrupt the messages
-    settings = json.loads(sys.stdin.readline())
-
-    def end_with_stdin():  # the GUI closed it (stop) or died: nobody waits for this run
-        sys.stdin.read()
-        os._exit(1)
-
-    threading.Thread(target=end_with_stdin, daemon=True).start()
-
-    def send(message: dict):
-        answers.write(json.dumps(message) + '\n')
-        answers.flush()
-
-    _simulate(settings, send)
-
-
-if __name__ == '__main__':
-    logging.basicConfig(level=logging.WARNING)
-    _serve()
+        return {'error': {'code': error.code if isinstance(error, CodedError) else INTERNAL_ERROR,
+                          'item': getattr(error, 'item', ''), 'message': str(error)},
+                'steps': [dataclasses.asdict(step) for step in trace.steps] if trace else None}

@@ -1,0 +1,279 @@
+"""The ``gr1synth`` command itself: its arguments, one run, and the writing of its outputs.
+
+Shared by the command line (``ltl_synthesizer.cli``) and the resident mode
+(``ltl_synthesizer.serve``), which answers each request line with one run; neither imports the
+other. The command's behaviour is described in ``ltl_synthesizer.cli``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import os
+import sys
+import time
+from pathlib import Path
+
+from respec.errors import ExitStatus, exit_status_help
+
+REALIZABLE_LINE = 'RESULT: Specification is realizable.'
+UNREALIZABLE_LINE = 'RESULT: Specification is unrealizable.'
+
+
+def _parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog='gr1synth', description='GR(1) synthesis with slugs-compatible input and output.',
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+        epilog=exit_status_help(ExitStatus.OK, ExitStatus.FAILED, ExitStatus.USAGE, ExitStatus.TIMED_OUT,
+                                ExitStatus.OUT_OF_MEMORY))
+    parser.add_argument('--explicitStrategy', action='store_true',
+                        help='write an explicit-state strategy when realizable')
+    parser.add_argument('--jsonOutput', action='store_true', help="strategies in slugs' JSON format")
+    parser.add_argument('--sysInitRoboticsSemantics', action='store_true',
+                        help='every state allowed by both init sections must be winning')
+    parser.add_argument('--counterStrategy', action='store_true',
+                        help='write a counter-strategy when unrealizable')
+    parser.add_argument('--convert', action='store_true',
+                        help='only convert INPUT.structuredslugs to slugsin')
+    parser.add_argument('--explain', action='store_true',
+                        help='when unrealizable, say why (losing initial states, blocked goal, a play)')
+    parser.add_argument('--timeout', type=_limit, default=None, metavar='SECONDS',
+                        help='give up after this many seconds, reading the input included (exit status 3)')
+    parser.add_argument('--memory-limit', type=_limit, default=2048, metavar='MB',
+                        help='give up beyond this much memory (default 2048, 0: none; exit status 4)')
+    parser.add_argument('--serve', action='store_true',
+                        help='resident mode: read one request per line on stdin (a JSON list of '
+                             'gr1synth arguments), answer one JSON line each on stdout')
+    parser.add_argument('input', metavar='INPUT', nargs='?')
+    parser.add_argument('output', metavar='OUTPUT', nargs='?')
+    return parser
+
+
+def _limit(text: str) -> float:
+    """A limit given on the command line: a finite number >= 0 (NaN would mean no limit)."""
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not math.isfinite(value) or value < 0:
+        raise argparse.ArgumentTypeError(f'must be a finite number >= 0, not {text[:40]!r}')
+    return value
+
+
+def parse_arguments(argv):
+    """The parsed gr1synth command line ``argv``; usage errors exit as argparse does (2), an
+    OUTPUT without a strategy to write exits 1 (as slugs)."""
+    parser = _parser()
+    args = parser.parse_args(argv)
+    if args.serve:
+        if args.input:
+            parser.error('--serve reads its requests from stdin: no INPUT')
+    elif not args.input:
+        parser.error('the following arguments are required: INPUT')
+    elif args.output and not (args.explicitStrategy or args.counterStrategy or args.convert):
+        # As slugs ("too many file names"): an output file is only ever a strategy's.
+        print('gr1synth: error: an OUTPUT file is written only with --explicitStrategy, '
+              '--counterStrategy or --convert', file=sys.stderr)
+        raise SystemExit(ExitStatus.FAILED)
+    return args
+
+
+def read_specification(path: str, check=None, deadline: float | None = None):
+    """Parse a .slugsin or .structuredslugs file (by extension) into a GR1Specification;
+    ``check`` (e.g. an ltl_synthesizer Interrupt) is called regularly while parsing. Reading
+    that has not ended by ``deadline`` (a FIFO no one writes to) raises SynthesisCancelledError."""
+    from respec.parsing import parse_slugsin, parse_structuredslugs
+    if path.endswith('.structuredslugs'):
+        parse = parse_structuredslugs
+    elif path.endswith('.slugsin'):
+        parse = parse_slugsin
+    else:
+        raise ValueError(f"{path}: unknown input format (expected .slugsin or .structuredslugs)")
+    return parse(_read_text(path, deadline), filename=path, check=check)
+
+
+def _read_text(path: str, deadline: float | None) -> str:
+    if deadline is None:
+        return Path(path).read_text()
+    import threading
+    from ltl_synthesizer.errors import SynthesisTimeoutError
+    outcome = {}
+
+    def read():  # opening a FIFO blocks until a writer comes: in a thread the process may leave
+        try:
+            outcome['text'] = Path(path).read_text()
+        except BaseException as error:  # re-raised in the caller's thread
+            outcome['error'] = error
+
+    reader = threading.Thread(target=read, name='gr1synth-input', daemon=True)
+    reader.start()
+    reader.join(max(0.0, deadline - time.monotonic()))
+    if reader.is_alive():
+        raise SynthesisTimeoutError(f'timeout: {path} was still being read')
+    if 'error' in outcome:
+        raise outcome['error']
+    return outcome['text']
+
+
+def synthesis_outcome(spec, args, limits, stream: bool = False):
+    """What a run of ``args`` prints and writes, as a SynthesisResult: the verdict, and the
+    strategy, counter-strategy or explanation asked for. ``stream`` (in-process only): the
+    strategy is extracted while it is written (bounded memory)."""
+    from ltl_synthesizer.synthesizer import (SynthesisResult, counter_strategy, explain,
+                                             explicit_strategy, solve, stream_strategy)
+    solved = solve(spec, args.sysInitRoboticsSemantics, limits)
+    result = SynthesisResult(solved.realizable)
+    if solved.realizable and args.explicitStrategy:
+        result.strategy = stream_strategy(solved) if stream else explicit_strategy(solved)
+    elif not solved.realizable:
+        if args.counterStrategy:
+            result.counterstrategy = counter_strategy(solved)
+        if args.explain:
+            result.explanation = explain(solved)
+    return result
+
+
+def _write(text: str, output: str | None) -> None:
+    _write_chunks([text], output)
+
+
+def _write_chunks(chunks, output: str | None) -> None:
+    """Write text pieces as they come (a large strategy is never one string in memory).
+
+    A file appears only complete: the pieces go to a hidden file beside it, renamed at the end,
+    so an interrupted run (a streamed strategy is extracted while written) leaves no output.
+    A device or FIFO (``/dev/stdout``) is written directly.
+    """
+    if output and os.path.exists(output) and not os.path.isfile(output):
+        with open(output, 'w') as stream:
+            stream.writelines(chunks)
+    elif output:
+        folder, name = os.path.split(os.path.abspath(output))
+        partial = os.path.join(folder, f'.{name}.{os.getpid()}.partial')
+        try:
+            with open(partial, 'w') as stream:
+                stream.writelines(chunks)
+            os.replace(partial, output)
+        finally:
+            if os.path.exists(partial):
+                os.remove(partial)
+    else:
+        sys.stdout.writelines(chunks)
+        sys.stdout.flush()
+
+
+def strategy_to_text(strategy: dict) -> str:
+    """slugs' plain explicit-strategy format (``State n with rank r -> <a:0, b:1>``)."""
+    lines = []
+    for name in sorted(strategy['nodes'], key=int):
+        node = strategy['nodes'][name]
+        rank = node['rank']
+        rank_text = f'({rank[0]},{rank[1]})' if isinstance(rank, list) else str(rank)
+        values = ', '.join(f'{variable}:{value}' for variable, value in
+                           zip(strategy['variables'], node['state']) if value is not None)
+        lines.append(f'State {name} with rank {rank_text} -> <{values}>')
+        if node['trans']:
+            lines.append('\tWith successors : ' + ', '.join(str(t) for t in node['trans']))
+        else:
+            lines.append('\tWith no successors.')
+        lines.append('')
+    return '\n'.join(lines) + ('\n' if lines else '')
+
+
+def run_with_deep_stack(function, *args):
+    """``function(*args)`` in a thread with room for formulas nested as deeply as the parsers accept."""
+    import threading
+    outcome = {}
+
+    def target():
+        try:
+            outcome['value'] = function(*args)
+        except BaseException as error:  # re-raised in the caller's thread
+            outcome['error'] = error
+
+    from respec.nesting import allow_deep_formulas
+    previous_stack, previous_limit = threading.stack_size(), sys.getrecursionlimit()
+    allow_deep_formulas()
+    try:
+        worker = threading.Thread(target=target, name='gr1synth', daemon=True)
+        worker.start()
+    finally:
+        threading.stack_size(previous_stack)
+    try:
+        while worker.is_alive():  # a timed join keeps Ctrl-C working in the main thread
+            worker.join(0.1)
+    finally:
+        sys.setrecursionlimit(previous_limit)
+    if 'error' in outcome:
+        raise outcome['error']
+    return outcome['value']
+
+
+def run(args) -> int:
+    """One gr1synth run of parsed arguments (not --serve): its exit status, printing as slugs."""
+    from respec.parsing import ParseError
+    from ltl_synthesizer.errors import (SynthesisCancelledError, SynthesisError,
+                                        SynthesisMemoryError)
+    from ltl_synthesizer.interrupt import Limits
+
+    deadline = time.monotonic() + args.timeout if args.timeout else None
+    limits = Limits(deadline=deadline,
+                    memory_limit=int(args.memory_limit * 2**20) if args.memory_limit > 0 else None)
+    try:
+        spec = read_specification(args.input, check=limits.interrupt(), deadline=deadline)
+    except SynthesisCancelledError as error:
+        print(f'gr1synth: error: {error}', file=sys.stderr)
+        return ExitStatus.TIMED_OUT
+    except (SynthesisMemoryError, MemoryError) as error:
+        print(f'gr1synth: error: memory limit: {error or "out of memory"} (while parsing {args.input})',
+              file=sys.stderr)
+        return ExitStatus.OUT_OF_MEMORY
+    except (ParseError, OSError, ValueError) as error:
+        print(f'gr1synth: error: {error}', file=sys.stderr)
+        return ExitStatus.FAILED
+
+    if args.convert:
+        _write(spec.to_slugsin(), args.output)
+        return ExitStatus.OK
+
+    if deadline is not None:
+        # With a time limit the synthesis runs in a child process, killed at the deadline even
+        # in the middle of a long CUDD operation (checks between operations could be late).
+        from ltl_synthesizer.isolated import SynthesisProcesses
+        processes = SynthesisProcesses()
+    try:
+        if deadline is None:
+            result = synthesis_outcome(spec, args, limits, stream=args.jsonOutput)
+        else:
+            result = processes.call(synthesis_outcome, (spec, args, limits), deadline=deadline)
+    except SynthesisCancelledError as error:
+        print(f'gr1synth: error: {error}', file=sys.stderr)
+        return ExitStatus.TIMED_OUT
+    except SynthesisMemoryError as error:
+        print(f'gr1synth: error: {error}', file=sys.stderr)
+        return ExitStatus.OUT_OF_MEMORY
+    except SynthesisError as error:
+        print(f'gr1synth: error: {args.input}: {error}', file=sys.stderr)
+        return ExitStatus.FAILED
+    finally:
+        if deadline is not None:
+            processes.close()
+    print(REALIZABLE_LINE if result.realizable else UNREALIZABLE_LINE, file=sys.stderr)
+    if not result.realizable and args.explain and result.explanation:
+        print(result.explanation, file=sys.stderr)
+    if result.realizable and args.explicitStrategy:
+        strategy = result.strategy
+    elif not result.realizable and args.counterStrategy:
+        strategy = result.counterstrategy
+    else:
+        return ExitStatus.OK
+    try:
+        if args.jsonOutput:
+            from ltl_synthesizer.strategy import strategy_json_chunks
+            _write_chunks(strategy_json_chunks(strategy), args.output)
+        else:
+            _write(strategy_to_text(strategy), args.output)
+    except SynthesisMemoryError as error:  # a streamed strategy is extracted while written
+        print(f'gr1synth: error: {error}', file=sys.stderr)
+        return ExitStatus.OUT_OF_MEMORY
+    return ExitStatus.OK

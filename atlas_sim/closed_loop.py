@@ -17,6 +17,7 @@ from atlas_sim.executive.executor import ExecutionResult, Executive, StateMappin
 from atlas_sim.executive.timeline import plot_timeline
 from atlas_sim.executive.trace_check import TraceCheckReport, TraceStep, check_trace
 from atlas_sim.simulator.rendering import KeyFrameRecorder
+from respec.robot import RobotSystem
 from respec.spec import GR1Specification
 
 FRAME_WIDTH, FRAME_HEIGHT = 480, 360
@@ -33,8 +34,8 @@ class CheckedRun:
     timeline: Path | None = None
 
 
-def run_and_check(states, robot, simulator, system: str, spec: GR1Specification, goals: list[str], *,
-                  ordered: bool = True, config_dir: str | Path | None = None, record_dir: str | Path | None = None,
+def run_and_check(states, robot, simulator, system: RobotSystem, spec: GR1Specification, goals: list[str], *,
+                  ordered: bool = True, record_dir: str | Path | None = None,
                   max_robot_time: float = 300.0, max_wall_time: float | None = None,
                   on_progress: Callable[[list[TraceStep], list[Path]], None] | None = None,
                   view=None, lock=None,
@@ -67,7 +68,7 @@ def run_and_check(states, robot, simulator, system: str, spec: GR1Specification,
     started = time.monotonic()
     try:
         if run_machine is None:
-            executive = Executive(states, robot, StateMapping(system, config_dir), max_robot_time=max_robot_time,
+            executive = Executive(states, robot, StateMapping(system), max_robot_time=max_robot_time,
                                   max_wall_time=max_wall_time, on_tick=tick)
             result = executive.run()
         else:

@@ -45,7 +45,7 @@ from pathlib import Path
 from typing import Mapping, Sequence
 
 from respec.robot import RobotSystem, robot_system
-from respec.robot.abstraction import AbstractionConfigError, RobotAbstraction, abstraction_from_document
+from respec.robot.abstraction import AbstractionConfigError, RobotAbstraction
 from respec.components import (
     SOURCE_CUSTOM, FormulaGroup, action_groups, action_specification, control_mode_groups,
     control_mode_specification, goal_groups, goal_specification, initial_conditions_groups,
@@ -215,12 +215,10 @@ def load_task_system(system: RobotSystem | str, config_dir=None) -> RobotSystem:
 def load_task_abstraction(system: RobotSystem | str, config_dir=None) -> RobotAbstraction:
     """The abstraction of an abstraction-kind system (as ``load_task_system``)."""
     system = load_task_system(system, config_dir)
-    if system.abstraction is None:
-        try:
-            abstraction_from_document(system.sections, system.name)  # names what is missing
-        except AbstractionConfigError as error:
-            raise InvalidAbstractionError(str(error), item=error.item) from error
-    return system.abstraction
+    try:
+        return system.required_abstraction()
+    except AbstractionConfigError as error:
+        raise InvalidAbstractionError(str(error), item=error.item) from error
 
 
 def _names(value: Sequence[str] | str | None, what: str, error) -> list[str]:

@@ -36,7 +36,7 @@ from ltl_synthesizer.unrealizable_core import environment_play, unrealizable_cor
 
 from ltl_specification.compiler import load_task_abstraction, load_task_system
 from ltl_specification.provenance import Provenance
-from ltl_specification.reachability import Finding, config_file, unreachable_goal_modes
+from ltl_specification.reachability import Finding, unreachable_goal_modes
 
 PLAY_LENGTH = 8
 # Custom formulas are checked by enumerating their variables' values: at most this many.

@@ -9,10 +9,8 @@ sentence, naming the missing transition and the modes the robot could change to 
 from __future__ import annotations
 
 from dataclasses import dataclass
-from pathlib import Path
 
 from respec.robot.abstraction import RobotAbstraction
-from respec.robot.files import system_config_path
 
 from ltl_specification.pertinence import mode_distances
 
@@ -25,12 +23,6 @@ class Finding:
     equation: str      # the paper equation whose formulas make it impossible
     config_item: str   # the configuration entry or request field to change
     item: str          # the goal, mode, action or custom formula concerned
-
-
-def config_file(system: str, config_dir=None) -> str:
-    """The configuration file as users know it, e.g. 'config/atlas.yaml'."""
-    path = Path(system_config_path(system, config_dir))
-    return f'{path.parent.name}/{path.name}'
 
 
 def modes_needed_by(abstraction: RobotAbstraction, item: str) -> list[str]:

@@ -147,11 +147,6 @@ def flexbe_config(system: RobotSystem) -> FlexBEConfig:
     return parse_flexbe_config(section, system.name)
 
 
-def load_flexbe_config(system: RobotSystem | str, config_dir: str | Path | None = None) -> FlexBEConfig:
-    """Load and validate the ``flexbe:`` section of ``config/<system>.yaml``."""
-    return flexbe_config(generation_system(system, config_dir))
-
-
 def parse_flexbe_config(section: dict, system: str = '') -> FlexBEConfig:
     """Validate an already-parsed ``flexbe:`` mapping."""
     if not isinstance(section, dict):

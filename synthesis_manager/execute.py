@@ -89,8 +89,9 @@ def run(args) -> int:
     from atlas_sim.simulator.factory import FaultSpecError, InitialConditionError, make_simulator, parse_faults
     from ltl_specification.errors import InvalidInitialConditionsError
     from ltl_specification.initial_conditions import asks_for_robot_state
-    from respec.robot.files import SystemConfigError
     from respec.naming import parse_names
+    from respec.robot import robot_system
+    from respec.robot.files import SystemConfigError
 
     if args.engine == 'flexbe':
         problem = _flexbe_usage_problem(args)
@@ -104,13 +105,14 @@ def run(args) -> int:
     try:  # the simulator first: a bad fault or start is a usage error, found before synthesis
         faults = parse_faults(parse_names(args.fail), parse_names(args.fail_first))
         start = [] if asks_for_robot_state(initial_conditions) else initial_conditions
-        simulator = make_simulator(args.system, args.config_dir or None, start, faults, args.seed)
+        system = robot_system(args.system, args.config_dir or None)
+        simulator = make_simulator(system, start, faults, args.seed)
     except (FaultSpecError, InitialConditionError, InvalidInitialConditionsError, SystemConfigError) as error:
         print(f'execute: {error}', file=sys.stderr)
         return ExitStatus.USAGE
     log = sys.stderr if args.json else sys.stdout
     report = {'system': args.system, 'faults': faults}
-    code = _synthesize_and_execute(args, simulator, initial_conditions, batches, report, log)
+    code = _synthesize_and_execute(args, system, simulator, initial_conditions, batches, report, log)
     report['exit_code'] = code
     if args.json:
         print(json.dumps(report))
@@ -128,10 +130,10 @@ def _flexbe_usage_problem(args) -> str:
     return ''
 
 
-def _synthesize_and_execute(args, simulator, initial_conditions, batches, report, log) -> int:
+def _synthesize_and_execute(args, system, simulator, initial_conditions, batches, report, log) -> int:
     try:
         with in_process_suite(args, 'execute_client') as (ros, client):
-            session = _Session(args, ros, client, simulator, log)
+            session = _Session(args, ros, client, system, simulator, log)
             if len(batches) == 1:
                 report.update(goals=batches[0])
                 return session.run_batch(initial_conditions, batches[0], report, args.record, args.expect)
@@ -142,10 +144,11 @@ def _synthesize_and_execute(args, simulator, initial_conditions, batches, report
 
 
 class _Session:
-    """Synthesis and execution of goal batches on one simulated robot."""
+    """Synthesis and execution of goal batches on one simulated robot (of ``system``, a RobotSystem)."""
 
-    def __init__(self, args, ros, client, simulator, log):
-        self.args, self.ros, self.client, self.simulator, self.log = args, ros, client, simulator, log
+    def __init__(self, args, ros, client, system, simulator, log):
+        self.args, self.ros, self.client, self.log = args, ros, client, log
+        self.system, self.simulator = system, simulator
         self._robot = None
         self.uses_ros_sim = args.ros_sim or args.engine == 'flexbe'  # FlexBE drives the node
 
@@ -211,7 +214,7 @@ class _Session:
             print(f'execute: synthesis failed: {outcome.error_name}: {outcome.message}', file=sys.stderr)
             return ExitStatus.for_error(outcome.error_name)
         robot, sim_node = self.robot()
-        return _execute(self.args, outcome, robot, self.simulator, goals, report, self.log, sim_node,
+        return _execute(self.args, self.system, outcome, robot, self.simulator, goals, report, self.log, sim_node,
                         record, expect, self.ros.domain_id)
 
     def initial_conditions_for(self, initial_conditions) -> tuple[list[str], str]:
@@ -249,7 +252,7 @@ def _ros_robot(ros, args, simulator):
     return robot, node
 
 
-def _execute(args, outcome, robot, simulator, goals, report, log, sim_node, record, expect,
+def _execute(args, system, outcome, robot, simulator, goals, report, log, sim_node, record, expect,
              domain_id=None) -> int:
     view = lock = None
     if record and sim_node is not None:  # the node steps physics in its own thread: render here
@@ -260,12 +263,12 @@ def _execute(args, outcome, robot, simulator, goals, report, log, sim_node, reco
         from synthesis_manager.ros.flexbe_engine import run_on_flexbe
 
         run_machine = lambda _tick: run_on_flexbe(  # noqa: E731
-            outcome.states, simulator, sim_node.lock, domain_id, args.system, args.config_dir or None,
+            outcome.states, simulator, sim_node.lock, domain_id, system,
             max_wall_time=args.max_robot_time * 10 + 60, verbose=args.verbose)
     try:
-        run = run_and_check(outcome.states, robot, simulator, args.system,
+        run = run_and_check(outcome.states, robot, simulator, system,
                             spec_from_text_sections(outcome.ltl_specification), goals,
-                            ordered=not args.unordered, config_dir=args.config_dir or None, record_dir=record,
+                            ordered=not args.unordered, record_dir=record,
                             max_robot_time=args.max_robot_time, max_wall_time=args.max_robot_time * 10 + 60,
                             view=view, lock=lock, run_machine=run_machine)
     except ExecutionError as error:

@@ -41,7 +41,7 @@ def add_arguments(parser):
 def run(args) -> int:
     from respec.naming import parse_names
     from sm_generation import SMGenerationError, StateInstantiation
-    from sm_generation.config import load_flexbe_config
+    from sm_generation.config import flexbe_config, generation_system
     from sm_generation.flexbe_behavior import (behavior_package, check_behavior_name, check_package_name,
                                                default_behavior_name)
 
@@ -50,7 +50,7 @@ def run(args) -> int:
     try:  # bad names and configurations are usage errors, found before synthesis
         check_behavior_name(behavior_name)
         check_package_name(args.package)
-        config = load_flexbe_config(args.system, args.config_dir or None)
+        config = flexbe_config(generation_system(args.system, args.config_dir or None))
     except SMGenerationError as error:
         print(f'export-behavior: {error.code}: {error}', file=sys.stderr)
         return ExitStatus.USAGE

@@ -13,6 +13,7 @@ from atlas_sim.simulator.factory import make_simulator
 from ltl_specification import compile_task
 from ltl_synthesizer import synthesize
 from respec.automaton import automaton_from_strategy
+from respec.robot import robot_system
 from sm_generation import generate_state_machine
 
 INITIAL, GOALS = ['stand_prep'], ['walk']
@@ -44,7 +45,7 @@ def drive(states, simulator, recorder):
 def test_recorded_trace_checks_clean_and_matches_our_executive():
     spec, states = machine()
     simulator = make_simulator('atlas', initial_conditions=INITIAL)
-    recorder = EngineTraceRecorder(states, simulator)
+    recorder = EngineTraceRecorder(states, simulator, robot_system('atlas'))
     end = drive(states, simulator, recorder)
     recorder.close()
     run = recorder.result()

@@ -10,9 +10,10 @@ from atlas_sim.simulated_robot import SimulatedRobot
 from atlas_sim.simulator.factory import FaultSpecError, InitialConditionError, make_simulator, parse_faults
 from ltl_specification import compile_task
 from sm_generation import StateInstantiation
-from sm_generation.config import load_flexbe_config
+from respec.robot import robot_system
+from sm_generation.config import flexbe_config
 
-FLEXBE = load_flexbe_config('atlas')
+FLEXBE = flexbe_config(robot_system('atlas'))
 MODES = ['stand_prep', 'stand', 'manipulate', 'step', 'walk']
 
 

@@ -128,10 +128,11 @@ def test_answers_are_pickled_as_flexbe_input_does_and_read_back_as_input_state_d
 
 
 def test_the_configured_operator_answers_by_request_type():
+    from respec.robot import robot_system
     from synthesis_manager.nodes.operator_node import configured_answers
 
-    assert configured_answers('atlas') == {0: 1, 3: [0.6, 0.0, 0.0]}
-    assert configured_answers('mobile_manipulator') == {}
+    assert configured_answers(robot_system('atlas')) == {0: 1, 3: [0.6, 0.0, 0.0]}
+    assert configured_answers(robot_system('mobile_manipulator')) == {}
 
 
 @pytest.mark.parametrize('entries, item', [

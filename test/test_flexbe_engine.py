@@ -16,7 +16,8 @@ from ltl_specification import compile_task
 from ltl_synthesizer import synthesize
 from respec.automaton import automaton_from_strategy
 from sm_generation import generate_state_machine
-from sm_generation.config import load_flexbe_config
+from respec.robot import robot_system
+from sm_generation.config import flexbe_config
 from sm_generation.flexbe_behavior import behavior_package
 from synthesis_manager.nodes.atlas_sim_node import AtlasSimNode
 
@@ -38,7 +39,7 @@ def test_exported_behavior_loads_in_flexbe_core_and_create_builds_the_machine(ro
     from synthesis_manager.ros.flexbe_engine import load_behavior_class, reset_flexbe_proxies
 
     _, states = synthesized(*PICKUP)
-    package = behavior_package(states, load_flexbe_config('atlas'), 'Look Down And Pickup')
+    package = behavior_package(states, flexbe_config(robot_system('atlas')), 'Look Down And Pickup')
     behavior_class, _ = load_behavior_class(package, tmp_path)
     node = ros.add_node(Node, 'flexbe_create_test')
     set_node(node)

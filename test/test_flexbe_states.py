@@ -13,13 +13,14 @@ import inspect
 import pytest
 from rclpy.node import Node
 
-from sm_generation.config import load_flexbe_config
+from respec.robot import robot_system
+from sm_generation.config import flexbe_config
 from sm_generation.flexbe_behavior import behavior_class_name, behavior_module_name, state_module_name
 
 pytestmark = pytest.mark.usefixtures('flexbe')
 
 SYSTEMS = ('atlas', 'mobile_manipulator')
-CONFIGS = {system: load_flexbe_config(system) for system in SYSTEMS}
+CONFIGS = {system: flexbe_config(robot_system(system)) for system in SYSTEMS}
 PRIMITIVES = [(system, s) for system, c in CONFIGS.items() for s in c.states.values() if not s.is_behavior()]
 BEHAVIORS = [(system, s) for system, c in CONFIGS.items() for s in c.states.values() if s.is_behavior()]
 

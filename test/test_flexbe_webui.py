@@ -127,14 +127,15 @@ def exported_behavior(tmp_path_factory):
     from ltl_synthesizer import synthesize
     from respec.automaton import automaton_from_strategy
     from sm_generation import generate_state_machine
-    from sm_generation.config import load_flexbe_config
+    from respec.robot import robot_system
+    from sm_generation.config import flexbe_config
     from sm_generation.flexbe_behavior import behavior_package
 
     initial, goals = ['stand_prep'], ['look_down', 'pickup_object']
     spec = compile_task('atlas', initial, goals)
     states = generate_state_machine(automaton_from_strategy(synthesize(spec).strategy, spec), 'atlas',
                                     initial_conditions=initial)
-    package = behavior_package(states, load_flexbe_config('atlas'), 'Look Down Pickup Object')
+    package = behavior_package(states, flexbe_config(robot_system('atlas')), 'Look Down Pickup Object')
     work = tmp_path_factory.mktemp('exported')
     folder = package.write(work / 'src')
     prefix = work / 'install'

@@ -14,7 +14,8 @@ from ltl_specification import compile_task
 from ltl_synthesizer import synthesize
 from respec.automaton import automaton_from_strategy
 from sm_generation import generate_state_machine, load_automaton
-from sm_generation.config import load_flexbe_config
+from respec.robot import robot_system
+from sm_generation.config import flexbe_config
 from sm_generation.flexbe_behavior import AUTONOMY_NAMES, behavior_package
 
 from test_sm_generation_flexbe_behavior import AUTOMATA, ROOT
@@ -59,7 +60,7 @@ def reading_of(parsed):
 @pytest.mark.parametrize('automaton', ['concurrent.yaml', 'two_behaviors.yaml'])
 def test_the_editor_parser_reads_an_exported_behavior_as_generated(parser, automaton):
     states = generate_state_machine(load_automaton(AUTOMATA / automaton), 'atlas')
-    package = behavior_package(states, load_flexbe_config('atlas'), 'Parsed Behavior')
+    package = behavior_package(states, flexbe_config(robot_system('atlas')), 'Parsed Behavior')
     answer = parser(package.files[f'{package.package}/{package.module}.py'])
     assert answer['warnings'] == []
     parsed = answer['result']
@@ -87,7 +88,7 @@ def test_the_editor_parser_reads_an_exported_behavior_as_generated(parser, autom
             assert seen['state_type'] == 'behavior'
         elif state.state_class != ':CONCURRENCY':
             # the editor qualifies a class with the package it is imported from
-            package = load_flexbe_config('atlas').state_package(state.state_class) or 'flexbe_states'
+            package = flexbe_config(robot_system('atlas')).state_package(state.state_class) or 'flexbe_states'
             assert seen['state_class'] == f'{package}__{state.state_class}'
             assert [(p['key'], p['value']) for p in seen['parameter_values']] == \
                 list(zip(state.parameter_names, state.parameter_values))
@@ -104,7 +105,7 @@ def test_the_editor_parser_reads_the_paper_task_and_atlas_sim_behaviors(parser):
     spec = compile_task('atlas', ['stand_prep'], ['look_down', 'pickup_object'])
     automaton = automaton_from_strategy(synthesize(spec).strategy, spec)
     states = generate_state_machine(automaton, 'atlas', initial_conditions=['stand_prep'])
-    package = behavior_package(states, load_flexbe_config('atlas'), 'Look Down Pickup Object')
+    package = behavior_package(states, flexbe_config(robot_system('atlas')), 'Look Down Pickup Object')
     answer = parser(package.files[f'{package.package}/{package.module}.py'])
     assert answer['warnings'] == []
     top = [s.name for s in states if s.parent_path == '/' and s.state_class != ':OUTCOME']

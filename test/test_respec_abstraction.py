@@ -2,7 +2,8 @@
 
 import pytest
 
-from respec.robot.abstraction import AbstractionConfigError, abstraction_from_dict, load_abstraction
+from respec.robot import robot_system
+from respec.robot.abstraction import AbstractionConfigError, abstraction_from_dict
 from respec.robot.files import SystemNotFoundError
 
 
@@ -25,7 +26,7 @@ def rejected(data) -> AbstractionConfigError:
 
 
 def test_atlas_abstraction_loads_in_file_order():
-    atlas = load_abstraction('atlas')
+    atlas = robot_system('atlas').abstraction
     assert list(atlas.control_modes) == ['stand_prep', 'stand', 'manipulate', 'step', 'walk']
     assert atlas.control_modes['stand'] == ('manipulate', 'step', 'walk')
     assert atlas.actions['pickup_object'] == ('object_template', 'manipulate')
@@ -39,7 +40,7 @@ def test_atlas_abstraction_loads_in_file_order():
 
 
 def test_mobile_manipulator_abstraction_loads():
-    robot = load_abstraction('mobile_manipulator')
+    robot = robot_system('mobile_manipulator').abstraction
     assert list(robot.control_modes) == ['parked', 'driving', 'manipulating']
     assert robot.initial_mode == 'parked'
     assert robot.actions['grasp'] == ('plan_grasp', 'manipulating')
@@ -58,7 +59,7 @@ def test_defaults_outcomes_and_optional_sections():
 
 def test_unknown_system():
     with pytest.raises(SystemNotFoundError) as caught:
-        load_abstraction('no_such_robot')
+        robot_system('no_such_robot')
     assert caught.value.item == 'no_such_robot'
 
 

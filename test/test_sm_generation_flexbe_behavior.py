@@ -10,7 +10,8 @@ from pathlib import Path
 import pytest
 
 from sm_generation import SMGenerationError, generate_state_machine, load_automaton
-from sm_generation.config import load_flexbe_config, parse_flexbe_config
+from respec.robot import robot_system
+from sm_generation.config import flexbe_config, parse_flexbe_config
 from sm_generation.flexbe_behavior import (behavior_class_name, behavior_module_name, behavior_package,
                                            state_module_name)
 from sm_generation.generator import generate_from_config
@@ -22,7 +23,7 @@ DATE = 'Sun Nov 22 2026'
 
 def export(automaton='concurrent.yaml', name='Look Down And Pickup', **kwargs):
     states = generate_state_machine(load_automaton(AUTOMATA / automaton), 'atlas')
-    return states, behavior_package(states, load_flexbe_config('atlas'), name, date=DATE, **kwargs)
+    return states, behavior_package(states, flexbe_config(robot_system('atlas')), name, date=DATE, **kwargs)
 
 
 def create_method(code):
@@ -95,7 +96,7 @@ def test_keys_read_but_written_by_no_state_are_the_roots_input_keys_with_their_d
     code = package.files['synthesized_flexbe_behaviors/pickup_and_grasp_sm.py']
     assert "OperatableStateMachine(outcomes=['finished', 'failed'], input_keys=['template_id'])" in code
     assert '_state_machine.userdata.template_id = None' in code
-    with_default = dataclasses.replace(load_flexbe_config('atlas'), userdata={'template_id': '1'})
+    with_default = dataclasses.replace(flexbe_config(robot_system('atlas')), userdata={'template_id': '1'})
     code = behavior_package(states, with_default, 'Pickup And Grasp', date=DATE).files[
         'synthesized_flexbe_behaviors/pickup_and_grasp_sm.py']
     assert '_state_machine.userdata.template_id = 1' in code
@@ -106,7 +107,7 @@ def test_keys_written_in_the_machine_are_not_input_keys():
     states, _ = export('concurrent.yaml')
     assert states[0].input_keys == []
     assert generate_from_config(load_automaton(AUTOMATA / 'concurrent.yaml'),
-                                load_flexbe_config('atlas'))[0].input_keys == []
+                                flexbe_config(robot_system('atlas')))[0].input_keys == []
 
 
 def test_writes_must_name_remapped_keys():
@@ -165,7 +166,7 @@ def test_bad_names_are_rejected_with_the_item(kwargs, item):
 
 def test_a_class_without_a_package_names_the_state():
     states = generate_state_machine(load_automaton(AUTOMATA / 'concurrent.yaml'), 'atlas')
-    config = load_flexbe_config('atlas')
+    config = flexbe_config(robot_system('atlas'))
     bare = parse_flexbe_config({'sm_outcomes': config.sm_outcomes, 'states': {
         proposition: {'class_decl': {'name': s.state_class, 'behavior_class': s.behavior_class,
                                      'param_names': list(s.parameter_names),

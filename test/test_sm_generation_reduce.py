@@ -8,7 +8,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from sm_generation import generate_state_machine, load_automaton, validate_state_machine
-from sm_generation.config import StateConfig, load_flexbe_config
+from respec.robot import robot_system
+from sm_generation.config import StateConfig, flexbe_config
 from sm_generation.generator import machine_from_view
 from sm_generation.machine import AutomatonView, Machine, MachineState
 from sm_generation.reduction import bisimulation_blocks
@@ -71,7 +72,7 @@ def test_bisimilar_loop_copies_are_merged():
 
 
 def test_blocks_separate_states_with_different_futures():
-    view = AutomatonView(load_automaton(AUTOMATA / 'sensors.yaml'), load_flexbe_config('atlas'))
+    view = AutomatonView(load_automaton(AUTOMATA / 'sensors.yaml'), flexbe_config(robot_system('atlas')))
     machine = machine_from_view(view, None)
     blocks = bisimulation_blocks(machine)
     assert blocks['4'] == blocks['5']        # both ask for the template, then finish or fail

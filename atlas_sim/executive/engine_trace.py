@@ -32,14 +32,15 @@ import threading
 from atlas_sim.executive.executor import ExecutionResult, StateMapping, entered_step
 from atlas_sim.executive.machine import load_machine, next_target
 from atlas_sim.executive.trace_check import OutcomeTracker, Trace, TraceStep
+from respec.robot import RobotSystem
 
 
 class EngineTraceRecorder:
     """Builds the trace of one run of ``states`` on ``simulator`` (see the module docstring)."""
 
-    def __init__(self, states, simulator, system: str = 'atlas', config_dir=None, simulator_lock=None):
+    def __init__(self, states, simulator, system: RobotSystem, simulator_lock=None):
         self.root = load_machine(states)
-        self.mapping = StateMapping(system, config_dir)
+        self.mapping = StateMapping(system)
         self.simulator = simulator
         self.simulator_lock = simulator_lock or contextlib.nullcontext()
         self.states = {child.name: child for child in self.root.states}

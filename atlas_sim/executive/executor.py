@@ -39,16 +39,15 @@ from __future__ import annotations
 import re
 import time
 from dataclasses import dataclass
-from pathlib import Path
 from typing import Any, Callable
 
 from atlas_sim.executive.machine import ExecutionError, UndeclaredOutcomeError, load_machine, next_target
 from atlas_sim.executive.robot import CapabilityResult, Robot
 from atlas_sim.executive.trace_check import OutcomeTracker, Trace, TraceStep
-from respec.robot.abstraction import load_abstraction
 from respec.errors import ErrorCode
 from respec.naming import activated, is_activation, outcome_proposition
-from sm_generation.config import load_flexbe_config
+from respec.robot import RobotSystem
+from sm_generation.config import flexbe_config, generation_system
 from sm_generation.instantiation import DECISION_CLASS, HELPER_STATE_CLASSES, StateInstantiation
 from sm_generation.state_machine import State
 
@@ -87,9 +86,9 @@ class Part:
 class StateMapping:
     """State class + parameter values (or behavior class) -> ``flexbe.states`` entry."""
 
-    def __init__(self, system: str, config_dir: str | Path | None = None):
-        self.flexbe = load_flexbe_config(system, config_dir)
-        abstraction = load_abstraction(system, config_dir)
+    def __init__(self, system: RobotSystem):
+        self.flexbe = flexbe_config(system)
+        abstraction = system.required_abstraction()
         self.control_modes = list(abstraction.control_modes)
         self.sensors = list(abstraction.sensors)
         self._by_key: dict[tuple, Any] = {}
@@ -321,16 +320,18 @@ class Executive:
         self.abandoned = [r for r in self.abandoned if r.result is None]
 
 
-def execute_state_machine(states, robot: Robot, system: str = 'atlas', config_dir: str | Path | None = None,
-                          **options) -> ExecutionResult:
+def execute_state_machine(states, robot: Robot, system: RobotSystem | str = 'atlas', **options) -> ExecutionResult:
     """Run ``states`` on ``robot`` until an SM outcome; returns the outcome and the trace.
+
+    ``system`` is a RobotSystem, or the name of one in config/ (another folder's system:
+    ``respec.robot.robot_system(name, config_dir)``).
 
     ``options``: ``max_robot_time`` (s, default 600), ``max_states`` (default 500),
     ``max_wall_time`` (s, default none),
     ``decide(path, outcomes) -> outcome`` for operator decisions, ``on_tick(robot)``.
     Raises :class:`ExecutionError` subclasses (with ``item`` and the partial ``trace``).
     """
-    return Executive(states, robot, StateMapping(system, config_dir), **options).run()
+    return Executive(states, robot, StateMapping(generation_system(system)), **options).run()
 
 
 __all__ = ['execute_state_machine', 'Executive', 'ExecutionResult', 'StateMapping', 'UnmappedStateError',

@@ -10,7 +10,7 @@ abstraction (mode transition system, action preconditions) and the
 
 Modules (MuJoCo is imported only by ``physics``, ``atlas_simulator``, ``rendering``)
 ------------------------------------------------------------------------------------
-``config``      ``load_system_config(path) -> SystemConfig`` (abstraction +
+``config``      ``SystemConfig.of(robot_system)``, ``load_system_config(path)`` (abstraction +
                 simulation sections; the schema is documented there).
 ``discrete``    ``DiscreteState``, ``DiscreteSemantics``: the
                 mode/precondition/validity rules, testable without physics.

@@ -1,6 +1,6 @@
-"""Loading a robot-system config (``config/<system>.yaml``) for atlas_sim.
+"""A robot system as atlas_sim sees it (``SystemConfig.of(RobotSystem)``).
 
-Two sections matter here:
+Two sections of the system file (``config/<system>.yaml``) matter here:
 
 ``abstraction``  the discrete model shared with the specification compiler, read and
                  validated by ``respec.robot.abstraction`` (``RobotAbstraction``).
@@ -46,9 +46,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Dict, Mapping, Optional, Tuple
 
+from respec.robot import RobotSystem, robot_system_from_file
 from respec.robot.abstraction import RobotAbstraction, abstraction_from_document
 from respec.errors import CodedError, ErrorCode
-from respec.robot.files import read_config_file, system_config_path
 
 class SimulationConfigError(CodedError, ValueError):
     """The ``simulation:`` section is invalid; ``item`` names the offending key or capability."""
@@ -178,20 +178,20 @@ class SystemConfig:
     simulation: SimulationConfig
 
     @classmethod
+    def of(cls, system: RobotSystem) -> "SystemConfig":
+        """The system's abstraction and ``simulation:`` section (defaults when it has none)."""
+        return cls(system=system.name, abstraction=system.required_abstraction(),
+                   simulation=SimulationConfig.from_dict(system.sections.get("simulation")))
+
+    @classmethod
     def from_dict(cls, document: Mapping[str, Any]) -> "SystemConfig":
-        system = str(document.get("system", "unnamed"))
-        return cls(
-            system=system,
-            abstraction=abstraction_from_document(document, system),
-            simulation=SimulationConfig.from_dict(document.get("simulation")),
-        )
+        """A system file's content held in memory (e.g. a variant of config/atlas.yaml in a test),
+        named by its ``system:`` key."""
+        name = str(document.get("system", "unnamed"))
+        return cls.of(RobotSystem(name, Path(f"{name}.yaml"), abstraction=abstraction_from_document(document, name),
+                                  sections=dict(document)))
 
 
 def load_system_config(path: Path | str = DEFAULT_CONFIG) -> SystemConfig:
-    """Read a robot-system YAML file."""
-    return SystemConfig.from_dict(read_config_file(path))
-
-
-def system_config(system: str, config_dir: str | Path | None = None) -> SystemConfig:
-    """The configuration of ``system`` (``config/<system>.yaml`` or in ``config_dir``)."""
-    return load_system_config(system_config_path(system, config_dir))
+    """The configuration of the robot-system YAML file ``path``."""
+    return SystemConfig.of(robot_system_from_file(path))

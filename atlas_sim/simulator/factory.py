@@ -5,11 +5,11 @@ given faults (``make_simulator``, ``parse_faults``), and the errors naming a bad
 from __future__ import annotations
 
 import dataclasses
-from pathlib import Path
 
-from atlas_sim.simulator.config import system_config
+from atlas_sim.simulator.config import SystemConfig
 from respec.errors import CodedError, ErrorCode
 from respec.naming import COMPLETED
+from respec.robot import RobotSystem, robot_system
 
 
 class InitialConditionError(CodedError, ValueError):
@@ -44,30 +44,32 @@ def parse_faults(fail=(), fail_first=(), probability=()) -> dict:
     return faults
 
 
-def make_simulator(system: str = 'atlas', config_dir: str | Path | None = None, initial_conditions=(),
-                   faults: dict | None = None, seed: int | None = None, **simulation_changes):
+def make_simulator(system: RobotSystem | str = 'atlas', initial_conditions=(), faults: dict | None = None,
+                   seed: int | None = None, **simulation_changes):
     """An ``AtlasSimulator`` for ``system``, started in the given initial conditions.
 
+    ``system`` is a RobotSystem, or the name of one in config/ (another folder's system:
+    ``respec.robot.robot_system(name, config_dir)``).
     ``initial_conditions`` name at most one control mode (the initial mode; default: the
     config's) and actions that have already completed. ``faults`` (capability -> entry of
     ``simulation.faults``) are added to the config's, ``seed`` replaces its seed.
     """
     from atlas_sim.simulator.atlas_simulator import AtlasSimulator  # here: parse_faults needs no MuJoCo
 
-    config = system_config(system, config_dir)
+    config = SystemConfig.of(robot_system(system))
     modes = [c for c in initial_conditions if c in config.abstraction.control_modes]
     actions = [c for c in initial_conditions if c in config.abstraction.actions]
     unknown = [c for c in initial_conditions if c not in modes and c not in actions]
     if unknown:
         raise InitialConditionError(f'initial condition {unknown[0]!r} is neither a control mode nor an '
-                                    f'action of {system}', item=unknown[0])
+                                    f'action of {config.system}', item=unknown[0])
     if len(modes) > 1:
         raise InitialConditionError(f'initial conditions name several control modes: {modes[0]!r} and '
                                     f'{modes[1]!r}', item=modes[1])
     capabilities = {*config.abstraction.control_modes, *config.abstraction.actions}
     for name in faults or {}:
         if name not in capabilities:
-            raise FaultSpecError(f'fault for {name!r}, which is not a capability of {system}', item=name)
+            raise FaultSpecError(f'fault for {name!r}, which is not a capability of {config.system}', item=name)
     changes = dict(simulation_changes)
     if modes:
         changes['initial_mode'] = modes[0]

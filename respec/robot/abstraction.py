@@ -22,11 +22,10 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass, field
-from pathlib import Path
 
 from respec.errors import ErrorCode
 from respec.naming import COMPLETED, DEFAULT_SM_OUTCOMES, FAILED, activation, memory, outcome_proposition
-from respec.robot.files import SystemConfigError, load_system_file
+from respec.robot.files import SystemConfigError
 
 _NAME = re.compile(r'^[A-Za-z][A-Za-z0-9_]*$')
 DEFAULT_OUTCOMES = (COMPLETED, FAILED)
@@ -105,11 +104,6 @@ class RobotAbstraction:
                     frontier.append(name)
         found.discard(action)
         return found
-
-
-def load_abstraction(system: str, config_dir: str | Path | None = None) -> RobotAbstraction:
-    """Load and validate the ``abstraction:`` section of ``config/<system>.yaml``."""
-    return abstraction_from_document(load_system_file(system, config_dir), system)
 
 
 def abstraction_from_document(document: dict, system: str) -> RobotAbstraction:

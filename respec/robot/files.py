@@ -66,16 +66,6 @@ def system_config_path(system: str, config_dir: str | Path | None = None) -> Pat
     return path
 
 
-def load_system_file(system: str, config_dir: str | Path | None = None) -> dict:
-    """Parse the whole configuration file of ``system`` into a dict."""
-    return read_config_file(system_config_path(system, config_dir))
-
-
-def read_config_file(path: str | Path) -> dict:
-    """A system configuration file as a dict (raises ConfigFileInvalidError naming the file)."""
-    return parse_config_text(Path(path).read_text(), path)
-
-
 def parse_config_text(text: str, path: str | Path) -> dict:
     """The text of the system configuration file ``path`` as a dict (errors name the file)."""
     try:
@@ -85,13 +75,3 @@ def parse_config_text(text: str, path: str | Path) -> dict:
     if not isinstance(document, dict):
         raise ConfigFileInvalidError(f'{path}: expected a mapping at the top level', item=str(path))
     return document
-
-
-def load_section(system: str, section: str, config_dir: str | Path | None = None) -> dict:
-    """One top-level section of a system's configuration; raises if it is missing."""
-    document = load_system_file(system, config_dir)
-    content = document.get(section)
-    if not isinstance(content, dict):
-        raise ConfigFileInvalidError(
-            f'{system}.yaml: missing or invalid section {section!r}', item=section)
-    return content

@@ -74,6 +74,11 @@ class RobotSystem:
     def has_section(self, name: str) -> bool:
         return isinstance(self.sections.get(name), Mapping)
 
+    def required_abstraction(self) -> RobotAbstraction:
+        """The abstraction, for a stage that cannot work without one: raises AbstractionConfigError
+        naming what is missing (a capability system, a file without an ``abstraction:`` section)."""
+        return self.abstraction or abstraction_from_document(self.sections, self.name)
+
 
 def robot_system_from_file(path: str | Path, name: str | None = None) -> RobotSystem:
     """The robot system of one system file (its kind told by its content)."""

@@ -42,6 +42,7 @@ from atlas_sim.simulator.node_names import ACTION_NAME, CAPABILITY_ACTION_PREFIX
 from atlas_sim.simulator.operator_data import decode_userdata
 from respec.errors import quoted
 from respec.naming import parse_names
+from respec.robot import robot_system
 from synthesis_manager.ros.errors import log_internal_error
 from synthesis_manager.ros.node_main import node_main
 from synthesis_msgs.action import ExecuteCapability
@@ -93,7 +94,7 @@ class AtlasSimNode(Node):
         if simulator is None:
             seed = int(value('seed'))
             simulator = make_simulator(
-                value('system'), value('config_dir') or None, parse_names(value('initial_conditions')),
+                robot_system(value('system'), value('config_dir') or None), parse_names(value('initial_conditions')),
                 faults=parse_faults(parse_names(value('fail')), parse_names(value('fail_first'))),
                 seed=None if seed < 0 else seed)
         self.simulator = simulator

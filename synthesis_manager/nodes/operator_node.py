@@ -23,18 +23,19 @@ from pathlib import Path
 
 import yaml
 
-from atlas_sim.simulator.config import SimulationConfigError, system_config
+from atlas_sim.simulator.config import SimulationConfigError, SystemConfig
 from atlas_sim.simulator.operator_data import answers_by_request_type, flexbe_input_data, parse_answers, quoted
-from sm_generation.config import input_request_capabilities, load_flexbe_config
+from respec.robot import RobotSystem, robot_system
+from sm_generation.config import flexbe_config, input_request_capabilities
 
 NODE_NAME = 'atlas_sim_operator'
 BEHAVIOR_INPUT_ACTION = 'flexbe/behavior_input'
 
 
-def configured_answers(system: str = 'atlas', config_dir=None) -> dict:
+def configured_answers(system: RobotSystem) -> dict:
     """Request type -> answer, from the system's InputStates and its simulated operator."""
-    settings = system_config(system, config_dir).simulation
-    return answers_by_request_type(settings, input_request_capabilities(load_flexbe_config(system, config_dir)))
+    settings = SystemConfig.of(system).simulation
+    return answers_by_request_type(settings, input_request_capabilities(flexbe_config(system)))
 
 
 def make_operator_node(answers: dict):
@@ -90,7 +91,7 @@ def parse_arguments(argv):
 
 
 def answers_from_arguments(args) -> dict:
-    answers = configured_answers(args.system, args.config_dir)
+    answers = configured_answers(robot_system(args.system, args.config_dir))
     if args.scenario is not None:
         with open(args.scenario, encoding='utf-8') as stream:
             document = yaml.safe_load(stream) or {}

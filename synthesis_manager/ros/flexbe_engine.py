@@ -33,7 +33,8 @@ from atlas_sim.executive.engine_trace import EngineTraceRecorder
 from atlas_sim.executive.executor import ExecutionLimitError
 from atlas_sim.simulator.node_names import CAPABILITY_ACTION_PREFIX
 from atlas_sim.simulator.operator_data import answers_by_request_type, flexbe_input_data
-from sm_generation.config import input_request_capabilities, load_flexbe_config
+from respec.robot import RobotSystem
+from sm_generation.config import flexbe_config, generation_system, input_request_capabilities
 from sm_generation.flexbe_behavior import behavior_package
 from sm_generation.instantiation import StateInstantiation
 
@@ -142,12 +143,13 @@ def reset_flexbe_proxies(executor=None, node=None) -> None:
                 registry.clear()
 
 
-def run_on_flexbe(states, simulator, simulator_lock, domain_id: int, system: str = 'atlas', config_dir=None,
+def run_on_flexbe(states, simulator, simulator_lock, domain_id: int, system: RobotSystem | str = 'atlas',
                   behavior_name: str = 'Synthesized Behavior', autonomy: int = FULL_AUTONOMY,
                   max_wall_time: float = 600.0, verbose: bool = False):
     """Run ``states`` (StateInstantiation objects or dicts) on FlexBE; returns an ExecutionResult.
 
-    The simulator node must be running on ``domain_id`` around ``simulator``. Raises
+    ``system`` is a RobotSystem, or the name of one in config/. The simulator node must be
+    running on ``domain_id`` around ``simulator``. Raises
     ExecutionLimitError (with the partial trace) if no outcome came within ``max_wall_time``.
     flexbe_core's INFO log lines and progress notes (about a hundred per run) are shown on
     stderr only when ``verbose``; its warnings and errors always are.
@@ -158,9 +160,10 @@ def run_on_flexbe(states, simulator, simulator_lock, domain_id: int, system: str
     from synthesis_manager.ros.harness import RosHarness
 
     states = [s if isinstance(s, StateInstantiation) else StateInstantiation.from_dict(s) for s in states]
-    config = load_flexbe_config(system, config_dir)
+    system = generation_system(system)
+    config = flexbe_config(system)
     package = behavior_package(states, config, behavior_name, date=time.strftime('%a %b %d %Y'))
-    recorder = EngineTraceRecorder(states, simulator, system, config_dir, simulator_lock)
+    recorder = EngineTraceRecorder(states, simulator, system, simulator_lock)
     notes = sys.stderr if verbose else open(os.devnull, 'w')  # noqa: SIM115 - closed below
     try:  # flexbe_core prints progress notes: keep them off stdout, which is the command's output
         with contextlib.redirect_stdout(notes), tempfile.TemporaryDirectory(prefix='flexbe_behavior_') as directory, \

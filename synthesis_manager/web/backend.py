@@ -55,10 +55,9 @@ class SynthesisBackend:
                  max_jobs: int = 100, max_unfinished_jobs: int = 50, description: str = '',
                  max_running_simulations: int = 2, max_simulations_per_job: int = 5):
         self.run_goal = run_goal
-        self.config_dir = config_dir or None
         # Where the robot systems come from: the suite's own (SuiteSystems, served over ROS)
         # when attached to a running suite, else the config directory's (SystemCatalog).
-        self.catalog = systems if systems is not None else SystemCatalog(self.config_dir)
+        self.catalog = systems if systems is not None else SystemCatalog(config_dir or None)
         self.max_jobs = max_jobs
         self.max_unfinished_jobs = max_unfinished_jobs
         # A simulation takes a process of ~225 MiB and a core for up to minutes: only a few run
@@ -245,7 +244,7 @@ class SynthesisBackend:
         with self._lock:
             self._admit_simulation(job_id)
             self._simulations[simulation.id] = simulation
-        threading.Thread(target=self._simulate, args=(simulation, job), name=f'gui-{simulation.id}',
+        threading.Thread(target=self._simulate, args=(simulation, job, robot), name=f'gui-{simulation.id}',
                          daemon=True).start()
         return simulation
 
@@ -296,13 +295,14 @@ class SynthesisBackend:
             raise NotFoundError(f'unknown simulation {quoted(simulation_id)}', simulation_id)
         return simulation
 
-    def _simulate(self, simulation: Simulation, job: Job):
-        """Run ``simulation`` in its child process (web/simulation_process.py), following it."""
+    def _simulate(self, simulation: Simulation, job: Job, robot: RobotSystem):
+        """Run ``simulation`` of ``job`` on ``robot`` in its child process (web/simulation_process.py),
+        following it. The child gets the system's files as read here, not a path to read them again."""
         request, started = job.request, time.monotonic()
         child = SimulationProcess({
             'states': [state.to_dict() for state in job.outcome.states],
             'ltl_specification': job.outcome.ltl_specification,
-            'system': request.system, 'config_dir': str(self.config_dir) if self.config_dir else None,
+            'system': robot.name, 'files': dict(robot.files), 'config_file': robot.config_file,
             'initial_conditions': list(request.initial_conditions), 'goals': list(request.goals),
             'ordered': not request.unordered, 'fail_first': list(simulation.fail_first),
             'record_dir': str(self._record_dir(simulation.id)), 'max_robot_time': 300.0, 'max_wall_time': 300.0})

@@ -90,13 +90,15 @@ def simulate(settings: dict, progress: Callable[[dict], None]) -> dict:
         from atlas_sim.simulated_robot import SimulatedRobot
         from atlas_sim.simulator.factory import make_simulator, parse_faults
         from respec.parsing import spec_from_text_sections
+        from respec.robot import robot_system_from_files
 
-        simulator = make_simulator(settings['system'], settings['config_dir'], settings['initial_conditions'],
+        # The GUI's system as the GUI read it (perhaps from a suite elsewhere), not a file here.
+        system = robot_system_from_files(settings['system'], settings['files'], settings['config_file'])
+        simulator = make_simulator(system, settings['initial_conditions'],
                                    faults=parse_faults(fail_first=[f'{c}:1' for c in settings['fail_first']]))
-        run = run_and_check(settings['states'], SimulatedRobot(simulator), simulator, settings['system'],
+        run = run_and_check(settings['states'], SimulatedRobot(simulator), simulator, system,
                             spec_from_text_sections(settings['ltl_specification']), settings['goals'],
-                            ordered=settings['ordered'], config_dir=settings['config_dir'],
-                            record_dir=Path(settings['record_dir']), max_robot_time=settings['max_robot_time'],
+                            ordered=settings['ordered'], record_dir=Path(settings['record_dir']), max_robot_time=settings['max_robot_time'],
                             max_wall_time=settings['max_wall_time'], on_progress=step_added)
         return {'result': {'outcome': run.result.outcome, 'check': run.check.to_dict(),
                            'timeline': str(run.timeline) if run.timeline else None,

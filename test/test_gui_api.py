@@ -243,6 +243,35 @@ def test_simulate_the_synthesized_machine_with_and_without_a_fault(client, backe
                for step in run['steps'] for r in step['results'])
 
 
+def test_a_simulation_runs_the_system_the_gui_was_served_not_a_local_file(tmp_path):
+    """A GUI attached to a suite elsewhere simulates the suite's system: the child rebuilds it
+    from the files the GUI holds (here a variant of ATLAS whose walk always fails, under a
+    name no local file has)."""
+    from pathlib import Path
+
+    from ltl_specification import compile_task
+    from ltl_synthesizer import synthesize
+    from respec.automaton import automaton_from_strategy
+    from respec.robot import robot_system_from_files
+    from sm_generation import generate_state_machine
+    from synthesis_manager.web.simulation_process import simulate
+
+    document = yaml.safe_load((Path(__file__).resolve().parent.parent / 'config' / 'atlas.yaml').read_text())
+    document['simulation']['faults'] = {'walk': {'always': True}}
+    files = {'served_atlas.yaml': yaml.safe_dump(document, sort_keys=False)}
+    served = robot_system_from_files('served_atlas', files, 'suite/served_atlas.yaml')
+    spec = compile_task(served, ['stand_prep'], ['walk'])
+    states = generate_state_machine(automaton_from_strategy(synthesize(spec).strategy, spec), served,
+                                    initial_conditions=['stand_prep'])
+    final = simulate({'states': [state.to_dict() for state in states], 'ltl_specification': spec.to_text_sections(),
+                      'system': served.name, 'files': dict(served.files), 'config_file': served.config_file,
+                      'initial_conditions': ['stand_prep'], 'goals': ['walk'], 'ordered': True, 'fail_first': [],
+                      'record_dir': str(tmp_path), 'max_robot_time': 300.0, 'max_wall_time': 300.0},
+                     lambda update: None)
+    assert 'error' not in final, final['error']
+    assert final['result']['outcome'] == 'failed' and final['result']['check']['ok'] is True
+
+
 def test_bad_simulation_requests_name_the_item(client):
     _, compiled = run_job(client, {**PAPER_TASK, 'option': 'ltl_compilation_only'})
     no_machine = client.post(f"/api/jobs/{compiled['id']}/simulations", json={})

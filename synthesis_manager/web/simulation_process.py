@@ -98,7 +98,8 @@ def simulate(settings: dict, progress: Callable[[dict], None]) -> dict:
                                    faults=parse_faults(fail_first=[f'{c}:1' for c in settings['fail_first']]))
         run = run_and_check(settings['states'], SimulatedRobot(simulator), simulator, system,
                             spec_from_text_sections(settings['ltl_specification']), settings['goals'],
-                            ordered=settings['ordered'], record_dir=Path(settings['record_dir']), max_robot_time=settings['max_robot_time'],
+                            ordered=settings['ordered'], record_dir=Path(settings['record_dir']),
+                            max_robot_time=settings['max_robot_time'],
                             max_wall_time=settings['max_wall_time'], on_progress=step_added)
         return {'result': {'outcome': run.result.outcome, 'check': run.check.to_dict(),
                            'timeline': str(run.timeline) if run.timeline else None,

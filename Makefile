@@ -23,7 +23,7 @@ FLEXBE_MSGS_BUILD := build/flexbe_msgs
 FLEXBE_SYNTHESIS_MSGS ?= $(FLEXBE_SOURCES)/flexbe_synthesis/flexbe_synthesis_msgs
 FLEXBE_SYNTHESIS_MSGS_BUILD := build/flexbe_synthesis_msgs
 # The FlexBE WebUI needs an older web stack than our GUI (starlette<0.47): installed into a
-# folder of its own that only the WebUI's process (test/test_flexbe_webui.py) puts on its path.
+# folder of its own that only the WebUI's process (test/integration/test_flexbe_webui.py) puts on its path.
 WEBUI_SITE := build/flexbe_webui_site
 # Our FlexBE packages (colcon packages; here used from source through the venv's path).
 FLEXBE_PACKAGES := atlas_sim/flexbe/atlas_sim_flexbe_states atlas_sim/flexbe/atlas_sim_flexbe_behaviors

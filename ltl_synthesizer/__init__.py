@@ -26,7 +26,7 @@ in each of its loops, so a synthesis stops within a few milliseconds plus one BD
 Modules: interrupt (Limits and their check), symbolic (the game: formulas to BDDs,
 enforceable predecessors), policy (Options and the automatic plan), synthesizer (the entry
 points above), gr1 (the solver and its fixpoints), strategy (explicit strategies,
-counter-strategies, slugs JSON), explain (why unrealizable), unrealizable_core (minimal
+counter-strategies, slugs JSON), explanation (why unrealizable), unrealizable_core (minimal
 unrealizable subsets of guarantees, by delta debugging), isolated (work in child processes
 that a cancel, a deadline or a shutdown ends at once), command (the ``gr1synth`` command:
 arguments, one run, outputs), cli (``gr1synth``) and serve (its resident mode), both on

@@ -149,7 +149,7 @@ def counter_strategy(solved: Solved) -> dict:
 
 def explain(solved: Solved) -> str:
     """Why an unrealizable game is lost: losing initial states, a blocked goal, a play."""
-    from ltl_synthesizer.explain import explain_unrealizable
+    from ltl_synthesizer.explanation import explain_unrealizable
     environment = _unrealizable(solved).environment()
     with _memory_failures_reported(solved.interrupt.memory_limit):
         return explain_unrealizable(solved.game, solved.solution, environment, solved.robotics_semantics)

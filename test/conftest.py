@@ -1,10 +1,25 @@
-"""Shared fixtures. ROS tests use ``ros``: an in-process harness on a reserved domain.
+"""Shared fixtures and the markers that select kinds of tests.
 
-Tests against the real FlexBE (``flexbe_sources``, ``flexbe``) find its pinned sources through
-FLEXBE_SOURCES, by default ../shared/third_party beside the repository when present; `make
-flexbe` (run by `make test`) builds and registers them in the venv. Without any sources (a
-user's machine) those tests skip with that reason; with FLEXBE_SOURCES set (CI) broken
-sources fail them.
+``test/`` mirrors the packages (test/respec, test/ltl_specification, test/ltl_synthesizer,
+test/sm_generation, test/atlas_sim, test/synthesis_manager), with test/integration for tests that
+span packages or run the real FlexBE, and test/bench for the benchmarks' own tests.
+
+Markers (given here, from the folder, the fixtures a test uses and the lists below):
+
+    ros      starts ROS 2 (the ``ros`` fixture, the shell's nodes or its processes)
+    browser  drives headless Chromium
+    mujoco   runs the MuJoCo simulator
+    flexbe   runs the real FlexBE (``flexbe_sources``, ``flexbe``)
+    slow     takes more than a few seconds on a 2-core machine
+
+The pure-core tests alone, in under a minute::
+
+    .venv/bin/python -m pytest -m "not (ros or browser or mujoco or flexbe or slow)"
+
+Tests against the real FlexBE find its pinned sources through FLEXBE_SOURCES, by default
+../shared/third_party beside the repository when present; `make flexbe` (run by `make test`)
+builds and registers them in the venv. Without any sources (a user's machine) those tests skip
+with that reason; with FLEXBE_SOURCES set (CI) broken sources fail them.
 """
 
 import os
@@ -13,16 +28,57 @@ from pathlib import Path
 
 import pytest
 
-from synthesis_manager.ros.env import prepare_ros_environment
+from respec.nesting import allow_deep_formulas
 
-# Every test process keeps DDS on loopback, whether or not it starts ROS itself.
-prepare_ros_environment()
 os.environ.setdefault('MUJOCO_GL', 'egl')
+# As every entry point does: this process's threads read any formula the parsers accept.
+allow_deep_formulas()
 
 REPOSITORY = Path(__file__).resolve().parents[1]
 DEFAULT_FLEXBE_SOURCES = REPOSITORY.parent / 'shared' / 'third_party'
 # Where `make flexbe` registers the FlexBE packages (the AMENT_PREFIX_PATH entry for them).
 FLEXBE_AMENT_PREFIX = Path(sys.prefix) / 'flexbe'
+
+MARKERS = {
+    'ros': 'starts ROS 2 (the ros fixture, the shell\'s nodes or its processes)',
+    'browser': 'drives headless Chromium',
+    'mujoco': 'runs the MuJoCo simulator',
+    'flexbe': 'runs the real FlexBE',
+    'slow': 'takes more than a few seconds on a 2-core machine',
+}
+# Everything the shell does goes through ROS (its nodes, its processes, its in-process suite).
+FOLDER_MARKERS = {'synthesis_manager': ('ros',)}
+MODULE_MARKERS = {
+    'browser': ('test_gui_browser', 'test_gui_browser_newcomer', 'test_gui_browser_usability',
+                'test_flexbe_webui', 'test_flexbe_webui_parser'),
+    'mujoco': ('test_atlas_sim_closed_loop', 'test_atlas_sim_engine_trace', 'test_atlas_sim_executor',
+               'test_atlas_sim_operator_data', 'test_atlas_sim_rendering', 'test_atlas_sim_simulator',
+               'test_atlas_sim_closed_loop_ros', 'test_atlas_sim_node', 'test_flexbe_engine'),
+    'ros': ('test_flexbe_engine', 'test_flexbe_onboard', 'test_flexbe_states', 'test_flexbe_webui',
+            'test_cnu_capabilities', 'test_readme_commands'),
+    'slow': ('test_bench_gr1_families', 'test_readme_commands'),
+}
+FIXTURE_MARKERS = {'ros': 'ros', 'flexbe': 'flexbe', 'flexbe_sources': 'flexbe'}
+
+
+def pytest_configure(config):
+    for name, meaning in MARKERS.items():
+        config.addinivalue_line('markers', f'{name}: {meaning}')
+
+
+def pytest_collection_modifyitems(config, items):
+    for item in items:
+        names = set(FOLDER_MARKERS.get(item.path.parent.name, ()))
+        names |= {marker for marker, modules in MODULE_MARKERS.items() if item.path.stem in modules}
+        names |= {marker for fixture, marker in FIXTURE_MARKERS.items() if fixture in item.fixturenames}
+        for name in sorted(names):
+            item.add_marker(name)
+    if any(item.get_closest_marker('ros') for item in items):
+        # Before any test runs: DDS stays on loopback in this process and every process it
+        # starts, whether or not a test starts ROS itself.
+        from synthesis_manager.ros.env import prepare_ros_environment
+
+        prepare_ros_environment()
 
 
 @pytest.fixture

@@ -1,0 +1,239 @@
+"""The FlexBE user's loop on FlexBE's own onboard executive (FLEXBE_SOURCES), no driver of ours.
+
+An exported behavior package is installed into a prefix the way a user without colcon does
+(pip), FlexBE's ``flexbe_onboard.start_behavior`` runs in its own process and finds it through
+the ament index, ``atlas-sim-node`` is the robot and ``atlas-sim-operator`` answers InputState
+exactly as flexbe_input's ``input_action_server`` does (a pickled value and nothing else). A
+``flexbe_msgs/BehaviorSelection`` on ``flexbe/start_behavior`` starts it, as be_launcher and
+the WebUI do; ``flexbe/status`` (BEStatus) reports the outcome. One test uses flexbe_input's
+own ``input_action_server`` with its Qt window (PyQt5, offscreen) and a scripted typist.
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import threading
+import time
+import zlib
+from pathlib import Path
+
+import pytest
+from rclpy.action import ActionClient
+from rclpy.node import Node
+
+pytestmark = pytest.mark.usefixtures('flexbe')
+
+BIN = Path(sys.executable).parent
+PAPER_TASK = ['--initial-conditions', 'stand_prep', '--goals', 'look_down,pickup_object']
+BEHAVIOR = 'Onboard Pickup'
+
+
+@pytest.fixture(scope='module')
+def installed_prefix(tmp_path_factory):
+    """The paper task exported and installed into a prefix with pip (no colcon)."""
+    work = tmp_path_factory.mktemp('onboard')
+    exported = subprocess.run([str(BIN / 'behavior-synthesis'), 'export-behavior', '--system', 'atlas', *PAPER_TASK,
+                               '--name', BEHAVIOR, '-o', str(work / 'src')],
+                              capture_output=True, text=True, timeout=120)
+    assert exported.returncode == 0, exported.stderr
+    prefix = work / 'install'
+    pip = subprocess.run([sys.executable, '-m', 'pip', 'install', '--quiet', '--no-deps', '--no-build-isolation',
+                          '--no-index', '--prefix', str(prefix), str(work / 'src' / 'synthesized_flexbe_behaviors')],
+                         capture_output=True, text=True, timeout=300)
+    assert pip.returncode == 0, pip.stderr
+    return prefix
+
+
+class OnboardSystem:
+    """The robot, the operator and FlexBE's onboard executive as processes on the test's domain."""
+
+    def __init__(self, ros, prefix: Path, flexbe_prefix: Path, logs: Path, sim_arguments=(), operator_arguments=(),
+                 operator_command=None, operator_path=()):
+        self.site = prefix / 'lib' / f'python{sys.version_info.major}.{sys.version_info.minor}' / 'site-packages'
+        self.ament_prefix_path = os.pathsep.join([str(prefix), str(flexbe_prefix), sys.prefix])
+        self.environment = dict(os.environ, ROS_DOMAIN_ID=str(ros.domain_id), MUJOCO_GL='egl',
+                                AMENT_PREFIX_PATH=self.ament_prefix_path,
+                                PYTHONPATH=os.pathsep.join(filter(None, [str(self.site), *operator_path,
+                                                                           os.environ.get('PYTHONPATH')])))
+        self.logs = logs
+        self.processes = {}
+        self.start('sim', [str(BIN / 'atlas-sim-node'), '--ros-args', '-p', 'speed:=20.0', *sim_arguments])
+        self.start('operator', operator_command or [str(BIN / 'atlas-sim-operator'), *operator_arguments])
+        self.start('onboard', [sys.executable, '-m', 'flexbe_onboard.start_behavior'])
+
+    def start(self, name, command):
+        log = open(self.logs / f'{name}.log', 'w', encoding='utf-8')  # noqa: SIM115 - closed in stop()
+        self.processes[name] = (subprocess.Popen(command, env=self.environment, stdout=log, stderr=subprocess.STDOUT,
+                                                 text=True), log)
+
+    def log(self, name) -> str:
+        return (self.logs / f'{name}.log').read_text(encoding='utf-8', errors='replace')
+
+    def stop(self):
+        for process, _ in self.processes.values():
+            if process.poll() is None:
+                process.send_signal(signal.SIGINT)
+        for name, (process, log) in self.processes.items():
+            try:
+                process.wait(timeout=10)
+            except subprocess.TimeoutExpired:
+                process.kill()
+                process.wait()
+            log.close()
+
+
+@pytest.fixture
+def onboard(ros, installed_prefix, flexbe, tmp_path, monkeypatch):
+    """Start the processes (sim and operator arguments as given); stopped after the test."""
+    systems = []
+
+    def start(sim_arguments=(), operator_arguments=(), operator_command=None, operator_path=()):
+        system = OnboardSystem(ros, installed_prefix, flexbe, tmp_path, sim_arguments, operator_arguments,
+                               operator_command, operator_path)
+        systems.append(system)
+        monkeypatch.setenv('AMENT_PREFIX_PATH', system.ament_prefix_path)  # this process's BehaviorLibrary
+        monkeypatch.syspath_prepend(str(system.site))
+        return system
+
+    yield start
+    for system in systems:
+        system.stop()
+
+
+class Operator:
+    """What a FlexBE operator sees: the status and log topics; starts behaviors like be_launcher."""
+
+    def __init__(self, ros):
+        from flexbe_msgs.msg import BehaviorLog, BEStatus
+        from synthesis_msgs.msg import RobotState
+
+        self.node = ros.add_node(Node, 'onboard_test_operator')
+        self.statuses, self.logs, self.robot = [], [], []
+        self.lock = threading.Lock()
+        self.node.create_subscription(BEStatus, 'flexbe/status', lambda m: self._keep(self.statuses, m), 10)
+        self.node.create_subscription(BehaviorLog, 'flexbe/log', lambda m: self._keep(self.logs, m), 100)
+        self.node.create_subscription(RobotState, 'atlas_sim/state', lambda m: self._keep(self.robot, m), 10)
+
+    def _keep(self, messages, message):
+        with self.lock:
+            messages.append(message)
+
+    def wait_until(self, condition, timeout, what):
+        deadline = time.monotonic() + timeout
+        while time.monotonic() < deadline:
+            with self.lock:
+                found = condition()
+            if found:
+                return found
+            time.sleep(0.05)
+        raise AssertionError(f'no {what} within {timeout} s')
+
+    def wait_for_servers(self):
+        from flexbe_msgs.action import BehaviorInput
+        from synthesis_msgs.action import ExecuteCapability
+
+        for action_type, name in ((BehaviorInput, 'flexbe/behavior_input'), (ExecuteCapability, 'atlas_sim/execute')):
+            client = ActionClient(self.node, action_type, name)
+            assert client.wait_for_server(timeout_sec=30.0), f'{name} is not served'
+
+    def start_behavior(self, name: str, autonomy: int = 3):
+        """A BehaviorSelection for ``name`` as be_launcher sends it; returns the final BEStatus."""
+        from flexbe_core import BehaviorLibrary
+        from flexbe_msgs.msg import BehaviorSelection, BEStatus
+
+        self.wait_for_servers()
+        self.wait_until(lambda: any(s.code == BEStatus.READY for s in self.statuses), 40, 'READY from onboard')
+        library = BehaviorLibrary(self.node)
+        key, entry = library.find_behavior(name)
+        assert entry is not None, f'{name} is not in the behavior library'
+        source = Path(library.get_sourcecode_filepath(key)).read_text(encoding='utf-8')
+        selection = BehaviorSelection(behavior_key=key, behavior_id=zlib.adler32(source.encode()) & 0x7fffffff,
+                                      autonomy_level=autonomy)
+        publisher = self.node.create_publisher(BehaviorSelection, 'flexbe/start_behavior', 10)
+        self.wait_until(lambda: publisher.get_subscription_count() > 0, 10, 'subscriber of flexbe/start_behavior')
+        publisher.publish(selection)
+        ended = (BEStatus.FINISHED, BEStatus.FAILED, BEStatus.ERROR)
+        return self.wait_until(lambda: next((s for s in self.statuses if s.code in ended), None), 120,
+                               'end of the behavior')
+
+    def log_text(self) -> str:
+        with self.lock:
+            return '\n'.join(m.text for m in self.logs)
+
+
+def test_be_launcher_starts_the_installed_behavior(ros, onboard, flexbe_sources):
+    """FlexBE's own command line (flexbe_widget's be_launcher), as README tells users to start it."""
+    from flexbe_msgs.msg import BEStatus
+
+    system = onboard()
+    operator = Operator(ros)
+    operator.wait_for_servers()
+    operator.wait_until(lambda: any(s.code == BEStatus.READY for s in operator.statuses), 40, 'READY from onboard')
+    engine = flexbe_sources / 'flexbe_behavior_engine'
+    system.environment['PYTHONPATH'] = os.pathsep.join(
+        [system.environment['PYTHONPATH'], *(str(engine / name) for name in ('flexbe_widget', 'flexbe_input',
+                                                                              'flexbe_mirror')),
+         str(flexbe_sources / 'rosidl_runtime_py')])
+    system.start('launcher', [sys.executable, str(engine / 'flexbe_widget' / 'bin' / 'be_launcher'),
+                              '-b', BEHAVIOR, '-a', '3'])
+    ended = (BEStatus.FINISHED, BEStatus.FAILED, BEStatus.ERROR)
+    status = operator.wait_until(lambda: next((s for s in operator.statuses if s.code in ended), None), 120,
+                                 'end of the behavior started by be_launcher')
+    ok, details = finished_with(status, 'finished', system)
+    assert ok, details + '\n--- be_launcher\n' + system.log('launcher')[-2000:]
+
+
+def test_flexbe_inputs_own_input_server_and_window_answer_the_input_state(ros, onboard, flexbe_sources):
+    """The operator types 1 into flexbe_input's real Qt window (offscreen): the behavior finishes."""
+    engine = flexbe_sources / 'flexbe_behavior_engine'
+    system = onboard(operator_command=[sys.executable, str(Path(__file__).parents[1] / 'flexbe_env' / 'typing_operator.py'),
+                                       '1'],
+                     operator_path=[str(engine / 'flexbe_input')])
+    status = Operator(ros).start_behavior(BEHAVIOR)
+    ok, details = finished_with(status, 'finished', system)
+    assert ok, details
+    assert "typing '1' into: 'Specify desired object template\\nint'" in system.log('operator')
+
+
+def finished_with(status, outcome, system):
+    from flexbe_msgs.msg import BEStatus
+
+    return status.code == BEStatus.FINISHED and list(status.args) == [outcome], (
+        f'{status.code} {list(status.args)}\n--- onboard\n{system.log("onboard")[-3000:]}\n'
+        f'--- sim\n{system.log("sim")[-1500:]}\n--- operator\n{system.log("operator")[-1500:]}')
+
+
+def test_an_exported_behavior_finishes_onboard_with_flexbe_inputs_plain_answer(ros, onboard):
+    system = onboard()
+    operator = Operator(ros)
+    status = operator.start_behavior(BEHAVIOR)
+    ok, details = finished_with(status, 'finished', system)
+    assert ok, details
+    # The state topic is periodic: the newest message received may predate the end of pickup_object.
+    last = operator.wait_until(lambda: next((m for m in reversed(operator.robot)
+                                             if 'pickup_object' in m.completed_actions), None),
+                               10, 'a robot state after pickup_object')
+    # The robot acted on the template id that flowed through userdata: it never ran object_template.
+    assert last.holding_object and last.mode == 'manipulate'
+    assert 'object_template' not in last.completed_actions and 'pickup_object' in last.completed_actions
+    assert 'answered 1' in system.log('operator')
+
+
+def test_an_injected_fault_ends_the_behavior_failed(ros, onboard):
+    system = onboard(sim_arguments=['-p', 'fail:=pickup_object'])
+    status = Operator(ros).start_behavior(BEHAVIOR)
+    ok, details = finished_with(status, 'failed', system)
+    assert ok, details
+
+
+def test_a_template_id_naming_no_object_fails_with_the_robots_reason(ros, onboard):
+    system = onboard(operator_arguments=['--answer', '0=7'])
+    operator = Operator(ros)
+    status = operator.start_behavior(BEHAVIOR)
+    ok, details = finished_with(status, 'failed', system)
+    assert ok, details
+    assert 'template_id 7 names no object of the scene (known template ids: 1)' in \
+        operator.log_text() + system.log('onboard')

@@ -1,0 +1,196 @@
+"""ltl_synthesizer.isolated: syntheses in child processes, stopped by killing the child."""
+
+import os
+import signal
+import threading
+import time
+from concurrent.futures import ThreadPoolExecutor
+from pathlib import Path
+
+import pytest
+
+from ltl_specification import compile_task
+from ltl_synthesizer import Limits, SynthesisCancelledError, synthesize
+from ltl_synthesizer.errors import SynthesisMemoryError, UndeclaredPropositionError
+from ltl_synthesizer.isolated import SynthesisProcessDiedError, SynthesisProcesses
+from respec.ltl import var
+from respec.spec import GR1Specification
+
+# Strategy extraction over 2**100 initial states: runs until stopped.
+RUNAWAY = GR1Specification(env_props=[f'x{i}' for i in range(100)],
+                           sys_props=[f'y{i}' for i in range(100)], sys_liveness=[var('y0')])
+
+
+@pytest.fixture
+def processes():
+    pool = SynthesisProcesses()
+    yield pool
+    pool.close()
+
+
+def children_of_this_process() -> set[int]:
+    """The synthesis processes (multiprocessing's resource tracker aside)."""
+    pids = set()
+    for entry in filter(str.isdigit, os.listdir('/proc')):  # by parent: a thread's children file ends with it
+        try:
+            with open(f'/proc/{entry}/stat') as stat:
+                if int(stat.read().rsplit(')', 1)[1].split()[1]) == os.getpid():
+                    pids.add(int(entry))
+        except (FileNotFoundError, NotADirectoryError, ProcessLookupError, IndexError):
+            pass
+    found = set()
+    for pid in pids:
+        try:
+            with open(f'/proc/{pid}/cmdline') as cmdline:
+                if b'ltl_synthesizer.isolated' in cmdline.read().encode():
+                    found.add(pid)
+        except FileNotFoundError:  # ended meanwhile
+            pass
+    return found
+
+
+def test_results_equal_the_in_process_synthesizer_and_children_are_reused(processes):
+    spec = compile_task('atlas', ['stand_prep'], ['pregrasp', 'grasp_object'])
+    first = processes.synthesize(spec)
+    children = children_of_this_process()
+    second = processes.synthesize(spec)
+    assert first.realizable and first.strategy == synthesize(spec).strategy == second.strategy
+    assert children_of_this_process() == children  # the same child served both
+
+
+def test_unrealizable_specs_come_back_with_their_explanation(processes):
+    spec = compile_task('atlas', ['stand_prep'], ['look_down', 'stand_prep'])
+    result = processes.synthesize(spec)
+    assert not result.realizable and result.explanation == synthesize(spec).explanation
+
+
+def test_errors_come_back_as_the_synthesizers_own(processes):
+    bad = GR1Specification(sys_props=['a'], sys_trans=[var('nowhere')])
+    with pytest.raises(UndeclaredPropositionError) as error:
+        processes.synthesize(bad)
+    assert error.value.item == 'nowhere' and error.value.code == 'UNKNOWN_PROPOSITION'
+    with pytest.raises(SynthesisMemoryError) as error:
+        processes.synthesize(RUNAWAY, limits=Limits(deadline=time.monotonic() + 120, memory_limit=16 * 2**20))
+    assert error.value.item == 'memory_limit'
+
+
+def test_a_cancel_kills_the_child_at_once_and_the_next_synthesis_works(processes):
+    cancel, working = threading.Event(), set()
+
+    def cancel_it():
+        working.update(children_of_this_process())
+        cancel.set()
+    threading.Timer(1.0, cancel_it).start()
+    with pytest.raises(SynthesisCancelledError) as error:
+        processes.synthesize(RUNAWAY, limits=Limits(cancel=cancel))
+    stopped = time.monotonic()
+    assert error.value.code == 'PREEMPTED'
+    assert len(working) == 1 and not Path(f'/proc/{working.pop()}').exists()  # killed and reaped
+    assert len(children_of_this_process()) <= 1  # at most the replacement, started idle
+    assert processes.synthesize(compile_task('atlas', ['stand_prep'], ['look_down'])).realizable
+    assert time.monotonic() - stopped < 30
+
+
+def test_the_deadline_stops_the_synthesis_within_a_poll(processes):
+    started = time.monotonic()
+    with pytest.raises(SynthesisCancelledError) as error:
+        processes.synthesize(RUNAWAY, limits=Limits(deadline=started + 1.0))
+    assert error.value.code == 'SYNTHESIS_TIMEOUT'
+    assert time.monotonic() - started < 1.5
+
+
+def test_a_child_killed_from_outside_is_reported_and_replaced(processes):
+    processes.prepare()
+    outcome = {}
+
+    def run():
+        try:
+            processes.synthesize(RUNAWAY, limits=Limits(deadline=time.monotonic() + 60))
+        except Exception as error:  # noqa: BLE001 -- inspected below
+            outcome['error'] = error
+
+    worker = threading.Thread(target=run)
+    worker.start()
+    time.sleep(1.0)
+    for pid in children_of_this_process():
+        os.kill(pid, signal.SIGKILL)
+    worker.join(timeout=10)
+    assert isinstance(outcome.get('error'), SynthesisProcessDiedError)
+    assert outcome['error'].code == 'SYNTHESIS_FAILED'
+    assert processes.synthesize(compile_task('atlas', ['stand_prep'], ['look_down'])).realizable
+
+
+def test_close_kills_busy_and_idle_children():
+    processes = SynthesisProcesses()
+    processes.prepare(2)
+    worker = threading.Thread(target=lambda: pytest.raises(SynthesisCancelledError, processes.synthesize, RUNAWAY))
+    worker.start()
+    time.sleep(1.0)
+    assert len(children_of_this_process()) >= 2
+    processes.close()
+    worker.join(timeout=5)
+    assert not worker.is_alive()
+    deadline = time.monotonic() + 5
+    while children_of_this_process() and time.monotonic() < deadline:
+        time.sleep(0.05)
+    assert children_of_this_process() == set()
+
+
+def rss_kib(pid: int) -> int:
+    with open(f'/proc/{pid}/status') as status:
+        return next(int(line.split()[1]) for line in status if line.startswith('VmRSS:'))
+
+
+@pytest.mark.slow
+def test_idle_children_are_released_and_fresh_prepared_ones_replace_them():
+    """After a burst the used children (their heaps grown by what they solved) end once idle;
+    the prepared number of fresh children, at baseline RSS, stay (issue 25)."""
+    processes = SynthesisProcesses(idle_seconds=3.0)  # margin for a loaded machine before the first check
+    try:
+        processes.prepare(1)
+        time.sleep(1.0)  # let the fresh child import the synthesizer
+        baseline = sum(rss_kib(pid) for pid in children_of_this_process())
+        spec = compile_task('atlas', ['stand_prep'], ['look_down', 'pickup_object'])
+        with ThreadPoolExecutor(3) as pool:  # three at once: three children
+            assert all(result.realizable for result in pool.map(lambda _: processes.synthesize(spec), range(6)))
+            list(pool.map(lambda _: processes.call(time.sleep, (0.5,)), range(3)))
+        used = children_of_this_process()
+        assert len(used) >= 2 and processes.idle_count >= 2
+        deadline = time.monotonic() + 10
+        while (children_of_this_process() & used or processes.idle_count != 1) and time.monotonic() < deadline:
+            time.sleep(0.1)
+        assert not children_of_this_process() & used  # every used child has ended
+        assert processes.idle_count == 1 and len(children_of_this_process()) == 1
+        time.sleep(0.5)
+        assert sum(rss_kib(pid) for pid in children_of_this_process()) < 1.5 * baseline
+        assert processes.synthesize(spec).realizable  # and the next synthesis is served at once
+    finally:
+        processes.close()
+
+
+def test_a_child_outlives_the_thread_that_started_it():
+    """Children are started from worker threads that end; the child must stay usable (the
+    kernel's parent-death signal would kill it with its starting thread)."""
+    processes = SynthesisProcesses()
+    try:
+        starter = threading.Thread(target=lambda: processes.call(time.sleep, (0.0,)))
+        starter.start()
+        starter.join()
+        time.sleep(1.0)
+        (child,) = children_of_this_process()
+        assert processes.call(os.getpid) == child  # the same child serves the next call
+    finally:
+        processes.close()
+
+
+def test_children_run_at_the_niceness_asked_below_their_parent():
+    """A server's syntheses must leave their parent the CPU to answer on time."""
+    processes = SynthesisProcesses(niceness=7)
+    try:
+        processes.synthesize(GR1Specification(sys_props=['y'], sys_liveness=[var('y')]))  # the child is up
+        (child,) = children_of_this_process()
+        with open(f'/proc/{child}/stat') as stat:
+            niceness = int(stat.read().rsplit(')', 1)[1].split()[16])
+        assert niceness == min(19, os.nice(0) + 7)
+    finally:
+        processes.close()

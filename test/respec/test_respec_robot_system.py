@@ -1,0 +1,78 @@
+"""RobotSystem: one object per robot system, read once, its kind decided when it is read."""
+
+from pathlib import Path
+
+import pytest
+
+from ltl_specification import compile_task
+from respec.robot import (ABSTRACTION_KIND, CAPABILITIES_KIND, RobotSystem, SystemCatalog, robot_system,
+                          robot_system_from_files)
+from respec.robot.abstraction import AbstractionConfigError
+from respec.robot.cnu import CapabilityConfigError
+from respec.robot.files import ConfigFileInvalidError, SystemNotFoundError
+
+CONFIG = Path(__file__).resolve().parents[2] / 'config'
+
+
+def test_atlas_is_an_abstraction_kind_system_with_its_sections():
+    atlas = robot_system('atlas')
+    assert atlas.kind == ABSTRACTION_KIND and not atlas.is_capability_system
+    assert atlas.name == 'atlas' and atlas.config_file == 'config/atlas.yaml'
+    assert 'look_down' in atlas.abstraction.actions
+    assert set(atlas.section('flexbe')) >= {'states'} and atlas.has_section('simulation')
+    assert list(atlas.files) == ['atlas.yaml'] and atlas.files['atlas.yaml'] == (CONFIG / 'atlas.yaml').read_text()
+    assert robot_system(atlas) is atlas  # already resolved: taken as it is
+
+
+def test_a_missing_section_is_named():
+    with pytest.raises(ConfigFileInvalidError, match="missing or invalid section 'nope'"):
+        robot_system('atlas').section('nope')
+
+
+def test_unknown_and_broken_systems_are_reported_with_the_offending_item(tmp_path):
+    with pytest.raises(SystemNotFoundError, match='known systems: atlas, mobile_manipulator'):
+        robot_system('marsrover')
+    (tmp_path / 'broken.yaml').write_text('abstraction:\n  actions: {a: [b]}\n')
+    with pytest.raises(AbstractionConfigError) as raised:
+        robot_system('broken', tmp_path)
+    assert raised.value.item
+    (tmp_path / 'cnu.yaml').write_text('system: cnu\ncnu_capabilities: missing.yaml\n')
+    with pytest.raises(CapabilityConfigError, match="cnu_capabilities 'missing.yaml' cannot be read"):
+        robot_system('cnu', tmp_path)
+
+
+def test_a_system_rebuilt_from_its_files_is_the_same_system():
+    atlas = robot_system('atlas')
+    copy = robot_system_from_files('atlas', dict(atlas.files))
+    assert copy == atlas and copy.config_file == atlas.config_file
+    assert copy.section('flexbe') == atlas.section('flexbe')
+    first = compile_task(atlas, ['stand_prep'], ['look_down', 'pickup_object'])
+    second = compile_task(copy, ['stand_prep'], ['look_down', 'pickup_object'])
+    assert first.to_structuredslugs() == second.to_structuredslugs()
+
+
+def test_a_capability_system_keeps_every_file_it_read(tmp_path, flexbe_sources):
+    cnu = flexbe_sources / 'flexbe_synthesis'
+    examples = cnu / 'flexbe_synthesis_examples' / 'example' / 'vending_demo'
+    (tmp_path / 'vending.yaml').write_text(
+        f'cnu_capabilities: {examples}/capabilities/vending_capabilities.yaml\n'
+        f'cnu_spec: {examples}/specs/vending_demo_capabilities_spec.yaml\n'
+        f'cnu_mappings: {cnu}/flexbe_synthesis_generic/mappings/global_mappings.yaml\n')
+    vending = robot_system('vending', tmp_path)
+    assert vending.kind == CAPABILITIES_KIND and vending.abstraction is None
+    assert len(vending.files) == 4  # the system file and the three CNU files
+    copy = robot_system_from_files('vending', dict(vending.files))
+    assert copy.capabilities == vending.capabilities
+    with pytest.raises(CapabilityConfigError, match='cannot be read'):
+        robot_system_from_files('vending', {'vending.yaml': vending.files['vending.yaml']})
+
+
+def test_the_catalog_lists_and_loads_the_systems_of_its_folder(tmp_path):
+    assert SystemCatalog().names() == ['atlas', 'mobile_manipulator']
+    assert isinstance(SystemCatalog().load('mobile_manipulator'), RobotSystem)
+    (tmp_path / 'tiny.yaml').write_text('abstraction:\n  actions: {wave: []}\n')
+    catalog = SystemCatalog(tmp_path)
+    assert catalog.names() == ['tiny'] and catalog.load('tiny').abstraction.actions == {'wave': ()}
+    # Loading reads afresh: an edit is seen by the next request.
+    (tmp_path / 'tiny.yaml').write_text('abstraction:\n  actions: {wave: [], nod: []}\n')
+    assert list(catalog.load('tiny').abstraction.actions) == ['wave', 'nod']

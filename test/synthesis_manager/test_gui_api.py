@@ -247,16 +247,14 @@ def test_a_simulation_runs_the_system_the_gui_was_served_not_a_local_file(tmp_pa
     """A GUI attached to a suite elsewhere simulates the suite's system: the child rebuilds it
     from the files the GUI holds (here a variant of ATLAS whose walk always fails, under a
     name no local file has)."""
-    from pathlib import Path
-
     from ltl_specification import compile_task
     from ltl_synthesizer import synthesize
     from respec.automaton import automaton_from_strategy
-    from respec.robot import robot_system_from_files
+    from respec.robot import robot_system, robot_system_from_files
     from sm_generation import generate_state_machine
     from synthesis_manager.web.simulation_process import simulate
 
-    document = yaml.safe_load((Path(__file__).resolve().parent.parent / 'config' / 'atlas.yaml').read_text())
+    document = yaml.safe_load(robot_system('atlas').files['atlas.yaml'])
     document['simulation']['faults'] = {'walk': {'always': True}}
     files = {'served_atlas.yaml': yaml.safe_dump(document, sort_keys=False)}
     served = robot_system_from_files('served_atlas', files, 'suite/served_atlas.yaml')

@@ -25,7 +25,21 @@ System (guarantees)
     has no SM outcomes (CNU's "infinite" mappings), each goal holds infinitely often.
 
 Initial values not given by the request or the spec file: no capability runs, memories as
-declared (default false), integers at their lowest value.
+declared (default false), integers at their lowest value. The spec file's other formulas
+(ENV_TRANS, SYS_TRANS, the livenesses) are added as they are (CNU's capability pipeline loads the
+spec file first and adds the capabilities' formulas to it).
+
+Without goals (CNU's request semantics) the request adds no success formula: the capabilities
+or the spec file already say what the machine does (a given machine, CNU's ``sm/`` route, is
+one: its transition relation leaves the strategy no choice).
+
+CNU's full-spec pipeline (``cnu_pipeline: full_spec``) takes the spec file as the whole
+specification; the request adds its initial conditions (each replaces the file's initial
+literal of the same proposition) and its goals, as CNU's request semantics say: with a success
+outcome among the file's outputs, reaching the goals' conjunction raises it and nothing else
+does, ``(!goal & X goal) -> X success`` and ``(!X goal & !success) -> !X success``; without one,
+each goal holds infinitely often. A goal or initial condition that names a capability with a
+memory proposition in the file (``soda`` -> ``soda_m``) means the memory.
 """
 
 from __future__ import annotations
@@ -33,9 +47,12 @@ from __future__ import annotations
 from typing import Mapping, Sequence
 
 from respec.robot.cnu import CapabilityConfigError, CapabilitySystem, Literal, parse_literal
-from respec.ltl import TRUE, Formula, conj, disj, iff, implies, neg, next_, var
-from respec.naming import COMPLETED, FAILED, activation, did_you_mean, memory
+from respec.ltl import TRUE, Formula, Not, Var, conj, disj, iff, implies, neg, next_, var, variables
+from respec.naming import COMPLETED, FAILED, activation, did_you_mean, memory, remembered
 from respec.parsing import IntegerVariable
+from respec.parsing.errors import ParseError
+from respec.parsing.grammar import parse_in_scope
+from respec.parsing.scope import Source, section_scopes
 from respec.spec import FORMULA_SECTIONS, GR1Specification
 from respec.robot.state_library import StateClass, capability_outcomes
 
@@ -102,16 +119,17 @@ def compile_capability_task(system: CapabilitySystem, library: Mapping[str, Stat
     if custom_ltl and any(custom_ltl.get(s) for s in FORMULA_SECTIONS + ('env_props', 'sys_props')):
         raise InvalidFormulaError(f'{system.system} is described by capabilities; custom LTL is not supported '
                                   'for it (put the formulas into its capability file)', item=system.system)
-    if not goals:
-        raise InvalidGoalsError(f'no goals given: name a capability, memory or proposition of {system.system}',
-                                item='')
     spec = CapabilitySpecification(system, capability_outcomes(system, library))
+    if system.full_spec:
+        return _full_specification(spec, initial_conditions, goals)
     parts = {section: [] for section in FORMULA_SECTIONS}
     _environment(spec, parts)
     _activations(spec, parts)
-    _goals(spec, goals, parts)
+    if goals:
+        _goals(spec, goals, parts)
     setters = _conditions(spec, parts)
     _initial_values(spec, initial_conditions, parts)
+    _spec_file_formulas(spec, parts)
     _frames(spec, setters, parts)
     memories = [memory(m) for m in spec.used_memories]
     return GR1Specification(env_props=list(spec.env_props), sys_props=[*spec.sys_props, *memories], **parts)
@@ -260,3 +278,92 @@ def _initial_values(spec: CapabilitySpecification, initial_conditions: Sequence[
         if integer.in_range(False) is not TRUE:
             environment_owned = spec.system.integers[integer.name].environment
             parts['env_init' if environment_owned else 'sys_init'].append(integer.in_range(False))
+
+
+def _parsed_spec_formulas(system: CapabilitySystem, env_props: list[str], sys_props: list[str],
+                          integers: Mapping[str, IntegerVariable], sections: Sequence[str]) -> dict[str, list[Formula]]:
+    """The spec file's formulas of ``sections``, each read in its section's scope (slugs' rules)."""
+    scopes = section_scopes(env_props, sys_props, dict(integers))
+    parsed: dict[str, list[Formula]] = {section: [] for section in FORMULA_SECTIONS}
+    for section, text in system.spec_formulas:
+        if section not in sections:
+            continue
+        where = f'specs.{section.upper()}'
+        try:
+            parsed[section].append(parse_in_scope(text, 'infix', scopes[section], Source(where)))
+        except ParseError as error:
+            raise CapabilityConfigError(f'{system.system}: {error}', item=where) from None
+    return parsed
+
+
+def _spec_file_formulas(spec: CapabilitySpecification, parts: dict) -> None:
+    """CNU's capability pipeline: the spec file's transitions and livenesses join the capabilities'
+    (its initial values are read as literals by ``_initial_values``). A memory they name is kept."""
+    memories = [memory(name) for name in spec.memories]
+    sections = ('env_trans', 'sys_trans', 'env_liveness', 'sys_liveness')
+    parsed = _parsed_spec_formulas(spec.system, spec.env_props, [*spec.sys_props, *memories], spec.integers,
+                                   sections)
+    for section in sections:
+        for formula in parsed[section]:
+            for name in variables(formula):
+                if name in memories:
+                    spec.used_memories.setdefault(remembered(name))
+            parts[section].append(formula)
+
+
+def _full_specification(spec: CapabilitySpecification, initial_conditions: Sequence[str],
+                        goals: Sequence[str]) -> GR1Specification:
+    """CNU's full-spec pipeline: the spec file, with the request's initial conditions and goals."""
+    system = spec.system
+    integers = {name: spec.integers[name] for name in system.integers}
+    env_props = [*system.spec_inputs, *(b for n, i in integers.items() if system.integers[n].environment
+                                        for b in i.bits)]
+    sys_props = [*system.spec_outputs, *(b for n, i in integers.items() if not system.integers[n].environment
+                                         for b in i.bits)]
+    parts = _parsed_spec_formulas(system, env_props, sys_props, integers, FORMULA_SECTIONS)
+    known = set(env_props) | set(sys_props)
+
+    def formula_of(text: str, what: str, error, next_step: bool = False) -> tuple[str, Formula]:
+        literal = _request_literal(spec, text, what, error)
+        name = literal.name
+        if literal.value is None and name not in known and memory(name) in known:
+            name = memory(name)
+        if literal.value is not None:
+            formula = integers[name].equals(literal.value, next_step)
+        elif name in known:
+            formula = next_(var(name)) if next_step else var(name)
+        else:
+            choices = sorted(n for n in known | set(integers) if '@' not in n)
+            raise UnknownPropositionError(f'{system.system} {what} {text!r} names {literal.name!r}, which is no '
+                                          f'proposition of its spec file{did_you_mean(literal.name, choices)} '
+                                          f'(known: {", ".join(choices)})', item=text)
+        return name, neg(formula) if literal.negated else formula
+
+    for text in initial_conditions:
+        name, formula = formula_of(text, 'initial condition', InvalidInitialConditionsError)
+        section = 'env_init' if name in env_props or name in integers and system.integers[name].environment \
+            else 'sys_init'
+        parts[section] = [f for f in parts[section] if _literal_name(f) != name] + [formula]
+    if goals:
+        now = conj(formula_of(g, 'goal', InvalidGoalsError)[1] for g in goals)
+        following = conj(formula_of(g, 'goal', InvalidGoalsError, True)[1] for g in goals)
+        success = next((o for o in dict.fromkeys(system.sm_outcomes.values()) if o != FAILED and o in sys_props),
+                       None)
+        if success is None:
+            parts['sys_liveness'] += [formula_of(g, 'goal', InvalidGoalsError)[1] for g in goals]
+        else:
+            parts['sys_trans'].append(implies(conj([neg(now), following]), next_(var(success))))
+            parts['sys_trans'].append(implies(conj([neg(following), neg(var(success))]), neg(next_(var(success)))))
+    for integer in integers.values():
+        owner = 'env' if system.integers[integer.name].environment else 'sys'
+        for section, next_step in ((f'{owner}_init', False), (f'{owner}_trans', True)):
+            if integer.in_range(next_step) is not TRUE:
+                parts[section].append(integer.in_range(next_step))
+    return GR1Specification(env_props=env_props, sys_props=sys_props, **parts)
+
+
+def _literal_name(formula: Formula) -> str | None:
+    """The proposition of an initial literal (``x`` or ``!x``), else None."""
+    if isinstance(formula, Not):
+        formula = formula.arg
+    return formula.name if isinstance(formula, Var) else None

@@ -9,6 +9,11 @@ value integer variable ``x`` has while the capability runs, named by ``variable_
 one state per value (``give_soda``). Memories and integer bits are bookkeeping: they never
 reach FlexBE, and the reduction (``sm_generation.reduction``, on by default for these systems)
 merges states that differ only in them.
+
+A full specification (CNU's full-spec pipeline) may model its environment with inputs no
+capability reports (the coffee maker's button ``bu``, a failure of a LogState, which has no
+failure outcome). FlexBE cannot see them: the machine is built from what it sees, the outcomes
+of the capabilities, as CNU's generator does.
 """
 
 from __future__ import annotations
@@ -33,7 +38,7 @@ def generate_capability_machine(automaton, system: CapabilitySystem, library: Ma
                                 reduce: bool | None = None) -> list[StateInstantiation]:
     """The FlexBE state machine implementing ``automaton`` on a capability system."""
     outcomes = capability_outcomes(system, library)
-    flexbe_automaton, variants = _with_parameter_variants(automaton, system)
+    flexbe_automaton, variants = _with_parameter_variants(automaton, system, _reported_inputs(system, outcomes))
     config = _flexbe_config(system, outcomes, library, variants)
     return generate_from_config(flexbe_automaton, config, None, system.reduce if reduce is None else reduce)
 
@@ -49,11 +54,21 @@ def parameter_source(value) -> str:
     return repr(value)
 
 
-def _with_parameter_variants(automaton, system: CapabilitySystem):
-    """The automaton with only what FlexBE sees: one activation per (capability, @var values)
-    and the SM outcomes. Returns it and the variants: proposition -> (capability, values)."""
+def _reported_inputs(system: CapabilitySystem, outcomes) -> set[str] | None:
+    """The inputs FlexBE sees in a full specification (the capabilities' outcomes); None: all."""
+    if not system.full_spec:
+        return None
+    return {system.outcome_proposition(name, system.transition_outcome(name, outcome))
+            for name in system.capabilities for outcome in outcomes[name]}
+
+
+def _with_parameter_variants(automaton, system: CapabilitySystem, reported: set[str] | None = None):
+    """The automaton with only what FlexBE sees: one activation per (capability, @var values),
+    the SM outcomes and the ``reported`` inputs (None: all). Returns it and the variants:
+    proposition -> (capability, values)."""
     outputs = list(automaton.output_variables)
     inputs = list(automaton.input_variables)
+    seen = [k for k, name in enumerate(inputs) if reported is None or name in reported]
     integers = {name: IntegerVariable(name, r.low, r.high) for name, r in system.integers.items()}
     sm_props = list(dict.fromkeys(system.sm_outcomes.values()))
     variants: dict[str, tuple[str, dict[str, object]]] = {}
@@ -74,10 +89,11 @@ def _with_parameter_variants(automaton, system: CapabilitySystem):
         rows.append((state, active, [bool(values.get(o)) for o in sm_props]))
     activation_props = list(variants)
     states = [AutomatonState(name=str(state.name), output_valuation=[p in active for p in activation_props] + exits,
-                             input_valuation=[bool(v) for v in state.input_valuation],
+                             input_valuation=[bool(state.input_valuation[k]) for k in seen],
                              transitions=[str(t) for t in state.transitions], rank=int(getattr(state, 'rank', 0)))
               for state, active, exits in rows]
-    reduced = Automaton(output_variables=activation_props + sm_props, input_variables=inputs, states=states,
+    reduced = Automaton(output_variables=activation_props + sm_props, input_variables=[inputs[k] for k in seen],
+                        states=states,
                         initial_states=[str(n) for n in (getattr(automaton, 'initial_states', None) or [])])
     return reduced, variants
 

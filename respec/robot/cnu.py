@@ -6,6 +6,8 @@ A system file of ours may point at CNU's files instead of describing the robot i
     cnu_capabilities: vending/vending_capabilities.yaml   # required
     cnu_spec: vending/vending_demo_capabilities_spec.yaml # optional: extra propositions, initial values
     cnu_mappings: mappings/global_mappings.yaml           # optional: outcome names, SM outcomes
+    cnu_pipeline: capabilities                            # optional: or full_spec (see below)
+    cnu_state_machine: hello_world/sm/hello_world_sm.yaml # optional: a given machine (see below)
 
 Paths are relative to the system file. Without ``cnu_mappings`` the meaning of CNU's global
 mappings applies (``done``/``finished``/``received``/``true`` complete, the usual failure
@@ -24,6 +26,21 @@ Integer variables (``variable_mappings``, or ``x:0...3`` in the spec) are slugs-
 integers, bit-blasted exactly as structured slugs does (``x@0.0.3``, ``x@1``), so the
 specification files we write are valid structured-slugs input too.
 
+The spec file may hold every section of a slugs specification (INPUT, OUTPUT, ENV_INIT,
+SYS_INIT, ENV_TRANS, SYS_TRANS, ENV_LIVENESS, SYS_LIVENESS; formulas in structured-slugs infix,
+``x'`` or ``next(x)``). CNU's processes pipeline decides what becomes of them, and so does
+``cnu_pipeline``: ``capabilities`` (CNU's capability_processes_def) adds the file's formulas to
+the ones the capabilities give; ``full_spec`` (CNU's full_spec_processes_def) takes the file as
+the whole specification, to which only the request is added; the capabilities then give the
+FlexBE state of each ``<capability>_a``.
+
+``cnu_state_machine`` names a hand-written machine in CNU's ``sm/`` format (CNU's given-automaton
+route, its ``sm_loader``): ``sm: {outcomes, initial_state}`` and ``states``, each with
+``name``, ``state_class``, ``parameters`` (Python source text), ``outcomes``, ``transitions``
+and ``autonomy`` (lists in the order of the outcomes). Its states replace the capabilities:
+each becomes a capability whose transition relation is the machine's, started first if it is
+the initial state, so the request's specification allows exactly the given machine.
+
 Every problem raises ``CapabilityConfigError`` whose ``item`` is ``<capability>.<key>`` (or
 the file key) of the offending entry.
 """
@@ -31,17 +48,19 @@ the file key) of the offending entry.
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Callable
 
 import yaml
 
 from respec.errors import ErrorCode
-from respec.naming import COMPLETED, FINISHED
+from respec.naming import COMPLETED, FINISHED, activation
 from respec.robot.files import SystemConfigError
 
 CAPABILITIES_KEY, SPEC_KEY, MAPPINGS_KEY = 'cnu_capabilities', 'cnu_spec', 'cnu_mappings'
-SYSTEM_FILE_KEYS = ('system', CAPABILITIES_KEY, SPEC_KEY, MAPPINGS_KEY, 'reduce')
+PIPELINE_KEY, STATE_MACHINE_KEY = 'cnu_pipeline', 'cnu_state_machine'
+SYSTEM_FILE_KEYS = ('system', CAPABILITIES_KEY, SPEC_KEY, MAPPINGS_KEY, PIPELINE_KEY, STATE_MACHINE_KEY, 'reduce')
+CAPABILITIES_PIPELINE, FULL_SPEC_PIPELINE = 'capabilities', 'full_spec'   # CNU's two processes pipelines
 FAILURE = 'failure'  # CNU's transition outcome of a failure; success is COMPLETED
 
 # The meaning of CNU's generic global_mappings.yaml, used when a system names no mappings file.
@@ -60,7 +79,9 @@ _INTEGER_DECLARATION = re.compile(r'^([A-Za-z][A-Za-z0-9_]*)\s*:\s*(-?[0-9]+)\s*
 _CAPABILITY_KEYS = ('interface', 'parameters', 'preconditions', 'postconditions', 'transition_relation',
                     'autonomy', 'outcomes')
 _FILE_KEYS = ('name', 'capabilities', 'variable_mappings', 'state_outcome_mappings', 'memory')
-_SPEC_SECTIONS = ('INPUT', 'OUTPUT', 'ENV_INIT', 'SYS_INIT')
+_INITIAL_SECTIONS = ('ENV_INIT', 'SYS_INIT')
+_FORMULA_SECTIONS = (*_INITIAL_SECTIONS, 'ENV_TRANS', 'SYS_TRANS', 'ENV_LIVENESS', 'SYS_LIVENESS')
+_SPEC_SECTIONS = ('INPUT', 'OUTPUT', *_FORMULA_SECTIONS)
 # CNU's files may spell a memory proposition with their suffix; ours is added by respec.naming.
 CNU_MEMORY_SUFFIX = '_m'
 # YAML reads `true`/`false` keys as booleans; CNU's mappings quote them, but be lenient.
@@ -130,6 +151,8 @@ class CapabilitySystem:
     spec_inputs: tuple[str, ...] = ()       # Boolean propositions the spec file adds
     spec_outputs: tuple[str, ...] = ()
     spec_initial: tuple[str, ...] = ()      # the spec's ENV_INIT and SYS_INIT entries (text)
+    spec_formulas: tuple[tuple[str, str], ...] = ()   # (section, e.g. 'sys_trans', infix text), all sections
+    full_spec: bool = False                 # CNU's full-spec pipeline: the spec file is the specification
     reduce: bool = True
     source: str = ''
 
@@ -149,8 +172,8 @@ class CapabilitySystem:
 
 
 def is_capability_document(document: dict) -> bool:
-    """Whether a parsed system file points at CNU capability files."""
-    return isinstance(document, dict) and CAPABILITIES_KEY in document
+    """Whether a parsed system file points at CNU capability files (or a given machine)."""
+    return isinstance(document, dict) and (CAPABILITIES_KEY in document or STATE_MACHINE_KEY in document)
 
 
 def load_capability_system(document: dict, system: str, read: Callable[[str], str]) -> CapabilitySystem:
@@ -163,15 +186,80 @@ def load_capability_system(document: dict, system: str, read: Callable[[str], st
     reduce = document.get('reduce', True)
     if not isinstance(reduce, bool):
         raise CapabilityConfigError(f'{system}.yaml: reduce must be true or false', item='reduce')
-    capabilities = _read_yaml(document, CAPABILITIES_KEY, read, system, required=True)
+    pipeline = document.get(PIPELINE_KEY, CAPABILITIES_PIPELINE)
+    if pipeline not in (CAPABILITIES_PIPELINE, FULL_SPEC_PIPELINE):
+        raise CapabilityConfigError(f'{system}.yaml: {PIPELINE_KEY} must be {CAPABILITIES_PIPELINE} or '
+                                    f'{FULL_SPEC_PIPELINE}, got {pipeline!r}', item=PIPELINE_KEY)
+    machine = _read_yaml(document, STATE_MACHINE_KEY, read, system)
+    capabilities = _read_yaml(document, CAPABILITIES_KEY, read, system, required=machine is None)
     spec = _read_yaml(document, SPEC_KEY, read, system) or {}
     mappings = _read_yaml(document, MAPPINGS_KEY, read, system)
-    return capability_system_from_dicts(capabilities, spec, mappings, system, reduce,
-                                        source=str(document[CAPABILITIES_KEY]))
+    initial = ()
+    if machine is not None:
+        if capabilities is not None and not isinstance(capabilities, dict):
+            raise CapabilityConfigError(f'{system}: the capabilities file must hold a mapping', item=CAPABILITIES_KEY)
+        given, initial = capabilities_of_state_machine(machine, system)
+        capabilities = {**(capabilities or {}), 'capabilities': given}
+    result = capability_system_from_dicts(capabilities, spec, mappings, system, reduce,
+                                          source=str(document.get(CAPABILITIES_KEY) or document[STATE_MACHINE_KEY]),
+                                          full_spec=pipeline == FULL_SPEC_PIPELINE)
+    if machine is not None:
+        _check_one_target_per_outcome(result)
+        result = replace(result, spec_initial=(*result.spec_initial, *initial))
+    return result
+
+
+def capabilities_of_state_machine(machine: object, system: str) -> tuple[dict, tuple[str, ...]]:
+    """A machine in CNU's ``sm/`` format as capability entries, and the initial condition that
+    starts its initial state. Parameters are Python source text already: ``*`` keeps them verbatim
+    (``sm_generation.capabilities.parameter_source``)."""
+    where = f'{system}: the state machine file'
+    if not isinstance(machine, dict) or not isinstance(machine.get('sm'), dict) \
+            or not isinstance(machine.get('states'), list) or not machine['states']:
+        raise CapabilityConfigError(f'{where} must hold sm (outcomes, initial_state) and a list of states',
+                                    item=STATE_MACHINE_KEY)
+    capabilities = {}
+    for index, state in enumerate(machine['states']):
+        name = state.get('name') if isinstance(state, dict) else None
+        item = f'states.{name if isinstance(name, str) else index}'
+        if not isinstance(name, str) or not _NAME.match(name) or name in capabilities:
+            raise CapabilityConfigError(f'{where}: state {index} needs a new name', item=item)
+        outcomes, transitions = state.get('outcomes') or [], state.get('transitions') or []
+        autonomy = state.get('autonomy') or []
+        parameters = state.get('parameters') or {}
+        if (not isinstance(outcomes, list) or not isinstance(transitions, list) or not isinstance(autonomy, list)
+                or len(transitions) != len(outcomes) or len(autonomy) not in (0, len(outcomes))):
+            raise CapabilityConfigError(f'{where}: state {name!r} needs outcomes, transitions and autonomy '
+                                        'as lists of one length', item=item)
+        if not isinstance(parameters, dict):
+            raise CapabilityConfigError(f'{where}: state {name!r}: parameters must be a mapping', item=item)
+        capabilities[name] = {
+            'interface': state.get('state_class'),
+            'parameters': {key: f'*{value}' for key, value in parameters.items()},
+            'outcomes': [_word(o) for o in outcomes],
+            'transition_relation': {_word(o): [str(t)] for o, t in zip(outcomes, transitions)},
+            'autonomy': {_word(o): level for o, level in zip(outcomes, autonomy)},
+        }
+    first = machine['sm'].get('initial_state', machine['states'][0].get('name'))
+    if first not in capabilities:
+        raise CapabilityConfigError(f'{where}: initial_state {first!r} is none of its states', item='sm.initial_state')
+    return capabilities, (activation(first),)
+
+
+def _check_one_target_per_outcome(system: CapabilitySystem) -> None:
+    """Two FlexBE outcomes of a given state that mean the same transition outcome must lead to the
+    same state: the specification sees the transition outcome only."""
+    for name, capability in system.capabilities.items():
+        for outcome, clauses in capability.transition_relation.items():
+            if len(set(clauses)) > 1:
+                raise CapabilityConfigError(
+                    f'{system.system}: state {name!r} leads to different states on outcomes that all mean '
+                    f'{outcome!r}; give them different transition outcomes in the mappings', item=f'states.{name}')
 
 
 def capability_system_from_dicts(capabilities: object, spec: object = None, mappings: object = None,
-                                 system: str = '<dict>', reduce: bool = True, source: str = '') -> CapabilitySystem:
+                                 system: str = '<dict>', reduce: bool = True, source: str = '',
+                                 full_spec: bool = False) -> CapabilitySystem:
     """Validate parsed CNU files (capabilities, spec, mappings) and build the system."""
     if not isinstance(capabilities, dict):
         raise CapabilityConfigError(f'{system}: the capabilities file must hold a mapping', item=CAPABILITIES_KEY)
@@ -188,7 +276,7 @@ def capability_system_from_dicts(capabilities: object, spec: object = None, mapp
                                         f'{", ".join(transition_outcomes)}', item=f'state_outcome_mappings.{outcome}')
 
     integers = _integers(capabilities.get('variable_mappings'), system)
-    inputs, outputs, initial = _spec(spec, system, integers)
+    inputs, outputs, initial, formulas = _spec(spec, system, integers)
     memory = _memory(capabilities.get('memory'), system)
     raw = capabilities.get('capabilities')
     if not isinstance(raw, dict) or not raw:
@@ -202,7 +290,8 @@ def capability_system_from_dicts(capabilities: object, spec: object = None, mapp
     result = CapabilitySystem(system=system, capabilities=parsed, integers=integers, memory=memory,
                               state_outcomes=state_outcomes, sm_outcomes=sm_outcomes,
                               transition_outcomes=transition_outcomes, spec_inputs=inputs, spec_outputs=outputs,
-                              spec_initial=initial, reduce=reduce, source=source)
+                              spec_initial=initial, spec_formulas=formulas, full_spec=full_spec, reduce=reduce,
+                              source=source)
     _check_targets(result)
     return result
 
@@ -286,20 +375,22 @@ def _integers(raw, system: str) -> dict[str, IntegerRange]:
 
 
 def _spec(spec, system: str, integers: dict[str, IntegerRange]):
-    """The spec file's propositions and initial values (its formulas are the capabilities')."""
+    """The spec file's propositions, its initial values (text) and its formulas (section, text)."""
     if not spec:
-        return (), (), ()
+        return (), (), (), ()
     if not isinstance(spec, dict):
         raise CapabilityConfigError(f'{system}: the spec file must hold a mapping', item=SPEC_KEY)
     sections = spec.get('specs') or {}
     if not isinstance(sections, dict):
         raise CapabilityConfigError(f'{system}: specs must map slugs sections to lists', item='specs')
-    inputs, outputs, initial = [], [], []
+    inputs, outputs, initial, formulas = [], [], [], []
     for section, entries in sections.items():
         where = f'specs.{section}'
         if section not in _SPEC_SECTIONS:
             raise CapabilityConfigError(f'{system}: spec section {section!r} is not supported for capability '
                                         f'systems (supported: {", ".join(_SPEC_SECTIONS)})', item=where)
+        if entries is None:   # a header without entries, as slugs allows
+            continue
         if not isinstance(entries, list) or not all(isinstance(e, str) and e.strip() for e in entries):
             raise CapabilityConfigError(f'{system}: {where} must be a list of strings', item=where)
         for entry in entries:
@@ -320,8 +411,10 @@ def _spec(spec, system: str, integers: dict[str, IntegerRange]):
                     raise CapabilityConfigError(f'{system}: {where} entry {entry!r} is not a name or '
                                                 'name:low...high', item=entry)
             else:
-                initial.append(entry)
-    return tuple(inputs), tuple(outputs), tuple(initial)
+                formulas.append((section.lower(), entry))
+                if section in _INITIAL_SECTIONS:
+                    initial.append(entry)
+    return tuple(inputs), tuple(outputs), tuple(initial), tuple(formulas)
 
 
 def _memory(raw, system: str) -> dict[str, bool]:

@@ -1,7 +1,8 @@
 """Robots described by CNU's capability YAML (flexbe_synthesis) as robot systems of ours.
 
 CNU's examples come from the pinned snapshot (``flexbe_sources``); each test writes a system
-file into tmp_path that points at them, as a user's config/<system>.yaml would.
+file into tmp_path that points at them, as a user's config/<system>.yaml would. All of CNU's
+example pairs (``cnu_example_pairs``, read from CNU's own test) run with CNU's request defaults.
 """
 
 from pathlib import Path
@@ -15,30 +16,35 @@ from ltl_synthesizer import synthesize
 from respec.automaton import automaton_from_strategy
 from respec.robot import robot_system
 from respec.robot.cnu import CapabilityConfigError
-from respec.ltl import conj, evaluate
+from ltl_specification.errors import UnknownPropositionError
+from respec.ltl import conj, evaluate, to_infix
 from respec.robot.state_library import StateClass, StateClassError, workspace_state_library
 from sm_generation import generate_state_machine, validate_state_machine
 
-# CNU's request defaults (flexbe_synthesis_examples/request_*.py) and the state counts
-# test_synthesis_example_pairs.py expects (post-reduction).
+from cnu_example_pairs import example_pairs, write_system_file
+
+# CNU's example files with CNU's request defaults (flexbe_synthesis_examples/request_*.py), for
+# the tests below that look into one machine; all of CNU's pairs run in
+# test_all_of_cnus_example_pairs_succeed_with_at_most_cnus_state_count. ``top_level`` bounds the
+# machine's own states (the capability states, without the root and the outcomes).
 EXAMPLES = {
     'coffee_maker': dict(capabilities='coffee_maker/capabilities/coffee_capabilities.yaml',
                          spec='coffee_maker/specs/coffee_demo_capabilities_spec.yaml', mappings='infinite_mappings.yaml',
-                         initial_conditions=['bd_a'], goals=['br_c'], cnu_states=4),
+                         initial_conditions=['bd_a'], goals=['br_c'], top_level=3),
     'coffee_maker_extended': dict(capabilities='coffee_maker/capabilities/coffee_capabilities_extended.yaml',
                                   spec='coffee_maker/specs/coffee_demo_capabilities_spec.yaml',
                                   mappings='infinite_mappings.yaml', initial_conditions=['bd_a'], goals=['br_c'],
-                                  cnu_states=4),
+                                  top_level=3),
     'vending_demo': dict(capabilities='vending_demo/capabilities/vending_capabilities.yaml',
                          spec='vending_demo/specs/vending_demo_capabilities_spec.yaml', mappings='global_mappings.yaml',
-                         initial_conditions=['prep_pay_a'], goals=['soda'], cnu_states=6),
+                         initial_conditions=['prep_pay_a'], goals=['soda'], top_level=4),
     'vending_demo_extended': dict(capabilities='vending_demo/capabilities/vending_capabilities_extended.yaml',
                                   spec='vending_demo/specs/vending_demo_capabilities_spec.yaml',
                                   mappings='global_mappings.yaml', initial_conditions=['prep_pay_a'], goals=['soda'],
-                                  cnu_states=6),
-    # CNU runs hello_world from a fixed machine (4 states); synthesizing it needs a goal.
+                                  top_level=4),
+    # CNU's hello_world pair runs a given machine; here its capabilities are synthesized, for a goal.
     'hello_world': dict(capabilities='hello_world/capabilities/hello_world_capabilities.yaml', spec=None,
-                        mappings='global_mappings.yaml', initial_conditions=[], goals=['say_world'], cnu_states=4),
+                        mappings='global_mappings.yaml', initial_conditions=[], goals=['say_world'], top_level=2),
 }
 
 
@@ -130,7 +136,7 @@ def test_cnu_example_requests_succeed_with_at_most_cnus_state_count(name, cnu, l
     # A machine that never exits (CNU's coffee maker) has no outcomes, which our validator flags.
     never_exits = ['/: a container needs outcomes'] if not states[0].outcomes else []
     assert validate_state_machine(states) == never_exits
-    assert len(top_level_states(states)) <= example['cnu_states']
+    assert len(top_level_states(states)) <= example['top_level']
     # Every capability state is the capability's own FlexBE class with its parameters.
     capabilities = robot_system(name, tmp_path).capabilities.capabilities
     for state in top_level_states(states):
@@ -138,6 +144,110 @@ def test_cnu_example_requests_succeed_with_at_most_cnus_state_count(name, cnu, l
         assert state.state_class == capability.interface
         assert dict(zip(state.parameter_names, state.parameter_values))['text' if 'text' in capability.parameters
                                                                         else 'hint'] is not None
+
+
+def test_all_of_cnus_example_pairs_succeed_with_at_most_cnus_state_count(cnu, library, tmp_path):
+    """CNU's 11 pairs (its test's list, its request defaults): the capability pipeline, the full
+    specifications and hello_world's given machine, each in a config folder of its own under the
+    request's system name, as CNU's launch serves it. CNU's count is every StateInstantiation."""
+    pairs = example_pairs(cnu)
+    assert len(pairs) == 11 and {p.files.get('cnu_pipeline') for p in pairs} == {'capabilities', 'full_spec', None}
+    results = {}
+    for pair in pairs:
+        config_dir = tmp_path / pair.launch
+        write_system_file(config_dir, pair)
+        request = pair.request
+        spec = compile_task(request['system_name'], request['initial_conditions'], request['goals'],
+                            config_dir=config_dir, state_library=library)
+        result = synthesize(spec)
+        assert result.realizable, pair.launch
+        assert strategy_violations(spec, result.strategy) == [], pair.launch
+        automaton = automaton_from_strategy(result.strategy, spec)
+        states = generate_state_machine(automaton, request['system_name'], config_dir, state_library=library)
+        never_exits = ['/: a container needs outcomes'] if not states[0].outcomes else []
+        assert validate_state_machine(states) == never_exits, pair.launch
+        assert states[0].outcomes == request['outcomes'], pair.launch
+        results[pair.launch] = (len(states), pair.cnu_state_count, [s.name for s in top_level_states(states)])
+    assert all(count <= cnu_count for count, cnu_count, _ in results.values()), results
+    # The machines do what CNU's do: hello_world is its given machine, the others CNU's sequences.
+    assert results['hello_world_example.launch.py'][2] == ['SayHello', 'SayWorld']
+    assert results['coffee_full_spec_example.launch.py'][2] == ['bd', 'gr', 'br']
+    assert results['vending_full_spec_example.launch.py'][2] == ['prep_pay', 'pay', 'select', 'soda']
+
+
+def test_a_given_machine_is_generated_as_given(cnu, library, tmp_path):
+    """CNU's sm/ file: classes, parameters (Python source), transitions and autonomy unchanged."""
+    (pair,) = [p for p in example_pairs(cnu) if 'cnu_state_machine' in p.files]
+    write_system_file(tmp_path, pair)
+    spec = compile_task('hello_world', [], [], config_dir=tmp_path, state_library=library)
+    automaton = automaton_from_strategy(synthesize(spec).strategy, spec)
+    states = generate_state_machine(automaton, 'hello_world', tmp_path, state_library=library)
+    given = yaml.safe_load(pair.files['cnu_state_machine'].read_text())
+    assert states[0].initial_state_name == given['sm']['initial_state']
+    assert [(s.name, s.state_class, dict(zip(s.parameter_names, s.parameter_values)), s.outcomes, s.transitions,
+             s.autonomy) for s in top_level_states(states)] == [
+        (g['name'], g['state_class'], g['parameters'], g['outcomes'], g['transitions'], g['autonomy'])
+        for g in given['states']]
+
+
+def test_full_spec_request_replaces_the_files_initial_literal_and_reads_goals_as_memories(cnu, library, tmp_path):
+    (pair,) = [p for p in example_pairs(cnu) if p.launch == 'vending_full_spec_example.launch.py']
+    write_system_file(tmp_path, pair)
+    spec = compile_task('vending_demo', ['prep_pay_a'], ['soda'], config_dir=tmp_path, state_library=library)
+    sys_init = [to_infix(f) for f in spec.sys_init]
+    assert 'prep_pay_a' in sys_init and '!prep_pay_a' not in sys_init   # the file says ! prep_pay_a
+    assert any("soda_m" in to_infix(f) and "finished" in to_infix(f) for f in spec.sys_trans)
+    with pytest.raises(UnknownPropositionError) as unknown:
+        compile_task('vending_demo', [], ['lemonade'], config_dir=tmp_path, state_library=library)
+    assert unknown.value.item == 'lemonade'
+
+
+def test_full_spec_goals_recur_without_a_success_outcome(cnu, library, tmp_path):
+    (pair,) = [p for p in example_pairs(cnu) if p.launch == 'coffee_full_spec_example.launch.py']
+    write_system_file(tmp_path, pair)
+    spec = compile_task('coffee_maker', ['bd_a'], ['br_c'], config_dir=tmp_path, state_library=library)
+    assert [to_infix(f) for f in spec.sys_liveness] == ['br_c'] and spec.env_liveness   # the file's `bu`
+    assert 'bu' in spec.env_props
+
+
+def test_empty_goals_add_no_success_formula(cnu, library, tmp_path):
+    example_system(tmp_path, cnu, 'vending_demo')
+    with_goal = compile_task('vending_demo', ['prep_pay_a'], ['soda'], config_dir=tmp_path, state_library=library)
+    without = compile_task('vending_demo', ['prep_pay_a'], [], config_dir=tmp_path, state_library=library)
+    assert [to_infix(f) for f in with_goal.sys_liveness] == ['finished'] and without.sys_liveness == []
+    assert len(with_goal.sys_trans) == len(without.sys_trans) + 1
+
+
+def test_a_given_state_with_two_targets_for_one_transition_outcome_is_named(library, tmp_path):
+    machine = {'sm': {'outcomes': ['finished'], 'initial_state': 'Ask'},
+               'states': [{'name': 'Ask', 'state_class': 'LogState', 'parameters': {'text': "'?'"},
+                           'outcomes': ['done', 'finished'], 'transitions': ['Ask', 'finished']}]}
+    (tmp_path / 'sm.yaml').write_text(yaml.safe_dump(machine))
+    write_system(tmp_path, 'robot', None, cnu_state_machine='sm.yaml')
+    with pytest.raises(CapabilityConfigError) as error:
+        compile_task('robot', [], [], config_dir=tmp_path, state_library=library)
+    assert error.value.item == 'states.Ask' and "'completed'" in str(error.value)
+
+
+def test_spec_file_formulas_join_the_capabilities_in_cnus_capability_pipeline(cnu, library, tmp_path):
+    """A spec file's SYS_TRANS (CNU's own remedy for a capability that must not restart) is added."""
+    example_system(tmp_path / 'plain', cnu, 'vending_demo')
+    plain = compile_task('vending_demo', ['prep_pay_a'], ['soda'], config_dir=tmp_path / 'plain', state_library=library)
+    spec_file = tmp_path / 'spec.yaml'
+    spec_file.write_text(yaml.safe_dump({'specs': {'OUTPUT': ['prep_pay_a', 'item:0...3'],
+                                                   'SYS_INIT': ['prep_pay_a', 'item=0'],
+                                                   'SYS_TRANS': ["pay_c' -> !prep_pay_a'"]}}))
+    examples = cnu / 'flexbe_synthesis_examples' / 'example'
+    write_system(tmp_path / 'more', 'vending_demo', cnu,
+                 cnu_capabilities=examples / EXAMPLES['vending_demo']['capabilities'], cnu_spec=spec_file,
+                 cnu_mappings=cnu / 'flexbe_synthesis_generic' / 'mappings' / 'global_mappings.yaml')
+    more = compile_task('vending_demo', ['prep_pay_a'], ['soda'], config_dir=tmp_path / 'more', state_library=library)
+    added = [to_infix(f) for f in more.sys_trans if f not in plain.sys_trans]
+    assert added == ['next(pay_c) -> !next(prep_pay_a)'] and synthesize(more).realizable
+    spec_file.write_text(yaml.safe_dump({'specs': {'SYS_TRANS': ['ghost -> pay_a']}}))
+    with pytest.raises(CapabilityConfigError) as unknown:
+        compile_task('vending_demo', ['prep_pay_a'], ['soda'], config_dir=tmp_path / 'more', state_library=library)
+    assert unknown.value.item == 'specs.SYS_TRANS' and 'ghost' in str(unknown.value)
 
 
 def test_coffee_maker_cycles_button_grind_brew_and_retries_failures(cnu, library, tmp_path):
@@ -325,36 +435,6 @@ def test_cnu_examples_through_our_behavior_synthesis_action(cnu, flexbe, tmp_pat
     bad = client.run(make_goal(system='vending_demo_extended', initial_conditions=['prep_pay_a'],
                                goals=['lemonade']), timeout=60)
     assert bad.error_name == 'UNKNOWN_PROPOSITION' and 'lemonade' in bad.message
-
-
-def test_cnu_examples_through_cnus_own_action_type(cnu, flexbe, tmp_path, ros, monkeypatch):
-    """An unmodified client of flexbe_synthesis_msgs/FlexBESynthesis sends CNU's request defaults."""
-    from flexbe_synthesis_msgs.msg import SynthesisErrorCode
-
-    from synthesis_manager.suite import suite_node_factories
-    from test_cnu_interface import PlainCnuClient
-    from test_synthesis_manager_pipeline import suite_args
-
-    monkeypatch.setenv('AMENT_PREFIX_PATH', str(flexbe))
-    config_dir = tmp_path / 'config'
-    names = ('coffee_maker', 'vending_demo', 'hello_world')
-    for name in names:
-        example_system(config_dir, cnu, name)
-    for factory in suite_node_factories(suite_args(tmp_path, config_dir=str(config_dir))):
-        ros.add_node(factory)
-    client = PlainCnuClient(ros)
-    try:
-        for name in names:
-            example = EXAMPLES[name]
-            goal = client.goal(example['initial_conditions'], example['goals'], system_name=name,
-                               sm_outcomes=['finished', 'failed'])
-            result = client.run(goal).result
-            assert result.error_code.value == SynthesisErrorCode.SUCCESS, (name, list(result.messages))
-            top = [s for s in result.states if s.state_path.count('/') == 1
-                   and s.state_class != ':OUTCOME' and s.state_path != '/']
-            assert 0 < len(top) <= example['cnu_states'], (name, [s.state_path for s in top])
-    finally:
-        client.close()
 
 
 def test_no_initial_conditions_keep_cnus_meaning_for_capability_systems(cnu, tmp_path):

@@ -230,6 +230,43 @@ def test_cancel_from_an_unmodified_cnu_client(plain_cnu_client, runaway_synthesi
     assert response.result.messages[-1].startswith('PREEMPTED:')
 
 
+def test_all_of_cnus_example_pairs_through_an_unmodified_cnu_client(cnu_package, flexbe, flexbe_sources, tmp_path,
+                                                                    monkeypatch):
+    """CNU's 11 pairs, each served as CNU's launch serves it (its own config folder, the system
+    under the request's name) and requested with CNU's request defaults unchanged, on
+    /flexbe_synthesis: SUCCESS with at most CNU's count of StateInstantiations."""
+    from flexbe_synthesis_msgs.msg import SynthesisErrorCode
+
+    from cnu_example_pairs import example_pairs, write_system_file
+    from synthesis_manager.ros.harness import RosHarness
+
+    monkeypatch.setenv('AMENT_PREFIX_PATH', str(flexbe))   # the nodes read the workspace's state classes
+    pairs = example_pairs(flexbe_sources / 'flexbe_synthesis')
+    assert len(pairs) == 11
+    counts = {}
+    for pair in pairs:
+        config_dir = tmp_path / pair.launch
+        write_system_file(config_dir, pair)
+        with RosHarness() as ros:
+            args = Namespace(config_dir=str(config_dir), byproducts_dir=str(tmp_path / 'byproducts'),
+                             backend='builtin', slugs_executable='slugs', synthesis_timeout=60.0,
+                             service_timeout=2.0, default_system='')
+            for factory in suite_node_factories(args):
+                ros.add_node(factory)
+            client = PlainCnuClient(ros)
+            try:
+                request = pair.request
+                goal = client.goal(request['initial_conditions'], request['goals'],
+                                   system_name=request['system_name'], spec_name=request['spec_name'],
+                                   sm_outcomes=request['outcomes'])
+                result = client.run(goal).result
+            finally:
+                client.close()
+        assert result.error_code.value == SynthesisErrorCode.SUCCESS, (pair.launch, list(result.messages))
+        counts[pair.launch] = (len(result.states), pair.cnu_state_count)
+    assert all(0 < ours <= cnu for ours, cnu in counts.values()), counts
+
+
 # --- Without CNU's package ---------------------------------------------------------------------
 
 @pytest.fixture

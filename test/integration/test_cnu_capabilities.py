@@ -209,6 +209,16 @@ def test_missing_state_class_and_unknown_parameter_are_named(cnu, tmp_path):
     assert parameter.value.item == 'prep_pay.parameters.text'  # the first capability of the file
 
 
+def test_a_missing_flexbe_workspace_says_what_to_set(cnu, tmp_path):
+    example_system(tmp_path, cnu, 'vending_demo')
+    for library in ({}, workspace_state_library(str(tmp_path))):  # nothing, or no FlexBE package, on the path
+        with pytest.raises(StateClassError) as missing:
+            compile_task('vending_demo', ['prep_pay_a'], ['soda'], config_dir=tmp_path, state_library=library)
+        message = str(missing.value)
+        assert 'no FlexBE state package is on AMENT_PREFIX_PATH at all' in message
+        assert 'source <workspace>/install/setup.bash' in message and '`make flexbe`' in message
+
+
 def test_the_workspace_library_reads_flexbe_state_packages_without_importing_them(library):
     log = library['LogState']
     assert log.package == 'flexbe_states' and log.outcomes == ('done',) and log.required == ('text',)

@@ -21,6 +21,7 @@ from ltl_specification.compiler import compile_task, explain
 from ltl_specification.errors import InvalidFormulaError, SpecificationError
 from respec.errors import ExitStatus, exit_status_help
 from respec.naming import parse_names
+from respec.robot.files import add_config_dir_argument
 
 FORMATS = ('structuredslugs', 'slugsin', 'json')
 
@@ -38,7 +39,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument('--unordered', action='store_true', help='goals may be achieved in any order')
     parser.add_argument('--format', choices=FORMATS, default='structuredslugs', help='output format')
     parser.add_argument('-o', '--output', help='write to FILE instead of standard output')
-    parser.add_argument('--config-dir', help='directory of <system>.yaml files')
+    add_config_dir_argument(parser)
     parser.add_argument('--custom-ltl', metavar='FILE',
                         help='YAML/JSON mapping of LTLSpecification sections to extra formulas')
     parser.add_argument('--explain', action='store_true', help='also print why each item is included (stderr)')

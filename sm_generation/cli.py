@@ -15,6 +15,7 @@ from pathlib import Path
 
 from respec.errors import ExitStatus, exit_status_help
 from respec.naming import parse_names
+from respec.robot.files import add_config_dir_argument
 from sm_generation.automaton_io import load_automaton
 from sm_generation.errors import SMGenerationError
 from sm_generation.export import RENDER_FORMATS, RenderError, render, to_dot, to_json, to_yaml
@@ -30,7 +31,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument('--automaton', required=True, type=Path,
                         help='automaton file: our YAML/JSON format, or a slugs JSON strategy (needs --spec)')
     parser.add_argument('--spec', type=Path, help='the .structuredslugs spec a slugs strategy was made from')
-    parser.add_argument('--config-dir', type=Path, help='directory of system configuration files')
+    add_config_dir_argument(parser)
     parser.add_argument('--initial-conditions', default=None,
                         help='comma-separated initial conditions, e.g. stand_prep')
     parser.add_argument('--reduce', action='store_true', help='merge equivalent states')

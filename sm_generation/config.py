@@ -35,12 +35,11 @@ is the dotted key of the offending entry (e.g. ``flexbe.states.look_down_a.auton
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from pathlib import Path
 
 from respec.naming import activated
 from sm_generation.instantiation import StateInstantiation
 from respec.robot import RobotSystem, robot_system
-from respec.robot.files import ConfigFileInvalidError, SystemNotFoundError
+from respec.robot.files import ConfigDirectoryNotFoundError, ConfigDirs, ConfigFileInvalidError, SystemNotFoundError
 from sm_generation.errors import (AutonomyConfigInvalidError, FlexBEConfigInvalidError, NoSystemConfigError,
                                   SMGenerationError, StateConfigInvalidError, SystemConfigNotFoundError,
                                   UserdataConfigInvalidError)
@@ -123,15 +122,14 @@ def input_request_capabilities(config: FlexBEConfig) -> dict[int, str]:
     return capabilities
 
 
-def generation_system(system: RobotSystem | str, config_dir: str | Path | None = None) -> RobotSystem:
+def generation_system(system: RobotSystem | str, config_dir: ConfigDirs = None) -> RobotSystem:
     """``system``, or the system of that name, with sm_generation's codes when it cannot be found."""
     if isinstance(system, RobotSystem):
         return system
-    if config_dir is not None and not Path(config_dir).is_dir():
-        raise SystemConfigNotFoundError(f'configuration directory {config_dir} does not exist',
-                                        str(config_dir))
     try:
         return robot_system(system, config_dir)
+    except ConfigDirectoryNotFoundError as error:
+        raise SystemConfigNotFoundError(str(error), error.item) from error
     except SystemNotFoundError as error:
         raise NoSystemConfigError(str(error), error.item or system) from error
     except ConfigFileInvalidError as error:

@@ -7,7 +7,9 @@ The task goes through the ``/behavior_synthesis`` action with the suite's nodes 
 in-process (as ``execute`` does); the returned state machine is written to ``DIR/PKG``
 (default package ``synthesized_flexbe_behaviors``) as FlexBE's editor saves a behavior: the
 behavior module and its manifest, plus package.xml/setup.py for colcon
-(``sm_generation.flexbe_behavior``). ``--name`` names the behavior (default: from the goals,
+(``sm_generation.flexbe_behavior``). Any system can be exported: ATLAS-style systems through
+their ``flexbe:`` section, CNU capability systems through their capabilities and the state
+classes of the FlexBE workspace on ``AMENT_PREFIX_PATH``. ``--name`` names the behavior (default: from the goals,
 e.g. "Look Down Pickup Object").
 
 Exit status: 0 written; 2 bad name, package or configuration; 3 synthesis failed; 130, 143
@@ -39,9 +41,11 @@ def add_arguments(parser):
 
 
 def run(args) -> int:
+    from respec.errors import CodedError
     from respec.naming import parse_names
     from sm_generation import SMGenerationError, StateInstantiation
-    from sm_generation.config import flexbe_config, generation_system
+    from sm_generation.config import generation_system
+    from sm_generation.for_system import behavior_flexbe_config
     from sm_generation.flexbe_behavior import (behavior_package, check_behavior_name, check_package_name,
                                                default_behavior_name)
 
@@ -50,8 +54,8 @@ def run(args) -> int:
     try:  # bad names and configurations are usage errors, found before synthesis
         check_behavior_name(behavior_name)
         check_package_name(args.package)
-        config = flexbe_config(generation_system(args.system, args.config_dir or None))
-    except SMGenerationError as error:
+        config = behavior_flexbe_config(generation_system(args.system, args.config_dir or None))
+    except CodedError as error:
         print(f'export-behavior: {error.code}: {error}', file=sys.stderr)
         return ExitStatus.USAGE
     progress = ProgressBar(stream=sys.stderr)  # the stream of now (the default is the one at import)

@@ -9,6 +9,7 @@ from rclpy.node import Node
 from rclpy.parameter import Parameter
 
 from respec.errors import CodedError, ErrorCode
+from respec.robot.files import add_config_dir_argument
 from synthesis_manager.client import SynthesisClient
 from synthesis_manager.nodes.ltl_compilation_node import LTLCompilationNode
 from synthesis_manager.nodes.ltl_synthesis_node import LTLSynthesisNode
@@ -22,7 +23,7 @@ SUITE_NODE_NAMES = ('ltl_compilation', 'ltl_synthesis', 'sm_generation', 'behavi
 def add_suite_arguments(parser):
     """Command-line settings shared by ``serve``, ``demo`` and ``execute``."""
     group = parser.add_argument_group('suite settings')
-    group.add_argument('--config-dir', default='', help='robot system configurations (default: config/)')
+    add_config_dir_argument(group)
     group.add_argument('--byproducts-dir', default='', help='where the synthesizer writes its byproducts')
     group.add_argument('--keep-byproducts', type=int, default=None, metavar='N',
                        help="keep the newest N spec names' byproduct files (default 200; 0: none)")

@@ -24,6 +24,10 @@ from respec.robot.cnu import CapabilityConfigError, CapabilitySystem
 from respec.errors import ErrorCode
 
 FLEXBE_STATES_EXPORT = '<flexbe_states'
+#: What to do when a capability's state class is not found: where the classes are looked for.
+WORKSPACE_HINT = ('AMENT_PREFIX_PATH must hold the FlexBE workspace that defines it: source that workspace '
+                  '(source <workspace>/install/setup.bash), or in this repository run `make flexbe` and add '
+                  '.venv/flexbe to AMENT_PREFIX_PATH')
 
 
 @dataclass(frozen=True)
@@ -142,10 +146,11 @@ def capability_outcomes(system: CapabilitySystem, library: Mapping[str, StateCla
     for name, capability in system.capabilities.items():
         state = library.get(capability.interface)
         if state is None:
-            known = ', '.join(sorted(library)) or 'none: no FlexBE state package on AMENT_PREFIX_PATH'
+            found = (f'known: {", ".join(sorted(library))}' if library
+                     else 'no FlexBE state package is on AMENT_PREFIX_PATH at all')
             raise StateClassError(f'{system.system}: capability {name!r} uses state class {capability.interface!r}, '
-                                  f'which no FlexBE state package in the workspace defines (known: {known})',
-                                  item=f'{name}.interface')
+                                  f'which no FlexBE state package in the workspace defines ({found}); '
+                                  f'{WORKSPACE_HINT}', item=f'{name}.interface')
         for parameter in capability.parameters:
             if parameter not in state.parameters and not state.accepts_any:
                 raise StateClassError(f'{system.system}: capability {name!r}: {capability.interface} '

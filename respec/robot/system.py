@@ -1,6 +1,7 @@
 """``RobotSystem``: one robot system, loaded once from its file(s), validated, immutable.
 
-A robot system is one YAML file, ``<config_dir>/<name>.yaml``, in one of two kinds:
+A robot system is one YAML file, ``<directory>/<name>.yaml`` (the first on the search path,
+``respec.robot.files.config_search_path``), in one of two kinds:
 
 ``abstraction``   our own format (ATLAS-style): an ``abstraction:`` section with control modes,
                   actions, outcomes and sensors (``respec.robot.abstraction``), a ``flexbe:``
@@ -26,8 +27,8 @@ from typing import Callable, Mapping
 
 from respec.robot.abstraction import RobotAbstraction, abstraction_from_document
 from respec.robot.cnu import CapabilitySystem, is_capability_document, load_capability_system
-from respec.robot.files import (ConfigFileInvalidError, SystemConfigError, SystemNotFoundError, available_systems,
-                                default_config_dir, parse_config_text, system_config_path)
+from respec.robot.files import (ConfigDirs, ConfigFileInvalidError, SystemConfigError, SystemNotFoundError,
+                                available_systems, parse_config_text, system_config_path)
 
 ABSTRACTION_KIND = 'abstraction'
 CAPABILITIES_KIND = 'capabilities'
@@ -116,8 +117,9 @@ def _robot_system(name: str, path: Path, read: Callable[[str], str]) -> RobotSys
                        files=MappingProxyType(files))
 
 
-def robot_system(system: RobotSystem | str, config_dir: str | Path | None = None) -> RobotSystem:
-    """``system`` itself, or the system of that name in ``config_dir`` (default: ``config/``).
+def robot_system(system: RobotSystem | str, config_dir: ConfigDirs = None) -> RobotSystem:
+    """``system`` itself, or the system of that name: the first found in ``config_dir`` (one
+    directory or several, see ``config_search_path``), ``$BEHAVIOR_SYNTHESIS_CONFIG_DIR``, ``config/``.
 
     The edge where a name becomes a RobotSystem: raises SystemNotFoundError for an unknown
     name and a SystemConfigError subclass (naming the entry) for an invalid file.
@@ -129,22 +131,20 @@ def robot_system(system: RobotSystem | str, config_dir: str | Path | None = None
 
 @dataclass(frozen=True)
 class SystemCatalog:
-    """The robot systems of a config directory: their names, and each one loaded on request.
+    """The robot systems of a search path: their names, and each one loaded on request.
 
-    Loading reads the files afresh, so a request sees a system file as it is when it arrives.
+    ``config_dir`` adds directories before the shipped ``config/`` (``config_search_path``);
+    ``names()`` is the union, a name in an earlier directory shadowing a later one. Loading reads
+    the files afresh, so a request sees a system file as it is when it arrives.
     """
 
-    config_dir: Path | None = None
-
-    @property
-    def directory(self) -> Path:
-        return Path(self.config_dir) if self.config_dir else default_config_dir()
+    config_dir: ConfigDirs = None
 
     def names(self) -> list[str]:
-        return available_systems(self.directory)
+        return available_systems(self.config_dir)
 
     def load(self, name: RobotSystem | str) -> RobotSystem:
-        return robot_system(name, self.directory)
+        return robot_system(name, self.config_dir)
 
 
 # --- a catalog as text: how a suite serves its systems to a GUI running elsewhere ---------------

@@ -19,7 +19,7 @@
   (0: as fast as possible; the default 10 is faster than real time), also between
   requests, as a real robot keeps balancing.
 
-Parameters: ``system`` (atlas), ``config_dir`` ('' = config/), ``initial_conditions``,
+Parameters: ``system`` (atlas), ``config_dir`` (searched before config/), ``initial_conditions``,
 ``fail`` (capabilities that always fail), ``fail_first`` ('capability:k'), ``seed``
 (-1: the config's), ``speed``, ``state_rate``, ``batch_window``. List parameters take a
 string array or a comma-separated string. Run it with ``atlas-sim-node`` (DDS stays on

@@ -10,6 +10,7 @@ from std_msgs.msg import String
 from ltl_specification import compile_task
 from ltl_specification.provenance import provenance_to_json
 from respec.robot import SystemCatalog, catalog_to_json
+from respec.robot.files import SystemConfigError
 from respec.naming import DEFAULT_SM_OUTCOMES
 from synthesis_manager.ros.conversions import error_code, msg_to_sections, spec_to_msg
 from synthesis_manager.limits import check_message
@@ -23,8 +24,8 @@ from synthesis_msgs.srv import GenerateLTLSpecification
 class LTLCompilationNode(Node):
     """Compiles partial tasks into complete GR(1) specifications.
 
-    Parameters: ``config_dir`` (robot system configurations; empty = the packaged config/).
-    Publishes the systems of ``config_dir`` on ``robot_systems`` (latched; checked for edits
+    Parameters: ``config_dir`` (directories of robot system files searched before the packaged
+    config/, joined with os.pathsep; empty = config/ alone). Publishes those systems on ``robot_systems`` (latched; checked for edits
     every ``SYSTEMS_PERIOD`` seconds), so clients elsewhere see the systems it compiles for.
     """
 
@@ -47,7 +48,7 @@ class LTLCompilationNode(Node):
         """Publish the systems when they changed (a system file edited, added or removed)."""
         try:
             text = catalog_to_json(self.catalog())
-        except OSError as error:  # e.g. the config directory vanished: keep serving the last list
+        except (OSError, SystemConfigError) as error:  # e.g. a config directory vanished: keep the last list
             self.get_logger().warning(f'cannot read the robot systems: {error}')
             return
         if text != self._published_systems:

@@ -26,6 +26,7 @@ import yaml
 from atlas_sim.simulator.config import SimulationConfigError, SystemConfig
 from atlas_sim.simulator.operator_data import answers_by_request_type, flexbe_input_data, parse_answers, quoted
 from respec.robot import RobotSystem, robot_system
+from respec.robot.files import add_config_dir_argument
 from sm_generation.config import flexbe_config, input_request_capabilities
 
 NODE_NAME = 'atlas_sim_operator'
@@ -82,7 +83,7 @@ def parse_arguments(argv):
                     'as flexbe_input does, from the system configuration or a scenario.',
         formatter_class=argparse.ArgumentDefaultsHelpFormatter)
     parser.add_argument('--system', default='atlas', help='robot system (config/<system>.yaml)')
-    parser.add_argument('--config-dir', default=None, help='folder of the system files (default: config/)')
+    add_config_dir_argument(parser)
     parser.add_argument('--scenario', type=Path, default=None,
                         help='YAML file: BehaviorInput request type -> answer, e.g. "0: 1"')
     parser.add_argument('--answer', action='append', default=[], metavar='TYPE=VALUE',

@@ -17,7 +17,7 @@ from synthesis_msgs.srv import GenerateFlexBESM
 class SMGenerationNode(Node):
     """Turns synthesized automata into FlexBE state instantiations.
 
-    Parameters: ``config_dir`` (robot system configurations; empty = the packaged config/),
+    Parameters: ``config_dir`` (directories of robot system files searched before the packaged config/),
     ``reduce`` (merge equivalent automaton states).
     """
 

@@ -11,9 +11,9 @@ from typing import Callable
 
 from respec.parsing import spec_from_text_sections
 from sm_generation import SMGenerationError, export
-from sm_generation.config import flexbe_config
 from sm_generation.export import render, to_dot
 from sm_generation.flexbe_behavior import behavior_package, check_behavior_name, default_behavior_name
+from sm_generation.for_system import behavior_flexbe_config
 from synthesis_manager.web.outcome import JobOutcome
 
 
@@ -47,7 +47,7 @@ def _specification(method):
 def _flexbe_behavior(outcome, request, systems) -> bytes:
     """The behavior package FlexBE's editor would save (as ``behavior-synthesis export-behavior``)."""
     name = request.name if request.name and check_name(request.name) else default_behavior_name(request.goals)
-    package = behavior_package(list(outcome.states), flexbe_config(systems.load(request.system)), name,
+    package = behavior_package(list(outcome.states), behavior_flexbe_config(systems.load(request.system)), name,
                                date=time.strftime('%a %b %d %Y'))
     return package.zip_bytes()
 

@@ -319,6 +319,28 @@ def test_missing_state_class_and_unknown_parameter_are_named(cnu, tmp_path):
     assert parameter.value.item == 'prep_pay.parameters.text'  # the first capability of the file
 
 
+def test_a_missing_flexbe_workspace_says_what_to_set(cnu, tmp_path):
+    example_system(tmp_path, cnu, 'vending_demo')
+    for library in ({}, workspace_state_library(str(tmp_path))):  # nothing, or no FlexBE package, on the path
+        with pytest.raises(StateClassError) as missing:
+            compile_task('vending_demo', ['prep_pay_a'], ['soda'], config_dir=tmp_path, state_library=library)
+        message = str(missing.value)
+        assert 'no FlexBE state package is on AMENT_PREFIX_PATH at all' in message
+        assert 'source <workspace>/install/setup.bash' in message and '`make flexbe`' in message
+
+
+def test_export_without_a_flexbe_workspace_says_what_to_set_before_synthesis(cnu, tmp_path, capsys, monkeypatch):
+    from synthesis_manager.cli import main
+
+    example_system(tmp_path, cnu, 'vending_demo')
+    monkeypatch.setenv('AMENT_PREFIX_PATH', str(tmp_path))  # no FlexBE state package there
+    code = main(['export-behavior', '--system', 'vending_demo', '--config-dir', str(tmp_path),
+                 '--initial-conditions', 'prep_pay_a', '--goals', 'soda', '-o', str(tmp_path / 'out')])
+    error = capsys.readouterr().err
+    assert code == 2 and 'CONFIG_VARIABLE_CONFIG_INVALID' in error and '`make flexbe`' in error
+    assert not (tmp_path / 'out').exists()
+
+
 def test_the_workspace_library_reads_flexbe_state_packages_without_importing_them(library):
     log = library['LogState']
     assert log.package == 'flexbe_states' and log.outcomes == ('done',) and log.required == ('text',)
@@ -361,15 +383,15 @@ def test_bad_system_files_are_reported_not_raised_as_tracebacks(tmp_path, librar
 
 
 def test_cnu_behaviors_run_on_the_real_flexbe_engine(cnu, library, tmp_path):
-    from sm_generation.capabilities import capability_flexbe_config
     from sm_generation.flexbe_behavior import behavior_package
+    from sm_generation.for_system import behavior_flexbe_config
     from synthesis_manager.ros.flexbe_engine import load_behavior_class
     from synthesis_manager.ros.harness import RosHarness
 
     for name in ('vending_demo', 'vending_demo_extended', 'hello_world'):
         example_system(tmp_path, cnu, name)
         _, _, states = synthesized(tmp_path, name, library)
-        config = capability_flexbe_config(robot_system(name, tmp_path).capabilities, library)
+        config = behavior_flexbe_config(robot_system(name, tmp_path), library)
         package = behavior_package(states, config, f'CNU {name.replace("_", " ")}')
         behavior_class, checksum = load_behavior_class(package, tmp_path / name)
         with RosHarness(default_context=True) as ros:  # flexbe_core uses rclpy's global context

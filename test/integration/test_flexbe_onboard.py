@@ -6,7 +6,9 @@ the ament index, ``atlas-sim-node`` is the robot and ``atlas-sim-operator`` answ
 exactly as flexbe_input's ``input_action_server`` does (a pickled value and nothing else). A
 ``flexbe_msgs/BehaviorSelection`` on ``flexbe/start_behavior`` starts it, as be_launcher and
 the WebUI do; ``flexbe/status`` (BEStatus) reports the outcome. One test uses flexbe_input's
-own ``input_action_server`` with its Qt window (PyQt5, offscreen) and a scripted typist.
+own ``input_action_server`` with its Qt window (PyQt5, offscreen) and a scripted typist. A CNU
+capability system (CNU's vending_demo, LogState capabilities, from a config folder of the user's)
+is exported and run the same way, with no robot but FlexBE's own states.
 """
 
 from __future__ import annotations
@@ -29,29 +31,35 @@ pytestmark = pytest.mark.usefixtures('flexbe')
 BIN = Path(sys.executable).parent
 PAPER_TASK = ['--initial-conditions', 'stand_prep', '--goals', 'look_down,pickup_object']
 BEHAVIOR = 'Onboard Pickup'
+CNU_BEHAVIOR = 'CNU Vending Soda'
+
+
+def exported_and_installed(work: Path, export_arguments, package='synthesized_flexbe_behaviors', environment=None):
+    """``export-behavior`` with ``export_arguments``, its package installed into a prefix with pip (no colcon)."""
+    exported = subprocess.run([str(BIN / 'behavior-synthesis'), 'export-behavior', *export_arguments,
+                               '--package', package, '-o', str(work / 'src')],
+                              capture_output=True, text=True, timeout=120, env=environment)
+    assert exported.returncode == 0, exported.stderr
+    prefix = work / 'install'
+    pip = subprocess.run([sys.executable, '-m', 'pip', 'install', '--quiet', '--no-deps', '--no-build-isolation',
+                          '--no-index', '--prefix', str(prefix), str(work / 'src' / package)],
+                         capture_output=True, text=True, timeout=300)
+    assert pip.returncode == 0, pip.stderr
+    return prefix
 
 
 @pytest.fixture(scope='module')
 def installed_prefix(tmp_path_factory):
-    """The paper task exported and installed into a prefix with pip (no colcon)."""
-    work = tmp_path_factory.mktemp('onboard')
-    exported = subprocess.run([str(BIN / 'behavior-synthesis'), 'export-behavior', '--system', 'atlas', *PAPER_TASK,
-                               '--name', BEHAVIOR, '-o', str(work / 'src')],
-                              capture_output=True, text=True, timeout=120)
-    assert exported.returncode == 0, exported.stderr
-    prefix = work / 'install'
-    pip = subprocess.run([sys.executable, '-m', 'pip', 'install', '--quiet', '--no-deps', '--no-build-isolation',
-                          '--no-index', '--prefix', str(prefix), str(work / 'src' / 'synthesized_flexbe_behaviors')],
-                         capture_output=True, text=True, timeout=300)
-    assert pip.returncode == 0, pip.stderr
-    return prefix
+    """The paper task exported and installed."""
+    return exported_and_installed(tmp_path_factory.mktemp('onboard'),
+                                  ['--system', 'atlas', *PAPER_TASK, '--name', BEHAVIOR])
 
 
 class OnboardSystem:
     """The robot, the operator and FlexBE's onboard executive as processes on the test's domain."""
 
     def __init__(self, ros, prefix: Path, flexbe_prefix: Path, logs: Path, sim_arguments=(), operator_arguments=(),
-                 operator_command=None, operator_path=()):
+                 operator_command=None, operator_path=(), robot=True):
         self.site = prefix / 'lib' / f'python{sys.version_info.major}.{sys.version_info.minor}' / 'site-packages'
         self.ament_prefix_path = os.pathsep.join([str(prefix), str(flexbe_prefix), sys.prefix])
         self.environment = dict(os.environ, ROS_DOMAIN_ID=str(ros.domain_id), MUJOCO_GL='egl',
@@ -60,8 +68,9 @@ class OnboardSystem:
                                                                            os.environ.get('PYTHONPATH')])))
         self.logs = logs
         self.processes = {}
-        self.start('sim', [str(BIN / 'atlas-sim-node'), '--ros-args', '-p', 'speed:=20.0', *sim_arguments])
-        self.start('operator', operator_command or [str(BIN / 'atlas-sim-operator'), *operator_arguments])
+        if robot:  # a behavior of FlexBE's own states (CNU's LogState capabilities) needs no robot
+            self.start('sim', [str(BIN / 'atlas-sim-node'), '--ros-args', '-p', 'speed:=20.0', *sim_arguments])
+            self.start('operator', operator_command or [str(BIN / 'atlas-sim-operator'), *operator_arguments])
         self.start('onboard', [sys.executable, '-m', 'flexbe_onboard.start_behavior'])
 
     def start(self, name, command):
@@ -70,7 +79,9 @@ class OnboardSystem:
                                                  text=True), log)
 
     def log(self, name) -> str:
-        return (self.logs / f'{name}.log').read_text(encoding='utf-8', errors='replace')
+        path = self.logs / f'{name}.log'
+        return path.read_text(encoding='utf-8', errors='replace') if path.exists() else f'(no {name} process)'
+
 
     def stop(self):
         for process, _ in self.processes.values():
@@ -86,13 +97,16 @@ class OnboardSystem:
 
 
 @pytest.fixture
-def onboard(ros, installed_prefix, flexbe, tmp_path, monkeypatch):
-    """Start the processes (sim and operator arguments as given); stopped after the test."""
+def onboard(ros, flexbe, tmp_path, monkeypatch, request):
+    """Start the processes (sim and operator arguments as given; by default the paper task's
+    package, else ``prefix``'s, with the robot unless ``robot=False``); stopped after the test."""
     systems = []
 
-    def start(sim_arguments=(), operator_arguments=(), operator_command=None, operator_path=()):
-        system = OnboardSystem(ros, installed_prefix, flexbe, tmp_path, sim_arguments, operator_arguments,
-                               operator_command, operator_path)
+    def start(sim_arguments=(), operator_arguments=(), operator_command=None, operator_path=(), prefix=None,
+              robot=True):
+        prefix = prefix or request.getfixturevalue('installed_prefix')
+        system = OnboardSystem(ros, prefix, flexbe, tmp_path, sim_arguments, operator_arguments,
+                               operator_command, operator_path, robot)
         systems.append(system)
         monkeypatch.setenv('AMENT_PREFIX_PATH', system.ament_prefix_path)  # this process's BehaviorLibrary
         monkeypatch.syspath_prepend(str(system.site))
@@ -139,12 +153,13 @@ class Operator:
             client = ActionClient(self.node, action_type, name)
             assert client.wait_for_server(timeout_sec=30.0), f'{name} is not served'
 
-    def start_behavior(self, name: str, autonomy: int = 3):
+    def start_behavior(self, name: str, autonomy: int = 3, robot: bool = True):
         """A BehaviorSelection for ``name`` as be_launcher sends it; returns the final BEStatus."""
         from flexbe_core import BehaviorLibrary
         from flexbe_msgs.msg import BehaviorSelection, BEStatus
 
-        self.wait_for_servers()
+        if robot:
+            self.wait_for_servers()
         self.wait_until(lambda: any(s.code == BEStatus.READY for s in self.statuses), 40, 'READY from onboard')
         library = BehaviorLibrary(self.node)
         key, entry = library.find_behavior(name)
@@ -237,3 +252,29 @@ def test_a_template_id_naming_no_object_fails_with_the_robots_reason(ros, onboar
     assert ok, details
     assert 'template_id 7 names no object of the scene (known template ids: 1)' in \
         operator.log_text() + system.log('onboard')
+
+
+def test_a_cnu_capability_system_exports_and_finishes_onboard(ros, onboard, flexbe, flexbe_sources, tmp_path):
+    """CNU's vending_demo, a system file in the user's own folder (``--config-dir``, beside the
+    shipped ATLAS), exported by export-behavior and run by FlexBE's onboard to ``finished``:
+    its LogState capabilities log, in order, the path the synthesized machine takes."""
+    from respec.robot import robot_system
+    from test_cnu_capabilities import example_system
+
+    config = tmp_path / 'config'
+    example = example_system(config, flexbe_sources / 'flexbe_synthesis', 'vending_demo')
+    prefix = exported_and_installed(
+        tmp_path / 'export', ['--system', 'vending_demo', '--config-dir', str(config),
+                              '--initial-conditions', ','.join(example['initial_conditions']),
+                              '--goals', ','.join(example['goals']), '--name', CNU_BEHAVIOR],
+        package='cnu_flexbe_behaviors', environment=dict(os.environ, AMENT_PREFIX_PATH=str(flexbe)))
+    system = onboard(prefix=prefix, robot=False)
+    operator = Operator(ros)
+    status = operator.start_behavior(CNU_BEHAVIOR, robot=False)
+    ok, details = finished_with(status, 'finished', system)
+    assert ok, details
+    capabilities = robot_system('vending_demo', config).capabilities.capabilities
+    texts = [capabilities[name].parameters['text'] for name in ('prep_pay', 'pay', 'select', 'soda')]
+    logged = operator.wait_until(lambda: [m.text for m in operator.logs if m.text in texts] == texts or None, 10,
+                                 f'the log lines {texts}')
+    assert logged

@@ -1,5 +1,8 @@
 """RobotSystem: one object per robot system, read once, its kind decided when it is read."""
 
+import argparse
+import os
+import shutil
 from pathlib import Path
 
 import pytest
@@ -9,7 +12,8 @@ from respec.robot import (ABSTRACTION_KIND, CAPABILITIES_KIND, RobotSystem, Syst
                           robot_system_from_files)
 from respec.robot.abstraction import AbstractionConfigError
 from respec.robot.cnu import CapabilityConfigError
-from respec.robot.files import ConfigFileInvalidError, SystemNotFoundError
+from respec.robot.files import (CONFIG_DIR_ENV, ConfigDirectoryNotFoundError, ConfigFileInvalidError,
+                                SystemNotFoundError, add_config_dir_argument, config_search_path)
 
 CONFIG = Path(__file__).resolve().parents[2] / 'config'
 
@@ -67,12 +71,59 @@ def test_a_capability_system_keeps_every_file_it_read(tmp_path, flexbe_sources):
         robot_system_from_files('vending', {'vending.yaml': vending.files['vending.yaml']})
 
 
-def test_the_catalog_lists_and_loads_the_systems_of_its_folder(tmp_path):
+def test_the_catalog_lists_and_loads_the_systems_of_its_folders(tmp_path):
     assert SystemCatalog().names() == ['atlas', 'mobile_manipulator']
     assert isinstance(SystemCatalog().load('mobile_manipulator'), RobotSystem)
     (tmp_path / 'tiny.yaml').write_text('abstraction:\n  actions: {wave: []}\n')
-    catalog = SystemCatalog(tmp_path)
-    assert catalog.names() == ['tiny'] and catalog.load('tiny').abstraction.actions == {'wave': ()}
+    catalog = SystemCatalog(tmp_path)  # adds to the shipped systems
+    assert catalog.names() == ['atlas', 'mobile_manipulator', 'tiny']
+    assert catalog.load('tiny').abstraction.actions == {'wave': ()}
+    assert catalog.load('atlas') == robot_system('atlas')
     # Loading reads afresh: an edit is seen by the next request.
     (tmp_path / 'tiny.yaml').write_text('abstraction:\n  actions: {wave: [], nod: []}\n')
     assert list(catalog.load('tiny').abstraction.actions) == ['wave', 'nod']
+
+
+def tiny_system(directory: Path, action: str) -> Path:
+    directory.mkdir(parents=True, exist_ok=True)
+    (directory / 'tiny.yaml').write_text(f'abstraction:\n  actions: {{{action}: []}}\n')
+    return directory
+
+
+def test_config_directories_add_to_the_shipped_systems_and_shadow_in_order(tmp_path, monkeypatch):
+    monkeypatch.delenv(CONFIG_DIR_ENV, raising=False)
+    first, second = tiny_system(tmp_path / 'first', 'wave'), tiny_system(tmp_path / 'second', 'nod')
+    shutil.copy(CONFIG / 'atlas.yaml', second / 'atlas.yaml')
+    (second / 'robot_b.yaml').write_text('abstraction:\n  actions: {beep: []}\n')
+    joined = os.pathsep.join([str(first), str(second)])
+    assert config_search_path(joined) == (first, second, CONFIG)
+    assert config_search_path([first, str(second)]) == config_search_path(joined)
+    assert SystemCatalog(joined).names() == ['atlas', 'mobile_manipulator', 'robot_b', 'tiny']
+    assert list(robot_system('tiny', joined).abstraction.actions) == ['wave']     # the first directory's
+    assert list(robot_system('tiny', [second, first]).abstraction.actions) == ['nod']
+    assert robot_system('atlas', joined).path == second / 'atlas.yaml'          # shadows config/atlas.yaml
+    assert robot_system('mobile_manipulator', joined).path == CONFIG / 'mobile_manipulator.yaml'
+    # The environment's directories come after the given ones and before config/.
+    monkeypatch.setenv(CONFIG_DIR_ENV, str(second))
+    assert config_search_path(first) == (first, second, CONFIG)
+    assert list(robot_system('tiny').abstraction.actions) == ['nod'] and 'robot_b' in SystemCatalog().names()
+
+
+def test_where_systems_were_looked_for_is_named(tmp_path, monkeypatch):
+    monkeypatch.delenv(CONFIG_DIR_ENV, raising=False)
+    with pytest.raises(SystemNotFoundError) as unknown:
+        robot_system('marsrover', tmp_path)
+    assert f'no marsrover.yaml in {tmp_path}, {CONFIG}' in str(unknown.value)
+    with pytest.raises(ConfigDirectoryNotFoundError, match='does not exist') as missing:
+        SystemCatalog(tmp_path / 'nowhere').names()
+    assert missing.value.item == str(tmp_path / 'nowhere') and missing.value.code.name == 'SYSTEM_CONFIG_NOT_FOUND'
+    monkeypatch.setenv(CONFIG_DIR_ENV, str(tmp_path / 'gone'))
+    with pytest.raises(ConfigDirectoryNotFoundError, match='gone'):
+        robot_system('atlas')
+
+
+def test_config_dir_options_add_up():
+    parser = argparse.ArgumentParser()
+    add_config_dir_argument(parser)
+    assert parser.parse_args([]).config_dir == ''
+    assert parser.parse_args(['--config-dir', 'a', '--config-dir', 'b']).config_dir == os.pathsep.join(['a', 'b'])

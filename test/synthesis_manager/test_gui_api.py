@@ -17,11 +17,11 @@ STATE_FIELDS = {'state_path', 'state_class', 'initial_state_name', 'input_keys',
                 'userdata_keys', 'userdata_remapping'}
 
 
-def gui_args(byproducts_dir):
+def gui_args(byproducts_dir, *more):
     """The settings ``behavior-synthesis gui`` would get, parsed by the real command line."""
     return build_parser(only='gui').parse_args(
         ['gui', '--byproducts-dir', str(byproducts_dir), '--synthesis-timeout', '60',
-         '--goal-timeout', '120'])
+         '--goal-timeout', '120', *more])
 
 
 @pytest.fixture(scope='module')
@@ -125,6 +125,36 @@ def test_paper_task_succeeds_with_progress_states_and_downloads(client):
     code = behavior.read('synthesized_flexbe_behaviors/synthesized_flexbe_behaviors/look_down_pickup_object_sm.py')
     assert b'class LookDownPickupObjectSM(Behavior):' in code
     assert b"self.use_behavior(PickupObjectSM, 'pickup_object')" in code
+
+
+def test_a_capability_system_exports_its_behavior_package_for_download(tmp_path, flexbe, flexbe_sources, monkeypatch):
+    """CNU's vending_demo from a config folder of the user's (added to the shipped systems):
+    its job offers the FlexBE behavior package export-behavior writes, with CNU's state classes."""
+    import io
+    import zipfile
+
+    monkeypatch.setenv('AMENT_PREFIX_PATH', str(flexbe))  # the workspace's state classes
+    cnu = flexbe_sources / 'flexbe_synthesis'
+    example = cnu / 'flexbe_synthesis_examples' / 'example' / 'vending_demo'
+    config = tmp_path / 'config'
+    config.mkdir()
+    (config / 'vending_demo.yaml').write_text(
+        f'cnu_capabilities: {example}/capabilities/vending_capabilities.yaml\n'
+        f'cnu_spec: {example}/specs/vending_demo_capabilities_spec.yaml\n'
+        f'cnu_mappings: {cnu}/flexbe_synthesis_generic/mappings/global_mappings.yaml\n')
+    with ros_backend(gui_args(tmp_path / 'byproducts', '--config-dir', str(config))) as backend, \
+            TestClient(create_app(backend)) as client:
+        assert {'atlas', 'vending_demo'} <= set(client.get('/api/systems').json()['systems'])
+        _, job = run_job(client, {'system': 'vending_demo', 'initial_conditions': ['prep_pay_a'], 'goals': ['soda']})
+        assert job['outcome']['error_name'] == 'SUCCESS', job['outcome']['message']
+        assert 'flexbe_behavior.zip' in job['artifacts']
+        download = client.get(f"/api/jobs/{job['id']}/artifacts/flexbe_behavior.zip")
+        assert download.status_code == 200, download.text
+    behavior = zipfile.ZipFile(io.BytesIO(download.content))
+    assert 'synthesized_flexbe_behaviors/manifest/soda.xml' in behavior.namelist()
+    code = behavior.read('synthesized_flexbe_behaviors/synthesized_flexbe_behaviors/soda_sm.py').decode()
+    assert 'class SodaSM(Behavior):' in code and 'from flexbe_states.log_state import LogState' in code
+    assert "text='Insert Coin'" in code
 
 
 def test_same_request_gives_byte_identical_downloads(client):

@@ -437,7 +437,7 @@ def test_cnu_examples_through_our_behavior_synthesis_action(cnu, flexbe, tmp_pat
 
     from synthesis_manager.client import SynthesisClient, make_goal
     from synthesis_manager.suite import suite_node_factories
-    from test_synthesis_manager_pipeline import suite_args
+    from suite_settings import suite_args
 
     monkeypatch.setenv('AMENT_PREFIX_PATH', str(flexbe))   # the nodes read the workspace's state classes
     config_dir = tmp_path / 'config'

@@ -9,17 +9,11 @@ from pathlib import Path
 import pytest
 
 import endless_diagnosis as endless_diagnosis_module
+from suite_settings import suite_args
 from synthesis_manager.client import SynthesisClient, make_goal
 from synthesis_manager.suite import suite_node_factories
 
 PAPER_TASK = dict(system='atlas', initial_conditions=['stand_prep'], goals=['look_down', 'pickup_object'])
-
-
-def suite_args(tmp_path, **overrides):
-    values = dict(config_dir='', byproducts_dir=str(tmp_path), backend='builtin',
-                  slugs_executable='slugs', synthesis_timeout=60.0, service_timeout=2.0)
-    values.update(overrides)
-    return Namespace(**values)
 
 
 @pytest.fixture

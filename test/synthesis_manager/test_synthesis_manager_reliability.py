@@ -14,7 +14,6 @@ import subprocess
 import sys
 import threading
 import time
-from argparse import Namespace
 from collections import Counter
 from pathlib import Path
 
@@ -22,6 +21,7 @@ import pytest
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 
+from suite_settings import suite_args
 from synthesis_manager.client import SynthesisClient, make_goal
 from synthesis_manager.limits import MAX_STRING_BYTES
 from synthesis_manager.nodes.server_node import BehaviorSynthesisServer
@@ -41,10 +41,8 @@ def runaway_goal(timeout=0.0):
                      timeout=timeout)
 
 
-def suite_args(byproducts_dir, **overrides):
-    return Namespace(**{'config_dir': '', 'byproducts_dir': str(byproducts_dir), 'backend': 'builtin',
-                        'slugs_executable': 'slugs', 'synthesis_timeout': 60.0, 'service_timeout': 5.0,
-                        **overrides})
+def reliability_suite_args(byproducts_dir, **overrides):
+    return suite_args(byproducts_dir, **{'service_timeout': 5.0, **overrides})
 
 
 def start_suite(ros, tmp_path, names=('ltl_compilation', 'ltl_synthesis', 'sm_generation'),
@@ -52,7 +50,7 @@ def start_suite(ros, tmp_path, names=('ltl_compilation', 'ltl_synthesis', 'sm_ge
     """The suite in ``ros`` (the synthesis node with extra parameters); returns a client."""
     from synthesis_manager.nodes.ltl_synthesis_node import LTLSynthesisNode
 
-    for factory in suite_node_factories(suite_args(tmp_path), [n for n in names if n != 'ltl_synthesis']):
+    for factory in suite_node_factories(reliability_suite_args(tmp_path), [n for n in names if n != 'ltl_synthesis']):
         ros.add_node(factory)
     if 'ltl_synthesis' in names:
         ros.add_node(LTLSynthesisNode, parameter_overrides=[

@@ -64,6 +64,7 @@ from respec.robot.state_library import StateClass, workspace_state_library
 from respec.robot.files import ConfigFileInvalidError, SystemNotFoundError
 
 from ltl_specification.capabilities import compile_capability_task
+from ltl_specification.capability_precheck import check_capability_names, check_capability_task
 from ltl_specification.errors import (
     InvalidAbstractionError, InvalidFormulaError, InvalidGoalsError, InvalidInitialConditionsError,
     InvalidSmOutcomesError, UnknownPropositionError, UnknownSystemError,
@@ -96,7 +97,10 @@ def compile_task(system: RobotSystem | str, initial_conditions: Sequence[str] | 
     A system described by CNU capability files (``respec.robot.cnu``) is compiled by
     ``ltl_specification.capabilities``; its state classes are checked against
     ``state_library`` (default: the FlexBE state packages on ``AMENT_PREFIX_PATH``), and
-    ``sm_outcomes`` and ``strict_order`` do not apply (its mappings name its outcomes).
+    ``sm_outcomes`` and ``strict_order`` do not apply (its mappings name its outcomes);
+    ``ltl_specification.capability_precheck`` refuses, before synthesis, an initial condition
+    that names nothing of it, a goal no capability can make true and a precondition nothing
+    establishes.
 
     Goals and initial conditions are action or control-mode names (a list, or one
     comma-separated string). At most one initial condition may be a control mode; without
@@ -108,9 +112,12 @@ def compile_task(system: RobotSystem | str, initial_conditions: Sequence[str] | 
     system = load_task_system(system, config_dir)
     if system.is_capability_system:
         library = workspace_state_library() if state_library is None else state_library
-        return CompiledSpecification(**_spec_fields(compile_capability_task(
-            system.capabilities, library, _names(initial_conditions, 'initial conditions', InvalidInitialConditionsError),
-            _names(goals, 'goals', InvalidGoalsError), custom_ltl)))
+        initial_conditions = _names(initial_conditions, 'initial conditions', InvalidInitialConditionsError)
+        goals = _names(goals, 'goals', InvalidGoalsError)
+        check_capability_names(system, initial_conditions)   # first: the sentence names the entry to change
+        spec = compile_capability_task(system.capabilities, library, initial_conditions, goals, custom_ltl)
+        check_capability_task(system, initial_conditions, goals)   # once the files' own errors are ruled out
+        return CompiledSpecification(**_spec_fields(spec))
     abstraction = load_task_abstraction(system)
     sm_outcomes = _check_sm_outcomes(sm_outcomes)
     goals = _check_goals(abstraction, goals)

@@ -267,6 +267,46 @@ def test_all_of_cnus_example_pairs_through_an_unmodified_cnu_client(cnu_package,
     assert all(0 < ours <= cnu for ours, cnu in counts.values()), counts
 
 
+def test_the_capability_precheck_sentence_reaches_both_actions(cnu_package, flexbe, flexbe_sources, tmp_path,
+                                                                monkeypatch):
+    """A goal no capability can make true (CNU's coffee maker sets no memory: `br`, not its outcome
+    `br_c`) is refused before synthesis with the pre-check's sentence, the same on
+    /behavior_synthesis (error_code.message, after the stage's words) and on CNU's /flexbe_synthesis (messages)."""
+    from flexbe_synthesis_msgs.msg import SynthesisErrorCode
+    from rclpy.node import Node
+
+    from cnu_example_pairs import example_pairs, write_system_file
+    from ltl_specification import InvalidGoalsError, compile_task
+    from respec.robot.state_library import workspace_state_library
+    from synthesis_manager.ros.harness import RosHarness
+
+    monkeypatch.setenv('AMENT_PREFIX_PATH', str(flexbe))
+    (pair,) = [p for p in example_pairs(flexbe_sources / 'flexbe_synthesis')
+               if p.launch == 'coffee_capabilities_example.launch.py']
+    write_system_file(tmp_path, pair)
+    with pytest.raises(InvalidGoalsError) as refused:
+        compile_task('coffee_maker', ['bd_a'], ['br'], config_dir=tmp_path,
+                     state_library=workspace_state_library(str(flexbe)))
+    sentence = str(refused.value)
+    assert sentence.startswith("Goal 'br' can never be reached: no capability sets br_m true")
+    with RosHarness() as ros:
+        args = Namespace(config_dir=str(tmp_path), byproducts_dir=str(tmp_path / 'byproducts'), backend='builtin',
+                         slugs_executable='slugs', synthesis_timeout=60.0, service_timeout=2.0, default_system='')
+        for factory in suite_node_factories(args):
+            ros.add_node(factory)
+        ours = SynthesisClient(ros.add_node(Node, 'precheck_client'), 'behavior_synthesis')
+        assert ours.wait_for_server(timeout=10.0)
+        outcome = ours.run(make_goal('coffee_maker', ['bd_a'], ['br']), timeout=120)
+        assert (outcome.error_name, outcome.message) == ('INVALID_GOALS', f'LTL compilation failed: {sentence}')
+        client = PlainCnuClient(ros)
+        try:
+            result = client.run(client.goal(['bd_a'], ['br'], system_name='coffee_maker')).result
+        finally:
+            client.close()
+    assert result.error_code.value == SynthesisErrorCode.SPEC_COMPILATION_FAILED
+    assert list(result.messages) == [f'INVALID_GOALS: LTL compilation failed: {sentence}']
+
+
 # --- Without CNU's package ---------------------------------------------------------------------
 
 @pytest.fixture

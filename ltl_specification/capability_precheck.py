@@ -29,8 +29,8 @@ from typing import Sequence
 
 from respec.naming import activation, did_you_mean, memory
 from respec.robot import RobotSystem
-from respec.robot.cnu import CAPABILITIES_KEY, SPEC_KEY, CapabilityConfigError, CapabilitySystem, Literal, \
-    parse_literal
+from respec.robot.cnu import (CAPABILITIES_KEY, SPEC_KEY, CapabilityConfigError, CapabilitySystem, Literal,
+                              parse_literal)
 
 from ltl_specification.errors import InvalidGoalsError, UnknownPropositionError
 
@@ -99,7 +99,7 @@ def unreachable_goals(system: RobotSystem, initial_conditions: Sequence[str],
             continue
         errors.append(InvalidGoalsError(
             f'Goal {goal!r} can never be reached: no capability sets {_value_words(literal)} and it '
-            f'{_initially_words(capabilities, literal, initial)}; add {_postcondition_words(literal)} to the '
+            f'{_initially_words(literal, initial)}; add {_term_text(literal)!r} to the '
             f'postconditions of the capability that achieves it in {_capability_file(system)}, or change the '
             "request's goals.", item=goal))
     return errors
@@ -118,7 +118,7 @@ def unestablished_preconditions(system: RobotSystem,
                 continue
             entry = ' | '.join(_term_text(term) for term in clause)
             reasons = '; '.join(f'{_value_words(term)} is set by no postcondition and it '
-                                f'{_initially_words(capabilities, term, initial)}' for term in clause)
+                                f'{_initially_words(term, initial)}' for term in clause)
             errors.append(CapabilityConfigError(
                 f'Capability {name!r} can never start: nothing establishes its precondition {entry!r} ({reasons}); '
                 f'change {name}.preconditions or add a postcondition that sets it in {_capability_file(system)}.',
@@ -202,32 +202,33 @@ def _initial_entries(system: RobotSystem, initial_conditions: Sequence[str]) -> 
 
 
 def _capability_file(system: RobotSystem) -> str:
+    """The capability file as the system file names it (where pre- and postconditions are)."""
     return str(system.sections.get(CAPABILITIES_KEY) or system.config_file)
 
 
 def _is_outcome(capabilities: CapabilitySystem, name: str) -> bool:
+    """Outcome propositions are left out of the names offered: they cannot hold initially."""
     return any(name == capabilities.outcome_proposition(c, t)
                for c in capabilities.capabilities for t in capabilities.transition_outcomes)
 
 
 def _value_words(literal: Literal) -> str:
+    """What a postcondition would have to set (``pick_m true``, ``bin to 2``)."""
     if literal.value is not None:
         return f'{literal.name} {"to a value other than" if literal.negated else "to"} {literal.value}'
     return f'{memory(literal.name)} {"false" if literal.negated else "true"}'
 
 
-def _initially_words(capabilities: CapabilitySystem, literal: Literal, initial: dict[str, set]) -> str:
+def _initially_words(literal: Literal, initial: dict[str, set]) -> str:
+    """How the variable starts, as the compiler sets it (``starts false``, ``starts at 0``)."""
     values = sorted(initial[literal.name])
     if literal.value is not None:
         return f'starts at {", ".join(str(v) for v in values)}'
     return f'starts {"true" if values == [True] else "false"}'
 
 
-def _postcondition_words(literal: Literal) -> str:
-    return repr(_term_text(literal))
-
-
 def _term_text(literal: Literal) -> str:
+    """The literal as the files write it."""
     if literal.value is not None:
         return f'{literal.name}{"!=" if literal.negated else "="}{literal.value}'
     return f'{"!" if literal.negated else ""}{literal.name}'

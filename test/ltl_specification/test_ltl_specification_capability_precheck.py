@@ -54,7 +54,8 @@ def test_a_possible_task_passes_and_synthesizes(tmp_path):
     assert synthesize(spec).realizable
 
 
-@pytest.mark.parametrize('goal, unset', [('pick', 'pick_m true'), ('bin=2', 'bin to 2'), ('signature', 'signature_m true')])
+@pytest.mark.parametrize('goal, unset', [('pick', 'pick_m true'), ('bin=2', 'bin to 2'),
+                                          ('signature', 'signature_m true')])
 def test_a_goal_no_capability_makes_true_is_named_with_the_file_to_change(tmp_path, goal, unset):
     with pytest.raises(InvalidGoalsError) as refused:
         compiled(courier(tmp_path), [], ['deliver', goal])

@@ -46,9 +46,9 @@ from __future__ import annotations
 
 from typing import Mapping, Sequence
 
-from respec.robot.cnu import CapabilityConfigError, CapabilitySystem, Literal, parse_literal
+from respec.robot.cnu import FAILURE, CapabilityConfigError, CapabilitySystem, Literal, parse_literal
 from respec.ltl import TRUE, Formula, Not, Var, conj, disj, iff, implies, neg, next_, var, variables
-from respec.naming import COMPLETED, FAILED, activation, did_you_mean, memory, remembered
+from respec.naming import COMPLETED, FAILED, FINISHED, activation, did_you_mean, memory, remembered
 from respec.parsing import IntegerVariable
 from respec.parsing.errors import ParseError
 from respec.parsing.grammar import parse_in_scope
@@ -57,14 +57,15 @@ from respec.spec import FORMULA_SECTIONS, GR1Specification
 from respec.robot.state_library import StateClass, capability_outcomes
 
 from ltl_specification.errors import (InvalidFormulaError, InvalidGoalsError, InvalidInitialConditionsError,
-                                      UnknownPropositionError)
+                                      InvalidSmOutcomesError, UnknownPropositionError)
 
 
 
 class CapabilitySpecification:
     """The propositions of a capability system and the literals over them (current or next step)."""
 
-    def __init__(self, system: CapabilitySystem, outcomes: Mapping[str, tuple[str, ...]]):
+    def __init__(self, system: CapabilitySystem, outcomes: Mapping[str, tuple[str, ...]],
+                 sm_outcomes: Sequence[str] = ()):
         self.system = system
         self.outcome_props: dict[str, dict[str, str]] = {}   # capability -> transition outcome -> proposition
         for name in system.capabilities:
@@ -72,7 +73,11 @@ class CapabilitySpecification:
             self.outcome_props[name] = {t: system.outcome_proposition(name, t)
                                         for t in system.transition_outcomes if t in meanings}
         self.activations = {name: activation(name) for name in system.capabilities}
-        self.sm_props = list(dict.fromkeys(system.sm_outcomes.values()))
+        self.success, self.failed, self.ending_failures = _machine_outcomes(system, self.outcome_props, sm_outcomes)
+        named = [system.sm_outcomes[t.name] for c in system.capabilities.values()
+                 for clauses in c.transition_relation.values() for clause in clauses for t in clause
+                 if t.name in system.sm_outcomes]
+        self.sm_props = list(dict.fromkeys(o for o in [self.success, *named, self.failed] if o))
         self.integers = {name: IntegerVariable(name, r.low, r.high) for name, r in system.integers.items()}
         self.memories = dict.fromkeys(system.capabilities, False)
         self.memories.update(system.memory)
@@ -111,20 +116,23 @@ class CapabilitySpecification:
 
 def compile_capability_task(system: CapabilitySystem, library: Mapping[str, StateClass],
                             initial_conditions: Sequence[str], goals: Sequence[str],
-                            custom_ltl=None) -> GR1Specification:
-    """The GR(1) specification of reaching ``goals`` from ``initial_conditions`` on ``system``.
+                            custom_ltl=None, sm_outcomes: Sequence[str] = ()) -> GR1Specification:
+    """The GR(1) specification of reaching ``goals`` from ``initial_conditions`` on ``system``,
+    with the requested state-machine outcomes ``sm_outcomes`` (CNU's request semantics: the
+    first one that is not ``failed`` is the success outcome, ``finished`` when none is given).
 
     State classes are checked against ``library`` first (StateClassError names the bad one).
     """
     if custom_ltl and any(custom_ltl.get(s) for s in FORMULA_SECTIONS + ('env_props', 'sys_props')):
         raise InvalidFormulaError(f'{system.system} is described by capabilities; custom LTL is not supported '
                                   'for it (put the formulas into its capability file)', item=system.system)
-    spec = CapabilitySpecification(system, capability_outcomes(system, library))
+    spec = CapabilitySpecification(system, capability_outcomes(system, library), sm_outcomes)
     if system.full_spec:
         return _full_specification(spec, initial_conditions, goals)
     parts = {section: [] for section in FORMULA_SECTIONS}
     _environment(spec, parts)
     _activations(spec, parts)
+    _failures(spec, parts)
     if goals:
         _goals(spec, goals, parts)
     setters = _conditions(spec, parts)
@@ -133,6 +141,31 @@ def compile_capability_task(system: CapabilitySystem, library: Mapping[str, Stat
     _frames(spec, setters, parts)
     memories = [memory(m) for m in spec.used_memories]
     return GR1Specification(env_props=list(spec.env_props), sys_props=[*spec.sys_props, *memories], **parts)
+
+
+def _machine_outcomes(system: CapabilitySystem, outcome_props: Mapping[str, Mapping[str, str]],
+                      requested: Sequence[str]) -> tuple[str | None, str | None, list[str]]:
+    """The machine's success outcome, its failure outcome and the failure outcomes that end in it.
+
+    The success outcome is the first requested outcome that is not ``failed`` (``finished`` by
+    default), as the mappings name it; a system without SM outcomes (CNU's infinite mappings)
+    never ends. A requested ``failed`` ends the machine after every failure its capabilities'
+    transition relations do not handle (their ``failure`` outcome, CNU's failure transition
+    outcome); without it those failures are retried. No capability that can fail: nothing to end.
+    """
+    wanted = [o for o in requested if o != FAILED][:1] or [FINISHED]
+    success = None
+    if system.sm_outcomes:
+        if wanted[0] not in system.sm_outcomes and wanted[0] not in system.sm_outcomes.values():
+            raise InvalidSmOutcomesError(
+                f'{system.system}: state-machine outcome {wanted[0]!r} is not one of its mappings\' '
+                f'sm_outcome_mappings ({", ".join(system.sm_outcomes)})', item=wanted[0])
+        success = system.sm_outcome(wanted[0])
+    ending = [props[FAILURE] for name, props in outcome_props.items()
+              if FAILURE in props and FAILURE not in system.capabilities[name].transition_relation]
+    if FAILED not in requested or not ending or not system.sm_outcomes:
+        return success, None, []
+    return success, system.sm_outcome(FAILED), ending
 
 
 def _environment(spec: CapabilitySpecification, parts: dict) -> None:
@@ -159,6 +192,17 @@ def _activations(spec: CapabilitySpecification, parts: dict) -> None:
     for name, active in spec.activations.items():
         parts['sys_trans'].append(implies(conj([var(active), neg(spec.outcome_next(name))]),
                                           next_(var(active))))
+
+
+def _failures(spec: CapabilitySpecification, parts: dict) -> None:
+    """A requested ``failed``: a failure no transition relation handles ends the machine there,
+    and nothing else does (a failure that a transition relation handles is followed as it says)."""
+    if spec.failed is None:
+        return
+    failed = var(spec.failed)
+    parts['sys_trans'] += [implies(next_(var(p)), next_(failed)) for p in spec.ending_failures]
+    failures = [props[FAILURE] for props in spec.outcome_props.values() if FAILURE in props]
+    parts['sys_trans'].append(implies(next_(failed), disj([failed, *(next_(var(p)) for p in failures)])))
 
 
 def _conditions(spec: CapabilitySpecification, parts: dict) -> dict[str, list[Formula]]:
@@ -241,13 +285,13 @@ def _request_literal(spec: CapabilitySpecification, text: str, what: str, error)
 def _goals(spec: CapabilitySpecification, goals: Sequence[str], parts: dict) -> None:
     literals = [_request_literal(spec, goal, 'goal', InvalidGoalsError) for goal in goals]
     atoms = [spec.atom(literal, False, 'goal', UnknownPropositionError) for literal in literals]
-    success = next((o for o in spec.sm_props if o != FAILED), None)
+    success = spec.success
     if success is None:
         parts['sys_liveness'] += atoms
         return
     reached = conj(spec.atom(literal, True, 'goal', UnknownPropositionError) for literal in literals)
     parts['sys_trans'].append(implies(next_(var(success)), disj([var(success), reached])))
-    parts['sys_liveness'].append(var(success))
+    parts['sys_liveness'].append(disj([var(success), var(spec.failed)]) if spec.failed else var(success))
 
 
 def _initial_values(spec: CapabilitySpecification, initial_conditions: Sequence[str], parts: dict) -> None:

@@ -96,8 +96,8 @@ def compile_task(system: RobotSystem | str, initial_conditions: Sequence[str] | 
     ``system`` is a RobotSystem, or the name of one in ``config_dir`` (default ``config/``).
     A system described by CNU capability files (``respec.robot.cnu``) is compiled by
     ``ltl_specification.capabilities``; its state classes are checked against
-    ``state_library`` (default: the FlexBE state packages on ``AMENT_PREFIX_PATH``), and
-    ``sm_outcomes`` and ``strict_order`` do not apply (its mappings name its outcomes);
+    ``state_library`` (default: the FlexBE state packages on ``AMENT_PREFIX_PATH``); its mappings
+    name the ``sm_outcomes`` (CNU's request semantics), and ``strict_order`` does not apply;
     ``ltl_specification.capability_precheck`` refuses, before synthesis, an initial condition
     that names nothing of it, a goal no capability can make true and a precondition nothing
     establishes.
@@ -115,7 +115,8 @@ def compile_task(system: RobotSystem | str, initial_conditions: Sequence[str] | 
         initial_conditions = _names(initial_conditions, 'initial conditions', InvalidInitialConditionsError)
         goals = _names(goals, 'goals', InvalidGoalsError)
         check_capability_names(system, initial_conditions)   # first: the sentence names the entry to change
-        spec = compile_capability_task(system.capabilities, library, initial_conditions, goals, custom_ltl)
+        spec = compile_capability_task(system.capabilities, library, initial_conditions, goals, custom_ltl,
+                                       _names(sm_outcomes, 'state-machine outcomes', InvalidSmOutcomesError))
         check_capability_task(system, initial_conditions, goals)   # once the files' own errors are ruled out
         return CompiledSpecification(**_spec_fields(spec))
     abstraction = load_task_abstraction(system)

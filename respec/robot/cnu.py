@@ -54,7 +54,7 @@ from typing import Callable
 import yaml
 
 from respec.errors import ErrorCode
-from respec.naming import COMPLETED, FINISHED, activation
+from respec.naming import COMPLETED, FAILED, FINISHED, activation
 from respec.robot.files import SystemConfigError
 
 CAPABILITIES_KEY, SPEC_KEY, MAPPINGS_KEY = 'cnu_capabilities', 'cnu_spec', 'cnu_mappings'
@@ -159,6 +159,18 @@ class CapabilitySystem:
     def outcome_proposition(self, capability: str, transition_outcome: str) -> str:
         """CNU's name: the capability and the outcome's first letter (``br_c``, ``pay_f``)."""
         return f'{capability}_{transition_outcome[0]}'
+
+    def sm_outcome(self, key: str) -> str:
+        """The machine outcome the mappings name for ``key`` (``finished``, ``failed``); the key
+        itself when they name none (a request may ask for ``failed`` although CNU's global
+        mappings leave it out to recover from failures)."""
+        return self.sm_outcomes.get(key, key)
+
+    def possible_sm_outcomes(self) -> tuple[str, ...]:
+        """Every outcome a machine of this system may end in: the mappings', and ``failed`` for
+        the capability pipeline (a request may ask for it; a full specification is as written)."""
+        extra = [] if self.full_spec else [self.sm_outcome(FAILED)]
+        return tuple(dict.fromkeys([*self.sm_outcomes.values(), *extra]))
 
     def transition_outcome(self, capability: str, outcome: str) -> str:
         """The transition outcome a FlexBE outcome of ``capability`` means."""

@@ -30,21 +30,22 @@ from cnu_example_pairs import example_pairs, write_system_file
 EXAMPLES = {
     'coffee_maker': dict(capabilities='coffee_maker/capabilities/coffee_capabilities.yaml',
                          spec='coffee_maker/specs/coffee_demo_capabilities_spec.yaml', mappings='infinite_mappings.yaml',
-                         initial_conditions=['bd_a'], goals=['br_c'], top_level=3),
+                         initial_conditions=['bd_a'], goals=['br_c'], outcomes=[], top_level=3),
     'coffee_maker_extended': dict(capabilities='coffee_maker/capabilities/coffee_capabilities_extended.yaml',
                                   spec='coffee_maker/specs/coffee_demo_capabilities_spec.yaml',
                                   mappings='infinite_mappings.yaml', initial_conditions=['bd_a'], goals=['br_c'],
-                                  top_level=3),
+                                  outcomes=[], top_level=3),
     'vending_demo': dict(capabilities='vending_demo/capabilities/vending_capabilities.yaml',
                          spec='vending_demo/specs/vending_demo_capabilities_spec.yaml', mappings='global_mappings.yaml',
-                         initial_conditions=['prep_pay_a'], goals=['soda'], top_level=4),
+                         initial_conditions=['prep_pay_a'], goals=['soda'], outcomes=['finished'], top_level=4),
     'vending_demo_extended': dict(capabilities='vending_demo/capabilities/vending_capabilities_extended.yaml',
                                   spec='vending_demo/specs/vending_demo_capabilities_spec.yaml',
                                   mappings='global_mappings.yaml', initial_conditions=['prep_pay_a'], goals=['soda'],
-                                  top_level=4),
+                                  outcomes=['finished'], top_level=4),
     # CNU's hello_world pair runs a given machine; here its capabilities are synthesized, for a goal.
     'hello_world': dict(capabilities='hello_world/capabilities/hello_world_capabilities.yaml', spec=None,
-                        mappings='global_mappings.yaml', initial_conditions=[], goals=['say_world'], top_level=2),
+                        mappings='global_mappings.yaml', initial_conditions=[], goals=['say_world'], outcomes=['finished'],
+                        top_level=2),
 }
 
 
@@ -83,8 +84,8 @@ def top_level_states(states):
 
 def synthesized(config_dir, name, library):
     example = EXAMPLES[name]
-    spec = compile_task(name, example['initial_conditions'], example['goals'], config_dir=config_dir,
-                        state_library=library)
+    spec = compile_task(name, example['initial_conditions'], example['goals'], example['outcomes'],
+                        config_dir=config_dir, state_library=library)
     result = synthesize(spec)
     assert result.realizable
     automaton = automaton_from_strategy(result.strategy, spec)
@@ -158,7 +159,7 @@ def test_all_of_cnus_example_pairs_succeed_with_at_most_cnus_state_count(cnu, li
         write_system_file(config_dir, pair)
         request = pair.request
         spec = compile_task(request['system_name'], request['initial_conditions'], request['goals'],
-                            config_dir=config_dir, state_library=library)
+                            request['outcomes'], config_dir=config_dir, state_library=library)
         result = synthesize(spec)
         assert result.realizable, pair.launch
         assert strategy_violations(spec, result.strategy) == [], pair.launch

@@ -34,7 +34,7 @@ def test_a_missing_section_is_named():
 
 
 def test_unknown_and_broken_systems_are_reported_with_the_offending_item(tmp_path):
-    with pytest.raises(SystemNotFoundError, match='known systems: atlas, mobile_manipulator'):
+    with pytest.raises(SystemNotFoundError, match='known systems: atlas, delivery_rover, mobile_manipulator'):
         robot_system('marsrover')
     (tmp_path / 'broken.yaml').write_text('abstraction:\n  actions: {a: [b]}\n')
     with pytest.raises(AbstractionConfigError) as raised:
@@ -72,11 +72,11 @@ def test_a_capability_system_keeps_every_file_it_read(tmp_path, flexbe_sources):
 
 
 def test_the_catalog_lists_and_loads_the_systems_of_its_folders(tmp_path):
-    assert SystemCatalog().names() == ['atlas', 'mobile_manipulator']
+    assert SystemCatalog().names() == ['atlas', 'delivery_rover', 'mobile_manipulator']
     assert isinstance(SystemCatalog().load('mobile_manipulator'), RobotSystem)
     (tmp_path / 'tiny.yaml').write_text('abstraction:\n  actions: {wave: []}\n')
     catalog = SystemCatalog(tmp_path)  # adds to the shipped systems
-    assert catalog.names() == ['atlas', 'mobile_manipulator', 'tiny']
+    assert catalog.names() == ['atlas', 'delivery_rover', 'mobile_manipulator', 'tiny']
     assert catalog.load('tiny').abstraction.actions == {'wave': ()}
     assert catalog.load('atlas') == robot_system('atlas')
     # Loading reads afresh: an edit is seen by the next request.
@@ -98,7 +98,7 @@ def test_config_directories_add_to_the_shipped_systems_and_shadow_in_order(tmp_p
     joined = os.pathsep.join([str(first), str(second)])
     assert config_search_path(joined) == (first, second, CONFIG)
     assert config_search_path([first, str(second)]) == config_search_path(joined)
-    assert SystemCatalog(joined).names() == ['atlas', 'mobile_manipulator', 'robot_b', 'tiny']
+    assert SystemCatalog(joined).names() == ['atlas', 'delivery_rover', 'mobile_manipulator', 'robot_b', 'tiny']
     assert list(robot_system('tiny', joined).abstraction.actions) == ['wave']     # the first directory's
     assert list(robot_system('tiny', [second, first]).abstraction.actions) == ['nod']
     assert robot_system('atlas', joined).path == second / 'atlas.yaml'          # shadows config/atlas.yaml

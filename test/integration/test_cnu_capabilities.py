@@ -44,8 +44,8 @@ EXAMPLES = {
                                   outcomes=['finished'], top_level=4),
     # CNU's hello_world pair runs a given machine; here its capabilities are synthesized, for a goal.
     'hello_world': dict(capabilities='hello_world/capabilities/hello_world_capabilities.yaml', spec=None,
-                        mappings='global_mappings.yaml', initial_conditions=[], goals=['say_world'], outcomes=['finished'],
-                        top_level=2),
+                        mappings='global_mappings.yaml', initial_conditions=[], goals=['say_world'],
+                        outcomes=['finished'], top_level=2),
 }
 
 
@@ -469,3 +469,68 @@ def test_no_initial_conditions_keep_cnus_meaning_for_capability_systems(cnu, tmp
     assert reads_robot_state(['current'], 'hello_world', tmp_path)
     assert reads_robot_state([], 'atlas') and not reads_robot_state(['stand'], 'atlas')
     assert reads_robot_state([], 'no_such_system', tmp_path)  # compiling reports the unknown system
+
+
+def rover_machine(library, sm_outcomes, config_dir=None):
+    """config/delivery_rover (or its variant in ``config_dir``): deliver, from a battery check."""
+    spec = compile_task('delivery_rover', ['check_battery_a'], ['hand_over'], sm_outcomes, config_dir=config_dir,
+                        state_library=library)
+    result = synthesize(spec)
+    assert result.realizable
+    assert strategy_violations(spec, result.strategy) == []
+    automaton = automaton_from_strategy(result.strategy, spec)
+    states = generate_state_machine(automaton, 'delivery_rover', config_dir, state_library=library)
+    assert validate_state_machine(states) == []
+    return spec, {s.state_path: s for s in states}
+
+
+def test_a_sensor_reaches_the_machine_through_the_state_that_observes_it(library):
+    """The rover's spec INPUT battery_low is an environment proposition; its ENV_TRANS binds it to
+    the battery check's outcomes, so the check's `low` outcome is where the machine reacts."""
+    spec, states = rover_machine(library, ['finished'])
+    assert 'battery_low' in spec.env_props
+    check = states['/check_battery']
+    assert dict(zip(check.outcomes, check.transitions)) == {'ok': 'drive', 'low': 'charge'}
+    assert dict(zip(states['/charge'].outcomes, states['/charge'].transitions)) == {'done': 'drive'}
+
+
+def test_a_requested_failed_outcome_ends_the_failures_no_transition_relation_handles(library):
+    _, retried = rover_machine(library, ['finished'])
+    assert retried['/'].outcomes == ['finished']
+    assert dict(zip(retried['/drive'].outcomes, retried['/drive'].transitions)) == {'done': 'hand_over',
+                                                                                   'failed': 'drive'}
+    _, ended = rover_machine(library, ['finished', 'failed'])
+    assert ended['/'].outcomes == ['finished', 'failed']
+    assert dict(zip(ended['/drive'].outcomes, ended['/drive'].transitions)) == {'done': 'hand_over',
+                                                                               'failed': 'failed'}
+
+
+def test_a_requested_outcome_the_mappings_do_not_name_is_refused(library):
+    from ltl_specification.errors import InvalidSmOutcomesError
+
+    with pytest.raises(InvalidSmOutcomesError, match="'delivered' is not one of its mappings' sm_outcome_mappings"):
+        compile_task('delivery_rover', [], ['hand_over'], ['delivered', 'failed'], state_library=library)
+
+
+def test_a_strategy_that_reacts_to_an_input_no_state_observes_is_refused(library, tmp_path):
+    """Without the battery check's binding, a SYS_TRANS that reads the sensor after a charge would
+    make FlexBE choose blindly: the machine is refused, naming the input."""
+    import shutil
+
+    from sm_generation.errors import StateConfigInvalidError
+
+    config = Path(__file__).resolve().parents[2] / 'config'
+    shutil.copy(config / 'delivery_rover.yaml', tmp_path / 'delivery_rover.yaml')
+    shutil.copytree(config / 'delivery_rover', tmp_path / 'delivery_rover')
+    spec_file = tmp_path / 'delivery_rover' / 'spec.yaml'
+    spec = yaml.safe_load(spec_file.read_text())
+    spec['specs']['ENV_TRANS'].remove("charge_c' -> !battery_low'")
+    spec['specs']['SYS_TRANS'] = ["(charge_c' & battery_low') -> hand_over_a'",
+                                  "(charge_c' & !battery_low') -> drive_a'"]
+    spec_file.write_text(yaml.safe_dump(spec))
+    capabilities_file = tmp_path / 'delivery_rover' / 'capabilities.yaml'
+    capabilities = yaml.safe_load(capabilities_file.read_text())
+    capabilities['capabilities']['hand_over']['preconditions'] = []
+    capabilities_file.write_text(yaml.safe_dump(capabilities))
+    with pytest.raises(StateConfigInvalidError, match="reacts to input 'battery_low', which no state reports"):
+        rover_machine(library, ['finished'], tmp_path)

@@ -8,7 +8,8 @@ exactly as flexbe_input's ``input_action_server`` does (a pickled value and noth
 the WebUI do; ``flexbe/status`` (BEStatus) reports the outcome. One test uses flexbe_input's
 own ``input_action_server`` with its Qt window (PyQt5, offscreen) and a scripted typist. A CNU
 capability system (CNU's vending_demo, LogState capabilities, from a config folder of the user's)
-is exported and run the same way, with no robot but FlexBE's own states.
+is exported and run the same way, with no robot but FlexBE's own states, and so is our own
+config/delivery_rover (a battery sensor; a drive that fails when its operator decision says so).
 """
 
 from __future__ import annotations
@@ -278,3 +279,66 @@ def test_a_cnu_capability_system_exports_and_finishes_onboard(ros, onboard, flex
     logged = operator.wait_until(lambda: [m.text for m in operator.logs if m.text in texts] == texts or None, 10,
                                  f'the log lines {texts}')
     assert logged
+
+
+ROVER_TASK = ['--initial-conditions', 'check_battery_a', '--goals', 'hand_over', '--sm-outcomes', 'finished,failed']
+
+
+def rover_variant(config: Path, suggestions: dict[str, str]) -> Path:
+    """The shipped delivery_rover in a folder of the user's (``--config-dir``, shadowing config/'s),
+    its OperatorDecisionStates suggesting ``suggestions`` (capability -> outcome): a sensor
+    reading or a failure injected the way an operator would choose it."""
+    import shutil
+
+    import yaml
+
+    shipped = Path(__file__).resolve().parents[2] / 'config'
+    config.mkdir()
+    shutil.copy(shipped / 'delivery_rover.yaml', config / 'delivery_rover.yaml')
+    shutil.copytree(shipped / 'delivery_rover', config / 'delivery_rover')
+    path = config / 'delivery_rover' / 'capabilities.yaml'
+    capabilities = yaml.safe_load(path.read_text(encoding='utf-8'))
+    for name, outcome in suggestions.items():
+        capabilities['capabilities'][name]['parameters']['suggestion'] = outcome
+    path.write_text(yaml.safe_dump(capabilities, sort_keys=False), encoding='utf-8')
+    return config
+
+
+def logged(operator, text: str) -> bool:
+    """Whether ``text`` was logged (called by ``Operator.wait_until``, which holds its lock)."""
+    return any(m.text == text for m in operator.logs)
+
+
+def test_the_delivery_rover_exports_and_finishes_onboard(ros, onboard, flexbe, tmp_path):
+    """config/delivery_rover (CNU's format, a battery sensor, FlexBE's own states), exported by
+    export-behavior and run by FlexBE's onboard to ``finished``: the battery is fine, so the rover
+    drives and hands the parcel over without charging."""
+    prefix = exported_and_installed(tmp_path / 'export', ['--system', 'delivery_rover', *ROVER_TASK,
+                                                          '--name', 'Rover Delivery'],
+                                    package='rover_flexbe_behaviors',
+                                    environment=dict(os.environ, AMENT_PREFIX_PATH=str(flexbe)))
+    system = onboard(prefix=prefix, robot=False)
+    operator = Operator(ros)
+    status = operator.start_behavior('Rover Delivery', robot=False)
+    ok, details = finished_with(status, 'finished', system)
+    assert ok, details
+    assert operator.wait_until(lambda: logged(operator, 'Handing the parcel over'), 10, 'the hand-over')
+    assert not logged(operator, 'Charging the battery')
+
+
+def test_the_delivery_rover_charges_on_a_low_battery_and_ends_failed_when_its_drive_fails(ros, onboard, flexbe,
+                                                                                         tmp_path):
+    """The battery check reports the sensor low (the machine reacts: it charges), then the drive
+    fails; the request asked for ``failed``, so the behavior ends there instead of retrying."""
+    config = rover_variant(tmp_path / 'config', {'check_battery': 'low', 'drive': 'failed'})
+    prefix = exported_and_installed(tmp_path / 'export', ['--system', 'delivery_rover', '--config-dir', str(config),
+                                                          *ROVER_TASK, '--name', 'Rover Failing Delivery'],
+                                    package='rover_failing_flexbe_behaviors',  # another behavior for this process
+                                    environment=dict(os.environ, AMENT_PREFIX_PATH=str(flexbe)))
+    system = onboard(prefix=prefix, robot=False)
+    operator = Operator(ros)
+    status = operator.start_behavior('Rover Failing Delivery', robot=False)
+    ok, details = finished_with(status, 'failed', system)
+    assert ok, details
+    assert operator.wait_until(lambda: logged(operator, 'Charging the battery'), 10, 'the charge')
+    assert not logged(operator, 'Handing the parcel over')

@@ -6,7 +6,10 @@ per transition outcome its FlexBE outcomes mean (``c_c`` completed, ``c_f`` fail
 
 Environment (assumptions)
   * no outcome initially; no outcome of ``c`` unless ``c`` ran; at most one at a time;
-  * fairness: a capability that keeps running eventually completes, □◇(¬c_a ∨ ◯c_c).
+  * fairness: a capability that keeps running eventually completes, □◇(¬c_a ∨ ◯c_c);
+  * the spec file's INPUTs (sensors) change as its ENV_TRANS and ENV_LIVENESS say; a state
+    observes one when ENV_TRANS binds the sensor to that capability's outcomes
+    (``check_l' <-> (check_a & low')``): FlexBE sees outcomes only (``sm_generation.capabilities``).
 
 System (guarantees)
   * exactly one capability runs, or the machine has ended in an SM outcome, at every step
@@ -16,6 +19,8 @@ System (guarantees)
   * ``preconditions`` hold whenever a capability starts (or restarts after an outcome);
   * ``transition_relation``: after outcome ``t`` of ``c``, the next capability is one of
     each listed choice;
+  * a requested ``failed`` (``_machine_outcomes``): a failure no transition relation handles
+    ends the machine in ``failed``; otherwise failures are retried;
   * ``postconditions``: outcome ``t`` of ``c`` sets the listed memories and integers in the
     same step (``@x`` lets the system choose ``x``); memories and integers keep their values
     otherwise;
@@ -25,7 +30,8 @@ System (guarantees)
     has no SM outcomes (CNU's "infinite" mappings), each goal holds infinitely often.
 
 Initial values not given by the request or the spec file: no capability runs, memories as
-declared (default false), integers at their lowest value. The spec file's other formulas
+declared (default false), integers at their lowest value; a spec INPUT (a sensor) may start
+either way (slugs' meaning of a variable ENV_INIT does not constrain). The spec file's other formulas
 (ENV_TRANS, SYS_TRANS, the livenesses) are added as they are (CNU's capability pipeline loads the
 spec file first and adds the capabilities' formulas to it).
 
@@ -179,7 +185,6 @@ def _environment(spec: CapabilitySpecification, parts: dict) -> None:
         progress = props.get(COMPLETED) or (outcomes[0] if outcomes else None)
         if progress:
             parts['env_liveness'].append(disj([neg(running), next_(var(progress))]))
-    parts['env_init'] += [neg(var(p)) for p in spec.system.spec_inputs]
 
 
 def _activations(spec: CapabilitySpecification, parts: dict) -> None:

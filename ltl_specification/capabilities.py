@@ -396,8 +396,7 @@ def _full_specification(spec: CapabilitySpecification, initial_conditions: Seque
     if goals:
         now = conj(formula_of(g, 'goal', InvalidGoalsError)[1] for g in goals)
         following = conj(formula_of(g, 'goal', InvalidGoalsError, True)[1] for g in goals)
-        success = next((o for o in dict.fromkeys(system.sm_outcomes.values()) if o != FAILED and o in sys_props),
-                       None)
+        success = spec.success if spec.success in sys_props else None
         if success is None:
             parts['sys_liveness'] += [formula_of(g, 'goal', InvalidGoalsError)[1] for g in goals]
         else:

@@ -471,6 +471,18 @@ def test_no_initial_conditions_keep_cnus_meaning_for_capability_systems(cnu, tmp
     assert reads_robot_state([], 'no_such_system', tmp_path)  # compiling reports the unknown system
 
 
+def copied_rover(config_dir: Path) -> Path:
+    """The shipped config/delivery_rover copied into ``config_dir`` (a user's folder, which shadows
+    config/'s), for a variant of it; returns ``config_dir``."""
+    import shutil
+
+    shipped = Path(__file__).resolve().parents[2] / 'config'
+    config_dir.mkdir(parents=True, exist_ok=True)
+    shutil.copy(shipped / 'delivery_rover.yaml', config_dir / 'delivery_rover.yaml')
+    shutil.copytree(shipped / 'delivery_rover', config_dir / 'delivery_rover')
+    return config_dir
+
+
 def rover_machine(library, sm_outcomes, config_dir=None):
     """config/delivery_rover (or its variant in ``config_dir``): deliver, from a battery check."""
     spec = compile_task('delivery_rover', ['check_battery_a'], ['hand_over'], sm_outcomes, config_dir=config_dir,
@@ -515,13 +527,9 @@ def test_a_requested_outcome_the_mappings_do_not_name_is_refused(library):
 def test_a_strategy_that_reacts_to_an_input_no_state_observes_is_refused(library, tmp_path):
     """Without the battery check's binding, a SYS_TRANS that reads the sensor after a charge would
     make FlexBE choose blindly: the machine is refused, naming the input."""
-    import shutil
-
     from sm_generation.errors import StateConfigInvalidError
 
-    config = Path(__file__).resolve().parents[2] / 'config'
-    shutil.copy(config / 'delivery_rover.yaml', tmp_path / 'delivery_rover.yaml')
-    shutil.copytree(config / 'delivery_rover', tmp_path / 'delivery_rover')
+    copied_rover(tmp_path)
     spec_file = tmp_path / 'delivery_rover' / 'spec.yaml'
     spec = yaml.safe_load(spec_file.read_text())
     spec['specs']['ENV_TRANS'].remove("charge_c' -> !battery_low'")
@@ -534,3 +542,18 @@ def test_a_strategy_that_reacts_to_an_input_no_state_observes_is_refused(library
     capabilities_file.write_text(yaml.safe_dump(capabilities))
     with pytest.raises(StateConfigInvalidError, match="reacts to input 'battery_low', which no state reports"):
         rover_machine(library, ['finished'], tmp_path)
+
+
+def test_a_sensor_starts_as_env_init_says_or_free(library, tmp_path):
+    """slugs' meaning: ENV_INIT constrains a spec INPUT's initial value; without it, it is free."""
+    free = compile_task('delivery_rover', [], ['hand_over'], ['finished'], state_library=library)
+    assert not any('battery_low' in to_infix(f) for f in free.env_init)
+    copied_rover(tmp_path)
+    spec_file = tmp_path / 'delivery_rover' / 'spec.yaml'
+    spec = yaml.safe_load(spec_file.read_text())
+    spec['specs']['ENV_INIT'] = ['battery_low']
+    spec_file.write_text(yaml.safe_dump(spec))
+    low = compile_task('delivery_rover', [], ['hand_over'], ['finished'], config_dir=tmp_path, state_library=library)
+    assert 'battery_low' in [to_infix(f) for f in low.env_init]
+    _, states = rover_machine(library, ['finished'], tmp_path)
+    assert dict(zip(states['/check_battery'].outcomes, states['/check_battery'].transitions))['low'] == 'charge'

@@ -288,15 +288,10 @@ def rover_variant(config: Path, suggestions: dict[str, str]) -> Path:
     """The shipped delivery_rover in a folder of the user's (``--config-dir``, shadowing config/'s),
     its OperatorDecisionStates suggesting ``suggestions`` (capability -> outcome): a sensor
     reading or a failure injected the way an operator would choose it."""
-    import shutil
-
     import yaml
+    from test_cnu_capabilities import copied_rover
 
-    shipped = Path(__file__).resolve().parents[2] / 'config'
-    config.mkdir()
-    shutil.copy(shipped / 'delivery_rover.yaml', config / 'delivery_rover.yaml')
-    shutil.copytree(shipped / 'delivery_rover', config / 'delivery_rover')
-    path = config / 'delivery_rover' / 'capabilities.yaml'
+    path = copied_rover(config) / 'delivery_rover' / 'capabilities.yaml'
     capabilities = yaml.safe_load(path.read_text(encoding='utf-8'))
     for name, outcome in suggestions.items():
         capabilities['capabilities'][name]['parameters']['suggestion'] = outcome

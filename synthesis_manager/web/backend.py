@@ -25,7 +25,7 @@ from synthesis_manager.limits import BusyError
 from synthesis_manager.web.artifacts import ARTIFACTS, Artifact
 from synthesis_manager.web.errors import (ArtifactFailedError, InvalidJobRequestError, NotAvailableError,
                                           NotFoundError)
-from synthesis_manager.web.jobs import JOB_OPTIONS, Job, JobRequest, ProgressNote, names_field
+from synthesis_manager.web.jobs import JOB_OPTIONS, Job, JobRequest, ProgressNote, checked_body, names_field
 from synthesis_manager.web.outcome import JobOutcome
 from synthesis_manager.web.simulation_process import SimulationProcess
 from synthesis_manager.web.simulations import Simulation, simulation_available
@@ -34,6 +34,7 @@ logger = logging.getLogger(__name__)
 
 
 SIMULATION_RETRY_AFTER = 10  # seconds: a short simulation's run time
+GOAL_CHECK_RETRY_AFTER = 1  # seconds: a goal check of a shipped system takes milliseconds
 
 GoalRunner = Callable[[JobRequest, Callable[[str, float], None], threading.Event], JobOutcome]
 
@@ -53,7 +54,8 @@ class SynthesisBackend:
 
     def __init__(self, run_goal: GoalRunner, config_dir: str | Path | None = None, systems=None,
                  max_jobs: int = 100, max_unfinished_jobs: int = 50, description: str = '',
-                 max_running_simulations: int = 2, max_simulations_per_job: int = 5):
+                 max_running_simulations: int = 2, max_simulations_per_job: int = 5,
+                 max_goal_checks: int = 2):
         self.run_goal = run_goal
         # Where the robot systems come from: the suite's own (SuiteSystems, served over ROS)
         # when attached to a running suite, else the config directory's (SystemCatalog).
@@ -64,6 +66,10 @@ class SynthesisBackend:
         # at once, and a job keeps only its newest few runs (frames included).
         self.max_running_simulations = max_running_simulations
         self.max_simulations_per_job = max_simulations_per_job
+        # The form's live goal check runs in the request's thread and costs CPU and memory with
+        # the system's size: only a few at once (10 large ones once took 64 s of CPU, +636 MiB).
+        self.max_goal_checks = max_goal_checks
+        self._goal_check_slots = threading.BoundedSemaphore(max_goal_checks)
         self.description = description
         self.job_gate = threading.Event()
         self.job_gate.set()
@@ -123,9 +129,19 @@ class SynthesisBackend:
 
     def goal_check(self, body) -> dict:
         """The request form's live check: chosen goals that can never be achieved, and why each
-        other action or mode cannot be the next goal (ltl_specification.diagnosis)."""
-        if not isinstance(body, dict):
-            raise InvalidJobRequestError('the request body must be a JSON object', 'body')
+        other action or mode cannot be the next goal (ltl_specification.diagnosis).
+
+        Beyond max_goal_checks at once: BusyError (429, Retry-After), nothing is checked."""
+        body = checked_body(body)
+        if not self._goal_check_slots.acquire(blocking=False):
+            raise BusyError(f'{self.max_goal_checks} goal checks are running (at most {self.max_goal_checks} at once); '
+                            'try again in a moment', 'goal-check', retry_after=GOAL_CHECK_RETRY_AFTER)
+        try:
+            return self._check_goals(body)
+        finally:
+            self._goal_check_slots.release()
+
+    def _check_goals(self, body: dict) -> dict:
         system = body.get('system')
         if system not in self.systems():
             raise NotFoundError(f'unknown system {quoted(system)}', str(system))
@@ -221,9 +237,7 @@ class SynthesisBackend:
     def start_simulation(self, job_id: str, body) -> Simulation:
         """Run the state machine of a finished job on atlas_sim's simulated robot."""
         job = self._job(job_id)
-        body = {} if body is None else body
-        if not isinstance(body, dict):
-            raise InvalidJobRequestError('the request body must be a JSON object', 'body')
+        body = checked_body({} if body is None else body)
         unknown = sorted(set(body) - {'fail_first'})
         if unknown:
             raise InvalidJobRequestError(f'unknown field {quoted(unknown[0])} (fields: fail_first)', unknown[0])

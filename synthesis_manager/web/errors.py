@@ -22,7 +22,12 @@ def http_answer(error: CodedError) -> tuple[int, dict, dict | None]:
 
 def _body(kind: str, error: CodedError) -> dict:
     item = error.item if isinstance(error.item, str) else quoted(error.item)
-    return {'error': kind, 'code': error.code, 'item': item, 'message': str(error)}
+    return {'error': kind, 'code': error.code, 'item': _encodable(item), 'message': _encodable(str(error))}
+
+
+def _encodable(text: str) -> str:
+    """``text`` with any lone surrogate written as its escape: the answer must encode as UTF-8."""
+    return text.encode('utf-8', 'backslashreplace').decode('utf-8')
 
 
 class GuiRequestError(CodedError):
@@ -48,6 +53,12 @@ class InvalidJobRequestError(GuiRequestError):
 
     status = 422
     kind = 'INVALID_REQUEST'
+
+
+class InvalidCharacterError(InvalidJobRequestError):
+    """A request string holding a control character (NUL included) or a lone surrogate."""
+
+    kind = 'INVALID_CHARACTER'
 
 
 class NotAvailableError(GuiRequestError):

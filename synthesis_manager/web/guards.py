@@ -9,16 +9,43 @@
 - A POST (PUT, PATCH) whose Content-Type is not ``application/json``: 415. A page from another
   site can make a browser send a form (urlencoded, multipart or text/plain) without asking,
   but not a JSON request, so no other site can start work here (a simulation costs GBs).
+- A JSON body nested deeper than ``MAX_JSON_NESTING`` arrays and objects: 400 TOO_DEEP, found
+  by a scan of its brackets before anything parses it. The JSON decoder recurses once per level
+  in C, and the process allows deep recursion for formulas (respec.nesting): a 200 KB body
+  nested 100,000 deep overflowed the 8 MB stack of the main thread, which serves HTTP.
 """
 
 from __future__ import annotations
 
 import json
+import re
 
 from respec.errors import ErrorCode, quoted
 from synthesis_manager.limits import MAX_BODY_BYTES
 
 LOOPBACK_ADDRESSES = ('127.0.0.1', '::1')
+#: Deepest nesting of arrays and objects in a request body (the API's own requests nest 2 deep).
+MAX_JSON_NESTING = 32
+# A JSON string, escapes included; an unterminated one runs to the end (so no text is scanned twice).
+_JSON_STRING = re.compile(rb'"(?:[^"\\]|\\.)*"?', re.DOTALL)
+_NOT_A_BRACKET = bytes(byte for byte in range(256) if byte not in b'[]{}')
+
+
+def json_nesting_exceeds(body: bytes, limit: int = MAX_JSON_NESTING) -> bool:
+    """Whether the JSON text ``body`` nests arrays and objects deeper than ``limit``.
+
+    Brackets inside strings do not count. Linear in the body's size, without recursion, and
+    it stops at the first level too deep; malformed JSON is left to the decoder to refuse.
+    """
+    depth = 0
+    for bracket in _JSON_STRING.sub(b'', body).translate(None, _NOT_A_BRACKET):
+        if bracket in b'[{':
+            depth += 1
+            if depth > limit:
+                return True
+        else:
+            depth -= 1
+    return False
 
 
 def accepted_hosts(server_host: str, server_port: int) -> set[str]:
@@ -72,6 +99,9 @@ class RequestGuard:
                 return await _refuse(send, 413, 'TOO_LARGE', 'body', self._too_large())
             if not message.get('more_body', False):
                 break
+        if json_nesting_exceeds(body):
+            return await _refuse(send, 400, 'TOO_DEEP', 'body',
+                                 f'the request body nests arrays and objects deeper than {MAX_JSON_NESTING} levels')
         return await self.app(scope, _replay(bytes(body), receive), send)
 
     def _too_large(self) -> str:

@@ -12,14 +12,20 @@ from respec.naming import DEFAULT_SM_OUTCOMES, parse_names
 from sm_generation.instantiation import StateInstantiation, count_states
 from synthesis_manager.limits import oversized_strings, too_long
 from synthesis_manager.web.artifacts import available_artifacts, download_labels
-from synthesis_manager.web.errors import InvalidJobRequestError, NotFoundError
+from synthesis_manager.web.errors import InvalidCharacterError, InvalidJobRequestError, NotFoundError
 from synthesis_manager.web.outcome import JobOutcome
 
 # The stop-early options the page offers (ltl_synthesis_only needs a whole specification).
 JOB_OPTIONS = ('ltl_compilation_only', 'ltl_steps_only')
 REQUEST_FIELDS = ('system', 'initial_conditions', 'goals', 'sm_outcomes', 'option', 'unordered', 'name')
-_NAME = re.compile(r'^[A-Za-z][A-Za-z0-9_]*$')
-
+_NAME = re.compile(r'[A-Za-z][A-Za-z0-9_]*')
+# Control characters (NUL included) and lone surrogates, which no request text may hold: a NUL
+# cut a goal short downstream, and a surrogate cannot be encoded into any answer.
+_FORBIDDEN_CHARACTER = re.compile('[\x00-\x1f\x7f-\x9f\ud800-\udfff]')
+# The same, but for fields of several names, where tab, newline and carriage return may
+# separate the names of a text (parse_names).
+_FORBIDDEN_IN_NAME_LISTS = re.compile('[\x00-\x08\x0b\x0c\x0e-\x1f\x7f-\x9f\ud800-\udfff]')
+NAME_LIST_FIELDS = ('initial_conditions', 'goals', 'sm_outcomes', 'fail_first')
 
 
 @dataclass(frozen=True)
@@ -41,10 +47,7 @@ class JobRequest:
         Goal and initial-condition names are not checked against the system here: the
         pipeline does that and explains unknown names itself (UNKNOWN_PROPOSITION).
         """
-        if not isinstance(body, dict):
-            raise InvalidJobRequestError('the request body must be a JSON object', 'body')
-        for item, value in oversized_strings(body, 'body'):
-            raise InvalidJobRequestError(too_long(item, value), item)
+        body = checked_body(body)
         unknown = sorted(set(body) - set(REQUEST_FIELDS))
         if unknown:
             raise InvalidJobRequestError(
@@ -66,12 +69,45 @@ class JobRequest:
         if not isinstance(unordered, bool):
             raise InvalidJobRequestError('field "unordered" must be true or false', 'unordered')
         name = body.get('name') or ''
-        if not isinstance(name, str) or (name and not _NAME.match(name)):
+        if not isinstance(name, str) or (name and not _NAME.fullmatch(name)):
             raise InvalidJobRequestError(
                 f'behavior name {quoted(name)} must start with a letter and contain only letters, '
                 'digits and underscores', str(name))
         return cls(system=system, initial_conditions=names_field(body, 'initial_conditions'), goals=goals,
                    sm_outcomes=sm_outcomes, option=option, unordered=unordered, name=name)
+
+
+def checked_body(body) -> dict:
+    """A decoded request body that is a JSON object whose strings (keys too) are neither too
+    long nor hold a character no name may have; else the error naming the first field that does."""
+    if not isinstance(body, dict):
+        raise InvalidJobRequestError('the request body must be a JSON object', 'body')
+    for item, value in oversized_strings(body, 'body'):
+        raise InvalidJobRequestError(too_long(item, value), item)
+    for path, text in _strings(body, ''):
+        field = re.split(r'[.\[]', path, maxsplit=1)[0] or 'body'
+        found = (_FORBIDDEN_IN_NAME_LISTS if field in NAME_LIST_FIELDS else _FORBIDDEN_CHARACTER).search(text)
+        if found:
+            character = found.group()
+            kind = 'a lone surrogate' if '\ud800' <= character <= '\udfff' else 'the control character'
+            raise InvalidCharacterError(f'{quoted(path) if path else "a field name"} holds {kind} '
+                                        f'U+{ord(character):04X} at character {found.start()}; names are '
+                                        'letters, digits and _', field if len(field) <= 64 else 'body')
+    return body
+
+
+def _strings(value, path: str):
+    """``(field path, string)`` for every string of decoded JSON, dict keys included (path of
+    the dict). The guard bounds the nesting, so recursion is safe."""
+    if isinstance(value, str):
+        yield path, value
+    elif isinstance(value, list):
+        for index, element in enumerate(value):
+            yield from _strings(element, f'{path}[{index}]')
+    elif isinstance(value, dict):
+        for key, element in value.items():
+            yield path, key
+            yield from _strings(element, f'{path}.{key}' if path else key)
 
 
 def names_field(body: dict, key: str) -> tuple[str, ...]:
@@ -82,7 +118,7 @@ def names_field(body: dict, key: str) -> tuple[str, ...]:
         raise InvalidJobRequestError(f'field {quoted(key)} must be a list of names or comma-separated text', key)
     names = tuple(parse_names(value))
     for name in names:
-        if not _NAME.match(name):
+        if not _NAME.fullmatch(name):
             raise InvalidJobRequestError(f'{key}: {quoted(name)} is not a proposition name', name)
     return names
 

@@ -21,9 +21,11 @@
 
 Bad input is answered with a 4xx JSON body ``{"error", "item", "message"}`` whose ``item``
 names the offending system, field, job or artifact; the server keeps serving. Requests with
-a foreign Host header (421), a body over 1 MB (413) or a POST whose body is not declared JSON
-(415: what a cross-site form can send) are refused first (web.guards); a new job while too many
-are unfinished is 503 BUSY, a simulation while too many run is 429 BUSY with Retry-After.
+a foreign Host header (421), a body over 1 MB (413), a POST whose body is not declared JSON
+(415: what a cross-site form can send) or one nested too deeply (400 TOO_DEEP) are refused first
+(web.guards); a control character or lone surrogate in any string is 422 INVALID_CHARACTER
+naming the field (web.jobs.checked_body); a new job while too many are unfinished is 503 BUSY,
+a simulation or goal check while too many run is 429 BUSY with Retry-After.
 
 The backend returns records (Job with its web.outcome.JobOutcome, Simulation, the job's
 sm_generation StateMachine); the routes turn them into JSON with their ``to_dict``.

@@ -67,6 +67,12 @@ def test_gui_serves_on_loopback_by_default_and_stops_on_ctrl_c():
         assert httpx.get(f'{url}static/app.js').status_code == 200
         assert 'atlas' in httpx.get(f'{url}api/systems').json()['systems']
         assert 'in-process suite' in httpx.get(f'{url}api/info').json()['description']
+        # A body nested 100,000 deep once ended this process with SIGSEGV (JSON decoded on the
+        # main thread's 8 MB stack under the formulas' recursion limit): refused, still serving.
+        deep = httpx.post(f'{url}api/jobs', content=b'[' * 100_000 + b']' * 100_000,
+                          headers={'Content-Type': 'application/json'})
+        assert (deep.status_code, deep.json()['error']) == (400, 'TOO_DEEP')
+        assert gui.poll() is None and httpx.get(f'{url}api/systems').status_code == 200
     finally:
         assert stop(gui) == 0
 

@@ -4,6 +4,7 @@ import http.client
 import json
 import os
 import signal
+import threading
 import time
 import urllib.parse
 from concurrent.futures import ThreadPoolExecutor
@@ -13,6 +14,8 @@ import pytest
 from synthesis_manager.cli import build_parser
 from synthesis_manager.gui import background_server, ros_backend
 from synthesis_manager.limits import MAX_BODY_BYTES
+from synthesis_manager.web import backend as backend_module
+from synthesis_manager.web.guards import json_nesting_exceeds
 from synthesis_manager.web.routes import create_app
 from synthesis_manager.web.simulation_process import CHILD_ENVIRONMENT, SimulationProcess
 
@@ -293,3 +296,77 @@ def test_a_simulation_process_gets_the_lean_rendering_environment(monkeypatch):
     assert variables[b'LP_NUM_THREADS'] == b'2'
     assert variables[b'MALLOC_TRIM_THRESHOLD_'] == b'131072'
     assert variables[b'MUJOCO_GL'] == b'egl'
+
+
+def test_a_body_nested_100000_deep_is_refused_before_it_is_parsed(gui):
+    """The attack that once ended the GUI with SIGSEGV (issue 34, item 1), at the same depth."""
+    _, url = gui
+    started = time.monotonic()
+    status, error = request(url, 'POST', '/api/jobs', b'[' * 100_000 + b']' * 100_000)
+    assert (status, error['error'], error['code'], error['item']) == (400, 'TOO_DEEP', 'INVALID_REQUEST', 'body')
+    assert time.monotonic() - started < 1.0
+    status, error = request(url, 'POST', '/api/goal-check', b'{"goals": ' + b'{"a": ' * 1000)
+    assert (status, error['error']) == (400, 'TOO_DEEP')
+    assert request(url, 'GET', '/api/systems')[0] == 200  # and it keeps serving
+
+
+@pytest.mark.parametrize('body, deeper', [
+    (b'[]', False), (b'[' * 32 + b']' * 32, False), (b'[' * 33, True),
+    (b'{"a": "[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[", "b": [[]]}', False),  # brackets in strings
+    (b'["\\"' + b'[' * 40 + b'"]', False),  # an escaped quote does not end the string
+    (b'["\\\\", ' + b'[' * 40 + b']', True),  # an escaped backslash does
+])
+def test_the_nesting_scan_counts_brackets_outside_strings(body, deeper):
+    assert json_nesting_exceeds(body) is deeper
+
+
+def test_goal_checks_beyond_the_limit_are_busy_with_retry_after(gui, monkeypatch):
+    backend, url = gui
+    running, release = threading.Semaphore(0), threading.Event()
+    real_findings = backend_module.goal_findings
+
+    def slow_findings(*args):
+        running.release()
+        release.wait(30)
+        return real_findings(*args)
+
+    monkeypatch.setattr(backend_module, 'goal_findings', slow_findings)
+    check = {'system': 'atlas', 'initial_conditions': [], 'goals': ['look_down']}
+    with ThreadPoolExecutor(backend.max_goal_checks) as pool:
+        held = [pool.submit(request, url, 'POST', '/api/goal-check', check) for _ in range(backend.max_goal_checks)]
+        try:
+            for _ in held:
+                assert running.acquire(timeout=30)
+            status, headers, error = post_raw(url, '/api/goal-check', json.dumps(check).encode(), 'application/json')
+        finally:
+            release.set()
+        assert [future.result()[0] for future in held] == [200] * backend.max_goal_checks
+    assert (status, error['error'], error['code'], error['item']) == (429, 'BUSY', 'BUSY', 'goal-check')
+    assert {name.lower(): value for name, value in headers.items()}['retry-after'] == '1'
+    assert request(url, 'POST', '/api/goal-check', check)[0] == 200  # a slot is free again
+
+
+@pytest.mark.parametrize('path, body, item', [
+    ('/api/jobs', b'{"system": "atlas", "goals": ["look_down\\ud800"]}', 'goals'),
+    ('/api/goal-check', b'{"system": "atlas", "goals": ["\\udc00"]}', 'goals'),
+    ('/api/goal-check', b'{"system": "atlas\\ud800", "goals": []}', 'system'),
+    ('/api/jobs', b'{"system": "atlas", "goals": ["look\\u0000down"]}', 'goals'),
+    ('/api/jobs', b'{"system": "atlas", "goals": "look_down", "initial_conditions": "stand\\u0007"}',
+     'initial_conditions'),
+    ('/api/jobs', b'{"system": "atlas\\u0000", "goals": ["look_down"]}', 'system'),
+    ('/api/jobs', b'{"system": "atlas", "goals": ["look_down"], "name": "pick\\u0000up"}', 'name'),
+    ('/api/jobs', b'{"system": "atlas", "goals": ["look_down"], "name": "pickup\\n"}', 'name'),
+    ('/api/jobs', b'{"system": "atlas", "goals": ["look_down"], "name\\ud800": 1}', 'body'),
+])
+def test_control_characters_and_lone_surrogates_are_refused_naming_the_field(gui, path, body, item):
+    _, url = gui
+    status, error = request(url, 'POST', path, body)
+    assert (status, error['error'], error['code'], error['item']) == (422, 'INVALID_CHARACTER', 'INVALID_REQUEST', item)
+    assert len(error['message']) < 200
+
+
+def test_names_in_a_text_may_still_be_separated_by_newlines(gui):
+    _, url = gui
+    status, check = request(url, 'POST', '/api/goal-check',
+                            {'system': 'atlas', 'initial_conditions': [], 'goals': 'look_down\nstand_prep'})
+    assert status == 200 and [f['item'] for f in check['findings']] == ['stand_prep']

@@ -15,6 +15,8 @@ export async function api(method, path, body) {
     const error = new Error(data.message || `${response.status} ${response.statusText}`);
     error.code = data.error || String(response.status);
     error.item = data.item;
+    error.status = response.status;
+    error.retryAfter = Number(response.headers.get('Retry-After')) || 0;
     throw error;
   }
   return data;

@@ -66,7 +66,11 @@ export async function checkGoals() {
     check = await api('POST', '/api/goal-check', { system: request.system, initial_conditions: request.initial_conditions,
       goals: request.goals, unordered: request.unordered });
   } catch (error) {
-    return;  // the synthesis itself will report what is wrong
+    // Too many checks at once (429, with Retry-After): ask again then, unless a newer check went out.
+    if (error.status === 429 && number === goalChecks) {
+      setTimeout(() => { if (number === goalChecks) checkGoals(); }, 1000 * (error.retryAfter || 1));
+    }
+    return;  // otherwise the synthesis itself will report what is wrong
   }
   if (number !== goalChecks) return;
   for (const option of $('goal-choice').options) {

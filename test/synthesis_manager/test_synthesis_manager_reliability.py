@@ -300,6 +300,20 @@ def test_goal_time_limits_hold_under_load(ros, tmp_path):
         assert max(outcome.seconds for outcome in limited) < 2.0 + 1.0
 
 
+def test_a_goal_asking_for_forever_gets_the_servers_cap(ros, tmp_path):
+    """Issue 34 item 5: a goal asking for 1e9 s runs under max_goal_timeout, and its feedback and
+    result name the cap."""
+    client = start_suite(ros, tmp_path, server_parameters=[Parameter('max_goal_timeout', value=2.0)])
+    statuses = []
+    started = time.monotonic()
+    outcome = client.run(runaway_goal(1e9), feedback=lambda status, _progress: statuses.append(status), timeout=60)
+    assert outcome.error_name == 'SYNTHESIS_TIMEOUT', outcome.message
+    assert 'time limit of 2 s passed' in outcome.message and 'max_goal_timeout' in outcome.message
+    assert 'asked for 1e+09 s' in statuses[0]
+    assert time.monotonic() - started < 2.0 + 1.0
+    assert client.run(make_goal(**PAPER_TASK, timeout=1e9), timeout=60).error_name == 'SUCCESS'
+
+
 def test_a_flood_is_rejected_on_arrival_and_reported_busy(ros, tmp_path):
     client = start_suite(ros, tmp_path, server_parameters=[Parameter('max_active_goals', value=0)])
     started = time.monotonic()

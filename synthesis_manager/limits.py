@@ -101,6 +101,15 @@ def check_message(message, path: str = 'request', limit: int = MAX_STRING_BYTES,
                                       f'take {total} bytes)', path)
 
 
+def check_texts(message, path: str = 'request'):
+    """Refuse a message with a control character in any string (:func:`check_text`): what a
+    client must check before sending, since serialization cuts a string at its first NUL and
+    the server would never see it."""
+    for field_path, value in message_parts(message, path):
+        if isinstance(value, str):
+            check_text(value, field_path)
+
+
 def is_name_field(field_path: str) -> bool:
     """Whether a field path (``goal.request.sm_outcomes[2]``) names a field of names."""
     return re.sub(r'\[\d+\]$', '', field_path).rsplit('.', 1)[-1] in NAME_FIELDS

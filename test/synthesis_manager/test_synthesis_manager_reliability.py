@@ -23,7 +23,7 @@ from rclpy.parameter import Parameter
 
 from suite_settings import suite_args
 from synthesis_manager.client import SynthesisClient, make_goal
-from synthesis_manager.limits import MAX_STRING_BYTES
+from synthesis_manager.limits import MAX_LIST_LENGTH, MAX_STRING_BYTES
 from synthesis_manager.nodes.server_node import BehaviorSynthesisServer
 from synthesis_manager.requests import byproduct_file_stem
 from synthesis_manager.ros.env import prepare_ros_environment
@@ -163,6 +163,24 @@ def test_oversized_strings_are_refused_without_echo(ros, tmp_path):
         assert outcome.error_name == 'INVALID_REQUEST', outcome.message
         assert f'{2 * MAX_STRING_BYTES} bytes' in outcome.message
         assert len(outcome.message) < 400
+    assert client.run(make_goal(**PAPER_TASK), timeout=60).error_name == 'SUCCESS'
+
+
+def test_long_lists_and_control_characters_are_refused_naming_the_field(ros, tmp_path):
+    """Issue 34 items 6 and 11: a list over MAX_LIST_LENGTH, a NUL that used to cut the goal
+    short (SUCCESS with half the task; serialization cuts it, so our client refuses it unsent),
+    a line break in a name: each INVALID_REQUEST at once."""
+    client = start_suite(ros, tmp_path)
+    for goal, named in [
+            (make_goal(**PAPER_TASK, sm_outcomes=['finished'] * (MAX_LIST_LENGTH + 1)), 'goal.request.sm_outcomes'),
+            (make_goal(system='atlas', initial_conditions=['stand_prep'], goals=['look_down\x00', 'pickup_object']),
+             'goal.request.goal'),
+            (make_goal(**PAPER_TASK, name='two\nlines'), 'goal.request.name')]:
+        started = time.monotonic()
+        outcome = client.run(goal, timeout=30)
+        assert outcome.error_name == 'INVALID_REQUEST', outcome.message
+        assert named in outcome.message and len(outcome.message) < 400
+        assert time.monotonic() - started < 2.0
     assert client.run(make_goal(**PAPER_TASK), timeout=60).error_name == 'SUCCESS'
 
 

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import enum
 import reprlib
+import sys
 import textwrap
 
 #: How much of a user's value any message quotes: a refused value may be megabytes long.
@@ -182,3 +183,14 @@ def exit_status_help(*statuses: ExitStatus) -> str:
     lines = [textwrap.fill(f'{int(status)}  {status.meaning.replace("`", "")}', width=88,
                            initial_indent='  ', subsequent_indent='     ') for status in statuses]
     return '\n'.join(['Exit status:', *lines, '  130, 143  stopped by SIGINT (Ctrl-C) or SIGTERM'])
+
+
+def unbuildable_value(error: ValueError) -> str:
+    """Why YAML (or JSON) text parsed but a value of it could not be built, in a few words:
+    PyYAML lets the constructors' ValueError through (an integer of more digits than Python
+    converts, an impossible date), which would otherwise be an internal error."""
+    text = str(error)
+    if 'integer string conversion' in text:
+        return f'an integer has more than {sys.get_int_max_str_digits()} digits'
+    return f'a value cannot be read: {quoted(text, 100)}'
+

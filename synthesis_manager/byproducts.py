@@ -20,8 +20,10 @@ directory is shared with other programs.
 from __future__ import annotations
 
 import contextlib
+import errno
 import os
 import re
+import stat
 import tempfile
 import time
 from pathlib import Path
@@ -40,6 +42,47 @@ _MARKER_FILE = re.compile(r'^\.(?P<stem>.+)' + re.escape(_MARKER_SUFFIX) + '$')
 
 class InvalidSpecNameError(CodedError):
     code = ErrorCode.INVALID_SPEC_NAME
+
+
+class ByproductsDirectoryError(CodedError):
+    """The byproducts cannot be written safely or at all: an unsafe directory, a symbolic link
+    where a byproduct goes, a full or read-only disk. Nothing was written outside the directory."""
+
+    code = ErrorCode.SYNTHESIS_FAILED
+
+
+def default_directory() -> Path:
+    """Where byproducts go unless configured: private to the user (see the module docstring)."""
+    return Path(tempfile.gettempdir()) / 'behavior_synthesis_byproducts'
+
+
+def private_directory(directory: Path) -> Path:
+    """``directory``, created 0700 if missing; refused unless it is a real directory of this
+    user that no one else can write to."""
+    try:
+        os.mkdir(directory, 0o700)
+    except FileExistsError:
+        pass
+    except OSError as error:
+        raise unwritable(directory, error) from None
+    info = os.lstat(directory)
+    if not stat.S_ISDIR(info.st_mode):
+        problem = 'is not a directory (a symbolic link or a file)'
+    elif info.st_uid != os.getuid():
+        problem = f'belongs to another user (uid {info.st_uid})'
+    elif info.st_mode & (stat.S_IWGRP | stat.S_IWOTH):
+        problem = f'is writable by others (mode {stat.S_IMODE(info.st_mode):o})'
+    else:
+        return directory
+    raise ByproductsDirectoryError(f'refusing the byproducts directory {quoted(str(directory))}: it {problem}; '
+                                   'remove it or set byproducts_dir', 'byproducts_dir')
+
+
+def unwritable(path: Path, error: OSError) -> ByproductsDirectoryError:
+    """The coded error for a byproduct that cannot be written (disk full, read-only, ...)."""
+    reason = errno.errorcode.get(error.errno, 'error')
+    return ByproductsDirectoryError(f'cannot write {quoted(path.name)} in the byproducts directory: '
+                                    f'{error.strerror or error} ({reason})', 'byproducts_dir')
 
 
 def is_spec_name(name: str) -> bool:
@@ -65,32 +108,59 @@ class ByproductSet:
         self.marker = directory / f'.{self.name}{_MARKER_SUFFIX}'
 
     def mark(self):
-        """Record that this set's files are ours (retention deletes nothing else)."""
-        self.marker.write_text(_MARKER_SIGNATURE + ', '.join(path.name for path in self.paths.values()) + '\n')
+        """Record that this set's files are ours (retention deletes nothing else).
+
+        Refused when the marker or a file name is a symbolic link (an external synthesizer
+        writing its file would follow it)."""
+        for path in [self.marker, *self.paths.values()]:
+            if path.is_symlink():
+                raise ByproductsDirectoryError(f'refusing the byproduct {quoted(path.name)}: it is a symbolic link '
+                                               '(links are never followed)', 'spec_name')
+        text = _MARKER_SIGNATURE + ', '.join(path.name for path in self.paths.values()) + '\n'
+        try:
+            descriptor = os.open(self.marker, os.O_WRONLY | os.O_CREAT | os.O_TRUNC | os.O_NOFOLLOW, 0o600)
+            with os.fdopen(descriptor, 'w', encoding='utf-8') as marker:
+                marker.write(text)
+        except OSError as error:
+            raise unwritable(self.marker, error) from None
 
     def is_marked(self) -> bool:
         try:
-            with self.marker.open(encoding='utf-8', errors='replace') as marker:
+            descriptor = os.open(self.marker, os.O_RDONLY | os.O_NOFOLLOW)
+            with os.fdopen(descriptor, encoding='utf-8', errors='replace') as marker:
                 return marker.read(len(_MARKER_SIGNATURE)) == _MARKER_SIGNATURE
         except OSError:
             return False
 
     def write(self, extension: str, text: str) -> Path:
+        """Write one file atomically: a new private file renamed over the name (a symbolic link
+        there is replaced, not followed); a full or read-only disk is a coded error."""
         path = self.paths[extension]
-        with tempfile.NamedTemporaryFile('w', dir=self.directory, prefix=f'.{self.name}.',
-                                         suffix='.part', delete=False) as part:
-            part.write(text)
-        os.replace(part.name, path)
+        part = None
+        try:
+            with tempfile.NamedTemporaryFile('w', dir=self.directory, prefix=f'.{self.name}.',
+                                             suffix='.part', delete=False) as part:
+                part.write(text)
+            os.replace(part.name, path)
+        except OSError as error:
+            if part is not None:
+                with contextlib.suppress(OSError):
+                    os.unlink(part.name)
+            raise unwritable(path, error) from None
         return path
 
 
 class ByproductStore:
     """Where byproducts go and how long they stay (see the module docstring)."""
 
-    def __init__(self, directory: str | Path, keep_last: int = DEFAULT_KEEP_LAST, max_age: float = 0.0):
+    def __init__(self, directory: str | Path, keep_last: int = DEFAULT_KEEP_LAST, max_age: float = 0.0,
+                 private: bool | None = None):
+        """``private``: check the directory as the default one (see :func:`private_directory`);
+        None: only when ``directory`` is :func:`default_directory`."""
         if keep_last < 0 or max_age < 0:
             raise ValueError('keep_last and max_age must be >= 0')
         self.directory = Path(directory)
+        self.private = self.directory == default_directory() if private is None else private
         self.keep_last = keep_last
         self.max_age = max_age
 
@@ -102,7 +172,13 @@ class ByproductStore:
             with tempfile.TemporaryDirectory(prefix='behavior-synthesis-byproducts-') as private:
                 yield ByproductSet(Path(private), spec_name)
             return
-        self.directory.mkdir(parents=True, exist_ok=True)
+        if self.private:
+            private_directory(self.directory)
+        else:
+            try:
+                self.directory.mkdir(parents=True, exist_ok=True)
+            except OSError as error:
+                raise unwritable(self.directory, error) from None
         files = ByproductSet(self.directory, spec_name)
         files.mark()
         try:

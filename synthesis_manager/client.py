@@ -10,6 +10,8 @@ import yaml
 
 from respec.errors import ErrorCode
 from respec.naming import DEFAULT_SM_OUTCOMES
+from synthesis_manager.limits import check_texts
+from synthesis_manager.requests import InvalidRequestError
 from synthesis_manager.ros.action_client import RaceFreeActionClient
 from synthesis_manager.ros.cnu_interface import load_flexbe_synthesis_interface
 from synthesis_manager.ros.conversions import error_name, msg_to_sections, msg_to_state_dict
@@ -153,8 +155,16 @@ class SynthesisClient:
 
     def run(self, goal, feedback=None, cancel: threading.Event | None = None,
             timeout: float = 600.0) -> SynthesisOutcome:
-        """Send ``goal``; call ``feedback(status, progress)``; cancel when ``cancel`` is set."""
+        """Send ``goal``; call ``feedback(status, progress)``; cancel when ``cancel`` is set.
+
+        A goal with a control character is answered INVALID_REQUEST here, unsent, as the server
+        would answer it: a NUL must be caught before sending, because serialization cuts the
+        string there and the server would run the rest (SUCCESS with half the task)."""
         started = time.monotonic()
+        try:
+            check_texts(goal, 'goal')
+        except InvalidRequestError as refused:
+            return SynthesisOutcome(refused.code.number, str(refused.code), str(refused))
         on_feedback = (lambda msg: feedback(msg.feedback.status, msg.feedback.progress)) if feedback else None
         handle = wait_for(self.action_client.send_goal_async(goal, feedback_callback=on_feedback),
                             timeout)

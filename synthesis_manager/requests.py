@@ -11,7 +11,7 @@ from typing import Any
 
 import yaml
 
-from respec.errors import CodedError, ErrorCode, quoted
+from respec.errors import CodedError, ErrorCode, quoted, unbuildable_value
 from respec.naming import DEFAULT_SM_OUTCOMES, parse_names
 
 OPTION_NAMES = ('ltl_compilation_only', 'ltl_synthesis_only', 'ltl_steps_only')
@@ -135,6 +135,8 @@ def load_request_yaml(text: str, item: str):
         where = f' (line {mark.line + 1}, column {mark.column + 1})' if mark is not None else ''
         problem = getattr(error, 'problem', None) or 'malformed'
         raise InvalidRequestError(f'{item} is not valid YAML: {quoted(problem, 80)}{where}', item) from None
+    except ValueError as error:
+        raise InvalidRequestError(f'{item}: {unbuildable_value(error)}', item) from None
     finally:
         loader.dispose()
 

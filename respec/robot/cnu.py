@@ -53,7 +53,7 @@ from typing import Callable
 
 import yaml
 
-from respec.errors import ErrorCode
+from respec.errors import ErrorCode, unbuildable_value
 from respec.naming import COMPLETED, FAILED, FINISHED, activation
 from respec.robot.files import SystemConfigError
 
@@ -327,6 +327,8 @@ def _read_yaml(document: dict, key: str, read: Callable[[str], str], system: str
         return yaml.safe_load(text)
     except yaml.YAMLError as error:
         raise CapabilityConfigError(f'{system}.yaml: {key} {value!r} is not valid YAML: {error}', item=key) from None
+    except ValueError as error:
+        raise CapabilityConfigError(f'{system}.yaml: {key} {value!r}: {unbuildable_value(error)}', item=key) from None
 
 
 def _mappings(mappings, system: str):

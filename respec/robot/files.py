@@ -21,7 +21,7 @@ from typing import Sequence, Union
 
 import yaml
 
-from respec.errors import CodedError, ErrorCode, quoted
+from respec.errors import CodedError, ErrorCode, quoted, unbuildable_value
 
 CONFIG_DIR_ENV = 'BEHAVIOR_SYNTHESIS_CONFIG_DIR'
 #: The systems shipped with the repository; always last on the search path.
@@ -121,6 +121,8 @@ def parse_config_text(text: str, path: str | Path) -> dict:
         document = yaml.load(text, Loader=_SAFE_LOADER)
     except yaml.YAMLError as error:
         raise ConfigFileInvalidError(f'{path}: not valid YAML: {error}', item=str(path)) from error
+    except ValueError as error:
+        raise ConfigFileInvalidError(f'{path}: {unbuildable_value(error)}', item=str(path)) from None
     if not isinstance(document, dict):
         raise ConfigFileInvalidError(f'{path}: expected a mapping at the top level', item=str(path))
     return document

@@ -102,7 +102,11 @@ def _robot_system(name: str, path: Path, read: Callable[[str], str]) -> RobotSys
     files: dict[str, str] = {}
 
     def read_and_keep(relative: str) -> str:
-        files[relative] = read(relative)
+        try:
+            files[relative] = read(relative)
+        except UnicodeDecodeError as error:  # its repr holds the whole file: never shown
+            raise ConfigFileInvalidError(f'{path.parent / relative}: not UTF-8 text (byte 0x{error.object[error.start]:02x} '
+                                         f'at position {error.start})', item=relative) from None
         return files[relative]
 
     document = parse_config_text(read_and_keep(path.name), path)

@@ -8,11 +8,9 @@ settings, and the diagnosis leads the answer's message (ltl_specification.diagno
 
 from __future__ import annotations
 
-import tempfile
 import threading
 import time
 import uuid
-from pathlib import Path
 
 from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.node import Node
@@ -26,7 +24,7 @@ from ltl_synthesizer.strategy import strategy_to_json
 from respec.automaton import automaton_from_strategy
 from respec.errors import ErrorCode
 from respec.parsing import ParseError, spec_from_text_sections
-from synthesis_manager.byproducts import DEFAULT_KEEP_LAST, ByproductStore
+from synthesis_manager.byproducts import DEFAULT_KEEP_LAST, ByproductStore, default_directory
 from synthesis_manager.limits import check_message, check_timeout
 from synthesis_manager.ros.conversions import automaton_to_msg, error_code, msg_to_sections
 from synthesis_manager.ros.errors import reported_error
@@ -68,8 +66,7 @@ class LTLSynthesisNode(Node):
 
     def __init__(self, **kwargs):
         super().__init__('ltl_synthesis', **kwargs)
-        default_dir = str(Path(tempfile.gettempdir()) / 'behavior_synthesis_byproducts')
-        self.declare_parameter('byproducts_dir', default_dir)
+        self.declare_parameter('byproducts_dir', str(default_directory()))
         self.declare_parameter('keep_byproducts', DEFAULT_KEEP_LAST)
         self.declare_parameter('byproducts_max_age', 0.0)
         self.declare_parameter('backend', 'builtin')

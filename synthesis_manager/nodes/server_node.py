@@ -31,8 +31,8 @@ from ltl_specification.initial_conditions import (detected_status, initial_condi
                                                   reads_robot_state)
 from respec.errors import INTERNAL_ERROR, CodedError, ErrorCode
 from sm_generation.instantiation import count_states
-from synthesis_manager.limits import (MAX_STRING_BYTES, BusyError, GoalDeadline, GoalTimeoutError, check_message,
-                                      check_timeout, utf8_length)
+from synthesis_manager.limits import (DEFAULT_MAX_GOAL_TIMEOUT, MAX_STRING_BYTES, BusyError, GoalDeadline,
+                                      GoalTimeoutError, capped_timeout, check_message, check_timeout, utf8_length)
 from synthesis_manager.nodes.atlas_sim_node import STATE_TOPIC
 from synthesis_manager.requests import (InvalidRequestError, SynthesisTask, task_from_behavior_synthesis,
                                         task_from_flexbe_synthesis)
@@ -141,7 +141,9 @@ class BehaviorSynthesisServer(Node):
     the simulator's ``atlas_sim/state``), ``robot_state_timeout`` (seconds to wait for a state
     when a request names no initial conditions, or ``current``: synthesis on the fly),
     ``max_active_goals`` (goals in progress at once, both actions together; more are answered
-    BUSY) and ``result_retention`` (seconds a finished goal's result stays available to its client).
+    BUSY), ``max_goal_timeout`` (seconds: the longest time limit a goal may have; a goal asking
+    for more gets this, and its feedback and a TIMEOUT result say so; 0: no cap) and
+    ``result_retention`` (seconds a finished goal's result stays available to its client).
     """
 
     def __init__(self, **kwargs):
@@ -157,6 +159,7 @@ class BehaviorSynthesisServer(Node):
         self.declare_parameter('robot_state_timeout', 2.0)
         self.declare_parameter('flexbe_log_topic', 'flexbe/log')
         self.declare_parameter('max_active_goals', 100)
+        self.declare_parameter('max_goal_timeout', DEFAULT_MAX_GOAL_TIMEOUT)
         self.declare_parameter('result_retention', 60.0)
         self._stopping = threading.Event()
         self._active_goals = 0
@@ -220,8 +223,11 @@ class BehaviorSynthesisServer(Node):
         try:
             check_message(goal_handle.request, 'goal')
             task = interface.read_goal(goal_handle.request, self.parameter('default_system'))
-            check_timeout(task.timeout)
-            deadline = GoalDeadline(task.timeout, started=self.accepted_at(goal_handle))
+            requested = check_timeout(task.timeout)
+            task = replace(task, timeout=capped_timeout(requested, self.parameter('max_goal_timeout')))
+            deadline = GoalDeadline(task.timeout, started=self.accepted_at(goal_handle), requested=requested)
+            if deadline.capped():
+                feedback(deadline.capped())
             with self.admitted():
                 await self.run_pipeline(goal_handle, task, outcome, feedback, deadline)
         except Preempted:

@@ -30,7 +30,9 @@ class SMGenerationNode(Node):
 
     def on_request(self, request, response):
         try:
-            check_message(request)
+            # No list or whole-message bound: the automaton is a synthesis result, as large as the
+            # specification makes it (its strings and names are still checked).
+            check_message(request, max_list=None, max_total=None)
             states = generate_state_machine(
                 msg_to_automaton(request.automaton), request.system,
                 config_dir=self.get_parameter('config_dir').value or None,

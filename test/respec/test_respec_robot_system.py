@@ -45,6 +45,22 @@ def test_unknown_and_broken_systems_are_reported_with_the_offending_item(tmp_pat
         robot_system('cnu', tmp_path)
 
 
+def test_a_binary_or_huge_number_config_file_is_invalid_in_few_words(tmp_path):
+    """Issue 34 item 11: not an internal error, and the message does not carry the file."""
+    (tmp_path / 'binary.yaml').write_bytes(bytes(range(128, 256)) * 94)  # 11.8 KB, not UTF-8
+    (tmp_path / 'digits.yaml').write_text('abstraction:\n  actions: {a: ' + '9' * 60_000 + '}\n')
+    (tmp_path / 'cnu.yaml').write_text('system: cnu\ncnu_capabilities: capabilities.yaml\n')
+    (tmp_path / 'capabilities.yaml').write_text('x: ' + '9' * 60_000 + '\n')
+    for name, words in [('binary', 'not UTF-8 text (byte 0x80 at position 0)'),
+                        ('digits', 'an integer has more than 4300 digits')]:
+        with pytest.raises(ConfigFileInvalidError) as raised:
+            robot_system(name, tmp_path)
+        assert words in str(raised.value) and len(str(raised.value)) < 300
+        assert raised.value.code == 'CONFIG_FILE_INVALID'
+    with pytest.raises(CapabilityConfigError, match='an integer has more than 4300 digits'):
+        robot_system('cnu', tmp_path)
+
+
 def test_a_system_rebuilt_from_its_files_is_the_same_system():
     atlas = robot_system('atlas')
     copy = robot_system_from_files('atlas', dict(atlas.files))

@@ -1,11 +1,14 @@
 """Byproduct files: names that never collide, retention (keep last N, max age, keep none)."""
 
+import errno
 import os
+import stat
 import time
 
 import pytest
 
-from synthesis_manager.byproducts import ByproductStore, InvalidSpecNameError
+from synthesis_manager.byproducts import (ByproductsDirectoryError, ByproductStore, InvalidSpecNameError,
+                                          default_directory)
 
 
 def write_set(store, name):
@@ -80,3 +83,113 @@ def test_retention_deletes_only_files_the_suite_wrote(tmp_path):
     store.prune(now=time.time() + 3600)  # every set of ours is too old now
     assert {name: (tmp_path / name).read_text() for name in foreign} == foreign
     assert sorted(path.name for path in tmp_path.iterdir()) == sorted(foreign)
+
+
+# Safety on a shared machine (issue 34, items 7 and 11): no link followed, a private default
+# directory, and a full or read-only disk answered with a code.
+
+def test_a_planted_marker_symlink_is_not_followed(tmp_path):
+    target = tmp_path / 'victim.txt'
+    target.write_text('precious\n')
+    directory = tmp_path / 'byproducts'
+    directory.mkdir(mode=0o700)
+    (directory / '.planted.byproducts').symlink_to(target)
+    with pytest.raises(ByproductsDirectoryError, match='symbolic link') as raised:
+        write_set(ByproductStore(directory), 'planted')
+    assert raised.value.code == 'SYNTHESIS_FAILED'
+    assert target.read_text() == 'precious\n'
+
+
+def test_a_planted_file_symlink_is_not_followed(tmp_path):
+    target = tmp_path / 'victim.txt'
+    target.write_text('precious\n')
+    (tmp_path / 'planted.json').symlink_to(target)
+    with pytest.raises(ByproductsDirectoryError, match='planted.json'):
+        write_set(ByproductStore(tmp_path), 'planted')
+    assert target.read_text() == 'precious\n'
+
+
+def test_a_marker_behind_a_symlink_is_not_ours(tmp_path):
+    """A link to a real marker elsewhere does not make retention delete its neighbours."""
+    elsewhere = tmp_path / 'elsewhere'
+    write_set(ByproductStore(elsewhere), 'other')
+    directory = tmp_path / 'byproducts'
+    directory.mkdir()
+    (directory / 'other.json').write_text('a user file\n')
+    (directory / '.other.byproducts').symlink_to(elsewhere / '.other.byproducts')
+    write_set(ByproductStore(directory, keep_last=1), 'mine')
+    assert (directory / 'other.json').read_text() == 'a user file\n'
+
+
+def test_a_fresh_private_directory_is_0700(tmp_path):
+    directory = tmp_path / 'private'
+    write_set(ByproductStore(directory, private=True), 'fresh')
+    assert stat.S_IMODE(directory.stat().st_mode) == 0o700
+    assert (directory / 'fresh.json').read_text() == 'fresh json\n'
+
+
+def test_the_default_directory_is_private():
+    assert ByproductStore(default_directory()).private
+    assert not ByproductStore('/somewhere/else').private
+
+
+@pytest.mark.parametrize('mode', [0o777, 0o770, 0o1777])
+def test_a_loose_private_directory_is_refused(tmp_path, mode):
+    directory = tmp_path / 'loose'
+    directory.mkdir()
+    os.chmod(directory, mode)
+    with pytest.raises(ByproductsDirectoryError, match='writable by others') as raised:
+        write_set(ByproductStore(directory, private=True), 'refused')
+    assert raised.value.item == 'byproducts_dir'
+    assert list(directory.iterdir()) == []
+
+
+def test_a_private_directory_of_another_user_is_refused(tmp_path, monkeypatch):
+    directory = tmp_path / 'theirs'
+    directory.mkdir(mode=0o700)
+    if os.getuid() == 0:
+        os.chown(directory, 12345, 12345)
+    else:  # only root can give a directory away: this process pretends to be someone else
+        monkeypatch.setattr(os, 'getuid', lambda: os.stat(directory).st_uid + 1)
+    with pytest.raises(ByproductsDirectoryError, match='another user'):
+        write_set(ByproductStore(directory, private=True), 'refused')
+    assert list(directory.iterdir()) == []
+
+
+def test_a_private_directory_that_is_a_symlink_is_refused(tmp_path):
+    real = tmp_path / 'real'
+    real.mkdir(mode=0o700)
+    (tmp_path / 'link').symlink_to(real)
+    with pytest.raises(ByproductsDirectoryError, match='not a directory'):
+        write_set(ByproductStore(tmp_path / 'link', private=True), 'refused')
+    assert list(real.iterdir()) == []
+
+
+@pytest.mark.parametrize('number', [errno.ENOSPC, errno.EROFS])
+def test_a_full_or_read_only_disk_is_a_coded_error(tmp_path, monkeypatch, number):
+    store = ByproductStore(tmp_path)
+
+    def failing_replace(source, destination):
+        raise OSError(number, os.strerror(number))
+
+    monkeypatch.setattr(os, 'replace', failing_replace)
+    with pytest.raises(ByproductsDirectoryError) as raised:
+        write_set(store, 'full')
+    message = str(raised.value)
+    assert raised.value.code == 'SYNTHESIS_FAILED'
+    assert errno.errorcode[number] in message and 'full.structuredslugs' in message
+    assert len(message) < 300
+    assert not list(tmp_path.glob('*.part'))
+
+
+def test_an_unwritable_marker_is_a_coded_error(tmp_path, monkeypatch):
+    real_open = os.open
+
+    def full_disk(path, flags, *args):
+        if flags & os.O_CREAT:
+            raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+        return real_open(path, flags, *args)
+
+    monkeypatch.setattr(os, 'open', full_disk)
+    with pytest.raises(ByproductsDirectoryError, match='ENOSPC'):
+        write_set(ByproductStore(tmp_path), 'full')

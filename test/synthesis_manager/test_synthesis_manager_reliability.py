@@ -23,7 +23,7 @@ from rclpy.parameter import Parameter
 
 from suite_settings import suite_args
 from synthesis_manager.client import SynthesisClient, make_goal
-from synthesis_manager.limits import MAX_STRING_BYTES
+from synthesis_manager.limits import MAX_LIST_LENGTH, MAX_STRING_BYTES
 from synthesis_manager.nodes.server_node import BehaviorSynthesisServer
 from synthesis_manager.requests import byproduct_file_stem
 from synthesis_manager.ros.env import prepare_ros_environment
@@ -166,6 +166,24 @@ def test_oversized_strings_are_refused_without_echo(ros, tmp_path):
     assert client.run(make_goal(**PAPER_TASK), timeout=60).error_name == 'SUCCESS'
 
 
+def test_long_lists_and_control_characters_are_refused_naming_the_field(ros, tmp_path):
+    """Issue 34 items 6 and 11: a list over MAX_LIST_LENGTH, a NUL that used to cut the goal
+    short (SUCCESS with half the task; serialization cuts it, so our client refuses it unsent),
+    a line break in a name: each INVALID_REQUEST at once."""
+    client = start_suite(ros, tmp_path)
+    for goal, named in [
+            (make_goal(**PAPER_TASK, sm_outcomes=['finished'] * (MAX_LIST_LENGTH + 1)), 'goal.request.sm_outcomes'),
+            (make_goal(system='atlas', initial_conditions=['stand_prep'], goals=['look_down\x00', 'pickup_object']),
+             'goal.request.goal'),
+            (make_goal(**PAPER_TASK, name='two\nlines'), 'goal.request.name')]:
+        started = time.monotonic()
+        outcome = client.run(goal, timeout=30)
+        assert outcome.error_name == 'INVALID_REQUEST', outcome.message
+        assert named in outcome.message and len(outcome.message) < 400
+        assert time.monotonic() - started < 2.0
+    assert client.run(make_goal(**PAPER_TASK), timeout=60).error_name == 'SUCCESS'
+
+
 def test_the_synthesis_service_refuses_bad_time_limits(ros, tmp_path):
     start_suite(ros, tmp_path, names=('ltl_synthesis',))
     node = ros.add_node(Node, 'direct_client')
@@ -298,6 +316,20 @@ def test_goal_time_limits_hold_under_load(ros, tmp_path):
         assert names(limited) == Counter({'SYNTHESIS_TIMEOUT': 6}), [o.message for o in limited]
         assert all("time limit of 2 s passed" in outcome.message for outcome in limited)
         assert max(outcome.seconds for outcome in limited) < 2.0 + 1.0
+
+
+def test_a_goal_asking_for_forever_gets_the_servers_cap(ros, tmp_path):
+    """Issue 34 item 5: a goal asking for 1e9 s runs under max_goal_timeout, and its feedback and
+    result name the cap."""
+    client = start_suite(ros, tmp_path, server_parameters=[Parameter('max_goal_timeout', value=2.0)])
+    statuses = []
+    started = time.monotonic()
+    outcome = client.run(runaway_goal(1e9), feedback=lambda status, _progress: statuses.append(status), timeout=60)
+    assert outcome.error_name == 'SYNTHESIS_TIMEOUT', outcome.message
+    assert 'time limit of 2 s passed' in outcome.message and 'max_goal_timeout' in outcome.message
+    assert 'asked for 1e+09 s' in statuses[0]
+    assert time.monotonic() - started < 2.0 + 1.0
+    assert client.run(make_goal(**PAPER_TASK, timeout=1e9), timeout=60).error_name == 'SUCCESS'
 
 
 def test_a_flood_is_rejected_on_arrival_and_reported_busy(ros, tmp_path):

@@ -81,6 +81,7 @@ def test_synthesis_options_yaml(text, expected):
     ('timeout: -1', 'timeout'),
     ('ltl_steps_only: maybe', 'ltl_steps_only'),
     ('{ltl_steps_only: true, ltl_compilation_only: true}', 'mutually exclusive'),
+    ('timeout: ' + '9' * 60_000, 'an integer has more than 4300 digits'),  # Python's int-string limit
 ])
 def test_bad_synthesis_options_are_invalid_requests(text, named):
     with pytest.raises(InvalidRequestError, match=named):

@@ -299,6 +299,19 @@ def rover_variant(config: Path, suggestions: dict[str, str]) -> Path:
     return config
 
 
+def rover_run_ends(ros, onboard, flexbe, tmp_path, name: str, package: str, config_arguments, outcome: str):
+    """Export the rover task as behavior ``name`` in ``package``, run it on FlexBE's onboard and
+    assert it ends in ``outcome``; returns the operator (its logs tell which states ran)."""
+    prefix = exported_and_installed(tmp_path / 'export', ['--system', 'delivery_rover', *config_arguments,
+                                                          *ROVER_TASK, '--name', name],
+                                    package=package, environment=dict(os.environ, AMENT_PREFIX_PATH=str(flexbe)))
+    system = onboard(prefix=prefix, robot=False)
+    operator = Operator(ros)
+    ok, details = finished_with(operator.start_behavior(name, robot=False), outcome, system)
+    assert ok, details
+    return operator
+
+
 def logged(operator, text: str) -> bool:
     """Whether ``text`` was logged (called by ``Operator.wait_until``, which holds its lock)."""
     return any(m.text == text for m in operator.logs)
@@ -308,15 +321,8 @@ def test_the_delivery_rover_exports_and_finishes_onboard(ros, onboard, flexbe, t
     """config/delivery_rover (CNU's format, a battery sensor, FlexBE's own states), exported by
     export-behavior and run by FlexBE's onboard to ``finished``: the battery is fine, so the rover
     drives and hands the parcel over without charging."""
-    prefix = exported_and_installed(tmp_path / 'export', ['--system', 'delivery_rover', *ROVER_TASK,
-                                                          '--name', 'Rover Delivery'],
-                                    package='rover_flexbe_behaviors',
-                                    environment=dict(os.environ, AMENT_PREFIX_PATH=str(flexbe)))
-    system = onboard(prefix=prefix, robot=False)
-    operator = Operator(ros)
-    status = operator.start_behavior('Rover Delivery', robot=False)
-    ok, details = finished_with(status, 'finished', system)
-    assert ok, details
+    operator = rover_run_ends(ros, onboard, flexbe, tmp_path, 'Rover Delivery', 'rover_flexbe_behaviors',
+                              [], 'finished')
     assert operator.wait_until(lambda: logged(operator, 'Handing the parcel over'), 10, 'the hand-over')
     assert not logged(operator, 'Charging the battery')
 
@@ -326,14 +332,8 @@ def test_the_delivery_rover_charges_on_a_low_battery_and_ends_failed_when_its_dr
     """The battery check reports the sensor low (the machine reacts: it charges), then the drive
     fails; the request asked for ``failed``, so the behavior ends there instead of retrying."""
     config = rover_variant(tmp_path / 'config', {'check_battery': 'low', 'drive': 'failed'})
-    prefix = exported_and_installed(tmp_path / 'export', ['--system', 'delivery_rover', '--config-dir', str(config),
-                                                          *ROVER_TASK, '--name', 'Rover Failing Delivery'],
-                                    package='rover_failing_flexbe_behaviors',  # another behavior for this process
-                                    environment=dict(os.environ, AMENT_PREFIX_PATH=str(flexbe)))
-    system = onboard(prefix=prefix, robot=False)
-    operator = Operator(ros)
-    status = operator.start_behavior('Rover Failing Delivery', robot=False)
-    ok, details = finished_with(status, 'failed', system)
-    assert ok, details
+    # Another behavior name and package: this process has loaded the first one's source.
+    operator = rover_run_ends(ros, onboard, flexbe, tmp_path, 'Rover Failing Delivery',
+                              'rover_failing_flexbe_behaviors', ['--config-dir', str(config)], 'failed')
     assert operator.wait_until(lambda: logged(operator, 'Charging the battery'), 10, 'the charge')
     assert not logged(operator, 'Handing the parcel over')

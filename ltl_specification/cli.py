@@ -29,6 +29,17 @@ FORMATS = ('structuredslugs', 'slugsin', 'json')
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Add the ``compile`` options to ``parser``."""
     parser.epilog = exit_status_help(ExitStatus.OK, ExitStatus.FAILED, ExitStatus.USAGE)
+    add_task_arguments(parser)
+    parser.add_argument('--format', choices=FORMATS, default='structuredslugs', help='output format')
+    parser.add_argument('-o', '--output', help='write to FILE instead of standard output')
+    parser.add_argument('--explain', action='store_true', help='also print why each item is included (stderr)')
+    parser.add_argument('--diagnose', action='store_true',
+                        help='also check realizability; if the task cannot be done, say why on stderr '
+                             '(pre-check, unrealizable core, environment play) and exit with status 1')
+
+
+def add_task_arguments(parser: argparse.ArgumentParser) -> None:
+    """The task's options, shared by every offline command that takes a task (compile, repair)."""
     parser.add_argument('--system', required=True, help='robot system, e.g. atlas (config/<system>.yaml)')
     parser.add_argument('--initial-conditions', default='',
                         help='comma-separated actions/control modes that hold initially '
@@ -37,21 +48,15 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument('--sm-outcomes', default='finished,failed',
                         help='finished,failed (stop on failure) or finished (retry failures)')
     parser.add_argument('--unordered', action='store_true', help='goals may be achieved in any order')
-    parser.add_argument('--format', choices=FORMATS, default='structuredslugs', help='output format')
-    parser.add_argument('-o', '--output', help='write to FILE instead of standard output')
     add_config_dir_argument(parser)
     parser.add_argument('--custom-ltl', metavar='FILE',
                         help='YAML/JSON mapping of LTLSpecification sections to extra formulas')
-    parser.add_argument('--explain', action='store_true', help='also print why each item is included (stderr)')
-    parser.add_argument('--diagnose', action='store_true',
-                        help='also check realizability; if the task cannot be done, say why on stderr '
-                             '(pre-check, unrealizable core, environment play) and exit with status 1')
 
 
 def run(args: argparse.Namespace) -> int:
     """Compile and write the specification; returns the process exit status."""
     try:
-        custom_ltl = _read_custom_ltl(args.custom_ltl)
+        custom_ltl = read_custom_ltl(args.custom_ltl)
         spec = compile_task(args.system, args.initial_conditions, args.goals,
                             sm_outcomes=parse_names(args.sm_outcomes), strict_order=not args.unordered,
                             custom_ltl=custom_ltl, config_dir=args.config_dir)
@@ -88,7 +93,8 @@ def main(argv: list[str] | None = None) -> int:
     return run(parser.parse_args(argv))
 
 
-def _read_custom_ltl(path: str | None):
+def read_custom_ltl(path: str | None):
+    """The ``--custom-ltl`` file's mapping (None without one); InvalidFormulaError if unreadable."""
     if not path:
         return None
     try:

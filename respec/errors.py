@@ -152,7 +152,7 @@ class ExitStatus(enum.IntEnum):
     OK = 0, 'done as asked (`gr1synth`: realizable or not, as slugs)'
     FAILED = 1, ('the input or the task was refused: an error code of the pipeline (printed with '
                  'the item it names), a malformed specification (`gr1synth`, as slugs), a task that '
-                 'cannot be done (`compile --diagnose`)')
+                 'cannot be done (`compile --diagnose`), no verified fix found (`repair`)')
     USAGE = 2, 'bad command line, or an argument file that cannot be read'
     TIMED_OUT = 3, 'a time limit ran out (`--timeout`, a goal\'s time limit)'
     OUT_OF_MEMORY = 4, 'a memory limit was exceeded (`gr1synth --memory-limit`)'

@@ -23,6 +23,7 @@ SUBCOMMANDS = {
     'serve': ('synthesis_manager.serve', 'run the synthesis suite until SIGINT/SIGTERM'),
     'send-goal': ('synthesis_manager.send_goal', 'send a goal to /behavior_synthesis and show the result'),
     'compile': ('ltl_specification.cli', 'compile a task into a GR(1) specification (no ROS)'),
+    'repair': ('ltl_specification.repair_cli', 'propose verified changes that make a refused task possible (no ROS)'),
     'generate-sm': ('sm_generation.cli', 'turn an automaton into a FlexBE state machine (no ROS)'),
     'execute': ('synthesis_manager.execute', 'synthesize a behavior and run it on the simulated ATLAS'),
     'export-behavior': ('synthesis_manager.export_behavior', 'synthesize a behavior and write it as a FlexBE '

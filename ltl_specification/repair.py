@@ -53,8 +53,10 @@ UNREALIZABLE = str(ErrorCode.SPEC_UNSYNTHESIZABLE)
 REPAIRABLE = frozenset({UNREALIZABLE, str(ErrorCode.INVALID_GOALS), str(ErrorCode.ABSTRACTION_CONFIG_INVALID)})
 DEFAULT_TIME_BUDGET = 10.0          # seconds for the whole search
 DEFAULT_MAX_PROPOSALS = 5
+MAX_DROPPED_PAIRS_FROM = 8          # custom guarantees: pairs of them dropped up to this many
 MAX_PERMUTED_GOALS = 5              # all orders up to this many goals, adjacent swaps beyond
 MAX_PLAY_STEPS = 12                 # of the environment play that guides assumption mining
+DIAGNOSIS_SHARE = 0.2               # of the time budget, at most, for the problem's diagnosis
 MAX_PER_KIND = 2                    # proposals of one kind, so that different fixes are offered
 
 # Kinds of proposals, by what they change.
@@ -220,7 +222,8 @@ def propose_repairs(system: RobotSystem | str, request: TaskRequest, custom_ltl:
     """Verified proposals that make ``request`` (with ``custom_ltl``) possible on ``system``.
 
     ``system`` is a RobotSystem or its name (read once). Candidates are verified cheapest first
-    until ``max_proposals`` are found or ``time_budget`` seconds are spent; ``on_proposal`` is
+    until ``max_proposals`` are found or ``time_budget`` seconds are spent (then the problem's
+    diagnosis gets at most a fifth of the budget more); ``on_proposal`` is
     called with each one as it is verified (to show progress). ``state_library`` is the
     capability compiler's (default: the workspace's FlexBE states). Raises the system's own
     SystemConfigError when its file cannot be read.
@@ -231,8 +234,6 @@ def propose_repairs(system: RobotSystem | str, request: TaskRequest, custom_ltl:
     request = replace(request, system=system.name)
     original = attempt(system, request, custom_ltl, deadline, state_library=state_library)
     repairs = Repairs(request, original.realizable, original.problem)
-    if original.code == UNREALIZABLE:
-        repairs.problem = f'{UNREALIZABLE}: {_diagnosed_sentence(system, request, custom_ltl, state_library)}'
     if original.realizable:
         return _finish(repairs, start)
     if original.code not in REPAIRABLE and not _names_a_goal_memory(system, original):
@@ -266,6 +267,10 @@ def propose_repairs(system: RobotSystem | str, request: TaskRequest, custom_ltl:
             on_proposal(candidate)
         if len(repairs.proposals) >= max_proposals:
             break
+    if original.code == UNREALIZABLE:   # after the search: proposals first, the core may take long
+        diagnosis_deadline = time.monotonic() + DIAGNOSIS_SHARE * time_budget
+        repairs.problem = f'{UNREALIZABLE}: ' + _diagnosed_sentence(system, request, custom_ltl, state_library,
+                                                                    diagnosis_deadline)
     return _finish(repairs, start)
 
 
@@ -283,14 +288,18 @@ def _memory_owner(system: RobotSystem, name: str) -> str | None:
     return item if abstraction.kind_of(item) is not None else None
 
 
-def _diagnosed_sentence(system: RobotSystem, request: TaskRequest, custom_ltl, state_library) -> str:
-    """The diagnosis' leading sentence, as every channel tells the problem."""
+def _diagnosed_sentence(system: RobotSystem, request: TaskRequest, custom_ltl, state_library,
+                        deadline: float) -> str:
+    """The diagnosis' leading sentence, as every channel tells the problem (its core search
+    stops at ``deadline``: the proposals matter more here)."""
     from ltl_specification.diagnosis import diagnose
 
     spec = compile_task(system, list(request.initial_conditions), list(request.goals),
                         sm_outcomes=request.sm_outcomes, strict_order=not request.unordered,
                         custom_ltl=custom_ltl, state_library=state_library)
-    diagnosis = diagnose(spec)
+    diagnosis = None
+    if getattr(spec, 'provenance', None) is not None:
+        diagnosis = diagnose(spec, limits=Limits(deadline=deadline))
     return diagnosis.sentence if diagnosis else 'the specification is unrealizable'
 
 
@@ -458,6 +467,15 @@ def _custom_ltl_candidates(system: RobotSystem, request: TaskRequest, custom_ltl
             weakened = _with_entries(custom_ltl, section, [t for i, t in enumerate(custom_ltl[section]) if i != index])
             yield Proposal(WEAKEN_GUARANTEE, f'Drop the custom guarantee {section}[{index}] {text!r}.', 2, True,
                            custom_ltl=weakened)
+    guarantees = [(section, index) for section in GUARANTEE_SECTIONS
+                  for index in range(len(custom_ltl.get(section) or ()))]
+    for pair in itertools.combinations(guarantees, 2) if len(guarantees) <= MAX_DROPPED_PAIRS_FROM else ():
+        weakened = {key: list(value) for key, value in custom_ltl.items()}
+        for section, index in sorted(pair, reverse=True):
+            del weakened[section][index]
+        weakened = {key: value for key, value in weakened.items() if value}
+        names = ' and '.join(f'{section}[{index}] {custom_ltl[section][index]!r}' for section, index in pair)
+        yield Proposal(WEAKEN_GUARANTEE, f'Drop the custom guarantees {names}.', 4, True, custom_ltl=weakened)
     for section, text, reason in mined_assumptions(system, request, custom_ltl):
         mined = _with_entries(custom_ltl, section, [*(custom_ltl.get(section) or ()), text])
         yield Proposal(ADD_ASSUMPTION, f'Assume of the environment {section} {text!r} ({reason}).', 1, True,
@@ -559,30 +577,36 @@ def _capability_candidates(system: RobotSystem, request: TaskRequest) -> Iterato
     if relative is None:
         return
     file = _shown_file(system, relative)
-    document = yaml.safe_load(system.files[relative]) or {}
-    entries = document.get('capabilities') or {}
+    entries = (yaml.safe_load(system.files[relative]) or {}).get('capabilities') or {}
+    entries = {name: entry for name, entry in entries.items() if isinstance(entry, dict)}
     success = capabilities.transition_outcomes[0] if capabilities.transition_outcomes else 'completed'
-    set_somewhere = {term for entry in entries.values() if isinstance(entry, dict)
-                     for terms in (entry.get('postconditions') or {}).values() for term in terms or ()}
+    set_somewhere = {term.name for capability in capabilities.capabilities.values()
+                     for terms in capability.postconditions.values() for term in terms if not term.negated}
     for goal in request.goals:
-        if goal in set_somewhere or goal.startswith('!') or not goal.isidentifier():
+        if goal in set_somewhere or not goal.isidentifier():
             continue
         # The capability of the goal's name first: CNU's convention for what achieves it.
         for name, entry in sorted(entries.items(), key=lambda item: item[0] != goal):
-            post = dict(entry.get('postconditions') or {})
-            before = list(post.get(success) or [])
-            patch = ConfigPatch(file, ('capabilities', name, 'postconditions', success), [*before, goal],
-                                before or None)
+            path, before = _success_postconditions(entry, name, success)
+            patch = ConfigPatch(file, path, [*before, goal], before or None)
             yield Proposal(ADD_POSTCONDITION, f'Change the robot: when {name} is {success}, {goal} holds '
-                           f'(capabilities.{name}.postconditions.{success} in {file}).', 1, True,
-                           config_patch=patch)
+                           f'(capabilities.{".".join(path[1:])} in {file}).', 1, True, config_patch=patch)
     for name, entry in entries.items():
-        preconditions = list(entry.get('preconditions') or []) if isinstance(entry, dict) else []
-        for precondition in preconditions:
+        preconditions = entry.get('preconditions')
+        for precondition in preconditions if isinstance(preconditions, list) else ():
             remaining = [p for p in preconditions if p != precondition]
             patch = ConfigPatch(file, ('capabilities', name, 'preconditions'), remaining, preconditions)
             yield Proposal(REMOVE_PRECONDITION, f'Change the robot: {name} no longer needs {precondition!r} '
                            f'(capabilities.{name}.preconditions in {file}).', 2, True, config_patch=patch)
+
+
+def _success_postconditions(entry: dict, name: str, success: str) -> tuple[tuple[str, ...], list]:
+    """Where a capability's file entry lists what its success sets, and what it lists: CNU's
+    files give either one list (the success's) or a mapping by transition outcome."""
+    post = entry.get('postconditions')
+    if isinstance(post, dict):
+        return ('capabilities', name, 'postconditions', success), list(post.get(success) or [])
+    return ('capabilities', name, 'postconditions'), list(post or [])
 
 
 def _capability_file(system: RobotSystem) -> str | None:

@@ -183,3 +183,11 @@ def test_proposals_are_deterministic():
 
     request = TaskRequest('atlas', ('stand_prep',), ('look_down', 'stand_prep'))
     assert without_times(propose_repairs('atlas', request)) == without_times(propose_repairs('atlas', request))
+
+
+def test_guarantees_that_contradict_each_other_get_both_dropped_when_one_is_not_enough():
+    custom = {'sys_trans': ['look_down_a', '!look_down_a']}
+    repairs = propose_repairs('atlas', TaskRequest('atlas', ('stand_prep',), ('look_down',)), custom)
+    assert [p.custom_ltl for p in repairs.proposals if p.kind == WEAKEN_GUARANTEE] == [{}]
+    assert repairs.proposals[0].summary == ("Drop the custom guarantees sys_trans[0] 'look_down_a' and "
+                                            "sys_trans[1] '!look_down_a'.")

@@ -43,7 +43,7 @@ ELSEWHERE = {
     'python': "FlexBE's onboard executive (test/integration/test_flexbe_onboard.py)",
 }
 SERVERS = {'serve': 'suite up', 'gui': 'behavior synthesis GUI: http://'}
-QUICK = {'compile', 'generate-sm', 'export-behavior', 'execute', 'demo'}
+QUICK = {'compile', 'repair', 'generate-sm', 'export-behavior', 'execute', 'demo'}
 
 
 def readme_commands(text: str) -> list[str]:

@@ -31,6 +31,12 @@ FLEXBE_PACKAGES := atlas_sim/flexbe/atlas_sim_flexbe_states atlas_sim/flexbe/atl
 # (AMENT_PREFIX_PATH). Separate from the venv so that tools which walk a behavior package's
 # prefix for manifests walk only these few files.
 FLEXBE_PREFIX := $(VENV)/flexbe
+# ros2cli (not on PyPI): the pinned Jazzy `ros2` with its action, topic, service, node,
+# interface and pkg verbs, installed from FLEXBE_SOURCES into a prefix of its own, so that a
+# machine without a ROS installation can use the terminal route (`$(ROS2CLI_PREFIX)/ros2`);
+# kept off the venv's PATH so a user's own ROS 2 `ros2` is never shadowed.
+ROS2CLI_PREFIX := $(VENV)/ros2cli
+ROS2CLI_PACKAGES := ros2cli ros2action ros2topic ros2service ros2node ros2interface ros2pkg
 
 setup: $(VENV)/.project-installed $(VENV)/.msgs-installed
 
@@ -72,7 +78,8 @@ $(VENV)/.msgs-installed: $(MSGS_SOURCES) $(VENV)/.project-installed
 # FlexBE packages importable through a .pth file, a tf2_ros stand-in last on the path (only
 # found when no real tf2_ros is installed), and the FlexBE packages registered in an ament
 # index under $(FLEXBE_PREFIX).
-flexbe: setup $(VENV)/.flexbe-msgs-installed $(VENV)/.flexbe-synthesis-msgs-installed $(WEBUI_SITE)/.installed
+flexbe: setup $(VENV)/.flexbe-msgs-installed $(VENV)/.flexbe-synthesis-msgs-installed $(WEBUI_SITE)/.installed \
+    $(ROS2CLI_PREFIX)/.installed
 	@site=$$($(BIN)/python -c 'import sysconfig; print(sysconfig.get_path("purelib"))'); \
 	  printf '%s\n' $(addprefix $(abspath $(FLEXBE_ENGINE))/,flexbe_core flexbe_states flexbe_onboard) \
 	    $(abspath $(FLEXBE_PACKAGES)) $(abspath test/flexbe_env/python) > $$site/flexbe.pth
@@ -126,6 +133,23 @@ $(WEBUI_SITE)/.installed: | $(BIN)/python
 	rm -rf $(WEBUI_SITE)
 	$(BIN)/python -m pip install --quiet --no-deps --target $(WEBUI_SITE) \
 	  'fastapi>=0.115,<0.116' 'starlette>=0.40,<0.47'
+	touch $@
+
+# The `ros2` launcher: the prefix's site-packages (ros2cli and rosidl_runtime_py, which its
+# `send_goal` needs to fill messages) on PYTHONPATH, the venv's Python (rclpy and the interfaces).
+$(ROS2CLI_PREFIX)/.installed: $(VENV)/.project-installed \
+    $(wildcard $(addprefix $(FLEXBE_SOURCES)/ros2cli/,$(addsuffix /setup.py,$(ROS2CLI_PACKAGES))))
+	@test -f "$(FLEXBE_SOURCES)/ros2cli/ros2cli/setup.py" || \
+	  { echo "ros2cli sources not found under FLEXBE_SOURCES (got '$(FLEXBE_SOURCES)')" >&2; exit 1; }
+	rm -rf $(ROS2CLI_PREFIX) && mkdir -p build
+	$(BIN)/python -m pip install --quiet --no-deps --no-build-isolation --prefix $(ROS2CLI_PREFIX) \
+	  $(addprefix $(FLEXBE_SOURCES)/ros2cli/,$(ROS2CLI_PACKAGES)) $(FLEXBE_SOURCES)/rosidl_runtime_py \
+	  > build/ros2cli-install.log 2>&1 || { cat build/ros2cli-install.log >&2; exit 1; }
+	@site=$$($(BIN)/python -c 'import sysconfig; print(sysconfig.get_path("purelib", vars={"base": "$(abspath $(ROS2CLI_PREFIX))"}))'); \
+	  printf '#!/bin/sh\n# The pinned ros2cli (Jazzy 0.32.2), written by `make flexbe`.\nPYTHONPATH="%s$${PYTHONPATH:+:$$PYTHONPATH}" exec "%s" "%s" "$$@"\n' \
+	    "$$site" "$(abspath $(BIN))/python" "$(abspath $(ROS2CLI_PREFIX))/bin/ros2" > $(ROS2CLI_PREFIX)/ros2; \
+	  chmod +x $(ROS2CLI_PREFIX)/ros2
+	$(ROS2CLI_PREFIX)/ros2 action --help > /dev/null
 	touch $@
 
 # Graphviz draws state machines; Chromium runs the browser tests (MuJoCo renders with EGL). Installed from Debian

@@ -35,7 +35,7 @@ ELSEWHERE = {
     'cp': 'colcon workspace setup (needs a ROS installation)',
     'source': 'a ROS installation',
     'colcon': 'a ROS installation',
-    'ros2': 'a ROS installation',
+    'ros2': 'a ROS installation (its `action send_goal` lines run here with the pinned ros2cli)',
     'pip': 'a ROS installation',
     'export': 'FlexBE onboard shells (test/integration/test_flexbe_onboard.py)',
     'F': 'FlexBE onboard shells (test/integration/test_flexbe_onboard.py)',
@@ -105,6 +105,23 @@ def suite(environment, scratch):
     server.wait(20)
 
 
+def check_ros2_send_goal(argv: list[str], environment: dict, flexbe_prefix: Path, scratch: Path) -> None:
+    """A ``ros2 action send_goal`` line, run with the ros2cli `make flexbe` installs (a user's own
+    ROS 2 ``ros2`` takes the same arguments): the goal succeeds and the result holds a machine."""
+    ros2 = Path(sys.prefix) / 'ros2cli' / 'ros2'
+    assert ros2.exists(), f'no {ros2}: run `make flexbe` (it installs the pinned ros2cli)'
+    result = subprocess.run([str(ros2), *argv[1:]], env=dict(environment, AMENT_PREFIX_PATH=str(flexbe_prefix)),
+                            cwd=scratch, capture_output=True, text=True, timeout=120)
+    output = result.stdout
+    assert result.returncode == 0 and 'Goal finished with status: SUCCEEDED' in output, (argv, output[-1500:],
+                                                                                         result.stderr[-1500:])
+    if '--feedback' in argv:
+        assert 'Feedback:' in output and 'status: Synthesizing an automaton' in output
+    result_part = output[output.index('Result:'):]
+    assert re.search(r'error_code:\s+value: 1\b', result_part), result_part[:500]   # SUCCESS
+    assert result_part.count('state_path:') >= 5
+
+
 def as_run(argv: list[str]) -> list[str]:
     """The command with .venv/bin/ meaning this interpreter's bin directory."""
     first = argv[0]
@@ -143,6 +160,9 @@ def test_a_readme_command_runs_as_written(command, scratch, environment, request
         environment = dict(environment, AMENT_PREFIX_PATH=str(request.getfixturevalue('flexbe')))
         argv = argv[1:]
     name = program(argv)
+    if name == 'ros2' and argv[1:3] == ['action', 'send_goal']:  # the terminal route, through the pinned ros2cli
+        check_ros2_send_goal(argv, request.getfixturevalue('suite'), request.getfixturevalue('flexbe'), scratch)
+        return
     if name in ELSEWHERE:
         return  # see ELSEWHERE: exercised by the named tests, not pasteable on this machine
     if name == 'behavior-synthesis':

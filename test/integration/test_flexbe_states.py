@@ -120,3 +120,40 @@ def test_userdata_defaults_are_for_keys_no_state_writes(system):
     read = {key for state in states for key in state.reads}
     written = {key for state in states for key in state.writes}
     assert set(CONFIGS[system].userdata) <= read - written
+
+
+def test_a_capability_whose_result_never_comes_ends_failed_naming_it(flexbe_node, ros):
+    """A robot that accepts the goal and never answers (a result lost on the way, a stuck robot):
+    the state fails after its result timeout instead of holding the behavior forever."""
+    import threading
+    import time
+
+    from rclpy.action import ActionServer
+    from rclpy.node import Node
+
+    from atlas_sim.simulator.node_names import CAPABILITY_ACTION_PREFIX
+    from atlas_sim_flexbe_states.capability_action_state import CapabilityActionState
+    from synthesis_msgs.action import ExecuteCapability
+
+    released = threading.Event()
+
+    def never_answer(goal_handle):
+        released.wait(30)
+        goal_handle.abort()
+        return ExecuteCapability.Result(outcome='failed', reason='released by the test')
+
+    robot = ros.add_node(Node, 'silent_robot')
+    server = ActionServer(robot, ExecuteCapability, CAPABILITY_ACTION_PREFIX + 'look_down', never_answer)
+    try:
+        state = CapabilityActionState('look_down')
+        state._run.result_timeout = 1.0
+        state.on_enter({})
+        started, outcome = time.monotonic(), None
+        while outcome is None and time.monotonic() - started < 20:
+            outcome = state.execute({})
+            time.sleep(0.05)
+        assert outcome == 'failed' and 1.0 <= time.monotonic() - started < 10
+        assert 'no result for look_down within 1 s' in state._run._failure
+    finally:
+        released.set()
+        server.destroy()

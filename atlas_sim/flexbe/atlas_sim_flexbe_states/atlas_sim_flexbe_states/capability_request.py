@@ -3,10 +3,14 @@
 The simulator node (atlas_sim) serves one ExecuteCapability action per capability under
 ``atlas_sim/capabilities/<capability>``: FlexBE's proxy keeps one goal per action name, and
 states running concurrently (a ConcurrencyContainer) each need their own. Nothing here
-blocks in ``execute``: the goal is sent on enter, the result is polled.
+blocks in ``execute``: the goal is sent on enter, the result is polled, and a result that
+never arrives ends the state in its failure outcome after ``RESULT_TIMEOUT`` seconds, naming
+the capability, instead of holding the behavior forever (one onboard run in 13 once waited
+forever for a result the robot had sent).
 """
 
 import json
+import time
 
 from flexbe_core import Logger
 from flexbe_core.proxy import ProxyActionClient
@@ -17,6 +21,9 @@ from synthesis_msgs.action import ExecuteCapability
 
 # How long on_enter waits for the simulator's action server the first time (discovery).
 SERVER_WAIT = 5.0
+# Wall-clock seconds a capability may take before the state gives up on its result: every
+# capability of the simulated robot completes within a few seconds of robot time.
+RESULT_TIMEOUT = 60.0
 
 
 def capability_goal(capability, userdata=None):
@@ -29,11 +36,13 @@ def capability_goal(capability, userdata=None):
 class CapabilityRequest:
     """Runs ``capability`` (None: the state's parameters name nothing the simulator can do)."""
 
-    def __init__(self, capability, state_name):
+    def __init__(self, capability, state_name, result_timeout=RESULT_TIMEOUT):
         self.capability = capability
         self.state_name = state_name
+        self.result_timeout = result_timeout
         self.result = None  # the ExecuteCapability result once it arrived
         self._failure = None
+        self._sent_at = None
         self._topic = CAPABILITY_ACTION_PREFIX + capability if capability else None
 
     def start(self, unsupported_reason='', userdata=None):
@@ -49,6 +58,7 @@ class CapabilityRequest:
             ProxyActionClient.setupClient(self._topic, ExecuteCapability, wait_duration=SERVER_WAIT)
             ProxyActionClient.send_goal(self._topic, capability_goal(self.capability, userdata),
                                         wait_duration=SERVER_WAIT)
+            self._sent_at = time.monotonic()
         except Exception as error:  # pylint: disable=broad-except  (no server, wrong type)
             self._failure = f'{self.state_name}: could not request {self.capability}: {error}'
             Logger.logwarn(self._failure)
@@ -58,7 +68,13 @@ class CapabilityRequest:
         if self._failure:
             return failed
         if not ProxyActionClient.has_result(self._topic):
-            return None
+            if time.monotonic() - self._sent_at < self.result_timeout:
+                return None
+            self._failure = (f'{self.state_name}: no result for {self.capability} within '
+                             f'{self.result_timeout:g} s; giving up on it')
+            Logger.logerr(self._failure)
+            ProxyActionClient.cancel(self._topic)
+            return failed
         self.result = ProxyActionClient.get_result(self._topic)
         ProxyActionClient.remove_result(self._topic)
         if self.result.outcome == COMPLETED:

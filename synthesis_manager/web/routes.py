@@ -14,6 +14,8 @@
     GET  /api/jobs/{id}/artifacts/{name}     a download (see ARTIFACTS); ?inline=1 to display it
                                              (a browser asking for a forgotten one gets a page saying so)
     POST /api/goal-check                     goals that cannot be achieved / cannot come next, and why
+    POST /api/repair                         verified changes that make a refused request possible
+    POST /api/jobs/{id}/play                 a play of a finished job: {"moves": [...]} -> the turn
     POST /api/jobs/{id}/simulations          run the job's state machine on the simulated robot
     GET  /api/simulations/{id}               its trace so far, frames, outcome and trace check
     GET  /api/simulations/{id}/events        the same as server-sent events until the run ends
@@ -25,7 +27,7 @@ a foreign Host header (421), a body over 1 MB (413), a POST whose body is not de
 (415: what a cross-site form can send) or one nested too deeply (400 TOO_DEEP) are refused first
 (web.guards); a control character or lone surrogate in any string is 422 INVALID_CHARACTER
 naming the field (web.jobs.checked_body); a new job while too many are unfinished is 503 BUSY,
-a simulation or goal check while too many run is 429 BUSY with Retry-After.
+a simulation, goal check, repair search or play while too many run is 429 BUSY with Retry-After.
 
 The backend returns records (Job with its web.outcome.JobOutcome, Simulation, the job's
 sm_generation StateMachine); the routes turn them into JSON with their ``to_dict``.
@@ -137,6 +139,14 @@ def create_app(backend) -> FastAPI:
     @app.post('/api/goal-check')
     def goal_check(body=Body(None)):
         return backend.goal_check(body)
+
+    @app.post('/api/repair')
+    def repair(body=Body(None)):
+        return backend.repair(body)
+
+    @app.post('/api/jobs/{job_id}/play')
+    def play(job_id: str, body=Body(None)):
+        return backend.play(job_id, body)
 
     @app.post('/api/jobs/{job_id}/simulations', status_code=202)
     def start_simulation(job_id: str, body=Body(None)):

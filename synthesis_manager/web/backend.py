@@ -15,6 +15,7 @@ from pathlib import Path
 from typing import Callable
 
 from ltl_specification.diagnosis import goal_findings, impossible_next_goals
+from ltl_specification.capability_precheck import clause_text
 from ltl_specification.compiler import load_task_abstraction
 from respec.errors import INTERNAL_ERROR, CodedError, ErrorCode, quoted
 from respec.naming import DEFAULT_SM_OUTCOMES, FINISHED
@@ -108,15 +109,21 @@ class SynthesisBackend:
         return self.catalog.load(system)
 
     def choices(self, system: str) -> dict:
-        """The control modes and actions of ``system``, in file order, with their relations."""
+        """The control modes and actions of ``system``, in file order, with their relations (a
+        capability robot's capabilities are its actions; it has no control modes)."""
         try:
             robot = self.robot_system(system)
-            abstraction = load_task_abstraction(robot)
+            if robot.is_capability_system:
+                modes = {}
+                actions = {name: [clause_text(clause) for clause in capability.preconditions]
+                           for name, capability in robot.capabilities.capabilities.items()}
+            else:
+                abstraction = load_task_abstraction(robot)
+                modes, actions = abstraction.control_modes, abstraction.actions
         except NotFoundError:
             raise
         except CodedError as error:
             raise NotAvailableError(str(error), error.item or system) from error
-        modes, actions = abstraction.control_modes, abstraction.actions
         return {
             'system': system,
             'control_modes': [{'name': m, 'next': list(n)} for m, n in modes.items()],

@@ -91,7 +91,8 @@ def create_app(backend) -> FastAPI:
     @app.get('/api/info')
     def info():
         return {'description': getattr(backend, 'description', ''),
-                'simulation': bool(getattr(backend, 'can_simulate', False))}
+                'simulation': bool(getattr(backend, 'can_simulate', False)),
+                'repair_time_budget': getattr(backend, 'repair_time_budget', 0)}
 
     @app.get('/api/vocabulary')
     def names():

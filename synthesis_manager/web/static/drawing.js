@@ -179,6 +179,18 @@ export function markRun(steps, running) {
   if (current) revealNode(current);  // follow the robot through a machine larger than the view
 }
 
+// Mark a play of the environment on the drawing as markRun marks a simulation: ``history`` the
+// (state path, outcome) pairs reported so far, ``active`` the active state's path (null: ended).
+export function markPlay(history, active) {
+  if (!machine) return;
+  const steps = history.map(([path, outcome]) => {
+    const state = machine.children.find((node) => node.state_path === path);
+    return { state: path, transition: state ? state.transitions[state.outcomes.indexOf(outcome)] : null };
+  });
+  if (active) steps.push({ state: active, transition: null });
+  markRun(steps, active !== null);
+}
+
 // Pan a focused state into view (keyboard users cannot drag).
 function revealNode(node) {
   const box = node.getBoundingClientRect();

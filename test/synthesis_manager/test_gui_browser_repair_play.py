@@ -51,6 +51,25 @@ def test_suggest_fixes_then_apply_one_and_the_new_machine_is_drawn(page):
     assert page.is_hidden('#repair-section') and page.is_hidden('#suggest-fixes')
 
 
+def test_custom_ltl_is_sent_and_a_weakened_guarantee_is_applied(page):
+    choose_task(page, ['look_down'])
+    page.click('#custom-ltl-box summary')
+    page.fill('#custom-ltl', '{oops')
+    page.click('#synthesize')
+    assert page.inner_text('#form-problem').startswith('Custom LTL: not JSON')
+    assert page.evaluate('document.activeElement.id') == 'custom-ltl'
+    page.fill('#custom-ltl', '{"sys_trans": ["!look_down_a"]}')
+    page.click('#synthesize')
+    assert result_code(page) == 'SPEC_UNSYNTHESIZABLE'
+    page.click('#suggest-fixes')
+    weakened = page.locator('li.proposal[data-kind="weaken_guarantee"]')
+    weakened.wait_for(timeout=60_000)
+    assert 'custom LTL becomes' in weakened.inner_text()
+    weakened.locator('button.apply-fix').click()
+    page.wait_for_function("document.querySelector('#result-code').textContent === 'SUCCESS'", timeout=120_000)
+    assert '!look_down_a' not in page.input_value('#custom-ltl')
+
+
 def test_playing_the_robot_of_an_unrealizable_task_until_it_loses(page):
     choose_task(page, ['look_down', 'stand_prep'])
     page.click('#synthesize')
@@ -119,8 +138,13 @@ def test_playing_the_environment_of_a_machine_until_it_ends(page):
     page.click('#play-back')
     page.wait_for_function(f"document.querySelector('#play-position').textContent.startsWith('Step {steps - 1}:')")
     assert page.locator('#graph svg g.node.active').count() == 1
-    page.click('#play-close')
+    page.focus('#play-back')
+    page.keyboard.press('Escape')                       # closes the play
     assert page.is_hidden('#play-panel') and page.locator('#graph svg .active, #graph svg .taken').count() == 0
+    page.click('#play-environment')                     # a new play starts at the initial state
+    page.wait_for_function("document.querySelector('#play-position').textContent.startsWith('Step 0:')")
+    page.click('#play-close')
+    assert page.is_hidden('#play-panel')
 
 
 def test_a_capability_robot_is_played_as_well(page):

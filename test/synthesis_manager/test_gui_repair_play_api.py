@@ -227,3 +227,38 @@ def test_plays_beyond_the_limit_are_busy(gui, monkeypatch):
     assert [answer.status_code for answer in held] == [200] * backend.max_goal_checks
     assert (busy.status_code, busy.json()['error'], busy.json()['item']) == (429, 'BUSY', 'plays')
     assert busy.headers['retry-after'] == '1'
+
+
+def search_settings(time_budget=10.0):
+    from ltl_specification.repair import TaskRequest
+    from respec.robot import robot_system
+
+    robot = robot_system('atlas')
+    return {'system': robot.name, 'files': dict(robot.files), 'config_file': robot.config_file,
+            'request': TaskRequest('atlas', ('stand_prep',), ('look_down', 'stand_prep')).to_dict(),
+            'custom_ltl': None, 'time_budget': time_budget, 'max_proposals': 5}
+
+
+def test_a_search_past_its_deadline_is_killed(monkeypatch):
+    from synthesis_manager.web import repair_process
+
+    monkeypatch.setattr(repair_process, 'STARTUP_GRACE', 0.0)
+    search = repair_process.RepairSearch(search_settings(time_budget=0.01))
+    with pytest.raises(repair_process.RepairSearchFailed, match='without an answer'):
+        search.run()
+    assert search.child.process.poll() is not None
+
+
+def test_stopping_the_gui_ends_a_running_search_at_once():
+    import time
+
+    from synthesis_manager.web.repair_process import RepairSearch, RepairSearchFailed
+
+    search = RepairSearch(search_settings())
+    with ThreadPoolExecutor(1) as pool:
+        answer = pool.submit(search.run)
+        started = time.monotonic()
+        search.stop()
+        with pytest.raises(RepairSearchFailed):
+            answer.result(timeout=10)
+    assert time.monotonic() - started < 2.0 and search.child.process.poll() is not None

@@ -5,6 +5,7 @@ from __future__ import annotations
 import dataclasses
 import itertools
 import logging
+import queue
 import shutil
 import tempfile
 import threading
@@ -179,8 +180,20 @@ class SynthesisBackend:
 
     def repair(self, body) -> dict:
         """Verified changes that make a job's request possible (``ltl_specification.repair``), as
-        ``Repairs.to_dict()``: searched in a child process (web/repair_process.py) on the robot
-        system the GUI has (perhaps a remote suite's), for at most ``repair_time_budget`` seconds.
+        ``Repairs.to_dict()`` (see :meth:`start_repair`)."""
+        answers = self.start_repair(body)
+        while True:
+            kind, value = answers.get()
+            if kind == 'error':
+                raise value
+            if kind == 'result':
+                return value
+
+    def start_repair(self, body) -> queue.Queue:
+        """Start searching for fixes of a job's request: in a child process (web/repair_process.py)
+        on the robot system the GUI has (perhaps a remote suite's), for at most
+        ``repair_time_budget`` seconds. The queue gets ``('proposal', dict)`` as each proposal is
+        verified, then ``('result', Repairs.to_dict())`` or ``('error', GuiRequestError)``.
 
         Beyond max_repairs at once: BusyError (429, Retry-After), nothing is searched."""
         from ltl_specification.repair import TaskRequest
@@ -194,17 +207,30 @@ class SynthesisBackend:
                             'try again when one has finished', 'repairs', retry_after=int(self.repair_time_budget))
         task = TaskRequest(request.system, request.initial_conditions, request.goals, request.sm_outcomes,
                            request.unordered)
-        search = RepairSearch({'system': robot.name, 'files': dict(robot.files), 'config_file': robot.config_file,
-                               'request': task.to_dict(), 'custom_ltl': request.custom_ltl,
-                               'time_budget': self.repair_time_budget, 'max_proposals': REPAIR_MAX_PROPOSALS})
-        with self._lock:
-            self._repair_searches.add(search)
+        settings = {'system': robot.name, 'files': dict(robot.files), 'config_file': robot.config_file,
+                    'request': task.to_dict(), 'custom_ltl': request.custom_ltl,
+                    'time_budget': self.repair_time_budget, 'max_proposals': REPAIR_MAX_PROPOSALS}
+        answers = queue.Queue()
+        threading.Thread(target=self._search_repairs, args=(settings, answers), name='gui-repair',
+                         daemon=True).start()
+        return answers
+
+    def _search_repairs(self, settings: dict, answers: queue.Queue):
+        """One search, its slot released when it ends, however it ends."""
+        search = None
         try:
-            return search.run()
+            search = RepairSearch(settings)
+            with self._lock:
+                self._repair_searches.add(search)
+            if self.stopping.is_set():
+                search.stop()
+            answers.put(('result', search.run(lambda proposal: answers.put(('proposal', proposal)))))
         except CodedError as error:  # the system's files as the compiler refuses them
-            raise NotAvailableError(str(error), error.item or request.system) from error
-        except RepairSearchFailed as error:
-            raise NotAvailableError(str(error), 'repair search') from error
+            answers.put(('error', NotAvailableError(str(error), error.item or settings['system'])))
+        except Exception as error:  # RepairSearchFailed, or the child could not start
+            if not isinstance(error, RepairSearchFailed):
+                logger.exception('repair search failed')
+            answers.put(('error', NotAvailableError(str(error), 'repair search')))
         finally:
             with self._lock:
                 self._repair_searches.discard(search)

@@ -15,6 +15,7 @@
                                              (a browser asking for a forgotten one gets a page saying so)
     POST /api/goal-check                     goals that cannot be achieved / cannot come next, and why
     POST /api/repair                         verified changes that make a refused request possible
+                                             (Accept: application/x-ndjson: each proposal as it is found)
     POST /api/jobs/{id}/play                 a play of a finished job: {"moves": [...]} -> the turn
     POST /api/jobs/{id}/simulations          run the job's state machine on the simulated robot
     GET  /api/simulations/{id}               its trace so far, frames, outcome and trace check
@@ -44,6 +45,7 @@ import asyncio
 import html
 import json
 import mimetypes
+import queue
 from pathlib import Path
 from typing import Callable
 
@@ -59,6 +61,7 @@ from synthesis_manager.web.guards import RequestGuard
 from synthesis_manager.web.vocabulary import vocabulary
 
 STATIC_DIR = Path(__file__).with_name('static')
+NDJSON = 'application/x-ndjson'
 # The page is ES modules, which a browser runs only when served with a JavaScript media type;
 # the host's mime.types (which StaticFiles reads) might map .js to something else.
 mimetypes.add_type('text/javascript', '.js')
@@ -142,8 +145,10 @@ def create_app(backend) -> FastAPI:
         return backend.goal_check(body)
 
     @app.post('/api/repair')
-    def repair(body=Body(None)):
-        return backend.repair(body)
+    def repair(request: Request, body=Body(None)):
+        if NDJSON not in request.headers.get('accept', ''):
+            return backend.repair(body)
+        return _repair_stream(request, backend.start_repair(body), _stopping(backend))
 
     @app.post('/api/jobs/{job_id}/play')
     def play(job_id: str, body=Body(None)):
@@ -197,6 +202,23 @@ def _stopping(backend) -> Callable[[], bool]:
     """Whether ``backend`` is stopping (a backend without ``stopping`` never is)."""
     stopping = getattr(backend, 'stopping', None)
     return stopping.is_set if stopping is not None else (lambda: False)
+
+
+def _repair_stream(request: Request, answers, stopping: Callable[[], bool]):
+    """A repair search's answers as JSON lines: ``{"proposal": ...}`` as each is verified, then
+    ``{"result": ...}`` (Repairs.to_dict()) or ``{"error": {...}}`` (a 4xx/5xx answer's body)."""
+    async def lines():
+        while not stopping() and not await request.is_disconnected():
+            try:
+                kind, value = answers.get_nowait()
+            except queue.Empty:
+                await asyncio.sleep(0.05)
+                continue
+            yield json.dumps({kind: value.to_dict() if kind == 'error' else value}) + '\n'
+            if kind != 'proposal':
+                return
+
+    return StreamingResponse(lines(), media_type=NDJSON, headers={'Cache-Control': 'no-cache'})
 
 
 def _event_stream(request: Request, revision: Callable[[], int], snapshot: Callable[[], dict],

@@ -33,7 +33,10 @@ def test_suggest_fixes_then_apply_one_and_the_new_machine_is_drawn(page):
     assert page.is_visible('#suggest-fixes') and page.is_visible('#play-robot')
     page.click('#suggest-fixes')
     assert page.is_visible('#repair-section')
-    page.wait_for_selector('#proposals li.proposal', timeout=60_000)
+    # proposals show as they are verified, while the search goes on (the problem's diagnosis comes last)
+    page.wait_for_selector('#repair-section.searching #proposals li.proposal', timeout=60_000)
+    assert page.inner_text('#repair-status').startswith('Searching for fixes…')
+    page.wait_for_selector('#repair-section:not(.searching)', timeout=60_000)   # the search has ended
     assert re.match(r'\d+ verified fix', page.inner_text('#repair-status'))
     assert page.inner_text('#repair-problem').startswith('The problem: SPEC_UNSYNTHESIZABLE: Goal 2 (stand_prep)')
     # a change of the robot is marked, shows its patch and cannot be applied from here

@@ -60,6 +60,20 @@ def test_suggest_fixes_offers_verified_changes_and_an_applied_one_succeeds(clien
         assert fixed['outcome']['error_name'] == 'SUCCESS', proposal['summary']
 
 
+def test_fixes_stream_as_json_lines_as_they_are_found(client):
+    import json
+
+    with client.stream('POST', '/api/repair', json=WRONG_ORDER, headers={'Accept': 'application/x-ndjson'}) as answer:
+        assert answer.status_code == 200 and answer.headers['content-type'].startswith('application/x-ndjson')
+        lines = [json.loads(line) for line in answer.iter_lines() if line]
+    *found, last = lines
+    assert found and all(set(line) == {'proposal'} for line in found)
+    assert [line['proposal'] for line in found] == last['result']['proposals']
+    with client.stream('POST', '/api/repair', json={**WRONG_ORDER, 'system': 'nowhere'},
+                       headers={'Accept': 'application/x-ndjson'}) as refused:
+        assert refused.status_code == 404     # refusals come before the stream, as plain answers
+
+
 def test_a_refusal_before_synthesis_gets_fixes_too(client):
     from_stand = {**WRONG_ORDER, 'initial_conditions': ['stand']}
     _, refused = run_job(client, from_stand)

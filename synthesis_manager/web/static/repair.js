@@ -2,7 +2,7 @@
 // possible, each with what it changes. A change of the request or the custom LTL is applied
 // with one click (the form takes it and synthesizes); a change of the robot is shown as the
 // patch of its file and never applied.
-import { api } from './api.js';
+import { lineError, postForLines } from './api.js';
 import { $, element, formatSeconds } from './dom.js';
 import { repairTimeBudget } from './form.js';
 import { vocabulary } from './vocabulary.js';
@@ -55,9 +55,22 @@ export async function suggestFixes() {
   clearInterval(ticker);
   ticker = setInterval(tick, 200);
   $('repair-section').scrollIntoView({ block: 'nearest' });
-  let repairs;
+  let repairs = null;
+  const found = [];
   try {
-    repairs = await api('POST', '/api/repair', job.request);
+    // Proposals are shown as they are verified; the last line is the whole answer.
+    await postForLines('/api/repair', job.request, (line) => {
+      if (number !== searches) return;
+      if (line.error) throw lineError(line.error);
+      if (line.result) {
+        repairs = line.result;
+        return;
+      }
+      found.push(line.proposal);
+      $('proposals').append(proposalItem(job, line.proposal, found.length - 1));
+      $('repair-note').textContent = `${found.length} found so far…`;
+    });
+    if (number === searches && !repairs) throw new Error('the server ended the search without an answer');
   } catch (error) {
     if (number !== searches) return;
     clearInterval(ticker);
@@ -82,9 +95,11 @@ function showRepairs(job, repairs) {
       : `No verified fix found (${repairs.tried} changes tried in ${formatSeconds(repairs.seconds)}).`;
   $('repair-problem').textContent = repairs.problem ? `The problem: ${repairs.problem}` : '';
   $('repair-note').textContent = repairs.note || '';
+  const focused = [...$('proposals').querySelectorAll('button')].indexOf(document.activeElement);
   $('proposals').replaceChildren(...repairs.proposals.map((proposal, index) => proposalItem(job, proposal, index)));
-  const first = $('proposals').querySelector('button');
-  if (first) first.focus();
+  const buttons = $('proposals').querySelectorAll('button');
+  const target = buttons[Math.max(0, focused)];   // keep a focus the search's progress found there
+  if (target && (focused >= 0 || document.activeElement === $('suggest-fixes'))) target.focus();
 }
 
 function proposalItem(job, proposal, index) {

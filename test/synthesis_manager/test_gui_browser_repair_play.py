@@ -31,12 +31,20 @@ def test_suggest_fixes_then_apply_one_and_the_new_machine_is_drawn(page):
     page.click('#synthesize')
     assert result_code(page) == 'SPEC_UNSYNTHESIZABLE'
     assert page.is_visible('#suggest-fixes') and page.is_visible('#play-robot')
+    # proposals show as they are verified, while the search goes on (the problem's diagnosis comes
+    # last): count those added while the section still says it is searching
+    page.evaluate('''() => {
+      window.shownWhileSearching = 0;
+      new MutationObserver((changes) => {
+        if (!document.querySelector('#repair-section').classList.contains('searching')) return;
+        window.shownWhileSearching += changes.reduce((sum, change) => sum + change.addedNodes.length, 0);
+      }).observe(document.querySelector('#proposals'), { childList: true });
+    }''')
     page.click('#suggest-fixes')
     assert page.is_visible('#repair-section')
-    # proposals show as they are verified, while the search goes on (the problem's diagnosis comes last)
-    page.wait_for_selector('#repair-section.searching #proposals li.proposal', timeout=60_000)
-    assert page.inner_text('#repair-status').startswith('Searching for fixes…')
+    page.wait_for_selector('#proposals li.proposal', timeout=60_000)
     page.wait_for_selector('#repair-section:not(.searching)', timeout=60_000)   # the search has ended
+    assert page.evaluate('window.shownWhileSearching') >= 1
     assert re.match(r'\d+ verified fix', page.inner_text('#repair-status'))
     assert page.inner_text('#repair-problem').startswith('The problem: SPEC_UNSYNTHESIZABLE: Goal 2 (stand_prep)')
     # a change of the robot is marked, shows its patch and cannot be applied from here
@@ -118,7 +126,12 @@ def play_environment_to_the_end(page):
     page.click('#play-environment')
     page.wait_for_selector('#play-choices button.play-choice')
     assert page.is_visible('#play-panel') and page.locator('#graph-layout.playing').count() == 1
-    steps = 0
+    # the active state's outcome cell on the drawing reports that outcome
+    first = page.inner_text('#play-choices button.play-choice >> nth=0').split(maxsplit=1)[1]
+    page.locator('#graph svg g.node.active text', has_text=first).first.click()
+    page.wait_for_function("document.querySelector('#play-position').textContent.startsWith('Step 1:')")
+    assert page.inner_text('#play-history li >> nth=0').endswith(f'→ {first}')
+    steps = 1
     while 'ended' not in page.inner_text('#play-position'):
         active = page.inner_text('#play-position').split(': ', 1)[1].removesuffix(' is active.')
         assert page.locator('#graph svg g.node.active').get_attribute('id') == f'state:{active}'

@@ -41,6 +41,7 @@ $('play-robot').addEventListener('click', () => startPlay(true));
 $('play-back').addEventListener('click', back);
 $('play-reset').addEventListener('click', reset);
 $('play-close').addEventListener('click', closePlay);
-$('play-panel').addEventListener('keydown', playKeys);
+$('graph-layout').addEventListener('keydown', playKeys);     // the panel and the drawing beside it
+$('robot-play-section').addEventListener('keydown', playKeys);
 loadVocabulary().then(loadSystems).then(() => document.body.classList.add('ready'),
   (error) => { $('status').textContent = `Cannot load the systems: ${error.message}`; });

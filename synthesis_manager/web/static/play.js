@@ -35,6 +35,7 @@ export function closePlay() {
   $('robot-play-section').hidden = true;
   $('graph-layout').classList.remove('playing');
   drawing.markRun([], false);
+  drawing.pickOutcomes(null);
 }
 
 // Start a play of the offered job: the panel beside the drawing (environment) or under the banner (robot).
@@ -96,12 +97,23 @@ function showMachineTurn() {
   $('play-verdict').textContent = '';
   $('play-verdict').className = turn.ended === null ? '' : `outcome-${turn.ended}`;
   $('play-prompt').textContent = turn.ended === null
-    ? `Which outcome does ${name(turn.active)} return? (keys 1–${Math.min(9, turn.outcomes.length)})`
+    ? `Which outcome does ${name(turn.active)} return? Click it on the drawing or below (keys ` +
+      `1–${Math.min(9, turn.outcomes.length)}).`
     : 'Back or Reset to play again.';
   $('play-choices').replaceChildren(...turn.outcomes.map((outcome, index) => choice(index + 1, outcome, '', outcome)));
   $('play-history').replaceChildren(...turn.history.map(([state, outcome]) =>
     element('li', { text: `${name(state)} → ${outcome}` })));
   drawing.markPlay(turn.history, turn.active);
+  drawing.pickOutcomes(turn.ended === null ? pickFromDrawing : null);
+}
+
+// An outcome cell of the active state clicked on the drawing (outcomes sharing a cell share
+// their target: the first is reported).
+function pickFromDrawing(names) {
+  const outcome = names.find((name) => turn && turn.outcomes.includes(name));
+  if (outcome === undefined) return false;
+  step([...moves, outcome]);
+  return true;
 }
 
 // The robot's side: what happened, what the environment does next, the moves and why they lose.
@@ -138,9 +150,10 @@ export function reset() {
   if (job && moves.length) step([]);
 }
 
-// 1-9 choose the numbered choice, Backspace goes back, Escape closes the panel.
+// While a play is shown, keys on the panel or the drawing beside it: 1-9 choose the numbered
+// choice, Backspace goes back, Escape closes the panel.
 export function playKeys(event) {
-  if (event.target.closest('textarea, input, select')) return;
+  if ($('play-panel').hidden || event.target.closest('textarea, input, select')) return;
   if (/^[1-9]$/.test(event.key)) {
     const buttons = $('play-choices').querySelectorAll('button.play-choice');
     const button = buttons[Number(event.key) - 1];

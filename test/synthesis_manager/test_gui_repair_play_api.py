@@ -84,6 +84,14 @@ def test_a_refusal_before_synthesis_gets_fixes_too(client):
     assert run_job(client, applied['request'])[1]['outcome']['error_name'] == 'SUCCESS'
 
 
+def test_the_page_learns_which_refusals_can_be_repaired_and_the_search_budget(client):
+    from ltl_specification.repair import REPAIRABLE
+
+    assert client.get('/api/vocabulary').json()['repairable'] == sorted(REPAIRABLE) == [
+        'ABSTRACTION_CONFIG_INVALID', 'INVALID_GOALS', 'SPEC_UNSYNTHESIZABLE']
+    assert client.get('/api/info').json()['repair_time_budget'] == 10.0
+
+
 def test_a_task_that_can_be_done_needs_no_fix_and_bad_requests_are_refused(client):
     repairs = client.post('/api/repair', json=PAPER_TASK).json()
     assert repairs['realizable'] is True and repairs['proposals'] == []

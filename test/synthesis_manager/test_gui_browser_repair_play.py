@@ -1,11 +1,14 @@
 """The page's "Suggest fixes" and plays in headless Chromium, against the real server and pipeline
-(issue 33: "Suggest fixes" -> apply -> SUCCESS, and a play to the end in both directions)."""
+(issue 33: "Suggest fixes" -> apply -> SUCCESS, and a play to the end in both directions).
+With $BEHAVIOR_SYNTHESIS_DOCS_SHOTS set to a directory, the fixes and a play of the environment
+are also written there (docs/gui-fixes.png, docs/gui-play.png)."""
 
 import re
 
 import pytest
 
 from test_gui_browser import browser_context, choose_task, gui_server, open_page, result_code  # noqa: F401
+from test_gui_browser_newcomer import docs_shot
 
 
 @pytest.fixture(scope='module')
@@ -45,6 +48,8 @@ def test_suggest_fixes_then_apply_one_and_the_new_machine_is_drawn(page):
     page.wait_for_selector('#proposals li.proposal', timeout=60_000)
     page.wait_for_selector('#repair-section:not(.searching)', timeout=60_000)   # the search has ended
     assert page.evaluate('window.shownWhileSearching') >= 1
+    page.locator('#repair-section').scroll_into_view_if_needed()
+    docs_shot(page, 'gui-fixes.png')
     assert re.match(r'\d+ verified fix', page.inner_text('#repair-status'))
     assert page.inner_text('#repair-problem').startswith('The problem: SPEC_UNSYNTHESIZABLE: Goal 2 (stand_prep)')
     # a change of the robot is marked, shows its patch and cannot be applied from here
@@ -154,6 +159,8 @@ def test_playing_the_environment_of_a_machine_until_it_ends(page):
     page.click('#play-back')
     page.wait_for_function(f"document.querySelector('#play-position').textContent.startsWith('Step {steps - 1}:')")
     assert page.locator('#graph svg g.node.active').count() == 1
+    page.locator('#graph-section').scroll_into_view_if_needed()
+    docs_shot(page, 'gui-play.png')
     page.focus('#play-back')
     page.keyboard.press('Escape')                       # closes the play
     assert page.is_hidden('#play-panel') and page.locator('#graph svg .active, #graph svg .taken').count() == 0

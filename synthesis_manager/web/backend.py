@@ -133,6 +133,8 @@ class SynthesisBackend:
             'sm_outcome_choices': [list(DEFAULT_SM_OUTCOMES), [FINISHED]],
             'options': list(JOB_OPTIONS),
             'simulation': self.simulation_support(robot),
+            # A capability robot's goal may also be that something does not hold ('!drive').
+            'negated_goals': robot.is_capability_system,
         }
 
     def simulation_support(self, robot: RobotSystem) -> dict:

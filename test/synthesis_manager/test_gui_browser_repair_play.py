@@ -170,12 +170,40 @@ def test_playing_the_environment_of_a_machine_until_it_ends(page):
     assert page.is_hidden('#play-panel')
 
 
-def test_a_capability_robot_is_played_as_well(page):
+def choose_rover_goals(page, goals):
     page.select_option('#system', 'delivery_rover')
     page.wait_for_selector('#goal-choice option[value="hand_over"]', state='attached')
-    for goal in ('drive', 'hand_over'):
+    assert page.locator('#initial-control-modes input').count() == 0   # capabilities, no control modes
+    for goal in goals:
         page.select_option('#goal-choice', goal)
         page.click('#add-goal')
+
+
+def test_a_capability_robot_is_played_as_well(page):
+    choose_rover_goals(page, ['drive', 'hand_over'])
     page.click('#synthesize')
     assert result_code(page) == 'SUCCESS'
     assert play_environment_to_the_end(page) >= 2
+
+
+def test_a_capability_robot_asked_to_drive_and_not_to_drive_is_played_and_fixed(page):
+    choose_rover_goals(page, ['drive', '!drive'])          # "must not hold at the end": a goal CNU allows
+    page.click('#synthesize')
+    assert result_code(page) == 'SPEC_UNSYNTHESIZABLE'
+    page.click('#play-robot')
+    page.wait_for_selector('#play-choices button.play-choice')
+    assert 'Why it cannot win: the environment keeps system goal 1' in page.inner_text('#play-verdict')
+    steps = 0
+    while not page.locator('#play-choices .play-choice.repeats').count():   # until a move closes a loop
+        page.locator('#play-choices button.play-choice').first.click()
+        steps += 1
+        page.wait_for_function(f"document.querySelector('#play-position').textContent.startsWith('Step {steps}:')")
+        assert steps < 12 and 'The robot lost' not in page.inner_text('#play-verdict')
+    assert 'loop: it returns to a position of this play' in page.inner_text('#play-choices')
+
+    page.click('#suggest-fixes')
+    dropped = page.locator('li.proposal[data-kind="drop_goal"]').first
+    dropped.wait_for(timeout=60_000)
+    dropped.locator('button.apply-fix').click()
+    page.wait_for_function("document.querySelector('#result-code').textContent === 'SUCCESS'", timeout=120_000)
+    assert len(goals_in_form(page)) == 1

@@ -164,6 +164,14 @@ def test_nothing_to_play_and_unknown_jobs(client):
     assert play(client, 'no-such-job', []).status_code == 404
 
 
+def test_a_capability_robot_offers_its_capabilities_as_actions_and_negated_goals(client):
+    choices = client.get('/api/systems/delivery_rover').json()
+    assert choices['control_modes'] == [] and choices['negated_goals'] is True
+    assert {a['name']: a['preconditions'] for a in choices['actions']} == {
+        'check_battery': [], 'charge': ['!battery_ok'], 'drive': ['battery_ok'], 'hand_over': ['drive']}
+    assert client.get('/api/systems/atlas').json()['negated_goals'] is False
+
+
 def test_a_capability_robot_plays_both_ways_and_is_repaired(client):
     _, refused = run_job(client, ROVER_CONTRADICTION)
     assert refused['outcome']['error_name'] == 'SPEC_UNSYNTHESIZABLE', refused['outcome']['message']

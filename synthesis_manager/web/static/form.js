@@ -41,9 +41,13 @@ export async function loadChoices() {
 
   const group = (label, items, hint) => element('optgroup', { label },
     ...items.map((item) => element('option', { value: item.name, title: hint(item), text: item.name })));
-  $('goal-choice').replaceChildren(
+  const negated = choices.negated_goals
+    ? [group('Must not hold at the end', choices.actions.map((a) => ({ name: `!${a.name}` })), (a) => `${a.name.slice(1)} is false`)]
+    : [];
+  $('goal-choice').replaceChildren(...[
     group('Actions', choices.actions, (a) => `needs: ${a.preconditions.join(', ') || 'nothing'}`),
-    group('Control modes', choices.control_modes, (m) => `reached from: ${predecessors(m.name).join(', ') || 'no other mode'}`));
+    group('Control modes', choices.control_modes, (m) => `reached from: ${predecessors(m.name).join(', ') || 'no other mode'}`),
+    ...negated].filter((optgroup) => optgroup.children.length));  // a capability robot has no modes
   $('goals').replaceChildren();
   updateGoalsHint();
 }

@@ -116,7 +116,7 @@ def unestablished_preconditions(system: RobotSystem,
         for clause in capability.preconditions:
             if any(_can_hold(capabilities, term, initial) for term in clause):
                 continue
-            entry = ' | '.join(_term_text(term) for term in clause)
+            entry = clause_text(clause)
             reasons = '; '.join(f'{_value_words(term)} is set by no postcondition and it '
                                 f'{_initially_words(term, initial)}' for term in clause)
             errors.append(CapabilityConfigError(
@@ -225,6 +225,11 @@ def _initially_words(literal: Literal, initial: dict[str, set]) -> str:
     if literal.value is not None:
         return f'starts at {", ".join(str(v) for v in values)}'
     return f'starts {"true" if values == [True] else "false"}'
+
+
+def clause_text(clause) -> str:
+    """A precondition clause (its literals, any of which may hold) as the files write it."""
+    return ' | '.join(_term_text(term) for term in clause)
 
 
 def _term_text(literal: Literal) -> str:

@@ -48,7 +48,7 @@ def play_machine(machine: StateMachine, outcomes: Sequence[str]) -> MachineTurn:
             raise MachinePlayError(f'the machine already ended in {ended!r} before step {step}')
         if outcome not in active.outcomes:
             raise MachinePlayError(f'{active.name} has no outcome {outcome!r} (its outcomes: '
-                                   f'{", ".join(active.outcomes)})')
+                                   f'{", ".join(active.outcomes)}): move {outcome!r} at step {step} does not exist')
         history.append((active.state_path, outcome))
         target = active.next_target(outcome)
         active = machine.state(target)

@@ -61,7 +61,8 @@ class RosGoalRunner:
                 f'{self.server_timeout:g} s (start one with `behavior-synthesis serve`)')
         else:
             goal = make_goal(request.system, request.initial_conditions, request.goals, request.sm_outcomes,
-                             option=request.option, name=request.name, unordered=request.unordered)
+                             option=request.option, name=request.name, unordered=request.unordered,
+                             ltl_specification=request.custom_ltl)
             outcome = self.client.run(goal, feedback=feedback, cancel=cancel, timeout=self.goal_timeout)
         return JobOutcome.from_dict(outcome.to_dict())
 

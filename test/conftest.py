@@ -50,6 +50,7 @@ MARKERS = {
 FOLDER_MARKERS = {'synthesis_manager': ('ros',)}
 MODULE_MARKERS = {
     'browser': ('test_gui_browser', 'test_gui_browser_newcomer', 'test_gui_browser_usability',
+                'test_gui_browser_repair_play',
                 'test_flexbe_webui', 'test_flexbe_webui_parser'),
     'mujoco': ('test_atlas_sim_closed_loop', 'test_atlas_sim_engine_trace', 'test_atlas_sim_executor',
                'test_atlas_sim_operator_data', 'test_atlas_sim_rendering', 'test_atlas_sim_simulator',

@@ -5,6 +5,7 @@ from __future__ import annotations
 import dataclasses
 import itertools
 import logging
+import queue
 import shutil
 import tempfile
 import threading
@@ -15,6 +16,7 @@ from pathlib import Path
 from typing import Callable
 
 from ltl_specification.diagnosis import goal_findings, impossible_next_goals
+from ltl_specification.capability_precheck import clause_text
 from ltl_specification.compiler import load_task_abstraction
 from respec.errors import INTERNAL_ERROR, CodedError, ErrorCode, quoted
 from respec.naming import DEFAULT_SM_OUTCOMES, FINISHED
@@ -27,6 +29,8 @@ from synthesis_manager.web.errors import (ArtifactFailedError, InvalidJobRequest
                                           NotFoundError)
 from synthesis_manager.web.jobs import JOB_OPTIONS, Job, JobRequest, ProgressNote, checked_body, names_field
 from synthesis_manager.web.outcome import JobOutcome
+from synthesis_manager.web.plays import Plays, play_body_moves
+from synthesis_manager.web.repair_process import RepairSearch, RepairSearchFailed
 from synthesis_manager.web.simulation_process import SimulationProcess
 from synthesis_manager.web.simulations import Simulation, simulation_available
 
@@ -35,6 +39,8 @@ logger = logging.getLogger(__name__)
 
 SIMULATION_RETRY_AFTER = 10  # seconds: a short simulation's run time
 GOAL_CHECK_RETRY_AFTER = 1  # seconds: a goal check of a shipped system takes milliseconds
+REPAIR_TIME_BUDGET = 10.0   # seconds a "Suggest fixes" search may take (ltl_specification.repair's default)
+REPAIR_MAX_PROPOSALS = 5
 
 GoalRunner = Callable[[JobRequest, Callable[[str, float], None], threading.Event], JobOutcome]
 
@@ -55,7 +61,7 @@ class SynthesisBackend:
     def __init__(self, run_goal: GoalRunner, config_dir: str | Path | None = None, systems=None,
                  max_jobs: int = 100, max_unfinished_jobs: int = 50, description: str = '',
                  max_running_simulations: int = 2, max_simulations_per_job: int = 5,
-                 max_goal_checks: int = 2):
+                 max_goal_checks: int = 2, max_repairs: int = 2, repair_time_budget: float = REPAIR_TIME_BUDGET):
         self.run_goal = run_goal
         # Where the robot systems come from: the suite's own (SuiteSystems, served over ROS)
         # when attached to a running suite, else the config directory's (SystemCatalog).
@@ -70,6 +76,14 @@ class SynthesisBackend:
         # the system's size: only a few at once (10 large ones once took 64 s of CPU, +636 MiB).
         self.max_goal_checks = max_goal_checks
         self._goal_check_slots = threading.BoundedSemaphore(max_goal_checks)
+        # A repair search takes a child process and a core for up to its time budget; a play
+        # (in the request's thread, like the goal check) solves the environment's game once.
+        self.max_repairs = max_repairs
+        self.repair_time_budget = repair_time_budget
+        self._repair_slots = threading.BoundedSemaphore(max_repairs)
+        self._repair_searches: set[RepairSearch] = set()
+        self._play_slots = threading.BoundedSemaphore(max_goal_checks)
+        self.plays = Plays(self.robot_system)
         self.description = description
         self.job_gate = threading.Event()
         self.job_gate.set()
@@ -96,15 +110,21 @@ class SynthesisBackend:
         return self.catalog.load(system)
 
     def choices(self, system: str) -> dict:
-        """The control modes and actions of ``system``, in file order, with their relations."""
+        """The control modes and actions of ``system``, in file order, with their relations (a
+        capability robot's capabilities are its actions; it has no control modes)."""
         try:
             robot = self.robot_system(system)
-            abstraction = load_task_abstraction(robot)
+            if robot.is_capability_system:
+                modes = {}
+                actions = {name: [clause_text(clause) for clause in capability.preconditions]
+                           for name, capability in robot.capabilities.capabilities.items()}
+            else:
+                abstraction = load_task_abstraction(robot)
+                modes, actions = abstraction.control_modes, abstraction.actions
         except NotFoundError:
             raise
         except CodedError as error:
             raise NotAvailableError(str(error), error.item or system) from error
-        modes, actions = abstraction.control_modes, abstraction.actions
         return {
             'system': system,
             'control_modes': [{'name': m, 'next': list(n)} for m, n in modes.items()],
@@ -113,6 +133,8 @@ class SynthesisBackend:
             'sm_outcome_choices': [list(DEFAULT_SM_OUTCOMES), [FINISHED]],
             'options': list(JOB_OPTIONS),
             'simulation': self.simulation_support(robot),
+            # A capability robot's goal may also be that something does not hold ('!drive').
+            'negated_goals': robot.is_capability_system,
         }
 
     def simulation_support(self, robot: RobotSystem) -> dict:
@@ -156,6 +178,82 @@ class SynthesisBackend:
             raise NotAvailableError(str(error), error.item or system) from error
         return {'findings': [dataclasses.asdict(f) for f in findings], 'impossible_next': impossible}
 
+    # repairs and plays ----------------------------------------------------------------
+
+    def repair(self, body) -> dict:
+        """Verified changes that make a job's request possible (``ltl_specification.repair``), as
+        ``Repairs.to_dict()`` (see :meth:`start_repair`)."""
+        answers = self.start_repair(body)
+        while True:
+            kind, value = answers.get()
+            if kind == 'error':
+                raise value
+            if kind == 'result':
+                return value
+
+    def start_repair(self, body) -> queue.Queue:
+        """Start searching for fixes of a job's request: in a child process (web/repair_process.py)
+        on the robot system the GUI has (perhaps a remote suite's), for at most
+        ``repair_time_budget`` seconds. The queue gets ``('proposal', dict)`` as each proposal is
+        verified, then ``('result', Repairs.to_dict())`` or ``('error', GuiRequestError)``.
+
+        Beyond max_repairs at once: BusyError (429, Retry-After), nothing is searched."""
+        from ltl_specification.repair import TaskRequest
+
+        if self.stopping.is_set():
+            raise BusyError('the server is stopping', 'repairs')
+        request = JobRequest.from_json(body, self.systems())
+        robot = self.robot_system(request.system)
+        if not self._repair_slots.acquire(blocking=False):
+            raise BusyError(f'{self.max_repairs} repair searches are running (at most {self.max_repairs} at once); '
+                            'try again when one has finished', 'repairs', retry_after=int(self.repair_time_budget))
+        task = TaskRequest(request.system, request.initial_conditions, request.goals, request.sm_outcomes,
+                           request.unordered)
+        settings = {'system': robot.name, 'files': dict(robot.files), 'config_file': robot.config_file,
+                    'request': task.to_dict(), 'custom_ltl': request.custom_ltl,
+                    'time_budget': self.repair_time_budget, 'max_proposals': REPAIR_MAX_PROPOSALS}
+        answers = queue.Queue()
+        threading.Thread(target=self._search_repairs, args=(settings, answers), name='gui-repair',
+                         daemon=True).start()
+        return answers
+
+    def _search_repairs(self, settings: dict, answers: queue.Queue):
+        """One search, its slot released when it ends, however it ends."""
+        search = None
+        try:
+            search = RepairSearch(settings)
+            with self._lock:
+                self._repair_searches.add(search)
+            if self.stopping.is_set():
+                search.stop()
+            answers.put(('result', search.run(lambda proposal: answers.put(('proposal', proposal)))))
+        except CodedError as error:  # the system's files as the compiler refuses them
+            answers.put(('error', NotAvailableError(str(error), error.item or settings['system'])))
+        except Exception as error:  # RepairSearchFailed, or the child could not start
+            if not isinstance(error, RepairSearchFailed):
+                logger.exception('repair search failed')
+            answers.put(('error', NotAvailableError(str(error), 'repair search')))
+        finally:
+            with self._lock:
+                self._repair_searches.discard(search)
+            self._repair_slots.release()
+
+    def play(self, job_id: str, body) -> dict:
+        """The turn of a play of a finished job after the body's ``moves`` (web/plays.py).
+
+        Beyond max_goal_checks plays at once: BusyError (429, Retry-After)."""
+        job = self._job(job_id)
+        moves = play_body_moves(checked_body({} if body is None else body))
+        if not job.finished:
+            raise NotAvailableError(f'job {quoted(job_id)} has not finished yet', job_id)
+        if not self._play_slots.acquire(blocking=False):
+            raise BusyError(f'{self.max_goal_checks} plays are being computed (at most {self.max_goal_checks} at once); '
+                            'try again in a moment', 'plays', retry_after=GOAL_CHECK_RETRY_AFTER)
+        try:
+            return self.plays.turn(job, moves)
+        finally:
+            self._play_slots.release()
+
     # jobs ------------------------------------------------------------------------------
 
     def stop(self):
@@ -167,7 +265,7 @@ class SynthesisBackend:
         for job in unfinished:
             job.cancel_requested.set()
         with self._lock:
-            running = list(self._simulation_processes)
+            running = list(self._simulation_processes) + list(self._repair_searches)
         for child in running:
             child.stop()
 

@@ -9,6 +9,7 @@ from dataclasses import asdict, dataclass, field
 
 from respec.errors import ErrorCode, quoted
 from respec.naming import DEFAULT_SM_OUTCOMES, parse_names
+from respec.spec import SECTIONS
 from sm_generation.instantiation import StateInstantiation, count_states
 from synthesis_manager.limits import oversized_strings, too_long
 from synthesis_manager.web.artifacts import available_artifacts, download_labels
@@ -17,8 +18,12 @@ from synthesis_manager.web.outcome import JobOutcome
 
 # The stop-early options the page offers (ltl_synthesis_only needs a whole specification).
 JOB_OPTIONS = ('ltl_compilation_only', 'ltl_steps_only')
-REQUEST_FIELDS = ('system', 'initial_conditions', 'goals', 'sm_outcomes', 'option', 'unordered', 'name')
+REQUEST_FIELDS = ('system', 'initial_conditions', 'goals', 'sm_outcomes', 'option', 'unordered', 'name',
+                  'custom_ltl')
 _NAME = re.compile(r'[A-Za-z][A-Za-z0-9_]*')
+# Goals and initial conditions may also be negated (CNU's capability robots: '!soda').
+_LITERAL = re.compile(r'!?[A-Za-z][A-Za-z0-9_]*')
+LITERAL_FIELDS = ('initial_conditions', 'goals')
 # Control characters (NUL included) and lone surrogates, which no request text may hold: a NUL
 # cut a goal short downstream, and a surrogate cannot be encoded into any answer.
 _FORBIDDEN_CHARACTER = re.compile('[\x00-\x1f\x7f-\x9f\ud800-\udfff]')
@@ -39,6 +44,9 @@ class JobRequest:
     option: str | None = None
     unordered: bool = False
     name: str = ''
+    # Formulas added to the compiled specification, by section (the action's ltl_specification,
+    # ``--custom-ltl``'s mapping); None: none.
+    custom_ltl: dict[str, list[str]] | None = None
 
     @classmethod
     def from_json(cls, body, systems: list[str]) -> 'JobRequest':
@@ -74,7 +82,8 @@ class JobRequest:
                 f'behavior name {quoted(name)} must start with a letter and contain only letters, '
                 'digits and underscores', str(name))
         return cls(system=system, initial_conditions=names_field(body, 'initial_conditions'), goals=goals,
-                   sm_outcomes=sm_outcomes, option=option, unordered=unordered, name=name)
+                   sm_outcomes=sm_outcomes, option=option, unordered=unordered, name=name,
+                   custom_ltl=custom_ltl_field(body))
 
 
 def checked_body(body) -> dict:
@@ -118,9 +127,27 @@ def names_field(body: dict, key: str) -> tuple[str, ...]:
         raise InvalidJobRequestError(f'field {quoted(key)} must be a list of names or comma-separated text', key)
     names = tuple(parse_names(value))
     for name in names:
-        if not _NAME.fullmatch(name):
+        if not (_LITERAL if key in LITERAL_FIELDS else _NAME).fullmatch(name):
             raise InvalidJobRequestError(f'{key}: {quoted(name)} is not a proposition name', name)
     return names
+
+
+def custom_ltl_field(body: dict) -> dict[str, list[str]] | None:
+    """The request's custom LTL: a JSON object mapping specification sections to lists of
+    formulas (their syntax is the compiler's to check); None when absent or empty."""
+    value = body.get('custom_ltl')
+    if value is None:
+        return None
+    if not isinstance(value, dict):
+        raise InvalidJobRequestError('field "custom_ltl" must map specification sections to lists of formulas',
+                                     'custom_ltl')
+    for section, formulas in value.items():
+        if section not in SECTIONS:
+            raise InvalidJobRequestError(f'custom_ltl: unknown section {quoted(section)} (sections: '
+                                         f'{", ".join(SECTIONS)})', section)
+        if not isinstance(formulas, list) or not all(isinstance(f, str) for f in formulas):
+            raise InvalidJobRequestError(f'custom_ltl: section {quoted(section)} must be a list of formulas', section)
+    return {section: list(formulas) for section, formulas in value.items() if formulas} or None
 
 
 # --- jobs ---------------------------------------------------------------------------------

@@ -14,6 +14,9 @@
     GET  /api/jobs/{id}/artifacts/{name}     a download (see ARTIFACTS); ?inline=1 to display it
                                              (a browser asking for a forgotten one gets a page saying so)
     POST /api/goal-check                     goals that cannot be achieved / cannot come next, and why
+    POST /api/repair                         verified changes that make a refused request possible
+                                             (Accept: application/x-ndjson: each proposal as it is found)
+    POST /api/jobs/{id}/play                 a play of a finished job: {"moves": [...]} -> the turn
     POST /api/jobs/{id}/simulations          run the job's state machine on the simulated robot
     GET  /api/simulations/{id}               its trace so far, frames, outcome and trace check
     GET  /api/simulations/{id}/events        the same as server-sent events until the run ends
@@ -25,7 +28,7 @@ a foreign Host header (421), a body over 1 MB (413), a POST whose body is not de
 (415: what a cross-site form can send) or one nested too deeply (400 TOO_DEEP) are refused first
 (web.guards); a control character or lone surrogate in any string is 422 INVALID_CHARACTER
 naming the field (web.jobs.checked_body); a new job while too many are unfinished is 503 BUSY,
-a simulation or goal check while too many run is 429 BUSY with Retry-After.
+a simulation, goal check, repair search or play while too many run is 429 BUSY with Retry-After.
 
 The backend returns records (Job with its web.outcome.JobOutcome, Simulation, the job's
 sm_generation StateMachine); the routes turn them into JSON with their ``to_dict``.
@@ -42,6 +45,7 @@ import asyncio
 import html
 import json
 import mimetypes
+import queue
 from pathlib import Path
 from typing import Callable
 
@@ -57,6 +61,7 @@ from synthesis_manager.web.guards import RequestGuard
 from synthesis_manager.web.vocabulary import vocabulary
 
 STATIC_DIR = Path(__file__).with_name('static')
+NDJSON = 'application/x-ndjson'
 # The page is ES modules, which a browser runs only when served with a JavaScript media type;
 # the host's mime.types (which StaticFiles reads) might map .js to something else.
 mimetypes.add_type('text/javascript', '.js')
@@ -89,7 +94,8 @@ def create_app(backend) -> FastAPI:
     @app.get('/api/info')
     def info():
         return {'description': getattr(backend, 'description', ''),
-                'simulation': bool(getattr(backend, 'can_simulate', False))}
+                'simulation': bool(getattr(backend, 'can_simulate', False)),
+                'repair_time_budget': getattr(backend, 'repair_time_budget', 0)}
 
     @app.get('/api/vocabulary')
     def names():
@@ -137,6 +143,16 @@ def create_app(backend) -> FastAPI:
     @app.post('/api/goal-check')
     def goal_check(body=Body(None)):
         return backend.goal_check(body)
+
+    @app.post('/api/repair')
+    def repair(request: Request, body=Body(None)):
+        if NDJSON not in request.headers.get('accept', ''):
+            return backend.repair(body)
+        return _repair_stream(request, backend.start_repair(body), _stopping(backend))
+
+    @app.post('/api/jobs/{job_id}/play')
+    def play(job_id: str, body=Body(None)):
+        return backend.play(job_id, body)
 
     @app.post('/api/jobs/{job_id}/simulations', status_code=202)
     def start_simulation(job_id: str, body=Body(None)):
@@ -186,6 +202,23 @@ def _stopping(backend) -> Callable[[], bool]:
     """Whether ``backend`` is stopping (a backend without ``stopping`` never is)."""
     stopping = getattr(backend, 'stopping', None)
     return stopping.is_set if stopping is not None else (lambda: False)
+
+
+def _repair_stream(request: Request, answers, stopping: Callable[[], bool]):
+    """A repair search's answers as JSON lines: ``{"proposal": ...}`` as each is verified, then
+    ``{"result": ...}`` (Repairs.to_dict()) or ``{"error": {...}}`` (a 4xx/5xx answer's body)."""
+    async def lines():
+        while not stopping() and not await request.is_disconnected():
+            try:
+                kind, value = answers.get_nowait()
+            except queue.Empty:
+                await asyncio.sleep(0.05)
+                continue
+            yield json.dumps({kind: value.to_dict() if kind == 'error' else value}) + '\n'
+            if kind != 'proposal':
+                return
+
+    return StreamingResponse(lines(), media_type=NDJSON, headers={'Cache-Control': 'no-cache'})
 
 
 def _event_stream(request: Request, revision: Callable[[], int], snapshot: Callable[[], dict],

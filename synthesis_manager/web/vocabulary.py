@@ -3,12 +3,13 @@ copies of them: state classes, autonomy levels, result codes, the machine's outc
 specification's sections.
 
 Each entry is built from the constant that defines it (sm_generation.instantiation,
-sm_generation.export, respec.errors, respec.naming, respec.spec); only the page's own words
+sm_generation.export, respec.errors, respec.naming, respec.spec, ltl_specification.repair); only the page's own words
 (section titles) are written here.
 """
 
 from __future__ import annotations
 
+from ltl_specification.repair import REPAIRABLE
 from respec.errors import ErrorCode
 from respec.naming import FAILED, FINISHED
 from respec.spec import SECTIONS
@@ -42,4 +43,5 @@ def vocabulary() -> dict:
         'sm_outcomes': {'finished': FINISHED, 'failed': FAILED},
         'specification_sections': [{'name': name, 'title': title} for name, title in SECTION_TITLES.items()],
         'preferred_system': PREFERRED_SYSTEM,
+        'repairable': sorted(REPAIRABLE),
     }

@@ -12,11 +12,15 @@
 //   state_details.js  the panel explaining a clicked state
 //   simulation.js     the closed-loop simulation view
 //   frames.js         its key frames and their player
+//   repair.js         "Suggest fixes" for a refused job, and applying one
+//   play.js           playing a finished job: the environment against its machine, or the robot
 // This module only connects the page's controls to them and starts the page.
 import { $ } from './dom.js';
-import { addGoal, checkGoals, loadChoices, loadSystems } from './form.js';
+import { addGoal, checkGoals, fillForm, loadChoices, loadSystems } from './form.js';
 import { playFrames, showFrame, stopPlaying } from './frames.js';
 import { cancel, synthesize } from './job.js';
+import { back, closePlay, playKeys, reset, startPlay } from './play.js';
+import { onApplyFix, suggestFixes } from './repair.js';
 import { simulate } from './simulation.js';
 import { loadVocabulary } from './vocabulary.js';
 
@@ -24,11 +28,20 @@ $('system').addEventListener('change', loadChoices);
 $('add-goal').addEventListener('click', addGoal);
 $('request-form').addEventListener('submit', synthesize);
 $('cancel').addEventListener('click', cancel);
-$('simulate').addEventListener('click', simulate);
+$('simulate').addEventListener('click', () => { closePlay(); simulate(); });
 $('frame-scrubber').addEventListener('input', (event) => { stopPlaying(); showFrame(Number(event.target.value)); });
 $('play-frames').addEventListener('click', playFrames);
 $('behavior-name').addEventListener('input', () => $('behavior-name-hint').classList.remove('bad'));
 $('initial-conditions').addEventListener('change', checkGoals);
 $('unordered').addEventListener('change', checkGoals);
+$('suggest-fixes').addEventListener('click', suggestFixes);
+onApplyFix(async (request) => { await fillForm(request); synthesize(); });
+$('play-environment').addEventListener('click', () => startPlay(false));
+$('play-robot').addEventListener('click', () => startPlay(true));
+$('play-back').addEventListener('click', back);
+$('play-reset').addEventListener('click', reset);
+$('play-close').addEventListener('click', closePlay);
+$('graph-layout').addEventListener('keydown', playKeys);     // the panel and the drawing beside it
+$('robot-play-section').addEventListener('keydown', playKeys);
 loadVocabulary().then(loadSystems).then(() => document.body.classList.add('ready'),
   (error) => { $('status').textContent = `Cannot load the systems: ${error.message}`; });

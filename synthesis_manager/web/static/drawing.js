@@ -16,6 +16,7 @@ let full = null;     // the drawing's own viewBox {x, y, w, h}
 let view = null;     // the part shown now
 let machine = null;  // the shown machine's tree: its root node
 let onSelect = null;
+let outcomePicker = null;  // during a play: (outcome names of the clicked cell) => whether one was taken
 
 function scale() { return viewport.clientWidth / view.w; }
 
@@ -105,9 +106,12 @@ function enablePanning() {
   });
 }
 
-// A clicked SVG element -> the top-level state it belongs to (id "state:<name>").
+// A clicked SVG element -> the top-level state it belongs to (id "state:<name>"); during a play,
+// a click on an outcome cell of the active state reports that outcome instead.
 function select(target) {
   const node = target.closest ? target.closest('g.node') : null;
+  if (outcomePicker && node && node.classList.contains('active') && target.tagName === 'text'
+      && outcomePicker(target.textContent.split(',').map((name) => name.trim()).filter(Boolean))) return;
   svg.querySelectorAll('g.node.selected').forEach((g) => g.classList.remove('selected'));
   if (!node || !node.id.startsWith('state:')) { if (onSelect) onSelect(null); return; }
   node.classList.add('selected');
@@ -179,6 +183,18 @@ export function markRun(steps, running) {
   if (current) revealNode(current);  // follow the robot through a machine larger than the view
 }
 
+// Mark a play of the environment on the drawing as markRun marks a simulation: ``history`` the
+// (state path, outcome) pairs reported so far, ``active`` the active state's path (null: ended).
+export function markPlay(history, active) {
+  if (!machine) return;
+  const steps = history.map(([path, outcome]) => {
+    const state = machine.children.find((node) => node.state_path === path);
+    return { state: path, transition: state ? state.transitions[state.outcomes.indexOf(outcome)] : null };
+  });
+  if (active) steps.push({ state: active, transition: null });
+  markRun(steps, active !== null);
+}
+
 // Pan a focused state into view (keyboard users cannot drag).
 function revealNode(node) {
   const box = node.getBoundingClientRect();
@@ -200,6 +216,13 @@ function outcomeBox(name, stateName) {
 }
 
 export function clear() { svg = null; viewport = null; machine = null; }
+
+// During a play the active state's outcome cells can be clicked: ``picker(names)`` gets the
+// outcome names of the clicked cell and says whether it took one (null: no play).
+export function pickOutcomes(picker) {
+  outcomePicker = picker;
+  if (viewport) viewport.classList.toggle('picking', Boolean(picker));
+}
 
 // Fit the drawing to its viewport again (it changed size), if one is shown.
 export function refit(readableOnly = true) {

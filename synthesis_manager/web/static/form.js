@@ -6,12 +6,14 @@ import { vocabulary } from './vocabulary.js';
 
 let choices = null;      // the current system's control modes and actions (GET /api/systems/{system})
 let canSimulate = false; // the server can run atlas_sim (GET /api/info)
+let repairBudget = 0;    // seconds a "Suggest fixes" search may take (GET /api/info)
 let goalChecks = 0;      // replies can overtake each other: only the newest check's is shown
 
 export async function loadSystems() {
   const [{ systems }, info] = await Promise.all([api('GET', '/api/systems'), api('GET', '/api/info')]);
   $('backend-description').textContent = info.description || '';
   canSimulate = info.simulation;
+  repairBudget = info.repair_time_budget || 0;
   const select = $('system');
   select.replaceChildren(...systems.map((name) => element('option', { value: name, text: name })));
   const preferred = vocabulary().preferred_system;
@@ -39,9 +41,13 @@ export async function loadChoices() {
 
   const group = (label, items, hint) => element('optgroup', { label },
     ...items.map((item) => element('option', { value: item.name, title: hint(item), text: item.name })));
-  $('goal-choice').replaceChildren(
+  const negated = choices.negated_goals
+    ? [group('Must not hold at the end', choices.actions.map((a) => ({ name: `!${a.name}` })), (a) => `${a.name.slice(1)} is false`)]
+    : [];
+  $('goal-choice').replaceChildren(...[
     group('Actions', choices.actions, (a) => `needs: ${a.preconditions.join(', ') || 'nothing'}`),
-    group('Control modes', choices.control_modes, (m) => `reached from: ${predecessors(m.name).join(', ') || 'no other mode'}`));
+    group('Control modes', choices.control_modes, (m) => `reached from: ${predecessors(m.name).join(', ') || 'no other mode'}`),
+    ...negated].filter((optgroup) => optgroup.children.length));  // a capability robot has no modes
   $('goals').replaceChildren();
   updateGoalsHint();
 }
@@ -49,6 +55,10 @@ export async function loadChoices() {
 // The names a simulation can make fail first: the system's actions, then its control modes.
 export function capabilityNames() {
   return [...choices.actions, ...choices.control_modes].map((c) => c.name);
+}
+
+export function repairTimeBudget() {
+  return repairBudget;
 }
 
 // Whether the simulated robot can run the chosen system's machines, and if not, why.
@@ -121,7 +131,9 @@ function updateGoalsHint() {
 
 export function currentRequest() {
   const checked = (selector) => document.querySelector(selector).value;
+  const custom = customLtl();
   return {
+    ...(custom.value ? { custom_ltl: custom.value } : {}),
     system: $('system').value,
     initial_conditions: [...document.querySelectorAll('input[name="initial-mode"]:checked, input[name="initial-condition"]:checked')]
       .map((b) => b.value),
@@ -139,9 +151,52 @@ export function requestProblem(request) {
   if (!request.goals.length) {
     return { field: 'goal-choice', message: 'Add at least one goal: pick it in the list and press “Add goal”.' };
   }
+  const custom = customLtl();
+  $('custom-ltl-problem').textContent = custom.problem;
+  if (custom.problem) {
+    $('custom-ltl-box').open = true;
+    return { field: 'custom-ltl', message: `Custom LTL: ${custom.problem}` };
+  }
   const name = $('behavior-name');
   if (!name.checkValidity()) {
     return { field: 'behavior-name', message: `Behavior name “${name.value}”: ${$('behavior-name-hint').textContent.trim()}` };
   }
   return null;
+}
+
+// The custom LTL field: empty, or a JSON object of sections to lists of formulas (the server
+// checks the sections and the compiler the formulas).
+function customLtl() {
+  const text = $('custom-ltl').value.trim();
+  if (!text) return { value: null, problem: '' };
+  let value;
+  try {
+    value = JSON.parse(text);
+  } catch (error) {
+    return { value: null, problem: `not JSON (${error.message})` };
+  }
+  if (value === null || typeof value !== 'object' || Array.isArray(value)) {
+    return { value: null, problem: 'write a JSON object of sections to lists of formulas, as in the example above' };
+  }
+  return { value: Object.keys(value).length ? value : null, problem: '' };
+}
+
+// Fill the form with ``request`` (a suggested fix): its initial conditions, goals, outcomes,
+// order and custom LTL; the system, stop-after option and behavior name stay as they are.
+export async function fillForm(request) {
+  if ($('system').value !== request.system) {
+    $('system').value = request.system;
+    await loadChoices();
+  }
+  const chosen = new Set(request.initial_conditions);
+  for (const box of document.querySelectorAll('input[name="initial-mode"], input[name="initial-condition"]')) {
+    box.checked = chosen.has(box.value);
+  }
+  $('goals').replaceChildren(...request.goals.map(goalItem));
+  const outcomes = document.querySelector(`input[name="sm-outcomes"][value="${request.sm_outcomes.join(',')}"]`);
+  if (outcomes) outcomes.checked = true;
+  $('unordered').checked = Boolean(request.unordered);
+  $('custom-ltl').value = request.custom_ltl ? JSON.stringify(request.custom_ltl) : '';
+  $('custom-ltl-box').open = Boolean(request.custom_ltl);
+  updateGoalsHint();
 }

@@ -12,8 +12,9 @@ let shownProgress = { id: null, revision: -1 };  // newest job snapshot shown: r
 let startedAt = 0;       // performance.now() when the followed job was started
 let elapsedTimer = null;
 
+// Send the form's request (``event``: the form's submit, none when called to apply a fix).
 export async function synthesize(event) {
-  event.preventDefault();
+  if (event) event.preventDefault();
   const request = currentRequest();
   const problem = requestProblem(request);
   $('form-problem').textContent = problem ? problem.message : '';

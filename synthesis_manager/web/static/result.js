@@ -2,6 +2,8 @@
 // specification; the simulation is offered from here.
 import * as drawing from './drawing.js';
 import { $, element, formatSeconds } from './dom.js';
+import { offerPlay, withdrawPlay } from './play.js';
+import { offerRepair, withdrawRepair } from './repair.js';
 import { offerSimulation, withdrawSimulation } from './simulation.js';
 import { showStateDetails } from './state_details.js';
 import { vocabulary } from './vocabulary.js';
@@ -9,6 +11,8 @@ import { vocabulary } from './vocabulary.js';
 export function resetResult() {
   $('result').hidden = true;
   withdrawSimulation();
+  withdrawRepair();
+  withdrawPlay();
   for (const id of ['graph-section', 'downloads-section', 'specification-section', 'simulation-section']) {
     $(id).hidden = true;
   }
@@ -40,6 +44,7 @@ export function resultWord(errorName) {
 }
 
 export function showRequestError(error) {
+  withdrawRepair();
   showBanner(error.code, error.message, false);
   $('summary').replaceChildren();
 }
@@ -49,6 +54,8 @@ export function showResult(job) {
   const message = outcome.message || (summary.succeeded ? describeSuccess(job) : '');
   const cancelled = outcome.error_name === vocabulary().job_results.cancelled;
   showBanner(resultWord(outcome.error_name), message, cancelled ? null : summary.succeeded);
+  offerRepair(job);
+  offerPlay(job, summary.realizable === false);
   showSummary(summary, job.stages);
   if (job.artifacts.includes('state_machine.svg')) drawStateMachine(job);
   showDownloads(job);

@@ -1,0 +1,98 @@
+"""Play a finished job (``POST /api/jobs/{id}/play``): the user against the environment or the machine.
+
+An unrealizable job is played as the robot against the environment's counter-strategy
+(``ltl_specification.play.RobotPlay``, its task compiled again here, ROS-free, on the job's
+robot system); a job with a state machine is played as the environment, reporting the active
+state's outcomes (``sm_generation.play.play_machine``). Both are stateless for the client,
+which sends every move so far; the server keeps the few newest counter-strategies (solving the
+environment's game is the costly part) and plays each under its own lock, since a CUDD manager
+serves one thread at a time.
+"""
+
+from __future__ import annotations
+
+import threading
+from collections import OrderedDict
+
+from ltl_specification import compile_task
+from ltl_specification.play import PlayError, RobotPlay
+from respec.errors import CodedError, ErrorCode, quoted
+from sm_generation.play import MachinePlayError, play_machine
+from sm_generation.state_machine import StateMachine
+from synthesis_manager.web.errors import GuiRequestError, InvalidJobRequestError, NotAvailableError
+from synthesis_manager.web.jobs import Job
+
+ROBOT, ENVIRONMENT = 'robot', 'environment'   # whom the user plays
+KEPT_COUNTER_STRATEGIES = 4
+
+
+class MoveError(GuiRequestError):
+    """A move the play does not have (an index out of range, an outcome the state lacks)."""
+
+    kind = 'BAD_MOVE'
+
+
+def play_body_moves(body) -> list:
+    """The ``moves`` of a play request: a list of move indices or outcome names."""
+    if not isinstance(body, dict) or set(body) - {'moves'}:
+        raise InvalidJobRequestError('the body must be {"moves": [...]}', 'body')
+    moves = body.get('moves', [])
+    if not isinstance(moves, list):
+        raise InvalidJobRequestError('field "moves" must be a list', 'moves')
+    return moves
+
+
+class Plays:
+    """The plays of a backend's jobs; ``robot_system(name)`` loads the job's RobotSystem."""
+
+    def __init__(self, robot_system):
+        self.robot_system = robot_system
+        self._lock = threading.Lock()
+        self._counter_strategies: OrderedDict[str, tuple[RobotPlay, threading.Lock]] = OrderedDict()
+
+    def turn(self, job: Job, moves: list) -> dict:
+        """The turn after ``moves``, with ``play`` saying whom the user plays."""
+        outcome = job.outcome
+        if outcome.states:
+            return {'play': ENVIRONMENT, **self._machine_turn(job, moves)}
+        if outcome.error_name == ErrorCode.SPEC_UNSYNTHESIZABLE:
+            return {'play': ROBOT, **self._robot_turn(job, moves)}
+        raise NotAvailableError(f'job {quoted(job.id)} ({outcome.error_name}) has nothing to play: neither a state '
+                                'machine nor an unrealizable specification', job.id)
+
+    def _machine_turn(self, job: Job, moves: list) -> dict:
+        if not all(isinstance(move, str) for move in moves):
+            raise InvalidJobRequestError('the moves of a machine play are outcome names', 'moves')
+        try:
+            return play_machine(StateMachine.from_instantiations(job.outcome.states), moves).to_dict()
+        except MachinePlayError as error:
+            raise MoveError(str(error), 'moves') from error
+
+    def _robot_turn(self, job: Job, moves: list) -> dict:
+        if not all(isinstance(move, int) and not isinstance(move, bool) for move in moves):
+            raise InvalidJobRequestError('the moves of a robot play are move indices (integers)', 'moves')
+        play, lock = self._counter_strategy(job)
+        with lock:
+            try:
+                return play.turn(moves).to_dict()
+            except PlayError as error:
+                raise MoveError(str(error), 'moves') from error
+
+    def _counter_strategy(self, job: Job) -> tuple[RobotPlay, threading.Lock]:
+        with self._lock:
+            if job.id in self._counter_strategies:
+                self._counter_strategies.move_to_end(job.id)
+                return self._counter_strategies[job.id]
+        request = job.request
+        try:
+            spec = compile_task(self.robot_system(request.system), list(request.initial_conditions),
+                                list(request.goals), sm_outcomes=request.sm_outcomes,
+                                strict_order=not request.unordered, custom_ltl=request.custom_ltl)
+            play = RobotPlay(spec, spec.provenance.meanings if spec.provenance is not None else {})
+        except (CodedError, PlayError) as error:  # e.g. the system's files changed since the job
+            raise NotAvailableError(f'cannot play job {quoted(job.id)}: {error}', job.id) from error
+        with self._lock:
+            self._counter_strategies[job.id] = (play, threading.Lock())
+            while len(self._counter_strategies) > KEPT_COUNTER_STRATEGIES:
+                self._counter_strategies.popitem(last=False)
+            return self._counter_strategies[job.id]

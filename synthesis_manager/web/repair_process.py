@@ -1,0 +1,68 @@
+"""The GUI's "Suggest fixes": ``ltl_specification.repair`` in a child process with a deadline.
+
+A repair search compiles and synthesizes dozens of candidate tasks for up to its time budget:
+in the GUI's own process it would hold Python's GIL (one CUDD operation can run for seconds),
+so every other request would wait. It therefore runs in a child process of its own
+(``ltl_synthesizer.isolated.ChildProcess``, which preloads this module), killed when the GUI
+stops or the search overruns its deadline. The child gets the robot system's files as the GUI
+read them (perhaps from a suite on another machine), not a name to read again, and reports
+each verified proposal as it is found.
+
+    search = RepairSearch(settings)          # in the GUI, in the request's thread
+    repairs = search.run(on_proposal)        # search.stop() from another thread ends it
+"""
+
+from __future__ import annotations
+
+import time
+from typing import Callable
+
+from ltl_synthesizer.errors import SynthesisError
+from ltl_synthesizer.isolated import SERVER_CHILD_NICENESS, ChildProcess
+
+#: Seconds a child may take beyond its search's time budget: the interpreter's start, the
+#: diagnosis after the search (a fifth of the budget at most) and the answer.
+STARTUP_GRACE = 20.0
+
+
+class RepairSearchFailed(Exception):
+    """The child ended (killed, crashed, overran its deadline) without an answer."""
+
+
+class RepairSearch:
+    """One search in its child process. ``settings``: ``system``, ``files``, ``config_file`` (the
+    RobotSystem's), ``request`` (TaskRequest.to_dict()), ``custom_ltl``, ``time_budget``,
+    ``max_proposals``."""
+
+    def __init__(self, settings: dict):
+        self.settings = settings
+        self.child = ChildProcess(niceness=SERVER_CHILD_NICENESS, preload=__name__)
+
+    def run(self, on_proposal: Callable[[dict], None] | None = None) -> dict:
+        """The search's ``Repairs.to_dict()``; ``on_proposal(proposal dict)`` as each is verified.
+        A refusal of the system's files is raised as the CodedError it is."""
+        deadline = time.monotonic() + self.settings['time_budget'] * 1.2 + STARTUP_GRACE
+        try:
+            return self.child.call(search, (self.settings,), on_progress=on_proposal or (lambda _: None),
+                                   deadline=deadline)
+        except SynthesisError as error:  # died, stopped or overran: SynthesisError's subclasses
+            raise RepairSearchFailed(f'the repair search ended without an answer ({error})') from error
+        finally:
+            self.child.kill()
+
+    def stop(self) -> None:
+        """End the child now, from any thread (the GUI stops)."""
+        if self.child.process.poll() is None:
+            self.child.process.kill()
+
+
+def search(settings: dict, progress: Callable[[dict], None]) -> dict:
+    """In the child: the verified proposals for the settings' task on the GUI's robot system."""
+    from ltl_specification.repair import TaskRequest, propose_repairs
+    from respec.robot import robot_system_from_files
+
+    system = robot_system_from_files(settings['system'], settings['files'], settings['config_file'])
+    repairs = propose_repairs(system, TaskRequest.from_dict(settings['request']), settings['custom_ltl'],
+                              time_budget=settings['time_budget'], max_proposals=settings['max_proposals'],
+                              on_proposal=lambda proposal: progress(proposal.to_dict()))
+    return repairs.to_dict()

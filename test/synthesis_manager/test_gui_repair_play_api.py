@@ -1,0 +1,294 @@
+"""The GUI's "Suggest fixes" (POST /api/repair) and play (POST /api/jobs/{id}/play) against the
+real in-process pipeline, for ATLAS and a CNU capability robot (issue 33, items 2 and 3)."""
+
+import shutil
+import threading
+from concurrent.futures import ThreadPoolExecutor
+
+import pytest
+from fastapi.testclient import TestClient
+
+from respec.robot import SystemCatalog
+from respec.robot.system import ServedCatalog, catalog_to_json
+from synthesis_manager.gui import ros_backend
+from synthesis_manager.web import backend as backend_module
+from synthesis_manager.web.backend import SynthesisBackend
+from synthesis_manager.web.routes import create_app
+
+from test_gui_api import gui_args, run_job
+
+WRONG_ORDER = {'system': 'atlas', 'initial_conditions': ['stand_prep'], 'goals': ['look_down', 'stand_prep']}
+PAPER_TASK = {'system': 'atlas', 'initial_conditions': ['stand_prep'], 'goals': ['look_down', 'pickup_object']}
+# The delivery rover asked to drive and not to drive: its capability game cannot be won.
+ROVER_CONTRADICTION = {'system': 'delivery_rover', 'initial_conditions': [], 'goals': ['drive', '!drive']}
+ROVER_TASK = {'system': 'delivery_rover', 'initial_conditions': [], 'goals': ['drive', 'hand_over']}
+
+
+@pytest.fixture(scope='module')
+def gui(tmp_path_factory, flexbe):
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setenv('AMENT_PREFIX_PATH', str(flexbe))  # the rover's FlexBE state classes
+        with ros_backend(gui_args(tmp_path_factory.mktemp('gui-repair'))) as backend, \
+                TestClient(create_app(backend)) as client:
+            yield backend, client
+
+
+@pytest.fixture
+def client(gui):
+    return gui[1]
+
+
+def play(client, job_id, moves):
+    return client.post(f'/api/jobs/{job_id}/play', json={'moves': moves})
+
+
+def test_suggest_fixes_offers_verified_changes_and_an_applied_one_succeeds(client):
+    _, refused = run_job(client, WRONG_ORDER)
+    assert refused['outcome']['error_name'] == 'SPEC_UNSYNTHESIZABLE'
+    response = client.post('/api/repair', json=WRONG_ORDER)
+    assert response.status_code == 200, response.text
+    repairs = response.json()
+    assert repairs['problem'].startswith('SPEC_UNSYNTHESIZABLE: Goal 2 (stand_prep) can never be achieved')
+    proposals = repairs['proposals']
+    assert proposals and all(p['verified'] for p in proposals)
+    assert [p['kind'] for p in proposals][:2] == ['goals_in_any_order', 'reorder_goals']
+    robot = [p for p in proposals if p['changes_robot']]
+    assert robot and all('config_patch' in p and 'request' not in p for p in robot)
+    assert robot[0]['config_patch']['file'] == 'config/atlas.yaml'
+    for proposal in proposals[:2]:
+        _, fixed = run_job(client, proposal['request'])
+        assert fixed['outcome']['error_name'] == 'SUCCESS', proposal['summary']
+
+
+def test_fixes_stream_as_json_lines_as_they_are_found(client):
+    import json
+
+    with client.stream('POST', '/api/repair', json=WRONG_ORDER, headers={'Accept': 'application/x-ndjson'}) as answer:
+        assert answer.status_code == 200 and answer.headers['content-type'].startswith('application/x-ndjson')
+        lines = [json.loads(line) for line in answer.iter_lines() if line]
+    *found, last = lines
+    assert found and all(set(line) == {'proposal'} for line in found)
+    assert [line['proposal'] for line in found] == last['result']['proposals']
+    with client.stream('POST', '/api/repair', json={**WRONG_ORDER, 'system': 'nowhere'},
+                       headers={'Accept': 'application/x-ndjson'}) as refused:
+        assert refused.status_code == 404     # refusals come before the stream, as plain answers
+
+
+def test_a_refusal_before_synthesis_gets_fixes_too(client):
+    from_stand = {**WRONG_ORDER, 'initial_conditions': ['stand']}
+    _, refused = run_job(client, from_stand)
+    assert refused['outcome']['error_name'] == 'INVALID_GOALS'
+    repairs = client.post('/api/repair', json=from_stand).json()
+    assert repairs['problem'].startswith('INVALID_GOALS') and repairs['proposals']
+    applied = next(p for p in repairs['proposals'] if 'request' in p)
+    assert run_job(client, applied['request'])[1]['outcome']['error_name'] == 'SUCCESS'
+
+
+def test_the_page_learns_which_refusals_can_be_repaired_and_the_search_budget(client):
+    from ltl_specification.repair import REPAIRABLE
+
+    assert client.get('/api/vocabulary').json()['repairable'] == sorted(REPAIRABLE) == [
+        'ABSTRACTION_CONFIG_INVALID', 'INVALID_GOALS', 'SPEC_UNSYNTHESIZABLE']
+    assert client.get('/api/info').json()['repair_time_budget'] == 10.0
+
+
+def test_a_task_that_can_be_done_needs_no_fix_and_bad_requests_are_refused(client):
+    repairs = client.post('/api/repair', json=PAPER_TASK).json()
+    assert repairs['realizable'] is True and repairs['proposals'] == []
+    unknown = client.post('/api/repair', json={**PAPER_TASK, 'system': 'nowhere'})
+    assert unknown.status_code == 404 and unknown.json()['item'] == 'nowhere'
+    no_goals = client.post('/api/repair', json={**PAPER_TASK, 'goals': []})
+    assert no_goals.status_code == 422 and no_goals.json()['item'] == 'goals'
+
+
+def test_custom_ltl_is_part_of_the_request_and_a_weakened_guarantee_is_proposed(client):
+    forbidden = {**PAPER_TASK, 'goals': ['look_down'], 'custom_ltl': {'sys_trans': ['!look_down_a']}}
+    _, refused = run_job(client, forbidden)
+    assert refused['outcome']['error_name'] == 'SPEC_UNSYNTHESIZABLE'
+    assert '!look_down_a' in refused['outcome']['ltl_specification']['sys_trans']
+    proposals = client.post('/api/repair', json=forbidden).json()['proposals']
+    weakened = next(p for p in proposals if p['kind'] == 'weaken_guarantee')
+    _, fixed = run_job(client, {**forbidden, 'custom_ltl': weakened['custom_ltl']})
+    assert fixed['outcome']['error_name'] == 'SUCCESS'
+    bad = client.post('/api/jobs', json={**forbidden, 'custom_ltl': {'sys_nonsense': ['x']}})
+    assert bad.status_code == 422 and bad.json()['item'] == 'sys_nonsense'
+
+
+def test_playing_the_robot_of_an_unrealizable_job_until_it_loses(client):
+    _, job = run_job(client, WRONG_ORDER)
+    start = play(client, job['id'], [])
+    assert start.status_code == 200, start.text
+    turn = start.json()
+    assert turn['play'] == 'robot' and turn['step'] == 0 and turn['happened'] == 'now in stand_prep'
+    assert turn['blocked_goal'].startswith('the environment keeps system goal 1')
+    dead_end = next(move for move in turn['moves'] if move['dead_end'])
+    lost = play(client, job['id'], [dead_end['index']]).json()
+    assert lost['lost'] and 'deadlock' in lost['lost'] and lost['moves'] == []
+    keep = next(m for m in turn['moves'] if m['words'] == 'keep every output as it is')
+    again = play(client, job['id'], [keep['index']]).json()
+    assert next(m for m in again['moves'] if m['words'] == 'keep every output as it is')['repeats']
+    assert again['history'] == ['nothing changes']
+
+    wrong = play(client, job['id'], [999])
+    assert wrong.status_code == 400
+    assert (wrong.json()['error'], wrong.json()['item']) == ('BAD_MOVE', 'moves')
+    assert 'move 999 at step 0 does not exist' in wrong.json()['message']
+    assert play(client, job['id'], ['look_down']).status_code == 422   # a robot's moves are indices
+
+
+def test_playing_the_environment_of_a_machine_until_it_ends(client):
+    _, job = run_job(client, PAPER_TASK)
+    turn = play(client, job['id'], []).json()
+    assert turn['play'] == 'environment' and turn['active'] and turn['outcomes']
+    moves = []
+    while turn['ended'] is None:      # report the first outcome (success) of each state
+        moves.append(turn['outcomes'][0])
+        turn = play(client, job['id'], moves).json()
+        assert len(moves) < 20
+    assert turn['ended'] == 'finished' and turn['active'] is None and turn['outcomes'] == []
+    assert [state for state, _ in turn['history']][:1] == [play(client, job['id'], []).json()['active']]
+
+    wrong = play(client, job['id'], [moves[0], 'exploded'])
+    assert wrong.status_code == 400 and wrong.json()['error'] == 'BAD_MOVE'
+    assert "move 'exploded' at step 1 does not exist" in wrong.json()['message']
+    after_the_end = play(client, job['id'], [*moves, moves[0]])
+    assert after_the_end.status_code == 400 and 'already ended' in after_the_end.json()['message']
+    assert play(client, job['id'], [0]).status_code == 422    # an environment's moves are outcomes
+    assert client.post(f"/api/jobs/{job['id']}/play", json={'moves': [], 'extra': 1}).status_code == 422
+
+
+def test_nothing_to_play_and_unknown_jobs(client):
+    _, compiled = run_job(client, {**PAPER_TASK, 'option': 'ltl_compilation_only'})
+    nothing = play(client, compiled['id'], [])
+    assert nothing.status_code == 409 and nothing.json()['item'] == compiled['id']
+    assert play(client, 'no-such-job', []).status_code == 404
+
+
+def test_a_capability_robot_offers_its_capabilities_as_actions_and_negated_goals(client):
+    choices = client.get('/api/systems/delivery_rover').json()
+    assert choices['control_modes'] == [] and choices['negated_goals'] is True
+    assert {a['name']: a['preconditions'] for a in choices['actions']} == {
+        'check_battery': [], 'charge': ['!battery_ok'], 'drive': ['battery_ok'], 'hand_over': ['drive']}
+    assert client.get('/api/systems/atlas').json()['negated_goals'] is False
+
+
+def test_a_capability_robot_plays_both_ways_and_is_repaired(client):
+    _, refused = run_job(client, ROVER_CONTRADICTION)
+    assert refused['outcome']['error_name'] == 'SPEC_UNSYNTHESIZABLE', refused['outcome']['message']
+    turn = play(client, refused['id'], []).json()
+    assert turn['play'] == 'robot' and turn['moves'] and turn['happened'] == 'check_battery_a'
+    moves = []
+    for _ in range(12):               # always the first move: the play goes round, never won
+        if turn['lost'] or not turn['moves']:
+            break
+        moves.append(turn['moves'][0]['index'])
+        turn = play(client, refused['id'], moves).json()
+        assert not (turn['values']['finished'] or turn['values']['failed'])
+    assert turn['lost'] or any(move['repeats'] for move in turn['moves'])
+
+    repairs = client.post('/api/repair', json=ROVER_CONTRADICTION).json()
+    dropped = next(p for p in repairs['proposals'] if p['kind'] == 'drop_goal')
+    _, fixed = run_job(client, dropped['request'])
+    assert fixed['outcome']['error_name'] == 'SUCCESS'
+
+    _, job = run_job(client, ROVER_TASK)
+    assert job['outcome']['error_name'] == 'SUCCESS', job['outcome']['message']
+    turn, moves = play(client, job['id'], []).json(), []
+    while turn['ended'] is None and len(moves) < 20:
+        moves.append(turn['outcomes'][0])
+        turn = play(client, job['id'], moves).json()
+    assert turn['ended'] == 'finished'
+
+
+def test_repairs_use_the_robot_system_the_gui_has_not_a_file_here(tmp_path):
+    """A GUI attached to a remote suite has its systems as served text: the search in the
+    child process must use them (here the file is gone once the catalog was read)."""
+    config = tmp_path / 'config'
+    config.mkdir()
+    shutil.copy('config/atlas.yaml', config / 'atlas_elsewhere.yaml')
+    served = ServedCatalog.from_json(catalog_to_json(SystemCatalog(str(config))))
+    shutil.rmtree(config)
+    backend = SynthesisBackend(run_goal=None, systems=served)
+    with TestClient(create_app(backend)) as client:
+        repairs = client.post('/api/repair', json={**WRONG_ORDER, 'system': 'atlas_elsewhere'})
+    assert repairs.status_code == 200, repairs.text
+    assert repairs.json()['proposals'][0]['request']['system'] == 'atlas_elsewhere'
+
+
+def busy_while_the_slots_are_held(monkeypatch, owner, method: str, slots: int, send) -> tuple:
+    """Send ``slots`` requests whose ``owner.method`` waits, then one more: (held answers, that answer)."""
+    running, release = threading.Semaphore(0), threading.Event()
+    real = getattr(owner, method)
+
+    def held(*args):
+        running.release()
+        release.wait(30)
+        return real(*args)
+
+    monkeypatch.setattr(owner, method, held)
+    with ThreadPoolExecutor(slots) as pool:
+        waiting = [pool.submit(send) for _ in range(slots)]
+        try:
+            for _ in waiting:
+                assert running.acquire(timeout=30)
+            busy = send()
+        finally:
+            release.set()
+        return [future.result() for future in waiting], busy
+
+
+def test_repairs_beyond_the_limit_are_busy(monkeypatch):
+    backend = SynthesisBackend(run_goal=None, max_repairs=1)
+    with TestClient(create_app(backend)) as client:
+        held, busy = busy_while_the_slots_are_held(monkeypatch, backend_module.RepairSearch, 'run', 1,
+                                                   lambda: client.post('/api/repair', json=WRONG_ORDER))
+        assert [answer.status_code for answer in held] == [200]
+        assert (busy.status_code, busy.json()['error'], busy.json()['item']) == (429, 'BUSY', 'repairs')
+        assert busy.headers['retry-after'] == str(int(backend.repair_time_budget))
+        monkeypatch.undo()
+        assert client.post('/api/repair', json=WRONG_ORDER).status_code == 200   # the slot is free again
+
+
+def test_plays_beyond_the_limit_are_busy(gui, monkeypatch):
+    backend, client = gui
+    _, job = run_job(client, WRONG_ORDER)
+    held, busy = busy_while_the_slots_are_held(monkeypatch, backend_module.Plays, 'turn', backend.max_goal_checks,
+                                               lambda: play(client, job['id'], []))
+    assert [answer.status_code for answer in held] == [200] * backend.max_goal_checks
+    assert (busy.status_code, busy.json()['error'], busy.json()['item']) == (429, 'BUSY', 'plays')
+    assert busy.headers['retry-after'] == '1'
+
+
+def search_settings(time_budget=10.0):
+    from ltl_specification.repair import TaskRequest
+    from respec.robot import robot_system
+
+    robot = robot_system('atlas')
+    return {'system': robot.name, 'files': dict(robot.files), 'config_file': robot.config_file,
+            'request': TaskRequest('atlas', ('stand_prep',), ('look_down', 'stand_prep')).to_dict(),
+            'custom_ltl': None, 'time_budget': time_budget, 'max_proposals': 5}
+
+
+def test_a_search_past_its_deadline_is_killed(monkeypatch):
+    from synthesis_manager.web import repair_process
+
+    monkeypatch.setattr(repair_process, 'STARTUP_GRACE', 0.0)
+    search = repair_process.RepairSearch(search_settings(time_budget=0.01))
+    with pytest.raises(repair_process.RepairSearchFailed, match='without an answer'):
+        search.run()
+    assert search.child.process.poll() is not None
+
+
+def test_stopping_the_gui_ends_a_running_search_at_once():
+    import time
+
+    from synthesis_manager.web.repair_process import RepairSearch, RepairSearchFailed
+
+    search = RepairSearch(search_settings())
+    with ThreadPoolExecutor(1) as pool:
+        answer = pool.submit(search.run)
+        started = time.monotonic()
+        search.stop()
+        with pytest.raises(RepairSearchFailed):
+            answer.result(timeout=10)
+    assert time.monotonic() - started < 2.0 and search.child.process.poll() is not None

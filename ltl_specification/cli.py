@@ -56,8 +56,12 @@ def run(args: argparse.Namespace) -> int:
                             sm_outcomes=parse_names(args.sm_outcomes), strict_order=not args.unordered,
                             custom_ltl=custom_ltl, config_dir=args.config_dir)
     except SpecificationError as error:
-        message = ' '.join(str(error).split())
+        # One line naming the code and the item; a refusal's diagnosis (core, play) follows it.
+        sentence, _, diagnosis = str(error).partition('\n')
+        message = ' '.join(sentence.split())
         print(f'error: {error.code}: {message} [item: {error.item!r}]', file=sys.stderr)
+        if getattr(error, 'diagnosis', None) is not None:
+            print(diagnosis.rstrip('\n'), file=sys.stderr)
         return ExitStatus.FAILED
     if args.format == 'json':
         text = json.dumps(spec.to_text_sections(), indent=2) + '\n'

@@ -66,12 +66,11 @@ from respec.robot.files import ConfigFileInvalidError, SystemNotFoundError
 from ltl_specification.capabilities import compile_capability_task
 from ltl_specification.capability_precheck import check_capability_names, check_capability_task
 from ltl_specification.errors import (
-    InvalidAbstractionError, InvalidFormulaError, InvalidGoalsError, InvalidInitialConditionsError,
-    InvalidSmOutcomesError, UnknownPropositionError, UnknownSystemError,
+    ImpossibleGoalsError, InvalidAbstractionError, InvalidFormulaError, InvalidGoalsError,
+    InvalidInitialConditionsError, InvalidSmOutcomesError, UnknownPropositionError, UnknownSystemError,
 )
-from ltl_specification.pertinence import Pertinence, infer_pertinence
+from ltl_specification.pertinence import Pertinence, infer_pertinence, mode_distances
 from ltl_specification.provenance import Provenance, task_provenance
-from ltl_specification.reachability import unreachable_goal_modes
 
 SUPPORTED_SM_OUTCOMES = (DEFAULT_SM_OUTCOMES, (FINISHED,))
 
@@ -127,9 +126,8 @@ def compile_task(system: RobotSystem | str, initial_conditions: Sequence[str] | 
     custom_formulas = _parse_custom_ltl(custom_ltl)
     mentioned, sensors = _items_mentioned(abstraction, custom_formulas)
     where = system.config_file
-    _check_goal_modes_reachable(abstraction, goals, initial_mode, where)
-
     pertinence = infer_pertinence(abstraction, initial_mode, initial_conditions, goals, mentioned)
+    unreachable = _unreachable_modes(abstraction, pertinence)
     parts, groups = _sub_specifications(abstraction, pertinence, initial_conditions, goals, sm_outcomes,
                                         strict_order)
     groups += _custom_groups(custom_formulas)
@@ -143,8 +141,18 @@ def compile_task(system: RobotSystem | str, initial_conditions: Sequence[str] | 
     _check_custom_scopes(spec, custom_ltl)
     provenance = task_provenance(system.name, abstraction, where, initial_conditions, goals, sm_outcomes, strict_order,
                                  pertinence, tuple(s for s in SECTIONS if custom_ltl and custom_ltl.get(s)),
-                                 groups)
-    return CompiledSpecification(**_spec_fields(spec), provenance=provenance)
+                                 groups, _flexbe_states(system))
+    compiled = CompiledSpecification(**_spec_fields(spec), provenance=provenance)
+    if unreachable:
+        raise _impossible_goals(compiled, *unreachable[0])
+    return compiled
+
+
+def _flexbe_states(system: RobotSystem) -> dict:
+    """The ``flexbe.states`` section of the system file (empty without one): it names the states
+    and outcomes of a diagnosis' play."""
+    states = system.section('flexbe').get('states') if system.has_section('flexbe') else None
+    return states if isinstance(states, dict) else {}
 
 
 def _spec_fields(spec: GR1Specification) -> dict:
@@ -284,15 +292,29 @@ def _check_initial_conditions(abstraction: RobotAbstraction, initial_conditions)
     return list(dict.fromkeys(names))
 
 
-def _check_goal_modes_reachable(abstraction: RobotAbstraction, goals: list[str], initial_mode: str | None,
-                                where: str) -> None:
-    """A goal whose mode no route from the initial mode reaches, in the sentence every channel
-    shows (the one the GUI's form and the pre-check use, naming the missing transition)."""
+def _unreachable_modes(abstraction: RobotAbstraction, pertinence: Pertinence) -> list[tuple[str, str]]:
+    """(mode, sentence) for each needed mode that no route from the initial mode reaches: such a
+    task is refused before synthesis (``_impossible_goals``)."""
+    initial_mode = pertinence.initial_mode
     if initial_mode is None:
-        return
-    unreachable = unreachable_goal_modes(abstraction, goals, initial_mode, strict_order=False, where=where)
-    if unreachable:
-        raise InvalidGoalsError(unreachable[0].sentence, item=unreachable[0].item)
+        return []
+    reachable = mode_distances(abstraction.control_modes, initial_mode)
+    return [(mode, f'control mode {mode!r} ({pertinence.reasons[mode]}) cannot be reached from the '
+                   f'initial mode {initial_mode!r} on {abstraction.system}')
+            for mode in pertinence.modes if mode not in reachable]
+
+
+def _impossible_goals(spec: CompiledSpecification, mode: str, sentence: str) -> ImpossibleGoalsError:
+    """The refusal of a task whose ``mode`` no route reaches: INVALID_GOALS, with the diagnosis
+    that synthesis would have given (the pre-check's sentence, the core, the environment play),
+    so every channel tells one story whichever stage finds the impossibility. ``sentence`` leads
+    when the pre-check names no goal (a mode needed by a precondition's precondition, or one
+    that custom LTL mentions)."""
+    from ltl_specification.diagnosis import refusal_diagnosis  # the diagnosis reads this module's systems
+
+    diagnosis = refusal_diagnosis(spec, sentence)
+    item = diagnosis.findings[0].item if diagnosis.findings else mode
+    return ImpossibleGoalsError(diagnosis.message(), item=item, diagnosis=diagnosis)
 
 
 def _initial_mode(abstraction: RobotAbstraction, initial_conditions: list[str]) -> str | None:

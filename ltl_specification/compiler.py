@@ -44,8 +44,8 @@ from dataclasses import dataclass, field, fields
 from pathlib import Path
 from typing import Mapping, Sequence
 
-from respec.robot import RobotSystem, robot_system
-from respec.robot.abstraction import AbstractionConfigError, RobotAbstraction
+from respec.robot import RobotSystem
+from respec.robot.abstraction import RobotAbstraction
 from respec.components import (
     SOURCE_CUSTOM, FormulaGroup, action_groups, action_specification, control_mode_groups,
     control_mode_specification, goal_groups, goal_specification, initial_conditions_groups,
@@ -61,16 +61,17 @@ from respec.spec import (
     merge_specifications,
 )
 from respec.robot.state_library import StateClass, workspace_state_library
-from respec.robot.files import ConfigFileInvalidError, SystemNotFoundError
 
 from ltl_specification.capabilities import compile_capability_task
 from ltl_specification.capability_precheck import check_capability_names, check_capability_task
+from ltl_specification.diagnosis import refusal_diagnosis
 from ltl_specification.errors import (
-    ImpossibleGoalsError, InvalidAbstractionError, InvalidFormulaError, InvalidGoalsError,
-    InvalidInitialConditionsError, InvalidSmOutcomesError, UnknownPropositionError, UnknownSystemError,
+    ImpossibleGoalsError, InvalidFormulaError, InvalidGoalsError, InvalidInitialConditionsError,
+    InvalidSmOutcomesError, UnknownPropositionError,
 )
 from ltl_specification.pertinence import Pertinence, infer_pertinence, mode_distances
 from ltl_specification.provenance import Provenance, task_provenance
+from ltl_specification.systems import load_task_abstraction, load_task_system
 
 SUPPORTED_SM_OUTCOMES = (DEFAULT_SM_OUTCOMES, (FINISHED,))
 
@@ -218,25 +219,6 @@ def explain(spec: CompiledSpecification) -> str:
 
 # --- request validation ---------------------------------------------------------------------
 
-def load_task_system(system: RobotSystem | str, config_dir=None) -> RobotSystem:
-    """The task's robot system, with the compiler's codes for an unknown or invalid one."""
-    try:
-        return robot_system(system, config_dir)
-    except SystemNotFoundError as error:
-        raise UnknownSystemError(str(error), item=error.item) from error
-    except (AbstractionConfigError, ConfigFileInvalidError) as error:
-        raise InvalidAbstractionError(str(error), item=error.item) from error
-
-
-def load_task_abstraction(system: RobotSystem | str, config_dir=None) -> RobotAbstraction:
-    """The abstraction of an abstraction-kind system (as ``load_task_system``)."""
-    system = load_task_system(system, config_dir)
-    try:
-        return system.required_abstraction()
-    except AbstractionConfigError as error:
-        raise InvalidAbstractionError(str(error), item=error.item) from error
-
-
 def _names(value: Sequence[str] | str | None, what: str, error) -> list[str]:
     if value is None:
         return []
@@ -310,8 +292,6 @@ def _impossible_goals(spec: CompiledSpecification, mode: str, sentence: str) -> 
     so every channel tells one story whichever stage finds the impossibility. ``sentence`` leads
     when the pre-check names no goal (a mode needed by a precondition's precondition, or one
     that custom LTL mentions)."""
-    from ltl_specification.diagnosis import refusal_diagnosis  # the diagnosis reads this module's systems
-
     diagnosis = refusal_diagnosis(spec, sentence)
     item = diagnosis.findings[0].item if diagnosis.findings else mode
     return ImpossibleGoalsError(diagnosis.message(), item=item, diagnosis=diagnosis)

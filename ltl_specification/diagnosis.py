@@ -37,7 +37,7 @@ from ltl_synthesizer.interrupt import Limits
 from ltl_synthesizer.unrealizable_core import environment_play, unrealizable_core
 
 from ltl_specification.capability_precheck import capability_file, unreachable_goals
-from ltl_specification.compiler import load_task_abstraction, load_task_system
+from ltl_specification.systems import load_task_abstraction, load_task_system
 from ltl_specification.provenance import Provenance
 from ltl_specification.reachability import Finding, unreachable_goal_modes
 

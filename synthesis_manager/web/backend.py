@@ -15,7 +15,7 @@ from pathlib import Path
 from typing import Callable
 
 from ltl_specification.diagnosis import goal_findings, impossible_next_goals
-from ltl_specification.compiler import load_task_abstraction
+from ltl_specification.systems import load_task_abstraction
 from respec.errors import INTERNAL_ERROR, CodedError, ErrorCode, quoted
 from respec.naming import DEFAULT_SM_OUTCOMES, FINISHED
 from respec.robot import RobotSystem, SystemCatalog

@@ -45,7 +45,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument('--explain', action='store_true', help='also print why each item is included (stderr)')
     parser.add_argument('--diagnose', action='store_true',
                         help='also check realizability; if the task cannot be done, say why on stderr '
-                             '(pre-check, unrealizable core, environment play) and exit with status 1')
+                             '(pre-check, unrealizable core, environment play) and exit with status 1; '
+                             'if it can, warn when the controller could win by forcing the environment '
+                             'to break its assumptions (not well-separated)')
 
 
 def run(args: argparse.Namespace) -> int:
@@ -82,6 +84,11 @@ def run(args: argparse.Namespace) -> int:
         if diagnosis is not None:
             print(f'SPEC_UNSYNTHESIZABLE: {diagnosis.message()}', file=sys.stderr)
             return ExitStatus.FAILED
+        from ltl_synthesizer.well_separation import well_separation_warning
+
+        warning = well_separation_warning(spec)   # realizable: but by cheating?
+        if warning:
+            print(warning, file=sys.stderr)
     return ExitStatus.OK
 
 

@@ -64,7 +64,7 @@ from respec.robot.state_library import StateClass, workspace_state_library
 
 from ltl_specification.capabilities import compile_capability_task
 from ltl_specification.capability_precheck import check_capability_names, check_capability_task
-from ltl_specification.diagnosis import refusal_diagnosis
+from ltl_specification.diagnosis import REFUSAL_DIAGNOSIS_SECONDS, refusal_diagnosis
 from ltl_specification.errors import (
     ImpossibleGoalsError, InvalidFormulaError, InvalidGoalsError, InvalidInitialConditionsError,
     InvalidSmOutcomesError, UnknownPropositionError,
@@ -90,7 +90,8 @@ def compile_task(system: RobotSystem | str, initial_conditions: Sequence[str] | 
                  sm_outcomes: Sequence[str] = DEFAULT_SM_OUTCOMES, strict_order: bool = True,
                  custom_ltl: Mapping[str, Sequence[str]] | None = None,
                  config_dir: str | Path | None = None,
-                 state_library: Mapping[str, StateClass] | None = None) -> CompiledSpecification:
+                 state_library: Mapping[str, StateClass] | None = None,
+                 explain_refusal: bool = True) -> CompiledSpecification:
     """Compile the GR(1) specification of reaching ``goals`` from ``initial_conditions``.
 
     ``system`` is a RobotSystem, or the name of one in ``config_dir`` (default ``config/``).
@@ -107,7 +108,12 @@ def compile_task(system: RobotSystem | str, initial_conditions: Sequence[str] | 
     one, the system's ``initial_mode`` is used. ``strict_order`` selects (20) over (17).
     ``custom_ltl`` maps LTLSpecification section names to infix formulas (or, for
     env_props / sys_props, new proposition names) that are conjoined to the result.
-    Raises a ``SpecificationError`` subclass naming the offending item.
+    Raises a ``SpecificationError`` subclass naming the offending item. A goal mode (or a mode
+    custom LTL names) that no route from the initial mode reaches is refused before synthesis
+    (INVALID_GOALS, ``ImpossibleGoalsError``) with the diagnosis synthesis would give (sentence,
+    unrealizable core, environment play; ``ltl_specification.diagnosis.refusal_diagnosis``,
+    up to its REFUSAL_DIAGNOSIS_SECONDS); ``explain_refusal=False`` refuses with the sentence
+    alone, at once (for callers that only need the verdict).
     """
     system = load_task_system(system, config_dir)
     if system.is_capability_system:
@@ -145,7 +151,7 @@ def compile_task(system: RobotSystem | str, initial_conditions: Sequence[str] | 
                                  groups, _flexbe_states(system))
     compiled = CompiledSpecification(**_spec_fields(spec), provenance=provenance)
     if unreachable:
-        raise _impossible_goals(compiled, *unreachable[0])
+        raise _impossible_goals(compiled, *unreachable[0], explain=explain_refusal)
     return compiled
 
 
@@ -286,13 +292,14 @@ def _unreachable_modes(abstraction: RobotAbstraction, pertinence: Pertinence) ->
             for mode in pertinence.modes if mode not in reachable]
 
 
-def _impossible_goals(spec: CompiledSpecification, mode: str, sentence: str) -> ImpossibleGoalsError:
+def _impossible_goals(spec: CompiledSpecification, mode: str, sentence: str,
+                      explain: bool = True) -> ImpossibleGoalsError:
     """The refusal of a task whose ``mode`` no route reaches: INVALID_GOALS, with the diagnosis
     that synthesis would have given (the pre-check's sentence, the core, the environment play),
     so every channel tells one story whichever stage finds the impossibility. ``sentence`` leads
     when the pre-check names no goal (a mode needed by a precondition's precondition, or one
     that custom LTL mentions)."""
-    diagnosis = refusal_diagnosis(spec, sentence)
+    diagnosis = refusal_diagnosis(spec, sentence, seconds=REFUSAL_DIAGNOSIS_SECONDS if explain else 0.0)
     item = diagnosis.findings[0].item if diagnosis.findings else mode
     return ImpossibleGoalsError(diagnosis.message(), item=item, diagnosis=diagnosis)
 

@@ -290,11 +290,15 @@ def refusal_diagnosis(spec: GR1Specification, sentence: str,
                       seconds: float = REFUSAL_DIAGNOSIS_SECONDS) -> Diagnosis:
     """The diagnosis of a compiled task that the compiler refuses (a mode no route reaches): the
     sentence, core and play that synthesis would lead with, within ``seconds``; ``sentence``
-    leads when the pre-check names nothing."""
-    diagnosis = diagnose(spec, limits=Limits(deadline=time.monotonic() + seconds))
+    leads when the pre-check names nothing. ``seconds`` 0: the pre-check alone (no core, no play)."""
     sentence = sentence[0].upper() + sentence[1:] + '.'
-    if diagnosis is None:  # realizable all the same (a mode only custom LTL names): the refusal stands
-        return Diagnosis(sentence)
+    if seconds > 0:
+        diagnosis = diagnose(spec, limits=Limits(deadline=time.monotonic() + seconds))
+        if diagnosis is None:  # realizable all the same (a mode only custom LTL names): the refusal stands
+            return Diagnosis(sentence)
+    else:
+        findings = precheck(spec)
+        diagnosis = Diagnosis(findings[0].sentence if findings else '', findings)
     if not diagnosis.findings:
         diagnosis.sentence = sentence
     return diagnosis

@@ -37,6 +37,13 @@ def test_in_any_order_the_refusal_leads_with_the_any_order_sentence():
     assert 'How the environment wins' in str(refused.value)
 
 
+def test_a_refusal_without_explanation_is_the_sentence_alone_and_immediate():
+    with pytest.raises(ImpossibleGoalsError) as refused:
+        compile_task('atlas', ['step'], ['stand_prep', 'pregrasp'], explain_refusal=False)
+    assert str(refused.value) == goal_findings('atlas', ['step'], ['stand_prep', 'pregrasp'])[0].sentence
+    assert refused.value.diagnosis.core == [] and refused.value.diagnosis.play == []
+
+
 def test_a_mode_only_custom_ltl_needs_is_refused_with_its_own_sentence_and_the_diagnosis():
     with pytest.raises(InvalidGoalsError) as refused:
         compile_task('atlas', ['stand'], ['look_down'], custom_ltl={'sys_trans': ['!stand_prep_a']})

@@ -78,15 +78,13 @@ def run(args: argparse.Namespace) -> int:
     if args.explain:
         print(explain(spec), file=sys.stderr)
     if args.diagnose:
-        from ltl_specification.diagnosis import diagnose
+        from ltl_specification.diagnosis import diagnose, explain_well_separation
 
         diagnosis = diagnose(spec)
         if diagnosis is not None:
             print(f'SPEC_UNSYNTHESIZABLE: {diagnosis.message()}', file=sys.stderr)
             return ExitStatus.FAILED
-        from ltl_synthesizer.well_separation import well_separation_warning
-
-        warning = well_separation_warning(spec)   # realizable: but by cheating?
+        warning = explain_well_separation(spec)   # realizable: but by cheating?
         if warning:
             print(warning, file=sys.stderr)
     return ExitStatus.OK

@@ -35,6 +35,7 @@ from ltl_synthesizer.errors import SynthesisCancelledError
 from ltl_synthesizer.explanation import without_play
 from ltl_synthesizer.interrupt import Limits
 from ltl_synthesizer.unrealizable_core import environment_play, unrealizable_core
+from ltl_synthesizer.well_separation import check_well_separation
 
 from ltl_specification.capability_precheck import capability_file, unreachable_goals
 from ltl_specification.systems import load_task_abstraction, load_task_system
@@ -303,6 +304,27 @@ def refusal_diagnosis(spec: GR1Specification, sentence: str,
         diagnosis.sentence = sentence
     return diagnosis
 
+
+
+def explain_well_separation(spec: GR1Specification, provenance: Provenance | None = None,
+                            limits: Limits = Limits()) -> str:
+    """The warning for a realizable ``spec`` whose controller can win by forcing the environment
+    to break its assumptions ('' when it cannot; ``ltl_synthesizer.well_separation``), naming each
+    assumption as the core names a requirement (paper equation, configuration entry, formula)
+    when ``provenance`` (default: the spec's own) records it."""
+    report = check_well_separation(spec, limits)
+    provenance = provenance or getattr(spec, 'provenance', None)
+    if report.well_separated or provenance is None:
+        return report.warning()
+    return report.warning([_assumption_line(spec, provenance, section, index) for section, index in report.involved])
+
+
+def _assumption_line(spec: GR1Specification, provenance: Provenance, section: str, index: int) -> str:
+    formula = getattr(spec, section)[index]
+    group = next((g for g in provenance.groups if g.section == section and formula in g.formulas), None)
+    if group is None:
+        return f'{section} #{index}: {to_infix(formula)}'
+    return CoreEntry(group.equation, group.title, group.item, provenance.origin(group), [to_infix(formula)]).line()
 
 
 def explain_unsynthesizable(details: str, spec: GR1Specification, provenance: Provenance | None,

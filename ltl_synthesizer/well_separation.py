@@ -52,17 +52,20 @@ class WellSeparation:
     well_separated: bool
     assumptions: list[str] = field(default_factory=list)
     cheating_initial_positions: int = 0
+    involved: list[tuple[str, int]] = field(default_factory=list)   # (section, index) of each assumption
 
     def summary(self) -> str:
         """The check's answer in one line, either way (what ``gr1synth --check-well-separation`` prints)."""
         return self.warning() or ('Well-separated: the system cannot force the environment to break '
                                   'its assumptions.')
 
-    def warning(self) -> str:
-        """One sentence for users ('' when well-separated)."""
+    def warning(self, names: list[str] | None = None) -> str:
+        """One sentence for users ('' when well-separated); ``names``: the assumptions as a
+        caller knows them (e.g. by paper equation and configuration entry), in ``involved``'s
+        order, instead of by section and index."""
         if self.well_separated:
             return ''
-        named = '; '.join(self.assumptions)
+        named = '; '.join(names or self.assumptions)
         return ('Warning: the controller can win by forcing the environment to break its assumptions '
                 f'(the specification is not well-separated): the system can force a violation of {named}. '
                 'A controller synthesized from it may meet its goals only by cheating; weaken or correct '
@@ -129,7 +132,8 @@ def check_well_separation(spec: GR1Specification, limits: Limits = Limits(),
         return WellSeparation(True)
     count = int(game.bdd.count(cheating, nvars=len(game.variables))) if game.variables else 1
     involved = _involved_assumptions(spec, limits)
-    return WellSeparation(False, [_assumption_text(spec, section, index) for section, index in involved], count)
+    return WellSeparation(False, [_assumption_text(spec, section, index) for section, index in involved], count,
+                          involved)
 
 
 def _forces_violation(spec: GR1Specification, kept: list[tuple[str, int]], limits: Limits) -> bool:
@@ -160,9 +164,3 @@ def _involved_assumptions(spec: GR1Specification, limits: Limits) -> list[tuple[
 
 def _assumption_text(spec: GR1Specification, section: str, index: int) -> str:
     return f"{section} #{index} '{to_infix(getattr(spec, section)[index])}'"
-
-
-def well_separation_warning(spec: GR1Specification, limits: Limits = Limits()) -> str:
-    """The warning for a realizable ``spec`` that is not well-separated ('' if it is): what the
-    synthesis node adds to its answer (a plain function of plain data, for a child process)."""
-    return check_well_separation(spec, limits).warning()

@@ -15,13 +15,12 @@ import uuid
 from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.node import Node
 
-from ltl_specification.diagnosis import explain_unsynthesizable
+from ltl_specification.diagnosis import explain_unsynthesizable, explain_well_separation
 from ltl_specification.provenance import provenance_from_json
 from ltl_synthesizer import Limits, SynthesisCancelledError, SynthesisError
 from ltl_synthesizer.external import run_external_synthesizer
 from ltl_synthesizer.isolated import SERVER_CHILD_NICENESS, SynthesisProcesses
 from ltl_synthesizer.strategy import strategy_to_json
-from ltl_synthesizer.well_separation import well_separation_warning
 from respec.automaton import automaton_from_strategy
 from respec.errors import ErrorCode
 from respec.parsing import ParseError, spec_from_text_sections
@@ -39,7 +38,7 @@ BACKENDS = ('builtin', 'slugs')
 # What explains an unrealizable specification (run in a synthesis child process; a module-level
 # name so that tests can put a stand-in there).
 DIAGNOSIS = explain_unsynthesizable
-WELL_SEPARATION = well_separation_warning
+WELL_SEPARATION = explain_well_separation
 DIAGNOSIS_GRACE = 1.0  # seconds past its own time limit before the diagnosis process is killed
 
 
@@ -222,8 +221,8 @@ class LTLSynthesisNode(Node):
             return ''
         limits = Limits(deadline=check_deadline, memory_limit=self.parameter('memory_limit_mb') * 2**20)
         try:
-            return self.synthesis_processes.call(WELL_SEPARATION, (spec, limits), cancel=cancel,
-                                                 deadline=check_deadline + DIAGNOSIS_GRACE)
+            return self.synthesis_processes.call(WELL_SEPARATION, (spec, self._provenance(request), limits),
+                                                 cancel=cancel, deadline=check_deadline + DIAGNOSIS_GRACE)
         except SynthesisError as error:
             if cancel.is_set():
                 raise SynthesisCancelledError('cancelled') from None
@@ -237,12 +236,8 @@ class LTLSynthesisNode(Node):
         child process, with the memory limit, and ends by diagnosis_timeout and before the
         request's time limit; without an answer by then the verdict stands with ``details``.
         A cancel raises SynthesisCancelledError."""
-        if not request.provenance:
-            return details
-        try:
-            provenance = provenance_from_json(request.provenance)
-        except ValueError as error:
-            self.get_logger().warning(f'request.provenance ignored (no diagnosis): {error!r}'[:300])
+        provenance = self._provenance(request)
+        if provenance is None:
             return details
         limit = request.diagnosis_timeout or self.parameter('diagnosis_timeout')
         diagnosis_deadline = min(time.monotonic() + limit, deadline - DIAGNOSIS_GRACE)
@@ -258,6 +253,16 @@ class LTLSynthesisNode(Node):
             if cancel.is_set():
                 raise SynthesisCancelledError('cancelled') from None
             return details  # out of time, or its process died: the verdict stands without it
+
+    def _provenance(self, request):
+        """The request's provenance (None without one, or when it cannot be read: logged)."""
+        if not request.provenance:
+            return None
+        try:
+            return provenance_from_json(request.provenance)
+        except ValueError as error:
+            self.get_logger().warning(f'request.provenance ignored (no diagnosis): {error!r}'[:300])
+            return None
 
     @staticmethod
     def _stopped(response, reason: str, timeout: float):

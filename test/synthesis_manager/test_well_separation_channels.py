@@ -78,12 +78,25 @@ def test_the_warning_reaches_every_channel_and_the_machine_is_still_made(ros, tm
     assert (outcome['error_name'], outcome['message']) == ('SUCCESS', warning)   # the banner's text
 
 
-def test_a_well_separated_task_succeeds_without_a_message(ros, tmp_path):
+def test_custom_ltl_assumptions_are_named_as_the_core_names_them_and_honest_tasks_get_no_message(ros, tmp_path):
     from rclpy.node import Node
 
-    for factory in suite_node_factories(suite_args(tmp_path)):
+    custom = tmp_path / 'custom.yaml'
+    custom.write_text('env_trans:\n  - "look_down_a -> !next(look_down_c)"\n')
+    compiled = subprocess.run([sys.executable, '-m', 'synthesis_manager', 'compile', '--system', 'atlas',
+                               '--initial-conditions', 'stand', '--goals', 'look_down', '--sm-outcomes', 'finished',
+                               '--custom-ltl', str(custom), '--diagnose', '-o', os.devnull],
+                              capture_output=True, text=True, timeout=120)
+    warning = compiled.stderr.strip()
+    assert 'custom LTL env_trans[0] (request custom LTL)' in warning and 'eq. (7) completion fairness' in warning
+
+    for factory in suite_node_factories(suite_args(tmp_path / 'byproducts')):
         ros.add_node(factory)
     client = SynthesisClient(ros.add_node(Node, 'honest_client'), 'behavior_synthesis')
     assert client.wait_for_server(timeout=10.0)
-    result = client.run(make_goal('atlas', ['stand_prep'], ['look_down', 'pickup_object']), timeout=120)
-    assert (result.error_name, result.message) == ('SUCCESS', '')
+    cheating = client.run(make_goal('atlas', ['stand'], ['look_down'], sm_outcomes=['finished'],
+                                    ltl_specification={'env_trans': ['look_down_a -> !next(look_down_c)']}),
+                          timeout=120)
+    assert (cheating.error_name, cheating.message) == ('SUCCESS', warning)  # named from the provenance
+    honest = client.run(make_goal('atlas', ['stand_prep'], ['look_down', 'pickup_object']), timeout=120)
+    assert (honest.error_name, honest.message) == ('SUCCESS', '')

@@ -330,11 +330,9 @@ def _assumption_line(spec: GR1Specification, provenance: Provenance, section: st
 def explain_unsynthesizable(details: str, spec: GR1Specification, provenance: Provenance | None,
                             robotics_semantics: bool = True, limits: Limits = Limits()) -> str:
     """The SPEC_UNSYNTHESIZABLE message for ``spec``: the diagnosis first, then ``details``
-    (the synthesizer's own explanation). Never raises: without a provenance (a specification
-    that was not compiled from a task), or if it cannot be diagnosed, ``details`` are returned
-    unchanged."""
-    if provenance is None:
-        return details
+    (the synthesizer's own explanation). Without a provenance (a specification given whole, a
+    CNU capability robot's) the core is told by section and index (``formula_groups``). Never
+    raises: if it cannot be diagnosed, ``details`` are returned unchanged."""
     try:
         diagnosis = diagnose(spec, robotics_semantics, limits, provenance)
     except Exception:  # the diagnosis is a help; the synthesizer's verdict stands without it

@@ -231,14 +231,12 @@ class LTLSynthesisNode(Node):
 
     def _diagnosed(self, details: str, spec, request, robotics_semantics: bool, cancel: threading.Event,
                    deadline: float) -> str:
-        """``details`` (the synthesizer's explanation), led by why the task cannot be done when
-        the request carries the specification's provenance. The diagnosis runs in a synthesis
-        child process, with the memory limit, and ends by diagnosis_timeout and before the
-        request's time limit; without an answer by then the verdict stands with ``details``.
-        A cancel raises SynthesisCancelledError."""
+        """``details`` (the synthesizer's explanation), led by why the task cannot be done: in
+        the task's terms when the request carries the specification's provenance, else by its
+        formulas. The diagnosis runs in a synthesis child process, with the memory limit, and
+        ends by diagnosis_timeout and before the request's time limit; without an answer by then
+        the verdict stands with ``details``. A cancel raises SynthesisCancelledError."""
         provenance = self._provenance(request)
-        if provenance is None:
-            return details
         limit = request.diagnosis_timeout or self.parameter('diagnosis_timeout')
         diagnosis_deadline = min(time.monotonic() + limit, deadline - DIAGNOSIS_GRACE)
         if diagnosis_deadline <= time.monotonic():

@@ -315,7 +315,7 @@ class BehaviorSynthesisServer(Node):
             provenance = compiled.provenance
             if utf8_length(provenance) > MAX_STRING_BYTES:  # the synthesizer would refuse the request
                 self.get_logger().warning(f'the provenance of {spec_name} ({utf8_length(provenance)} bytes) is '
-                                          'not sent: an unrealizable specification is not diagnosed')
+                                          'not sent: an unrealizable specification is diagnosed by its formulas only')
                 provenance = ''
             feedback('Compiled the LTL specification', 1 / 3)
             if task.option == 'ltl_compilation_only':

@@ -124,3 +124,19 @@ def test_a_goal_no_capability_makes_true_is_named_up_front_in_every_channel(chan
     assert (result.error_name, result.message) == ('INVALID_GOALS', COMPILATION_FAILED + sentence)
     cnu = channels.cnus.run(make_flexbe_goal('delivery_rover', [], ['charge']), timeout=120)
     assert cnu.message == f'INVALID_GOALS: {COMPILATION_FAILED}{sentence}'
+
+
+def test_a_specification_given_whole_is_diagnosed_by_its_formulas(channels):
+    from ltl_specification.diagnosis import diagnose
+    from respec.parsing import spec_from_text_sections
+
+    sections = {'env_props': ['door_open'], 'sys_props': ['inside'], 'env_trans': ['!next(door_open)'],
+                'sys_trans': ['next(inside) -> next(door_open)'], 'sys_liveness': ['inside']}
+    result = channels.ours.run(make_goal('atlas', [], [], option='ltl_synthesis_only', ltl_specification=sections),
+                               timeout=120)
+    assert result.error_name == 'SPEC_UNSYNTHESIZABLE'
+    offline = diagnose(spec_from_text_sections({**{s: [] for s in ('env_init', 'sys_init', 'env_liveness')},
+                                                **sections}))
+    assert diagnosis_part(result.message) == offline.message()
+    assert 'formula sys_trans[0] (the specification): next(inside) -> next(door_open)' in result.message
+    assert PLAY_HEADING in result.message and 'Details from the synthesizer' in result.message

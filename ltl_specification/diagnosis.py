@@ -14,6 +14,14 @@ groups, each mapped to its paper equation and the configuration entry or request
 produced it, and a short environment play told in words. ``Diagnosis.message`` leads with one
 plain sentence; the details follow.
 
+One diagnosis serves every channel, whichever stage finds the impossibility: the compiler
+refuses a goal mode no route reaches (INVALID_GOALS) with ``refusal_diagnosis`` of the
+specification it compiled, the synthesis node leads SPEC_UNSYNTHESIZABLE with ``diagnose``
+(``explain_unsynthesizable``, the synthesizer's own play left out), and the GUI's form shows
+the pre-check's sentence (``goal_findings``, capability robots included). A specification
+without provenance is diagnosed by its formulas (``formula_groups``). A realizable one is
+checked for winning by cheating (``explain_well_separation``).
+
 The pre-check and the diagnosis read only the specification and its provenance
 (``ltl_specification.provenance``: the compiler puts there everything that needs the robot
 configuration), so whoever holds a specification diagnoses it with its own settings: the
@@ -223,7 +231,7 @@ def _exists(names: set[str], holds) -> bool | None:
 def diagnose(spec: GR1Specification, robotics_semantics: bool = True, limits: Limits = Limits(),
              provenance: Provenance | None = None) -> Diagnosis | None:
     """Why ``spec`` is unrealizable; None if it is realizable. ``provenance`` is what it was
-    compiled from (default: its own ``provenance``).
+    compiled from (default: its own ``provenance``; without one, by its formulas).
 
     When ``limits`` stop the core search (a cancel, the deadline), the pre-check's findings
     are still returned and the note says the core was not computed.
@@ -303,7 +311,6 @@ def refusal_diagnosis(spec: GR1Specification, sentence: str,
     if not diagnosis.findings:
         diagnosis.sentence = sentence
     return diagnosis
-
 
 
 def explain_well_separation(spec: GR1Specification, provenance: Provenance | None = None,

@@ -100,7 +100,7 @@ def unreachable_goals(system: RobotSystem, initial_conditions: Sequence[str],
         errors.append(InvalidGoalsError(
             f'Goal {goal!r} can never be reached: no capability sets {_value_words(literal)} and it '
             f'{_initially_words(literal, initial)}; add {_term_text(literal)!r} to the '
-            f'postconditions of the capability that achieves it in {_capability_file(system)}, or change the '
+            f'postconditions of the capability that achieves it in {capability_file(system)}, or change the '
             "request's goals.", item=goal))
     return errors
 
@@ -121,7 +121,7 @@ def unestablished_preconditions(system: RobotSystem,
                                 f'{_initially_words(term, initial)}' for term in clause)
             errors.append(CapabilityConfigError(
                 f'Capability {name!r} can never start: nothing establishes its precondition {entry!r} ({reasons}); '
-                f'change {name}.preconditions or add a postcondition that sets it in {_capability_file(system)}.',
+                f'change {name}.preconditions or add a postcondition that sets it in {capability_file(system)}.',
                 item=f'{name}.preconditions'))
     return errors
 
@@ -201,7 +201,7 @@ def _initial_entries(system: RobotSystem, initial_conditions: Sequence[str]) -> 
     return entries + [(text, REQUEST_INITIAL_CONDITIONS) for text in initial_conditions]
 
 
-def _capability_file(system: RobotSystem) -> str:
+def capability_file(system: RobotSystem) -> str:
     """The capability file as the system file names it (where pre- and postconditions are)."""
     return str(system.sections.get(CAPABILITIES_KEY) or system.config_file)
 

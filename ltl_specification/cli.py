@@ -35,7 +35,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument('--explain', action='store_true', help='also print why each item is included (stderr)')
     parser.add_argument('--diagnose', action='store_true',
                         help='also check realizability; if the task cannot be done, say why on stderr '
-                             '(pre-check, unrealizable core, environment play) and exit with status 1')
+                             '(pre-check, unrealizable core, environment play) and exit with status 1; '
+                             'if it can, warn when the controller could win by forcing the environment '
+                             'to break its assumptions (not well-separated)')
 
 
 def add_task_arguments(parser: argparse.ArgumentParser) -> None:
@@ -61,8 +63,12 @@ def run(args: argparse.Namespace) -> int:
                             sm_outcomes=parse_names(args.sm_outcomes), strict_order=not args.unordered,
                             custom_ltl=custom_ltl, config_dir=args.config_dir)
     except SpecificationError as error:
-        message = ' '.join(str(error).split())
+        # One line naming the code and the item; a refusal's diagnosis (core, play) follows it.
+        sentence, _, diagnosis = str(error).partition('\n')
+        message = ' '.join(sentence.split())
         print(f'error: {error.code}: {message} [item: {error.item!r}]', file=sys.stderr)
+        if getattr(error, 'diagnosis', None) is not None:
+            print(diagnosis.rstrip('\n'), file=sys.stderr)
         return ExitStatus.FAILED
     if args.format == 'json':
         text = json.dumps(spec.to_text_sections(), indent=2) + '\n'
@@ -77,12 +83,15 @@ def run(args: argparse.Namespace) -> int:
     if args.explain:
         print(explain(spec), file=sys.stderr)
     if args.diagnose:
-        from ltl_specification.diagnosis import diagnose
+        from ltl_specification.diagnosis import diagnose, explain_well_separation
 
         diagnosis = diagnose(spec)
         if diagnosis is not None:
             print(f'SPEC_UNSYNTHESIZABLE: {diagnosis.message()}', file=sys.stderr)
             return ExitStatus.FAILED
+        warning = explain_well_separation(spec)   # realizable: but by cheating?
+        if warning:
+            print(warning, file=sys.stderr)
     return ExitStatus.OK
 
 

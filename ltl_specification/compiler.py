@@ -44,8 +44,8 @@ from dataclasses import dataclass, field, fields
 from pathlib import Path
 from typing import Mapping, Sequence
 
-from respec.robot import RobotSystem, robot_system
-from respec.robot.abstraction import AbstractionConfigError, RobotAbstraction
+from respec.robot import RobotSystem
+from respec.robot.abstraction import RobotAbstraction
 from respec.components import (
     SOURCE_CUSTOM, FormulaGroup, action_groups, action_specification, control_mode_groups,
     control_mode_specification, goal_groups, goal_specification, initial_conditions_groups,
@@ -61,17 +61,17 @@ from respec.spec import (
     merge_specifications,
 )
 from respec.robot.state_library import StateClass, workspace_state_library
-from respec.robot.files import ConfigFileInvalidError, SystemNotFoundError
 
 from ltl_specification.capabilities import compile_capability_task
 from ltl_specification.capability_precheck import check_capability_names, check_capability_task
+from ltl_specification.diagnosis import REFUSAL_DIAGNOSIS_SECONDS, refusal_diagnosis
 from ltl_specification.errors import (
-    InvalidAbstractionError, InvalidFormulaError, InvalidGoalsError, InvalidInitialConditionsError,
-    InvalidSmOutcomesError, UnknownPropositionError, UnknownSystemError,
+    ImpossibleGoalsError, InvalidFormulaError, InvalidGoalsError, InvalidInitialConditionsError,
+    InvalidSmOutcomesError, UnknownPropositionError,
 )
-from ltl_specification.pertinence import Pertinence, infer_pertinence
+from ltl_specification.pertinence import Pertinence, infer_pertinence, mode_distances
 from ltl_specification.provenance import Provenance, task_provenance
-from ltl_specification.reachability import unreachable_goal_modes
+from ltl_specification.systems import load_task_abstraction, load_task_system
 
 SUPPORTED_SM_OUTCOMES = (DEFAULT_SM_OUTCOMES, (FINISHED,))
 
@@ -90,7 +90,8 @@ def compile_task(system: RobotSystem | str, initial_conditions: Sequence[str] | 
                  sm_outcomes: Sequence[str] = DEFAULT_SM_OUTCOMES, strict_order: bool = True,
                  custom_ltl: Mapping[str, Sequence[str]] | None = None,
                  config_dir: str | Path | None = None,
-                 state_library: Mapping[str, StateClass] | None = None) -> CompiledSpecification:
+                 state_library: Mapping[str, StateClass] | None = None,
+                 explain_refusal: bool = True) -> CompiledSpecification:
     """Compile the GR(1) specification of reaching ``goals`` from ``initial_conditions``.
 
     ``system`` is a RobotSystem, or the name of one in ``config_dir`` (default ``config/``).
@@ -107,7 +108,12 @@ def compile_task(system: RobotSystem | str, initial_conditions: Sequence[str] | 
     one, the system's ``initial_mode`` is used. ``strict_order`` selects (20) over (17).
     ``custom_ltl`` maps LTLSpecification section names to infix formulas (or, for
     env_props / sys_props, new proposition names) that are conjoined to the result.
-    Raises a ``SpecificationError`` subclass naming the offending item.
+    Raises a ``SpecificationError`` subclass naming the offending item. A goal mode (or a mode
+    custom LTL names) that no route from the initial mode reaches is refused before synthesis
+    (INVALID_GOALS, ``ImpossibleGoalsError``) with the diagnosis synthesis would give (sentence,
+    unrealizable core, environment play; ``ltl_specification.diagnosis.refusal_diagnosis``,
+    up to its REFUSAL_DIAGNOSIS_SECONDS); ``explain_refusal=False`` refuses with the sentence
+    alone, at once (for callers that only need the verdict).
     """
     system = load_task_system(system, config_dir)
     if system.is_capability_system:
@@ -127,9 +133,8 @@ def compile_task(system: RobotSystem | str, initial_conditions: Sequence[str] | 
     custom_formulas = _parse_custom_ltl(custom_ltl)
     mentioned, sensors = _items_mentioned(abstraction, custom_formulas)
     where = system.config_file
-    _check_goal_modes_reachable(abstraction, goals, initial_mode, where)
-
     pertinence = infer_pertinence(abstraction, initial_mode, initial_conditions, goals, mentioned)
+    unreachable = _unreachable_modes(abstraction, pertinence)
     parts, groups = _sub_specifications(abstraction, pertinence, initial_conditions, goals, sm_outcomes,
                                         strict_order)
     groups += _custom_groups(custom_formulas)
@@ -143,8 +148,18 @@ def compile_task(system: RobotSystem | str, initial_conditions: Sequence[str] | 
     _check_custom_scopes(spec, custom_ltl)
     provenance = task_provenance(system.name, abstraction, where, initial_conditions, goals, sm_outcomes, strict_order,
                                  pertinence, tuple(s for s in SECTIONS if custom_ltl and custom_ltl.get(s)),
-                                 groups)
-    return CompiledSpecification(**_spec_fields(spec), provenance=provenance)
+                                 groups, _flexbe_states(system))
+    compiled = CompiledSpecification(**_spec_fields(spec), provenance=provenance)
+    if unreachable:
+        raise _impossible_goals(compiled, *unreachable[0], explain=explain_refusal)
+    return compiled
+
+
+def _flexbe_states(system: RobotSystem) -> dict:
+    """The ``flexbe.states`` section of the system file (empty without one): it names the states
+    and outcomes of a diagnosis' play."""
+    states = system.section('flexbe').get('states') if system.has_section('flexbe') else None
+    return states if isinstance(states, dict) else {}
 
 
 def _spec_fields(spec: GR1Specification) -> dict:
@@ -210,25 +225,6 @@ def explain(spec: CompiledSpecification) -> str:
 
 # --- request validation ---------------------------------------------------------------------
 
-def load_task_system(system: RobotSystem | str, config_dir=None) -> RobotSystem:
-    """The task's robot system, with the compiler's codes for an unknown or invalid one."""
-    try:
-        return robot_system(system, config_dir)
-    except SystemNotFoundError as error:
-        raise UnknownSystemError(str(error), item=error.item) from error
-    except (AbstractionConfigError, ConfigFileInvalidError) as error:
-        raise InvalidAbstractionError(str(error), item=error.item) from error
-
-
-def load_task_abstraction(system: RobotSystem | str, config_dir=None) -> RobotAbstraction:
-    """The abstraction of an abstraction-kind system (as ``load_task_system``)."""
-    system = load_task_system(system, config_dir)
-    try:
-        return system.required_abstraction()
-    except AbstractionConfigError as error:
-        raise InvalidAbstractionError(str(error), item=error.item) from error
-
-
 def _names(value: Sequence[str] | str | None, what: str, error) -> list[str]:
     if value is None:
         return []
@@ -284,15 +280,28 @@ def _check_initial_conditions(abstraction: RobotAbstraction, initial_conditions)
     return list(dict.fromkeys(names))
 
 
-def _check_goal_modes_reachable(abstraction: RobotAbstraction, goals: list[str], initial_mode: str | None,
-                                where: str) -> None:
-    """A goal whose mode no route from the initial mode reaches, in the sentence every channel
-    shows (the one the GUI's form and the pre-check use, naming the missing transition)."""
+def _unreachable_modes(abstraction: RobotAbstraction, pertinence: Pertinence) -> list[tuple[str, str]]:
+    """(mode, sentence) for each needed mode that no route from the initial mode reaches: such a
+    task is refused before synthesis (``_impossible_goals``)."""
+    initial_mode = pertinence.initial_mode
     if initial_mode is None:
-        return
-    unreachable = unreachable_goal_modes(abstraction, goals, initial_mode, strict_order=False, where=where)
-    if unreachable:
-        raise InvalidGoalsError(unreachable[0].sentence, item=unreachable[0].item)
+        return []
+    reachable = mode_distances(abstraction.control_modes, initial_mode)
+    return [(mode, f'control mode {mode!r} ({pertinence.reasons[mode]}) cannot be reached from the '
+                   f'initial mode {initial_mode!r} on {abstraction.system}')
+            for mode in pertinence.modes if mode not in reachable]
+
+
+def _impossible_goals(spec: CompiledSpecification, mode: str, sentence: str,
+                      explain: bool = True) -> ImpossibleGoalsError:
+    """The refusal of a task whose ``mode`` no route reaches: INVALID_GOALS, with the diagnosis
+    that synthesis would have given (the pre-check's sentence, the core, the environment play),
+    so every channel tells one story whichever stage finds the impossibility. ``sentence`` leads
+    when the pre-check names no goal (a mode needed by a precondition's precondition, or one
+    that custom LTL mentions)."""
+    diagnosis = refusal_diagnosis(spec, sentence, seconds=REFUSAL_DIAGNOSIS_SECONDS if explain else 0.0)
+    item = diagnosis.findings[0].item if diagnosis.findings else mode
+    return ImpossibleGoalsError(diagnosis.message(), item=item, diagnosis=diagnosis)
 
 
 def _initial_mode(abstraction: RobotAbstraction, initial_conditions: list[str]) -> str | None:

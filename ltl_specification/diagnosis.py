@@ -14,6 +14,14 @@ groups, each mapped to its paper equation and the configuration entry or request
 produced it, and a short environment play told in words. ``Diagnosis.message`` leads with one
 plain sentence; the details follow.
 
+One diagnosis serves every channel, whichever stage finds the impossibility: the compiler
+refuses a goal mode no route reaches (INVALID_GOALS) with ``refusal_diagnosis`` of the
+specification it compiled, the synthesis node leads SPEC_UNSYNTHESIZABLE with ``diagnose``
+(``explain_unsynthesizable``, the synthesizer's own play left out), and the GUI's form shows
+the pre-check's sentence (``goal_findings``, capability robots included). A specification
+without provenance is diagnosed by its formulas (``formula_groups``). A realizable one is
+checked for winning by cheating (``explain_well_separation``).
+
 The pre-check and the diagnosis read only the specification and its provenance
 (``ltl_specification.provenance``: the compiler puts there everything that needs the robot
 configuration), so whoever holds a specification diagnoses it with its own settings: the
@@ -24,21 +32,28 @@ answer (``explain_unsynthesizable``).
 from __future__ import annotations
 
 import itertools
+import time
 from dataclasses import asdict, dataclass, field
 
 from respec.components import SOURCE_CUSTOM, FormulaGroup
 from respec.ltl import Formula, evaluate, mentions_next, to_infix, variables
 from respec.naming import activation
-from respec.spec import GR1Specification
+from respec.spec import FORMULA_SECTIONS, GR1Specification
 from ltl_synthesizer.errors import SynthesisCancelledError
+from ltl_synthesizer.explanation import without_play
 from ltl_synthesizer.interrupt import Limits
 from ltl_synthesizer.unrealizable_core import environment_play, unrealizable_core
+from ltl_synthesizer.well_separation import check_well_separation
 
-from ltl_specification.compiler import load_task_abstraction, load_task_system
+from ltl_specification.capability_precheck import capability_file, unreachable_goals
+from ltl_specification.systems import load_task_abstraction, load_task_system
 from ltl_specification.provenance import Provenance
 from ltl_specification.reachability import Finding, unreachable_goal_modes
 
 PLAY_LENGTH = 8
+# Seconds the compiler spends diagnosing a task it refuses (the core search is cut there; the
+# sentence and the findings are told even then).
+REFUSAL_DIAGNOSIS_SECONDS = 5.0
 # Custom formulas are checked by enumerating their variables' values: at most this many.
 MAX_ENUMERATED_VARIABLES = 14
 
@@ -58,7 +73,7 @@ class CoreEntry:
 
     def name(self) -> str:
         if self.equation == 'custom':
-            return f'custom LTL {self.item}'
+            return f'{"custom LTL" if self.title == "custom LTL" else "formula"} {self.item}'
         return f'eq. {self.equation} {self.title}' + (f' for {self.item}' if self.item else '')
 
 
@@ -115,6 +130,9 @@ def goal_findings(system, initial_conditions, goals, strict_order: bool = True,
     skipped (compilation reports them).
     """
     system = load_task_system(system, config_dir)
+    if system.is_capability_system:  # a goal no capability can make true, as the compiler refuses it
+        return [Finding(str(error), 'frame axiom', f'postconditions in {capability_file(system)}', error.item)
+                for error in unreachable_goals(system, initial_conditions, goals)]
     abstraction = load_task_abstraction(system)
     modes = [i for i in initial_conditions if abstraction.kind_of(i) == 'control_mode']
     initial_mode = modes[0] if modes else abstraction.initial_mode
@@ -129,7 +147,9 @@ def impossible_next_goals(system, initial_conditions, goals, strict_order: bool 
     """For every action or mode that is not a goal yet: why it cannot be the next goal (if so)."""
     system = load_task_system(system, config_dir)
     impossible = {}
-    for candidate in load_task_abstraction(system).items():
+    candidates = list(system.capabilities.capabilities) if system.is_capability_system else \
+        load_task_abstraction(system).items()
+    for candidate in candidates:
         if candidate in goals:
             continue
         findings = goal_findings(system, initial_conditions, [*goals, candidate], strict_order)
@@ -211,22 +231,24 @@ def _exists(names: set[str], holds) -> bool | None:
 def diagnose(spec: GR1Specification, robotics_semantics: bool = True, limits: Limits = Limits(),
              provenance: Provenance | None = None) -> Diagnosis | None:
     """Why ``spec`` is unrealizable; None if it is realizable. ``provenance`` is what it was
-    compiled from (default: its own ``provenance``).
+    compiled from (default: its own ``provenance``; without one, by its formulas).
 
     When ``limits`` stop the core search (a cancel, the deadline), the pre-check's findings
     are still returned and the note says the core was not computed.
     """
-    provenance = provenance or spec.provenance
-    findings = precheck(spec, provenance)
+    provenance = provenance or getattr(spec, 'provenance', None)
+    findings = precheck(spec, provenance) if provenance else []
+    groups = provenance.groups if provenance else formula_groups(spec)
     diagnosis = Diagnosis(sentence=findings[0].sentence if findings else '', findings=findings)
     try:
-        core = unrealizable_core(spec, provenance.groups, robotics_semantics, limits)
+        core = unrealizable_core(spec, groups, robotics_semantics, limits)
         if core is None:
             return None
-        diagnosis.core = [CoreEntry(g.equation, g.title, g.item, provenance.origin(g),
+        diagnosis.core = [CoreEntry(g.equation, g.title, g.item,
+                                    provenance.origin(g) if provenance else 'the specification',
                                     [to_infix(f) for f in g.formulas]) for g in core.groups]
         steps = environment_play(spec, robotics_semantics, PLAY_LENGTH, limits)
-        diagnosis.play = play_in_words(steps, provenance)
+        diagnosis.play = play_in_words(steps, provenance.meanings if provenance else {})
     except SynthesisCancelledError as stopped:
         diagnosis.note = f'(The unrealizable core was not computed: {stopped.reason}.)'
     if not diagnosis.sentence:
@@ -243,9 +265,16 @@ def _core_sentence(core: list[CoreEntry]) -> str:
     return f'The task cannot be done as requested; these requirements are what makes it impossible: {named}.'
 
 
-def play_in_words(steps: list[dict], provenance: Provenance) -> list[str]:
-    """Each step of an environment play as a sentence about what changed."""
-    meaning = provenance.meanings
+def formula_groups(spec: GR1Specification) -> list[FormulaGroup]:
+    """One group per formula, named by its section and index: the core's units for a
+    specification that records no provenance (a CNU capability robot's, one given whole)."""
+    return [FormulaGroup(section, 'custom', 'formula', f'{section}[{index}]', SOURCE_CUSTOM, (formula,))
+            for section in FORMULA_SECTIONS for index, formula in enumerate(getattr(spec, section))]
+
+
+def play_in_words(steps: list[dict], meaning: dict[str, str]) -> list[str]:
+    """Each step of an environment play as a sentence about what changed (``meaning``: what a
+    proposition turning true means, e.g. ``Provenance.meanings``; others are named as they are)."""
     words = []
     previous: dict = {}
     for index, step in enumerate(steps):
@@ -266,18 +295,57 @@ def play_in_words(steps: list[dict], provenance: Provenance) -> list[str]:
 
 # --- for the pipeline -------------------------------------------------------------------------
 
+def refusal_diagnosis(spec: GR1Specification, sentence: str,
+                      seconds: float = REFUSAL_DIAGNOSIS_SECONDS) -> Diagnosis:
+    """The diagnosis of a compiled task that the compiler refuses (a mode no route reaches): the
+    sentence, core and play that synthesis would lead with, within ``seconds``; ``sentence``
+    leads when the pre-check names nothing. ``seconds`` 0: the pre-check alone (no core, no play)."""
+    sentence = sentence[0].upper() + sentence[1:] + '.'
+    if seconds > 0:
+        diagnosis = diagnose(spec, limits=Limits(deadline=time.monotonic() + seconds))
+        if diagnosis is None:  # realizable all the same (a mode only custom LTL names): the refusal stands
+            return Diagnosis(sentence)
+    else:
+        findings = precheck(spec)
+        diagnosis = Diagnosis(findings[0].sentence if findings else '', findings)
+    if not diagnosis.findings:
+        diagnosis.sentence = sentence
+    return diagnosis
+
+
+def explain_well_separation(spec: GR1Specification, provenance: Provenance | None = None,
+                            limits: Limits = Limits()) -> str:
+    """The warning for a realizable ``spec`` whose controller can win by forcing the environment
+    to break its assumptions ('' when it cannot; ``ltl_synthesizer.well_separation``), naming each
+    assumption as the core names a requirement (paper equation, configuration entry, formula)
+    when ``provenance`` (default: the spec's own) records it."""
+    report = check_well_separation(spec, limits)
+    provenance = provenance or getattr(spec, 'provenance', None)
+    if report.well_separated or provenance is None:
+        return report.warning()
+    return report.warning([_assumption_line(spec, provenance, section, index) for section, index in report.involved])
+
+
+def _assumption_line(spec: GR1Specification, provenance: Provenance, section: str, index: int) -> str:
+    formula = getattr(spec, section)[index]
+    group = next((g for g in provenance.groups if g.section == section and formula in g.formulas), None)
+    if group is None:
+        return f'{section} #{index}: {to_infix(formula)}'
+    return CoreEntry(group.equation, group.title, group.item, provenance.origin(group), [to_infix(formula)]).line()
+
+
 def explain_unsynthesizable(details: str, spec: GR1Specification, provenance: Provenance | None,
                             robotics_semantics: bool = True, limits: Limits = Limits()) -> str:
     """The SPEC_UNSYNTHESIZABLE message for ``spec``: the diagnosis first, then ``details``
-    (the synthesizer's own explanation). Never raises: without a provenance (a specification
-    that was not compiled from a task), or if it cannot be diagnosed, ``details`` are returned
-    unchanged."""
-    if provenance is None:
-        return details
+    (the synthesizer's own explanation). Without a provenance (a specification given whole, a
+    CNU capability robot's) the core is told by section and index (``formula_groups``). Never
+    raises: if it cannot be diagnosed, ``details`` are returned unchanged."""
     try:
         diagnosis = diagnose(spec, robotics_semantics, limits, provenance)
     except Exception:  # the diagnosis is a help; the synthesizer's verdict stands without it
         return details
     if diagnosis is None:
         return details
+    if diagnosis.play:  # one play in the message: the diagnosis' is a play of the same counter-strategy
+        details = without_play(details)
     return f'{diagnosis.message()}\n\nDetails from the synthesizer:\n{details}'

@@ -40,6 +40,16 @@ class InvalidGoalsError(SpecificationError):
     code = ErrorCode.INVALID_GOALS
 
 
+class ImpossibleGoalsError(InvalidGoalsError):
+    """A goal the configured mode changes can never reach, refused before synthesis with the
+    whole ``diagnosis`` (``ltl_specification.diagnosis.Diagnosis``: sentence, core, play) as its
+    message, so the refusal tells what synthesis would have told."""
+
+    def __init__(self, message: str, item='', diagnosis=None):
+        super().__init__(message, item)
+        self.diagnosis = diagnosis
+
+
 class InvalidSmOutcomesError(SpecificationError):
     """The requested state-machine outcomes are not [finished, failed] or [finished]."""
 

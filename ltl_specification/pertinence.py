@@ -8,7 +8,8 @@ Pertinence rule:
    actions (and modes that custom LTL mentions).
 3. Control modes: the initial mode, plus every mode lying on some shortest path, in the
    system's full mode transition graph, from the initial mode or a needed mode to a needed
-   mode. Every needed mode must be reachable from the initial mode.
+   mode. A needed mode that no route from the initial mode reaches is kept as well: the
+   compiler refuses such a task, diagnosing the specification that shows why it is impossible.
 
 Rule 3 keeps the specification small (a mode that is never on a shortest route is left
 out), yet the modes kept always allow the robot to travel between any two modes the task
@@ -28,8 +29,6 @@ from dataclasses import dataclass, field
 from typing import Sequence
 
 from respec.robot.abstraction import RobotAbstraction
-
-from ltl_specification.errors import InvalidGoalsError
 
 
 @dataclass(frozen=True)
@@ -77,12 +76,9 @@ def infer_pertinence(abstraction: RobotAbstraction, initial_mode: str | None,
     modes = set()  # membership only; the result follows configuration order
     if initial_mode is not None:
         modes.add(initial_mode)
-        reachable = mode_distances(abstraction.control_modes, initial_mode)
-        for target in needed_modes:
-            if target not in reachable:
-                raise InvalidGoalsError(
-                    f'control mode {target!r} ({reasons[target]}) cannot be reached from the '
-                    f'initial mode {initial_mode!r} on {abstraction.system}', item=target)
+        # A needed mode no route reaches is pertinent all the same (the compiler refuses the
+        # task, with the diagnosis of the specification that says why it is impossible).
+        modes.update(needed_modes)
         for source in [initial_mode, *needed_modes]:
             for target in needed_modes:
                 for mode in _on_shortest_paths(abstraction.control_modes, source, target):

@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import json
 from dataclasses import asdict, dataclass, field
+from typing import Mapping
 
 from respec.robot.abstraction import RobotAbstraction
 from respec.components import (SOURCE_ACTIONS, SOURCE_CONTROL_MODES, SOURCE_GOALS, SOURCE_INITIAL_CONDITIONS,
@@ -60,13 +61,15 @@ class Provenance:
 
 
 def task_provenance(system: str, abstraction: RobotAbstraction, where: str, initial_conditions, goals,
-                    sm_outcomes, strict_order: bool, pertinence: Pertinence, custom_sections, groups) -> Provenance:
+                    sm_outcomes, strict_order: bool, pertinence: Pertinence, custom_sections, groups,
+                    flexbe_states: Mapping | None = None) -> Provenance:
     """The provenance of a task compiled for ``system`` on its ``abstraction`` (whose file, as
-    users know it, is ``where``)."""
+    users know it, is ``where``); ``flexbe_states`` is the ``flexbe.states`` section of its file
+    (if any), which names the state machine's states and outcomes in a play told in words."""
     provenance = Provenance(system, tuple(initial_conditions), tuple(goals), tuple(sm_outcomes),
                             strict_order, pertinence, tuple(custom_sections), tuple(groups))
     provenance.origins = tuple(_origin(group, provenance, abstraction, where) for group in groups)
-    provenance.meanings = _meanings(provenance, abstraction)
+    provenance.meanings = _meanings(provenance, abstraction, flexbe_states or {})
     if pertinence.initial_mode is not None:
         provenance.findings = tuple(unreachable_goal_modes(abstraction, provenance.goals, pertinence.initial_mode,
                                                            strict_order, where))
@@ -94,21 +97,44 @@ def _origin(group: FormulaGroup, provenance: Provenance, abstraction: RobotAbstr
     return 'request custom LTL'
 
 
-def _meanings(provenance: Provenance, abstraction: RobotAbstraction) -> dict[str, str]:
-    """Proposition -> what it turning true means (activations, outcomes, goal memories, SM outcomes)."""
+def _meanings(provenance: Provenance, abstraction: RobotAbstraction, flexbe_states: Mapping) -> dict[str, str]:
+    """Proposition -> what it turning true means (activations, outcomes, goal memories, SM outcomes),
+    in the state machine's terms where the FlexBE mapping names them: the state (named after its
+    action or mode, as ``sm_generation`` names it), its class and the outcome it returns."""
     meaning = {}
     pertinence = provenance.pertinence
     for item in [*pertinence.modes, *pertinence.actions]:
         is_mode = item in pertinence.modes
-        meaning[activation(item)] = f'the robot starts {"changing to " if is_mode else ""}{item}'
+        state_class, returns = _flexbe_state(flexbe_states, activation(item))
+        meaning[activation(item)] = (f'state {item} ({state_class}) starts' if state_class else
+                                     f'the robot starts {"changing to " if is_mode else ""}{item}')
         for outcome in abstraction.outcomes:
-            meaning[outcome_proposition(item, outcome)] = (
-                f'now in {item}' if is_mode and outcome == abstraction.success_outcome else f'{item} {outcome}')
+            proposition = outcome_proposition(item, outcome)
+            now_in = is_mode and outcome == abstraction.success_outcome
+            if proposition in returns:
+                meaning[proposition] = f'{item} returns {returns[proposition]}' + (f' (now in {item})' if now_in else '')
+            else:
+                meaning[proposition] = f'now in {item}' if now_in else f'{item} {outcome}'
     for goal in provenance.goals:
         meaning[memory(goal)] = f'goal {goal} achieved'
     for outcome in provenance.sm_outcomes:
         meaning[outcome] = f'the state machine ends {outcome}'
     return meaning
+
+
+def _flexbe_state(flexbe_states: Mapping, proposition: str) -> tuple[str, dict[str, str]]:
+    """The FlexBE class of the state ``proposition`` activates ('' if unmapped) and, for each
+    outcome proposition, the state outcome(s) that mean it (read leniently: sm_generation
+    validates the section when it generates the machine)."""
+    entry = flexbe_states.get(proposition)
+    if not isinstance(entry, Mapping) or not isinstance(entry.get('class_decl'), Mapping):
+        return '', {}
+    declaration = entry['class_decl']
+    state_class = declaration.get('behavior_class') if declaration.get('name') == ':BEHAVIOR' else declaration.get('name')
+    mapping = entry.get('output_mapping') if isinstance(entry.get('output_mapping'), Mapping) else {}
+    returns = {str(name): ' or '.join(map(str, outcomes)) for name, outcomes in mapping.items()
+               if isinstance(outcomes, (list, tuple)) and outcomes}
+    return (str(state_class) if state_class else ''), returns
 
 
 # --- JSON ---------------------------------------------------------------------------------

@@ -36,7 +36,6 @@ from typing import Callable, Iterator, Mapping, Sequence
 import yaml
 
 from respec.errors import CodedError, ErrorCode
-from respec.ltl import Const
 from respec.naming import DEFAULT_SM_OUTCOMES, FAILED, memory, parse_names
 from respec.robot import RobotSystem, robot_system
 from respec.robot.files import ConfigDirs
@@ -187,18 +186,19 @@ def attempt(system: RobotSystem, request: TaskRequest, custom_ltl: Mapping | Non
     A specification realizable only vacuously (its initial conditions contradict each other)
     does not count: it has no strategy to run. With ``honest_environment`` (for added
     assumptions) neither does one whose controller could win by forcing the environment to
-    break its assumptions.
+    break its assumptions (not well-separated, ``ltl_synthesizer.well_separation``). A refusal
+    before synthesis is not diagnosed here (its sentence suffices to reject a candidate).
     """
     from ltl_synthesizer.synthesizer import solve   # the synthesizer loads only when a repair runs
+    from ltl_synthesizer.well_separation import is_well_separated
 
     start = time.perf_counter()
     try:
         spec = compile_task(system, list(request.initial_conditions), list(request.goals),
                             sm_outcomes=request.sm_outcomes, strict_order=not request.unordered,
-                            custom_ltl=custom_ltl, state_library=state_library)
+                            custom_ltl=custom_ltl, state_library=state_library, explain_refusal=False)
         solved = solve(spec, limits=Limits(deadline=deadline))
-        if solved.realizable and not solved.warnings and honest_environment \
-                and solve(replace(spec, sys_liveness=[Const(False)]), limits=Limits(deadline=deadline)).realizable:
+        if solved.realizable and not solved.warnings and honest_environment and not is_well_separated(solved.game):
             return Attempt(False, time.perf_counter() - start,
                            'the controller could win by forcing the environment to break its assumptions')
     except CodedError as error:
@@ -297,9 +297,7 @@ def _diagnosed_sentence(system: RobotSystem, request: TaskRequest, custom_ltl, s
     spec = compile_task(system, list(request.initial_conditions), list(request.goals),
                         sm_outcomes=request.sm_outcomes, strict_order=not request.unordered,
                         custom_ltl=custom_ltl, state_library=state_library)
-    diagnosis = None
-    if getattr(spec, 'provenance', None) is not None:
-        diagnosis = diagnose(spec, limits=Limits(deadline=deadline))
+    diagnosis = diagnose(spec, limits=Limits(deadline=deadline))
     return diagnosis.sentence if diagnosis else 'the specification is unrealizable'
 
 
@@ -523,7 +521,7 @@ def _held_inputs(system: RobotSystem, request: TaskRequest, custom_ltl, inputs: 
     try:
         spec = compile_task(system, list(request.initial_conditions), list(request.goals),
                             sm_outcomes=request.sm_outcomes, strict_order=not request.unordered,
-                            custom_ltl=custom_ltl)
+                            custom_ltl=custom_ltl, explain_refusal=False)
         steps = environment_play(spec, length=MAX_PLAY_STEPS)
     except CodedError:
         return {}

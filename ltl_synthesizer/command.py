@@ -37,6 +37,10 @@ def _parser() -> argparse.ArgumentParser:
                         help='only convert INPUT.structuredslugs to slugsin')
     parser.add_argument('--explain', action='store_true',
                         help='when unrealizable, say why (losing initial states, blocked goal, a play)')
+    parser.add_argument('--check-well-separation', action='store_true',
+                        help='when realizable, check that the system cannot win by forcing the environment '
+                             'to break its assumptions (Maoz & Ringert); print the result, or a warning '
+                             'naming the assumptions involved')
     parser.add_argument('--timeout', type=_limit, default=None, metavar='SECONDS',
                         help='give up after this many seconds, reading the input included (exit status 3)')
     parser.add_argument('--memory-limit', type=_limit, default=2048, metavar='MB',
@@ -123,6 +127,9 @@ def synthesis_outcome(spec, args, limits, stream: bool = False):
                                              explicit_strategy, solve, stream_strategy)
     solved = solve(spec, args.sysInitRoboticsSemantics, limits)
     result = SynthesisResult(solved.realizable)
+    if solved.realizable and args.check_well_separation:
+        from ltl_synthesizer.well_separation import check_well_separation
+        result.stats['well_separation'] = check_well_separation(spec, limits, solved.game).summary()
     if solved.realizable and args.explicitStrategy:
         result.strategy = stream_strategy(solved) if stream else explicit_strategy(solved)
     elif not solved.realizable:
@@ -259,6 +266,8 @@ def run(args) -> int:
         if deadline is not None:
             processes.close()
     print(REALIZABLE_LINE if result.realizable else UNREALIZABLE_LINE, file=sys.stderr)
+    if 'well_separation' in result.stats:
+        print(result.stats['well_separation'], file=sys.stderr)
     if not result.realizable and args.explain and result.explanation:
         print(result.explanation, file=sys.stderr)
     if result.realizable and args.explicitStrategy:

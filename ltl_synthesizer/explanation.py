@@ -17,6 +17,7 @@ from ltl_synthesizer.symbolic import SymbolicGame
 
 MAX_LISTED_STATES = 3
 PLAY_LENGTH = 8
+PLAY_HEADING = 'Environment play (counter-strategy'
 
 
 def _true_set(names, values) -> str:
@@ -37,6 +38,17 @@ def explain_unrealizable(game: SymbolicGame, system: SystemSolution,
     play = extract_counterstrategy(game, environment, robotics_semantics, play_length=PLAY_LENGTH)
     lines += _blocked_goal_and_play(game, play)
     return '\n'.join(lines)
+
+
+def without_play(explanation: str) -> str:
+    """``explanation`` without its environment play (and the deadlock found at the play's end),
+    for a caller that tells its own play of the same counter-strategy: what remains is what the
+    synthesizer adds (the losing initial states, the goal the environment blocks)."""
+    lines = explanation.split('\n')
+    heading = next((i for i, line in enumerate(lines) if line.startswith(PLAY_HEADING)), None)
+    if heading is None:
+        return explanation
+    return '\n'.join(lines[:heading])
 
 
 def _initial_conditions(game, system, environment, robotics_semantics) -> list[str]:
@@ -106,7 +118,7 @@ def _blocked_goal_and_play(game: SymbolicGame, play: dict) -> list[str]:
     if deadlock is None:
         lines.append(f'The environment can prevent {_goal_text(game, blocked)} from holding '
                      'infinitely often, while satisfying all of its own assumptions.')
-    lines.append('Environment play (counter-strategy; inputs chosen by the environment, '
+    lines.append(f'{PLAY_HEADING}; inputs chosen by the environment, '
                  'outputs one legal system response):')
     for step, node in enumerate(steps):
         inputs = _true_set(names[:n_inputs], node['state'][:n_inputs])

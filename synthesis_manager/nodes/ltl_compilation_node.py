@@ -69,7 +69,7 @@ class LTLCompilationNode(Node):
             self.get_logger().warning(response.error_code.message)
             return response
         response.ltl_specification = spec_to_msg(spec)
-        # CNU capability systems record none: their unrealizable specifications are not diagnosed.
+        # CNU capability systems record none: their unrealizable specifications are diagnosed by formula.
         response.provenance = provenance_to_json(spec.provenance) if spec.provenance is not None else ''
         response.error_code = error_code()
         return response

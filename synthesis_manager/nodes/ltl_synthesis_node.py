@@ -15,7 +15,7 @@ import uuid
 from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.node import Node
 
-from ltl_specification.diagnosis import explain_unsynthesizable
+from ltl_specification.diagnosis import explain_unsynthesizable, explain_well_separation
 from ltl_specification.provenance import provenance_from_json
 from ltl_synthesizer import Limits, SynthesisCancelledError, SynthesisError
 from ltl_synthesizer.external import run_external_synthesizer
@@ -38,6 +38,7 @@ BACKENDS = ('builtin', 'slugs')
 # What explains an unrealizable specification (run in a synthesis child process; a module-level
 # name so that tests can put a stand-in there).
 DIAGNOSIS = explain_unsynthesizable
+WELL_SEPARATION = explain_well_separation
 DIAGNOSIS_GRACE = 1.0  # seconds past its own time limit before the diagnosis process is killed
 
 
@@ -55,7 +56,10 @@ class LTLSynthesisNode(Node):
     ``memory_limit_mb`` (per synthesis; beyond it the synthesis ends with SYNTHESIS_FAILED
     naming the limit, not an OOM kill); ``diagnosis_timeout`` (seconds to find why an
     unrealizable specification cannot be met, used when a request gives none; never past the
-    request's time limit); ``parallel_syntheses`` (run at once) and ``queued_syntheses`` (waiting beyond those;
+    request's time limit); ``check_well_separation`` (a realizable specification's answer
+    carries, as its SUCCESS message, a warning when the controller can win by forcing the
+    environment to break its assumptions: ltl_synthesizer.well_separation; checked within the
+    diagnosis time); ``parallel_syntheses`` (run at once) and ``queued_syntheses`` (waiting beyond those;
     further requests are answered BUSY).
 
     Syntheses run in the node's own worker threads, awaited by an async service callback,
@@ -75,6 +79,7 @@ class LTLSynthesisNode(Node):
         self.declare_parameter('robotics_semantics', True)
         self.declare_parameter('memory_limit_mb', 2048)
         self.declare_parameter('diagnosis_timeout', 20.0)
+        self.declare_parameter('check_well_separation', True)
         self.declare_parameter('parallel_syntheses', 8)
         self.declare_parameter('queued_syntheses', 200)
         self._running: dict[str, threading.Event] = {}
@@ -195,23 +200,43 @@ class LTLSynthesisNode(Node):
                 response.error_code = error_code(ErrorCode.SPEC_UNSYNTHESIZABLE, message)
                 return
             files.write('json', strategy_to_json(strategy))
+        try:
+            warning = self._well_separation_warning(spec, request, cancel, deadline)
+        except SynthesisCancelledError as stopped:
+            return self._stopped(response, stopped.reason, timeout)
         response.automaton = automaton_to_msg(automaton_from_strategy(strategy, spec))
-        response.error_code = error_code()
+        response.error_code = error_code(ErrorCode.SUCCESS, warning)
+
+    def _well_separation_warning(self, spec, request, cancel: threading.Event, deadline: float) -> str:
+        """The warning that the controller can win by forcing the environment to break its
+        assumptions ('' when it cannot, when check_well_separation is off, or when the check
+        does not end within the diagnosis time and the request's time limit: the automaton
+        stands without it). The check runs in a synthesis child process, with the memory
+        limit; a cancel raises SynthesisCancelledError."""
+        if not self.parameter('check_well_separation'):
+            return ''
+        limit = request.diagnosis_timeout or self.parameter('diagnosis_timeout')
+        check_deadline = min(time.monotonic() + limit, deadline)
+        if check_deadline <= time.monotonic():
+            return ''
+        limits = Limits(deadline=check_deadline, memory_limit=self.parameter('memory_limit_mb') * 2**20)
+        try:
+            return self.synthesis_processes.call(WELL_SEPARATION, (spec, self._provenance(request), limits),
+                                                 cancel=cancel, deadline=check_deadline + DIAGNOSIS_GRACE)
+        except SynthesisError as error:
+            if cancel.is_set():
+                raise SynthesisCancelledError('cancelled') from None
+            self.get_logger().warning(f'well-separation not checked: {error}'[:300])
+            return ''
 
     def _diagnosed(self, details: str, spec, request, robotics_semantics: bool, cancel: threading.Event,
                    deadline: float) -> str:
-        """``details`` (the synthesizer's explanation), led by why the task cannot be done when
-        the request carries the specification's provenance. The diagnosis runs in a synthesis
-        child process, with the memory limit, and ends by diagnosis_timeout and before the
-        request's time limit; without an answer by then the verdict stands with ``details``.
-        A cancel raises SynthesisCancelledError."""
-        if not request.provenance:
-            return details
-        try:
-            provenance = provenance_from_json(request.provenance)
-        except ValueError as error:
-            self.get_logger().warning(f'request.provenance ignored (no diagnosis): {error!r}'[:300])
-            return details
+        """``details`` (the synthesizer's explanation), led by why the task cannot be done: in
+        the task's terms when the request carries the specification's provenance, else by its
+        formulas. The diagnosis runs in a synthesis child process, with the memory limit, and
+        ends by diagnosis_timeout and before the request's time limit; without an answer by then
+        the verdict stands with ``details``. A cancel raises SynthesisCancelledError."""
+        provenance = self._provenance(request)
         limit = request.diagnosis_timeout or self.parameter('diagnosis_timeout')
         diagnosis_deadline = min(time.monotonic() + limit, deadline - DIAGNOSIS_GRACE)
         if diagnosis_deadline <= time.monotonic():
@@ -226,6 +251,16 @@ class LTLSynthesisNode(Node):
             if cancel.is_set():
                 raise SynthesisCancelledError('cancelled') from None
             return details  # out of time, or its process died: the verdict stands without it
+
+    def _provenance(self, request):
+        """The request's provenance (None without one, or when it cannot be read: logged)."""
+        if not request.provenance:
+            return None
+        try:
+            return provenance_from_json(request.provenance)
+        except ValueError as error:
+            self.get_logger().warning(f'request.provenance ignored (no diagnosis): {error!r}'[:300])
+            return None
 
     @staticmethod
     def _stopped(response, reason: str, timeout: float):

@@ -315,7 +315,7 @@ class BehaviorSynthesisServer(Node):
             provenance = compiled.provenance
             if utf8_length(provenance) > MAX_STRING_BYTES:  # the synthesizer would refuse the request
                 self.get_logger().warning(f'the provenance of {spec_name} ({utf8_length(provenance)} bytes) is '
-                                          'not sent: an unrealizable specification is not diagnosed')
+                                          'not sent: an unrealizable specification is diagnosed by its formulas only')
                 provenance = ''
             feedback('Compiled the LTL specification', 1 / 3)
             if task.option == 'ltl_compilation_only':
@@ -339,6 +339,9 @@ class BehaviorSynthesisServer(Node):
             # Name the goal's limit, not the time that was left of it.
             synthesized.error_code.message = str(deadline.timed_out('LTL synthesis'))
         self.check(synthesized.error_code)
+        if synthesized.error_code.message:  # a warning the automaton comes with (not well-separated)
+            outcome.message = synthesized.error_code.message
+            outcome.notes.append(synthesized.error_code.message)
         outcome.automaton = synthesized.automaton
         feedback(f'Synthesized an automaton with {len(outcome.automaton.automaton)} states', 2 / 3)
         if task.option in ('ltl_synthesis_only', 'ltl_steps_only'):

@@ -17,7 +17,7 @@ from typing import Callable
 
 from ltl_specification.diagnosis import goal_findings, impossible_next_goals
 from ltl_specification.capability_precheck import clause_text
-from ltl_specification.compiler import load_task_abstraction
+from ltl_specification.systems import load_task_abstraction
 from respec.errors import INTERNAL_ERROR, CodedError, ErrorCode, quoted
 from respec.naming import DEFAULT_SM_OUTCOMES, FINISHED
 from respec.robot import RobotSystem, SystemCatalog

@@ -121,7 +121,10 @@ def test_explain_unsynthesizable_keeps_the_details_and_never_raises():
     impossible = compile_task(**IMPOSSIBLE)
     message = explain_unsynthesizable('DETAILS', impossible, impossible.provenance)
     assert message.splitlines()[0].startswith('Goal 2 (stand_prep)') and message.endswith('DETAILS')
-    assert explain_unsynthesizable('DETAILS', impossible, None) == 'DETAILS'  # no provenance: nothing to tell
+    # without a provenance (a specification given whole): diagnosed by its formulas (issue 33)
+    given_whole = spec_from_text_sections(impossible.to_text_sections())
+    by_formulas = explain_unsynthesizable('DETAILS', given_whole, None)
+    assert by_formulas.startswith('The task cannot be done as requested') and by_formulas.endswith('DETAILS')
     realizable = compile_task('atlas', [], ['look_down'])
     assert explain_unsynthesizable('DETAILS', realizable, realizable.provenance) == 'DETAILS'
 

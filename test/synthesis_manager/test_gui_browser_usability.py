@@ -63,6 +63,22 @@ def test_unrealizable_request_banner_names_the_missing_transition(page):
     shot(page, 'unrealizable-banner')
 
 
+def test_a_request_the_compiler_refuses_shows_the_forms_sentence_and_the_same_evidence(page):
+    # from stand the compiler refuses (INVALID_GOALS); the banner leads with the sentence the goal
+    # list shows, and the folded details hold the core and the play, as for a start in stand_prep
+    choose_task(page, ['look_down', 'stand_prep'], initial_conditions=('stand',))
+    page.wait_for_function("document.querySelector('#goals li[data-goal=\"stand_prep\"] .goal-warning')"
+                           ".textContent.includes('goal 1 (look_down) needs the robot in stand')")
+    warning = page.inner_text('#goals li[data-goal="stand_prep"] .goal-warning')
+    page.click('#synthesize')
+    assert result_code(page) == 'INVALID_GOALS'
+    assert page.inner_text('#result-message') == f'LTL compilation failed: {warning}'
+    page.click('#result-details summary')
+    details = page.inner_text('#result-details-text')
+    assert 'eq. (9) control-mode topology for stand' in details
+    assert 'How the environment wins' in details and 'state look_down (TiltHeadState) starts' in details
+
+
 def test_goal_picker_says_which_goals_are_impossible_and_why(page):
     choose_task(page, [])
     assert page.get_attribute('#goal-choice option[value="stand"]', 'title') == \

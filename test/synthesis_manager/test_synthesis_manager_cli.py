@@ -89,9 +89,11 @@ def test_send_goal_fails_with_the_code_and_message(served):
 def test_send_goal_gives_the_sentence_naming_the_missing_transition(served):
     result = send_goal(served, '--initial-conditions', 'stand', '--goals', 'look_down,stand_prep')
     assert result.returncode == 1 and 'result: INVALID_GOALS' in result.stdout
-    assert ('Goal 2 (stand_prep) can never be achieved: the robot starts in stand, and stand -> '
+    # the goals in order: the pre-check's sentence (as for a start in stand_prep), then the diagnosis
+    assert ('Goal 2 (stand_prep) can never be achieved: goal 1 (look_down) needs the robot in stand, and stand -> '
             'stand_prep is not a transition in config/atlas.yaml (from stand the robot can only change to '
             'manipulate, step, walk).') in result.stdout
+    assert 'Unrealizable core' in result.stdout and 'How the environment wins' in result.stdout
 
 
 def test_ctrl_c_cancels_the_goal(served, tmp_path):

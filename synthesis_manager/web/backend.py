@@ -17,6 +17,7 @@ from typing import Callable
 
 from ltl_specification.diagnosis import goal_findings, impossible_next_goals
 from ltl_specification.capability_precheck import clause_text
+from ltl_specification.repair_process import RepairSearch, RepairSearchFailed, repair_settings
 from ltl_specification.systems import load_task_abstraction
 from respec.errors import INTERNAL_ERROR, CodedError, ErrorCode, quoted
 from respec.naming import DEFAULT_SM_OUTCOMES, FINISHED
@@ -30,7 +31,6 @@ from synthesis_manager.web.errors import (ArtifactFailedError, InvalidJobRequest
 from synthesis_manager.web.jobs import JOB_OPTIONS, Job, JobRequest, ProgressNote, checked_body, names_field
 from synthesis_manager.web.outcome import JobOutcome
 from synthesis_manager.web.plays import Plays, play_body_moves
-from synthesis_manager.web.repair_process import RepairSearch, RepairSearchFailed
 from synthesis_manager.web.simulation_process import SimulationProcess
 from synthesis_manager.web.simulations import Simulation, simulation_available
 
@@ -192,7 +192,7 @@ class SynthesisBackend:
                 return value
 
     def start_repair(self, body) -> queue.Queue:
-        """Start searching for fixes of a job's request: in a child process (web/repair_process.py)
+        """Start searching for fixes of a job's request: in a child process (ltl_specification.repair_process)
         on the robot system the GUI has (perhaps a remote suite's), for at most
         ``repair_time_budget`` seconds. The queue gets ``('proposal', dict)`` as each proposal is
         verified, then ``('result', Repairs.to_dict())`` or ``('error', GuiRequestError)``.
@@ -209,9 +209,8 @@ class SynthesisBackend:
                             'try again when one has finished', 'repairs', retry_after=int(self.repair_time_budget))
         task = TaskRequest(request.system, request.initial_conditions, request.goals, request.sm_outcomes,
                            request.unordered)
-        settings = {'system': robot.name, 'files': dict(robot.files), 'config_file': robot.config_file,
-                    'request': task.to_dict(), 'custom_ltl': request.custom_ltl,
-                    'time_budget': self.repair_time_budget, 'max_proposals': REPAIR_MAX_PROPOSALS}
+        settings = repair_settings(robot, task.to_dict(), request.custom_ltl, self.repair_time_budget,
+                                   REPAIR_MAX_PROPOSALS)
         answers = queue.Queue()
         threading.Thread(target=self._search_repairs, args=(settings, answers), name='gui-repair',
                          daemon=True).start()

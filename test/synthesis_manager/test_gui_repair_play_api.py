@@ -270,7 +270,7 @@ def search_settings(time_budget=10.0):
 
 
 def test_a_search_past_its_deadline_is_killed(monkeypatch):
-    from synthesis_manager.web import repair_process
+    from ltl_specification import repair_process
 
     monkeypatch.setattr(repair_process, 'STARTUP_GRACE', 0.0)
     search = repair_process.RepairSearch(search_settings(time_budget=0.01))
@@ -282,7 +282,7 @@ def test_a_search_past_its_deadline_is_killed(monkeypatch):
 def test_stopping_the_gui_ends_a_running_search_at_once():
     import time
 
-    from synthesis_manager.web.repair_process import RepairSearch, RepairSearchFailed
+    from ltl_specification.repair_process import RepairSearch, RepairSearchFailed
 
     search = RepairSearch(search_settings())
     with ThreadPoolExecutor(1) as pool:

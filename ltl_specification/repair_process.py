@@ -1,14 +1,15 @@
-"""The GUI's "Suggest fixes": ``ltl_specification.repair`` in a child process with a deadline.
+"""``ltl_specification.repair`` in a child process with a deadline, for servers (the GUI's
+"Suggest fixes", the fixes the synthesis action's result proposes).
 
 A repair search compiles and synthesizes dozens of candidate tasks for up to its time budget:
-in the GUI's own process it would hold Python's GIL (one CUDD operation can run for seconds),
+in a server's own process it would hold Python's GIL (one CUDD operation can run for seconds),
 so every other request would wait. It therefore runs in a child process of its own
-(``ltl_synthesizer.isolated.ChildProcess``, which preloads this module), killed when the GUI
-stops or the search overruns its deadline. The child gets the robot system's files as the GUI
-read them (perhaps from a suite on another machine), not a name to read again, and reports
-each verified proposal as it is found.
+(``ltl_synthesizer.isolated.ChildProcess``, which preloads this module), killed when the server
+stops or the search overruns its deadline. The child gets the robot system's files as the
+server read them (perhaps from a suite on another machine), not a name to read again, and
+reports each verified proposal as it is found.
 
-    search = RepairSearch(settings)          # in the GUI, in the request's thread
+    search = RepairSearch(repair_settings(system, request, custom_ltl, budget, count))
     repairs = search.run(on_proposal)        # search.stop() from another thread ends it
 """
 
@@ -27,6 +28,14 @@ STARTUP_GRACE = 20.0
 
 class RepairSearchFailed(Exception):
     """The child ended (killed, crashed, overran its deadline) without an answer."""
+
+
+def repair_settings(system, request: dict, custom_ltl, time_budget: float, max_proposals: int) -> dict:
+    """What a child needs for a search of ``request`` (``TaskRequest.to_dict()``) on ``system``
+    (a RobotSystem: its files travel, not its name)."""
+    return {'system': system.name, 'files': dict(system.files), 'config_file': system.config_file,
+            'request': request, 'custom_ltl': custom_ltl, 'time_budget': time_budget,
+            'max_proposals': max_proposals}
 
 
 class RepairSearch:

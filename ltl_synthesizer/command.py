@@ -180,35 +180,6 @@ def strategy_to_text(strategy: dict) -> str:
     return '\n'.join(lines) + ('\n' if lines else '')
 
 
-def run_with_deep_stack(function, *args):
-    """``function(*args)`` in a thread with room for formulas nested as deeply as the parsers accept."""
-    import threading
-    outcome = {}
-
-    def target():
-        try:
-            outcome['value'] = function(*args)
-        except BaseException as error:  # re-raised in the caller's thread
-            outcome['error'] = error
-
-    from respec.nesting import allow_deep_formulas
-    previous_stack, previous_limit = threading.stack_size(), sys.getrecursionlimit()
-    allow_deep_formulas()
-    try:
-        worker = threading.Thread(target=target, name='gr1synth', daemon=True)
-        worker.start()
-    finally:
-        threading.stack_size(previous_stack)
-    try:
-        while worker.is_alive():  # a timed join keeps Ctrl-C working in the main thread
-            worker.join(0.1)
-    finally:
-        sys.setrecursionlimit(previous_limit)
-    if 'error' in outcome:
-        raise outcome['error']
-    return outcome['value']
-
-
 def run(args) -> int:
     """One gr1synth run of parsed arguments (not --serve): its exit status, printing as slugs."""
     from respec.parsing import ParseError

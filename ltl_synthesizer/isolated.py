@@ -47,7 +47,7 @@ import traceback
 from typing import Callable
 
 from ltl_synthesizer.errors import SynthesisCancelledError, SynthesisError, SynthesisTimeoutError
-from ltl_synthesizer.interrupt import Limits
+from ltl_synthesizer.interrupt import Limits, resident_memory
 
 # How often the caller looks at its cancel flag and deadline while a child works.
 POLL_SECONDS = 0.02
@@ -59,6 +59,15 @@ SERVER_CHILD_NICENESS = 15
 #: How long an idle child is kept for the next synthesis.
 IDLE_SECONDS = 30.0
 _LENGTH_BYTES = 8
+#: A child that holds more than this above its fresh size after answering and releasing what
+#: it answered (heap it could not give back) is ended, and a fresh one serves the next request:
+#: a memory limit counts from a synthesis's start, so a reused child peaks within this of a
+#: fresh one (a child holding its previous answer peaked at twice its limit, issue 34 item 4).
+REUSE_MARGIN_BYTES = 64 * 2**20
+#: Growth after an answer below which the child does not collect and trim its heap.
+RELEASE_ABOVE_BYTES = 16 * 2**20
+#: How long a child may take to release what it answered before it is ended instead of reused.
+SETTLE_SECONDS = 5.0
 
 
 class SynthesisProcessDiedError(SynthesisError):
@@ -73,7 +82,8 @@ class ChildProcess:
     """One child process (``python -m ltl_synthesizer.isolated PARENT NICENESS PRELOAD``),
     spoken to through its stdin and stdout: length-prefixed pickles, a request (function,
     args, kwargs, whether progress is wanted) in; ('progress', value) messages and then an
-    answer ('result', value) or ('error', exception) out. ``preload`` is imported at its start,
+    answer ('result', value) or ('error', exception) out, then ('ready' or 'retire', bytes
+    held) once the child has released the request and its answer (see :meth:`settle`). ``preload`` is imported at its start,
     so the first request need not wait for it; ``environment`` holds defaults for variables
     the parent's environment does not set."""
 
@@ -81,6 +91,8 @@ class ChildProcess:
                  environment: dict[str, str] | None = None):
         self.idle_since = time.monotonic()
         self.fresh = True  # has served nothing yet: its RSS is the baseline
+        self.said = 'ready'  # what it said after its last answer
+        self.settling = False  # releasing its last request and answer: says 'ready' or 'retire' then
         self.process = subprocess.Popen(
             [sys.executable, '-m', 'ltl_synthesizer.isolated', str(os.getpid()), str(niceness), preload],
             stdin=subprocess.PIPE, stdout=subprocess.PIPE,
@@ -93,6 +105,8 @@ class ChildProcess:
         The child is killed once ``cancel`` is set or at ``deadline`` (time.monotonic());
         one that dies raises SynthesisProcessDiedError."""
         try:
+            if not self.settle() and self.said == 'nothing':  # its next words would be misread
+                raise self.died()
             self.send((function, tuple(args), dict(kwargs or {}), on_progress is not None))
             while True:
                 while not self.answered(POLL_SECONDS):
@@ -110,9 +124,24 @@ class ChildProcess:
                 on_progress(value)
         except (EOFError, OSError, ValueError):  # the child died, or its pipes were closed
             raise self.died() from None
+        self.settling = True
         if kind == 'error':
             raise value
         return value
+
+    def settle(self, timeout: float = SETTLE_SECONDS) -> bool:
+        """Whether this child may serve another request: after each answer it releases the
+        request and the answer and then says 'ready', or 'retire' when it still holds more than
+        REUSE_MARGIN_BYTES above its fresh size (a child that says neither in ``timeout`` or
+        died may not serve either)."""
+        if self.settling:
+            self.settling = False
+            try:
+                said = self.receive()[0] if self.answered(timeout) else 'nothing'
+            except (EOFError, OSError, ValueError):
+                said = 'nothing'
+            self.said = said
+        return self.said == 'ready' and self.alive()
 
     def died(self) -> SynthesisProcessDiedError:
         self.kill()
@@ -128,8 +157,9 @@ class ChildProcess:
         return bool(select.select([self.process.stdout], [], [], timeout)[0])
 
     def receive(self):
-        return pickle.loads(_read_exactly(self.process.stdout, int.from_bytes(
-            _read_exactly(self.process.stdout, _LENGTH_BYTES), 'little')))
+        # Unbuffered: the next message must stay in the pipe, where answered() looks for it.
+        answers = self.process.stdout.raw
+        return pickle.loads(_read_exactly(answers, int.from_bytes(_read_exactly(answers, _LENGTH_BYTES), 'little')))
 
     def alive(self) -> bool:
         return self.process.poll() is None
@@ -147,10 +177,13 @@ class ChildProcess:
 
 
 def _read_exactly(stream, size: int) -> bytes:
-    data = stream.read(size)
-    if len(data) != size:
-        raise EOFError('the synthesis process closed its output')
-    return data
+    data = bytearray()
+    while len(data) < size:  # a raw pipe gives what has arrived
+        chunk = stream.read(size - len(data))
+        if not chunk:
+            raise EOFError('the synthesis process closed its output')
+        data += chunk
+    return bytes(data)
 
 
 class SynthesisProcesses:
@@ -232,7 +265,7 @@ class SynthesisProcesses:
             if self._closed:
                 raise SynthesisCancelledError('cancelled')
             child = self._idle.pop() if self._idle else None
-        if child is None or not child.alive():
+        if child is None or not child.settle():
             if child is not None:
                 child.kill()
             child = ChildProcess(self.niceness)
@@ -266,12 +299,10 @@ def _serve(parent_pid: int, preload: str) -> None:
     answers = os.fdopen(os.dup(sys.stdout.fileno()), 'wb')
     sys.stdout = sys.stderr  # stray prints must not corrupt the answers
     importlib.import_module(preload)  # imported now: the first request need not wait for it
+    fresh = _released_memory()
 
     def send(message) -> None:
-        try:
-            data = pickle.dumps(message, protocol=pickle.HIGHEST_PROTOCOL)
-        except Exception as error:  # noqa: BLE001 -- e.g. an exception that cannot be pickled
-            data = pickle.dumps(('error', SynthesisError(f'synthesis process: {error!r}')))
+        data = _pickled(message)
         answers.write(len(data).to_bytes(_LENGTH_BYTES, 'little') + data)
         answers.flush()
 
@@ -289,6 +320,35 @@ def _serve(parent_pid: int, preload: str) -> None:
             error.add_note(f'in the synthesis process:\n{traceback.format_exc()}')
             answer = ('error', error)
         send(answer)
+        # The request and its answer (an error's traceback holds the whole solver) are released
+        # before the next request is read (after answering: freeing them takes time), so that
+        # its memory limit counts from what the child really holds.
+        del function, args, kwargs, answer
+        held = resident_memory() - fresh
+        if held > RELEASE_ABOVE_BYTES:  # a collection and a trim take 20-30 ms: only when it pays
+            held = _released_memory() - fresh
+        # 'retire': the parent ends this child, a fresh one serves the next request.
+        send(('retire' if held > REUSE_MARGIN_BYTES else 'ready', held))
+
+
+def _pickled(message) -> bytes:
+    try:
+        return pickle.dumps(message, protocol=pickle.HIGHEST_PROTOCOL)
+    except Exception as error:  # noqa: BLE001 -- e.g. an exception that cannot be pickled
+        return pickle.dumps(('error', SynthesisError(f'synthesis process: {error!r}')))
+
+
+def _released_memory() -> int:
+    """This process's resident size after its garbage is collected and freed heap pages go
+    back to the system (glibc's malloc_trim; elsewhere only the collection)."""
+    import gc
+    gc.collect()
+    try:
+        import ctypes
+        ctypes.CDLL('libc.so.6').malloc_trim(0)
+    except (OSError, AttributeError):
+        pass
+    return resident_memory()
 
 
 def _die_with_parent(parent_pid: int) -> None:
@@ -312,8 +372,7 @@ if __name__ == '__main__':
     # Below the parent's priority: syntheses filling every core must not delay the parent's
     # answers (time limits, cancels, BUSY) on a loaded machine.
     os.nice(int(sys.argv[2]))
-    from respec.nesting import allow_deep_formulas
-    allow_deep_formulas()  # requests are served in a thread with room for any formula accepted
-    server = threading.Thread(target=_serve, args=(int(sys.argv[1]), sys.argv[3]), name='synthesis-process')
-    server.start()
-    server.join()
+    from respec.nesting import run_with_deep_stack
+    # Requests are served in a thread with room for any formula accepted (pickles of formula
+    # trees are read and written recursively).
+    run_with_deep_stack(_serve, int(sys.argv[1]), sys.argv[3])

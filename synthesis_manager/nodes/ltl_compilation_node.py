@@ -12,6 +12,7 @@ from ltl_specification.provenance import provenance_to_json
 from respec.robot import SystemCatalog, catalog_to_json
 from respec.robot.files import SystemConfigError
 from respec.naming import DEFAULT_SM_OUTCOMES
+from respec.nesting import run_with_deep_stack
 from synthesis_manager.ros.conversions import error_code, msg_to_sections, spec_to_msg
 from synthesis_manager.limits import check_message
 from synthesis_manager.ros.errors import reported_error
@@ -58,21 +59,26 @@ class LTLCompilationNode(Node):
     def on_request(self, request, response):
         try:
             check_message(request)
-            spec = compile_task(
-                request.system, list(request.initial_conditions), list(request.goals),
-                sm_outcomes=tuple(request.sm_outcomes) or DEFAULT_SM_OUTCOMES,
-                strict_order=not request.unordered_goals,
-                custom_ltl=msg_to_sections(request.custom_ltl) or None,
-                config_dir=self.get_parameter('config_dir').value or None)
+            # Custom formulas may nest MAX_FORMULA_NESTING deep: compiled and printed on a deep stack.
+            response.ltl_specification, response.provenance = run_with_deep_stack(self._compile, request)
         except Exception as error:  # every failure becomes an error code; the node keeps serving
             response.error_code = reported_error(error, self.get_logger(), 'LTL compilation failed')
             self.get_logger().warning(response.error_code.message)
             return response
-        response.ltl_specification = spec_to_msg(spec)
-        # CNU capability systems record none: their unrealizable specifications are not diagnosed.
-        response.provenance = provenance_to_json(spec.provenance) if spec.provenance is not None else ''
         response.error_code = error_code()
         return response
+
+    def _compile(self, request):
+        """The request's specification message and its provenance (JSON)."""
+        spec = compile_task(
+            request.system, list(request.initial_conditions), list(request.goals),
+            sm_outcomes=tuple(request.sm_outcomes) or DEFAULT_SM_OUTCOMES,
+            strict_order=not request.unordered_goals,
+            custom_ltl=msg_to_sections(request.custom_ltl) or None,
+            config_dir=self.get_parameter('config_dir').value or None)
+        # CNU capability systems record none: their unrealizable specifications are not diagnosed.
+        provenance = provenance_to_json(spec.provenance) if spec.provenance is not None else ''
+        return spec_to_msg(spec), provenance
 
 
 def main():

@@ -23,6 +23,7 @@ from ltl_synthesizer.isolated import SERVER_CHILD_NICENESS, SynthesisProcesses
 from ltl_synthesizer.strategy import strategy_to_json
 from respec.automaton import automaton_from_strategy
 from respec.errors import ErrorCode
+from respec.nesting import run_with_deep_stack
 from respec.parsing import ParseError, spec_from_text_sections
 from synthesis_manager.byproducts import DEFAULT_KEEP_LAST, ByproductStore, default_directory
 from synthesis_manager.limits import check_message, check_timeout
@@ -136,7 +137,9 @@ class LTLSynthesisNode(Node):
             # The time limit starts now: waiting for a worker counts.
             deadline = time.monotonic() + timeout
             try:
-                await self.workers.run(self._synthesize, request, response, cancel, timeout, deadline,
+                # Formulas are parsed, printed and pickled to the synthesis process on a deep stack.
+                await self.workers.run(run_with_deep_stack, self._synthesize, request, response, cancel,
+                                       timeout, deadline,
                                        wake=self._wake_executor,
                                        give_up=lambda: cancel.is_set() or time.monotonic() > deadline)
             except Abandoned:  # stopped while waiting for a worker

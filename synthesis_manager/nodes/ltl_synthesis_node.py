@@ -22,7 +22,7 @@ from ltl_synthesizer.external import run_external_synthesizer
 from ltl_synthesizer.isolated import SERVER_CHILD_NICENESS, SynthesisProcesses
 from ltl_synthesizer.strategy import strategy_to_json
 from respec.automaton import automaton_from_strategy
-from respec.errors import ErrorCode
+from respec.errors import CodedError, ErrorCode
 from respec.nesting import run_with_deep_stack
 from respec.parsing import ParseError, spec_from_text_sections
 from synthesis_manager.byproducts import DEFAULT_KEEP_LAST, ByproductStore, default_directory
@@ -83,6 +83,7 @@ class LTLSynthesisNode(Node):
         self.workers = WorkerPool(self.parameter('parallel_syntheses'), self.parameter('queued_syntheses'),
                                   name='synthesis')
         self.synthesis_processes = SynthesisProcesses(niceness=SERVER_CHILD_NICENESS)
+        self._prune_leftovers()
         if self.parameter('backend') == 'builtin':
             self.synthesis_processes.prepare()
         group = ReentrantCallbackGroup()
@@ -92,6 +93,16 @@ class LTLSynthesisNode(Node):
                             qos_profile=service_qos())
         self.create_service(CancelSynthesis, 'ltl_synthesis/cancel', self.on_cancel_request,
                             callback_group=group, qos_profile=service_qos())
+
+    def _prune_leftovers(self):
+        """Delete what cut-short writes left in the byproducts directory (a full disk, a kill)."""
+        try:
+            deleted = self.byproduct_store().prune_leftovers()
+        except (OSError, CodedError) as error:  # e.g. an unsafe directory: every synthesis will say so
+            self.get_logger().warning(f'byproduct leftovers not pruned: {error}'[:300])
+            return
+        if deleted:
+            self.get_logger().info(f'pruned {len(deleted)} byproduct leftovers (.part files, empty markers)')
 
     def stop_work(self):
         """Stop every running synthesis (at shutdown, so the process exits promptly)."""

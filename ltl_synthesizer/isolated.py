@@ -190,8 +190,10 @@ class SynthesisProcesses:
     """A pool of synthesis child processes, one per synthesis running at the same time, each
     ``niceness`` below its parent's CPU priority."""
 
-    def __init__(self, idle_seconds: float = IDLE_SECONDS, niceness: int = CHILD_NICENESS):
-        self.idle_seconds, self.niceness = idle_seconds, niceness
+    def __init__(self, idle_seconds: float = IDLE_SECONDS, niceness: int = CHILD_NICENESS,
+                 preload: str = SYNTHESIZER_MODULE):
+        """``preload``: what the children import before their first request."""
+        self.idle_seconds, self.niceness, self.preload = idle_seconds, niceness, preload
         self._idle: list[ChildProcess] = []
         self._busy: set[ChildProcess] = set()
         self._lock = threading.Lock()
@@ -206,7 +208,7 @@ class SynthesisProcesses:
         with self._lock:
             self._prepared = count
             while len(self._idle) < count and not self._closed:
-                self._idle.append(ChildProcess(self.niceness))
+                self._idle.append(ChildProcess(self.niceness, self.preload))
 
     @property
     def idle_count(self) -> int:
@@ -223,7 +225,7 @@ class SynthesisProcesses:
                          and not child.fresh]
                 self._idle = [child for child in self._idle if child not in stale]
                 replacements = min(len(stale), self._prepared - len(self._idle))
-                self._idle += [ChildProcess(self.niceness) for _ in range(replacements)]
+                self._idle += [ChildProcess(self.niceness, self.preload) for _ in range(replacements)]
                 next_check = min((child.idle_since + self.idle_seconds for child in self._idle
                                   if not child.fresh), default=None)
             for child in stale:
@@ -268,7 +270,7 @@ class SynthesisProcesses:
         if child is None or not child.settle():
             if child is not None:
                 child.kill()
-            child = ChildProcess(self.niceness)
+            child = ChildProcess(self.niceness, self.preload)
         with self._lock:
             self._busy.add(child)
         return child
@@ -287,7 +289,7 @@ class SynthesisProcesses:
                 self._wake_reaper.set()
             elif not self._closed and not self._idle:
                 # A replacement starts now, while the caller reports the stop.
-                self._idle.append(ChildProcess(self.niceness))
+                self._idle.append(ChildProcess(self.niceness, self.preload))
         if not keep:
             child.kill()
 

@@ -26,7 +26,7 @@ from respec.errors import CodedError, ErrorCode
 from respec.nesting import run_with_deep_stack
 from respec.parsing import ParseError, spec_from_text_sections
 from synthesis_manager.byproducts import DEFAULT_KEEP_LAST, ByproductStore, default_directory
-from synthesis_manager.limits import check_message, check_timeout
+from synthesis_manager.limits import DEFAULT_MAX_GOAL_TIMEOUT, capped_timeout, check_message, check_timeout
 from synthesis_manager.ros.conversions import automaton_to_msg, error_code, msg_to_sections
 from synthesis_manager.ros.errors import reported_error
 from synthesis_manager.ros.node_main import node_main
@@ -56,7 +56,8 @@ class LTLSynthesisNode(Node):
     ``memory_limit_mb`` (per synthesis; beyond it the synthesis ends with SYNTHESIS_FAILED
     naming the limit, not an OOM kill); ``diagnosis_timeout`` (seconds to find why an
     unrealizable specification cannot be met, used when a request gives none; never past the
-    request's time limit); ``parallel_syntheses`` (run at once) and ``queued_syntheses`` (waiting beyond those;
+    request's time limit); ``max_timeout`` (seconds: the longest time limit a request gets,
+    600; 0: no cap); ``parallel_syntheses`` (run at once) and ``queued_syntheses`` (waiting beyond those;
     further requests are answered BUSY).
 
     Syntheses run in the node's own worker threads, awaited by an async service callback,
@@ -73,6 +74,7 @@ class LTLSynthesisNode(Node):
         self.declare_parameter('backend', 'builtin')
         self.declare_parameter('slugs_executable', 'slugs')
         self.declare_parameter('timeout', 60.0)
+        self.declare_parameter('max_timeout', DEFAULT_MAX_GOAL_TIMEOUT)
         self.declare_parameter('robotics_semantics', True)
         self.declare_parameter('memory_limit_mb', 2048)
         self.declare_parameter('diagnosis_timeout', 20.0)
@@ -143,7 +145,9 @@ class LTLSynthesisNode(Node):
             self._running[request_id] = cancel
         try:
             check_message(request)
-            timeout = check_timeout(request.timeout, 'request.timeout') or self.parameter('timeout')
+            # A request asking more than max_timeout gets the cap (as a goal gets max_goal_timeout).
+            timeout = capped_timeout(check_timeout(request.timeout, 'request.timeout') or self.parameter('timeout'),
+                                     self.parameter('max_timeout'))
             check_timeout(request.diagnosis_timeout, 'request.diagnosis_timeout')
             # The time limit starts now: waiting for a worker counts.
             deadline = time.monotonic() + timeout

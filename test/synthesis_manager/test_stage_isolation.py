@@ -1,0 +1,74 @@
+"""Large custom formulas are compiled where they can be stopped, and the direct synthesis
+service caps its time limit (issue 34, item 2): 20 goals of 11 MB custom formulas froze the
+server (compiled synchronously in its process, holding the GIL; a normal goal after them
+waited 228 s), and a SynthesizeAutomaton request could ask for any time limit."""
+
+import threading
+import time
+
+from rclpy.parameter import Parameter
+
+from respec.nesting import run_with_deep_stack
+from synthesis_manager.client import make_goal
+from synthesis_manager.nodes.ltl_compilation_node import SMALL_CUSTOM_BYTES, LTLCompilationNode, compiled_sections
+from test_synthesis_manager_reliability import PAPER_TASK, runaway_goal, start_suite
+
+FORMULA_BYTES = 56_000  # as in the attack: just under the 64 KB string cap
+
+
+def custom_formulas(total_bytes: int) -> list[str]:
+    """Formulas over the paper task's propositions, FORMULA_BYTES each, ``total_bytes`` in all."""
+    clause = '(look_down_a | !stand_prep_a)'
+    formula = ' & '.join([clause] * (FORMULA_BYTES // (len(clause) + 3)))
+    return [formula] * max(1, total_bytes // len(formula))
+
+
+def start(ros, tmp_path, compile_timeout: float = 30.0, synthesis_parameters=()):
+    ros.add_node(LTLCompilationNode, parameter_overrides=[Parameter('timeout', value=compile_timeout)])
+    return start_suite(ros, tmp_path, names=('ltl_synthesis', 'sm_generation'),
+                       synthesis_parameters=synthesis_parameters)
+
+
+def test_large_custom_formulas_compile_in_a_child_to_the_same_specification(ros, tmp_path):
+    client = start(ros, tmp_path)
+    formulas = custom_formulas(2 * SMALL_CUSTOM_BYTES)
+    outcome = client.run(make_goal(**PAPER_TASK, option='ltl_compilation_only',
+                                   ltl_specification={'sys_trans': formulas}), timeout=60)
+    assert outcome.error_name == 'SUCCESS', outcome.message
+    sections, _ = run_with_deep_stack(compiled_sections, PAPER_TASK['system'], PAPER_TASK['initial_conditions'],
+                                      PAPER_TASK['goals'], ('finished', 'failed'), True, {'sys_trans': formulas}, None)
+    assert outcome.ltl_specification == {name: lines for name, lines in sections.items() if lines}
+
+
+def test_a_huge_compilation_stops_at_its_limit_and_a_normal_goal_is_served_meanwhile(ros, tmp_path):
+    client = start(ros, tmp_path, compile_timeout=2.0)
+    huge = make_goal(**PAPER_TASK, option='ltl_compilation_only',
+                     ltl_specification={'sys_trans': custom_formulas(3_900_000)})  # about 8 s to compile
+    answers = {}
+
+    def send_huge():
+        started = time.monotonic()
+        answers['huge'] = client.run(huge, timeout=120)
+        answers['huge seconds'] = time.monotonic() - started
+
+    sender = threading.Thread(target=send_huge)
+    sender.start()
+    time.sleep(1.0)  # the huge one is compiling
+    started = time.monotonic()
+    normal = client.run(make_goal(**PAPER_TASK), timeout=60)
+    normal_seconds = time.monotonic() - started
+    sender.join(60)
+    print(f'normal goal: {normal_seconds:.2f} s during a huge compilation; the huge one: '
+          f'{answers["huge"].error_name} after {answers["huge seconds"]:.2f} s')
+    assert normal.error_name == 'SUCCESS' and normal_seconds < 2.0, normal.message
+    assert answers['huge'].error_name == 'TIMEOUT', answers['huge'].message
+    assert 'LTL compilation' in answers['huge'].message
+    assert answers['huge seconds'] < 2.0 + 2.0  # its limit, sending 4 MB and the answer
+
+
+def test_the_synthesis_service_caps_a_requests_time_limit(ros, tmp_path):
+    client = start(ros, tmp_path, synthesis_parameters=[Parameter('max_timeout', value=2.0)])
+    started = time.monotonic()
+    outcome = client.run(runaway_goal(), timeout=60)  # asks the server's 120 s
+    assert outcome.error_name == 'SYNTHESIS_TIMEOUT', outcome.message
+    assert 'time limit 2 s' in outcome.message and time.monotonic() - started < 2.0 + 1.5

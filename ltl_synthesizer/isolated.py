@@ -74,6 +74,32 @@ class SynthesisProcessDiedError(SynthesisError):
     """The process running the synthesis ended without an answer."""
 
 
+class StrategyTooLargeError(SynthesisError):
+    """A strategy with more edges than the caller takes (``item``: 'max_strategy_edges')."""
+
+
+def strategy_edges(strategy: dict) -> int:
+    """The transitions of an explicit strategy (slugs' JSON shape)."""
+    return sum(len(node['trans']) for node in strategy['nodes'].values())
+
+
+def synthesize_within(spec, robotics_semantics: bool, limits: Limits, options, max_strategy_edges: int):
+    """:func:`ltl_synthesizer.synthesize`, refusing (StrategyTooLargeError) a strategy of more
+    than ``max_strategy_edges`` edges before it is sent: each edge costs the receiving server
+    about 900 B once turned into an automaton, its byproduct and its messages (a 215-byte
+    specification with 11 free inputs has 8.4 M edges and grew a server to 7.7 GB)."""
+    from ltl_synthesizer.synthesizer import synthesize
+    result = synthesize(spec, robotics_semantics, limits, options)
+    if result.strategy is not None:
+        edges = strategy_edges(result.strategy)
+        if edges > max_strategy_edges:
+            raise StrategyTooLargeError(
+                f'the strategy has {edges:,} transitions ({len(result.strategy["nodes"]):,} states), over the '
+                f'{max_strategy_edges:,} this server sends (max_strategy_edges); constrain the inputs '
+                '(ENV_TRANS) or raise the limit', item='max_strategy_edges')
+    return result
+
+
 #: What the pool's children import before their first request.
 SYNTHESIZER_MODULE = 'ltl_synthesizer.synthesizer'
 
@@ -233,9 +259,14 @@ class SynthesisProcesses:
             self._wake_reaper.wait(None if next_check is None else max(0.05, next_check - time.monotonic()))
             self._wake_reaper.clear()
 
-    def synthesize(self, spec, robotics_semantics: bool = True, limits: Limits = Limits(), options=None):
-        """:func:`ltl_synthesizer.synthesize` in a child, killed once ``limits`` stop it."""
+    def synthesize(self, spec, robotics_semantics: bool = True, limits: Limits = Limits(), options=None,
+                   max_strategy_edges: int | None = None):
+        """:func:`ltl_synthesizer.synthesize` in a child, killed once ``limits`` stop it; with
+        ``max_strategy_edges``, a larger strategy is refused in the child (:func:`synthesize_within`)."""
         from ltl_synthesizer.synthesizer import synthesize
+        if max_strategy_edges:
+            return self.call(synthesize_within, (spec, robotics_semantics, limits.without_cancel(), options,
+                                                 max_strategy_edges), cancel=limits.cancel, deadline=limits.deadline)
         return self.call(synthesize, (spec, robotics_semantics, limits.without_cancel(), options),
                          cancel=limits.cancel, deadline=limits.deadline)
 

@@ -40,6 +40,9 @@ BACKENDS = ('builtin', 'slugs')
 # name so that tests can put a stand-in there).
 DIAGNOSIS = explain_unsynthesizable
 DIAGNOSIS_GRACE = 1.0  # seconds past its own time limit before the diagnosis process is killed
+#: Largest strategy (transitions) a builtin synthesis sends back: about 900 B each in the
+#: server (automaton, JSON byproduct, messages), so about 90 MB per goal at most.
+DEFAULT_MAX_STRATEGY_EDGES = 100_000
 
 
 WAKE_PERIOD = 0.1  # seconds
@@ -56,7 +59,8 @@ class LTLSynthesisNode(Node):
     ``memory_limit_mb`` (per synthesis; beyond it the synthesis ends with SYNTHESIS_FAILED
     naming the limit, not an OOM kill); ``diagnosis_timeout`` (seconds to find why an
     unrealizable specification cannot be met, used when a request gives none; never past the
-    request's time limit); ``max_timeout`` (seconds: the longest time limit a request gets,
+    request's time limit); ``max_strategy_edges`` (largest builtin strategy sent back, in
+    transitions; larger ones are SYNTHESIS_FAILED naming their size; 0: no limit); ``max_timeout`` (seconds: the longest time limit a request gets,
     600; 0: no cap); ``parallel_syntheses`` (run at once) and ``queued_syntheses`` (waiting beyond those;
     further requests are answered BUSY).
 
@@ -75,6 +79,7 @@ class LTLSynthesisNode(Node):
         self.declare_parameter('slugs_executable', 'slugs')
         self.declare_parameter('timeout', 60.0)
         self.declare_parameter('max_timeout', DEFAULT_MAX_GOAL_TIMEOUT)
+        self.declare_parameter('max_strategy_edges', DEFAULT_MAX_STRATEGY_EDGES)
         self.declare_parameter('robotics_semantics', True)
         self.declare_parameter('memory_limit_mb', 2048)
         self.declare_parameter('diagnosis_timeout', 20.0)
@@ -189,7 +194,8 @@ class LTLSynthesisNode(Node):
             if backend == 'builtin':
                 try:
                     result = self.synthesis_processes.synthesize(spec, robotics, Limits(
-                        cancel, deadline, self.parameter('memory_limit_mb') * 2**20))
+                        cancel, deadline, self.parameter('memory_limit_mb') * 2**20),
+                        max_strategy_edges=self.parameter('max_strategy_edges'))
                 except SynthesisCancelledError as stopped:
                     return self._stopped(response, stopped.reason, timeout)
                 realizable, strategy, explanation = result.realizable, result.strategy, result.explanation

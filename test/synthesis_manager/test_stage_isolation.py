@@ -72,3 +72,27 @@ def test_the_synthesis_service_caps_a_requests_time_limit(ros, tmp_path):
     outcome = client.run(runaway_goal(), timeout=60)  # asks the server's 120 s
     assert outcome.error_name == 'SYNTHESIS_TIMEOUT', outcome.message
     assert 'time limit 2 s' in outcome.message and time.monotonic() - started < 2.0 + 1.5
+
+
+def free_inputs_spec(inputs: int) -> dict:
+    """A specification whose strategy answers every valuation of ``inputs`` free inputs:
+    2**(inputs + 1) states, 2**(2 inputs + 1) transitions (11 inputs: 8.4 M, issue 34 item 3)."""
+    return {'env_props': [f'e{i}' for i in range(inputs)], 'sys_props': ['p'], 'sys_liveness': ['p']}
+
+
+def test_a_strategy_over_the_budget_is_refused_naming_its_size(ros, tmp_path):
+    """Issue 34, item 3: a 215-byte specification's 8.4 M-transition strategy grew the server to
+    7.7 GB. The synthesis child counts the strategy before sending it: over max_strategy_edges
+    it is SYNTHESIS_FAILED naming both sizes; within it, SUCCESS as before."""
+    client = start(ros, tmp_path, synthesis_parameters=[Parameter('max_strategy_edges', value=1000)])
+    started = time.monotonic()
+    refused = client.run(make_goal('atlas', [], [], option='ltl_synthesis_only',
+                                   ltl_specification=free_inputs_spec(6)), timeout=60)
+    assert refused.error_name == 'SYNTHESIS_FAILED', refused.message
+    assert '8,192 transitions' in refused.message and '1,000' in refused.message
+    assert 'max_strategy_edges' in refused.message and len(refused.message) < 300
+    assert time.monotonic() - started < 10
+    within = client.run(make_goal('atlas', [], [], option='ltl_synthesis_only',
+                                  ltl_specification=free_inputs_spec(3)), timeout=60)
+    assert within.error_name == 'SUCCESS', within.message
+    assert sum(len(state['transitions']) for state in within.automaton['states']) <= 1000

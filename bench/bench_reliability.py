@@ -16,12 +16,18 @@
   says what came back, how long after its limit, and the server's peak RSS growth; the
   simulations also the peak RSS of a simulation process itself (VmHWM).
 - idle: the server's RSS (with its synthesis processes) after a burst and after they idled.
+- service (issue 34, full sizes; reliability_service.py): 20 goals of 3.9 MB custom LTL with
+  5 s limits (and one of 11 MB), a strategy of 8.4 M transitions, two BDD bombs in a row, a
+  50 MB goal list, a 200-goal mixed burst with 1 s limits, each on a fresh ``serve``: what came
+  back and when, the server's peak RSS, a normal goal's time right after, SIGTERM's time 2 s
+  into it; ``kill -9`` of serve during a goal (when send-goal notices), gr1synth
+  --memory-limit 200 on a 192 MB input, and a 100,000-deep body POSTed to the GUI.
 
 The server and GUI run as their real console entry points in separate processes on a
 reserved ROS domain; the clients are in this process. Prints a table and writes the sections
 run into bench/results/reliability.md (the others are kept).
 
-    .venv/bin/python bench/bench_reliability.py [--sections burst,soak,gui,attacks,idle]
+    .venv/bin/python bench/bench_reliability.py [--sections burst,soak,gui,attacks,idle,service]
         [--goals 2000] [--in-flight 4] [--warmup 600] [--flood 10000]
 """
 
@@ -210,7 +216,7 @@ def idle_release(client, server_pid: int, idle_seconds: float = 35.0) -> dict:
             f'RSS after {idle_seconds:g} s idle MiB': rss_kib(server_pid) / 1024}
 
 
-SECTIONS = ('burst', 'soak', 'gui', 'attacks', 'idle')
+SECTIONS = ('burst', 'soak', 'gui', 'attacks', 'idle', 'service')
 #: The parts of 'attacks', each also selectable alone.
 ATTACKS = ('hostile', 'limits', 'qos', 'simulations')
 
@@ -235,6 +241,21 @@ def main(argv=None) -> int:
     from synthesis_manager.ros.harness import RosHarness, reserve_domain_id
 
     report = {}
+    if 'service' in sections:
+        import reliability_service as service
+        with reserve_domain_id() as domain:
+            report.update({f'service: {title}': figures
+                           for title, figures in service.serve_attacks(domain, rss_kib, Serve).items()})
+            print('service: kill -9 of serve during a goal', flush=True)
+            report['service: kill -9 of serve during a goal'] = service.killed_server(domain, Serve)
+        print('service: gr1synth on a large input', flush=True)
+        report['service: gr1synth --memory-limit'] = service.gr1synth_large_input()
+        with reserve_domain_id() as domain, tempfile.TemporaryDirectory(prefix='bench-gui-') as byproducts, \
+                gui_process(domain, byproducts) as (url, gui_pid):
+            print('service: a 100,000-deep body to the GUI', flush=True)
+            report['service: GUI, 100,000-deep body'] = service.gui_deep_body(url, gui_pid, rss_kib)
+    if not set(sections) - {'service'}:
+        sections = []
     with tempfile.TemporaryDirectory(prefix='bench-reliability-') as byproducts:
         with reserve_domain_id() as domain:
             serve = Serve(domain, byproducts)

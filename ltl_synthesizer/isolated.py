@@ -78,6 +78,25 @@ class StrategyTooLargeError(SynthesisError):
     """A strategy with more edges than the caller takes (``item``: 'max_strategy_edges')."""
 
 
+class SpecificationText:
+    """A specification as its text sections, parsed where it is used: in the child (passed as
+    an argument, the child gives the function the parsed GR1Specification). Parsing, printing
+    and pickling a large specification take seconds of pure Python: done in the caller, they
+    hold its interpreter, uninterruptible (a 3.9 MB one, about 9 s)."""
+
+    def __init__(self, sections: dict):
+        self.sections = sections
+
+    def parsed(self):
+        from respec.parsing import spec_from_text_sections
+        return spec_from_text_sections(self.sections)
+
+
+def byproduct_texts(spec) -> tuple[str, str, list, list]:
+    """The ``.structuredslugs`` and ``.slugsin`` texts of ``spec``, and its inputs and outputs."""
+    return spec.to_structuredslugs(), spec.to_slugsin(), list(spec.env_props), list(spec.sys_props)
+
+
 def strategy_edges(strategy: dict) -> int:
     """The transitions of an explicit strategy (slugs' JSON shape)."""
     return sum(len(node['trans']) for node in strategy['nodes'].values())
@@ -327,6 +346,8 @@ class SynthesisProcesses:
 
 def _serve(parent_pid: int, preload: str) -> None:
     """The child: answer requests until stdin closes or the parent is gone."""
+    # This module runs as __main__ here: requests name the class of its imported copy.
+    text_type = importlib.import_module('ltl_synthesizer.isolated').SpecificationText
     _die_with_parent(parent_pid)
     requests = sys.stdin.buffer
     answers = os.fdopen(os.dup(sys.stdout.fileno()), 'wb')
@@ -348,6 +369,7 @@ def _serve(parent_pid: int, preload: str) -> None:
         if wants_progress:
             kwargs['progress'] = lambda value: send(('progress', value))
         try:
+            args = [argument.parsed() if isinstance(argument, text_type) else argument for argument in args]
             answer = ('result', function(*args, **kwargs))
         except Exception as error:  # noqa: BLE001 -- every failure goes back to the caller
             error.add_note(f'in the synthesis process:\n{traceback.format_exc()}')

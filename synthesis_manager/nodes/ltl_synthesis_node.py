@@ -19,14 +19,16 @@ from ltl_specification.diagnosis import explain_unsynthesizable
 from ltl_specification.provenance import provenance_from_json
 from ltl_synthesizer import Limits, SynthesisCancelledError, SynthesisError
 from ltl_synthesizer.external import run_external_synthesizer
-from ltl_synthesizer.isolated import SERVER_CHILD_NICENESS, SynthesisProcesses
+from ltl_synthesizer.isolated import SERVER_CHILD_NICENESS, SpecificationText, SynthesisProcesses, byproduct_texts
 from ltl_synthesizer.strategy import strategy_to_json
 from respec.automaton import automaton_from_strategy
 from respec.errors import CodedError, ErrorCode
 from respec.nesting import run_with_deep_stack
 from respec.parsing import ParseError, spec_from_text_sections
+from respec.spec import GR1Specification
 from synthesis_manager.byproducts import DEFAULT_KEEP_LAST, ByproductStore, default_directory
-from synthesis_manager.limits import DEFAULT_MAX_GOAL_TIMEOUT, capped_timeout, check_message, check_timeout
+from synthesis_manager.limits import (DEFAULT_MAX_GOAL_TIMEOUT, capped_timeout, check_message, check_timeout,
+                                      utf8_length)
 from synthesis_manager.ros.conversions import automaton_to_msg, error_code, msg_to_sections
 from synthesis_manager.ros.errors import reported_error
 from synthesis_manager.ros.node_main import node_main
@@ -40,6 +42,9 @@ BACKENDS = ('builtin', 'slugs')
 # name so that tests can put a stand-in there).
 DIAGNOSIS = explain_unsynthesizable
 DIAGNOSIS_GRACE = 1.0  # seconds past its own time limit before the diagnosis process is killed
+#: Specifications (bytes of text) over this are parsed and printed in a synthesis child process,
+#: where a deadline or a cancel stops them, not in the node's (builtin backend).
+LARGE_SPEC_BYTES = 64 * 1024
 #: Largest strategy (transitions) a builtin synthesis sends back: about 900 B each in the
 #: server (automaton, JSON byproduct, messages), so about 90 MB per goal at most.
 DEFAULT_MAX_STRATEGY_EDGES = 100_000
@@ -185,12 +190,25 @@ class LTLSynthesisNode(Node):
     def _synthesize(self, request, response, cancel, timeout, deadline):
         if cancel.is_set() or time.monotonic() > deadline:  # stopped while waiting for a worker
             return self._stopped(response, 'cancelled' if cancel.is_set() else 'timeout', timeout)
-        spec = spec_from_text_sections(msg_to_sections(request.ltl_specification))
+        sections = msg_to_sections(request.ltl_specification)
+        backend = self.parameter('backend')
+        if backend == 'builtin' and sum(utf8_length(line) for lines in sections.values() for line in lines) > \
+                LARGE_SPEC_BYTES:
+            spec = SpecificationText(sections)  # parsed in the synthesis children
+            try:
+                structuredslugs, slugsin, inputs, outputs = self.synthesis_processes.call(
+                    byproduct_texts, (spec,), cancel=cancel, deadline=deadline)
+            except SynthesisCancelledError as stopped:
+                return self._stopped(response, stopped.reason, timeout)
+            variables = GR1Specification(env_props=inputs, sys_props=outputs)  # what the automaton names
+        else:
+            spec = variables = spec_from_text_sections(sections)
+            structuredslugs, slugsin = spec.to_structuredslugs(), spec.to_slugsin()
         with self.byproduct_store().open_set(request.spec_name) as files:
-            files.write('structuredslugs', spec.to_structuredslugs())
-            slugsin_path = files.write('slugsin', spec.to_slugsin())
+            files.write('structuredslugs', structuredslugs)
+            slugsin_path = files.write('slugsin', slugsin)
+            del structuredslugs, slugsin
             robotics = self.parameter('robotics_semantics')
-            backend = self.parameter('backend')
             if backend == 'builtin':
                 try:
                     result = self.synthesis_processes.synthesize(spec, robotics, Limits(
@@ -219,7 +237,7 @@ class LTLSynthesisNode(Node):
                 response.error_code = error_code(ErrorCode.SPEC_UNSYNTHESIZABLE, message)
                 return
             files.write('json', strategy_to_json(strategy))
-        response.automaton = automaton_to_msg(automaton_from_strategy(strategy, spec))
+        response.automaton = automaton_to_msg(automaton_from_strategy(strategy, variables))
         response.error_code = error_code()
 
     def _diagnosed(self, details: str, spec, request, robotics_semantics: bool, cancel: threading.Event,

@@ -16,9 +16,8 @@ from test_synthesis_manager_reliability import PAPER_TASK, runaway_goal, start_s
 FORMULA_BYTES = 56_000  # as in the attack: just under the 64 KB string cap
 
 
-def custom_formulas(total_bytes: int) -> list[str]:
+def custom_formulas(total_bytes: int, clause: str = '(look_down_a | !stand_prep_a)') -> list[str]:
     """Formulas over the paper task's propositions, FORMULA_BYTES each, ``total_bytes`` in all."""
-    clause = '(look_down_a | !stand_prep_a)'
     formula = ' & '.join([clause] * (FORMULA_BYTES // (len(clause) + 3)))
     return [formula] * max(1, total_bytes // len(formula))
 
@@ -96,3 +95,57 @@ def test_a_strategy_over_the_budget_is_refused_naming_its_size(ros, tmp_path):
                                   ltl_specification=free_inputs_spec(3)), timeout=60)
     assert within.error_name == 'SUCCESS', within.message
     assert sum(len(state['transitions']) for state in within.automaton['states']) <= 1000
+
+
+def large_spec(total_bytes: int) -> dict:
+    """A realizable specification of ``total_bytes`` of formulas (over the node's LARGE_SPEC_BYTES)."""
+    return {'env_props': ['look_down_a'], 'sys_props': ['stand_prep_a'], 'sys_liveness': ['stand_prep_a'],
+            'sys_trans': custom_formulas(total_bytes, "(stand_prep_a' | !look_down_a)")}
+
+
+def test_a_large_specification_is_read_in_the_synthesis_child_to_the_same_automaton(ros, tmp_path):
+    from ltl_synthesizer import synthesize
+    from respec.automaton import automaton_from_strategy
+    from respec.parsing import spec_from_text_sections
+    from synthesis_manager.client import automaton_to_dict
+    from synthesis_manager.nodes.ltl_synthesis_node import LARGE_SPEC_BYTES
+    from synthesis_manager.ros.conversions import automaton_to_msg
+
+    client = start(ros, tmp_path)
+    sections = large_spec(2 * LARGE_SPEC_BYTES)
+    outcome = client.run(make_goal('atlas', [], [], option='ltl_synthesis_only', ltl_specification=sections),
+                         timeout=60)
+    assert outcome.error_name == 'SUCCESS', outcome.message
+    spec = run_with_deep_stack(spec_from_text_sections, sections)
+    expected = automaton_to_msg(automaton_from_strategy(synthesize(spec).strategy, spec))
+    assert outcome.automaton == automaton_to_dict(expected)
+    [slugsin] = tmp_path.glob('*.slugsin')  # the byproduct, printed in the child
+    assert slugsin.read_text() == spec.to_slugsin()
+    malformed = client.run(make_goal('atlas', [], [], option='ltl_synthesis_only', ltl_specification={
+        **sections, 'sys_trans': [*sections['sys_trans'], 'stand_prep_a &']}), timeout=60)
+    assert malformed.error_name == 'INVALID_FORMULA' and 'malformed specification' in malformed.message
+
+
+def test_a_huge_specification_stops_at_its_limit_and_a_normal_goal_is_served_meanwhile(ros, tmp_path):
+    client = start(ros, tmp_path)
+    huge = make_goal('atlas', [], [], option='ltl_synthesis_only', timeout=2.0,
+                     ltl_specification=large_spec(3_900_000))  # about 9 s to parse and print
+    answers = {}
+
+    def send_huge():
+        started = time.monotonic()
+        answers['huge'] = client.run(huge, timeout=120)
+        answers['huge seconds'] = time.monotonic() - started
+
+    sender = threading.Thread(target=send_huge)
+    sender.start()
+    time.sleep(1.0)
+    started = time.monotonic()
+    normal = client.run(make_goal(**PAPER_TASK), timeout=60)
+    normal_seconds = time.monotonic() - started
+    sender.join(60)
+    print(f'normal goal: {normal_seconds:.2f} s beside a huge specification; the huge one: '
+          f'{answers["huge"].error_name} after {answers["huge seconds"]:.2f} s')
+    assert normal.error_name == 'SUCCESS' and normal_seconds < 2.0, normal.message
+    assert answers['huge'].error_name in ('SYNTHESIS_TIMEOUT', 'TIMEOUT'), answers['huge'].message
+    assert answers['huge seconds'] < 2.0 + 2.0

@@ -254,47 +254,50 @@ def main(argv=None) -> int:
                 gui_process(domain, byproducts) as (url, gui_pid):
             print('service: a 100,000-deep body to the GUI', flush=True)
             report['service: GUI, 100,000-deep body'] = service.gui_deep_body(url, gui_pid, rss_kib)
-    if not set(sections) - {'service'}:
-        sections = []
+    on_serve = set(sections) & {'idle', 'burst', 'soak', 'hostile', 'limits', 'qos'}
     with tempfile.TemporaryDirectory(prefix='bench-reliability-') as byproducts:
-        with reserve_domain_id() as domain:
-            serve = Serve(domain, byproducts)
-            try:
-                with RosHarness(domain_id=domain) as ros:
-                    client = SynthesisClient(ros.add_node(Node, 'bench_reliability_client'))
-                    assert client.wait_for_server(timeout=60.0), 'serve did not come up'
-                    for _ in range(3):  # warm-up: imports, discovery
-                        timed_run(client, make_goal(*TASK))
-                    if 'idle' in sections:
-                        print('idle: RSS after a burst and after idling', flush=True)
-                        report['idle synthesis processes'] = idle_release(client, serve.process.pid)
-                    if 'burst' in sections:
-                        print('burst: 50 goals at once to serve', flush=True)
-                        report['burst'] = burst(client)
-                    if 'hostile' in sections:
-                        print('attacks: hostile goals', flush=True)
-                        flexbe_client = SynthesisClient(ros.add_node(Node, 'bench_flexbe_client'), 'flexbe_synthesis')
-                        assert flexbe_client.wait_for_server(timeout=60.0)
-                        report['hostile goals'] = attacks.hostile_goals(client, flexbe_client, serve.process.pid, rss_kib)
-                    if 'limits' in sections:
-                        print('attacks: time limits under load', flush=True)
-                        runaway = make_goal('atlas', [], [], option='ltl_synthesis_only', timeout=30.0, ltl_specification={
-                            'sys_props': [f'p{i}' for i in range(200)], 'env_props': ['e'], 'sys_liveness': ['p0']})
-                        report['time limits under load'] = attacks.limits_under_load(client, runaway)
-                    if 'qos' in sections:
-                        print('attacks: default-QoS clients', flush=True)
-                        plain = attacks.plain_client(ros.add_node(Node, 'bench_default_qos_client'))
-                        report['default-QoS client, 200 goals'] = attacks.plain_client_burst(plain, 200)
-                        report[f'default-QoS client, {args.flood} goals'] = attacks.plain_client_burst(
-                            plain, args.flood)
-                        deep = attacks.plain_client(ros.add_node(Node, 'bench_deep_qos_client'), deep_queues=True)
-                        report[f'client with deep queues, {args.flood} goals'] = attacks.plain_client_burst(
-                            deep, args.flood)
-                    if 'soak' in sections:
-                        print(f'soak: {args.goals} goals, {args.in_flight} in flight', flush=True)
-                        report['soak'] = soak(client, serve.process.pid, args.goals, args.in_flight, args.warmup)
-            finally:
-                serve.stop()
+        if on_serve:  # the sections on one shared serve
+            with reserve_domain_id() as domain:
+                serve = Serve(domain, byproducts)
+                try:
+                    with RosHarness(domain_id=domain) as ros:
+                        client = SynthesisClient(ros.add_node(Node, 'bench_reliability_client'))
+                        assert client.wait_for_server(timeout=60.0), 'serve did not come up'
+                        for _ in range(3):  # warm-up: imports, discovery
+                            timed_run(client, make_goal(*TASK))
+                        if 'idle' in sections:
+                            print('idle: RSS after a burst and after idling', flush=True)
+                            report['idle synthesis processes'] = idle_release(client, serve.process.pid)
+                        if 'burst' in sections:
+                            print('burst: 50 goals at once to serve', flush=True)
+                            report['burst'] = burst(client)
+                        if 'hostile' in sections:
+                            print('attacks: hostile goals', flush=True)
+                            flexbe_client = SynthesisClient(ros.add_node(Node, 'bench_flexbe_client'),
+                                                            'flexbe_synthesis')
+                            assert flexbe_client.wait_for_server(timeout=60.0)
+                            report['hostile goals'] = attacks.hostile_goals(client, flexbe_client,
+                                                                            serve.process.pid, rss_kib)
+                        if 'limits' in sections:
+                            print('attacks: time limits under load', flush=True)
+                            runaway = make_goal('atlas', [], [], option='ltl_synthesis_only', timeout=30.0,
+                                                ltl_specification={'sys_props': [f'p{i}' for i in range(200)],
+                                                                   'env_props': ['e'], 'sys_liveness': ['p0']})
+                            report['time limits under load'] = attacks.limits_under_load(client, runaway)
+                        if 'qos' in sections:
+                            print('attacks: default-QoS clients', flush=True)
+                            plain = attacks.plain_client(ros.add_node(Node, 'bench_default_qos_client'))
+                            report['default-QoS client, 200 goals'] = attacks.plain_client_burst(plain, 200)
+                            report[f'default-QoS client, {args.flood} goals'] = attacks.plain_client_burst(
+                                plain, args.flood)
+                            deep = attacks.plain_client(ros.add_node(Node, 'bench_deep_qos_client'), deep_queues=True)
+                            report[f'client with deep queues, {args.flood} goals'] = attacks.plain_client_burst(
+                                deep, args.flood)
+                        if 'soak' in sections:
+                            print(f'soak: {args.goals} goals, {args.in_flight} in flight', flush=True)
+                            report['soak'] = soak(client, serve.process.pid, args.goals, args.in_flight, args.warmup)
+                finally:
+                    serve.stop()
         if 'gui' in sections or 'simulations' in sections:
             with reserve_domain_id() as domain, gui_process(domain, byproducts) as (url, gui_pid):
                 if 'gui' in sections:

@@ -5,6 +5,8 @@ back and when (against its limit), the server's peak RSS alone and with its chil
 and how long a normal goal sent right after it takes; and once more, stopped by SIGTERM two
 seconds into it, giving the seconds to exit. The GUI's deep body, ``gr1synth``'s large input
 and ``kill -9`` during a goal have their own processes.
+
+    .venv/bin/python bench/bench_reliability.py --sections service
 """
 
 from __future__ import annotations
@@ -29,8 +31,7 @@ SIGTERM_AFTER = 2.0  # seconds into an attack
 STRATEGY_INPUTS = 9
 
 
-def custom_formulas(total_bytes: int, formula_bytes: int = 56_000) -> list[str]:
-    clause = '(look_down_a | !stand_prep_a)'
+def custom_formulas(total_bytes: int, formula_bytes: int = 56_000, clause: str = '(look_down_a | !stand_prep_a)'):
     formula = ' & '.join([clause] * (formula_bytes // (len(clause) + 3)))
     return [formula] * max(1, total_bytes // len(formula))
 
@@ -62,6 +63,20 @@ def compile_freeze(client, _flexbe):
     return {'codes': _codes(answers), 'answered after the 5 s limit, s (max)': max(late),
             'answered after the 5 s limit, s (median)': sorted(late)[len(late) // 2],
             'the original 11 MB goal': f'{_code(original)} after {seconds:.2f} s'}
+
+
+def synthesis_freeze(client, _flexbe):
+    """20 ``ltl_synthesis_only`` goals of 3.9 MB specifications with 5 s limits, all at once."""
+    from synthesis_manager.client import make_goal
+    spec = {'env_props': ['look_down_a'], 'sys_props': ['stand_prep_a'], 'sys_liveness': ['stand_prep_a'],
+            'sys_trans': custom_formulas(3_900_000, clause="(stand_prep_a' | !look_down_a)")}
+    goals = [make_goal('atlas', [], [], option='ltl_synthesis_only', name=f'large{i}', timeout=5.0,
+                       ltl_specification=spec) for i in range(20)]
+    with ThreadPoolExecutor(len(goals)) as pool:
+        answers = list(pool.map(lambda goal: timed(client.run, goal, timeout=300), goals))
+    late = sorted(seconds - 5.0 for _, seconds in answers)
+    return {'codes': _codes(answers), 'answered after the 5 s limit, s (max)': late[-1],
+            'answered after the 5 s limit, s (median)': late[len(late) // 2]}
 
 
 def huge_strategy(client, _flexbe):
@@ -107,6 +122,7 @@ def mixed_burst(client, _flexbe, count: int = 200):
 
 
 SERVE_ATTACKS = {'compile freeze (20 x 3.9 MB custom LTL, 5 s limits)': compile_freeze,
+                 'synthesis freeze (20 x 3.9 MB specifications, 5 s limits)': synthesis_freeze,
                  'huge strategy (9 free inputs)': huge_strategy,
                  'two BDD bombs in a row': bdd_bombs,
                  '50 MB goal list': huge_list,

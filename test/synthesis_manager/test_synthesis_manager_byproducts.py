@@ -218,3 +218,19 @@ def test_leftovers_of_cut_short_writes_are_pruned_and_nothing_else(tmp_path):
     assert not any(path.exists() for path in leftovers)
     assert all(path.exists() for path in recent + users + [kept.marker, *kept.paths.values(), link])
     assert (tmp_path / 'target').read_text() == 'a user file'
+
+
+def test_the_synthesis_node_prunes_leftovers_at_its_start(ros, tmp_path):
+    from rclpy.parameter import Parameter
+
+    from synthesis_manager.byproducts import LEFTOVER_AGE
+    from synthesis_manager.nodes.ltl_synthesis_node import LTLSynthesisNode
+    old = time.time() - LEFTOVER_AGE - 10
+    leftovers = [tmp_path / '.cut.a1b2c3d4.part', tmp_path / '.empty.byproducts']
+    for path in leftovers:
+        path.write_text('' if path.suffix == '.byproducts' else 'partial')
+        os.utime(path, (old, old))
+    (tmp_path / 'precious.json').write_text('{}')
+    ros.add_node(LTLSynthesisNode, parameter_overrides=[Parameter('byproducts_dir', value=str(tmp_path))])
+    assert not any(path.exists() for path in leftovers)
+    assert (tmp_path / 'precious.json').exists()

@@ -16,12 +16,18 @@
   says what came back, how long after its limit, and the server's peak RSS growth; the
   simulations also the peak RSS of a simulation process itself (VmHWM).
 - idle: the server's RSS (with its synthesis processes) after a burst and after they idled.
+- service (issue 34, full sizes; reliability_service.py): 20 goals of 3.9 MB custom LTL with
+  5 s limits (and one of 11 MB), a strategy of 8.4 M transitions, two BDD bombs in a row, a
+  50 MB goal list, a 200-goal mixed burst with 1 s limits, each on a fresh ``serve``: what came
+  back and when, the server's peak RSS, a normal goal's time right after, SIGTERM's time 2 s
+  into it; ``kill -9`` of serve during a goal (when send-goal notices), gr1synth
+  --memory-limit 200 on a 192 MB input, and a 100,000-deep body POSTed to the GUI.
 
 The server and GUI run as their real console entry points in separate processes on a
 reserved ROS domain; the clients are in this process. Prints a table and writes the sections
 run into bench/results/reliability.md (the others are kept).
 
-    .venv/bin/python bench/bench_reliability.py [--sections burst,soak,gui,attacks,idle]
+    .venv/bin/python bench/bench_reliability.py [--sections burst,soak,gui,attacks,idle,service]
         [--goals 2000] [--in-flight 4] [--warmup 600] [--flood 10000]
 """
 
@@ -210,7 +216,7 @@ def idle_release(client, server_pid: int, idle_seconds: float = 35.0) -> dict:
             f'RSS after {idle_seconds:g} s idle MiB': rss_kib(server_pid) / 1024}
 
 
-SECTIONS = ('burst', 'soak', 'gui', 'attacks', 'idle')
+SECTIONS = ('burst', 'soak', 'gui', 'attacks', 'idle', 'service')
 #: The parts of 'attacks', each also selectable alone.
 ATTACKS = ('hostile', 'limits', 'qos', 'simulations')
 
@@ -235,45 +241,63 @@ def main(argv=None) -> int:
     from synthesis_manager.ros.harness import RosHarness, reserve_domain_id
 
     report = {}
-    with tempfile.TemporaryDirectory(prefix='bench-reliability-') as byproducts:
+    if 'service' in sections:
+        import reliability_service as service
         with reserve_domain_id() as domain:
-            serve = Serve(domain, byproducts)
-            try:
-                with RosHarness(domain_id=domain) as ros:
-                    client = SynthesisClient(ros.add_node(Node, 'bench_reliability_client'))
-                    assert client.wait_for_server(timeout=60.0), 'serve did not come up'
-                    for _ in range(3):  # warm-up: imports, discovery
-                        timed_run(client, make_goal(*TASK))
-                    if 'idle' in sections:
-                        print('idle: RSS after a burst and after idling', flush=True)
-                        report['idle synthesis processes'] = idle_release(client, serve.process.pid)
-                    if 'burst' in sections:
-                        print('burst: 50 goals at once to serve', flush=True)
-                        report['burst'] = burst(client)
-                    if 'hostile' in sections:
-                        print('attacks: hostile goals', flush=True)
-                        flexbe_client = SynthesisClient(ros.add_node(Node, 'bench_flexbe_client'), 'flexbe_synthesis')
-                        assert flexbe_client.wait_for_server(timeout=60.0)
-                        report['hostile goals'] = attacks.hostile_goals(client, flexbe_client, serve.process.pid, rss_kib)
-                    if 'limits' in sections:
-                        print('attacks: time limits under load', flush=True)
-                        runaway = make_goal('atlas', [], [], option='ltl_synthesis_only', timeout=30.0, ltl_specification={
-                            'sys_props': [f'p{i}' for i in range(200)], 'env_props': ['e'], 'sys_liveness': ['p0']})
-                        report['time limits under load'] = attacks.limits_under_load(client, runaway)
-                    if 'qos' in sections:
-                        print('attacks: default-QoS clients', flush=True)
-                        plain = attacks.plain_client(ros.add_node(Node, 'bench_default_qos_client'))
-                        report['default-QoS client, 200 goals'] = attacks.plain_client_burst(plain, 200)
-                        report[f'default-QoS client, {args.flood} goals'] = attacks.plain_client_burst(
-                            plain, args.flood)
-                        deep = attacks.plain_client(ros.add_node(Node, 'bench_deep_qos_client'), deep_queues=True)
-                        report[f'client with deep queues, {args.flood} goals'] = attacks.plain_client_burst(
-                            deep, args.flood)
-                    if 'soak' in sections:
-                        print(f'soak: {args.goals} goals, {args.in_flight} in flight', flush=True)
-                        report['soak'] = soak(client, serve.process.pid, args.goals, args.in_flight, args.warmup)
-            finally:
-                serve.stop()
+            report.update({f'service: {title}': figures
+                           for title, figures in service.serve_attacks(domain, rss_kib, Serve).items()})
+            print('service: kill -9 of serve during a goal', flush=True)
+            report['service: kill -9 of serve during a goal'] = service.killed_server(domain, Serve)
+        print('service: gr1synth on a large input', flush=True)
+        report['service: gr1synth --memory-limit'] = service.gr1synth_large_input()
+        with reserve_domain_id() as domain, tempfile.TemporaryDirectory(prefix='bench-gui-') as byproducts, \
+                gui_process(domain, byproducts) as (url, gui_pid):
+            print('service: a 100,000-deep body to the GUI', flush=True)
+            report['service: GUI, 100,000-deep body'] = service.gui_deep_body(url, gui_pid, rss_kib)
+    on_serve = set(sections) & {'idle', 'burst', 'soak', 'hostile', 'limits', 'qos'}
+    with tempfile.TemporaryDirectory(prefix='bench-reliability-') as byproducts:
+        if on_serve:  # the sections on one shared serve
+            with reserve_domain_id() as domain:
+                serve = Serve(domain, byproducts)
+                try:
+                    with RosHarness(domain_id=domain) as ros:
+                        client = SynthesisClient(ros.add_node(Node, 'bench_reliability_client'))
+                        assert client.wait_for_server(timeout=60.0), 'serve did not come up'
+                        for _ in range(3):  # warm-up: imports, discovery
+                            timed_run(client, make_goal(*TASK))
+                        if 'idle' in sections:
+                            print('idle: RSS after a burst and after idling', flush=True)
+                            report['idle synthesis processes'] = idle_release(client, serve.process.pid)
+                        if 'burst' in sections:
+                            print('burst: 50 goals at once to serve', flush=True)
+                            report['burst'] = burst(client)
+                        if 'hostile' in sections:
+                            print('attacks: hostile goals', flush=True)
+                            flexbe_client = SynthesisClient(ros.add_node(Node, 'bench_flexbe_client'),
+                                                            'flexbe_synthesis')
+                            assert flexbe_client.wait_for_server(timeout=60.0)
+                            report['hostile goals'] = attacks.hostile_goals(client, flexbe_client,
+                                                                            serve.process.pid, rss_kib)
+                        if 'limits' in sections:
+                            print('attacks: time limits under load', flush=True)
+                            runaway = make_goal('atlas', [], [], option='ltl_synthesis_only', timeout=30.0,
+                                                ltl_specification={'sys_props': [f'p{i}' for i in range(200)],
+                                                                   'env_props': ['e'], 'sys_liveness': ['p0']})
+                            report['time limits under load'] = attacks.limits_under_load(client, runaway)
+                        if 'qos' in sections:
+                            print('attacks: default-QoS clients', flush=True)
+                            plain = attacks.plain_client(ros.add_node(Node, 'bench_default_qos_client'))
+                            report['default-QoS client, 200 goals'] = attacks.plain_client_burst(plain, 200)
+                            report[f'default-QoS client, {args.flood} goals'] = attacks.plain_client_burst(
+                                plain, args.flood)
+                            deep = attacks.plain_client(ros.add_node(Node, 'bench_deep_qos_client'), deep_queues=True)
+                            report[f'client with deep queues, {args.flood} goals'] = attacks.plain_client_burst(
+                                deep, args.flood)
+                        if 'soak' in sections:
+                            print(f'soak: {args.goals} goals, {args.in_flight} in flight', flush=True)
+                            report['soak'] = soak(client, serve.process.pid, args.goals, args.in_flight, args.warmup)
+                finally:
+                    serve.stop()
         if 'gui' in sections or 'simulations' in sections:
             with reserve_domain_id() as domain, gui_process(domain, byproducts) as (url, gui_pid):
                 if 'gui' in sections:

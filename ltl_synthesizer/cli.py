@@ -22,7 +22,8 @@ from __future__ import annotations
 
 import sys
 
-from ltl_synthesizer.command import parse_arguments, run, run_with_deep_stack
+from ltl_synthesizer.command import parse_arguments, run
+from respec.nesting import run_with_deep_stack
 
 
 def main(argv=None) -> int:

@@ -12,7 +12,6 @@ import math
 import os
 import sys
 import time
-from pathlib import Path
 
 from respec.errors import ExitStatus, exit_status_help
 
@@ -82,10 +81,17 @@ def parse_arguments(argv):
     return args
 
 
-def read_specification(path: str, check=None, deadline: float | None = None):
+#: Memory a parsed specification takes per byte of its text, at least (token-dense formulas
+#: take about 22): an input over memory_limit / INPUT_EXPANSION bytes is refused unread.
+INPUT_EXPANSION = 8
+
+
+def read_specification(path: str, check=None, deadline: float | None = None, memory_limit: int | None = None):
     """Parse a .slugsin or .structuredslugs file (by extension) into a GR1Specification;
     ``check`` (e.g. an ltl_synthesizer Interrupt) is called regularly while parsing. Reading
-    that has not ended by ``deadline`` (a FIFO no one writes to) raises SynthesisCancelledError."""
+    that has not ended by ``deadline`` (a FIFO no one writes to) raises SynthesisCancelledError;
+    an input over ``memory_limit`` / INPUT_EXPANSION bytes raises SynthesisMemoryError before
+    it is read (a file, by its size) or as soon as that much is read (a pipe)."""
     from respec.parsing import parse_slugsin, parse_structuredslugs
     if path.endswith('.structuredslugs'):
         parse = parse_structuredslugs
@@ -93,19 +99,20 @@ def read_specification(path: str, check=None, deadline: float | None = None):
         parse = parse_slugsin
     else:
         raise ValueError(f"{path}: unknown input format (expected .slugsin or .structuredslugs)")
-    return parse(_read_text(path, deadline), filename=path, check=check)
+    max_chars = None if memory_limit is None else memory_limit // INPUT_EXPANSION
+    return parse(_read_text(path, deadline, max_chars), filename=path, check=check)
 
 
-def _read_text(path: str, deadline: float | None) -> str:
+def _read_text(path: str, deadline: float | None, max_chars: int | None = None) -> str:
     if deadline is None:
-        return Path(path).read_text()
+        return _read_at_most(path, max_chars)
     import threading
     from ltl_synthesizer.errors import SynthesisTimeoutError
     outcome = {}
 
     def read():  # opening a FIFO blocks until a writer comes: in a thread the process may leave
         try:
-            outcome['text'] = Path(path).read_text()
+            outcome['text'] = _read_at_most(path, max_chars)
         except BaseException as error:  # re-raised in the caller's thread
             outcome['error'] = error
 
@@ -117,6 +124,23 @@ def _read_text(path: str, deadline: float | None) -> str:
     if 'error' in outcome:
         raise outcome['error']
     return outcome['text']
+
+
+def _read_at_most(path: str, max_chars: int | None) -> str:
+    """The text of ``path``, refused (SynthesisMemoryError) beyond ``max_chars``."""
+    with open(path) as stream:
+        if max_chars is None:
+            return stream.read()
+        size = os.fstat(stream.fileno()).st_size  # a file's size: refused before reading
+        text = stream.read(max_chars + 1) if size <= max_chars else ''
+    if size > max_chars or len(text) > max_chars:
+        from ltl_synthesizer.errors import SynthesisMemoryError
+        shown = f'{size:,} bytes' if size > max_chars else f'over {max_chars:,} characters'
+        raise SynthesisMemoryError(
+            f'the input has {shown}: reading it needs more than the memory limit of '
+            f'{max_chars * INPUT_EXPANSION / 2**20:.0f} MB (an input may have 1/{INPUT_EXPANSION} '
+            'of the limit)', item='memory_limit')
+    return text
 
 
 def synthesis_outcome(spec, args, limits, stream: bool = False):
@@ -187,35 +211,6 @@ def strategy_to_text(strategy: dict) -> str:
     return '\n'.join(lines) + ('\n' if lines else '')
 
 
-def run_with_deep_stack(function, *args):
-    """``function(*args)`` in a thread with room for formulas nested as deeply as the parsers accept."""
-    import threading
-    outcome = {}
-
-    def target():
-        try:
-            outcome['value'] = function(*args)
-        except BaseException as error:  # re-raised in the caller's thread
-            outcome['error'] = error
-
-    from respec.nesting import allow_deep_formulas
-    previous_stack, previous_limit = threading.stack_size(), sys.getrecursionlimit()
-    allow_deep_formulas()
-    try:
-        worker = threading.Thread(target=target, name='gr1synth', daemon=True)
-        worker.start()
-    finally:
-        threading.stack_size(previous_stack)
-    try:
-        while worker.is_alive():  # a timed join keeps Ctrl-C working in the main thread
-            worker.join(0.1)
-    finally:
-        sys.setrecursionlimit(previous_limit)
-    if 'error' in outcome:
-        raise outcome['error']
-    return outcome['value']
-
-
 def run(args) -> int:
     """One gr1synth run of parsed arguments (not --serve): its exit status, printing as slugs."""
     from respec.parsing import ParseError
@@ -227,7 +222,8 @@ def run(args) -> int:
     limits = Limits(deadline=deadline,
                     memory_limit=int(args.memory_limit * 2**20) if args.memory_limit > 0 else None)
     try:
-        spec = read_specification(args.input, check=limits.interrupt(), deadline=deadline)
+        spec = read_specification(args.input, check=limits.interrupt(), deadline=deadline,
+                                  memory_limit=limits.memory_limit)
     except SynthesisCancelledError as error:
         print(f'gr1synth: error: {error}', file=sys.stderr)
         return ExitStatus.TIMED_OUT

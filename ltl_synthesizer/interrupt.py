@@ -58,7 +58,7 @@ class Interrupt:
         self.cancel = cancel
         self.deadline = deadline
         self.memory_limit = memory_limit
-        self._baseline_memory = _resident_memory() if memory_limit is not None else 0
+        self._baseline_memory = resident_memory() if memory_limit is not None else 0
         self._memory_checked_at = time.monotonic()
 
     def check(self) -> None:
@@ -69,13 +69,13 @@ class Interrupt:
             raise SynthesisTimeoutError()
         if self.memory_limit is not None and now - self._memory_checked_at >= self.MEMORY_CHECK_SECONDS:
             self._memory_checked_at = now
-            if _resident_memory() - self._baseline_memory > self.memory_limit:
+            if resident_memory() - self._baseline_memory > self.memory_limit:
                 raise memory_exceeded(self.memory_limit)
 
     __call__ = check
 
 
-def _resident_memory() -> int:
+def resident_memory() -> int:
     """This process's resident memory in bytes (Linux; elsewhere its peak so far)."""
     try:
         with open('/proc/self/statm') as statm:

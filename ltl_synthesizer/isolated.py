@@ -47,7 +47,7 @@ import traceback
 from typing import Callable
 
 from ltl_synthesizer.errors import SynthesisCancelledError, SynthesisError, SynthesisTimeoutError
-from ltl_synthesizer.interrupt import Limits
+from ltl_synthesizer.interrupt import Limits, resident_memory
 
 # How often the caller looks at its cancel flag and deadline while a child works.
 POLL_SECONDS = 0.02
@@ -59,10 +59,64 @@ SERVER_CHILD_NICENESS = 15
 #: How long an idle child is kept for the next synthesis.
 IDLE_SECONDS = 30.0
 _LENGTH_BYTES = 8
+#: A child that holds more than this above its fresh size after answering and releasing what
+#: it answered (heap it could not give back) is ended, and a fresh one serves the next request:
+#: a memory limit counts from a synthesis's start, so a reused child peaks within this of a
+#: fresh one (a child holding its previous answer peaked at twice its limit, issue 34 item 4).
+REUSE_MARGIN_BYTES = 64 * 2**20
+#: Growth after an answer below which the child does not collect and trim its heap.
+RELEASE_ABOVE_BYTES = 16 * 2**20
+#: How long a child may take to release what it answered before it is ended instead of reused.
+SETTLE_SECONDS = 5.0
 
 
 class SynthesisProcessDiedError(SynthesisError):
     """The process running the synthesis ended without an answer."""
+
+
+class StrategyTooLargeError(SynthesisError):
+    """A strategy with more edges than the caller takes (``item``: 'max_strategy_edges')."""
+
+
+class SpecificationText:
+    """A specification as its text sections, parsed where it is used: in the child (passed as
+    an argument, the child gives the function the parsed GR1Specification). Parsing, printing
+    and pickling a large specification take seconds of pure Python: done in the caller, they
+    hold its interpreter, uninterruptible (a 3.9 MB one, about 9 s)."""
+
+    def __init__(self, sections: dict):
+        self.sections = sections
+
+    def parsed(self):
+        from respec.parsing import spec_from_text_sections
+        return spec_from_text_sections(self.sections)
+
+
+def byproduct_texts(spec) -> tuple[str, str, list, list]:
+    """The ``.structuredslugs`` and ``.slugsin`` texts of ``spec``, and its inputs and outputs."""
+    return spec.to_structuredslugs(), spec.to_slugsin(), list(spec.env_props), list(spec.sys_props)
+
+
+def strategy_edges(strategy: dict) -> int:
+    """The transitions of an explicit strategy (slugs' JSON shape)."""
+    return sum(len(node['trans']) for node in strategy['nodes'].values())
+
+
+def synthesize_within(spec, robotics_semantics: bool, limits: Limits, options, max_strategy_edges: int):
+    """:func:`ltl_synthesizer.synthesize`, refusing (StrategyTooLargeError) a strategy of more
+    than ``max_strategy_edges`` edges before it is sent: each edge costs the receiving server
+    about 900 B once turned into an automaton, its byproduct and its messages (a 215-byte
+    specification with 11 free inputs has 8.4 M edges and grew a server to 7.7 GB)."""
+    from ltl_synthesizer.synthesizer import synthesize
+    result = synthesize(spec, robotics_semantics, limits, options)
+    if result.strategy is not None:
+        edges = strategy_edges(result.strategy)
+        if edges > max_strategy_edges:
+            raise StrategyTooLargeError(
+                f'the strategy has {edges:,} transitions ({len(result.strategy["nodes"]):,} states), over the '
+                f'{max_strategy_edges:,} this server sends (max_strategy_edges); constrain the inputs '
+                '(ENV_TRANS) or raise the limit', item='max_strategy_edges')
+    return result
 
 
 #: What the pool's children import before their first request.
@@ -73,7 +127,8 @@ class ChildProcess:
     """One child process (``python -m ltl_synthesizer.isolated PARENT NICENESS PRELOAD``),
     spoken to through its stdin and stdout: length-prefixed pickles, a request (function,
     args, kwargs, whether progress is wanted) in; ('progress', value) messages and then an
-    answer ('result', value) or ('error', exception) out. ``preload`` is imported at its start,
+    answer ('result', value) or ('error', exception) out, then ('ready' or 'retire', bytes
+    held) once the child has released the request and its answer (see :meth:`settle`). ``preload`` is imported at its start,
     so the first request need not wait for it; ``environment`` holds defaults for variables
     the parent's environment does not set."""
 
@@ -81,6 +136,8 @@ class ChildProcess:
                  environment: dict[str, str] | None = None):
         self.idle_since = time.monotonic()
         self.fresh = True  # has served nothing yet: its RSS is the baseline
+        self.said = 'ready'  # what it said after its last answer
+        self.settling = False  # releasing its last request and answer: says 'ready' or 'retire' then
         self.process = subprocess.Popen(
             [sys.executable, '-m', 'ltl_synthesizer.isolated', str(os.getpid()), str(niceness), preload],
             stdin=subprocess.PIPE, stdout=subprocess.PIPE,
@@ -93,6 +150,8 @@ class ChildProcess:
         The child is killed once ``cancel`` is set or at ``deadline`` (time.monotonic());
         one that dies raises SynthesisProcessDiedError."""
         try:
+            if not self.settle() and self.said == 'nothing':  # its next words would be misread
+                raise self.died()
             self.send((function, tuple(args), dict(kwargs or {}), on_progress is not None))
             while True:
                 while not self.answered(POLL_SECONDS):
@@ -110,9 +169,24 @@ class ChildProcess:
                 on_progress(value)
         except (EOFError, OSError, ValueError):  # the child died, or its pipes were closed
             raise self.died() from None
+        self.settling = True
         if kind == 'error':
             raise value
         return value
+
+    def settle(self, timeout: float = SETTLE_SECONDS) -> bool:
+        """Whether this child may serve another request: after each answer it releases the
+        request and the answer and then says 'ready', or 'retire' when it still holds more than
+        REUSE_MARGIN_BYTES above its fresh size (a child that says neither in ``timeout`` or
+        died may not serve either)."""
+        if self.settling:
+            self.settling = False
+            try:
+                said = self.receive()[0] if self.answered(timeout) else 'nothing'
+            except (EOFError, OSError, ValueError):
+                said = 'nothing'
+            self.said = said
+        return self.said == 'ready' and self.alive()
 
     def died(self) -> SynthesisProcessDiedError:
         self.kill()
@@ -128,8 +202,9 @@ class ChildProcess:
         return bool(select.select([self.process.stdout], [], [], timeout)[0])
 
     def receive(self):
-        return pickle.loads(_read_exactly(self.process.stdout, int.from_bytes(
-            _read_exactly(self.process.stdout, _LENGTH_BYTES), 'little')))
+        # Unbuffered: the next message must stay in the pipe, where answered() looks for it.
+        answers = self.process.stdout.raw
+        return pickle.loads(_read_exactly(answers, int.from_bytes(_read_exactly(answers, _LENGTH_BYTES), 'little')))
 
     def alive(self) -> bool:
         return self.process.poll() is None
@@ -147,18 +222,23 @@ class ChildProcess:
 
 
 def _read_exactly(stream, size: int) -> bytes:
-    data = stream.read(size)
-    if len(data) != size:
-        raise EOFError('the synthesis process closed its output')
-    return data
+    data = bytearray()
+    while len(data) < size:  # a raw pipe gives what has arrived
+        chunk = stream.read(size - len(data))
+        if not chunk:
+            raise EOFError('the synthesis process closed its output')
+        data += chunk
+    return bytes(data)
 
 
 class SynthesisProcesses:
     """A pool of synthesis child processes, one per synthesis running at the same time, each
     ``niceness`` below its parent's CPU priority."""
 
-    def __init__(self, idle_seconds: float = IDLE_SECONDS, niceness: int = CHILD_NICENESS):
-        self.idle_seconds, self.niceness = idle_seconds, niceness
+    def __init__(self, idle_seconds: float = IDLE_SECONDS, niceness: int = CHILD_NICENESS,
+                 preload: str = SYNTHESIZER_MODULE):
+        """``preload``: what the children import before their first request."""
+        self.idle_seconds, self.niceness, self.preload = idle_seconds, niceness, preload
         self._idle: list[ChildProcess] = []
         self._busy: set[ChildProcess] = set()
         self._lock = threading.Lock()
@@ -173,7 +253,7 @@ class SynthesisProcesses:
         with self._lock:
             self._prepared = count
             while len(self._idle) < count and not self._closed:
-                self._idle.append(ChildProcess(self.niceness))
+                self._idle.append(ChildProcess(self.niceness, self.preload))
 
     @property
     def idle_count(self) -> int:
@@ -190,7 +270,7 @@ class SynthesisProcesses:
                          and not child.fresh]
                 self._idle = [child for child in self._idle if child not in stale]
                 replacements = min(len(stale), self._prepared - len(self._idle))
-                self._idle += [ChildProcess(self.niceness) for _ in range(replacements)]
+                self._idle += [ChildProcess(self.niceness, self.preload) for _ in range(replacements)]
                 next_check = min((child.idle_since + self.idle_seconds for child in self._idle
                                   if not child.fresh), default=None)
             for child in stale:
@@ -198,9 +278,14 @@ class SynthesisProcesses:
             self._wake_reaper.wait(None if next_check is None else max(0.05, next_check - time.monotonic()))
             self._wake_reaper.clear()
 
-    def synthesize(self, spec, robotics_semantics: bool = True, limits: Limits = Limits(), options=None):
-        """:func:`ltl_synthesizer.synthesize` in a child, killed once ``limits`` stop it."""
+    def synthesize(self, spec, robotics_semantics: bool = True, limits: Limits = Limits(), options=None,
+                   max_strategy_edges: int | None = None):
+        """:func:`ltl_synthesizer.synthesize` in a child, killed once ``limits`` stop it; with
+        ``max_strategy_edges``, a larger strategy is refused in the child (:func:`synthesize_within`)."""
         from ltl_synthesizer.synthesizer import synthesize
+        if max_strategy_edges:
+            return self.call(synthesize_within, (spec, robotics_semantics, limits.without_cancel(), options,
+                                                 max_strategy_edges), cancel=limits.cancel, deadline=limits.deadline)
         return self.call(synthesize, (spec, robotics_semantics, limits.without_cancel(), options),
                          cancel=limits.cancel, deadline=limits.deadline)
 
@@ -232,10 +317,10 @@ class SynthesisProcesses:
             if self._closed:
                 raise SynthesisCancelledError('cancelled')
             child = self._idle.pop() if self._idle else None
-        if child is None or not child.alive():
+        if child is None or not child.settle():
             if child is not None:
                 child.kill()
-            child = ChildProcess(self.niceness)
+            child = ChildProcess(self.niceness, self.preload)
         with self._lock:
             self._busy.add(child)
         return child
@@ -254,24 +339,24 @@ class SynthesisProcesses:
                 self._wake_reaper.set()
             elif not self._closed and not self._idle:
                 # A replacement starts now, while the caller reports the stop.
-                self._idle.append(ChildProcess(self.niceness))
+                self._idle.append(ChildProcess(self.niceness, self.preload))
         if not keep:
             child.kill()
 
 
 def _serve(parent_pid: int, preload: str) -> None:
     """The child: answer requests until stdin closes or the parent is gone."""
+    # This module runs as __main__ here: requests name the class of its imported copy.
+    text_type = importlib.import_module('ltl_synthesizer.isolated').SpecificationText
     _die_with_parent(parent_pid)
     requests = sys.stdin.buffer
     answers = os.fdopen(os.dup(sys.stdout.fileno()), 'wb')
     sys.stdout = sys.stderr  # stray prints must not corrupt the answers
     importlib.import_module(preload)  # imported now: the first request need not wait for it
+    fresh = _released_memory()
 
     def send(message) -> None:
-        try:
-            data = pickle.dumps(message, protocol=pickle.HIGHEST_PROTOCOL)
-        except Exception as error:  # noqa: BLE001 -- e.g. an exception that cannot be pickled
-            data = pickle.dumps(('error', SynthesisError(f'synthesis process: {error!r}')))
+        data = _pickled(message)
         answers.write(len(data).to_bytes(_LENGTH_BYTES, 'little') + data)
         answers.flush()
 
@@ -284,11 +369,41 @@ def _serve(parent_pid: int, preload: str) -> None:
         if wants_progress:
             kwargs['progress'] = lambda value: send(('progress', value))
         try:
+            args = [argument.parsed() if isinstance(argument, text_type) else argument for argument in args]
             answer = ('result', function(*args, **kwargs))
         except Exception as error:  # noqa: BLE001 -- every failure goes back to the caller
             error.add_note(f'in the synthesis process:\n{traceback.format_exc()}')
             answer = ('error', error)
         send(answer)
+        # The request and its answer (an error's traceback holds the whole solver) are released
+        # before the next request is read (after answering: freeing them takes time), so that
+        # its memory limit counts from what the child really holds.
+        del function, args, kwargs, answer
+        held = resident_memory() - fresh
+        if held > RELEASE_ABOVE_BYTES:  # a collection and a trim take 20-30 ms: only when it pays
+            held = _released_memory() - fresh
+        # 'retire': the parent ends this child, a fresh one serves the next request.
+        send(('retire' if held > REUSE_MARGIN_BYTES else 'ready', held))
+
+
+def _pickled(message) -> bytes:
+    try:
+        return pickle.dumps(message, protocol=pickle.HIGHEST_PROTOCOL)
+    except Exception as error:  # noqa: BLE001 -- e.g. an exception that cannot be pickled
+        return pickle.dumps(('error', SynthesisError(f'synthesis process: {error!r}')))
+
+
+def _released_memory() -> int:
+    """This process's resident size after its garbage is collected and freed heap pages go
+    back to the system (glibc's malloc_trim; elsewhere only the collection)."""
+    import gc
+    gc.collect()
+    try:
+        import ctypes
+        ctypes.CDLL('libc.so.6').malloc_trim(0)
+    except (OSError, AttributeError):
+        pass
+    return resident_memory()
 
 
 def _die_with_parent(parent_pid: int) -> None:
@@ -312,8 +427,7 @@ if __name__ == '__main__':
     # Below the parent's priority: syntheses filling every core must not delay the parent's
     # answers (time limits, cancels, BUSY) on a loaded machine.
     os.nice(int(sys.argv[2]))
-    from respec.nesting import allow_deep_formulas
-    allow_deep_formulas()  # requests are served in a thread with room for any formula accepted
-    server = threading.Thread(target=_serve, args=(int(sys.argv[1]), sys.argv[3]), name='synthesis-process')
-    server.start()
-    server.join()
+    from respec.nesting import run_with_deep_stack
+    # Requests are served in a thread with room for any formula accepted (pickles of formula
+    # trees are read and written recursively).
+    run_with_deep_stack(_serve, int(sys.argv[1]), sys.argv[3])

@@ -15,7 +15,8 @@ import json
 
 from respec.errors import ExitStatus
 
-from ltl_synthesizer.command import parse_arguments, run, run_with_deep_stack
+from ltl_synthesizer.command import parse_arguments, run
+from respec.nesting import run_with_deep_stack
 
 
 def serve(requests, answers) -> int:

@@ -38,6 +38,10 @@ SPEC_NAME = re.compile(r'^[A-Za-z0-9][A-Za-z0-9_.-]{0,99}$')
 _MARKER_SUFFIX = '.byproducts'
 _MARKER_SIGNATURE = 'behavior synthesis byproducts; retention may delete: '
 _MARKER_FILE = re.compile(r'^\.(?P<stem>.+)' + re.escape(_MARKER_SUFFIX) + '$')
+# What a write cut short leaves: a ByproductSet.write's temporary file (``.<stem>.<random>.part``).
+_PART_FILE = re.compile(r'^\.(?P<stem>.+)\.[A-Za-z0-9_]+\.part$')
+#: Leftovers younger than this may be another synthesis's writing now: left alone.
+LEFTOVER_AGE = 60.0
 
 
 class InvalidSpecNameError(CodedError):
@@ -209,6 +213,30 @@ class ByproductStore:
                     if path.is_file() and not path.is_symlink():
                         path.unlink()
                         deleted.append(path)
+        return deleted
+
+    def prune_leftovers(self, now: float | None = None) -> list[Path]:
+        """Delete what writes cut short left behind (a full disk, a killed process): the
+        ``.part`` files of byproducts and empty markers, older than LEFTOVER_AGE (plain files
+        named as the suite names them; nothing else is touched). Run at the synthesis node's
+        start; returns the deleted files."""
+        if not self.directory.is_dir() or self.keep_last == 0:
+            return []
+        if self.private:
+            private_directory(self.directory)  # never in a directory that is not safely ours
+        cutoff = (time.time() if now is None else now) - LEFTOVER_AGE
+        deleted = []
+        with os.scandir(self.directory) as entries:
+            for entry in entries:
+                part, marker = _PART_FILE.match(entry.name), _MARKER_FILE.match(entry.name)
+                stem = (part or marker)['stem'] if part or marker else ''
+                if not is_spec_name(stem) or not entry.is_file(follow_symlinks=False):
+                    continue
+                info = entry.stat(follow_symlinks=False)
+                if info.st_mtime < cutoff and (part or info.st_size == 0):
+                    with contextlib.suppress(FileNotFoundError):
+                        os.unlink(entry.path)
+                        deleted.append(Path(entry.path))
         return deleted
 
     def _last_written(self, files: ByproductSet) -> float:

@@ -135,6 +135,11 @@ _FINISHED_STATES = tuple(GOAL_STATUS_NAMES)
 # after RESULT_REQUEST_RETRY): a result request or its response can be lost.
 RESULT_GRACE = 5.0
 RESULT_REQUEST_RETRY = 10.0
+# A goal's server missing from the ROS graph this long is gone (killed, crashed): the goal
+# ends SERVICE_UNAVAILABLE instead of waiting out its time limit. DDS leases are 1 s
+# (ros/fastdds_loopback.xml), so a dead server leaves the graph within about 2 s.
+SERVER_LOST_SECONDS = 2.5
+LIVENESS_PERIOD = 0.25
 
 
 class SynthesisClient:
@@ -148,6 +153,7 @@ class SynthesisClient:
     def __init__(self, node, action_name: str = ACTION_NAME):
         """``action_name``: one of ACTIONS, or any name served with BehaviorSynthesis."""
         self.node = node
+        self.action_name = action_name
         self.action_client = RaceFreeActionClient(node, action_type(action_name), action_name)
 
     def wait_for_server(self, timeout: float = 10.0) -> bool:
@@ -183,8 +189,15 @@ class SynthesisClient:
         request_result()
         cancel_sent = False
         finished_seen = None
+        server_seen = checked = time.monotonic()
         while not done.wait(0.02):
             now = time.monotonic()
+            if now - checked >= LIVENESS_PERIOD:
+                checked = now
+                if self.action_client.server_is_ready():
+                    server_seen = now
+                elif now - server_seen >= SERVER_LOST_SECONDS:
+                    return self.server_lost(now - started)
             if cancel is not None and cancel.is_set() and not cancel_sent:
                 handle.cancel_goal_async()
                 cancel_sent = True
@@ -202,3 +215,11 @@ class SynthesisClient:
         answers = [future.result() for future, _ in requests if future.done()]
         response = next((answer for answer in answers if answer.status != GOAL_STATUS_UNKNOWN), answers[0])
         return outcome_from_response(response, time.monotonic() - started)
+
+    def server_lost(self, seconds: float) -> SynthesisOutcome:
+        """The outcome of a goal whose server left the ROS graph before answering."""
+        return SynthesisOutcome(
+            ErrorCode.SERVICE_UNAVAILABLE.number, ErrorCode.SERVICE_UNAVAILABLE,
+            f'the /{self.action_name} action server went away while the goal was in progress (gone from '
+            f'the ROS graph for {SERVER_LOST_SECONDS:g} s: killed or crashed); start it again and send '
+            'the goal again', seconds=seconds)

@@ -43,6 +43,7 @@ from pathlib import Path
 from atlas_sim.closed_loop import DeferredEvents, run_and_check
 from atlas_sim.executive.machine import ExecutionError
 from respec.errors import ExitStatus, exit_status_help
+from respec.nesting import run_with_deep_stack
 from respec.parsing import spec_from_text_sections
 from synthesis_manager.send_goal import ProgressBar, add_goal_arguments, goal_from_args, print_summary
 from synthesis_manager.suite import SuiteUnavailableError, add_suite_arguments, in_process_suite
@@ -267,7 +268,7 @@ def _execute(args, system, outcome, robot, simulator, goals, report, log, sim_no
             max_wall_time=args.max_robot_time * 10 + 60, verbose=args.verbose)
     try:
         run = run_and_check(outcome.states, robot, simulator, system,
-                            spec_from_text_sections(outcome.ltl_specification), goals,
+                            run_with_deep_stack(spec_from_text_sections, outcome.ltl_specification), goals,
                             ordered=not args.unordered, record_dir=record,
                             max_robot_time=args.max_robot_time, max_wall_time=args.max_robot_time * 10 + 60,
                             view=view, lock=lock, run_machine=run_machine)

@@ -11,6 +11,7 @@ from rclpy.node import Node
 
 from respec.errors import CodedError, ExitStatus, exit_status_help
 from respec.naming import parse_names
+from respec.nesting import run_with_deep_stack
 from respec.parsing import parse_structuredslugs
 from sm_generation.instantiation import count_states
 from synthesis_manager.client import SynthesisClient, make_flexbe_goal, make_goal
@@ -90,7 +91,8 @@ def read_spec_file(path: str) -> dict:
     text = Path(path).read_text()
     if path.endswith('.json'):
         return json.loads(text)
-    return parse_structuredslugs(text, filename=path).to_text_sections()
+    # Its formulas may nest MAX_FORMULA_NESTING deep: read and printed on a deep stack.
+    return run_with_deep_stack(lambda: parse_structuredslugs(text, filename=path).to_text_sections())
 
 
 SERVER_WAIT = 10.0  # seconds to wait for the action server to appear

@@ -28,11 +28,7 @@ from pathlib import Path
 
 import pytest
 
-from respec.nesting import allow_deep_formulas
-
 os.environ.setdefault('MUJOCO_GL', 'egl')
-# As every entry point does: this process's threads read any formula the parsers accept.
-allow_deep_formulas()
 
 REPOSITORY = Path(__file__).resolve().parents[1]
 DEFAULT_FLEXBE_SOURCES = REPOSITORY.parent / 'shared' / 'third_party'

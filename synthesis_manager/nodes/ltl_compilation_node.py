@@ -1,6 +1,17 @@
-"""The ``ltl_compilation`` service node (GenerateLTLSpecification): a thin adapter around compile_task."""
+"""The ``ltl_compilation`` service node (GenerateLTLSpecification): a thin adapter around compile_task.
+
+Compiling custom formulas is pure Python and takes about 2 s per MB: in the node's process it
+would hold the GIL of a whole suite (20 goals of 4 MB froze ``serve`` for minutes, issue 34
+item 2). A request whose custom formulas add up to over ``SMALL_CUSTOM_BYTES`` is compiled in
+a child process (ltl_synthesizer.isolated), killed at the node's time limit, on a cancel or at
+shutdown; the others (every request without custom formulas) are compiled here at once, so a
+normal goal never waits behind large ones.
+"""
 
 from __future__ import annotations
+
+import threading
+import time
 
 from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.node import Node
@@ -9,16 +20,40 @@ from std_msgs.msg import String
 
 from ltl_specification import compile_task
 from ltl_specification.provenance import provenance_to_json
+from ltl_synthesizer import SynthesisCancelledError
+from ltl_synthesizer.isolated import SERVER_CHILD_NICENESS, SynthesisProcesses
+from respec.errors import ErrorCode
 from respec.robot import SystemCatalog, catalog_to_json
 from respec.robot.files import SystemConfigError
 from respec.naming import DEFAULT_SM_OUTCOMES
-from synthesis_manager.ros.conversions import error_code, msg_to_sections, spec_to_msg
-from synthesis_manager.limits import check_message
+from respec.nesting import run_with_deep_stack
+from synthesis_manager.ros.conversions import error_code, msg_to_sections, sections_to_msg
+from synthesis_manager.limits import check_message, utf8_length
 from synthesis_manager.ros.errors import reported_error
 from synthesis_manager.ros.node_main import node_main
 from synthesis_manager.ros.qos import service_qos
 from synthesis_manager.ros.robot_systems import create_systems_publisher
+from synthesis_manager.ros.worker_pool import Abandoned, WorkerPool
 from synthesis_msgs.srv import GenerateLTLSpecification
+
+#: Custom formulas (bytes, all sections) up to which a request is compiled in the node's process.
+SMALL_CUSTOM_BYTES = 64 * 1024
+
+
+def compiled_sections(system: str, initial_conditions: list, goals: list, sm_outcomes: tuple, strict_order: bool,
+                      custom_ltl: dict | None, config_dir: str | None) -> tuple[dict, str]:
+    """The compiled specification's text sections and its provenance (JSON): plain data, so
+    that a child process can send them back."""
+    spec = compile_task(system, initial_conditions, goals, sm_outcomes=sm_outcomes, strict_order=strict_order,
+                        custom_ltl=custom_ltl, config_dir=config_dir)
+    # CNU capability systems record none: their unrealizable specifications are diagnosed by formula.
+    provenance = provenance_to_json(spec.provenance) if spec.provenance is not None else ''
+    return spec.to_text_sections(), provenance
+
+
+def _compiled_in_child(*args) -> tuple[dict, str]:
+    """compiled_sections in a child process's thread with room for deep formulas."""
+    return run_with_deep_stack(compiled_sections, *args)
 
 
 class LTLCompilationNode(Node):
@@ -27,6 +62,9 @@ class LTLCompilationNode(Node):
     Parameters: ``config_dir`` (directories of robot system files searched before the packaged
     config/, joined with os.pathsep; empty = config/ alone). Publishes those systems on ``robot_systems`` (latched; checked for edits
     every ``SYSTEMS_PERIOD`` seconds), so clients elsewhere see the systems it compiles for.
+    ``timeout`` (seconds a request with large custom formulas may take from its arrival, waiting
+    included; then TIMEOUT), ``parallel_compilations`` and ``queued_compilations`` (such requests
+    compiled at once in child processes, and waiting beyond those; further ones are BUSY).
     """
 
     SYSTEMS_PERIOD = 2.0
@@ -34,12 +72,30 @@ class LTLCompilationNode(Node):
     def __init__(self, **kwargs):
         super().__init__('ltl_compilation', **kwargs)
         self.declare_parameter('config_dir', '')
+        self.declare_parameter('timeout', 30.0)
+        self.declare_parameter('parallel_compilations', 2)
+        self.declare_parameter('queued_compilations', 200)
+        self._stopping = threading.Event()
+        self.large = WorkerPool(self.get_parameter('parallel_compilations').value,
+                                self.get_parameter('queued_compilations').value, name='compilation')
+        self.compile_processes = SynthesisProcesses(niceness=SERVER_CHILD_NICENESS, preload='ltl_specification')
+        group = ReentrantCallbackGroup()
+        self.create_timer(0.1, lambda: None, callback_group=group)  # waiting requests see their deadline pass
         self.create_service(GenerateLTLSpecification, 'ltl_compilation', self.on_request,
-                            callback_group=ReentrantCallbackGroup(), qos_profile=service_qos())
+                            callback_group=group, qos_profile=service_qos())
         self._systems_publisher = create_systems_publisher(self)
         self._published_systems = None
         self.publish_systems()
         self.create_timer(self.SYSTEMS_PERIOD, self.publish_systems)
+
+    def stop_work(self):
+        """Stop every compilation in a child process (at shutdown, so the process exits promptly)."""
+        self._stopping.set()
+        self.compile_processes.close()
+
+    def destroy_node(self):
+        self.compile_processes.close()
+        return super().destroy_node()
 
     def catalog(self) -> SystemCatalog:
         return SystemCatalog(self.get_parameter('config_dir').value or None)
@@ -55,24 +111,51 @@ class LTLCompilationNode(Node):
             self._systems_publisher.publish(String(data=text))
             self._published_systems = text
 
-    def on_request(self, request, response):
+    async def on_request(self, request, response):
         try:
             check_message(request)
-            spec = compile_task(
-                request.system, list(request.initial_conditions), list(request.goals),
-                sm_outcomes=tuple(request.sm_outcomes) or DEFAULT_SM_OUTCOMES,
-                strict_order=not request.unordered_goals,
-                custom_ltl=msg_to_sections(request.custom_ltl) or None,
-                config_dir=self.get_parameter('config_dir').value or None)
+            deadline = time.monotonic() + self.get_parameter('timeout').value
+            arguments = (request.system, list(request.initial_conditions), list(request.goals),
+                         tuple(request.sm_outcomes) or DEFAULT_SM_OUTCOMES, not request.unordered_goals,
+                         msg_to_sections(request.custom_ltl) or None,
+                         self.get_parameter('config_dir').value or None)
+            custom_bytes = sum(utf8_length(formula) for section in (arguments[5] or {}).values()
+                               for formula in section)
+            if custom_bytes <= SMALL_CUSTOM_BYTES:
+                # Formulas may nest MAX_FORMULA_NESTING deep: compiled on a deep stack.
+                sections, provenance = run_with_deep_stack(compiled_sections, *arguments)
+            else:
+                try:
+                    sections, provenance = await self.large.run(
+                        self._compile_in_child, arguments, deadline, wake=self._wake_executor,
+                        give_up=lambda: self._stopping.is_set() or time.monotonic() > deadline)
+                except (Abandoned, SynthesisCancelledError):
+                    timed_out = not self._stopping.is_set()
+                    response.error_code = error_code(
+                        ErrorCode.TIMEOUT if timed_out else ErrorCode.PREEMPTED,
+                        f'LTL compilation stopped: {"time limit" if timed_out else "shutdown"} '
+                        f'({self.get_parameter("timeout").value:g} s for {custom_bytes:,} bytes of custom formulas)')
+                    self.get_logger().warning(response.error_code.message)
+                    return response
         except Exception as error:  # every failure becomes an error code; the node keeps serving
             response.error_code = reported_error(error, self.get_logger(), 'LTL compilation failed')
             self.get_logger().warning(response.error_code.message)
             return response
-        response.ltl_specification = spec_to_msg(spec)
-        # CNU capability systems record none: their unrealizable specifications are diagnosed by formula.
-        response.provenance = provenance_to_json(spec.provenance) if spec.provenance is not None else ''
+        response.ltl_specification = sections_to_msg(sections)
+        response.provenance = provenance
         response.error_code = error_code()
         return response
+
+    def _compile_in_child(self, arguments, deadline: float):
+        """compiled_sections in a child process, killed at ``deadline`` or at shutdown."""
+        if self._stopping.is_set() or time.monotonic() > deadline:
+            raise SynthesisCancelledError('stopped while waiting')
+        return self.compile_processes.call(_compiled_in_child, arguments, cancel=self._stopping, deadline=deadline)
+
+    def _wake_executor(self):
+        executor = self.executor
+        if executor is not None:
+            executor.wake()
 
 
 def main():

@@ -19,13 +19,16 @@ from ltl_specification.diagnosis import explain_unsynthesizable, explain_well_se
 from ltl_specification.provenance import provenance_from_json
 from ltl_synthesizer import Limits, SynthesisCancelledError, SynthesisError
 from ltl_synthesizer.external import run_external_synthesizer
-from ltl_synthesizer.isolated import SERVER_CHILD_NICENESS, SynthesisProcesses
+from ltl_synthesizer.isolated import SERVER_CHILD_NICENESS, SpecificationText, SynthesisProcesses, byproduct_texts
 from ltl_synthesizer.strategy import strategy_to_json
 from respec.automaton import automaton_from_strategy
-from respec.errors import ErrorCode
+from respec.errors import CodedError, ErrorCode
+from respec.nesting import run_with_deep_stack
 from respec.parsing import ParseError, spec_from_text_sections
+from respec.spec import GR1Specification
 from synthesis_manager.byproducts import DEFAULT_KEEP_LAST, ByproductStore, default_directory
-from synthesis_manager.limits import check_message, check_timeout
+from synthesis_manager.limits import (DEFAULT_MAX_GOAL_TIMEOUT, capped_timeout, check_message, check_timeout,
+                                      utf8_length)
 from synthesis_manager.ros.conversions import automaton_to_msg, error_code, msg_to_sections
 from synthesis_manager.ros.errors import reported_error
 from synthesis_manager.ros.node_main import node_main
@@ -40,6 +43,12 @@ BACKENDS = ('builtin', 'slugs')
 DIAGNOSIS = explain_unsynthesizable
 WELL_SEPARATION = explain_well_separation
 DIAGNOSIS_GRACE = 1.0  # seconds past its own time limit before the diagnosis process is killed
+#: Specifications (bytes of text) over this are parsed and printed in a synthesis child process,
+#: where a deadline or a cancel stops them, not in the node's (builtin backend).
+LARGE_SPEC_BYTES = 64 * 1024
+#: Largest strategy (transitions) a builtin synthesis sends back: about 900 B each in the
+#: server (automaton, JSON byproduct, messages), so about 90 MB per goal at most.
+DEFAULT_MAX_STRATEGY_EDGES = 100_000
 
 
 WAKE_PERIOD = 0.1  # seconds
@@ -59,7 +68,9 @@ class LTLSynthesisNode(Node):
     request's time limit); ``check_well_separation`` (a realizable specification's answer
     carries, as its SUCCESS message, a warning when the controller can win by forcing the
     environment to break its assumptions: ltl_synthesizer.well_separation; checked within the
-    diagnosis time); ``parallel_syntheses`` (run at once) and ``queued_syntheses`` (waiting beyond those;
+    diagnosis time); ``max_strategy_edges`` (largest builtin strategy sent back, in
+    transitions; larger ones are SYNTHESIS_FAILED naming their size; 0: no limit); ``max_timeout`` (seconds: the longest time limit a request gets,
+    600; 0: no cap); ``parallel_syntheses`` (run at once) and ``queued_syntheses`` (waiting beyond those;
     further requests are answered BUSY).
 
     Syntheses run in the node's own worker threads, awaited by an async service callback,
@@ -76,6 +87,8 @@ class LTLSynthesisNode(Node):
         self.declare_parameter('backend', 'builtin')
         self.declare_parameter('slugs_executable', 'slugs')
         self.declare_parameter('timeout', 60.0)
+        self.declare_parameter('max_timeout', DEFAULT_MAX_GOAL_TIMEOUT)
+        self.declare_parameter('max_strategy_edges', DEFAULT_MAX_STRATEGY_EDGES)
         self.declare_parameter('robotics_semantics', True)
         self.declare_parameter('memory_limit_mb', 2048)
         self.declare_parameter('diagnosis_timeout', 20.0)
@@ -87,6 +100,7 @@ class LTLSynthesisNode(Node):
         self.workers = WorkerPool(self.parameter('parallel_syntheses'), self.parameter('queued_syntheses'),
                                   name='synthesis')
         self.synthesis_processes = SynthesisProcesses(niceness=SERVER_CHILD_NICENESS)
+        self._prune_leftovers()
         if self.parameter('backend') == 'builtin':
             self.synthesis_processes.prepare()
         group = ReentrantCallbackGroup()
@@ -96,6 +110,16 @@ class LTLSynthesisNode(Node):
                             qos_profile=service_qos())
         self.create_service(CancelSynthesis, 'ltl_synthesis/cancel', self.on_cancel_request,
                             callback_group=group, qos_profile=service_qos())
+
+    def _prune_leftovers(self):
+        """Delete what cut-short writes left in the byproducts directory (a full disk, a kill)."""
+        try:
+            deleted = self.byproduct_store().prune_leftovers()
+        except (OSError, CodedError) as error:  # e.g. an unsafe directory: every synthesis will say so
+            self.get_logger().warning(f'byproduct leftovers not pruned: {error}'[:300])
+            return
+        if deleted:
+            self.get_logger().info(f'pruned {len(deleted)} byproduct leftovers (.part files, empty markers)')
 
     def stop_work(self):
         """Stop every running synthesis (at shutdown, so the process exits promptly)."""
@@ -136,12 +160,16 @@ class LTLSynthesisNode(Node):
             self._running[request_id] = cancel
         try:
             check_message(request)
-            timeout = check_timeout(request.timeout, 'request.timeout') or self.parameter('timeout')
+            # A request asking more than max_timeout gets the cap (as a goal gets max_goal_timeout).
+            timeout = capped_timeout(check_timeout(request.timeout, 'request.timeout') or self.parameter('timeout'),
+                                     self.parameter('max_timeout'))
             check_timeout(request.diagnosis_timeout, 'request.diagnosis_timeout')
             # The time limit starts now: waiting for a worker counts.
             deadline = time.monotonic() + timeout
             try:
-                await self.workers.run(self._synthesize, request, response, cancel, timeout, deadline,
+                # Formulas are parsed, printed and pickled to the synthesis process on a deep stack.
+                await self.workers.run(run_with_deep_stack, self._synthesize, request, response, cancel,
+                                       timeout, deadline,
                                        wake=self._wake_executor,
                                        give_up=lambda: cancel.is_set() or time.monotonic() > deadline)
             except Abandoned:  # stopped while waiting for a worker
@@ -167,16 +195,30 @@ class LTLSynthesisNode(Node):
     def _synthesize(self, request, response, cancel, timeout, deadline):
         if cancel.is_set() or time.monotonic() > deadline:  # stopped while waiting for a worker
             return self._stopped(response, 'cancelled' if cancel.is_set() else 'timeout', timeout)
-        spec = spec_from_text_sections(msg_to_sections(request.ltl_specification))
+        sections = msg_to_sections(request.ltl_specification)
+        backend = self.parameter('backend')
+        if backend == 'builtin' and sum(utf8_length(line) for lines in sections.values() for line in lines) > \
+                LARGE_SPEC_BYTES:
+            spec = SpecificationText(sections)  # parsed in the synthesis children
+            try:
+                structuredslugs, slugsin, inputs, outputs = self.synthesis_processes.call(
+                    byproduct_texts, (spec,), cancel=cancel, deadline=deadline)
+            except SynthesisCancelledError as stopped:
+                return self._stopped(response, stopped.reason, timeout)
+            variables = GR1Specification(env_props=inputs, sys_props=outputs)  # what the automaton names
+        else:
+            spec = variables = spec_from_text_sections(sections)
+            structuredslugs, slugsin = spec.to_structuredslugs(), spec.to_slugsin()
         with self.byproduct_store().open_set(request.spec_name) as files:
-            files.write('structuredslugs', spec.to_structuredslugs())
-            slugsin_path = files.write('slugsin', spec.to_slugsin())
+            files.write('structuredslugs', structuredslugs)
+            slugsin_path = files.write('slugsin', slugsin)
+            del structuredslugs, slugsin
             robotics = self.parameter('robotics_semantics')
-            backend = self.parameter('backend')
             if backend == 'builtin':
                 try:
                     result = self.synthesis_processes.synthesize(spec, robotics, Limits(
-                        cancel, deadline, self.parameter('memory_limit_mb') * 2**20))
+                        cancel, deadline, self.parameter('memory_limit_mb') * 2**20),
+                        max_strategy_edges=self.parameter('max_strategy_edges'))
                 except SynthesisCancelledError as stopped:
                     return self._stopped(response, stopped.reason, timeout)
                 realizable, strategy, explanation = result.realizable, result.strategy, result.explanation
@@ -204,7 +246,7 @@ class LTLSynthesisNode(Node):
             warning = self._well_separation_warning(spec, request, cancel, deadline)
         except SynthesisCancelledError as stopped:
             return self._stopped(response, stopped.reason, timeout)
-        response.automaton = automaton_to_msg(automaton_from_strategy(strategy, spec))
+        response.automaton = automaton_to_msg(automaton_from_strategy(strategy, variables))
         response.error_code = error_code(ErrorCode.SUCCESS, warning)
 
     def _well_separation_warning(self, spec, request, cancel: threading.Event, deadline: float) -> str:

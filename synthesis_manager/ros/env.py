@@ -11,8 +11,6 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-from respec.nesting import allow_deep_formulas
-
 LOOPBACK_SETTINGS = {
     'ROS_AUTOMATIC_DISCOVERY_RANGE': 'LOCALHOST',
     'RMW_IMPLEMENTATION': 'rmw_fastrtps_cpp',
@@ -27,7 +25,6 @@ def prepare_ros_environment(domain_id: int | None = None, environ=os.environ) ->
 
     Returns ``environ`` so the same call prepares a subprocess environment too.
     """
-    allow_deep_formulas()  # this process's threads, started after this, read any formula the parsers accept
     environ.update(LOOPBACK_SETTINGS)
     for name in CONFLICTING_SETTINGS:
         environ.pop(name, None)

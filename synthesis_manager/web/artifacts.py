@@ -9,6 +9,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable
 
+from respec.nesting import run_with_deep_stack
 from respec.parsing import spec_from_text_sections
 from sm_generation import SMGenerationError, export
 from sm_generation.export import render, to_dot
@@ -40,7 +41,9 @@ def _picture(fmt):
 
 def _specification(method):
     def build(outcome, *_) -> bytes:
-        return getattr(spec_from_text_sections(outcome.ltl_specification), method)().encode()
+        def printed():  # the job's formulas may nest MAX_FORMULA_NESTING deep
+            return getattr(spec_from_text_sections(outcome.ltl_specification), method)().encode()
+        return run_with_deep_stack(printed)
     return build
 
 

@@ -4,6 +4,7 @@ import json
 import os
 import subprocess
 import sys
+import threading
 import time
 from pathlib import Path
 
@@ -176,6 +177,47 @@ def test_the_memory_limit_hit_while_parsing_exits_with_4(tmp_path):
     done = gr1synth('--memory-limit', '1', write(tmp_path, 'big.structuredslugs', text))
     assert done.returncode == 4, done.stderr[-2000:]
     assert 'memory' in done.stderr and 'Traceback' not in done.stderr
+
+
+def peak_rss_of(command) -> tuple[int, str, int]:
+    """(exit status, stderr, peak RSS in KiB) of ``command``, started by a small Python (a
+    child forked from this process would count this process's size as its own peak)."""
+    launcher = ('import resource, subprocess, sys; status = subprocess.run(sys.argv[1:]).returncode; '
+                'print(status, resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss)')
+    done = subprocess.run([sys.executable, '-c', launcher, *command], capture_output=True, text=True,
+                          cwd=REPOSITORY, timeout=120)
+    status, peak_kib = map(int, done.stdout.split())
+    return status, done.stderr, peak_kib
+
+
+@pytest.mark.parametrize('fifo', [False, True])
+def test_an_input_too_large_for_the_memory_limit_is_refused_before_it_is_read(tmp_path, fifo):
+    """Issue 34, item 8: --memory-limit 200 peaked at 1,282 MiB reading a 192 MB input. A
+    40 MB input at 64 MB: refused by its size (a file) or once 1/8 of the limit is read (a
+    pipe), exit 4, the process never near the input's size."""
+    line = '| a & b | ! a ' * 20 + 'b\n'
+    text = '[INPUT]\na\n\n[OUTPUT]\nb\n\n[SYS_TRANS]\n' + line * (40_000_000 // len(line))
+    path = tmp_path / 'big.slugsin'
+    if fifo:
+        os.mkfifo(path)
+
+        def feed():
+            try:
+                with open(path, 'w') as stream:
+                    stream.write(text)
+            except BrokenPipeError:  # gr1synth stopped reading: expected
+                pass
+        writer = threading.Thread(target=feed, daemon=True)
+        writer.start()
+    else:
+        path.write_text(text)
+    started = time.monotonic()
+    status, stderr, peak_kib = peak_rss_of([sys.executable, '-m', 'ltl_synthesizer', '--memory-limit', '64',
+                                            str(path)])
+    assert status == 4 and 'memory limit of 64 MB' in stderr and 'Traceback' not in stderr, stderr[-2000:]
+    assert (f'{len(text):,} bytes' in stderr) is not fifo  # a file's size is named
+    assert peak_kib < 64 * 1024  # the interpreter and 8 MB of text, never the 40 MB input parsed
+    assert time.monotonic() - started < 10
 
 
 def test_a_fifo_no_one_writes_to_ends_at_the_time_limit(tmp_path):

@@ -1,5 +1,7 @@
 """ltl_synthesizer.isolated: syntheses in child processes, stopped by killing the child."""
 
+import atexit
+import operator
 import os
 import signal
 import threading
@@ -194,3 +196,25 @@ def test_children_run_at_the_niceness_asked_below_their_parent():
         assert niceness == min(19, os.nice(0) + 7)
     finally:
         processes.close()
+
+
+
+def test_a_child_releases_what_it_answered_before_it_is_reused(processes):
+    """Issue 34, item 4: a child kept its last answer (an error's traceback holds the whole
+    solver) until the next request, whose memory limit then counted from above it: a reused
+    child reached twice its limit. Now what it answered is released before it waits again."""
+    child = processes.call(os.getpid)
+    fresh_kib = rss_kib(child)
+    assert len(processes.call(operator.mul, (b'x', 100 * 2**20))) == 100 * 2**20
+    assert rss_kib(child) - fresh_kib < 16 * 1024  # idle near its fresh size, not +100 MB
+    assert processes.call(os.getpid) == child  # and reused
+
+
+def test_a_child_holding_memory_it_cannot_release_is_replaced(processes):
+    """What a child cannot give back (here 100 MB that atexit holds) would count against the
+    next synthesis: beyond REUSE_MARGIN_BYTES the child is ended and a fresh one serves."""
+    first = processes.call(os.getpid)
+    processes.call(atexit.register, (len, 'x' * 100 * 2**20))
+    second = processes.call(os.getpid)
+    assert second != first and first not in children_of_this_process()
+    assert processes.call(os.getpid) == second  # a fresh child is reused as before

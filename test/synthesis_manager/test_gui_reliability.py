@@ -4,6 +4,7 @@ import http.client
 import json
 import os
 import signal
+import sys
 import threading
 import time
 import urllib.parse
@@ -308,6 +309,22 @@ def test_a_body_nested_100000_deep_is_refused_before_it_is_parsed(gui):
     status, error = request(url, 'POST', '/api/goal-check', b'{"goals": ' + b'{"a": ' * 1000)
     assert (status, error['error']) == (400, 'TOO_DEEP')
     assert request(url, 'GET', '/api/systems')[0] == 200  # and it keeps serving
+
+
+def test_the_gui_process_never_raises_its_recursion_limit(gui):
+    """Deep recursion only on the threads that read formulas (issue 34, item 1): after a job
+    (compiled, synthesized, generated in this process) the limit is what it was, so a deep JSON
+    document that got past the guard would be a RecursionError here, not a SIGSEGV."""
+    _, url = gui
+    limit = sys.getrecursionlimit()
+    status, job = request(url, 'POST', '/api/jobs', PAPER_TASK)
+    assert status == 202
+    assert wait_until_finished(url, job['id'])['outcome']['error_name'] == 'SUCCESS'
+    assert request(url, 'POST', '/api/jobs', b'[' * 100_000 + b']' * 100_000)[0] == 400
+    assert sys.getrecursionlimit() == limit
+    with pytest.raises(RecursionError):
+        json.loads('[' * 100_000 + ']' * 100_000)
+    assert request(url, 'GET', '/api/systems')[0] == 200
 
 
 @pytest.mark.parametrize('body, deeper', [

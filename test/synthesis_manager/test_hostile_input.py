@@ -80,7 +80,7 @@ def test_short_values_are_quoted_whole():
 # --- deep nesting: one limit for every parser ------------------------------------------------
 
 def in_deep_thread(function, *args):
-    from ltl_synthesizer.command import run_with_deep_stack
+    from respec.nesting import run_with_deep_stack
     return run_with_deep_stack(function, *args)
 
 

@@ -193,3 +193,44 @@ def test_an_unwritable_marker_is_a_coded_error(tmp_path, monkeypatch):
     monkeypatch.setattr(os, 'open', full_disk)
     with pytest.raises(ByproductsDirectoryError, match='ENOSPC'):
         write_set(ByproductStore(tmp_path), 'full')
+
+
+def test_leftovers_of_cut_short_writes_are_pruned_and_nothing_else(tmp_path):
+    """Issue 34, item 12: a full disk or a kill leaves ``.part`` files and empty markers that
+    retention never saw. The synthesis node's start deletes them once older than LEFTOVER_AGE;
+    a set being written now, a marked set, a user's files and links stay."""
+    from synthesis_manager.byproducts import LEFTOVER_AGE
+    store = ByproductStore(tmp_path)
+    kept = write_set(store, 'kept')
+    old = time.time() - LEFTOVER_AGE - 10
+    leftovers = [tmp_path / '.cut.a1b2c3d4.part', tmp_path / '.empty.byproducts']
+    recent = [tmp_path / '.writing.e5f6g7h8.part', tmp_path / '.starting.byproducts']
+    users = [tmp_path / 'precious.part', tmp_path / '.hidden.part', tmp_path / '.notes.byproducts.txt']
+    for path in leftovers + recent + users:
+        path.write_text('' if path.name.endswith('.byproducts') else 'partial')
+    (tmp_path / 'target').write_text('a user file')
+    link = tmp_path / '.link.a1b2c3d4.part'
+    link.symlink_to(tmp_path / 'target')
+    for path in leftovers + users + [kept.marker]:
+        os.utime(path, (old, old))
+    os.utime(link, (old, old), follow_symlinks=False)
+    assert sorted(store.prune_leftovers()) == sorted(leftovers)
+    assert not any(path.exists() for path in leftovers)
+    assert all(path.exists() for path in recent + users + [kept.marker, *kept.paths.values(), link])
+    assert (tmp_path / 'target').read_text() == 'a user file'
+
+
+def test_the_synthesis_node_prunes_leftovers_at_its_start(ros, tmp_path):
+    from rclpy.parameter import Parameter
+
+    from synthesis_manager.byproducts import LEFTOVER_AGE
+    from synthesis_manager.nodes.ltl_synthesis_node import LTLSynthesisNode
+    old = time.time() - LEFTOVER_AGE - 10
+    leftovers = [tmp_path / '.cut.a1b2c3d4.part', tmp_path / '.empty.byproducts']
+    for path in leftovers:
+        path.write_text('' if path.suffix == '.byproducts' else 'partial')
+        os.utime(path, (old, old))
+    (tmp_path / 'precious.json').write_text('{}')
+    ros.add_node(LTLSynthesisNode, parameter_overrides=[Parameter('byproducts_dir', value=str(tmp_path))])
+    assert not any(path.exists() for path in leftovers)
+    assert (tmp_path / 'precious.json').exists()

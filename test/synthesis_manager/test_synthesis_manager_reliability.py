@@ -270,6 +270,7 @@ def test_deeply_nested_custom_ltl_gets_its_specific_code_at_once(ros, tmp_path):
     """5,000 parentheses (within the limit) are read like any formula; beyond the one nesting
     limit of every parser the answer is INVALID_FORMULA with a short message, no traceback."""
     from respec.nesting import MAX_FORMULA_NESTING
+    limit = sys.getrecursionlimit()  # raised only where formulas are read, never process-wide
     client = start_suite(ros, tmp_path)
     within = client.run(make_goal(**PAPER_TASK, option='ltl_compilation_only', ltl_specification={
         'sys_trans': ['(' * 5000 + 'look_down_a' + ')' * 5000]}), timeout=60)
@@ -286,6 +287,7 @@ def test_deeply_nested_custom_ltl_gets_its_specific_code_at_once(ros, tmp_path):
             'sys_props': ['look_down_a'], 'sys_trans': [formula]}), timeout=60)
         assert direct.error_name == 'INVALID_FORMULA', direct.message[:300]
         assert f'nested deeper than {MAX_FORMULA_NESTING}' in direct.message and len(direct.message) < 300
+    assert sys.getrecursionlimit() == limit
 
 
 def test_a_yaml_bomb_in_synthesis_options_is_refused_at_once(ros, tmp_path):

@@ -1,0 +1,70 @@
+"""Clients notice a dead server within seconds (issue 34, item 12): after ``kill -9`` of
+``serve`` during a long goal, ``send-goal`` ended only after 148 s (exit 1), and a GUI job
+connected to it stayed "running" 150 s. Now the goal ends SERVICE_UNAVAILABLE (exit 5) once
+the action server has left the ROS graph for SERVER_LOST_SECONDS."""
+
+import json
+import os
+import signal
+import time
+
+import httpx
+
+from synthesis_manager.client import SERVER_LOST_SECONDS
+from test_entry_point_shutdown import (BIN, GUI_URL, assert_busy_synthesizing, loopback_domain, many_parts_config,
+                                       runaway_gui_job, started)
+from test_synthesis_manager_reliability import RUNAWAY_SPEC
+
+NOTICED_WITHIN = SERVER_LOST_SECONDS + 3.5  # the DDS lease (1 s), its discovery, a loaded machine
+UNAVAILABLE_STATUS = 5  # README's exit status table: a server the command needs is missing
+
+
+def kill_server(server) -> float:
+    """kill -9 the server and its synthesis processes; returns when."""
+    assert_busy_synthesizing(server.pid)
+    os.killpg(server.pid, signal.SIGKILL)
+    return time.monotonic()
+
+
+def test_send_goal_notices_a_killed_server_within_seconds(tmp_path):
+    spec = tmp_path / 'runaway.json'
+    spec.write_text(json.dumps(RUNAWAY_SPEC))
+    with loopback_domain() as (_, environment):
+        with started([BIN / 'behavior-synthesis', 'serve', '--byproducts-dir', tmp_path / 'byproducts'],
+                     environment) as (server, server_output):
+            server_output.wait_for('suite up')
+            with started([BIN / 'behavior-synthesis', 'send-goal', '--synthesis-only', spec],
+                         environment) as (client, output):
+                output.wait_for('Synthesizing')
+                killed = kill_server(server)
+                while client.poll() is None and time.monotonic() - killed < 60:
+                    time.sleep(0.05)
+                noticed = time.monotonic() - killed
+                print(f'send-goal: exit {client.returncode} {noticed:.2f} s after kill -9 of serve')
+                assert client.returncode == UNAVAILABLE_STATUS, output.text()
+                assert noticed < NOTICED_WITHIN, f'{noticed:.1f} s'
+                assert 'SERVICE_UNAVAILABLE' in output.text() and 'went away' in output.text()
+
+
+def test_a_connected_gui_job_ends_with_its_dead_servers_reason(tmp_path):
+    config = many_parts_config(tmp_path / 'config')
+    with loopback_domain() as (_, environment):
+        with started([BIN / 'behavior-synthesis', 'serve', '--config-dir', config, '--byproducts-dir',
+                      tmp_path / 'byproducts'], environment) as (server, server_output):
+            server_output.wait_for('suite up')
+            with started([BIN / 'behavior-synthesis', 'gui', '--port', '0', '--connect', '--config-dir', config],
+                         environment) as (_, output):
+                url = output.wait_for(GUI_URL).group(1)
+                with runaway_gui_job(url) as job:
+                    killed = kill_server(server)
+                    while time.monotonic() - killed < 60:
+                        state = httpx.get(f'{url}api/jobs/{job}').json()
+                        if state['state'] == 'finished':
+                            break
+                        time.sleep(0.1)
+                    noticed = time.monotonic() - killed
+                print(f'GUI job: {state["outcome"]["error_name"]} {noticed:.2f} s after kill -9 of serve')
+                assert state['state'] == 'finished', state
+                assert state['outcome']['error_name'] == 'SERVICE_UNAVAILABLE', state['outcome']
+                assert 'went away' in state['outcome']['message']
+                assert noticed < NOTICED_WITHIN, f'{noticed:.1f} s'

@@ -1,0 +1,151 @@
+"""Large custom formulas are compiled where they can be stopped, and the direct synthesis
+service caps its time limit (issue 34, item 2): 20 goals of 11 MB custom formulas froze the
+server (compiled synchronously in its process, holding the GIL; a normal goal after them
+waited 228 s), and a SynthesizeAutomaton request could ask for any time limit."""
+
+import threading
+import time
+
+from rclpy.parameter import Parameter
+
+from respec.nesting import run_with_deep_stack
+from synthesis_manager.client import make_goal
+from synthesis_manager.nodes.ltl_compilation_node import SMALL_CUSTOM_BYTES, LTLCompilationNode, compiled_sections
+from test_synthesis_manager_reliability import PAPER_TASK, runaway_goal, start_suite
+
+FORMULA_BYTES = 56_000  # as in the attack: just under the 64 KB string cap
+
+
+def custom_formulas(total_bytes: int, clause: str = '(look_down_a | !stand_prep_a)') -> list[str]:
+    """Formulas over the paper task's propositions, FORMULA_BYTES each, ``total_bytes`` in all."""
+    formula = ' & '.join([clause] * (FORMULA_BYTES // (len(clause) + 3)))
+    return [formula] * max(1, total_bytes // len(formula))
+
+
+def start(ros, tmp_path, compile_timeout: float = 30.0, synthesis_parameters=()):
+    ros.add_node(LTLCompilationNode, parameter_overrides=[Parameter('timeout', value=compile_timeout)])
+    return start_suite(ros, tmp_path, names=('ltl_synthesis', 'sm_generation'),
+                       synthesis_parameters=synthesis_parameters)
+
+
+def test_large_custom_formulas_compile_in_a_child_to_the_same_specification(ros, tmp_path):
+    client = start(ros, tmp_path)
+    formulas = custom_formulas(2 * SMALL_CUSTOM_BYTES)
+    outcome = client.run(make_goal(**PAPER_TASK, option='ltl_compilation_only',
+                                   ltl_specification={'sys_trans': formulas}), timeout=60)
+    assert outcome.error_name == 'SUCCESS', outcome.message
+    sections, _ = run_with_deep_stack(compiled_sections, PAPER_TASK['system'], PAPER_TASK['initial_conditions'],
+                                      PAPER_TASK['goals'], ('finished', 'failed'), True, {'sys_trans': formulas}, None)
+    assert outcome.ltl_specification == {name: lines for name, lines in sections.items() if lines}
+
+
+def test_a_huge_compilation_stops_at_its_limit_and_a_normal_goal_is_served_meanwhile(ros, tmp_path):
+    client = start(ros, tmp_path, compile_timeout=2.0)
+    huge = make_goal(**PAPER_TASK, option='ltl_compilation_only',
+                     ltl_specification={'sys_trans': custom_formulas(3_900_000)})  # about 8 s to compile
+    answers = {}
+
+    def send_huge():
+        started = time.monotonic()
+        answers['huge'] = client.run(huge, timeout=120)
+        answers['huge seconds'] = time.monotonic() - started
+
+    sender = threading.Thread(target=send_huge)
+    sender.start()
+    time.sleep(1.0)  # the huge one is compiling
+    started = time.monotonic()
+    normal = client.run(make_goal(**PAPER_TASK), timeout=60)
+    normal_seconds = time.monotonic() - started
+    sender.join(60)
+    print(f'normal goal: {normal_seconds:.2f} s during a huge compilation; the huge one: '
+          f'{answers["huge"].error_name} after {answers["huge seconds"]:.2f} s')
+    assert normal.error_name == 'SUCCESS' and normal_seconds < 2.0, normal.message
+    assert answers['huge'].error_name == 'TIMEOUT', answers['huge'].message
+    assert 'LTL compilation' in answers['huge'].message
+    assert answers['huge seconds'] < 2.0 + 2.0  # its limit, sending 4 MB and the answer
+
+
+def test_the_synthesis_service_caps_a_requests_time_limit(ros, tmp_path):
+    client = start(ros, tmp_path, synthesis_parameters=[Parameter('max_timeout', value=2.0)])
+    started = time.monotonic()
+    outcome = client.run(runaway_goal(), timeout=60)  # asks the server's 120 s
+    assert outcome.error_name == 'SYNTHESIS_TIMEOUT', outcome.message
+    assert 'time limit 2 s' in outcome.message and time.monotonic() - started < 2.0 + 1.5
+
+
+def free_inputs_spec(inputs: int) -> dict:
+    """A specification whose strategy answers every valuation of ``inputs`` free inputs:
+    2**(inputs + 1) states, 2**(2 inputs + 1) transitions (11 inputs: 8.4 M, issue 34 item 3)."""
+    return {'env_props': [f'e{i}' for i in range(inputs)], 'sys_props': ['p'], 'sys_liveness': ['p']}
+
+
+def test_a_strategy_over_the_budget_is_refused_naming_its_size(ros, tmp_path):
+    """Issue 34, item 3: a 215-byte specification's 8.4 M-transition strategy grew the server to
+    7.7 GB. The synthesis child counts the strategy before sending it: over max_strategy_edges
+    it is SYNTHESIS_FAILED naming both sizes; within it, SUCCESS as before."""
+    client = start(ros, tmp_path, synthesis_parameters=[Parameter('max_strategy_edges', value=1000)])
+    started = time.monotonic()
+    refused = client.run(make_goal('atlas', [], [], option='ltl_synthesis_only',
+                                   ltl_specification=free_inputs_spec(6)), timeout=60)
+    assert refused.error_name == 'SYNTHESIS_FAILED', refused.message
+    assert '8,192 transitions' in refused.message and '1,000' in refused.message
+    assert 'max_strategy_edges' in refused.message and len(refused.message) < 300
+    assert time.monotonic() - started < 10
+    within = client.run(make_goal('atlas', [], [], option='ltl_synthesis_only',
+                                  ltl_specification=free_inputs_spec(3)), timeout=60)
+    assert within.error_name == 'SUCCESS', within.message
+    assert sum(len(state['transitions']) for state in within.automaton['states']) <= 1000
+
+
+def large_spec(total_bytes: int) -> dict:
+    """A realizable specification of ``total_bytes`` of formulas (over the node's LARGE_SPEC_BYTES)."""
+    return {'env_props': ['look_down_a'], 'sys_props': ['stand_prep_a'], 'sys_liveness': ['stand_prep_a'],
+            'sys_trans': custom_formulas(total_bytes, "(stand_prep_a' | !look_down_a)")}
+
+
+def test_a_large_specification_is_read_in_the_synthesis_child_to_the_same_automaton(ros, tmp_path):
+    from ltl_synthesizer import synthesize
+    from respec.automaton import automaton_from_strategy
+    from respec.parsing import spec_from_text_sections
+    from synthesis_manager.client import automaton_to_dict
+    from synthesis_manager.nodes.ltl_synthesis_node import LARGE_SPEC_BYTES
+    from synthesis_manager.ros.conversions import automaton_to_msg
+
+    client = start(ros, tmp_path)
+    sections = large_spec(2 * LARGE_SPEC_BYTES)
+    outcome = client.run(make_goal('atlas', [], [], option='ltl_synthesis_only', ltl_specification=sections),
+                         timeout=60)
+    assert outcome.error_name == 'SUCCESS', outcome.message
+    spec = run_with_deep_stack(spec_from_text_sections, sections)
+    expected = automaton_to_msg(automaton_from_strategy(synthesize(spec).strategy, spec))
+    assert outcome.automaton == automaton_to_dict(expected)
+    [slugsin] = tmp_path.glob('*.slugsin')  # the byproduct, printed in the child
+    assert slugsin.read_text() == spec.to_slugsin()
+    malformed = client.run(make_goal('atlas', [], [], option='ltl_synthesis_only', ltl_specification={
+        **sections, 'sys_trans': [*sections['sys_trans'], 'stand_prep_a &']}), timeout=60)
+    assert malformed.error_name == 'INVALID_FORMULA' and 'malformed specification' in malformed.message
+
+
+def test_a_huge_specification_stops_at_its_limit_and_a_normal_goal_is_served_meanwhile(ros, tmp_path):
+    client = start(ros, tmp_path)
+    huge = make_goal('atlas', [], [], option='ltl_synthesis_only', timeout=2.0,
+                     ltl_specification=large_spec(3_900_000))  # about 9 s to parse and print
+    answers = {}
+
+    def send_huge():
+        started = time.monotonic()
+        answers['huge'] = client.run(huge, timeout=120)
+        answers['huge seconds'] = time.monotonic() - started
+
+    sender = threading.Thread(target=send_huge)
+    sender.start()
+    time.sleep(1.0)
+    started = time.monotonic()
+    normal = client.run(make_goal(**PAPER_TASK), timeout=60)
+    normal_seconds = time.monotonic() - started
+    sender.join(60)
+    print(f'normal goal: {normal_seconds:.2f} s beside a huge specification; the huge one: '
+          f'{answers["huge"].error_name} after {answers["huge seconds"]:.2f} s')
+    assert normal.error_name == 'SUCCESS' and normal_seconds < 2.0, normal.message
+    assert answers['huge'].error_name in ('SYNTHESIS_TIMEOUT', 'TIMEOUT'), answers['huge'].message
+    assert answers['huge seconds'] < 2.0 + 2.0

@@ -40,6 +40,9 @@ def add_suite_arguments(parser):
                             '(synthesis_msgs/RobotState; default: atlas_sim/state)')
     group.add_argument('--robot-state-timeout', type=float, default=None,
                        help='seconds to wait for a robot state (default: 2)')
+    group.add_argument('--repair-time-budget', type=float, default=None, metavar='S',
+                       help='seconds to search for verified fixes of a goal refused as impossible, '
+                            'suggested in its result (default: 3; 0: none)')
 
 
 def suite_node_factories(args=None, names=SUITE_NODE_NAMES):
@@ -63,7 +66,8 @@ def suite_node_factories(args=None, names=SUITE_NODE_NAMES):
             default_system=getattr(args, 'default_system', ''),
             config_dir=getattr(args, 'config_dir', ''),
             robot_state_topic=getattr(args, 'robot_state_topic', ''),
-            robot_state_timeout=getattr(args, 'robot_state_timeout', None))),
+            robot_state_timeout=getattr(args, 'robot_state_timeout', None),
+            repair_time_budget=getattr(args, 'repair_time_budget', None))),
     }
     return [functools.partial(settings[name][0], parameter_overrides=settings[name][1])
             for name in names]

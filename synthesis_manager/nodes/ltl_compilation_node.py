@@ -6,10 +6,15 @@ item 2). A request whose custom formulas add up to over ``SMALL_CUSTOM_BYTES`` i
 a child process (ltl_synthesizer.isolated), killed at the node's time limit, on a cancel or at
 shutdown; the others (every request without custom formulas) are compiled here at once, so a
 normal goal never waits behind large ones.
+
+It also serves ``propose_repairs`` (ProposeRepairs): verified changes that make a refused task
+possible (``ltl_specification.repair``), searched in a child process on the robot system this
+node compiles for, within the request's time budget.
 """
 
 from __future__ import annotations
 
+import json
 import threading
 import time
 
@@ -20,6 +25,8 @@ from std_msgs.msg import String
 
 from ltl_specification import compile_task
 from ltl_specification.provenance import provenance_to_json
+from ltl_specification.repair import TaskRequest
+from ltl_specification.repair_process import RepairSearch, RepairSearchFailed, repair_settings
 from ltl_synthesizer import SynthesisCancelledError
 from ltl_synthesizer.isolated import SERVER_CHILD_NICENESS, SynthesisProcesses
 from respec.errors import ErrorCode
@@ -34,10 +41,14 @@ from synthesis_manager.ros.node_main import node_main
 from synthesis_manager.ros.qos import service_qos
 from synthesis_manager.ros.robot_systems import create_systems_publisher
 from synthesis_manager.ros.worker_pool import Abandoned, WorkerPool
-from synthesis_msgs.srv import GenerateLTLSpecification
+from synthesis_msgs.srv import GenerateLTLSpecification, ProposeRepairs
 
 #: Custom formulas (bytes, all sections) up to which a request is compiled in the node's process.
 SMALL_CUSTOM_BYTES = 64 * 1024
+#: Proposals a ProposeRepairs request gets when it names no number.
+DEFAULT_REPAIR_PROPOSALS = 3
+#: The longest search a request may ask for (seconds).
+MAX_REPAIR_TIME_BUDGET = 60.0
 
 
 def compiled_sections(system: str, initial_conditions: list, goals: list, sm_outcomes: tuple, strict_order: bool,
@@ -65,6 +76,8 @@ class LTLCompilationNode(Node):
     ``timeout`` (seconds a request with large custom formulas may take from its arrival, waiting
     included; then TIMEOUT), ``parallel_compilations`` and ``queued_compilations`` (such requests
     compiled at once in child processes, and waiting beyond those; further ones are BUSY).
+    ``repair_time_budget`` (seconds a ProposeRepairs search takes when the request names none,
+    3) and ``parallel_repairs`` (searches at once, each in a child process; 8 more may wait).
     """
 
     SYSTEMS_PERIOD = 2.0
@@ -75,13 +88,19 @@ class LTLCompilationNode(Node):
         self.declare_parameter('timeout', 30.0)
         self.declare_parameter('parallel_compilations', 2)
         self.declare_parameter('queued_compilations', 200)
+        self.declare_parameter('repair_time_budget', 3.0)
+        self.declare_parameter('parallel_repairs', 1)
         self._stopping = threading.Event()
+        self.repairs = WorkerPool(self.get_parameter('parallel_repairs').value, 8, name='repair')
+        self._repair_searches: set[RepairSearch] = set()
         self.large = WorkerPool(self.get_parameter('parallel_compilations').value,
                                 self.get_parameter('queued_compilations').value, name='compilation')
         self.compile_processes = SynthesisProcesses(niceness=SERVER_CHILD_NICENESS, preload='ltl_specification')
         group = ReentrantCallbackGroup()
         self.create_timer(0.1, lambda: None, callback_group=group)  # waiting requests see their deadline pass
         self.create_service(GenerateLTLSpecification, 'ltl_compilation', self.on_request,
+                            callback_group=group, qos_profile=service_qos())
+        self.create_service(ProposeRepairs, 'propose_repairs', self.on_repair_request,
                             callback_group=group, qos_profile=service_qos())
         self._systems_publisher = create_systems_publisher(self)
         self._published_systems = None
@@ -92,6 +111,8 @@ class LTLCompilationNode(Node):
         """Stop every compilation in a child process (at shutdown, so the process exits promptly)."""
         self._stopping.set()
         self.compile_processes.close()
+        for search in list(self._repair_searches):
+            search.stop()
 
     def destroy_node(self):
         self.compile_processes.close()
@@ -151,6 +172,43 @@ class LTLCompilationNode(Node):
         if self._stopping.is_set() or time.monotonic() > deadline:
             raise SynthesisCancelledError('stopped while waiting')
         return self.compile_processes.call(_compiled_in_child, arguments, cancel=self._stopping, deadline=deadline)
+
+    async def on_repair_request(self, request, response):
+        """Verified proposals for the request's task (at most ``max_proposals``) as sentences and
+        as the whole ``Repairs.to_dict()`` in JSON; every failure is an error code."""
+        try:
+            check_message(request)
+            system = self.catalog().load(request.system)
+            budget = min(request.time_budget or self.get_parameter('repair_time_budget').value,
+                         MAX_REPAIR_TIME_BUDGET)
+            task = TaskRequest(system.name, tuple(request.initial_conditions), tuple(request.goals),
+                               tuple(request.sm_outcomes) or DEFAULT_SM_OUTCOMES, request.unordered_goals)
+            settings = repair_settings(system, task.to_dict(), msg_to_sections(request.custom_ltl) or None, budget,
+                                       request.max_proposals or DEFAULT_REPAIR_PROPOSALS)
+            repairs = await self.repairs.run(self._search_repairs, settings, wake=self._wake_executor,
+                                             give_up=self._stopping.is_set)
+        except (RepairSearchFailed, Abandoned, SynthesisCancelledError) as error:
+            response.error_code = error_code(ErrorCode.TIMEOUT, f'repair search stopped: {error or "shutdown"}')
+            return response
+        except Exception as error:  # every failure becomes an error code; the node keeps serving
+            response.error_code = reported_error(error, self.get_logger(), 'repair search failed')
+            self.get_logger().warning(response.error_code.message)
+            return response
+        response.summaries = [proposal['summary'] for proposal in repairs['proposals']]
+        response.repairs = json.dumps(repairs, sort_keys=True)
+        response.error_code = error_code()
+        return response
+
+    def _search_repairs(self, settings: dict) -> dict:
+        """One repair search in its child process (RepairSearch), stopped at shutdown."""
+        search = RepairSearch(settings)
+        self._repair_searches.add(search)
+        try:
+            if self._stopping.is_set():
+                raise SynthesisCancelledError('stopped while waiting')
+            return search.run()
+        finally:
+            self._repair_searches.discard(search)
 
     def _wake_executor(self):
         executor = self.executor

@@ -27,6 +27,7 @@ from rclpy.node import Node
 from rclpy.time import Time
 
 from ltl_specification.errors import InvalidInitialConditionsError
+from ltl_specification.repair import REPAIRABLE
 from ltl_specification.initial_conditions import (detected_status, initial_conditions_from_robot_state,
                                                   reads_robot_state)
 from respec.errors import INTERNAL_ERROR, CodedError, ErrorCode
@@ -46,12 +47,17 @@ from synthesis_manager.ros.stage_calls import (Preempted, ServerStoppingError, S
                                               StageTimeoutError)
 from synthesis_msgs.action import BehaviorSynthesis
 from synthesis_msgs.msg import FSAutomaton, LTLSpecification
-from synthesis_msgs.srv import (CancelSynthesis, GenerateFlexBESM, GenerateLTLSpecification,
+from synthesis_msgs.srv import (CancelSynthesis, GenerateFlexBESM, GenerateLTLSpecification, ProposeRepairs,
                                 SynthesizeAutomaton)
 
 
 # Seconds past synthesis_timeout the synthesis node has to answer (a goal's own limit gets none).
 SYNTHESIS_ANSWER_GRACE = 1.0
+# Fixes a refused goal's result suggests, and how long their search may take: its budget times
+# this (the problem's diagnosis after the search), plus a child interpreter's start.
+MAX_SUGGESTED_FIXES = 3
+REPAIR_DEADLINE_FACTOR = 1.2
+REPAIR_STARTUP_GRACE = 5.0
 
 
 @dataclass
@@ -64,6 +70,15 @@ class PipelineOutcome:
     automaton: FSAutomaton = field(default_factory=FSAutomaton)
     states: list = field(default_factory=list)
     notes: list = field(default_factory=list)  # what the result should tell, e.g. detected initial conditions
+    fixes: list = field(default_factory=list)  # verified fixes of a refused task, one sentence each
+
+    def message_with_fixes(self) -> str:
+        """The message, followed by the suggested fixes when there are any."""
+        if not self.fixes:
+            return self.message
+        return (f'{self.message}\n\nVerified fixes (each compiled and synthesized, and found realizable; '
+                '`behavior-synthesis repair` with the same task lists more):\n'
+                + '\n'.join(f'  {line}' for line in self.fixes))
 
     @property
     def succeeded(self) -> bool:
@@ -85,14 +100,14 @@ class ActionInterface:
 
 def behavior_synthesis_result(outcome: PipelineOutcome):
     return BehaviorSynthesis.Result(
-        error_code=error_code(outcome.code, outcome.message), states=outcome.states,
+        error_code=error_code(outcome.code, outcome.message_with_fixes()), states=outcome.states,
         ltl_specification=outcome.ltl_specification, automaton=outcome.automaton)
 
 
 def action_interfaces(flexbe_synthesis) -> tuple[ActionInterface, ...]:
     """The served actions; ``flexbe_synthesis``: the FlexBESynthesisInterface offered."""
     def flexbe_synthesis_result(outcome: PipelineOutcome):
-        return flexbe_synthesis.result(outcome.code, outcome.message, outcome.states, outcome.notes)
+        return flexbe_synthesis.result(outcome.code, outcome.message, outcome.states, outcome.notes, outcome.fixes)
     return (ActionInterface(BehaviorSynthesis, 'behavior_synthesis', task_from_behavior_synthesis,
                             behavior_synthesis_result),
             ActionInterface(flexbe_synthesis.action_type, 'flexbe_synthesis', task_from_flexbe_synthesis,
@@ -161,6 +176,7 @@ class BehaviorSynthesisServer(Node):
         self.declare_parameter('max_active_goals', 100)
         self.declare_parameter('max_goal_timeout', DEFAULT_MAX_GOAL_TIMEOUT)
         self.declare_parameter('result_retention', 60.0)
+        self.declare_parameter('repair_time_budget', 3.0)
         self._stopping = threading.Event()
         self._active_goals = 0
         self._accepted_goals = 0  # accepted and not finished: running, or waiting for the executor
@@ -175,6 +191,7 @@ class BehaviorSynthesisServer(Node):
         self.synthesizer = client(SynthesizeAutomaton, 'ltl_synthesis')
         self.synthesis_cancel = client(CancelSynthesis, 'ltl_synthesis/cancel')
         self.generator = client(GenerateFlexBESM, 'sm_generate')
+        self.repairer = client(ProposeRepairs, 'propose_repairs')
         self.robot_state = RobotStateListener(self, self.parameter('robot_state_topic'), callback_group=group)
         flexbe_synthesis = load_flexbe_synthesis_interface()
         if flexbe_synthesis.fallback_reason:
@@ -220,6 +237,7 @@ class BehaviorSynthesisServer(Node):
     async def execute(self, goal_handle, interface: ActionInterface):
         feedback = FeedbackChannel(goal_handle, interface.action_type.Feedback)
         outcome = PipelineOutcome()
+        task = deadline = None
         try:
             check_message(goal_handle.request, 'goal')
             task = interface.read_goal(goal_handle.request, self.parameter('default_system'))
@@ -239,6 +257,8 @@ class BehaviorSynthesisServer(Node):
         except Exception as error:  # a bug: logged with its traceback; the server keeps serving
             log_internal_error(self.get_logger(), 'behavior synthesis failed', error)
             outcome.fail(INTERNAL_ERROR, f'internal error: {error!r}')
+        if not outcome.succeeded and task is not None:
+            await self.suggest_fixes(goal_handle, task, outcome, feedback, deadline)
         if outcome.succeeded:
             goal_handle.succeed()
         else:
@@ -250,6 +270,31 @@ class BehaviorSynthesisServer(Node):
             self.get_logger().warning(failure)
             goal_handle.abort()
         return interface.make_result(outcome)
+
+    async def suggest_fixes(self, goal_handle, task: SynthesisTask, outcome: PipelineOutcome, feedback,
+                            deadline: GoalDeadline | None):
+        """For a task refused as impossible: the best verified fixes (``ltl_specification.repair``,
+        searched by the compilation node within ``repair_time_budget``): after the message in
+        BehaviorSynthesis' ``error_code.message``, one per line after the failure in CNU's
+        FlexBESynthesis ``messages[]``.
+        Without an answer in time the refusal stands as it is."""
+        budget = self.parameter('repair_time_budget')
+        if budget <= 0 or str(outcome.code) not in REPAIRABLE or task.option == 'ltl_synthesis_only' \
+                or goal_handle.is_cancel_requested or (deadline is not None and deadline.passed()):
+            return
+        feedback('Looking for changes that make the task possible')
+        try:
+            found = await self.call(goal_handle, self.repairer, ProposeRepairs.Request(
+                system=task.system, goals=task.goals, initial_conditions=task.initial_conditions,
+                sm_outcomes=task.sm_outcomes, custom_ltl=task.custom_ltl or LTLSpecification(),
+                unordered_goals=task.unordered_goals, time_budget=float(budget), max_proposals=MAX_SUGGESTED_FIXES),
+                'repair search', budget * REPAIR_DEADLINE_FACTOR + REPAIR_STARTUP_GRACE, deadline=deadline)
+        except (CodedError, Preempted) as error:  # the refusal is the answer; the fixes were a help
+            self.get_logger().info(f'no fixes suggested: {error}'[:300])
+            return
+        if error_name(found.error_code.value) != ErrorCode.SUCCESS or not found.summaries:
+            return
+        outcome.fixes = [f'Suggested fix {number}: {summary}' for number, summary in enumerate(found.summaries, 1)]
 
     def admit_goal(self, _goal_request) -> GoalResponse:
         """Accept a goal unless a flood is under way: beyond max_active_goals accepted goals

@@ -88,9 +88,10 @@ class FlexBESynthesisInterface:
         return [copy_message(state, self.state_type, {'cond_transition': self.condition_type})
                 for state in states]
 
-    def result(self, code: ErrorCode, message: str, states: list, notes: list):
-        """The action's result: CNU's code, the states, and on failure ``NAME: message``."""
-        failure = [] if code == ErrorCode.SUCCESS else [f'{code}: {message}']
+    def result(self, code: ErrorCode, message: str, states: list, notes: list, fixes: list = ()):
+        """The action's result: CNU's code, the states, and on failure ``NAME: message`` followed
+        by the suggested ``fixes`` (one message each; the FlexBE WebUI shows them in its dialog)."""
+        failure = [] if code == ErrorCode.SUCCESS else [f'{code}: {message}', *fixes]
         return self.action_type.Result(error_code=self.error_code(code), states=self.states(states),
                                        messages=list(notes) + failure)
 

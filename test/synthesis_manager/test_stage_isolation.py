@@ -39,10 +39,9 @@ def test_large_custom_formulas_compile_in_a_child_to_the_same_specification(ros,
     assert outcome.ltl_specification == {name: lines for name, lines in sections.items() if lines}
 
 
-def test_a_huge_compilation_stops_at_its_limit_and_a_normal_goal_is_served_meanwhile(ros, tmp_path):
-    client = start(ros, tmp_path, compile_timeout=2.0)
-    huge = make_goal(**PAPER_TASK, option='ltl_compilation_only',
-                     ltl_specification={'sys_trans': custom_formulas(3_900_000)})  # about 8 s to compile
+def normal_goal_beside(client, huge):
+    """Send ``huge``, and a second later the paper task: (its result, its seconds, and the huge
+    goal's result and seconds as ``answers['huge']``, ``answers['huge seconds']``)."""
     answers = {}
 
     def send_huge():
@@ -52,11 +51,19 @@ def test_a_huge_compilation_stops_at_its_limit_and_a_normal_goal_is_served_meanw
 
     sender = threading.Thread(target=send_huge)
     sender.start()
-    time.sleep(1.0)  # the huge one is compiling
+    time.sleep(1.0)  # the huge one is being compiled or parsed
     started = time.monotonic()
     normal = client.run(make_goal(**PAPER_TASK), timeout=60)
     normal_seconds = time.monotonic() - started
     sender.join(60)
+    return normal, normal_seconds, answers
+
+
+def test_a_huge_compilation_stops_at_its_limit_and_a_normal_goal_is_served_meanwhile(ros, tmp_path):
+    client = start(ros, tmp_path, compile_timeout=2.0)
+    huge = make_goal(**PAPER_TASK, option='ltl_compilation_only',
+                     ltl_specification={'sys_trans': custom_formulas(3_900_000)})  # about 8 s to compile
+    normal, normal_seconds, answers = normal_goal_beside(client, huge)
     print(f'normal goal: {normal_seconds:.2f} s during a huge compilation; the huge one: '
           f'{answers["huge"].error_name} after {answers["huge seconds"]:.2f} s')
     assert normal.error_name == 'SUCCESS' and normal_seconds < 2.0, normal.message
@@ -130,20 +137,7 @@ def test_a_huge_specification_stops_at_its_limit_and_a_normal_goal_is_served_mea
     client = start(ros, tmp_path)
     huge = make_goal('atlas', [], [], option='ltl_synthesis_only', timeout=2.0,
                      ltl_specification=large_spec(3_900_000))  # about 9 s to parse and print
-    answers = {}
-
-    def send_huge():
-        started = time.monotonic()
-        answers['huge'] = client.run(huge, timeout=120)
-        answers['huge seconds'] = time.monotonic() - started
-
-    sender = threading.Thread(target=send_huge)
-    sender.start()
-    time.sleep(1.0)
-    started = time.monotonic()
-    normal = client.run(make_goal(**PAPER_TASK), timeout=60)
-    normal_seconds = time.monotonic() - started
-    sender.join(60)
+    normal, normal_seconds, answers = normal_goal_beside(client, huge)
     print(f'normal goal: {normal_seconds:.2f} s beside a huge specification; the huge one: '
           f'{answers["huge"].error_name} after {answers["huge seconds"]:.2f} s')
     assert normal.error_name == 'SUCCESS' and normal_seconds < 2.0, normal.message

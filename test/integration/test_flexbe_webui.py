@@ -153,12 +153,17 @@ def exported_behavior(tmp_path_factory):
 
 
 @pytest.fixture(scope='module')
-def webui(flexbe, flexbe_sources, ros_domain, synthesis_server, exported_behavior, tmp_path_factory):
+def webui_log(tmp_path_factory) -> Path:
+    """Where the WebUI process's output (its terminal) goes."""
+    return tmp_path_factory.mktemp('webui') / 'webui.log'
+
+
+@pytest.fixture(scope='module')
+def webui(flexbe, flexbe_sources, ros_domain, synthesis_server, exported_behavior, webui_log):
     """The WebUI backend started as README tells users without a FlexBE install (``make webui``
-    with the exported package's prefix); yields its URL and the path of its log."""
+    with the exported package's prefix); yields its URL."""
     if not (WEBUI_SITE / 'starlette').is_dir():
         pytest.fail(f'{WEBUI_SITE} is missing: `make flexbe` installs the web stack of the WebUI')
-    folder = tmp_path_factory.mktemp('webui')
     environment = prepare_ros_environment(ros_domain, environ=dict(os.environ, FLEXBE_SOURCES=str(flexbe_sources)))
     url = f'http://127.0.0.1:{WEBUI_PORT}/'
 
@@ -169,7 +174,7 @@ def webui(flexbe, flexbe_sources, ros_domain, synthesis_server, exported_behavio
         return False
 
     command = ['make', '-s', '-C', str(REPOSITORY), 'webui', f'WEBUI_BEHAVIORS={exported_behavior[2]}']
-    with port_for_this_run(WEBUI_PORT), running(command, environment, answers, 120, folder / 'webui.log'):
+    with port_for_this_run(WEBUI_PORT), running(command, environment, answers, 120, webui_log):
         yield url
 
 
@@ -346,5 +351,32 @@ def test_a_five_goal_synthesis_saves_in_the_webui_and_runs_onboard(editor, expor
         status = Operator(ros).start_behavior('Five Goals Saved')
         ok, details = finished_with(status, 'finished', system)
         assert ok, details
+    finally:
+        system.stop()
+
+
+def test_runtime_control_cannot_start_a_behavior_on_engine_2_3_3(editor, exported_behavior, ros_domain, flexbe,
+                                                                   webui_log, tmp_path):
+    """README's upstream mismatch: with FlexBE's onboard executive up on the WebUI's domain, Runtime
+    Control's Start Execution fails to publish the request (WebUI 4.0.3's BehaviorRequest against
+    engine 2.3.3's flexbe_msgs), so README starts behaviors with be_launcher instead."""
+    from types import SimpleNamespace
+
+    from test_flexbe_onboard import OnboardSystem
+
+    name = exported_behavior[0]
+    assert editor.evaluate(LOAD_BEHAVIOR, name)['error'] is None
+    system = OnboardSystem(SimpleNamespace(domain_id=ros_domain), exported_behavior[2], flexbe, tmp_path,
+                           robot=False)
+    try:
+        editor.click('#button_to_rc')
+        editor.wait_for_selector('#button_behavior_start', state='visible', timeout=60_000)
+        editor.click('#button_behavior_start')
+        failure = "Failed to publish '/flexbe/request_behavior' - 'Container' object has no attribute 'state_id'"
+        deadline = time.monotonic() + 60
+        while failure not in webui_log.read_text(errors='replace') and time.monotonic() < deadline:
+            time.sleep(0.5)
+        assert failure in webui_log.read_text(errors='replace'), webui_log.read_text(errors='replace')[-3000:]
+        assert 'Prepare behavior id=' not in system.log('onboard'), system.log('onboard')[-2000:]  # nothing reached it
     finally:
         system.stop()

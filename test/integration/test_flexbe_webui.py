@@ -321,6 +321,10 @@ def test_a_five_goal_synthesis_saves_in_the_webui_and_runs_onboard(editor, expor
 
     synthesize_in_new_container(editor, *FIVE_GOALS)
     editor.wait_for_function(f'() => ({READ_CONTAINER})("/Container")?.states.length > 0', timeout=120_000)
+    # README's step 3: Save refuses a behavior without a description.
+    assert editor.evaluate("""() => { UI.Dashboard.setBehaviorName('Five Goals Saved');
+                                      UI.Dashboard.setBehaviorDescription('');
+                                      return Checking.checkBehavior(); }""") == 'behavior description needs to be set'
     add_manual_imports(editor, MANUAL_IMPORTS)
     assert editor.evaluate(PREPARE_AND_SAVE, 'Five Goals Saved') is None
     editor.wait_for_function("() => document.getElementById('terminal').innerText"

@@ -99,6 +99,12 @@ def test_the_section_runs_in_order_to_a_finished_behavior(ros, flexbe, flexbe_so
                     status = next((s for s in operator.statuses if s.code in ended), None)
                 time.sleep(0.5)
             assert status.code == BEStatus.FINISHED and list(status.args) == ['finished'], output()[-4000:]
+            # What the section tells the user to look for in the onboard log.
+            deadline_for_log = time.monotonic() + 10
+            finished_line = re.compile(r'Behavior execution finished for Look Down Pickup: \d+ with result finished')
+            while not finished_line.search(output()) and time.monotonic() < deadline_for_log:
+                time.sleep(0.2)
+            assert finished_line.search(output()), output()[-4000:]
             assert 'suite up' in output(), output()[-4000:]
             while not up['webui'] and time.monotonic() < deadline:
                 up['webui'] = webui_answers()

@@ -12,7 +12,7 @@ MSGS_SOURCES := $(wildcard synthesis_msgs/msg/*.msg synthesis_msgs/srv/*.srv syn
                 synthesis_msgs/CMakeLists.txt synthesis_msgs/cmake/wheel_include_filter.cmake synthesis_msgs/package.xml
 SYSTEM_PACKAGES := graphviz chromium
 
-.PHONY: setup run test bench serve clean system-packages flexbe
+.PHONY: setup run test bench serve clean system-packages flexbe webui
 
 # FlexBE: the folder holding flexbe_behavior_engine/ (and flexbe_webui/, rosidl_runtime_py/).
 FLEXBE_SOURCES ?= $(if $(wildcard ../shared/third_party/flexbe_behavior_engine),$(abspath ../shared/third_party))
@@ -151,6 +151,29 @@ $(ROS2CLI_PREFIX)/.installed: $(VENV)/.project-installed \
 	  chmod +x $(ROS2CLI_PREFIX)/ros2
 	$(ROS2CLI_PREFIX)/ros2 action --help > /dev/null
 	touch $@
+
+# The pinned FlexBE WebUI (4.0.3) wired to this suite, for users without a FlexBE install:
+# served on 127.0.0.1:$(WEBUI_PORT) (its page subscribes to topics at localhost:8000 only) with
+# its own web stack first on its path, our FlexBE packages in its ament index, and the settings
+# README's "Use it from FlexBE" gives (synthesis on /behavior_synthesis, code for engine 2.3.3).
+# WEBUI_BEHAVIORS: the install prefix of the behavior package it saves into (installed first).
+WEBUI_PORT := 8000
+WEBUI_BEHAVIORS ?=
+WEBUI_CONFIG := build/flexbe_webui_config
+WEBUI_SETTINGS := {"synthesis_enabled": true, "synthesis_topic": "/behavior_synthesis", \
+  "synthesis_type": "synthesis_msgs/BehaviorSynthesisAction", "synthesis_system": "system_wide", \
+  "pkg_cache_enabled": false, "initialize_flexbe_core": false, "default_package": "synthesized_flexbe_behaviors"}
+PYTHON_SITE_SUFFIX = lib/python$(shell $(BIN)/python -c 'import sys; print("%d.%d" % sys.version_info[:2])')/site-packages
+webui:
+	@test -f $(WEBUI_SITE)/.installed -a -d $(FLEXBE_PREFIX) || { echo "run \`make flexbe\` first" >&2; exit 1; }
+	@test -d "$(FLEXBE_SOURCES)/flexbe_webui" || \
+	  { echo "FlexBE WebUI sources not found: set FLEXBE_SOURCES to the folder holding flexbe_webui/ (got '$(FLEXBE_SOURCES)')" >&2; exit 1; }
+	@mkdir -p $(WEBUI_CONFIG) && printf '%s\n' '$(WEBUI_SETTINGS)' > $(WEBUI_CONFIG)/webui.json
+	ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST \
+	PYTHONPATH=$(abspath $(WEBUI_SITE)):$(FLEXBE_SOURCES)/flexbe_webui:$(FLEXBE_SOURCES)/rosidl_runtime_py$(if $(WEBUI_BEHAVIORS),:$(abspath $(WEBUI_BEHAVIORS))/$(PYTHON_SITE_SUFFIX))$${PYTHONPATH:+:$$PYTHONPATH} \
+	AMENT_PREFIX_PATH=$(if $(WEBUI_BEHAVIORS),$(abspath $(WEBUI_BEHAVIORS)):)$(abspath $(FLEXBE_PREFIX)) \
+	  exec $(BIN)/python -m flexbe_webui.webui_node --port $(WEBUI_PORT) \
+	    --config_folder $(abspath $(WEBUI_CONFIG)) --config_file webui.json
 
 # Graphviz draws state machines; Chromium runs the browser tests (MuJoCo renders with EGL). Installed from Debian
 # when missing and we may (root); otherwise tell the user what to install.

@@ -14,7 +14,7 @@
         goal_pose: '[2.0, 0.0, 0.0]'
       states:                   # activation proposition <p>_a (or sensor) -> FlexBE state
         look_down_a:
-          class_decl: {name: TiltHeadState, param_names: [desired_tilt], param_values: [TiltHeadState.DOWN_45]}
+          class_decl: {name: TiltHeadState, param_names: [desired_tilt], param_values: ['-45.0']}
           output_mapping: {look_down_c: [done], look_down_f: [failed]}
           autonomy: 0           # one level for all outcomes, or a list in outcome order
           userdata_keys: []     # optional, same length as userdata_remapping

@@ -15,38 +15,20 @@ config/delivery_rover (a battery sensor; a drive that fails when its operator de
 from __future__ import annotations
 
 import os
-import signal
-import subprocess
 import sys
-import threading
-import time
-import zlib
 from pathlib import Path
 
 import pytest
-from rclpy.action import ActionClient
-from rclpy.node import Node
+
+# The processes and the operator, shared with bench/bench_flexbe_onboard.py (which runs them 100 times).
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / 'bench'))
+from flexbe_onboard_system import Operator, OnboardSystem, exported_and_installed, finished_with  # noqa: E402,F401
 
 pytestmark = pytest.mark.usefixtures('flexbe')
 
-BIN = Path(sys.executable).parent
 PAPER_TASK = ['--initial-conditions', 'stand_prep', '--goals', 'look_down,pickup_object']
 BEHAVIOR = 'Onboard Pickup'
 CNU_BEHAVIOR = 'CNU Vending Soda'
-
-
-def exported_and_installed(work: Path, export_arguments, package='synthesized_flexbe_behaviors', environment=None):
-    """``export-behavior`` with ``export_arguments``, its package installed into a prefix with pip (no colcon)."""
-    exported = subprocess.run([str(BIN / 'behavior-synthesis'), 'export-behavior', *export_arguments,
-                               '--package', package, '-o', str(work / 'src')],
-                              capture_output=True, text=True, timeout=120, env=environment)
-    assert exported.returncode == 0, exported.stderr
-    prefix = work / 'install'
-    pip = subprocess.run([sys.executable, '-m', 'pip', 'install', '--quiet', '--no-deps', '--no-build-isolation',
-                          '--no-index', '--prefix', str(prefix), str(work / 'src' / package)],
-                         capture_output=True, text=True, timeout=300)
-    assert pip.returncode == 0, pip.stderr
-    return prefix
 
 
 @pytest.fixture(scope='module')
@@ -54,47 +36,6 @@ def installed_prefix(tmp_path_factory):
     """The paper task exported and installed."""
     return exported_and_installed(tmp_path_factory.mktemp('onboard'),
                                   ['--system', 'atlas', *PAPER_TASK, '--name', BEHAVIOR])
-
-
-class OnboardSystem:
-    """The robot, the operator and FlexBE's onboard executive as processes on the test's domain."""
-
-    def __init__(self, ros, prefix: Path, flexbe_prefix: Path, logs: Path, sim_arguments=(), operator_arguments=(),
-                 operator_command=None, operator_path=(), robot=True):
-        self.site = prefix / 'lib' / f'python{sys.version_info.major}.{sys.version_info.minor}' / 'site-packages'
-        self.ament_prefix_path = os.pathsep.join([str(prefix), str(flexbe_prefix), sys.prefix])
-        self.environment = dict(os.environ, ROS_DOMAIN_ID=str(ros.domain_id), MUJOCO_GL='egl',
-                                AMENT_PREFIX_PATH=self.ament_prefix_path,
-                                PYTHONPATH=os.pathsep.join(filter(None, [str(self.site), *operator_path,
-                                                                           os.environ.get('PYTHONPATH')])))
-        self.logs = logs
-        self.processes = {}
-        if robot:  # a behavior of FlexBE's own states (CNU's LogState capabilities) needs no robot
-            self.start('sim', [str(BIN / 'atlas-sim-node'), '--ros-args', '-p', 'speed:=20.0', *sim_arguments])
-            self.start('operator', operator_command or [str(BIN / 'atlas-sim-operator'), *operator_arguments])
-        self.start('onboard', [sys.executable, '-m', 'flexbe_onboard.start_behavior'])
-
-    def start(self, name, command):
-        log = open(self.logs / f'{name}.log', 'w', encoding='utf-8')  # noqa: SIM115 - closed in stop()
-        self.processes[name] = (subprocess.Popen(command, env=self.environment, stdout=log, stderr=subprocess.STDOUT,
-                                                 text=True), log)
-
-    def log(self, name) -> str:
-        path = self.logs / f'{name}.log'
-        return path.read_text(encoding='utf-8', errors='replace') if path.exists() else f'(no {name} process)'
-
-
-    def stop(self):
-        for process, _ in self.processes.values():
-            if process.poll() is None:
-                process.send_signal(signal.SIGINT)
-        for name, (process, log) in self.processes.items():
-            try:
-                process.wait(timeout=10)
-            except subprocess.TimeoutExpired:
-                process.kill()
-                process.wait()
-            log.close()
 
 
 @pytest.fixture
@@ -116,68 +57,6 @@ def onboard(ros, flexbe, tmp_path, monkeypatch, request):
     yield start
     for system in systems:
         system.stop()
-
-
-class Operator:
-    """What a FlexBE operator sees: the status and log topics; starts behaviors like be_launcher."""
-
-    def __init__(self, ros):
-        from flexbe_msgs.msg import BehaviorLog, BEStatus
-        from synthesis_msgs.msg import RobotState
-
-        self.node = ros.add_node(Node, 'onboard_test_operator')
-        self.statuses, self.logs, self.robot = [], [], []
-        self.lock = threading.Lock()
-        self.node.create_subscription(BEStatus, 'flexbe/status', lambda m: self._keep(self.statuses, m), 10)
-        self.node.create_subscription(BehaviorLog, 'flexbe/log', lambda m: self._keep(self.logs, m), 100)
-        self.node.create_subscription(RobotState, 'atlas_sim/state', lambda m: self._keep(self.robot, m), 10)
-
-    def _keep(self, messages, message):
-        with self.lock:
-            messages.append(message)
-
-    def wait_until(self, condition, timeout, what):
-        deadline = time.monotonic() + timeout
-        while time.monotonic() < deadline:
-            with self.lock:
-                found = condition()
-            if found:
-                return found
-            time.sleep(0.05)
-        raise AssertionError(f'no {what} within {timeout} s')
-
-    def wait_for_servers(self):
-        from flexbe_msgs.action import BehaviorInput
-        from synthesis_msgs.action import ExecuteCapability
-
-        for action_type, name in ((BehaviorInput, 'flexbe/behavior_input'), (ExecuteCapability, 'atlas_sim/execute')):
-            client = ActionClient(self.node, action_type, name)
-            assert client.wait_for_server(timeout_sec=30.0), f'{name} is not served'
-
-    def start_behavior(self, name: str, autonomy: int = 3, robot: bool = True):
-        """A BehaviorSelection for ``name`` as be_launcher sends it; returns the final BEStatus."""
-        from flexbe_core import BehaviorLibrary
-        from flexbe_msgs.msg import BehaviorSelection, BEStatus
-
-        if robot:
-            self.wait_for_servers()
-        self.wait_until(lambda: any(s.code == BEStatus.READY for s in self.statuses), 40, 'READY from onboard')
-        library = BehaviorLibrary(self.node)
-        key, entry = library.find_behavior(name)
-        assert entry is not None, f'{name} is not in the behavior library'
-        source = Path(library.get_sourcecode_filepath(key)).read_text(encoding='utf-8')
-        selection = BehaviorSelection(behavior_key=key, behavior_id=zlib.adler32(source.encode()) & 0x7fffffff,
-                                      autonomy_level=autonomy)
-        publisher = self.node.create_publisher(BehaviorSelection, 'flexbe/start_behavior', 10)
-        self.wait_until(lambda: publisher.get_subscription_count() > 0, 10, 'subscriber of flexbe/start_behavior')
-        publisher.publish(selection)
-        ended = (BEStatus.FINISHED, BEStatus.FAILED, BEStatus.ERROR)
-        return self.wait_until(lambda: next((s for s in self.statuses if s.code in ended), None), 120,
-                               'end of the behavior')
-
-    def log_text(self) -> str:
-        with self.lock:
-            return '\n'.join(m.text for m in self.logs)
 
 
 def test_be_launcher_starts_the_installed_behavior(ros, onboard, flexbe_sources):
@@ -212,14 +91,6 @@ def test_flexbe_inputs_own_input_server_and_window_answer_the_input_state(ros, o
     ok, details = finished_with(status, 'finished', system)
     assert ok, details
     assert "typing '1' into: 'Specify desired object template\\nint'" in system.log('operator')
-
-
-def finished_with(status, outcome, system):
-    from flexbe_msgs.msg import BEStatus
-
-    return status.code == BEStatus.FINISHED and list(status.args) == [outcome], (
-        f'{status.code} {list(status.args)}\n--- onboard\n{system.log("onboard")[-3000:]}\n'
-        f'--- sim\n{system.log("sim")[-1500:]}\n--- operator\n{system.log("operator")[-1500:]}')
 
 
 def test_an_exported_behavior_finishes_onboard_with_flexbe_inputs_plain_answer(ros, onboard):

@@ -5,7 +5,9 @@ Its backend (FastAPI + a ROS node) runs as its own process with its older web st
 editor page runs in headless Chromium. The test clicks what a FlexBE user clicks (add a
 container, "Display synthesis", the task, Synthesize) and reads the result from the page's own
 JavaScript model (``Behavior.getStatemachine()``). Our behaviors (the synthesized one as
-`export-behavior` writes it, and atlas_sim's) open through the behavior dashboard's loader.
+`export-behavior` writes it, and atlas_sim's) open through the behavior dashboard's loader. The
+WebUI starts as README tells users without a FlexBE install (``make webui``); a machine saved in
+it with README's two manual imports runs on FlexBE's onboard executive.
 """
 
 import contextlib
@@ -36,12 +38,11 @@ WEBUI_SITE = REPOSITORY / 'build' / 'flexbe_webui_site'
 # The WebUI 4.0.3 page opens its topic subscriptions at ws://localhost:8000 whatever port it is
 # served from, so it only fully works on 8000; runs on one machine take turns (a lock file).
 WEBUI_PORT = 8000
-# The WebUI's settings for our legacy interface (what README tells FlexBE users to set).
-# initialize_flexbe_core: false generates code for the pinned engine 2.3.3 (README).
-WEBUI_SETTINGS = {'synthesis_enabled': True, 'synthesis_topic': '/behavior_synthesis',
-                  'synthesis_type': 'synthesis_msgs/BehaviorSynthesisAction',
-                  'synthesis_system': 'system_wide', 'pkg_cache_enabled': False,
-                  'initialize_flexbe_core': False, 'default_package': 'synthesized_flexbe_behaviors'}
+# README's workaround for the upstream mismatch, typed under the Dashboard's Manual Imports:
+# WebUI 4.0.3 calls these two names of engine 2.3.3 without importing them.
+MANUAL_IMPORTS = ('from flexbe_core import StateLogger', 'from flexbe_core.proxy import initialize_proxies')
+# What the WebUI's check writes to its terminal and console for a parameter value it cannot resolve.
+UNRESOLVED_PARAMETER = 'Unknown variable for parameter'
 PAPER_TASK = ('stand_prep', 'look_down, pickup_object')
 
 # The container's content in the page model: states, transitions, initial state, outcomes.
@@ -82,9 +83,11 @@ def port_for_this_run(port: int, timeout: float = 600):
 
 @contextlib.contextmanager
 def running(command, environment, ready, timeout: float, log_path: Path):
-    """A subprocess (output to ``log_path``) that ``ready()`` confirms up; stopped with SIGINT."""
+    """A subprocess (output to ``log_path``) that ``ready()`` confirms up; stopped with SIGINT to
+    its process group (``make webui`` waits for the WebUI it started)."""
     with open(log_path, 'w') as log:
-        process = subprocess.Popen(command, env=environment, stdout=log, stderr=subprocess.STDOUT)
+        process = subprocess.Popen(command, env=environment, stdout=log, stderr=subprocess.STDOUT,
+                                   start_new_session=True)
         try:
             deadline = time.monotonic() + timeout
             while not ready():
@@ -93,11 +96,12 @@ def running(command, environment, ready, timeout: float, log_path: Path):
                 time.sleep(0.2)
             yield process
         finally:
-            process.send_signal(signal.SIGINT)
+            with contextlib.suppress(ProcessLookupError):
+                os.killpg(process.pid, signal.SIGINT)
             try:
                 process.wait(timeout=20)
             except subprocess.TimeoutExpired:
-                process.kill()
+                os.killpg(process.pid, signal.SIGKILL)
                 process.wait()
 
 
@@ -149,20 +153,18 @@ def exported_behavior(tmp_path_factory):
 
 
 @pytest.fixture(scope='module')
-def webui(flexbe, flexbe_sources, ros_domain, synthesis_server, exported_behavior, tmp_path_factory):
-    """The WebUI backend process; yields its URL."""
-    import json
+def webui_log(tmp_path_factory) -> Path:
+    """Where the WebUI process's output (its terminal) goes."""
+    return tmp_path_factory.mktemp('webui') / 'webui.log'
 
+
+@pytest.fixture(scope='module')
+def webui(flexbe, flexbe_sources, ros_domain, synthesis_server, exported_behavior, webui_log):
+    """The WebUI backend started as README tells users without a FlexBE install (``make webui``
+    with the exported package's prefix); yields its URL."""
     if not (WEBUI_SITE / 'starlette').is_dir():
         pytest.fail(f'{WEBUI_SITE} is missing: `make flexbe` installs the web stack of the WebUI')
-    folder = tmp_path_factory.mktemp('webui')
-    (folder / 'webui.json').write_text(json.dumps(WEBUI_SETTINGS))
-    environment = prepare_ros_environment(ros_domain, environ=dict(os.environ))
-    environment['PYTHONPATH'] = os.pathsep.join(
-        [str(WEBUI_SITE), str(flexbe_sources / 'flexbe_webui'), str(flexbe_sources / 'rosidl_runtime_py'),
-         str(exported_behavior[3])]
-        + [entry for entry in os.environ.get('PYTHONPATH', '').split(os.pathsep) if entry])
-    environment['AMENT_PREFIX_PATH'] = os.pathsep.join([str(exported_behavior[2]), str(flexbe)])
+    environment = prepare_ros_environment(ros_domain, environ=dict(os.environ, FLEXBE_SOURCES=str(flexbe_sources)))
     url = f'http://127.0.0.1:{WEBUI_PORT}/'
 
     def answers():
@@ -171,9 +173,8 @@ def webui(flexbe, flexbe_sources, ros_domain, synthesis_server, exported_behavio
                 return response.status == 200
         return False
 
-    command = [sys.executable, '-m', 'flexbe_webui.webui_node', '--port', str(WEBUI_PORT),
-               '--config_folder', str(folder), '--config_file', 'webui.json']
-    with port_for_this_run(WEBUI_PORT), running(command, environment, answers, 120, folder / 'webui.log'):
+    command = ['make', '-s', '-C', str(REPOSITORY), 'webui', f'WEBUI_BEHAVIORS={exported_behavior[2]}']
+    with port_for_this_run(WEBUI_PORT), running(command, environment, answers, 120, webui_log):
         yield url
 
 
@@ -189,6 +190,8 @@ def editor(webui, browser):
     page = browser.new_page()
     errors = []
     page.on('pageerror', lambda error: errors.append(str(error)))
+    page.console = []  # what the WebUI prints to its console (its terminal, where pywebview runs it)
+    page.on('console', lambda message: page.console.append(message.text))
     page.goto(webui)
     page.wait_for_function("""() => typeof RC !== 'undefined' && RC.ROS.isConnected()
         && WS.Behaviorlib.getBehaviorList().length > 0
@@ -296,17 +299,39 @@ PREPARE_AND_SAVE = """name => {
 }"""
 
 
-def test_a_five_goal_synthesis_saves_in_the_webui_and_its_imports_exist(editor, exported_behavior):
-    """Every key the synthesized states read is written in the machine: the WebUI's check accepts it."""
+def add_manual_imports(page, lines):
+    """Type ``lines`` under the Dashboard's Manual Imports, as README's step 3 says, and go back to the editor."""
+    page.click('#button_to_db')
+    for line in lines:
+        page.fill('#input_db_manual_import_value_add', line)
+        page.click('#button_db_manual_import_add')
+    page.click('#button_to_sm')
+
+
+def test_a_five_goal_synthesis_saves_in_the_webui_and_runs_onboard(editor, exported_behavior, ros, flexbe, tmp_path,
+                                                                    monkeypatch):
+    """Every key the synthesized states read is written in the machine: the WebUI's check accepts
+    it, resolves every parameter value, and with README's two manual imports the saved behavior
+    defines every name it uses and runs to ``finished`` on FlexBE's onboard executive."""
     import ast
     import builtins
     import importlib
 
+    from test_flexbe_onboard import Operator, OnboardSystem, finished_with
+
     synthesize_in_new_container(editor, *FIVE_GOALS)
     editor.wait_for_function(f'() => ({READ_CONTAINER})("/Container")?.states.length > 0', timeout=120_000)
+    # README's step 3: Save refuses a behavior without a description.
+    assert editor.evaluate("""() => { UI.Dashboard.setBehaviorName('Five Goals Saved');
+                                      UI.Dashboard.setBehaviorDescription('');
+                                      return Checking.checkBehavior(); }""") == 'behavior description needs to be set'
+    add_manual_imports(editor, MANUAL_IMPORTS)
     assert editor.evaluate(PREPARE_AND_SAVE, 'Five Goals Saved') is None
     editor.wait_for_function("() => document.getElementById('terminal').innerText"
                              ".includes('Save behavior was successful!')", timeout=60_000)
+    terminal = editor.inner_text('#terminal')
+    assert UNRESOLVED_PARAMETER not in terminal, terminal
+    assert [line for line in editor.console if UNRESOLVED_PARAMETER in line] == []
     saved = exported_behavior[3] / 'synthesized_flexbe_behaviors' / 'five_goals_saved_sm.py'
     tree = ast.parse(saved.read_text(encoding='utf-8'))
     imported = [(node.module, alias.name) for node in ast.walk(tree) if isinstance(node, ast.ImportFrom)
@@ -316,10 +341,46 @@ def test_a_five_goal_synthesis_saves_in_the_webui_and_its_imports_exist(editor, 
     missing = [f'{module}.{name}' for module, name in imported
                if not hasattr(importlib.import_module(module), name)]
     assert missing == []
-    # The known upstream mismatch (README): WebUI 4.0.3 calls two flexbe_core names it does not import.
     used = {node.id for node in ast.walk(tree) if isinstance(node, ast.Name) and isinstance(node.ctx, ast.Load)}
     defined = ({name for _, name in imported} | set(dir(builtins))
                | {node.id for node in ast.walk(tree) if isinstance(node, ast.Name) and isinstance(node.ctx, ast.Store)}
                | {node.arg for node in ast.walk(tree) if isinstance(node, ast.arg)}
                | {node.name for node in ast.walk(tree) if isinstance(node, (ast.ClassDef, ast.FunctionDef))})
-    assert sorted(used - defined) == ['StateLogger', 'initialize_proxies']
+    assert sorted(used - defined) == []
+
+    system = OnboardSystem(ros, exported_behavior[2], flexbe, tmp_path)
+    monkeypatch.setenv('AMENT_PREFIX_PATH', system.ament_prefix_path)  # this process's BehaviorLibrary
+    monkeypatch.syspath_prepend(str(system.site))
+    try:
+        status = Operator(ros).start_behavior('Five Goals Saved')
+        ok, details = finished_with(status, 'finished', system)
+        assert ok, details
+    finally:
+        system.stop()
+
+
+def test_runtime_control_cannot_start_a_behavior_on_engine_2_3_3(editor, exported_behavior, ros_domain, flexbe,
+                                                                   webui_log, tmp_path):
+    """README's upstream mismatch: with FlexBE's onboard executive up on the WebUI's domain, Runtime
+    Control's Start Execution fails to publish the request (WebUI 4.0.3's BehaviorRequest against
+    engine 2.3.3's flexbe_msgs), so README starts behaviors with be_launcher instead."""
+    from types import SimpleNamespace
+
+    from test_flexbe_onboard import OnboardSystem
+
+    name = exported_behavior[0]
+    assert editor.evaluate(LOAD_BEHAVIOR, name)['error'] is None
+    system = OnboardSystem(SimpleNamespace(domain_id=ros_domain), exported_behavior[2], flexbe, tmp_path,
+                           robot=False)
+    try:
+        editor.click('#button_to_rc')
+        editor.wait_for_selector('#button_behavior_start', state='visible', timeout=60_000)
+        editor.click('#button_behavior_start')
+        failure = "Failed to publish '/flexbe/request_behavior' - 'Container' object has no attribute 'state_id'"
+        deadline = time.monotonic() + 60
+        while failure not in webui_log.read_text(errors='replace') and time.monotonic() < deadline:
+            time.sleep(0.5)
+        assert failure in webui_log.read_text(errors='replace'), webui_log.read_text(errors='replace')[-3000:]
+        assert 'Prepare behavior id=' not in system.log('onboard'), system.log('onboard')[-2000:]  # nothing reached it
+    finally:
+        system.stop()

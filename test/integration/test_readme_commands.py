@@ -7,7 +7,8 @@ run to exit status 0, the servers (``serve``, ``gui``) start, say they are ready
 within 3 s of Ctrl-C, ``send-goal`` talks to a ``serve`` of its own, and our other programs
 answer ``--help``. Commands for other environments (a ROS installation, FlexBE's onboard
 processes in several shells, make targets that build the venv) are listed in ``ELSEWHERE``
-with the test that covers them; any other command fails this test.
+with the test that covers them; any other command fails this test. The commands of the section
+"Use it from FlexBE" run in order in test/integration/test_readme_flexbe.py instead.
 """
 
 import os
@@ -37,10 +38,6 @@ ELSEWHERE = {
     'colcon': 'a ROS installation',
     'ros2': 'a ROS installation (its `action send_goal` lines run here with the pinned ros2cli)',
     'pip': 'a ROS installation',
-    'export': 'FlexBE onboard shells (test/integration/test_flexbe_onboard.py)',
-    'F': 'FlexBE onboard shells (test/integration/test_flexbe_onboard.py)',
-    'PYTHONPATH': 'FlexBE onboard shells: be_launcher (test/integration/test_flexbe_onboard.py)',
-    'python': "FlexBE's onboard executive (test/integration/test_flexbe_onboard.py)",
 }
 SERVERS = {'serve': 'suite up', 'gui': 'behavior synthesis GUI: http://'}
 QUICK = {'compile', 'repair', 'generate-sm', 'export-behavior', 'execute', 'demo'}
@@ -151,7 +148,22 @@ def start_and_stop(argv, environment, cwd, ready: str):
             process.kill()
 
 
-@pytest.mark.parametrize('command', readme_commands(README.read_text()))
+FLEXBE_SECTION = '## Use it from FlexBE'
+
+
+def flexbe_section(text: str) -> str:
+    """The README's "Use it from FlexBE" section, up to the next ``##`` heading."""
+    start = text.index(f'\n{FLEXBE_SECTION}\n')
+    end = text.find('\n## ', start + 1)
+    return text[start:end if end >= 0 else len(text)]
+
+
+def outside_the_flexbe_section(text: str) -> str:
+    """The README without its "Use it from FlexBE" section (test_readme_flexbe.py runs that one in order)."""
+    return text.replace(flexbe_section(text), '\n')
+
+
+@pytest.mark.parametrize('command', readme_commands(outside_the_flexbe_section(README.read_text())))
 def test_a_readme_command_runs_as_written(command, scratch, environment, request):
     argv = shlex.split(command, comments=True)
     background = argv[-1] == '&'

@@ -75,7 +75,7 @@ def test_sequence_of_single_states():
     stand, look = states['/stand'], states['/look_down']
     assert stand.state_class == 'ChangeControlModeActionState'
     assert stand.parameter_names == ['target_mode']
-    assert stand.parameter_values == ['ChangeControlModeActionState.STAND']
+    assert stand.parameter_values == ['"stand"']  # ChangeControlModeActionState.STAND's value
     assert edges(stand) == {'changed': 'look_down', 'failed': 'failed'}
     assert look.state_class == 'TiltHeadState'
     assert edges(look) == {'done': 'finished', 'failed': 'failed'}  # SM-outcome states become outcomes

@@ -21,8 +21,8 @@ DEPTH = 6
 
 def test_runs_of_a_small_machine():
     states = generate_state_machine(load_automaton(AUTOMATA / 'look_down.yaml'), 'atlas')
-    stand = ('ChangeControlModeActionState', '', ('ChangeControlModeActionState.STAND',))
-    look = ('TiltHeadState', '', ('TiltHeadState.DOWN_45',))
+    stand = ('ChangeControlModeActionState', '', ('"stand"',))
+    look = ('TiltHeadState', '', ('-45.0',))
     assert runs(states, DEPTH) == {
         (((stand,), ((stand, 'changed'),)), ((look,), ((look, 'done'),)), ('exit', 'finished')),
         (((stand,), ((stand, 'changed'),)), ((look,), ((look, 'failed'),)), ('exit', 'failed')),

@@ -9,7 +9,7 @@ class ChangeControlModeActionState(EventState):
     """
     Changes ATLAS's control mode (the simulator's control-mode capability of the same name).
 
-    -- target_mode  string   One of the class constants, e.g. ChangeControlModeActionState.STAND.
+    -- target_mode  string   A class constant or its value (ChangeControlModeActionState.STAND or "stand").
 
     <= changed               The robot is in the target mode.
     <= failed                The mode change failed.

@@ -9,7 +9,7 @@ class SetBaseModeState(EventState):
     """
     Switches the mobile manipulator's control mode (the simulator capability of that name).
 
-    -- mode         string   One of the class constants, e.g. SetBaseModeState.PARKED.
+    -- mode         string   A class constant or its value (SetBaseModeState.PARKED or "parked").
 
     <= changed               The robot is in the mode.
     <= failed                The mode change failed.

@@ -18,8 +18,8 @@ from pathlib import Path
 import yaml
 
 from ltl_specification.compiler import compile_task, explain
-from ltl_specification.errors import InvalidFormulaError, SpecificationError
-from respec.errors import ExitStatus, exit_status_help
+from ltl_specification.errors import InvalidFormulaError
+from respec.errors import CodedError, ExitStatus, exit_status_help
 from respec.naming import parse_names
 from respec.robot.files import add_config_dir_argument
 
@@ -62,7 +62,7 @@ def run(args: argparse.Namespace) -> int:
         spec = compile_task(args.system, args.initial_conditions, args.goals,
                             sm_outcomes=parse_names(args.sm_outcomes), strict_order=not args.unordered,
                             custom_ltl=custom_ltl, config_dir=args.config_dir)
-    except SpecificationError as error:
+    except CodedError as error:  # the task's and the robot files' own errors (a state class the workspace lacks)
         # One line naming the code and the item; a refusal's diagnosis (core, play) follows it.
         sentence, _, diagnosis = str(error).partition('\n')
         message = ' '.join(sentence.split())

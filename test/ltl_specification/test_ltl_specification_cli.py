@@ -91,3 +91,13 @@ def test_diagnose_says_why_a_task_cannot_be_done():
     assert 'stand -> stand_prep is not a transition in config/atlas.yaml' in impossible.stderr.splitlines()[0]
     possible = cli(*DEMO, '--diagnose')
     assert possible.returncode == 0 and possible.stderr == ''
+
+
+def test_a_capability_robot_without_its_flexbe_states_is_a_coded_error_not_a_traceback():
+    env = {key: value for key, value in os.environ.items() if key != 'AMENT_PREFIX_PATH'}
+    result = subprocess.run([sys.executable, '-m', 'ltl_specification', '--system', 'delivery_rover', '--goals', 'drive'],
+                            cwd=ROOT, env=dict(env, PYTHONPATH=str(ROOT)), capture_output=True, text=True, timeout=60)
+    assert result.returncode == 1 and 'Traceback' not in result.stderr
+    assert result.stderr.startswith("error: CONFIG_VARIABLE_CONFIG_INVALID: delivery_rover: capability 'check_battery' "
+                                    "uses state class 'OperatorDecisionState'")
+    assert "[item: 'check_battery.interface']" in result.stderr

@@ -157,3 +157,41 @@ def test_a_capability_whose_result_never_comes_ends_failed_naming_it(flexbe_node
     finally:
         released.set()
         server.destroy()
+
+
+def test_a_result_lost_on_the_way_is_asked_for_again(flexbe_node, ros, monkeypatch):
+    """The robot finishes and sends its result, but the proxy's result callback never runs (the
+    lost response seen in 4 of 100 onboard runs): the state asks for the result again once the
+    goal's status has said finished for RESULT_RETRY s, and ends with the robot's outcome."""
+    import time
+
+    from flexbe_core.proxy import ProxyActionClient
+    from rclpy.action import ActionServer
+    from rclpy.node import Node
+
+    from atlas_sim.simulator.node_names import CAPABILITY_ACTION_PREFIX
+    from atlas_sim_flexbe_states import capability_request
+    from atlas_sim_flexbe_states.capability_action_state import CapabilityActionState
+    from synthesis_msgs.action import ExecuteCapability
+
+    def complete(goal_handle):
+        goal_handle.succeed()
+        return ExecuteCapability.Result(outcome='completed', reason='')
+
+    lost = []
+    monkeypatch.setattr(ProxyActionClient, '_result_callback', classmethod(lambda cls, future, topic: lost.append(topic)))
+    monkeypatch.setattr(capability_request, 'RESULT_RETRY', 0.5)
+    robot = ros.add_node(Node, 'forgetful_network_robot')
+    server = ActionServer(robot, ExecuteCapability, CAPABILITY_ACTION_PREFIX + 'stand', complete)
+    try:
+        state = CapabilityActionState('stand')  # its own action: the proxy's state is per action name
+        state.on_enter({})
+        started, outcome = time.monotonic(), None
+        while outcome is None and time.monotonic() - started < 20:
+            outcome = state.execute({})
+            time.sleep(0.05)
+        assert outcome == 'completed', lost
+        assert CAPABILITY_ACTION_PREFIX + 'stand' in lost
+        assert time.monotonic() - started < 10
+    finally:
+        server.destroy()

@@ -3,15 +3,20 @@
 The simulator node (atlas_sim) serves one ExecuteCapability action per capability under
 ``atlas_sim/capabilities/<capability>``: FlexBE's proxy keeps one goal per action name, and
 states running concurrently (a ConcurrencyContainer) each need their own. Nothing here
-blocks in ``execute``: the goal is sent on enter, the result is polled, and a result that
-never arrives ends the state in its failure outcome after ``RESULT_TIMEOUT`` seconds, naming
-the capability, instead of holding the behavior forever (one onboard run in 13 once waited
-forever for a result the robot had sent).
+blocks in ``execute``: the goal is sent on enter and the result is polled.
+
+A result the robot sent can be lost on the way (4 of 100 onboard runs of the 5-goal behavior,
+each on a different capability: the goal's status said it had finished, the result never came).
+So when the goal's status has said "finished" for ``RESULT_RETRY`` seconds without a result,
+the result is asked for again (the action server keeps it); and a result that still never
+arrives ends the state in its failure outcome after ``RESULT_TIMEOUT`` seconds, naming the
+capability, instead of holding the behavior forever.
 """
 
 import json
 import time
 
+from action_msgs.msg import GoalStatus
 from flexbe_core import Logger
 from flexbe_core.proxy import ProxyActionClient
 
@@ -24,6 +29,9 @@ SERVER_WAIT = 5.0
 # Wall-clock seconds a capability may take before the state gives up on its result: every
 # capability of the simulated robot completes within a few seconds of robot time.
 RESULT_TIMEOUT = 60.0
+# Seconds after the goal's status said it finished before its result is asked for again.
+RESULT_RETRY = 2.0
+_FINISHED = (GoalStatus.STATUS_SUCCEEDED, GoalStatus.STATUS_ABORTED, GoalStatus.STATUS_CANCELED)
 
 
 def capability_goal(capability, userdata=None):
@@ -43,11 +51,15 @@ class CapabilityRequest:
         self.result = None  # the ExecuteCapability result once it arrived
         self._failure = None
         self._sent_at = None
+        self._finished_at = None    # when the goal's status was first seen finished
+        self._asked_again_at = None
+        self._result_asked_again = None
         self._topic = CAPABILITY_ACTION_PREFIX + capability if capability else None
 
     def start(self, unsupported_reason='', userdata=None):
         """Send the goal (on_enter); ``userdata``: the keys the robot needs, e.g. ``{'template_id': 1}``."""
         self.result, self._failure = None, None
+        self._finished_at = self._asked_again_at = self._result_asked_again = None
         if not self._topic:
             self._failure = unsupported_reason or f'{self.state_name}: nothing the simulator can do'
             Logger.logwarn(self._failure)
@@ -67,7 +79,13 @@ class CapabilityRequest:
         """``completed``/``failed`` once the robot answered, None while it runs (execute)."""
         if self._failure:
             return failed
-        if not ProxyActionClient.has_result(self._topic):
+        if ProxyActionClient.has_result(self._topic):
+            self.result = ProxyActionClient.get_result(self._topic)
+            ProxyActionClient.remove_result(self._topic)
+        elif self._result_asked_again is not None:
+            self.result = self._result_asked_again
+        else:
+            self._ask_again_if_lost()
             if time.monotonic() - self._sent_at < self.result_timeout:
                 return None
             self._failure = (f'{self.state_name}: no result for {self.capability} within '
@@ -75,12 +93,32 @@ class CapabilityRequest:
             Logger.logerr(self._failure)
             ProxyActionClient.cancel(self._topic)
             return failed
-        self.result = ProxyActionClient.get_result(self._topic)
-        ProxyActionClient.remove_result(self._topic)
         if self.result.outcome == COMPLETED:
             return completed
         Logger.logwarn(f'{self.state_name}: {self.capability} failed: {self.result.reason}')
         return failed
+
+    def _ask_again_if_lost(self):
+        """Ask for the result again when the goal's status has said "finished" for RESULT_RETRY
+        seconds (and again every RESULT_RETRY seconds). flexbe_core 2.3.3's proxy has no public
+        accessor for the goal's handle: its ``_current_goal`` future is read."""
+        goal = ProxyActionClient._current_goal.get(self._topic)  # pylint: disable=protected-access
+        handle = goal.result() if goal is not None and goal.done() else None
+        if handle is None or handle.status not in _FINISHED:
+            return
+        now = time.monotonic()
+        self._finished_at = self._finished_at or now
+        if now - max(self._finished_at, self._asked_again_at or 0.0) < RESULT_RETRY:
+            return
+        self._asked_again_at = now
+        Logger.logwarn(f'{self.state_name}: {self.capability} finished {now - self._finished_at:.0f} s ago '
+                       'but its result has not arrived; asking for it again')
+        handle.get_result_async().add_done_callback(self._got_result_again)
+
+    def _got_result_again(self, future):
+        response = future.result()
+        if response is not None:
+            self._result_asked_again = response.result
 
     def report(self):
         """What the simulator reported, for output userdata (it computes no poses or plans)."""

@@ -11,6 +11,7 @@ with a ``flexbe_msgs/BehaviorSelection`` as be_launcher does.
 
 from __future__ import annotations
 
+import importlib
 import os
 import signal
 import subprocess
@@ -129,6 +130,11 @@ class Operator:
         library = BehaviorLibrary(self.node)
         key, entry = library.find_behavior(name)
         assert entry is not None, f'{name} is not in the behavior library'
+        # The library finds the source through an import of the behavior's package: this process
+        # may hold a package of that name from another prefix (an earlier run), so import afresh.
+        for module in [m for m in sys.modules if m == entry['package'] or m.startswith(entry['package'] + '.')]:
+            del sys.modules[module]
+        importlib.invalidate_caches()
         source = Path(library.get_sourcecode_filepath(key)).read_text(encoding='utf-8')
         selection = BehaviorSelection(behavior_key=key, behavior_id=zlib.adler32(source.encode()) & 0x7fffffff,
                                       autonomy_level=autonomy)

@@ -26,7 +26,7 @@ from ltl_synthesizer.isolated import SERVER_CHILD_NICENESS, ChildProcess
 STARTUP_GRACE = 20.0
 
 
-class RepairSearchFailed(Exception):
+class RepairSearchError(Exception):
     """The child ended (killed, crashed, overran its deadline) without an answer."""
 
 
@@ -55,7 +55,7 @@ class RepairSearch:
             return self.child.call(search, (self.settings,), on_progress=on_proposal or (lambda _: None),
                                    deadline=deadline)
         except SynthesisError as error:  # died, stopped or overran: SynthesisError's subclasses
-            raise RepairSearchFailed(f'the repair search ended without an answer ({error})') from error
+            raise RepairSearchError(f'the repair search ended without an answer ({error})') from error
         finally:
             self.child.kill()
 

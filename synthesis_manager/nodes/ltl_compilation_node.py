@@ -26,7 +26,7 @@ from std_msgs.msg import String
 from ltl_specification import compile_task
 from ltl_specification.provenance import provenance_to_json
 from ltl_specification.repair import TaskRequest
-from ltl_specification.repair_process import RepairSearch, RepairSearchFailed, repair_settings
+from ltl_specification.repair_process import RepairSearch, RepairSearchError, repair_settings
 from ltl_synthesizer import SynthesisCancelledError
 from ltl_synthesizer.isolated import SERVER_CHILD_NICENESS, SynthesisProcesses
 from respec.errors import ErrorCode
@@ -187,7 +187,7 @@ class LTLCompilationNode(Node):
                                        request.max_proposals or DEFAULT_REPAIR_PROPOSALS)
             repairs = await self.repairs.run(self._search_repairs, settings, wake=self._wake_executor,
                                              give_up=self._stopping.is_set)
-        except (RepairSearchFailed, Abandoned, SynthesisCancelledError) as error:
+        except (RepairSearchError, Abandoned, SynthesisCancelledError) as error:
             response.error_code = error_code(ErrorCode.TIMEOUT, f'repair search stopped: {error or "shutdown"}')
             return response
         except Exception as error:  # every failure becomes an error code; the node keeps serving

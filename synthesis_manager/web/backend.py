@@ -17,7 +17,7 @@ from typing import Callable
 
 from ltl_specification.diagnosis import goal_findings, impossible_next_goals
 from ltl_specification.capability_precheck import clause_text
-from ltl_specification.repair_process import RepairSearch, RepairSearchFailed, repair_settings
+from ltl_specification.repair_process import RepairSearch, RepairSearchError, repair_settings
 from ltl_specification.systems import load_task_abstraction
 from respec.errors import INTERNAL_ERROR, CodedError, ErrorCode, quoted
 from respec.naming import DEFAULT_SM_OUTCOMES, FINISHED
@@ -228,8 +228,8 @@ class SynthesisBackend:
             answers.put(('result', search.run(lambda proposal: answers.put(('proposal', proposal)))))
         except CodedError as error:  # the system's files as the compiler refuses them
             answers.put(('error', NotAvailableError(str(error), error.item or settings['system'])))
-        except Exception as error:  # RepairSearchFailed, or the child could not start
-            if not isinstance(error, RepairSearchFailed):
+        except Exception as error:  # RepairSearchError, or the child could not start
+            if not isinstance(error, RepairSearchError):
                 logger.exception('repair search failed')
             answers.put(('error', NotAvailableError(str(error), 'repair search')))
         finally:

@@ -297,14 +297,18 @@ def test_the_capability_precheck_sentence_reaches_both_actions(cnu_package, flex
         ours = SynthesisClient(ros.add_node(Node, 'precheck_client'), 'behavior_synthesis')
         assert ours.wait_for_server(timeout=10.0)
         outcome = ours.run(make_goal('coffee_maker', ['bd_a'], ['br']), timeout=120)
-        assert (outcome.error_name, outcome.message) == ('INVALID_GOALS', f'LTL compilation failed: {sentence}')
+        refusal, _, fixes = outcome.message.partition('\n\nVerified fixes')
+        assert (outcome.error_name, refusal) == ('INVALID_GOALS', f'LTL compilation failed: {sentence}')
+        # the robot change that makes it possible follows (test_suggested_fixes.py)
+        assert 'Suggested fix 1: Change the robot: when br is completed, br holds' in fixes
         client = PlainCnuClient(ros)
         try:
             result = client.run(client.goal(['bd_a'], ['br'], system_name='coffee_maker')).result
         finally:
             client.close()
     assert result.error_code.value == SynthesisErrorCode.SPEC_COMPILATION_FAILED
-    assert list(result.messages) == [f'INVALID_GOALS: LTL compilation failed: {sentence}']
+    assert list(result.messages)[0] == f'INVALID_GOALS: LTL compilation failed: {sentence}'
+    assert all(message.startswith('Suggested fix ') for message in list(result.messages)[1:])
 
 
 # --- Without CNU's package ---------------------------------------------------------------------

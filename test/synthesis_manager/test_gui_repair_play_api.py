@@ -274,7 +274,7 @@ def test_a_search_past_its_deadline_is_killed(monkeypatch):
 
     monkeypatch.setattr(repair_process, 'STARTUP_GRACE', 0.0)
     search = repair_process.RepairSearch(search_settings(time_budget=0.01))
-    with pytest.raises(repair_process.RepairSearchFailed, match='without an answer'):
+    with pytest.raises(repair_process.RepairSearchError, match='without an answer'):
         search.run()
     assert search.child.process.poll() is not None
 
@@ -282,13 +282,13 @@ def test_a_search_past_its_deadline_is_killed(monkeypatch):
 def test_stopping_the_gui_ends_a_running_search_at_once():
     import time
 
-    from ltl_specification.repair_process import RepairSearch, RepairSearchFailed
+    from ltl_specification.repair_process import RepairSearch, RepairSearchError
 
     search = RepairSearch(search_settings())
     with ThreadPoolExecutor(1) as pool:
         answer = pool.submit(search.run)
         started = time.monotonic()
         search.stop()
-        with pytest.raises(RepairSearchFailed):
+        with pytest.raises(RepairSearchError):
             answer.result(timeout=10)
     assert time.monotonic() - started < 2.0 and search.child.process.poll() is not None

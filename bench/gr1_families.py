@@ -332,3 +332,16 @@ FAMILIES = {
     'gridworld_unrealizable': [(f'{w}x{h} k={k}', gridworld, (w, h, k, False))
                                for w, h, k in GRIDWORLD_SIZES],
 }
+
+
+def free_inputs(width: int) -> str:
+    """``width`` free inputs and ``width`` outputs, each output following the previous one and
+    its input (a shift register of parities), and an environment liveness that never holds:
+    every position wins, and an explicit strategy answers all 2^width inputs at every state
+    (the case of a specification whose assumptions contradict: 10^4-10^6 strategy edges)."""
+    lines = {'INPUT': [f'x{i}' for i in range(width)],
+             'OUTPUT': [f'y{i}' for i in range(width)],
+             'SYS_TRANS': ["y0' <-> x0'"] + [f"y{i}' <-> (y{i - 1} ^ x{i}')" for i in range(1, width)],
+             'ENV_LIVENESS': ['x0 & !x0'],
+             'SYS_LIVENESS': [f'y{width - 1}', f'!y{width - 1} | x0']}
+    return _text(lines)

@@ -43,6 +43,9 @@ GR1SYNTH = [sys.executable, '-m', 'ltl_synthesizer']
 RESIDENT_BELOW = 2.0
 # CPU seconds of repeated requests per instance (the kernel counts CPU time in 10 ms ticks).
 RESIDENT_BUDGET = 1.0
+# Counter-strategies up to this many bytes of JSON are loaded and checked (larger ones hold
+# millions of system answers: the check would need gigabytes).
+COUNTERSTRATEGY_CHECKED_BYTES = 4 * 2**20
 
 
 def run_timed(command: list[str], timeout: float, stdout=subprocess.DEVNULL) -> dict:
@@ -155,6 +158,10 @@ def counterstrategy_check(spec, slugsin: Path, slugs: str | None, timeout: float
     if run['timeout'] or run['status'] != 0:
         said = f'> {timeout:.0f} s' if run['timeout'] else run['stderr'].strip()[-200:]
         return f'counter-strategy not extracted ({said})'
+    size = output.stat().st_size
+    if size > COUNTERSTRATEGY_CHECKED_BYTES:  # every node lists every system answer
+        output.unlink()
+        return f'counter-strategy of {size / 2**20:.0f} MB not checked ({run["cpu"]:.2f} s)'
     strategy = json.loads(output.read_text())
     output.unlink()
     problems = check_counterstrategy(spec, strategy)

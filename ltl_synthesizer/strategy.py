@@ -309,11 +309,34 @@ class EnvironmentStrategy:
         self.env_trans = game.env_trans()
         self.sys_trans = game.sys_trans()
         self.responses_counted = 0
+        # Z_k, the union of level k's blocking sets: the outer least fixpoint's iterates.
+        self.won_by_level = []
+        for level in self.levels:
+            won = game.false
+            for blocking in level.blocking:
+                won |= blocking
+            self.won_by_level.append(won)
+        self._levels_found = {}
 
     def level_of(self, state) -> int:
-        # Z_k grows with k, so the first level whose blocking sets contain the position.
-        return next(k for k, level in enumerate(self.levels)
-                    if any(self.game.evaluate(blocking, state) for blocking in level.blocking))
+        """The first level whose blocking sets contain the position. Z_k grows with k (the
+        iterates of a least fixpoint), so a binary search over the Z_k finds it: a few
+        evaluations per state instead of one per level and goal (remembered per state: each
+        node's level is asked again by its predecessors)."""
+        key = tuple(state[name] for name in self.game.variables)
+        found = self._levels_found.get(key)
+        if found is None:
+            low, high = 0, len(self.won_by_level) - 1
+            if not self.game.evaluate(self.won_by_level[high], state):
+                raise ValueError('the position is not won by the environment')
+            while low < high:
+                middle = (low + high) // 2
+                if self.game.evaluate(self.won_by_level[middle], state):
+                    high = middle
+                else:
+                    low = middle + 1
+            found = self._levels_found[key] = low
+        return found
 
     def first_blockable_goal(self, state, level: int | None = None) -> int:
         level = self.level_of(state) if level is None else level

@@ -163,9 +163,21 @@ def check_counterstrategy(spec, strategy: dict, robotics_semantics: bool = False
         return [f'counter-strategy variables {names} are not the specification\'s']
     inputs, outputs = list(spec.env_props), list(spec.sys_props)
     next_inputs, next_outputs = [v + "'" for v in inputs], [v + "'" for v in outputs]
-    env_init, sys_init, env_trans, sys_trans, assumptions, goals = formulas.game(spec)
+    # The safety sections stay lists of formulas, cofactored by each node's state before they
+    # are conjoined: as one BDD in the declared order, GenBuf's SYS_TRANS alone is huge.
+    env_init, sys_init = formulas.conjunction(spec.env_init), formulas.conjunction(spec.sys_init)
+    env_parts = [formulas.translate(f) for f in spec.env_trans]
+    sys_parts = [formulas.translate(f) for f in spec.sys_trans]
+    assumptions = [formulas.translate(f) for f in spec.env_liveness] or [bdd.true]
+    goals = [formulas.translate(f) for f in spec.sys_liveness] or [bdd.true]
     nodes = strategy['nodes']
     problems = []
+
+    def cofactor(parts, assignment):
+        result = bdd.true
+        for part in parts:
+            result &= bdd.let(assignment, part)
+        return result
 
     def state_of(name):
         return {variable: None if value is None else bool(value)
@@ -203,9 +215,9 @@ def check_counterstrategy(spec, strategy: dict, robotics_semantics: bool = False
             problems.append(f'node {name}: successors differ in their inputs')
             continue
         here = {**state, **chosen}
-        if bdd.let(here, env_trans) != bdd.true:
+        if cofactor(env_parts, here) != bdd.true:
             problems.append(f'node {name}: its next input violates ENV_TRANS')
-        sys_answers = bdd.let(here, sys_trans)  # a function of the next outputs only
+        sys_answers = cofactor(sys_parts, here)  # a function of the next outputs only
         if any(deadlock(state_of(s)) for s in successors):
             if len(successors) != 1 or sys_answers != bdd.false:
                 problems.append(f'node {name}: a deadlock successor where the system can move')

@@ -317,6 +317,7 @@ class EnvironmentStrategy:
                 won |= blocking
             self.won_by_level.append(won)
         self._levels_found = {}
+        self._goals_found = {}
 
     def level_of(self, state) -> int:
         """The first level whose blocking sets contain the position. Z_k grows with k (the
@@ -339,9 +340,16 @@ class EnvironmentStrategy:
         return found
 
     def first_blockable_goal(self, state, level: int | None = None) -> int:
+        """The first goal the environment can block at the position (on its level),
+        remembered per position: many transitions lead to the same one."""
         level = self.level_of(state) if level is None else level
-        return next(j for j, blocking in enumerate(self.levels[level].blocking)
-                    if self.game.evaluate(blocking, state))
+        key = (tuple(state[name] for name in self.game.variables), level)
+        found = self._goals_found.get(key)
+        if found is None:
+            found = self._goals_found[key] = next(
+                j for j, blocking in enumerate(self.levels[level].blocking)
+                if self.game.evaluate(blocking, state))
+        return found
 
     def successors(self, state: dict, rank: tuple, only_first: bool) -> list[tuple]:
         """The successor nodes (values, rank) of node (state, rank): a deadlock node when the

@@ -15,6 +15,16 @@ Each family is a function ``size -> text``; ``FAMILIES`` lists the sizes the ben
   the robot lets it glitch (slugs' moving obstacle benchmark).
 - ``evasion``: slugs' EvasionOnGrid scene scaled: a w x h grid with static walls, a moving
   obstacle, and two delivery points the robot must visit in turn.
+- ``genbuf``: the generalized buffer after Bloem et al., JCSS 2012, Sect. 7.1 (written from
+  the paper's description): ``senders`` senders hand data over by a four-phase handshake
+  (StoB_REQ / BtoS_ACK), the buffer stores it in a FIFO (ENQ / DEQ, FULL / EMPTY from the FIFO)
+  and hands it to two receivers (BtoR_REQ / RtoB_ACK); every handshake completes. The
+  unrealizable variant drops the receivers' fairness (a receiver may never acknowledge), so
+  the FIFO may stay full while a sender waits.
+- ``gridworld``: a robot on a w x h grid must visit k goal regions infinitely often while a
+  patrolling adversary walks the middle row; one goal lies on that row. Realizable: the
+  adversary must reach both ends of its row infinitely often (it patrols); unrealizable: it
+  may stop anywhere, e.g. on the goal.
 """
 
 from __future__ import annotations
@@ -190,6 +200,82 @@ def evasion(width: int, height: int) -> str:
     return _text(lines)
 
 
+def genbuf(senders: int, realizable: bool = True) -> str:
+    """Generalized buffer of ``senders`` senders and two receivers (JCSS 2012 Sect. 7.1)."""
+    receivers = 2
+    requests = [f'sreq{i}' for i in range(senders)]
+    acks = [f'sack{i}' for i in range(senders)]
+    rreqs = [f'rreq{j}' for j in range(receivers)]
+    racks = [f'rack{j}' for j in range(receivers)]
+    lines = {'INPUT': requests + racks + ['full', 'empty'],
+             'OUTPUT': acks + rreqs + ['enq', 'deq', f'slc:0...{max(senders - 1, 1)}']}
+    lines['ENV_INIT'] = [f'!{r}' for r in requests + racks] + ['empty', '!full']
+    env_trans = []
+    for req, ack in zip(requests, acks):
+        # A sender keeps its request until acknowledged, then lowers it.
+        env_trans += [f"{req} & !{ack} -> {req}'", f"{ack} -> !{req}'"]
+    for rreq, rack in zip(rreqs, racks):
+        # A receiver acknowledges only a request, and keeps its acknowledgement while requested.
+        env_trans += [f"!{rreq} -> !{rack}'", f"{rreq} & {rack} -> {rack}'"]
+    # The FIFO: an enqueue makes it non-empty, a dequeue non-full; idle, it keeps its flags.
+    env_trans += ["enq & !deq -> !empty'", "deq & !enq -> !full'",
+                  "!enq & !deq -> ((full' <-> full) & (empty' <-> empty))", "!(full' & empty')"]
+    lines['ENV_TRANS'] = env_trans
+    lines['ENV_LIVENESS'] = [f'{rreq} <-> {rack}' for rreq, rack in zip(rreqs, racks)] \
+        if realizable else []
+    lines['SYS_INIT'] = [f'!{a}' for a in acks + rreqs] + ['!enq', '!deq']
+    sys_trans = []
+    for index, (req, ack) in enumerate(zip(requests, acks)):
+        # No acknowledgement without a request; kept while requested; a new one enqueues the
+        # sender's data (slc selects the sender).
+        sys_trans += [f"!{req} -> !{ack}'", f"{req} & {ack} -> {ack}'",
+                      f"!{ack} & {ack}' -> (enq' & slc' = {index})"]
+    sys_trans.append("enq' -> (" + ' | '.join(f'(!{a} & {a}\')' for a in acks) + ')')
+    sys_trans += [f"!{a}' | !{b}'" for k, a in enumerate(acks) for b in acks[k + 1:]]
+    for rreq, rack in zip(rreqs, racks):
+        # A request to a receiver is kept until acknowledged, then lowered; a new one dequeues.
+        sys_trans += [f"{rreq} & !{rack} -> {rreq}'", f"{rack} -> !{rreq}'",
+                      f"!{rreq} & {rreq}' -> deq'"]
+    sys_trans.append("deq' -> (" + ' | '.join(f"(!{r} & {r}')" for r in rreqs) + ')')
+    sys_trans += [f"!{rreqs[0]}' | !{rreqs[1]}'", "full' -> !enq'", "empty' -> !deq'"]
+    lines['SYS_TRANS'] = sys_trans
+    # Every sender's handshake completes infinitely often; so does every receiver's.
+    lines['SYS_LIVENESS'] = [f'{req} <-> {ack}' for req, ack in zip(requests, acks)] \
+        + [f'{rreq} <-> {rack}' for rreq, rack in zip(rreqs, racks)]
+    return _text(lines)
+
+
+def gridworld(width: int, height: int, goals: int, realizable: bool = True) -> str:
+    """A robot visits ``goals`` regions of a ``width`` x ``height`` grid infinitely often; an
+    adversary patrols the middle row (it must reach both of its ends infinitely often when
+    ``realizable``). The robot never shares a cell with the adversary nor swaps with it."""
+    row = height // 2
+    regions = _goal_regions(width, height, row, goals)
+    lines = {'INPUT': [f'ax:0...{width - 1}'],
+             'OUTPUT': [f'x:0...{width - 1}', f'y:0...{height - 1}'],
+             'ENV_INIT': ['ax = 0'],
+             'SYS_INIT': [f'x = {width - 1}', 'y = 0'],
+             'ENV_TRANS': ["ax' <= ax+1 & ax <= ax'+1"],
+             'SYS_TRANS': ["x' <= x+1 & x <= x'+1 & y' <= y+1 & y <= y'+1 & (x' = x | y' = y)",
+                           f"y' != {row} | x' != ax'", f"y' != {row} | x' != ax"],
+             'ENV_LIVENESS': ['ax = 0', f'ax = {width - 1}'] if realizable else [],
+             'SYS_LIVENESS': [_at(region) for region in regions]}
+    return _text(lines)
+
+
+def _goal_regions(width: int, height: int, row: int, goals: int) -> list:
+    """``goals`` boxes (x0, x1, y0, y1): 2x2 squares spread over the grid, alternately above
+    and below the adversary's row, and one cell on that row."""
+    regions = []
+    for index in range(goals - 1):
+        x0 = min(width - 2, round(index * (width - 2) / max(goals - 2, 1)))
+        y0 = 0 if index % 2 == 0 else height - 2
+        regions.append((x0, x0 + 1, y0, y0 + 1))
+    middle = width // 2
+    regions.append((middle, middle, row, row))
+    return regions
+
+
 def _sum_at_most(terms: list[str], bound: int) -> str:
     """``t0+t1+... <= bound`` split into halves (each half's partial sum enumerated), so that
     no single comparison ranges over too many valuations for the parser."""
@@ -222,6 +308,9 @@ def _text(lines: dict) -> str:
                    for section in SECTION_ORDER if section in lines)
 
 
+GRIDWORLD_SIZES = [(7, 5, 3), (10, 8, 4), (13, 10, 6), (16, 13, 7), (19, 16, 8), (25, 20, 10),
+                   (32, 24, 12), (48, 32, 14), (64, 48, 16)]
+
 # (name, size label, generator arguments), smallest first within each family.
 FAMILIES = {
     'amba': [(f'{n} masters', amba, (n,)) for n in range(2, 11)],
@@ -237,4 +326,22 @@ FAMILIES = {
         (48, 19), (64, 27), (96, 43), (128, 60)]],
     'evasion': [(f'{w}x{h}', evasion, (w, h)) for w, h in [
         (24, 8), (48, 16), (64, 24), (96, 32), (128, 64), (256, 128), (512, 256)]],
+    'genbuf': [(f'{n} senders', genbuf, (n, True)) for n in (4, 8, 16, 24, 32, 48, 64)],
+    'genbuf_unrealizable': [(f'{n} senders', genbuf, (n, False)) for n in (4, 8, 16, 24, 32, 48, 64)],
+    'gridworld': [(f'{w}x{h} k={k}', gridworld, (w, h, k, True)) for w, h, k in GRIDWORLD_SIZES],
+    'gridworld_unrealizable': [(f'{w}x{h} k={k}', gridworld, (w, h, k, False))
+                               for w, h, k in GRIDWORLD_SIZES],
 }
+
+
+def free_inputs(width: int) -> str:
+    """``width`` free inputs and ``width`` outputs, each output following the previous one and
+    its input (a shift register of parities), and an environment liveness that never holds:
+    every position wins, and an explicit strategy answers all 2^width inputs at every state
+    (the case of a specification whose assumptions contradict: 10^4-10^6 strategy edges)."""
+    lines = {'INPUT': [f'x{i}' for i in range(width)],
+             'OUTPUT': [f'y{i}' for i in range(width)],
+             'SYS_TRANS': ["y0' <-> x0'"] + [f"y{i}' <-> (y{i - 1} ^ x{i}')" for i in range(1, width)],
+             'ENV_LIVENESS': ['x0 & !x0'],
+             'SYS_LIVENESS': [f'y{width - 1}', f'!y{width - 1} | x0']}
+    return _text(lines)

@@ -140,6 +140,133 @@ def check_strategy(spec, strategy: dict, limit: int = 20) -> list[str]:
     return problems[:limit]
 
 
+def check_counterstrategy(spec, strategy: dict, robotics_semantics: bool = False,
+                          limit: int = 20) -> list[str]:
+    """Problems found (at most ``limit``) in the environment's explicit counter-strategy
+    (slugs' ``--counterStrategy --jsonOutput`` shape); empty when it wins against every
+    system move:
+
+    1. initial: some initial input (standard semantics; robotics: some initial position) has
+       a node for every initial output the system may pick;
+    2. moves: at every node, the environment picks one next input allowed by ENV_TRANS (all
+       successors share it); every output SYS_TRANS allows in answer has a successor, each
+       successor is such an output, or the one successor is a deadlock node (outputs
+       ``null``) because SYS_TRANS allows none;
+    3. winning plays: every cycle meets every assumption (the graph without the
+       transitions of assumption i has no cycle) and misses some goal (no strongly
+       connected part has internal transitions of every goal).
+    """
+    formulas = _Formulas(spec)
+    bdd = formulas.bdd
+    names = strategy['variables']
+    if sorted(names) != sorted(formulas.variables):
+        return [f'counter-strategy variables {names} are not the specification\'s']
+    inputs, outputs = list(spec.env_props), list(spec.sys_props)
+    next_inputs, next_outputs = [v + "'" for v in inputs], [v + "'" for v in outputs]
+    # The safety sections stay lists of formulas, cofactored by each node's state before they
+    # are conjoined: as one BDD in the declared order, GenBuf's SYS_TRANS alone is huge.
+    env_init, sys_init = formulas.conjunction(spec.env_init), formulas.conjunction(spec.sys_init)
+    env_parts = [formulas.translate(f) for f in spec.env_trans]
+    sys_parts = [formulas.translate(f) for f in spec.sys_trans]
+    assumptions = [formulas.translate(f) for f in spec.env_liveness] or [bdd.true]
+    goals = [formulas.translate(f) for f in spec.sys_liveness] or [bdd.true]
+    nodes = strategy['nodes']
+    problems = []
+
+    def cofactor(parts, assignment):
+        result = bdd.true
+        for part in parts:
+            result &= bdd.let(assignment, part)
+        return result
+
+    def state_of(name):
+        return {variable: None if value is None else bool(value)
+                for variable, value in zip(names, nodes[name]['state'])}
+
+    def deadlock(state):
+        return any(state[variable] is None for variable in outputs)
+
+    # 1. Initial positions with a node.
+    covered = bdd.false
+    for name in nodes:
+        state = state_of(name)
+        if not deadlock(state):
+            covered |= bdd.cube(state)
+    if robotics_semantics:
+        won_initially = env_init & sys_init & covered != bdd.false
+    else:
+        won_initially = bdd.exist(outputs, env_init) & bdd.forall(outputs, ~sys_init | covered) \
+            != bdd.false
+    if not won_initially:
+        problems.append('no initial input (position) has nodes for every initial system choice')
+
+    # 2. Moves; labels of the transitions for 3.
+    edges = {}
+    for name in nodes:
+        state = state_of(name)
+        if deadlock(state):
+            continue
+        successors = [str(successor) for successor in nodes[name]['trans']]
+        if not successors:
+            problems.append(f'node {name} has no successor')
+            continue
+        chosen = {v + "'": state_of(successors[0])[v] for v in inputs}
+        if any(state_of(s)[v] != chosen[v + "'"] for s in successors for v in inputs):
+            problems.append(f'node {name}: successors differ in their inputs')
+            continue
+        here = {**state, **chosen}
+        if cofactor(env_parts, here) != bdd.true:
+            problems.append(f'node {name}: its next input violates ENV_TRANS')
+        sys_answers = cofactor(sys_parts, here)  # a function of the next outputs only
+        if any(deadlock(state_of(s)) for s in successors):
+            if len(successors) != 1 or sys_answers != bdd.false:
+                problems.append(f'node {name}: a deadlock successor where the system can move')
+            edges[name] = []
+            continue
+        answered = bdd.false
+        edges[name] = []
+        for successor in successors:
+            following = state_of(successor)
+            move = {v + "'": following[v] for v in outputs}
+            if bdd.let(move, sys_answers) != bdd.true:
+                problems.append(f'node {name} -> {successor} violates SYS_TRANS')
+            answered |= bdd.cube(move)
+            transition = {**state, **{v + "'": following[v] for v in names}}
+            edges[name].append((successor, (
+                tuple(bdd.let(transition, a) == bdd.true for a in assumptions),
+                tuple(bdd.let(transition, g) == bdd.true for g in goals))))
+        if sys_answers & ~answered != bdd.false:
+            problems.append(f'node {name}: some system answer allowed by SYS_TRANS has no successor')
+        if len(problems) >= limit:
+            return problems
+    problems += _counter_fairness_problems(edges, len(assumptions), len(goals))
+    return problems[:limit]
+
+
+def _counter_fairness_problems(edges: dict, assumption_count: int, goal_count: int) -> list[str]:
+    problems = []
+    for assumption in range(assumption_count):
+        graph = {name: [(target, labels) for target, labels in out if not labels[0][assumption]]
+                 for name, out in edges.items()}
+        for component in _components(graph):
+            if any(target in component for name in component for target, _ in graph[name]):
+                problems.append(f'a cycle through node {min(component, key=int)} never meets '
+                                f'assumption {assumption}')
+                break
+    for component in _components(edges):
+        seen = [False] * goal_count
+        internal = False
+        for name in component:
+            for target, labels in edges[name]:
+                if target in component:
+                    internal = True
+                    seen = [a or b for a, b in zip(seen, labels[1])]
+        if internal and all(seen):
+            problems.append(f'a cycle through node {min(component, key=int)} meets every goal')
+            break
+    return problems
+
+
 def move_values(cube, bdd) -> dict:
     """The valuation of a cube over next-step variables (``{"x'": True, ...}``)."""
     return bdd.pick(cube)

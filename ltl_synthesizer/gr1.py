@@ -31,6 +31,8 @@ class Solver:
         self.game = game
         self.options = options or Options()
         self.plan = plan(game, self.options)
+        if self.plan.sifting_growth is not None:
+            game.bdd.configure(max_growth=self.plan.sifting_growth)
         if self.plan.sift_once:
             game.bdd.reorder()
         self.reordering = ReorderingSwitch(game, self.plan.reordering)
@@ -149,7 +151,11 @@ def solve_system_game(solver: Solver, stop_when_losing=None) -> SystemSolution:
         nu Z. /\\_j mu Y. \\/_i nu X. cox( (G_j & Z') | Y' | (!A_i & X') ).
 
     ``stop_when_losing(Z)`` may return False to stop early: Z only shrinks, so once the
-    initial positions are not covered they never will be (used to reject quickly).
+    initial positions are not covered they never will be (used to reject quickly). It is
+    also asked after each goal within an iteration, whenever the intersection of the goals'
+    attractors so far has shrunk: that intersection already bounds the winning positions
+    from above (each attractor is monotone in Z, and Z bounds them), so a loss seen there
+    is final one goal early instead of one whole iteration late.
     """
     # Z may start from any upper bound of the winning positions (the iterates still descend
     # to the same greatest fixpoint). The safety game's winning positions are one, and cheap;
@@ -170,7 +176,11 @@ def solve_system_game(solver: Solver, stop_when_losing=None) -> SystemSolution:
         for goal_index, goal in enumerate(game.sys_goals):
             attracted, steps = _attract_to_goal(solver, goal_index, goal, Z, warm_starts)
             attractor_steps += steps
-            next_Z &= attracted
+            narrowed = next_Z & attracted
+            if narrowed != next_Z and stop_when_losing is not None \
+                    and not stop_when_losing(narrowed):
+                return SystemSolution(narrowed, [], complete=False, reachable_only=reachable_only)
+            next_Z = narrowed
             if next_Z == game.false:
                 break
         if next_Z == Z:

@@ -36,6 +36,14 @@ SIFTED_RELATION_NODES = 1000
 # lose up to 2x to sifting, cinderella (many variables, small BDDs) 4x
 # (bench/bench_gr1_families.py, bench_goals.py).
 DYNAMIC_REORDERING_FROM_NODES = 100_000
+# With many system goals (GenBuf: one per sender), dynamic sifting from the start still pays,
+# but CUDD's default growth bound (1.2: a variable keeps moving while the BDDs are at most
+# 20% larger) makes each pass over the many variables cost most of the solve (GenBuf 48
+# senders: 4.2 of 7.0 s, 64 senders unrealizable 21 of 26 s). A 2% bound stops each
+# variable's walk early: 2.1 s and 8.8 s. AMBA (at most 11 goals) keeps the default: its
+# sifting results, and so its solve times, vary by up to 4x with the bound.
+MANY_SYSTEM_GOALS = 16
+MANY_GOALS_SIFTING_GROWTH = 1.02
 REORDERING_CHECK_PERIOD = 4
 # Small pure safety games over wide integers (moving obstacle: few variables, large BDDs) need
 # sifting too, but CUDD's automatic sifting strikes in the middle of a relational product,
@@ -85,6 +93,7 @@ class Plan:
     sift_once: bool
     reachable_only: bool
     reordering: str  # NEVER, FROM_START, ONCE_LARGE or BETWEEN_ITERATIONS
+    sifting_growth: float | None = None  # CUDD's max growth during sifting; None: its default
 
 
 def cluster_limit(has_liveness: bool, options: Options) -> int:
@@ -114,10 +123,12 @@ def plan(game, options: Options) -> Plan:
         reordering = NEVER if large else BETWEEN_ITERATIONS
     else:
         reordering = ONCE_LARGE
+    many_goals = reordering == FROM_START and len(game.sys_goals) > MANY_SYSTEM_GOALS
     return Plan(
         sift_once=sift_once if options.sift_once is None else options.sift_once,
         reachable_only=reachable_only if options.reachable_only is None else options.reachable_only,
-        reordering=reordering)
+        reordering=reordering,
+        sifting_growth=MANY_GOALS_SIFTING_GROWTH if many_goals else None)
 
 
 class ReorderingSwitch:

@@ -25,6 +25,7 @@ def test_the_families_bench_times_ours_cold_and_resident(tmp_path, monkeypatch):
     for row in rows:
         assert 0 < row['resident'] < row['ours']
     assert 'symbolic ok' in rows[1]['checks'] and 'explicit ok' in rows[1]['checks']
+    assert 'counter-strategy ok' in rows[0]['checks']  # issue 38: checked independently
     table = (tmp_path / 'gr1_families.md').read_text()
     assert '| ours | ours resident | slugs |' in table
     assert (tmp_path / 'gr1_families_factory.png').stat().st_size > 0

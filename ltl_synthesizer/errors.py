@@ -44,3 +44,8 @@ class SynthesisTimeoutError(SynthesisCancelledError):
 
 class SynthesisMemoryError(SynthesisError):
     """The synthesis needed more memory than its limit (``item`` is 'memory_limit')."""
+
+
+class StrategyTooLargeError(SynthesisError):
+    """A strategy with more transitions than the caller takes (``item``: 'max_strategy_edges'),
+    found while it is extracted."""

@@ -74,10 +74,6 @@ class SynthesisProcessDiedError(SynthesisError):
     """The process running the synthesis ended without an answer."""
 
 
-class StrategyTooLargeError(SynthesisError):
-    """A strategy with more edges than the caller takes (``item``: 'max_strategy_edges')."""
-
-
 class SpecificationText:
     """A specification as its text sections, parsed where it is used: in the child (passed as
     an argument, the child gives the function the parsed GR1Specification). Parsing, printing
@@ -97,26 +93,14 @@ def byproduct_texts(spec) -> tuple[str, str, list, list]:
     return spec.to_structuredslugs(), spec.to_slugsin(), list(spec.env_props), list(spec.sys_props)
 
 
-def strategy_edges(strategy: dict) -> int:
-    """The transitions of an explicit strategy (slugs' JSON shape)."""
-    return sum(len(node['trans']) for node in strategy['nodes'].values())
-
-
 def synthesize_within(spec, robotics_semantics: bool, limits: Limits, options, max_strategy_edges: int):
     """:func:`ltl_synthesizer.synthesize`, refusing (StrategyTooLargeError) a strategy of more
-    than ``max_strategy_edges`` edges before it is sent: each edge costs the receiving server
-    about 900 B once turned into an automaton, its byproduct and its messages (a 215-byte
-    specification with 11 free inputs has 8.4 M edges and grew a server to 7.7 GB)."""
+    than ``max_strategy_edges`` edges as soon as its extraction passes them, before anything is
+    sent: each edge costs the receiving server about 900 B once turned into an automaton, its
+    byproduct and its messages (a 215-byte specification with 11 free inputs has 8.4 M edges and
+    grew a server to 7.7 GB; counted only after extraction, it took minutes in the child)."""
     from ltl_synthesizer.synthesizer import synthesize
-    result = synthesize(spec, robotics_semantics, limits, options)
-    if result.strategy is not None:
-        edges = strategy_edges(result.strategy)
-        if edges > max_strategy_edges:
-            raise StrategyTooLargeError(
-                f'the strategy has {edges:,} transitions ({len(result.strategy["nodes"]):,} states), over the '
-                f'{max_strategy_edges:,} this server sends (max_strategy_edges); constrain the inputs '
-                '(ENV_TRANS) or raise the limit', item='max_strategy_edges')
-    return result
+    return synthesize(spec, robotics_semantics, limits, options, max_edges=max_strategy_edges)
 
 
 #: What the pool's children import before their first request.

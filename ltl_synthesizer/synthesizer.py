@@ -20,6 +20,7 @@ from respec.spec import GR1Specification
 
 from ltl_synthesizer.gr1 import (EnvironmentSolution, Solver, SystemSolution, solve_environment_game,
                                  solve_system_game)
+from ltl_synthesizer.errors import StrategyTooLargeError
 from ltl_synthesizer.interrupt import Interrupt, Limits, memory_exceeded
 from ltl_synthesizer.policy import Options
 from ltl_synthesizer.symbolic import SymbolicGame
@@ -124,11 +125,23 @@ def is_realizable(spec: GR1Specification, robotics_semantics: bool = True, limit
 # Strategies and explanations load only when asked: a verdict alone on a tiny specification is
 # mostly start-up (5 ms less of about 120).
 
-def explicit_strategy(solved: Solved) -> dict:
-    """The explicit-state strategy of a realizable game (slugs ``--explicitStrategy --jsonOutput`` shape)."""
-    from ltl_synthesizer.strategy import extract_strategy
+def explicit_strategy(solved: Solved, max_edges: int | None = None) -> dict:
+    """The explicit-state strategy of a realizable game (slugs ``--explicitStrategy --jsonOutput``
+    shape). With ``max_edges``, StrategyTooLargeError as soon as the nodes extracted so far have
+    more transitions: a strategy too large to use is not extracted to the end."""
+    from ltl_synthesizer.strategy import streamed_strategy
     with _memory_failures_reported(solved.interrupt.memory_limit):
-        return extract_strategy(solved.game, _realizable(solved).solution)
+        strategy = streamed_strategy(solved.game, _realizable(solved).solution)
+        nodes, edges = {}, 0
+        for name, node in strategy['nodes']:
+            edges += len(node['trans'])
+            if max_edges and edges > max_edges:
+                raise StrategyTooLargeError(
+                    f'the strategy has over {max_edges:,} transitions (found after {len(nodes) + 1:,} states), '
+                    'more than this server sends (max_strategy_edges); constrain the inputs (ENV_TRANS) or '
+                    'raise the limit', item='max_strategy_edges')
+            nodes[name] = node
+        return {**strategy, 'nodes': nodes}
 
 
 def stream_strategy(solved: Solved) -> dict:
@@ -156,15 +169,15 @@ def explain(solved: Solved) -> str:
 
 
 def synthesize(spec: GR1Specification, robotics_semantics: bool = True, limits: Limits = Limits(),
-               options: Options | None = None) -> SynthesisResult:
-    """Solve ``spec``; its explicit strategy when realizable, else the explanation why not
-    (limits and errors as :func:`solve`)."""
+               options: Options | None = None, max_edges: int | None = None) -> SynthesisResult:
+    """Solve ``spec``; its explicit strategy when realizable (at most ``max_edges`` transitions,
+    see :func:`explicit_strategy`), else the explanation why not (limits and errors as :func:`solve`)."""
     start = time.perf_counter()
     solved = solve(spec, robotics_semantics, limits, options)
     extracting = time.perf_counter()
     result = SynthesisResult(solved.realizable)
     if solved.realizable:
-        result.strategy = explicit_strategy(solved)
+        result.strategy = explicit_strategy(solved, max_edges)
     else:
         result.explanation = explain(solved)
     if solved.warnings:

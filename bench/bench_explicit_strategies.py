@@ -22,7 +22,7 @@ RESULTS = ROOT / 'bench' / 'results'
 sys.path[:0] = [str(ROOT), str(ROOT / 'bench')]
 
 import gr1_families  # noqa: E402
-from bench_gr1_families import GR1SYNTH, run_timed  # noqa: E402
+from bench_gr1_families import GR1SYNTH, add_comparison_arguments, run_timed  # noqa: E402
 
 INSTANCES = [
     ('free inputs, width 4', gr1_families.free_inputs, (4,)),
@@ -94,8 +94,7 @@ def write_report(rows: list[dict], timeout: float) -> None:
 
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument('--slugs', help='slugs executable (compared when given)')
-    parser.add_argument('--timeout', type=float, default=120, help='seconds per run')
+    add_comparison_arguments(parser)
     parser.add_argument('--check-edges', type=int, default=100_000,
                         help='check our strategies of at most this many edges')
     parser.add_argument('--max-instances', type=int, default=None)

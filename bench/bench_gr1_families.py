@@ -304,10 +304,15 @@ def _in_family_order(rows: list[dict]) -> list[dict]:
     return sorted(rows, key=lambda row: order.index(row['family']))  # stable within a family
 
 
-def main(argv=None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+def add_comparison_arguments(parser: argparse.ArgumentParser) -> None:
+    """The options every bench against slugs takes: the slugs executable and a run's time limit."""
     parser.add_argument('--slugs', help='slugs executable (compared when given)')
     parser.add_argument('--timeout', type=float, default=120, help='seconds per run')
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    add_comparison_arguments(parser)
     parser.add_argument('--strategy-timeout', type=float, default=10,
                         help='seconds for extracting the explicit strategy')
     parser.add_argument('--check-timeout', type=float, default=120,

@@ -128,9 +128,7 @@ def check_strategy(spec, strategy: dict, limit: int = 20) -> list[str]:
                 problems.append(f'node {name} -> {successor_name} violates SYS_TRANS')
             answered |= bdd.exist([v + "'" for v in spec.sys_props], move)
             transition = {**state, **move_values(move, bdd)}
-            labels = (tuple(bdd.let(transition, a) == bdd.true for a in assumptions),
-                      tuple(bdd.let(transition, g) == bdd.true for g in goals))
-            edges[name].append((successor_name, labels))
+            edges[name].append((successor_name, _labels(bdd, transition, assumptions, goals)))
         allowed_inputs = bdd.exist([v + "'" for v in spec.sys_props], env_here)
         if allowed_inputs & ~answered != bdd.false:
             problems.append(f'node {name}: some next input allowed by ENV_TRANS has no successor')
@@ -232,9 +230,7 @@ def check_counterstrategy(spec, strategy: dict, robotics_semantics: bool = False
                 problems.append(f'node {name} -> {successor} violates SYS_TRANS')
             answered |= bdd.cube(move)
             transition = {**state, **{v + "'": following[v] for v in names}}
-            edges[name].append((successor, (
-                tuple(bdd.let(transition, a) == bdd.true for a in assumptions),
-                tuple(bdd.let(transition, g) == bdd.true for g in goals))))
+            edges[name].append((successor, _labels(bdd, transition, assumptions, goals)))
         if sys_answers & ~answered != bdd.false:
             problems.append(f'node {name}: some system answer allowed by SYS_TRANS has no successor')
         if len(problems) >= limit:
@@ -501,3 +497,10 @@ if __name__ == '__main__':
     from pathlib import Path
     sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
     sys.exit(main())
+
+
+def _labels(bdd, transition: dict, assumptions, goals) -> tuple[tuple, tuple]:
+    """Which assumptions and which goals an edge (a full transition's values) satisfies: what the
+    fairness checks of strategies and counter-strategies read off their cycles."""
+    return (tuple(bdd.let(transition, a) == bdd.true for a in assumptions),
+            tuple(bdd.let(transition, g) == bdd.true for g in goals))

@@ -75,12 +75,15 @@ class Interrupt:
     __call__ = check
 
 
-def resident_memory() -> int:
-    """This process's resident memory in bytes (Linux; elsewhere its peak so far)."""
+def resident_memory(pid: int | None = None) -> int:
+    """This process's resident memory in bytes (Linux; elsewhere its peak so far), or that of
+    process ``pid`` (0 once it is gone)."""
     try:
-        with open('/proc/self/statm') as statm:
+        with open(f'/proc/{pid or "self"}/statm') as statm:
             return int(statm.read().split()[1]) * _PAGE_SIZE
     except OSError:
+        if pid is not None:
+            return 0
         import resource
         return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
 

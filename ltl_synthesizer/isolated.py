@@ -29,8 +29,11 @@ Functions are passed as themselves (picklable: defined at the top level of a mod
 child imports what the caller already imports. Arguments and results travel as pickles; an
 exception raised in the child is raised in the caller. A child that dies (killed from outside,
 crashed) raises :class:`SynthesisProcessDiedError`; a cancel or the deadline raises
-SynthesisCancelledError (SynthesisTimeoutError). The memory limit is the work's own
-(``ltl_synthesizer.Limits``, checked in the child).
+SynthesisCancelledError (SynthesisTimeoutError). A synthesis's memory limit is its own
+(``ltl_synthesizer.Limits``, checked in the child, which can say what it was doing); work that
+checks no limit of its own (compilation, state-machine generation) is given ``memory_limit``:
+the caller watches the child's resident memory as it polls and kills it once the work has
+grown it by more (SynthesisMemoryError).
 """
 
 from __future__ import annotations
@@ -46,7 +49,7 @@ import time
 import traceback
 from typing import Callable
 
-from ltl_synthesizer.errors import SynthesisCancelledError, SynthesisError, SynthesisTimeoutError
+from ltl_synthesizer.errors import SynthesisCancelledError, SynthesisError, SynthesisMemoryError, SynthesisTimeoutError
 from ltl_synthesizer.interrupt import Limits, resident_memory
 
 # How often the caller looks at its cancel flag and deadline while a child works.
@@ -128,14 +131,18 @@ class ChildProcess:
             env={**environment, **os.environ} if environment else None)
 
     def call(self, function: Callable, args=(), kwargs=None, cancel: threading.Event | None = None,
-             deadline: float | None = None, on_progress: Callable | None = None):
+             deadline: float | None = None, on_progress: Callable | None = None,
+             memory_limit: int | None = None):
         """``function(*args, **kwargs)`` in this child; with ``on_progress``, ``function`` is
         also given ``progress=`` a callable whose every value reaches ``on_progress`` here.
-        The child is killed once ``cancel`` is set or at ``deadline`` (time.monotonic());
-        one that dies raises SynthesisProcessDiedError."""
+        The child is killed once ``cancel`` is set, at ``deadline`` (time.monotonic()) or once
+        its resident memory has grown by more than ``memory_limit`` bytes since the call
+        (SynthesisMemoryError, ``item`` 'memory_limit'); one that dies raises
+        SynthesisProcessDiedError."""
         try:
             if not self.settle() and self.said == 'nothing':  # its next words would be misread
                 raise self.died()
+            baseline = resident_memory(self.process.pid) if memory_limit is not None else 0
             self.send((function, tuple(args), dict(kwargs or {}), on_progress is not None))
             while True:
                 while not self.answered(POLL_SECONDS):
@@ -145,6 +152,11 @@ class ChildProcess:
                     if deadline is not None and time.monotonic() >= deadline:
                         self.kill()
                         raise SynthesisTimeoutError()
+                    if memory_limit is not None and resident_memory(self.process.pid) - baseline > memory_limit:
+                        self.kill()
+                        raise SynthesisMemoryError(
+                            f'the work needed more than its memory limit of {memory_limit / 2**20:.0f} MB',
+                            item='memory_limit')
                     if not self.alive():
                         raise self.died()
                 kind, value = self.receive()
@@ -274,11 +286,11 @@ class SynthesisProcesses:
                          cancel=limits.cancel, deadline=limits.deadline)
 
     def call(self, function: Callable, args=(), kwargs=None, cancel: threading.Event | None = None,
-             deadline: float | None = None):
+             deadline: float | None = None, memory_limit: int | None = None):
         """``function(*args, **kwargs)`` in a child (:meth:`ChildProcess.call`)."""
         child = self._take()
         try:
-            return child.call(function, args, kwargs, cancel, deadline)
+            return child.call(function, args, kwargs, cancel, deadline, memory_limit=memory_limit)
         except SynthesisProcessDiedError:
             if self._closed:  # close() killed it
                 raise SynthesisCancelledError('cancelled') from None

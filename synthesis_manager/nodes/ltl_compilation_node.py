@@ -28,6 +28,7 @@ from ltl_specification.provenance import provenance_to_json
 from ltl_specification.repair import TaskRequest
 from ltl_specification.repair_process import RepairSearch, RepairSearchError, repair_settings
 from ltl_synthesizer import SynthesisCancelledError
+from ltl_synthesizer.errors import SynthesisMemoryError
 from ltl_synthesizer.isolated import SERVER_CHILD_NICENESS, SynthesisProcesses
 from respec.errors import ErrorCode
 from respec.robot import SystemCatalog, catalog_to_json
@@ -40,7 +41,7 @@ from synthesis_manager.ros.errors import reported_error
 from synthesis_manager.ros.node_main import node_main
 from synthesis_manager.ros.qos import service_qos
 from synthesis_manager.ros.robot_systems import create_systems_publisher
-from synthesis_manager.ros.worker_pool import Abandoned, WorkerPool
+from synthesis_manager.ros.worker_pool import Abandoned, WorkerPool, executor_waker
 from synthesis_msgs.srv import GenerateLTLSpecification, ProposeRepairs
 
 #: Custom formulas (bytes, all sections) up to which a request is compiled in the node's process.
@@ -74,7 +75,8 @@ class LTLCompilationNode(Node):
     config/, joined with os.pathsep; empty = config/ alone). Publishes those systems on ``robot_systems`` (latched; checked for edits
     every ``SYSTEMS_PERIOD`` seconds), so clients elsewhere see the systems it compiles for.
     ``timeout`` (seconds a request with large custom formulas may take from its arrival, waiting
-    included; then TIMEOUT), ``parallel_compilations`` and ``queued_compilations`` (such requests
+    included; then TIMEOUT), ``memory_limit_mb`` (growth of the child compiling such a request;
+    then LTL_SPEC_COMPILATION_FAILED naming it), ``parallel_compilations`` and ``queued_compilations`` (such requests
     compiled at once in child processes, and waiting beyond those; further ones are BUSY).
     ``repair_time_budget`` (seconds a ProposeRepairs search takes when the request names none,
     3) and ``parallel_repairs`` (searches at once, each in a child process; 8 more may wait).
@@ -86,6 +88,7 @@ class LTLCompilationNode(Node):
         super().__init__('ltl_compilation', **kwargs)
         self.declare_parameter('config_dir', '')
         self.declare_parameter('timeout', 30.0)
+        self.declare_parameter('memory_limit_mb', 2048)
         self.declare_parameter('parallel_compilations', 2)
         self.declare_parameter('queued_compilations', 200)
         self.declare_parameter('repair_time_budget', 3.0)
@@ -148,7 +151,7 @@ class LTLCompilationNode(Node):
             else:
                 try:
                     sections, provenance = await self.large.run(
-                        self._compile_in_child, arguments, deadline, wake=self._wake_executor,
+                        self._compile_in_child, arguments, deadline, wake=executor_waker(self),
                         give_up=lambda: self._stopping.is_set() or time.monotonic() > deadline)
                 except (Abandoned, SynthesisCancelledError):
                     timed_out = not self._stopping.is_set()
@@ -156,6 +159,12 @@ class LTLCompilationNode(Node):
                         ErrorCode.TIMEOUT if timed_out else ErrorCode.PREEMPTED,
                         f'LTL compilation stopped: {"time limit" if timed_out else "shutdown"} '
                         f'({self.get_parameter("timeout").value:g} s for {custom_bytes:,} bytes of custom formulas)')
+                    self.get_logger().warning(response.error_code.message)
+                    return response
+                except SynthesisMemoryError as error:
+                    response.error_code = error_code(
+                        ErrorCode.LTL_SPEC_COMPILATION_FAILED,
+                        f'LTL compilation failed: {error} (memory_limit_mb, {custom_bytes:,} bytes of custom formulas)')
                     self.get_logger().warning(response.error_code.message)
                     return response
         except Exception as error:  # every failure becomes an error code; the node keeps serving
@@ -171,7 +180,8 @@ class LTLCompilationNode(Node):
         """compiled_sections in a child process, killed at ``deadline`` or at shutdown."""
         if self._stopping.is_set() or time.monotonic() > deadline:
             raise SynthesisCancelledError('stopped while waiting')
-        return self.compile_processes.call(_compiled_in_child, arguments, cancel=self._stopping, deadline=deadline)
+        return self.compile_processes.call(_compiled_in_child, arguments, cancel=self._stopping, deadline=deadline,
+                                           memory_limit=self.get_parameter('memory_limit_mb').value * 2**20)
 
     async def on_repair_request(self, request, response):
         """Verified proposals for the request's task (at most ``max_proposals``) as sentences and
@@ -185,7 +195,7 @@ class LTLCompilationNode(Node):
                                tuple(request.sm_outcomes) or DEFAULT_SM_OUTCOMES, request.unordered_goals)
             settings = repair_settings(system, task.to_dict(), msg_to_sections(request.custom_ltl) or None, budget,
                                        request.max_proposals or DEFAULT_REPAIR_PROPOSALS)
-            repairs = await self.repairs.run(self._search_repairs, settings, wake=self._wake_executor,
+            repairs = await self.repairs.run(self._search_repairs, settings, wake=executor_waker(self),
                                              give_up=self._stopping.is_set)
         except (RepairSearchError, Abandoned, SynthesisCancelledError) as error:
             response.error_code = error_code(ErrorCode.TIMEOUT, f'repair search stopped: {error or "shutdown"}')
@@ -210,10 +220,6 @@ class LTLCompilationNode(Node):
         finally:
             self._repair_searches.discard(search)
 
-    def _wake_executor(self):
-        executor = self.executor
-        if executor is not None:
-            executor.wake()
 
 
 def main():

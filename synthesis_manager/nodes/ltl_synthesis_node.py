@@ -33,7 +33,7 @@ from synthesis_manager.ros.conversions import automaton_to_msg, error_code, msg_
 from synthesis_manager.ros.errors import reported_error
 from synthesis_manager.ros.node_main import node_main
 from synthesis_manager.ros.qos import service_qos
-from synthesis_manager.ros.worker_pool import Abandoned, WorkerPool
+from synthesis_manager.ros.worker_pool import Abandoned, WorkerPool, executor_waker
 from synthesis_msgs.srv import CancelSynthesis, SynthesizeAutomaton
 
 BACKENDS = ('builtin', 'slugs')
@@ -170,7 +170,7 @@ class LTLSynthesisNode(Node):
                 # Formulas are parsed, printed and pickled to the synthesis process on a deep stack.
                 await self.workers.run(run_with_deep_stack, self._synthesize, request, response, cancel,
                                        timeout, deadline,
-                                       wake=self._wake_executor,
+                                       wake=executor_waker(self),
                                        give_up=lambda: cancel.is_set() or time.monotonic() > deadline)
             except Abandoned:  # stopped while waiting for a worker
                 self._stopped(response, 'cancelled' if cancel.is_set() else 'timeout', timeout)
@@ -187,10 +187,6 @@ class LTLSynthesisNode(Node):
             self.get_logger().warning(response.error_code.message)
         return response
 
-    def _wake_executor(self):
-        executor = self.executor
-        if executor is not None:
-            executor.wake()
 
     def _synthesize(self, request, response, cancel, timeout, deadline):
         if cancel.is_set() or time.monotonic() > deadline:  # stopped while waiting for a worker

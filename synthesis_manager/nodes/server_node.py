@@ -220,10 +220,6 @@ class BehaviorSynthesisServer(Node):
         self._stopping.set()
         self.stages.stop()
 
-    def _wake_executor(self):
-        if self.executor is not None:
-            self.executor.wake()
-
     def destroy_node(self):
         for action_server in self.action_servers:
             action_server.destroy()

@@ -26,6 +26,16 @@ class Abandoned(ControlFlowSignal):
     WorkerPool.run's ``give_up``); the caller answers its request itself."""
 
 
+def executor_waker(node):
+    """A ``wake`` for :meth:`WorkerPool.run`: wakes ``node``'s executor, once it has one, so the
+    callback awaiting a finished job resumes at once instead of at the executor's next event."""
+    def wake():
+        executor = node.executor
+        if executor is not None:
+            executor.wake()
+    return wake
+
+
 class WorkerPool:
     def __init__(self, workers: int, max_waiting: int, name: str = 'worker'):
         if workers < 1 or max_waiting < 0:

@@ -218,3 +218,21 @@ def test_a_child_holding_memory_it_cannot_release_is_replaced(processes):
     second = processes.call(os.getpid)
     assert second != first and first not in children_of_this_process()
     assert processes.call(os.getpid) == second  # a fresh child is reused as before
+
+
+def grow_and_wait(megabytes: int, seconds: float) -> str:
+    """Code that holds ``megabytes`` of written memory for ``seconds`` (work that checks no limit
+    of its own), for the child's ``exec`` (the child cannot import this test module)."""
+    return f'held = b"x" * {megabytes * 2**20}\nimport time\ntime.sleep({seconds})'
+
+
+def test_work_without_limits_of_its_own_is_killed_beyond_the_callers_memory_limit(processes):
+    """Issue 34, item 2: compilation and generation check no memory limit; the caller watches
+    the child's resident memory as it polls and ends the child beyond ``memory_limit``."""
+    child = processes.call(os.getpid)
+    started = time.monotonic()
+    with pytest.raises(SynthesisMemoryError) as refused:
+        processes.call(exec, (grow_and_wait(200, 30.0), {}), memory_limit=64 * 2**20)
+    assert refused.value.item == 'memory_limit' and 'memory limit of 64 MB' in str(refused.value)
+    assert time.monotonic() - started < 10 and child not in children_of_this_process()
+    assert processes.call(exec, (grow_and_wait(16, 0.0), {}), memory_limit=64 * 2**20) is None  # a fresh child

@@ -22,8 +22,9 @@ def custom_formulas(total_bytes: int, clause: str = '(look_down_a | !stand_prep_
     return [formula] * max(1, total_bytes // len(formula))
 
 
-def start(ros, tmp_path, compile_timeout: float = 30.0, synthesis_parameters=()):
-    ros.add_node(LTLCompilationNode, parameter_overrides=[Parameter('timeout', value=compile_timeout)])
+def start(ros, tmp_path, compile_timeout: float = 30.0, synthesis_parameters=(), compile_memory_mb: int = 2048):
+    ros.add_node(LTLCompilationNode, parameter_overrides=[Parameter('timeout', value=compile_timeout),
+                                                          Parameter('memory_limit_mb', value=compile_memory_mb)])
     return start_suite(ros, tmp_path, names=('ltl_synthesis', 'sm_generation'),
                        synthesis_parameters=synthesis_parameters)
 
@@ -37,6 +38,16 @@ def test_large_custom_formulas_compile_in_a_child_to_the_same_specification(ros,
     sections, _ = run_with_deep_stack(compiled_sections, PAPER_TASK['system'], PAPER_TASK['initial_conditions'],
                                       PAPER_TASK['goals'], ('finished', 'failed'), True, {'sys_trans': formulas}, None)
     assert outcome.ltl_specification == {name: lines for name, lines in sections.items() if lines}
+
+
+def test_a_large_compilation_beyond_its_memory_limit_names_the_limit(ros, tmp_path):
+    """Issue 34, item 2: the child compiling large custom formulas has a memory limit too."""
+    client = start(ros, tmp_path, compile_memory_mb=1)
+    outcome = client.run(make_goal(**PAPER_TASK, option='ltl_compilation_only',
+                                   ltl_specification={'sys_trans': custom_formulas(3_900_000)}), timeout=60)
+    assert outcome.error_name == 'LTL_SPEC_COMPILATION_FAILED', outcome.message
+    assert 'memory limit of 1 MB' in outcome.message and 'memory_limit_mb' in outcome.message
+    assert client.run(make_goal(**PAPER_TASK), timeout=60).error_name == 'SUCCESS'
 
 
 def normal_goal_beside(client, huge):
@@ -144,3 +155,61 @@ def test_a_huge_specification_stops_at_its_limit_and_a_normal_goal_is_served_mea
     assert normal.error_name == 'SUCCESS' and normal_seconds < 2.0, normal.message
     assert answers['huge'].error_name in ('SYNTHESIS_TIMEOUT', 'TIMEOUT'), answers['huge'].message
     assert answers['huge seconds'] < 2.0 + 2.0
+
+
+def chain_automaton_message(steps: int):
+    """bench_sm_generation's synthetic chain (2 * steps + 2 states) as a message, and as itself."""
+    import sys
+    from pathlib import Path
+
+    from synthesis_manager.ros.conversions import automaton_to_msg
+    sys.path.insert(0, str(Path(__file__).resolve().parents[2] / 'bench'))
+    from bench_sm_generation import chain_automaton
+    automaton = chain_automaton(steps)
+    return automaton_to_msg(automaton), automaton
+
+
+def generation_service(ros, **parameters):
+    from rclpy.node import Node
+
+    from synthesis_manager.nodes.sm_generation_node import SMGenerationNode
+    from synthesis_msgs.srv import GenerateFlexBESM
+    ros.add_node(SMGenerationNode, parameter_overrides=[Parameter(name, value=value)
+                                                        for name, value in parameters.items()])
+    service = ros.add_node(Node, 'generation_client').create_client(GenerateFlexBESM, 'sm_generate')
+    assert service.wait_for_service(timeout_sec=10)
+    return lambda message: service.call(GenerateFlexBESM.Request(automaton=message, system='atlas'), timeout_sec=120)
+
+
+def test_a_large_automaton_is_generated_in_a_child_to_the_same_state_machine(ros):
+    """Issue 34, item 2: a large automaton (here 3,002 states, over SMALL_AUTOMATON_STATES) is
+    generated in a child process, to the state machine generated in-process."""
+    from sm_generation import generate_state_machine
+    from synthesis_manager.nodes.sm_generation_node import SMALL_AUTOMATON_STATES
+    from synthesis_manager.ros.conversions import state_to_msg
+
+    message, automaton = chain_automaton_message(1500)
+    assert len(message.automaton) > SMALL_AUTOMATON_STATES
+    answer = generation_service(ros)(message)
+    assert answer.error_code.value == 1, answer.error_code.message
+    assert list(answer.state_definition) == [state_to_msg(state) for state in generate_state_machine(automaton, 'atlas')]
+
+
+def test_a_large_generation_stops_at_its_time_and_memory_limits(ros):
+    """The node's ``timeout`` and ``memory_limit_mb`` end a generation in its child (40,002 states
+    take over a second here); the node answers the next request."""
+    message, _ = chain_automaton_message(20_000)
+    generate = generation_service(ros, timeout=0.5)
+    started = time.monotonic()
+    late = generate(message)
+    assert late.error_code.value == late.error_code.TIMEOUT, late.error_code.message
+    assert '0.5 s for 40,002 automaton states' in late.error_code.message
+    assert time.monotonic() - started < 0.5 + 3.0
+    assert generate(chain_automaton_message(3)[0]).error_code.value == 1
+
+
+def test_a_large_generation_beyond_its_memory_limit_names_the_limit(ros):
+    message, _ = chain_automaton_message(20_000)
+    answer = generation_service(ros, memory_limit_mb=1)(message)
+    assert answer.error_code.value == answer.error_code.SM_GENERATION_FAILED, answer.error_code.message
+    assert 'memory limit of 1 MB' in answer.error_code.message and 'memory_limit_mb' in answer.error_code.message

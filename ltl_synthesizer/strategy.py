@@ -114,11 +114,14 @@ def enumerate_states(game: SymbolicGame, states, names, limit: int | None = None
     return found
 
 
-def _successor_goal(game: SymbolicGame, goals, rank: int, transition: dict[str, bool]) -> int:
-    """The goal pursued after ``transition``: advance past every goal it satisfies."""
+def _successor_goal(game: SymbolicGame, goals, rank: int, transition: dict[str, bool],
+                    supports: list | None = None) -> int:
+    """The goal pursued after ``transition``: advance past every goal it satisfies
+    (``supports``: the goals' supports, when known)."""
     goal = rank
     first_try = True
-    while (goal != rank or first_try) and game.evaluate(goals[goal], transition):
+    while (goal != rank or first_try) and game.evaluate(goals[goal], transition,
+                                                        supports[goal] if supports else None):
         goal = (goal + 1) % len(goals)
         first_try = False
     return goal
@@ -318,38 +321,54 @@ class EnvironmentStrategy:
             self.won_by_level.append(won)
         self._levels_found = {}
         self._goals_found = {}
+        # Supports of the sets evaluated at every node (finding one walks its whole BDD).
+        self._won_supports = [game.bdd.support(won) for won in self.won_by_level]
+        self._blocking_supports = {}
+        self._env_goal_supports = [game.bdd.support(goal) for goal in game.env_goals]
 
-    def level_of(self, state) -> int:
-        """The first level whose blocking sets contain the position. Z_k grows with k (the
-        iterates of a least fixpoint), so a binary search over the Z_k finds it: a few
-        evaluations per state instead of one per level and goal (remembered per state: each
-        node's level is asked again by its predecessors)."""
-        key = tuple(state[name] for name in self.game.variables)
+    def level_of(self, state, values: tuple | None = None) -> int:
+        """The first level whose blocking sets contain the position (``values``: its
+        variables' values in order, when known). Z_k grows with k (the iterates of a least
+        fixpoint), so a binary search over the Z_k finds it: a few evaluations per state
+        instead of one per level and goal (remembered per state: each node's level is asked
+        again by its predecessors)."""
+        key = tuple(state[name] for name in self.game.variables) if values is None else values
         found = self._levels_found.get(key)
         if found is None:
             low, high = 0, len(self.won_by_level) - 1
-            if not self.game.evaluate(self.won_by_level[high], state):
+            if not self._won_at(high, state):
                 raise ValueError('the position is not won by the environment')
             while low < high:
                 middle = (low + high) // 2
-                if self.game.evaluate(self.won_by_level[middle], state):
+                if self._won_at(middle, state):
                     high = middle
                 else:
                     low = middle + 1
             found = self._levels_found[key] = low
         return found
 
-    def first_blockable_goal(self, state, level: int | None = None) -> int:
+    def first_blockable_goal(self, state, level: int | None = None, values: tuple | None = None) -> int:
         """The first goal the environment can block at the position (on its level),
         remembered per position: many transitions lead to the same one."""
-        level = self.level_of(state) if level is None else level
-        key = (tuple(state[name] for name in self.game.variables), level)
+        values = tuple(state[name] for name in self.game.variables) if values is None else values
+        level = self.level_of(state, values) if level is None else level
+        key = (values, level)
         found = self._goals_found.get(key)
         if found is None:
             found = self._goals_found[key] = next(
                 j for j, blocking in enumerate(self.levels[level].blocking)
-                if self.game.evaluate(blocking, state))
+                if self.game.evaluate(blocking, state, self._blocking_support(level, j)))
         return found
+
+    def _won_at(self, level: int, state) -> bool:
+        return self.game.evaluate(self.won_by_level[level], state, self._won_supports[level])
+
+    def _blocking_support(self, level: int, goal: int) -> set[str]:
+        support = self._blocking_supports.get((level, goal))
+        if support is None:
+            support = self._blocking_supports[level, goal] = \
+                self.game.bdd.support(self.levels[level].blocking[goal])
+        return support
 
     def successors(self, state: dict, rank: tuple, only_first: bool) -> list[tuple]:
         """The successor nodes (values, rank) of node (state, rank): a deadlock node when the
@@ -365,19 +384,20 @@ class EnvironmentStrategy:
         moves = game.bdd.let(state, self.moves[level][goal][assumption])
         chosen_input, input_cube = game.pick(moves, game.next_inputs)
         responses = input_cube & allowed_sys
-        self.responses_counted = int(game.bdd.count(game.bdd.exist(game.next_inputs, responses),
-                                                    nvars=len(game.next_outputs)))
+        if only_first:  # the one-play explanation says how many answers the system had
+            self.responses_counted = int(game.bdd.count(game.bdd.exist(game.next_inputs, responses),
+                                                        nvars=len(game.next_outputs)))
         successors = []
-        while responses != game.false and not (only_first and successors):
-            choice, single = game.pick(responses, game.next_outputs)
+        next_variables = [game.to_next[name] for name in game.variables]
+        for choice in _output_valuations(game, responses, only_first):
             transition = {**state, **chosen_input, **choice}
-            next_state = {name: transition[game.to_next[name]] for name in game.variables}
-            next_assumption = _successor_goal(game, game.env_goals, assumption, transition)
-            next_level = self.level_of(next_state)
-            next_goal = goal if next_level == level else self.first_blockable_goal(next_state, next_level)
-            successors.append((tuple(next_state[name] for name in game.variables),
-                               (next_assumption, next_goal)))
-            responses &= ~single
+            next_values = tuple(transition[name] for name in next_variables)
+            next_state = dict(zip(game.variables, next_values))
+            next_assumption = _successor_goal(game, game.env_goals, assumption, transition,
+                                              self._env_goal_supports)
+            next_level = self.level_of(next_state, next_values)
+            next_goal = goal if next_level == level else self.first_blockable_goal(next_state, next_level, next_values)
+            successors.append((next_values, (next_assumption, next_goal)))
         return successors
 
     def _deadlock_input(self, state: dict, allowed_sys) -> tuple | None:
@@ -390,6 +410,22 @@ class EnvironmentStrategy:
             return None
         choice, _ = game.pick(deadlock_inputs, game.next_inputs)
         return tuple(choice[game.to_next[name]] for name in game.inputs) + (None,) * len(game.outputs)
+
+
+def _output_valuations(game: SymbolicGame, responses, only_first: bool) -> list[dict]:
+    """The system's responses (output valuations over next outputs; the input is fixed) in
+    ``responses``, smallest first (False before True, in declared order): the order repeated
+    ``pick``s would give. All read off at once, sorted: a pick per response cost one BDD
+    operation per output (a third of a gridworld counter-strategy's time)."""
+    if responses == game.false:
+        return []
+    if only_first:
+        return [game.pick(responses, game.next_outputs)[0]]
+    names = game.next_outputs
+    outputs = game.exist_next_inputs(responses)
+    valuations = sorted(tuple(minterm[name] for name in names)
+                        for minterm in game.bdd._pick_iter(outputs, care_vars=set(names)))
+    return [dict(zip(names, values)) for values in valuations]
 
 
 def _first_environment_moves(game: SymbolicGame, solution: EnvironmentSolution) -> list:

@@ -262,9 +262,11 @@ class SymbolicGame:
                 u, assignment[name] = u & variable, True
         return assignment, (u & self.bdd.cube(unconstrained) if unconstrained else u)
 
-    def evaluate(self, u, assignment: dict[str, bool]) -> bool:
+    def evaluate(self, u, assignment: dict[str, bool], support: set[str] | None = None) -> bool:
+        """Whether ``assignment`` satisfies ``u``; ``support``, u's support when the caller
+        evaluates the same ``u`` many times (finding it walks the whole BDD)."""
         # Substituting only the variables u depends on is much cheaper for small u.
-        support = self.bdd.support(u)
+        support = self.bdd.support(u) if support is None else support
         value = self.bdd.let({name: assignment[name] for name in support}, u) if support else u
         if value == self.true:
             return True

@@ -189,3 +189,30 @@ def test_stopped_syntheses_and_cut_short_diagnoses_are_not_kept(fresh_and_cached
     assert whole.error_code.message != hurried.error_code.message
     assert cached.statistics.stored == 1
     assert answer_of(whole) == answer_of(fresh.call(request_for(UNREALIZABLE)))
+
+
+def test_an_unsafe_directory_leaves_the_cache_in_memory(ros, tmp_path):
+    shared = tmp_path / 'shared'
+    shared.mkdir()
+    shared.chmod(0o777)
+    service = SynthesisService(ros, tmp_path, 'unsafe', strategy_cache_dir=str(shared))
+    assert service.node.strategy_cache.directory is None and service.node.strategy_cache.enabled
+    request = request_for(REALIZABLE)
+    assert answer_of(service.call(request)) == answer_of(service.call(request))
+    assert service.statistics.hits == 1 and list(shared.iterdir()) == []
+
+
+def test_serve_options_set_the_cache(ros, tmp_path):
+    import argparse
+
+    from synthesis_manager.suite import add_suite_arguments
+
+    parser = argparse.ArgumentParser()
+    add_suite_arguments(parser)
+    args = parser.parse_args(['--byproducts-dir', str(tmp_path / 'byproducts'), '--strategy-cache-mb', '0.5',
+                              '--strategy-cache-dir', str(tmp_path / 'kept')])
+    node = ros.add_node(suite_node_factories(args, ['ltl_synthesis'])[0])
+    assert node.strategy_cache.max_bytes == 2**19 and node.strategy_cache.directory == tmp_path / 'kept'
+    off = parser.parse_args(['--strategy-cache-mb', '0'])
+    assert not ros.add_node(suite_node_factories(off, ['ltl_synthesis'])[0],
+                            namespace='/off').strategy_cache.enabled

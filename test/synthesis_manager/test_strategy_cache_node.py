@@ -216,3 +216,20 @@ def test_serve_options_set_the_cache(ros, tmp_path):
     off = parser.parse_args(['--strategy-cache-mb', '0'])
     assert not ros.add_node(suite_node_factories(off, ['ltl_synthesis'])[0],
                             namespace='/off').strategy_cache.enabled
+
+
+def test_an_option_that_changes_the_answer_is_another_key(fresh_and_cached):
+    fresh, cached = fresh_and_cached
+    request = request_for(REALIZABLE)
+    cached.call(request)
+    for name, value in (('robotics_semantics', False), ('check_well_separation', False),
+                        ('max_strategy_edges', 5000)):
+        for service in (fresh, cached):
+            service.node.set_parameters([Parameter(name, value=value)])
+        misses = cached.statistics.misses
+        assert answer_of(cached.call(request)) == answer_of(fresh.call(request))
+        assert cached.statistics.misses == misses + 1, name
+    # Limits are not part of the key: a longer time limit is the same answer.
+    request.timeout = 30.0
+    assert answer_of(cached.call(request)) == answer_of(fresh.call(request))
+    assert cached.statistics.misses == 4

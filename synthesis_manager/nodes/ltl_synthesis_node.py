@@ -195,7 +195,9 @@ class LTLSynthesisNode(Node):
             check_timeout(request.diagnosis_timeout, 'request.diagnosis_timeout')
             # The time limit starts now: waiting for a worker counts.
             deadline = time.monotonic() + timeout
-            key = self._cache_key(request)
+            # A large specification's key is computed in the worker: hashing megabytes here would
+            # hold the executor thread (3.9 MB: 26 ms).
+            key = None if _is_large(msg_to_sections(request.ltl_specification)) else self._cache_key(request)
             cached = self.strategy_cache.get(key) if key else None
             if cached is not None:  # answered here: no worker, no synthesis process
                 self._answer_from_cache(cached, request, response)
@@ -267,9 +269,11 @@ class LTLSynthesisNode(Node):
 
     def _synthesize(self, request, response, cancel, timeout, deadline, key: str | None):
         """Synthesize (in a worker thread), once for concurrent identical requests: with a
-        cache ``key``, a request identical to one being synthesized waits for its answer."""
+        cache key, a request identical to one being synthesized waits for its answer. ``key``:
+        the one on_request computed (None: computed here, e.g. a large specification's)."""
         if cancel.is_set() or time.monotonic() > deadline:  # stopped while waiting for a worker
             return self._stopped(response, 'cancelled' if cancel.is_set() else 'timeout', timeout)
+        key = key or self._cache_key(request)
         if key is None:
             self._synthesize_fresh(request, response, cancel, timeout, deadline)
             return
@@ -291,8 +295,7 @@ class LTLSynthesisNode(Node):
             return self._stopped(response, 'cancelled' if cancel.is_set() else 'timeout', timeout)
         sections = msg_to_sections(request.ltl_specification)
         backend = self.parameter('backend')
-        if backend == 'builtin' and sum(utf8_length(line) for lines in sections.values() for line in lines) > \
-                LARGE_SPEC_BYTES:
+        if backend == 'builtin' and _is_large(sections):
             spec = SpecificationText(sections)  # parsed in the synthesis children
             try:
                 structuredslugs, slugsin, inputs, outputs = self.synthesis_processes.call(
@@ -338,7 +341,9 @@ class LTLSynthesisNode(Node):
                 response.error_code = error_code(ErrorCode.SPEC_UNSYNTHESIZABLE, message)
                 if not (keep and diagnosed):
                     return None
-                before, _, after = message.rpartition(head)  # kept without the spec name
+                before, found, after = message.rpartition(head)  # kept without the spec name
+                if not found:
+                    return None
                 return {**entry, 'synthesizable': b'0', 'code': b'SPEC_UNSYNTHESIZABLE',
                         'message_before': before.encode(), 'message_after': after.encode()}
             strategy_json = strategy_to_json(strategy)
@@ -416,6 +421,11 @@ class LTLSynthesisNode(Node):
     def _stopped(response, reason: str, timeout: float):
         code = ErrorCode.SYNTHESIS_TIMEOUT if reason == 'timeout' else ErrorCode.PREEMPTED
         response.error_code = error_code(code, f'synthesis stopped: {reason} (time limit {timeout:g} s)')
+
+
+def _is_large(sections: dict) -> bool:
+    """Whether a specification's text is over LARGE_SPEC_BYTES."""
+    return sum(utf8_length(line) for lines in sections.values() for line in lines) > LARGE_SPEC_BYTES
 
 
 def _unrealizable_head(spec_name: str) -> str:

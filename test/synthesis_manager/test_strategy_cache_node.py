@@ -233,3 +233,18 @@ def test_an_option_that_changes_the_answer_is_another_key(fresh_and_cached):
     request.timeout = 30.0
     assert answer_of(cached.call(request)) == answer_of(fresh.call(request))
     assert cached.statistics.misses == 4
+
+
+def test_a_large_specification_is_kept_too(fresh_and_cached):
+    from synthesis_manager.nodes.ltl_synthesis_node import LARGE_SPEC_BYTES
+
+    fresh, cached = fresh_and_cached
+    tautology = ' & '.join(['(p0 | !p0)'] * 100)
+    formulas = [tautology] * (LARGE_SPEC_BYTES // len(tautology) + 1)
+    request = SynthesizeAutomaton.Request(ltl_specification=LTLSpecification(
+        sys_props=['p0'], env_props=['e'], sys_trans=formulas, sys_liveness=['p0']), spec_name='large')
+    expected = answer_of(fresh.call(request))
+    assert answer_of(cached.call(request)) == expected  # parsed in a synthesis process, kept
+    assert answer_of(cached.call(request)) == expected  # its key computed in a worker: a hit
+    assert cached.statistics.misses == 1 and cached.statistics.hits == 1
+    assert cached.byproduct('large.slugsin') == fresh.byproduct('large.slugsin')

@@ -149,7 +149,8 @@ class StrategyCache:
                 return entry
         entry = self._read(key) if self.directory is not None else None
         if entry is not None:
-            self._remember(key, entry)
+            if entry_size(entry) <= self.max_bytes:  # a bound lowered since it was written
+                self._remember(key, entry)
             with self._lock:
                 self.statistics.hits += 1
                 self.statistics.disk_hits += 1
@@ -258,8 +259,9 @@ class StrategyCache:
             return None
         try:
             with os.fdopen(descriptor, 'rb') as file:
-                if not stat.S_ISREG(os.fstat(file.fileno()).st_mode):
-                    raise ValueError('not a regular file')
+                info = os.fstat(file.fileno())
+                if not stat.S_ISREG(info.st_mode) or info.st_size > self.max_bytes + 2**20:
+                    raise ValueError('not a regular file, or larger than any entry kept')
                 entry = _parsed_entry(file.read(), key)
                 os.utime(file.fileno())  # recently used: the directory's pruning keeps it longer
             return entry

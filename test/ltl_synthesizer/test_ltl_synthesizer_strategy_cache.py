@@ -219,3 +219,10 @@ def test_the_directory_keeps_within_the_bound(tmp_path):
     assert sum(sizes) <= cache.max_bytes
     restarted = StrategyCache(max_bytes=cache.max_bytes, directory=tmp_path / 'cache')
     assert restarted.get(key('a')) is None and restarted.get(key('e')) == entry('e', 1000)
+
+
+def test_a_lowered_bound_misses_entries_over_it(tmp_path):
+    StrategyCache(directory=tmp_path / 'cache').put(key('big'), entry('big', 4 * 2**20))
+    small = StrategyCache(max_bytes=2**20, directory=tmp_path / 'cache')
+    assert small.get(key('big')) is None and small.memory_bytes == 0
+    assert list((tmp_path / 'cache').iterdir()) == []

@@ -164,14 +164,18 @@ def test_identical_goals_at_once_are_one_synthesis(ros, tmp_path):
 
 def test_a_restarted_node_answers_from_its_directory(tmp_path):
     cache_dir = tmp_path / 'strategy-cache'
-    answers = []
-    for run in ('first', 'restarted'):
+    answers, statistics = [], []
+    for run in ('first', 'restarted', 'corrupted'):
+        if run == 'corrupted':  # half the file: a miss, synthesized again, never a crash
+            [kept] = cache_dir.iterdir()
+            kept.write_bytes(kept.read_bytes()[:kept.stat().st_size // 2])
         with RosHarness() as ros:
             service = SynthesisService(ros, tmp_path, run, strategy_cache_dir=str(cache_dir))
             answers.append(answer_of(service.call(request_for(REALIZABLE))))
-            statistics = service.statistics
-    assert answers[0] == answers[1]
-    assert statistics.misses == 0 and statistics.disk_hits == 1
+            statistics.append(service.statistics)
+    assert answers[0] == answers[1] == answers[2]
+    assert statistics[1].misses == 0 and statistics[1].disk_hits == 1
+    assert statistics[2].misses == 1 and statistics[2].corrupt == 1 and statistics[2].stored == 1
     assert [path.suffix for path in cache_dir.iterdir()] == ['.entry']
 
 

@@ -57,6 +57,10 @@ REFUSAL_DIAGNOSIS_SECONDS = 5.0
 # Custom formulas are checked by enumerating their variables' values: at most this many.
 MAX_ENUMERATED_VARIABLES = 14
 
+#: The note of a diagnosis whose core search its limits stopped (the message then depends on
+#: how much time it had: a strategy cache keeps no such message).
+CORE_NOT_COMPUTED = 'The unrealizable core was not computed'
+
 
 @dataclass
 class CoreEntry:
@@ -250,7 +254,7 @@ def diagnose(spec: GR1Specification, robotics_semantics: bool = True, limits: Li
         steps = environment_play(spec, robotics_semantics, PLAY_LENGTH, limits)
         diagnosis.play = play_in_words(steps, provenance.meanings if provenance else {})
     except SynthesisCancelledError as stopped:
-        diagnosis.note = f'(The unrealizable core was not computed: {stopped.reason}.)'
+        diagnosis.note = f'({CORE_NOT_COMPUTED}: {stopped.reason}.)'
     if not diagnosis.sentence:
         diagnosis.sentence = _core_sentence(diagnosis.core)
     return diagnosis

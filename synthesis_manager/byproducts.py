@@ -23,12 +23,12 @@ import contextlib
 import errno
 import os
 import re
-import stat
 import tempfile
 import time
 from pathlib import Path
 
 from respec.errors import CodedError, ErrorCode, quoted
+from respec.private_files import private_directory_problem
 
 EXTENSIONS = ('structuredslugs', 'slugsin', 'json')
 DEFAULT_SPEC_NAME = 'synthesized_spec'
@@ -62,21 +62,12 @@ def default_directory() -> Path:
 
 def private_directory(directory: Path) -> Path:
     """``directory``, created 0700 if missing; refused unless it is a real directory of this
-    user that no one else can write to."""
+    user that no one else can write to (respec.private_files)."""
     try:
-        os.mkdir(directory, 0o700)
-    except FileExistsError:
-        pass
+        problem = private_directory_problem(directory)
     except OSError as error:
         raise unwritable(directory, error) from None
-    info = os.lstat(directory)
-    if not stat.S_ISDIR(info.st_mode):
-        problem = 'is not a directory (a symbolic link or a file)'
-    elif info.st_uid != os.getuid():
-        problem = f'belongs to another user (uid {info.st_uid})'
-    elif info.st_mode & (stat.S_IWGRP | stat.S_IWOTH):
-        problem = f'is writable by others (mode {stat.S_IMODE(info.st_mode):o})'
-    else:
+    if problem is None:
         return directory
     raise ByproductsDirectoryError(f'refusing the byproducts directory {quoted(str(directory))}: it {problem}; '
                                    'remove it or set byproducts_dir', 'byproducts_dir')

@@ -31,6 +31,12 @@ def add_suite_arguments(parser):
                        help='synthesizer: our own (builtin) or a slugs executable on PATH')
     group.add_argument('--slugs-executable', default='slugs', help='the executable for --backend slugs')
     group.add_argument('--synthesis-timeout', type=float, default=120.0, help='seconds per synthesis')
+    group.add_argument('--strategy-cache-mb', type=float, default=None, metavar='MB',
+                       help='MiB of synthesis answers kept for identical requests, least recently used '
+                            'dropped first (default 64; 0: no cache)')
+    group.add_argument('--strategy-cache-dir', default='', metavar='DIR',
+                       help='keep the strategy cache in this private directory too, so that a restarted '
+                            'server finds it (default: memory only)')
     group.add_argument('--service-timeout', type=float, default=5.0,
                        help='seconds to wait for a pipeline service to appear')
     group.add_argument('--default-system', default='',
@@ -58,7 +64,9 @@ def suite_node_factories(args=None, names=SUITE_NODE_NAMES):
             keep_byproducts=getattr(args, 'keep_byproducts', None),
             backend=getattr(args, 'backend', ''),
             slugs_executable=getattr(args, 'slugs_executable', ''),
-            timeout=getattr(args, 'synthesis_timeout', None))),
+            timeout=getattr(args, 'synthesis_timeout', None),
+            strategy_cache_mb=getattr(args, 'strategy_cache_mb', None),
+            strategy_cache_dir=getattr(args, 'strategy_cache_dir', ''))),
         'sm_generation': (SMGenerationNode, overrides(config_dir=getattr(args, 'config_dir', ''))),
         'behavior_synthesis_server': (BehaviorSynthesisServer, overrides(
             synthesis_timeout=getattr(args, 'synthesis_timeout', None),

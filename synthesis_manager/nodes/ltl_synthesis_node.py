@@ -8,16 +8,19 @@ settings, and the diagnosis leads the answer's message (ltl_specification.diagno
 
 from __future__ import annotations
 
+import importlib.metadata
 import threading
 import time
 import uuid
 
 from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.node import Node
+from rclpy.serialization import deserialize_message, serialize_message
 
-from ltl_specification.diagnosis import explain_unsynthesizable, explain_well_separation
+from ltl_specification.diagnosis import CORE_NOT_COMPUTED, explain_unsynthesizable, explain_well_separation
 from ltl_specification.provenance import provenance_from_json
 from ltl_synthesizer import Limits, SynthesisCancelledError, SynthesisError
+from ltl_synthesizer.cache import DEFAULT_MAX_BYTES, CacheDirectoryError, StrategyCache, cache_key, source_digest
 from ltl_synthesizer.external import run_external_synthesizer
 from ltl_synthesizer.isolated import SERVER_CHILD_NICENESS, SpecificationText, SynthesisProcesses, byproduct_texts
 from ltl_synthesizer.strategy import strategy_to_json
@@ -26,7 +29,7 @@ from respec.errors import CodedError, ErrorCode
 from respec.nesting import run_with_deep_stack
 from respec.parsing import ParseError, spec_from_text_sections
 from respec.spec import GR1Specification
-from synthesis_manager.byproducts import DEFAULT_KEEP_LAST, ByproductStore, default_directory
+from synthesis_manager.byproducts import DEFAULT_KEEP_LAST, EXTENSIONS, ByproductStore, default_directory
 from synthesis_manager.limits import (DEFAULT_MAX_GOAL_TIMEOUT, capped_timeout, check_message, check_timeout,
                                       utf8_length)
 from synthesis_manager.ros.conversions import automaton_to_msg, error_code, msg_to_sections
@@ -34,6 +37,7 @@ from synthesis_manager.ros.errors import reported_error
 from synthesis_manager.ros.node_main import node_main
 from synthesis_manager.ros.qos import service_qos
 from synthesis_manager.ros.worker_pool import Abandoned, WorkerPool, executor_waker
+from synthesis_msgs.msg import FSAutomaton
 from synthesis_msgs.srv import CancelSynthesis, SynthesizeAutomaton
 
 BACKENDS = ('builtin', 'slugs')
@@ -49,6 +53,11 @@ LARGE_SPEC_BYTES = 64 * 1024
 #: Largest strategy (transitions) a builtin synthesis sends back: about 900 B each in the
 #: server (automaton, JSON byproduct, messages), so about 90 MB per goal at most.
 DEFAULT_MAX_STRATEGY_EDGES = 100_000
+#: The strategy cache's default bound (MiB; strategy_cache_mb).
+DEFAULT_STRATEGY_CACHE_MB = DEFAULT_MAX_BYTES / 2**20
+#: The code an answer comes from: part of every cache key, so that entries kept on disk by
+#: other code miss (ltl_synthesizer.cache.source_digest).
+ANSWERING_PACKAGES = ('respec', 'ltl_specification', 'ltl_synthesizer', 'synthesis_manager')
 
 
 WAKE_PERIOD = 0.1  # seconds
@@ -71,7 +80,10 @@ class LTLSynthesisNode(Node):
     diagnosis time); ``max_strategy_edges`` (largest builtin strategy sent back, in
     transitions; larger ones are SYNTHESIS_FAILED naming their size; 0: no limit); ``max_timeout`` (seconds: the longest time limit a request gets,
     600; 0: no cap); ``parallel_syntheses`` (run at once) and ``queued_syntheses`` (waiting beyond those;
-    further requests are answered BUSY).
+    further requests are answered BUSY); ``strategy_cache_mb`` (MiB of answers kept for identical
+    requests, least recently used dropped first; 0: no cache) and ``strategy_cache_dir`` (a
+    private directory where they are kept too, so that a restarted node finds them; '': memory
+    only): see :meth:`_cache_key` for what an identical request is and which answers are kept.
 
     Syntheses run in the node's own worker threads, awaited by an async service callback,
     so the executor stays free for cancel requests and the other nodes of the process. Each
@@ -95,11 +107,14 @@ class LTLSynthesisNode(Node):
         self.declare_parameter('check_well_separation', True)
         self.declare_parameter('parallel_syntheses', 8)
         self.declare_parameter('queued_syntheses', 200)
+        self.declare_parameter('strategy_cache_mb', DEFAULT_STRATEGY_CACHE_MB)
+        self.declare_parameter('strategy_cache_dir', '')
         self._running: dict[str, threading.Event] = {}
         self._lock = threading.Lock()
         self.workers = WorkerPool(self.parameter('parallel_syntheses'), self.parameter('queued_syntheses'),
                                   name='synthesis')
         self.synthesis_processes = SynthesisProcesses(niceness=SERVER_CHILD_NICENESS)
+        self.strategy_cache = self._strategy_cache()
         self._prune_leftovers()
         if self.parameter('backend') == 'builtin':
             self.synthesis_processes.prepare()
@@ -120,6 +135,20 @@ class LTLSynthesisNode(Node):
             return
         if deleted:
             self.get_logger().info(f'pruned {len(deleted)} byproduct leftovers (.part files, empty markers)')
+
+    def _strategy_cache(self) -> StrategyCache:
+        """The cache of answers (strategy_cache_mb, strategy_cache_dir). An unsafe or unusable
+        directory is logged and the cache kept in memory only: answers stay right, only a
+        restart loses them."""
+        max_bytes = int(self.parameter('strategy_cache_mb') * 2**20)
+        directory = self.parameter('strategy_cache_dir')
+        self._answering_code = (f"{source_digest(ANSWERING_PACKAGES)} dd {importlib.metadata.version('dd')}"
+                                if max_bytes > 0 else '')
+        try:
+            return StrategyCache(max_bytes, directory or None)
+        except (CacheDirectoryError, OSError) as error:
+            self.get_logger().warning(f'strategy cache kept in memory only: {error}'[:300])
+            return StrategyCache(max_bytes)
 
     def stop_work(self):
         """Stop every running synthesis (at shutdown, so the process exits promptly)."""
@@ -166,14 +195,21 @@ class LTLSynthesisNode(Node):
             check_timeout(request.diagnosis_timeout, 'request.diagnosis_timeout')
             # The time limit starts now: waiting for a worker counts.
             deadline = time.monotonic() + timeout
-            try:
-                # Formulas are parsed, printed and pickled to the synthesis process on a deep stack.
-                await self.workers.run(run_with_deep_stack, self._synthesize, request, response, cancel,
-                                       timeout, deadline,
-                                       wake=executor_waker(self),
-                                       give_up=lambda: cancel.is_set() or time.monotonic() > deadline)
-            except Abandoned:  # stopped while waiting for a worker
-                self._stopped(response, 'cancelled' if cancel.is_set() else 'timeout', timeout)
+            # A large specification's key is computed in the worker: hashing megabytes here would
+            # hold the executor thread (3.9 MB: 26 ms).
+            key = None if _is_large(msg_to_sections(request.ltl_specification)) else self._cache_key(request)
+            cached = self.strategy_cache.get(key) if key else None
+            if cached is not None:  # answered here: no worker, no synthesis process
+                self._answer_from_cache(cached, request, response)
+            else:
+                try:
+                    # Formulas are parsed, printed and pickled to the synthesis process on a deep stack.
+                    await self.workers.run(run_with_deep_stack, self._synthesize, request, response, cancel,
+                                           timeout, deadline, key,
+                                           wake=executor_waker(self),
+                                           give_up=lambda: cancel.is_set() or time.monotonic() > deadline)
+                except Abandoned:  # stopped while waiting for a worker
+                    self._stopped(response, 'cancelled' if cancel.is_set() else 'timeout', timeout)
         except ParseError as error:  # the parsers' own code, as in every other stage
             response.synthesizable = False
             response.error_code = error_code(error.code, f'malformed specification: {error}')
@@ -187,14 +223,74 @@ class LTLSynthesisNode(Node):
             self.get_logger().warning(response.error_code.message)
         return response
 
+    def _cache_key(self, request) -> str | None:
+        """The strategy cache's key of ``request`` (None: not cached, with the cache off or the
+        slugs backend, an external program that may change unseen).
 
-    def _synthesize(self, request, response, cancel, timeout, deadline):
+        It digests everything the answer (the response and the byproduct files) depends on:
+        the specification's text as sent, the provenance (the diagnosis and the well-separation
+        warning tell it), the options that change the answer (robotics_semantics,
+        check_well_separation, max_strategy_edges), and the code that computes it (the sources
+        of ANSWERING_PACKAGES, the dd version). Both the specification and its provenance are
+        compiled from the robot system's files, so a changed file that changes the answer
+        changes the key; the request names no system beyond them. spec_name only names the
+        byproduct files and appears in an unrealizable answer's message, so it is left out
+        (the message is kept without it). Time and memory limits decide whether an answer
+        comes, not which: a hit is the answer of a synthesis that had enough of both."""
+        if not self.strategy_cache.enabled or self.parameter('backend') != 'builtin':
+            return None
+        return cache_key({
+            'code': self._answering_code,
+            'specification': msg_to_sections(request.ltl_specification), 'provenance': request.provenance,
+            'robotics_semantics': self.parameter('robotics_semantics'),
+            'check_well_separation': self.parameter('check_well_separation'),
+            'max_strategy_edges': self.parameter('max_strategy_edges')})
+
+    def _answer_from_cache(self, entry, request, response):
+        """Answer ``request`` with a kept answer: its byproduct files written again under this
+        request's spec_name, the response byte-identical to the synthesis it was kept from."""
+        with self.byproduct_store().open_set(request.spec_name) as files:
+            for extension in EXTENSIONS:
+                if extension in entry:
+                    files.write(extension, entry[extension].decode())
+        response.synthesizable = entry['synthesizable'] == b'1'
+        if response.synthesizable:
+            response.automaton = deserialize_message(entry['automaton'], FSAutomaton)
+            message = entry['message'].decode()
+        else:
+            message = (entry['message_before'] + _unrealizable_head(files.name).encode()
+                       + entry['message_after']).decode()
+        response.error_code = error_code(ErrorCode[entry['code'].decode()], message)
+
+    def _synthesize(self, request, response, cancel, timeout, deadline, key: str | None):
+        """Synthesize (in a worker thread), once for concurrent identical requests: with a
+        cache key, a request identical to one being synthesized waits for its answer. ``key``:
+        the one on_request computed (None: computed here, e.g. a large specification's)."""
         if cancel.is_set() or time.monotonic() > deadline:  # stopped while waiting for a worker
+            return self._stopped(response, 'cancelled' if cancel.is_set() else 'timeout', timeout)
+        key = key or self._cache_key(request)
+        if key is None:
+            self._synthesize_fresh(request, response, cancel, timeout, deadline)
+            return
+        entry, how = self.strategy_cache.answer(
+            key, lambda: self._synthesize_fresh(request, response, cancel, timeout, deadline, keep=True),
+            give_up=lambda: cancel.is_set() or time.monotonic() > deadline)
+        if how == 'gave up':
+            self._stopped(response, 'cancelled' if cancel.is_set() else 'timeout', timeout)
+        elif how != 'computed':
+            self._answer_from_cache(entry, request, response)
+
+    def _synthesize_fresh(self, request, response, cancel, timeout, deadline, keep: bool = False) -> dict | None:
+        """Synthesize ``request`` into ``response``; with ``keep``, return what the strategy
+        cache keeps of the answer, or None when the answer must not be kept: a stop (time
+        limit, cancel), a failure (memory limit, a strategy too large, the process died), or a
+        diagnosis or well-separation check cut short by its time (a fresh synthesis with more
+        time would say more). Realizable and unrealizable verdicts are deterministic: kept."""
+        if cancel.is_set() or time.monotonic() > deadline:  # e.g. after waiting for an identical request
             return self._stopped(response, 'cancelled' if cancel.is_set() else 'timeout', timeout)
         sections = msg_to_sections(request.ltl_specification)
         backend = self.parameter('backend')
-        if backend == 'builtin' and sum(utf8_length(line) for lines in sections.values() for line in lines) > \
-                LARGE_SPEC_BYTES:
+        if backend == 'builtin' and _is_large(sections):
             spec = SpecificationText(sections)  # parsed in the synthesis children
             try:
                 structuredslugs, slugsin, inputs, outputs = self.synthesis_processes.call(
@@ -205,6 +301,7 @@ class LTLSynthesisNode(Node):
         else:
             spec = variables = spec_from_text_sections(sections)
             structuredslugs, slugsin = spec.to_structuredslugs(), spec.to_slugsin()
+        entry = {'structuredslugs': structuredslugs.encode(), 'slugsin': slugsin.encode()} if keep else {}
         with self.byproduct_store().open_set(request.spec_name) as files:
             files.write('structuredslugs', structuredslugs)
             slugsin_path = files.write('slugsin', slugsin)
@@ -230,65 +327,80 @@ class LTLSynthesisNode(Node):
                 return
             response.synthesizable = realizable
             if not realizable:
-                details = f'specification {files.name!r} is unrealizable: {explanation}'.rstrip(': ')
+                head = _unrealizable_head(files.name)
+                details = f'{head}: {explanation}'.rstrip(': ')
                 try:
-                    message = self._diagnosed(details, spec, request, robotics, cancel, deadline)
+                    message, diagnosed = self._diagnosed(details, spec, request, robotics, cancel, deadline)
                 except SynthesisCancelledError as stopped:
                     return self._stopped(response, stopped.reason, timeout)
                 response.error_code = error_code(ErrorCode.SPEC_UNSYNTHESIZABLE, message)
-                return
-            files.write('json', strategy_to_json(strategy))
+                if not (keep and diagnosed):
+                    return None
+                before, found, after = message.rpartition(head)  # kept without the spec name
+                if not found:
+                    return None
+                return {**entry, 'synthesizable': b'0', 'code': b'SPEC_UNSYNTHESIZABLE',
+                        'message_before': before.encode(), 'message_after': after.encode()}
+            strategy_json = strategy_to_json(strategy)
+            files.write('json', strategy_json)
         try:
-            warning = self._well_separation_warning(spec, request, cancel, deadline)
+            warning, checked = self._well_separation_warning(spec, request, cancel, deadline)
         except SynthesisCancelledError as stopped:
             return self._stopped(response, stopped.reason, timeout)
         response.automaton = automaton_to_msg(automaton_from_strategy(strategy, variables))
         response.error_code = error_code(ErrorCode.SUCCESS, warning)
+        if not (keep and checked):
+            return None
+        return {**entry, 'json': strategy_json.encode(), 'synthesizable': b'1', 'code': b'SUCCESS',
+                'message': warning.encode(), 'automaton': serialize_message(response.automaton)}
 
-    def _well_separation_warning(self, spec, request, cancel: threading.Event, deadline: float) -> str:
+    def _well_separation_warning(self, spec, request, cancel: threading.Event, deadline: float) -> tuple[str, bool]:
         """The warning that the controller can win by forcing the environment to break its
         assumptions ('' when it cannot, when check_well_separation is off, or when the check
         does not end within the diagnosis time and the request's time limit: the automaton
-        stands without it). The check runs in a synthesis child process, with the memory
-        limit; a cancel raises SynthesisCancelledError."""
+        stands without it), and whether the check ended (or was off). The check runs in a
+        synthesis child process, with the memory limit; a cancel raises SynthesisCancelledError."""
         if not self.parameter('check_well_separation'):
-            return ''
+            return '', True
         limit = request.diagnosis_timeout or self.parameter('diagnosis_timeout')
         check_deadline = min(time.monotonic() + limit, deadline)
         if check_deadline <= time.monotonic():
-            return ''
+            return '', False
         limits = Limits(deadline=check_deadline, memory_limit=self.parameter('memory_limit_mb') * 2**20)
         try:
             return self.synthesis_processes.call(WELL_SEPARATION, (spec, self._provenance(request), limits),
-                                                 cancel=cancel, deadline=check_deadline + DIAGNOSIS_GRACE)
+                                                 cancel=cancel, deadline=check_deadline + DIAGNOSIS_GRACE), True
         except SynthesisError as error:
             if cancel.is_set():
                 raise SynthesisCancelledError('cancelled') from None
             self.get_logger().warning(f'well-separation not checked: {error}'[:300])
-            return ''
+            return '', False
 
     def _diagnosed(self, details: str, spec, request, robotics_semantics: bool, cancel: threading.Event,
-                   deadline: float) -> str:
+                   deadline: float) -> tuple[str, bool]:
         """``details`` (the synthesizer's explanation), led by why the task cannot be done: in
         the task's terms when the request carries the specification's provenance, else by its
-        formulas. The diagnosis runs in a synthesis child process, with the memory limit, and
-        ends by diagnosis_timeout and before the request's time limit; without an answer by then
-        the verdict stands with ``details``. A cancel raises SynthesisCancelledError."""
+        formulas; and whether the diagnosis was whole (its core computed). The diagnosis runs in
+        a synthesis child process, with the memory limit, and ends by diagnosis_timeout and
+        before the request's time limit; without an answer by then the verdict stands with
+        ``details``. A cancel raises SynthesisCancelledError."""
         provenance = self._provenance(request)
         limit = request.diagnosis_timeout or self.parameter('diagnosis_timeout')
         diagnosis_deadline = min(time.monotonic() + limit, deadline - DIAGNOSIS_GRACE)
         if diagnosis_deadline <= time.monotonic():
-            return details
+            return details, False
         limits = Limits(deadline=diagnosis_deadline, memory_limit=self.parameter('memory_limit_mb') * 2**20)
         try:
             # The diagnosis keeps its own deadline; the child is killed only if it overruns.
-            return self.synthesis_processes.call(
+            message = self.synthesis_processes.call(
                 DIAGNOSIS, (details, spec, provenance, robotics_semantics, limits),
                 cancel=cancel, deadline=diagnosis_deadline + DIAGNOSIS_GRACE)
         except SynthesisError:
             if cancel.is_set():
                 raise SynthesisCancelledError('cancelled') from None
-            return details  # out of time, or its process died: the verdict stands without it
+            return details, False  # out of time, or its process died: the verdict stands without it
+        # A diagnosis that failed says only the details; one whose time ran out says so.
+        return message, message != details and CORE_NOT_COMPUTED not in message
 
     def _provenance(self, request):
         """The request's provenance (None without one, or when it cannot be read: logged)."""
@@ -304,6 +416,16 @@ class LTLSynthesisNode(Node):
     def _stopped(response, reason: str, timeout: float):
         code = ErrorCode.SYNTHESIS_TIMEOUT if reason == 'timeout' else ErrorCode.PREEMPTED
         response.error_code = error_code(code, f'synthesis stopped: {reason} (time limit {timeout:g} s)')
+
+
+def _is_large(sections: dict) -> bool:
+    """Whether a specification's text is over LARGE_SPEC_BYTES."""
+    return sum(utf8_length(line) for lines in sections.values() for line in lines) > LARGE_SPEC_BYTES
+
+
+def _unrealizable_head(spec_name: str) -> str:
+    """How an unrealizable answer's synthesizer details start (the only part naming the spec)."""
+    return f'specification {spec_name!r} is unrealizable'
 
 
 def main():

@@ -30,8 +30,9 @@ def run(args) -> int:
     if unknown:
         print(f'behavior-synthesis serve: unknown node {unknown[0]!r}', file=sys.stderr)
         return ExitStatus.USAGE
-    where = ', '.join(filter(None, robot_namespaces(args))) or 'its own namespace'
+    namespaces = ', '.join(filter(None, robot_namespaces(args)))
     return run_nodes(*suite_node_factories(args, names),
                      argv=['behavior-synthesis', *getattr(args, 'ros_args', [])],
-                     ready_message=f'behavior synthesis suite up: {", ".join(names)} in {where} '
+                     ready_message=f'behavior synthesis suite up: {", ".join(names)}'
+                                   f'{" in " + namespaces if namespaces else ""} '
                                    '(actions behavior_synthesis and flexbe_synthesis); Ctrl-C to stop')

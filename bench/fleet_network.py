@@ -260,6 +260,15 @@ class Round:
             counts[entry['error_name']] = counts.get(entry['error_name'], 0) + 1
         return dict(sorted(counts.items()))
 
+    def failures(self) -> dict:
+        """How many non-SUCCESS answers said what (code and message, node names kept)."""
+        counts: dict = {}
+        for entry in self.results:
+            if entry['error_name'] != 'SUCCESS':
+                said = f"{entry['error_name']}: {entry['message'][:140]}"
+                counts[said] = counts.get(said, 0) + 1
+        return dict(sorted(counts.items(), key=lambda item: -item[1]))
+
     def latencies(self) -> list:
         return sorted(entry['answered'] - entry['sent'] for entry in self.results
                       if entry['error_name'] == 'SUCCESS')
@@ -289,15 +298,22 @@ class Round:
         return figures
 
 
-def run_round(fleet: Fleet, tag: str, clients_per_host: int, goals: int, interval: float,
+def clients_on_each_host(clients: int) -> dict:
+    """``clients`` spread over the hosts as evenly as they go (50 -> 13, 13, 12, 12)."""
+    hosts = list(ROLES)
+    return {host: clients // len(hosts) + (index < clients % len(hosts)) for index, host in enumerate(hosts)}
+
+
+def run_round(fleet: Fleet, tag: str, clients: int, goals: int, interval: float,
               fault=None, fault_after: float = 0.2, timeout: float = 600.0) -> Round:
-    """Clients on every host (``clients_per_host`` x ``goals``); ``fault`` ``fault_after`` s after
+    """``clients`` clients of ``goals`` goals, spread over every host; ``fault`` ``fault_after`` s after
     they all found the server and began their goals.
 
     Clients are connected before a fault: a client process whose discovery was still under way
     when its host's cable was pulled once stayed without the server after the cable was back
     (Fast DDS 2.14; see docs/deployment.md), a case of its own, not the one measured here."""
-    started = [fleet.start_clients(host, clients_per_host, goals, interval, tag) for host in ROLES]
+    started = [fleet.start_clients(host, count, goals, interval, tag)
+               for host, count in clients_on_each_host(clients).items() if count]
     ready_by = time.monotonic() + 60.0
     while not all(ready_marker(path).exists() for _, path in started) and time.monotonic() < ready_by:
         time.sleep(0.02)
@@ -312,7 +328,7 @@ def run_round(fleet: Fleet, tag: str, clients_per_host: int, goals: int, interva
         except subprocess.TimeoutExpired:
             kill_group(process)
     results = [entry for _, path in started for entry in read_results(path)]
-    return Round(tag, results, clients_per_host * goals * len(ROLES), fault_times)
+    return Round(tag, results, clients * goals, fault_times)
 
 
 def ready_marker(results: Path) -> Path:

@@ -28,7 +28,7 @@ if not network_namespaces_available():
         raise RuntimeError('the across-hosts test needs root and `ip` (iproute2), and CI requires it')
     pytest.skip('the across-hosts test needs root and `ip` (iproute2)', allow_module_level=True)
 
-CLIENTS_PER_HOST, GOALS, INTERVAL = 2, 2, 2.5
+CLIENTS, GOALS, INTERVAL = 8, 2, 2.5  # 2 clients on each host
 SPECIFIC_CODES = {'SUCCESS', 'SERVICE_UNAVAILABLE'}  # what a client may get while hosts fail
 
 
@@ -62,7 +62,7 @@ def test_a_fleet_across_four_hosts_answers_every_goal_once_through_faults(tmp_pa
         fleet = Fleet(network, tmp_path)
         fleet.start()
 
-        cable = run_round(fleet, 'cable', CLIENTS_PER_HOST, GOALS, INTERVAL, pulled_cable(3, 5.0))
+        cable = run_round(fleet, 'cable', CLIENTS, GOALS, INTERVAL, pulled_cable(3, 5.0))
         figures = assert_each_goal_answered_once(cable)
         others = [e for e in cable.results if e['host'] != 3]
         assert all(e['error_name'] == 'SUCCESS' for e in others), others  # host 4's worker answered
@@ -70,12 +70,17 @@ def test_a_fleet_across_four_hosts_answers_every_goal_once_through_faults(tmp_pa
                    and cable.fault['began'] + 1.5 < e['answered'] < cable.fault['ended']]
         assert not cut_off, cut_off  # no way around the pulled cable: DDS stays on the private link
         assert figures['recovery_s'] is not None and figures['recovery_s'] < 15.0, figures
+        # a hot standby: both workers synthesized (each request reaches every server of the name)
+        synthesized = {host: {path.stem for path in (tmp_path / f'byproducts{host}').glob('*.structuredslugs')}
+                       for host in (3, 4)}
+        succeeded = {f"h{e['host']}c{e['client']}g{e['goal']}" for e in cable.results if e['error_name'] == 'SUCCESS'}
+        assert succeeded <= synthesized[4] and synthesized[3] & synthesized[4], synthesized
 
-        killed = run_round(fleet, 'killed', CLIENTS_PER_HOST, GOALS, INTERVAL, killed_host(4))
+        killed = run_round(fleet, 'killed', CLIENTS, GOALS, INTERVAL, killed_host(4))
         figures = assert_each_goal_answered_once(killed)
         assert figures['codes'] == {'SUCCESS': killed.expected}, figures  # host 3's worker answered
 
-        restarted = run_round(fleet, 'restarted', CLIENTS_PER_HOST, GOALS, INTERVAL, restarted_host(2))
+        restarted = run_round(fleet, 'restarted', CLIENTS, GOALS, INTERVAL, restarted_host(2))
         figures = assert_each_goal_answered_once(restarted)
         assert figures['recovery_s'] is not None and figures['recovery_s'] < 15.0, figures
         namespaces = {network.namespace(host) for host in range(1, 5)} | {network.switch}

@@ -101,22 +101,34 @@ def test_without_namespaces_the_suite_is_placed_as_before(tmp_path):
     assert all('cli_args' not in factory.keywords for factory in one)
 
 
-def test_the_documented_commands_serve_two_robots_and_send_goal_picks_one(tmp_path):
-    """docs/deployment.md: ``serve --namespace /robot1 --namespace /robot2``, each robot's
-    ``atlas-sim-node --ros-args -r __ns:=...``, and ``send-goal --namespace``: each robot's
-    server reads its own robot's state."""
+def test_the_documented_commands_serve_two_robots_and_the_clients_pick_one(tmp_path):
+    """docs/deployment.md: one synthesis service in /fleet (``serve --ros-args -r __ns:=/fleet``),
+    both robots' other nodes in one ``serve --namespace /robot1 --namespace /robot2
+    --synthesis-namespace /fleet``, each robot's ``atlas-sim-node --ros-args -r __ns:=...``;
+    ``send-goal --namespace`` and ``gui --connect --namespace`` pick the robot, whose server reads
+    its own robot's state."""
     import json
     import subprocess
+    import time
 
-    from test_entry_point_shutdown import BIN, loopback_domain, started
+    import httpx
 
+    from test_entry_point_shutdown import BIN, GUI_URL, loopback_domain, started
+
+    serve = [BIN / 'behavior-synthesis', 'serve', '--byproducts-dir', tmp_path]
     with loopback_domain() as (_, environment):
-        with started([BIN / 'behavior-synthesis', 'serve', '--namespace', '/robot1', '--namespace', '/robot2',
-                      '--byproducts-dir', tmp_path], environment) as (_, server_output), \
+        with started([*serve, '--nodes', 'ltl_synthesis', '--ros-args', '-r', '__ns:=/fleet'],
+                     environment) as (_, synthesis_output), \
+                started([*serve, '--namespace', '/robot1', '--namespace', '/robot2', '--synthesis-namespace', '/fleet',
+                         '--nodes', 'behavior_synthesis_server,ltl_compilation,sm_generation'],
+                        environment) as (_, server_output), \
                 started([BIN / 'atlas-sim-node', '--ros-args', '-r', '__ns:=/robot1',
                          '-p', 'initial_conditions:=stand_prep'], environment), \
                 started([BIN / 'atlas-sim-node', '--ros-args', '-r', '__ns:=/robot2',
-                         '-p', 'initial_conditions:=stand'], environment):
+                         '-p', 'initial_conditions:=stand'], environment), \
+                started([BIN / 'behavior-synthesis', 'gui', '--port', '0', '--connect', '--namespace', '/robot2'],
+                        environment) as (_, gui_output):
+            synthesis_output.wait_for('suite up')
             assert 'in /robot1, /robot2' in server_output.wait_for('suite up').string
             for namespace, start in (('/robot2', 'stand'), ('/robot1', 'stand_prep')):
                 sent = subprocess.run(
@@ -127,3 +139,16 @@ def test_the_documented_commands_serve_two_robots_and_send_goal_picks_one(tmp_pa
                 assert f'waiting for {namespace}/flexbe_synthesis' in sent.stderr
                 result = json.loads(sent.stdout)  # CNU's result says where its initial conditions came from
                 assert initial_conditions_in_status(result['message']) == ('atlas_sim/state', [start])
+
+            url = gui_output.wait_for(GUI_URL).group(1)
+            assert 'the suite of /robot2' in httpx.get(f'{url}api/info').json()['description']
+            answer = httpx.post(f'{url}api/jobs', json={'system': 'atlas', 'initial_conditions': ['current'],
+                                                        'goals': ['look_down']})
+            assert answer.status_code == 202, answer.text
+            deadline = time.monotonic() + 120
+            while (job := httpx.get(f"{url}api/jobs/{answer.json()['id']}").json())['state'] != 'finished':
+                assert time.monotonic() < deadline, job
+                time.sleep(0.1)
+            assert job['outcome']['error_name'] == 'SUCCESS', job['outcome']
+            detected = next(filter(None, (initial_conditions_in_status(note['status']) for note in job['timeline'])))
+            assert detected == ('atlas_sim/state', ['stand'])  # robot 2's state, read by robot 2's server

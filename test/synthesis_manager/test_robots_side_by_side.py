@@ -142,6 +142,7 @@ def test_the_documented_commands_serve_two_robots_and_the_clients_pick_one(tmp_p
 
             url = gui_output.wait_for(GUI_URL).group(1)
             assert 'the suite of /robot2' in httpx.get(f'{url}api/info').json()['description']
+            assert 'atlas' in json.dumps(httpx.get(f'{url}api/systems').json())  # from /robot2/robot_systems
             answer = httpx.post(f'{url}api/jobs', json={'system': 'atlas', 'initial_conditions': ['current'],
                                                         'goals': ['look_down']})
             assert answer.status_code == 202, answer.text

@@ -60,7 +60,8 @@ class RosGoalRunner:
     def __call__(self, request, feedback, cancel) -> JobOutcome:
         if not self.client.wait_for_server(timeout=self.server_timeout):
             outcome = SynthesisOutcome(
-                ErrorCode.SERVICE_UNAVAILABLE.number, ErrorCode.SERVICE_UNAVAILABLE, 'no /behavior_synthesis action server answered within '
+                ErrorCode.SERVICE_UNAVAILABLE.number, ErrorCode.SERVICE_UNAVAILABLE,
+                f'no {self.client.node.resolve_service_name(self.client.action_name)} action server answered within '
                 f'{self.server_timeout:g} s (start one with `behavior-synthesis serve`)')
         else:
             goal = make_goal(request.system, request.initial_conditions, request.goals, request.sm_outcomes,

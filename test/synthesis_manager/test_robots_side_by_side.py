@@ -153,3 +153,10 @@ def test_the_documented_commands_serve_two_robots_and_the_clients_pick_one(tmp_p
             assert job['outcome']['error_name'] == 'SUCCESS', job['outcome']
             detected = next(filter(None, (initial_conditions_in_status(note['status']) for note in job['timeline'])))
             assert detected == ('atlas_sim/state', ['stand'])  # robot 2's state, read by robot 2's server
+
+
+def test_a_client_names_its_robots_action_when_the_server_is_gone(ros):
+    client = SynthesisClient(ros.add_node(Node, 'operator', namespace='/robot9'))
+    assert 'the /robot9/behavior_synthesis action server went away' in client.server_lost(3.0).message
+    assert 'the /behavior_synthesis action server went away' in \
+        SynthesisClient(ros.add_node(Node, 'operator')).server_lost(3.0).message

@@ -31,6 +31,9 @@ SUBCOMMANDS = {
     'gui': ('synthesis_manager.gui', 'serve the synthesis web GUI on 127.0.0.1'),
 }
 
+# Commands running nodes for others, which take standard ROS arguments after --ros-args.
+COMMANDS_WITH_ROS_ARGUMENTS = ('serve',)
+
 
 class HelpFormatter(argparse.RawDescriptionHelpFormatter):
     """Every option's help ends with its default (unless it says it already, or has none)."""
@@ -63,7 +66,12 @@ def main(argv: list[str] | None = None) -> int:
     # Import only the module of the requested subcommand (fast start, isolated failures).
     command = next((word for word in argv if word in SUBCOMMANDS), None)
     parser = build_parser(only=command or '')
+    argv, ros_args = split_ros_arguments(argv)
     args = parser.parse_args(argv)
+    if ros_args and command not in COMMANDS_WITH_ROS_ARGUMENTS:
+        parser.error(f'{command or "this command"} takes no --ros-args (a client picks its robot with '
+                     '--namespace)')
+    args.ros_args = ros_args
     if not getattr(args, 'run', None):
         parser.print_help()
         return 0 if not argv or '-h' in argv or '--help' in argv else 2
@@ -77,6 +85,15 @@ def main(argv: list[str] | None = None) -> int:
         except KeyboardInterrupt:
             print(f'\nbehavior-synthesis {args.command}: interrupted', file=sys.stderr)
             return 128 + (received[-1] if received else signal.SIGINT)
+
+
+def split_ros_arguments(argv: list[str]) -> tuple[list[str], list[str]]:
+    """``[..., '--ros-args', ...]`` -> (our arguments, the ROS arguments from ``--ros-args`` on),
+    so standard ROS arguments (remappings, ``__ns:=``, parameters) reach rclpy, not argparse."""
+    if '--ros-args' not in argv:
+        return argv, []
+    start = argv.index('--ros-args')
+    return argv[:start], argv[start:]
 
 
 @contextlib.contextmanager

@@ -220,6 +220,7 @@ class SynthesisClient:
         """The outcome of a goal whose server left the ROS graph before answering."""
         return SynthesisOutcome(
             ErrorCode.SERVICE_UNAVAILABLE.number, ErrorCode.SERVICE_UNAVAILABLE,
-            f'the /{self.action_name} action server went away while the goal was in progress (gone from '
+            f'the {self.node.resolve_service_name(self.action_name)} action server went away while the goal '
+            'was in progress (gone from '
             f'the ROS graph for {SERVER_LOST_SECONDS:g} s: killed or crashed); start it again and send '
             'the goal again', seconds=seconds)

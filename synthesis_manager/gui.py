@@ -22,7 +22,9 @@ from rclpy.node import Node
 from respec.errors import ErrorCode, ExitStatus, exit_status_help
 from synthesis_manager.client import SynthesisClient, SynthesisOutcome, make_goal
 from synthesis_manager.ros.harness import RosHarness, environment_domain_id
+from synthesis_manager.ros.namespaces import namespace_placement
 from synthesis_manager.ros.robot_systems import SuiteSystems
+from synthesis_manager.send_goal import add_robot_namespace_argument
 from synthesis_manager.suite import add_suite_arguments, suite_node_factories
 from synthesis_manager.web.backend import SynthesisBackend
 from synthesis_manager.web.outcome import JobOutcome
@@ -40,6 +42,7 @@ def add_arguments(parser):
                         help='address to listen on (default 127.0.0.1: this machine only)')
     parser.add_argument('--connect', action='store_true',
                         help='use the suite already running on $ROS_DOMAIN_ID instead of starting one')
+    add_robot_namespace_argument(parser)  # with --connect: the robot whose suite the page uses
     parser.add_argument('--goal-timeout', type=float, default=600.0,
                         help='seconds to wait for the result of one goal')
     add_suite_arguments(parser)
@@ -57,7 +60,8 @@ class RosGoalRunner:
     def __call__(self, request, feedback, cancel) -> JobOutcome:
         if not self.client.wait_for_server(timeout=self.server_timeout):
             outcome = SynthesisOutcome(
-                ErrorCode.SERVICE_UNAVAILABLE.number, ErrorCode.SERVICE_UNAVAILABLE, 'no /behavior_synthesis action server answered within '
+                ErrorCode.SERVICE_UNAVAILABLE.number, ErrorCode.SERVICE_UNAVAILABLE,
+                f'no {self.client.node.resolve_service_name(self.client.action_name)} action server answered within '
                 f'{self.server_timeout:g} s (start one with `behavior-synthesis serve`)')
         else:
             goal = make_goal(request.system, request.initial_conditions, request.goals, request.sm_outcomes,
@@ -74,9 +78,13 @@ def ros_backend(args=None, connect: bool = False):
         if not connect:
             for factory in suite_node_factories(args):
                 ros.add_node(factory)
-        client_node = ros.add_node(Node, 'behavior_synthesis_gui')
+        # In the robot's namespace, the node's relative names (behavior_synthesis, robot_systems)
+        # reach that robot's suite.
+        client_node = ros.add_node(Node, 'behavior_synthesis_gui',
+                                   **namespace_placement(getattr(args, 'namespace', '') if connect else ''))
         client = SynthesisClient(client_node)
-        where = (f'the suite on ROS_DOMAIN_ID {ros.domain_id}' if connect
+        robot = '' if client_node.get_namespace() == '/' else f' of {client_node.get_namespace()}'
+        where = (f'the suite{robot} on ROS_DOMAIN_ID {ros.domain_id}' if connect
                  else f'an in-process suite (private ROS domain {ros.domain_id})')
         # Attached to a running suite, the page shows and checks the suite's systems (served on
         # robot_systems), never config files of this machine.

@@ -17,6 +17,7 @@ from sm_generation.instantiation import count_states
 from synthesis_manager.client import SynthesisClient, make_flexbe_goal, make_goal
 from synthesis_manager.requests import InvalidRequestError
 from synthesis_manager.ros.harness import RosHarness, environment_domain_id
+from synthesis_manager.ros.namespaces import namespace_placement
 from synthesis_manager.summary import spec_size, state_machine_tree
 
 
@@ -51,8 +52,16 @@ def add_arguments(parser):
                         default='behavior_synthesis',
                         help="the server's interface: the original BehaviorSynthesis or CNU's FlexBESynthesis")
     parser.add_argument('--timeout', type=float, default=120.0, help='seconds to wait for the result')
+    add_robot_namespace_argument(parser)
     parser.add_argument('--json', action='store_true', help='print the result as one JSON object')
     parser.add_argument('-o', '--output', help='also write the JSON result to this file')
+
+
+def add_robot_namespace_argument(parser):
+    """A client's ``--namespace``: the robot whose server (and so whose state) it asks."""
+    parser.add_argument('--namespace', default='', metavar='NS',
+                        help="the robot's ROS namespace, e.g. /robot1: its server's <NS>/behavior_synthesis "
+                             '(default: the server outside any namespace)')
 
 
 def use_demo_goals_unless_given(args, command: str, stream=None) -> None:
@@ -138,11 +147,13 @@ def run(args) -> int:
         print(f'send-goal: cannot read the request: {error}', file=sys.stderr)
         return ExitStatus.USAGE
 
-    print(f'send-goal: waiting for /{args.action}…', file=sys.stderr, flush=True)
     with RosHarness(domain_id=environment_domain_id()) as ros:
-        client = SynthesisClient(ros.add_node(Node, 'behavior_synthesis_client'), args.action)
+        node = ros.add_node(Node, 'behavior_synthesis_client', **namespace_placement(args.namespace))
+        action = node.resolve_service_name(args.action)  # the absolute name the client asks
+        print(f'send-goal: waiting for {action}…', file=sys.stderr, flush=True)
+        client = SynthesisClient(node, args.action)
         if not client.wait_for_server(timeout=SERVER_WAIT):
-            print(f'send-goal: no /{args.action} action server after {SERVER_WAIT:g} s (start one with '
+            print(f'send-goal: no {action} action server after {SERVER_WAIT:g} s (start one with '
                   '`behavior-synthesis serve` or `behavior-synthesis gui`)', file=sys.stderr)
             return ExitStatus.UNAVAILABLE
         progress = None if args.json else ProgressBar()

@@ -16,6 +16,7 @@ from synthesis_manager.nodes.ltl_synthesis_node import LTLSynthesisNode
 from synthesis_manager.nodes.server_node import BehaviorSynthesisServer
 from synthesis_manager.nodes.sm_generation_node import SMGenerationNode
 from synthesis_manager.ros.harness import RosHarness
+from synthesis_manager.ros.namespaces import absolute_namespace, namespace_placement, synthesis_service_remapping
 
 SUITE_NODE_NAMES = ('ltl_compilation', 'ltl_synthesis', 'sm_generation', 'behavior_synthesis_server')
 
@@ -77,8 +78,42 @@ def suite_node_factories(args=None, names=SUITE_NODE_NAMES):
             robot_state_timeout=getattr(args, 'robot_state_timeout', None),
             repair_time_budget=getattr(args, 'repair_time_budget', None))),
     }
-    return [functools.partial(settings[name][0], parameter_overrides=settings[name][1])
-            for name in names]
+    namespaces = robot_namespaces(args)
+    synthesis_namespace = shared_synthesis_namespace(args)
+    factories = []
+    for name in names:
+        node_class, parameters = settings[name]
+        for namespace in ([synthesis_namespace] if name == 'ltl_synthesis' else namespaces):
+            placement = namespace_placement(namespace)
+            if name == 'behavior_synthesis_server' and synthesis_namespace != namespace:
+                placement['cli_args'] = synthesis_service_remapping(synthesis_namespace)
+            factories.append(functools.partial(node_class, parameter_overrides=parameters, **placement))
+    return factories
+
+
+def add_namespace_arguments(parser):
+    """``serve``'s robot namespaces: several robots' nodes side by side in one process."""
+    group = parser.add_argument_group('robots side by side (docs/deployment.md)')
+    group.add_argument('--namespace', action='append', default=[], metavar='NS', dest='namespaces',
+                       help="a robot's ROS namespace, e.g. /robot1 (repeatable: the nodes of --nodes run "
+                            'once per namespace, except ltl_synthesis, which runs once, in --synthesis-namespace)')
+    group.add_argument('--synthesis-namespace', default=None, metavar='NS',
+                       help='where the ltl_synthesis service the servers call lives (default: the one '
+                            '--namespace given, or / for several): one synthesis service for several robots')
+
+
+def robot_namespaces(args) -> list[str]:
+    """The robots' namespaces of ``args`` ('' : the node's own, i.e. / or a ``__ns`` remapping)."""
+    return [absolute_namespace(namespace) for namespace in getattr(args, 'namespaces', None) or ['']]
+
+
+def shared_synthesis_namespace(args) -> str:
+    """The namespace of the one ltl_synthesis service the servers of ``args`` call."""
+    given = getattr(args, 'synthesis_namespace', None)
+    if given is not None:
+        return absolute_namespace(given) or '/'
+    namespaces = robot_namespaces(args)
+    return namespaces[0] if len(namespaces) == 1 else '/'
 
 
 class SuiteUnavailableError(CodedError):

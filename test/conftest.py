@@ -11,6 +11,8 @@ Markers (given here, from the folder, the fixtures a test uses and the lists bel
     mujoco   runs the MuJoCo simulator
     flexbe   runs the real FlexBE (``flexbe_sources``, ``flexbe``)
     slow     takes more than a few seconds on a 2-core machine
+    netns    builds private network namespaces (needs root and ``ip``; skipped without them
+             unless BEHAVIOR_SYNTHESIS_REQUIRE_NETNS=1, which .ci/run sets when root)
 
 The pure-core tests alone, in under a minute::
 
@@ -41,6 +43,7 @@ MARKERS = {
     'mujoco': 'runs the MuJoCo simulator',
     'flexbe': 'runs the real FlexBE',
     'slow': 'takes more than a few seconds on a 2-core machine',
+    'netns': 'builds private network namespaces (root and ip)',
 }
 # Everything the shell does goes through ROS (its nodes, its processes, its in-process suite).
 FOLDER_MARKERS = {'synthesis_manager': ('ros',)}
@@ -53,7 +56,9 @@ MODULE_MARKERS = {
                'test_atlas_sim_closed_loop_ros', 'test_atlas_sim_node', 'test_flexbe_engine', 'test_readme_flexbe'),
     'ros': ('test_colcon_route', 'test_flexbe_engine', 'test_flexbe_onboard', 'test_flexbe_states', 'test_flexbe_webui',
             'test_cnu_capabilities', 'test_readme_commands', 'test_readme_flexbe'),
-    'slow': ('test_bench_gr1_families', 'test_colcon_route', 'test_readme_commands', 'test_readme_flexbe'),
+    'slow': ('test_bench_gr1_families', 'test_colcon_route', 'test_readme_commands', 'test_readme_flexbe',
+             'test_fleet_hosts'),
+    'netns': ('test_fleet_hosts',),
 }
 FIXTURE_MARKERS = {'ros': 'ros', 'flexbe': 'flexbe', 'flexbe_sources': 'flexbe'}
 

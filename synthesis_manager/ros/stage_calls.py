@@ -10,6 +10,7 @@ these happens (checked at least every WATCH_PERIOD seconds):
 - the stage's time limit passes            -> StageTimeoutError (TIMEOUT)
 - the server shuts down                    -> ServerStoppingError (BEHAVIOR_SYNTHESIS_FAILED)
 - the node serving the stage goes away     -> StageUnavailableError (SERVICE_UNAVAILABLE) naming it
+  (also when a new node took its place: the request went to the one that left)
 
 How the waiting works: rclpy's executor resumes every pending coroutine each time it wakes,
 and a node-wide watchdog timer wakes it every WATCH_PERIOD seconds; a coroutine waits by
@@ -27,6 +28,7 @@ from rclpy.callback_groups import ReentrantCallbackGroup
 from respec.errors import CodedError, ControlFlowSignal, ErrorCode
 
 WATCH_PERIOD = 0.1
+READER_CHECK_PERIOD = 0.5  # seconds between two looks at who receives a pending request
 
 
 class StageFailedError(CodedError):
@@ -99,22 +101,28 @@ class StageCaller:
         """``client``'s response to ``request``, or one of the exceptions above."""
         await self._wait_for_service(client, stage, service_timeout, cancelled)
         provider = self._providers.get(client.srv_name) or self._find_provider(client.srv_name)
+        readers = self._request_readers(client.srv_name)
         future = client.call_async(request)
         deadline = time.monotonic() + timeout
+        next_reader_check = time.monotonic() + READER_CHECK_PERIOD
         while not future.done():
             failure = None
+            now = time.monotonic()
             if self._stopping.is_set():
                 failure = ServerStoppingError(f'{stage}: the server is shutting down', stage)
             elif cancelled():
                 failure = Preempted()
-            elif time.monotonic() > deadline:
+            elif now > deadline:
                 failure = StageTimeoutError(f'{stage}: no answer from {client.srv_name!r} within {timeout:g} s',
                                         client.srv_name)
-            elif not client.service_is_ready():
+            elif not client.service_is_ready() or (
+                    readers and now >= next_reader_check and not readers & self._request_readers(client.srv_name)):
                 self._providers.pop(client.srv_name, None)
                 failure = StageUnavailableError(f'{stage}: node {provider!r} (service '
                                            f'{self.node.resolve_service_name(client.srv_name)!r}) went '
                                            'away before answering', provider)
+            if now >= next_reader_check:
+                next_reader_check = now + READER_CHECK_PERIOD
             if failure is not None:
                 client.remove_pending_request(future)
                 if on_cancel is not None and getattr(failure, 'code', None) != ErrorCode.SERVICE_UNAVAILABLE:
@@ -134,6 +142,18 @@ class StageCaller:
                 raise StageUnavailableError(f'{stage}: service {client.srv_name!r} is not available '
                                        f'(waited {service_timeout:g} s)', client.srv_name)
             await next_executor_turn()
+
+    def _request_readers(self, service_name: str) -> set[bytes]:
+        """The endpoints that receive ``service_name``'s requests now (DDS reader ids).
+
+        A node that died and was started again at once (a restarted host) offers the service
+        again before its old self's lease ends, so the service never looks unavailable; but the
+        request went to the old one, which will never answer. When none of the readers a
+        request was sent to is left, its answer cannot come. (Several servers of one name: each
+        got the request, and any one left may still answer.)
+        """
+        topic = f'rq{self.node.resolve_service_name(service_name)}Request'  # rmw_fastrtps's request topic
+        return {bytes(info.endpoint_gid) for info in self.node.get_subscriptions_info_by_topic(topic, no_mangle=True)}
 
     def _find_provider(self, service_name: str) -> str:
         """The full name of the node serving ``service_name`` (remembered until it goes away)."""

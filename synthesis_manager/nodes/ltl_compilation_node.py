@@ -3,8 +3,8 @@
 Compiling custom formulas is pure Python and takes about 2 s per MB: in the node's process it
 would hold the GIL of a whole suite (20 goals of 4 MB froze ``serve`` for minutes, issue 34
 item 2). A request whose custom formulas add up to over ``SMALL_CUSTOM_BYTES`` is compiled in
-a child process (ltl_synthesizer.isolated), killed at the node's time limit, on a cancel or at
-shutdown; the others (every request without custom formulas) are compiled here at once, so a
+a child process (``synthesis_manager.ros.child_stage``), killed at the node's time or memory
+limit or at shutdown; the others (every request without custom formulas) are compiled here at once, so a
 normal goal never waits behind large ones.
 
 It also serves ``propose_repairs`` (ProposeRepairs): verified changes that make a refused task
@@ -28,13 +28,12 @@ from ltl_specification.provenance import provenance_to_json
 from ltl_specification.repair import TaskRequest
 from ltl_specification.repair_process import RepairSearch, RepairSearchError, repair_settings
 from ltl_synthesizer import SynthesisCancelledError
-from ltl_synthesizer.errors import SynthesisMemoryError
-from ltl_synthesizer.isolated import SERVER_CHILD_NICENESS, SynthesisProcesses
 from respec.errors import ErrorCode
 from respec.robot import SystemCatalog, catalog_to_json
 from respec.robot.files import SystemConfigError
 from respec.naming import DEFAULT_SM_OUTCOMES
 from respec.nesting import run_with_deep_stack
+from synthesis_manager.ros.child_stage import ChildStage, StageStopped
 from synthesis_manager.ros.conversions import error_code, msg_to_sections, sections_to_msg
 from synthesis_manager.limits import check_message, utf8_length
 from synthesis_manager.ros.errors import reported_error
@@ -96,9 +95,9 @@ class LTLCompilationNode(Node):
         self._stopping = threading.Event()
         self.repairs = WorkerPool(self.get_parameter('parallel_repairs').value, 8, name='repair')
         self._repair_searches: set[RepairSearch] = set()
-        self.large = WorkerPool(self.get_parameter('parallel_compilations').value,
-                                self.get_parameter('queued_compilations').value, name='compilation')
-        self.compile_processes = SynthesisProcesses(niceness=SERVER_CHILD_NICENESS, preload='ltl_specification')
+        self.children = ChildStage(self, 'ltl_specification', self.get_parameter('parallel_compilations').value,
+                                   self.get_parameter('queued_compilations').value, name='compilation',
+                                   what='LTL compilation', failed=ErrorCode.LTL_SPEC_COMPILATION_FAILED)
         group = ReentrantCallbackGroup()
         self.create_timer(0.1, lambda: None, callback_group=group)  # waiting requests see their deadline pass
         self.create_service(GenerateLTLSpecification, 'ltl_compilation', self.on_request,
@@ -113,12 +112,12 @@ class LTLCompilationNode(Node):
     def stop_work(self):
         """Stop every compilation in a child process (at shutdown, so the process exits promptly)."""
         self._stopping.set()
-        self.compile_processes.close()
+        self.children.stop()
         for search in list(self._repair_searches):
             search.stop()
 
     def destroy_node(self):
-        self.compile_processes.close()
+        self.children.stop()
         return super().destroy_node()
 
     def catalog(self) -> SystemCatalog:
@@ -137,8 +136,8 @@ class LTLCompilationNode(Node):
 
     async def on_request(self, request, response):
         try:
+            arrival = time.monotonic()
             check_message(request)
-            deadline = time.monotonic() + self.get_parameter('timeout').value
             arguments = (request.system, list(request.initial_conditions), list(request.goals),
                          tuple(request.sm_outcomes) or DEFAULT_SM_OUTCOMES, not request.unordered_goals,
                          msg_to_sections(request.custom_ltl) or None,
@@ -150,21 +149,10 @@ class LTLCompilationNode(Node):
                 sections, provenance = run_with_deep_stack(compiled_sections, *arguments)
             else:
                 try:
-                    sections, provenance = await self.large.run(
-                        self._compile_in_child, arguments, deadline, wake=executor_waker(self),
-                        give_up=lambda: self._stopping.is_set() or time.monotonic() > deadline)
-                except (Abandoned, SynthesisCancelledError):
-                    timed_out = not self._stopping.is_set()
-                    response.error_code = error_code(
-                        ErrorCode.TIMEOUT if timed_out else ErrorCode.PREEMPTED,
-                        f'LTL compilation stopped: {"time limit" if timed_out else "shutdown"} '
-                        f'({self.get_parameter("timeout").value:g} s for {custom_bytes:,} bytes of custom formulas)')
-                    self.get_logger().warning(response.error_code.message)
-                    return response
-                except SynthesisMemoryError as error:
-                    response.error_code = error_code(
-                        ErrorCode.LTL_SPEC_COMPILATION_FAILED,
-                        f'LTL compilation failed: {error} (memory_limit_mb, {custom_bytes:,} bytes of custom formulas)')
+                    sections, provenance = await self.children.run(
+                        _compiled_in_child, arguments, size=f'{custom_bytes:,} bytes of custom formulas', arrival=arrival)
+                except StageStopped as stopped:
+                    response.error_code = stopped.error_code
                     self.get_logger().warning(response.error_code.message)
                     return response
         except Exception as error:  # every failure becomes an error code; the node keeps serving
@@ -175,13 +163,6 @@ class LTLCompilationNode(Node):
         response.provenance = provenance
         response.error_code = error_code()
         return response
-
-    def _compile_in_child(self, arguments, deadline: float):
-        """compiled_sections in a child process, killed at ``deadline`` or at shutdown."""
-        if self._stopping.is_set() or time.monotonic() > deadline:
-            raise SynthesisCancelledError('stopped while waiting')
-        return self.compile_processes.call(_compiled_in_child, arguments, cancel=self._stopping, deadline=deadline,
-                                           memory_limit=self.get_parameter('memory_limit_mb').value * 2**20)
 
     async def on_repair_request(self, request, response):
         """Verified proposals for the request's task (at most ``max_proposals``) as sentences and

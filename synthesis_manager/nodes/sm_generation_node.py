@@ -3,29 +3,25 @@
 Small automata (the tasks' own, a few dozen states) are turned into state machines at once, in
 this process. A large one (a synthesized strategy may have up to the synthesis node's
 ``max_strategy_edges``; 100,000 states took 5.5 s here) is generated in a child process
-(ltl_synthesizer.isolated), within the node's time and memory limits and killed at shutdown,
-so one request can neither hold this process's interpreter for seconds nor grow it without bound.
+(``synthesis_manager.ros.child_stage``), within the node's time and memory limits and killed at
+shutdown, so one request can neither hold this process's interpreter for seconds nor grow it
+without bound.
 """
 
 from __future__ import annotations
 
-import threading
 import time
-
 from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.node import Node
 
-from ltl_synthesizer import SynthesisCancelledError
-from ltl_synthesizer.errors import SynthesisMemoryError, SynthesisTimeoutError
-from ltl_synthesizer.isolated import SERVER_CHILD_NICENESS, SynthesisProcesses
 from respec.errors import ErrorCode
 from sm_generation import generate_state_machine
 from synthesis_manager.limits import check_message
+from synthesis_manager.ros.child_stage import ChildStage, StageStopped
 from synthesis_manager.ros.conversions import error_code, msg_to_automaton, state_to_msg
 from synthesis_manager.ros.errors import reported_error
 from synthesis_manager.ros.node_main import node_main
 from synthesis_manager.ros.qos import service_qos
-from synthesis_manager.ros.worker_pool import Abandoned, WorkerPool, executor_waker
 from synthesis_msgs.srv import GenerateFlexBESM
 
 #: Automata with more states than this are generated in a child process (2,000 chain states
@@ -52,10 +48,9 @@ class SMGenerationNode(Node):
         self.declare_parameter('memory_limit_mb', 2048)
         self.declare_parameter('parallel_generations', 1)
         self.declare_parameter('queued_generations', 50)
-        self._stopping = threading.Event()
-        self.large = WorkerPool(self.get_parameter('parallel_generations').value,
-                                self.get_parameter('queued_generations').value, name='generation')
-        self.generation_processes = SynthesisProcesses(niceness=SERVER_CHILD_NICENESS, preload='sm_generation')
+        self.children = ChildStage(self, 'sm_generation', self.get_parameter('parallel_generations').value,
+                                   self.get_parameter('queued_generations').value, name='generation',
+                                   what='state machine generation', failed=ErrorCode.SM_GENERATION_FAILED)
         group = ReentrantCallbackGroup()
         self.create_timer(0.1, lambda: None, callback_group=group)  # waiting requests see their deadline pass
         self.create_service(GenerateFlexBESM, 'sm_generate', self.on_request,
@@ -63,19 +58,18 @@ class SMGenerationNode(Node):
 
     def stop_work(self):
         """Stop every generation in a child process (at shutdown, so the process exits promptly)."""
-        self._stopping.set()
-        self.generation_processes.close()
+        self.children.stop()
 
     def destroy_node(self):
-        self.generation_processes.close()
+        self.children.stop()
         return super().destroy_node()
 
     async def on_request(self, request, response):
         try:
             # No list or whole-message bound: the automaton is a synthesis result, as large as the
             # specification makes it (its strings and names are still checked).
+            arrival = time.monotonic()
             check_message(request, max_list=None, max_total=None)
-            deadline = time.monotonic() + self.get_parameter('timeout').value
             arguments = (msg_to_automaton(request.automaton), request.system)
             options = {'config_dir': self.get_parameter('config_dir').value or None,
                        'initial_conditions': list(request.initial_conditions) or None,
@@ -84,22 +78,11 @@ class SMGenerationNode(Node):
                 states = generate_state_machine(*arguments, **options)
             else:
                 try:
-                    states = await self.large.run(
-                        self._generate_in_child, arguments, options, deadline, wake=executor_waker(self),
-                        give_up=lambda: self._stopping.is_set() or time.monotonic() > deadline)
-                except (Abandoned, SynthesisCancelledError, SynthesisTimeoutError):
-                    timed_out = not self._stopping.is_set()
-                    response.error_code = error_code(
-                        ErrorCode.TIMEOUT if timed_out else ErrorCode.PREEMPTED,
-                        f'state machine generation stopped: {"time limit" if timed_out else "shutdown"} '
-                        f'({self.get_parameter("timeout").value:g} s for {len(request.automaton.automaton):,} automaton states)')
-                    self.get_logger().warning(response.error_code.message)
-                    return response
-                except SynthesisMemoryError as error:
-                    response.error_code = error_code(
-                        ErrorCode.SM_GENERATION_FAILED,
-                        f'state machine generation failed: {error} (memory_limit_mb, '
-                        f'{len(request.automaton.automaton):,} automaton states)')
+                    states = await self.children.run(generate_state_machine, arguments, options,
+                                                     size=f'{len(request.automaton.automaton):,} automaton states',
+                                                     arrival=arrival)
+                except StageStopped as stopped:
+                    response.error_code = stopped.error_code
                     self.get_logger().warning(response.error_code.message)
                     return response
         except Exception as error:  # every failure becomes an error code; the node keeps serving
@@ -109,16 +92,6 @@ class SMGenerationNode(Node):
         response.state_definition = [state_to_msg(state) for state in states]
         response.error_code = error_code()
         return response
-
-    def _generate_in_child(self, arguments, options: dict, deadline: float):
-        """generate_state_machine in a child process, killed at ``deadline``, beyond the memory
-        limit or at shutdown."""
-        if self._stopping.is_set() or time.monotonic() > deadline:
-            raise SynthesisCancelledError('stopped while waiting')
-        return self.generation_processes.call(
-            generate_state_machine, arguments, options, cancel=self._stopping, deadline=deadline,
-            memory_limit=self.get_parameter('memory_limit_mb').value * 2**20)
-
 
 
 def main():

@@ -204,7 +204,7 @@ def test_a_large_generation_stops_at_its_time_and_memory_limits(ros):
     late = generate(message)
     assert late.error_code.value == late.error_code.TIMEOUT, late.error_code.message
     assert '0.5 s for 40,002 automaton states' in late.error_code.message
-    assert time.monotonic() - started < 0.5 + 3.0
+    assert time.monotonic() - started < 0.5 + 6.0  # sending and converting 40,002 states, on a loaded machine
     assert generate(chain_automaton_message(3)[0]).error_code.value == 1
 
 

@@ -42,6 +42,9 @@ def run_and_check(states, robot, simulator, system: RobotSystem, spec: GR1Specif
                   run_machine: Callable[[Callable], ExecutionResult] | None = None) -> CheckedRun:
     """Run ``states`` on ``robot`` (driving ``simulator``), then check and plot the run.
 
+    The simulator's incidents (the robot's body in furniture, a fall) go into the trace, so the
+    check reports them as violations.
+
     With ``record_dir``, key frames go to ``record_dir/frames`` and the timeline to
     ``record_dir/timeline.png``. ``view`` is what the frame recorder watches (default: the
     simulator; see ``DeferredEvents`` when another thread steps it: its ``replay()`` runs every
@@ -80,6 +83,7 @@ def run_and_check(states, robot, simulator, system: RobotSystem, spec: GR1Specif
                 recorder.capture('end')
             recorder.close()
     wall_seconds = time.monotonic() - started
+    result.trace.incidents = [incident.to_dict() for incident in simulator.incidents]
     check = check_trace(result.trace, spec, goals=list(goals), ordered=ordered)
     run = CheckedRun(result, check, wall_seconds, frames=list(recorder.paths) if recorder else [])
     if record_dir is not None:

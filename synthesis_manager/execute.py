@@ -298,6 +298,7 @@ def print_run(run, check, fallen: bool, wall: float, stream=sys.stdout) -> None:
     print('trace:', file=stream)
     for step in run.trace.steps:
         results = ', '.join(f"{r['capability']} {r['outcome']}" + (' (abandoned)' if r['abandoned'] else '')
+                            + (f" ({r['reason']})" if r['outcome'] != 'completed' and r.get('reason') else '')
                             for r in step.results) or '-'
         print(f'  {step.index:3d}  {step.entered_at:7.2f}-{step.ended_at:7.2f} s  {step.state:<28} '
               f'[{", ".join(step.activated)}]  {results}  => {step.state_outcome} -> {step.transition}',

@@ -45,8 +45,9 @@ def run_and_check(states, robot, simulator, system: RobotSystem, spec: GR1Specif
     The simulator's incidents (the robot's body in furniture, a fall) go into the trace, so the
     check reports them as violations.
 
-    With ``record_dir``, key frames go to ``record_dir/frames`` and the timeline to
-    ``record_dir/timeline.png``. ``view`` is what the frame recorder watches (default: the
+    With ``record_dir``, frames go to ``record_dir/frames`` (key moments, and the motion at
+    ``MOTION_FPS`` frames per robot second; each file name carries its robot time, see
+    ``KeyFrameRecorder``) and the timeline to ``record_dir/timeline.png``. ``view`` is what the frame recorder watches (default: the
     simulator; see ``DeferredEvents`` when another thread steps it: its ``replay()`` runs every
     tick) and ``lock`` guards rendering. ``on_progress(steps, frames)`` follows every control
     tick. ``run_machine(on_tick) -> ExecutionResult`` runs the machine on another engine (default:
@@ -65,6 +66,9 @@ def run_and_check(states, robot, simulator, system: RobotSystem, spec: GR1Specif
     def tick(_robot):
         if view is not None and hasattr(view, 'replay'):
             view.replay()
+        if recorder is not None:
+            with lock:
+                recorder.capture_motion()
         if on_progress is not None and executive is not None:
             on_progress(executive.trace.steps, list(recorder.paths) if recorder else [])
 

@@ -51,7 +51,7 @@ MODULE_MARKERS = {
     'mujoco': ('test_atlas_sim_closed_loop', 'test_atlas_sim_engine_trace', 'test_atlas_sim_executor',
                'test_atlas_sim_operator_data', 'test_atlas_sim_rendering', 'test_atlas_sim_simulator',
                'test_atlas_sim_closed_loop_ros', 'test_atlas_sim_node', 'test_flexbe_engine', 'test_readme_flexbe',
-               'test_atlas_sim_obstacles'),
+               'test_atlas_sim_obstacles', 'test_atlas_sim_motion_frames'),
     'ros': ('test_colcon_route', 'test_flexbe_engine', 'test_flexbe_onboard', 'test_flexbe_states', 'test_flexbe_webui',
             'test_cnu_capabilities', 'test_readme_commands', 'test_readme_flexbe'),
     'slow': ('test_bench_gr1_families', 'test_colcon_route', 'test_readme_commands', 'test_readme_flexbe'),

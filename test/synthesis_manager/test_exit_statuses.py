@@ -25,6 +25,7 @@ README = Path(__file__).resolve().parents[2] / 'README.md'
 
 
 def started_server(command, environment):
+    """``command`` started and ready; ``process.ready_line`` is the line that said so."""
     arguments = ['--port', '0'] if command == 'gui' else []
     process = subprocess.Popen(CLI + [command, *arguments], env=environment, stdout=subprocess.PIPE,
                                stderr=subprocess.STDOUT, text=True)
@@ -33,6 +34,7 @@ def started_server(command, environment):
     while READY[command] not in line and time.monotonic() < deadline:
         line = process.stdout.readline()
         assert line or process.poll() is None, f'{command} ended before it was ready'
+    process.ready_line = line
     return process
 
 
@@ -87,3 +89,36 @@ def test_record_with_the_flexbe_engine_is_still_a_bad_command_line():
     run = subprocess.run(CLI + ['execute', '--engine', 'flexbe', '--record', 'out', '--goals', 'look_down'],
                          capture_output=True, text=True, timeout=120)
     assert run.returncode == ExitStatus.USAGE and '--record is not available with --engine flexbe' in run.stderr
+
+
+@pytest.mark.parametrize('stop_signal', [signal.SIGINT, signal.SIGTERM], ids=['SIGINT', 'SIGTERM'])
+def test_a_gui_stopped_in_the_middle_of_a_simulation_exits_within_three_seconds(stop_signal):
+    """The issue saw the GUI take 3-8 s to stop; a running simulation (a child process
+    filming the robot) must not hold it up."""
+    import httpx
+
+    with reserve_domain_id() as domain:
+        process = started_server('gui', prepare_ros_environment(domain, environ=dict(os.environ)))
+        try:
+            url = re.search(r'(http://\S+/)', process.ready_line).group(1)
+            job = httpx.post(f'{url}api/jobs', json={'system': 'atlas', 'initial_conditions': ['stand_prep'],
+                                                     'goals': ['look_down', 'approach_object', 'pickup_object']})
+            job_id = job.json()['id']
+            while httpx.get(f'{url}api/jobs/{job_id}').json()['state'] != 'finished':
+                time.sleep(0.1)
+            simulation = httpx.post(f'{url}api/jobs/{job_id}/simulations', json={}).json()['id']
+            deadline = time.monotonic() + 120
+            while len(httpx.get(f'{url}api/simulations/{simulation}').json()['frames']) < 20:
+                assert time.monotonic() < deadline, 'the simulation recorded no frames'
+                time.sleep(0.1)
+            assert httpx.get(f'{url}api/simulations/{simulation}').json()['state'] != 'finished'
+            signalled = time.monotonic()
+            process.send_signal(stop_signal)
+            status = process.wait(30)
+            seconds = time.monotonic() - signalled
+        finally:
+            if process.poll() is None:
+                process.kill()
+                process.wait()
+    assert status == 128 + stop_signal
+    assert seconds < STOP_WITHIN, f'the GUI took {seconds:.2f} s to stop after {stop_signal.name}'

@@ -9,7 +9,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Dict, Iterable, List, Mapping, Optional, Tuple
+from typing import Iterable, List, Mapping, Optional, Tuple
 
 import mujoco
 import numpy as np
@@ -81,8 +81,9 @@ class HumanoidPhysics:
         robot_bodies = self._subtree(self._pelvis)
         touching = set().union(*(self._subtree(self._body_id(name)) for name in TOUCHING_BODIES))
         geom_body = self.model.geom_bodyid
-        self._robot_geoms = [g for g in range(self.model.ngeom) if geom_body[g] in robot_bodies]
-        self._colliding_robot_geoms = {g for g in self._robot_geoms if geom_body[g] not in touching}
+        #: the robot's geoms that must not touch furniture (all but the hands')
+        self._colliding_robot_geoms = {g for g in range(self.model.ngeom)
+                                       if geom_body[g] in robot_bodies and geom_body[g] not in touching}
         #: furniture: colliding geoms of the scene on bodies of their own (not the robot, not the floor)
         self._furniture_geoms = {
             g for g in range(self.model.ngeom)

@@ -42,8 +42,12 @@ def run_and_check(states, robot, simulator, system: RobotSystem, spec: GR1Specif
                   run_machine: Callable[[Callable], ExecutionResult] | None = None) -> CheckedRun:
     """Run ``states`` on ``robot`` (driving ``simulator``), then check and plot the run.
 
-    With ``record_dir``, key frames go to ``record_dir/frames`` and the timeline to
-    ``record_dir/timeline.png``. ``view`` is what the frame recorder watches (default: the
+    The simulator's incidents (the robot's body in furniture, a fall) go into the trace, so the
+    check reports them as violations.
+
+    With ``record_dir``, frames go to ``record_dir/frames`` (key moments, and the motion at
+    ``MOTION_FPS`` frames per robot second; each file name carries its robot time, see
+    ``KeyFrameRecorder``) and the timeline to ``record_dir/timeline.png``. ``view`` is what the frame recorder watches (default: the
     simulator; see ``DeferredEvents`` when another thread steps it: its ``replay()`` runs every
     tick) and ``lock`` guards rendering. ``on_progress(steps, frames)`` follows every control
     tick. ``run_machine(on_tick) -> ExecutionResult`` runs the machine on another engine (default:
@@ -62,6 +66,9 @@ def run_and_check(states, robot, simulator, system: RobotSystem, spec: GR1Specif
     def tick(_robot):
         if view is not None and hasattr(view, 'replay'):
             view.replay()
+        if recorder is not None:
+            with lock:
+                recorder.capture_motion()
         if on_progress is not None and executive is not None:
             on_progress(executive.trace.steps, list(recorder.paths) if recorder else [])
 
@@ -80,6 +87,7 @@ def run_and_check(states, robot, simulator, system: RobotSystem, spec: GR1Specif
                 recorder.capture('end')
             recorder.close()
     wall_seconds = time.monotonic() - started
+    result.trace.incidents = [incident.to_dict() for incident in simulator.incidents]
     check = check_trace(result.trace, spec, goals=list(goals), ordered=ordered)
     run = CheckedRun(result, check, wall_seconds, frames=list(recorder.paths) if recorder else [])
     if record_dir is not None:

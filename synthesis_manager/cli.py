@@ -5,8 +5,8 @@ and ``run(args) -> int``; modules are imported only when their subcommand is bui
 ``--help`` stays fast.
 
 SIGTERM stops a command as Ctrl-C (SIGINT) does: a client cancels its goal, an in-process
-suite shuts down, and the command exits with 128 + the signal's number (130, 143).
-Servers (``serve``, ``gui``) handle both signals themselves and exit with 0.
+suite or a server (``serve``, ``gui``) shuts down, and the command exits with 128 + the
+signal's number (130, 143), as README's status table and every ``--help`` say.
 """
 
 from __future__ import annotations
@@ -81,10 +81,12 @@ def main(argv: list[str] | None = None) -> int:
         use_demo_goals_unless_given(args, args.command)
     with stop_signals_interrupt() as received:
         try:
-            return args.run(args)
+            status = args.run(args)
         except KeyboardInterrupt:
             print(f'\nbehavior-synthesis {args.command}: interrupted', file=sys.stderr)
             return 128 + (received[-1] if received else signal.SIGINT)
+    # a server ends its run normally once a signal has stopped it: the signal still says why
+    return 128 + received[-1] if received else status
 
 
 def split_ros_arguments(argv: list[str]) -> tuple[list[str], list[str]]:

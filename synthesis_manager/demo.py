@@ -18,7 +18,8 @@ from synthesis_manager.suite import SuiteUnavailableError, add_suite_arguments, 
 
 
 def add_arguments(parser):
-    parser.epilog = exit_status_help(ExitStatus.OK, ExitStatus.FAILED, ExitStatus.TIMED_OUT, ExitStatus.UNAVAILABLE)
+    parser.epilog = exit_status_help(ExitStatus.OK, ExitStatus.FAILED, ExitStatus.USAGE, ExitStatus.TIMED_OUT,
+                                     ExitStatus.UNAVAILABLE)
     add_goal_arguments(parser, with_options=False)
     parser.set_defaults(name='demo')
     add_suite_arguments(parser)

@@ -8,7 +8,7 @@ executed trace is checked against the returned specification.
     behavior-synthesis execute --initial-conditions stand_prep --goals look_down,pickup_object
     behavior-synthesis execute --goals pickup_object --fail pickup_object --expect failed
     behavior-synthesis execute --goals pickup_object --sm-outcomes finished --fail-first pickup_object:2
-    behavior-synthesis execute --json --record out/run      # PNG key frames + timeline.png
+    behavior-synthesis execute --json --record out/run      # PNG frames (motion, key moments) + timeline.png
 
 Mission mode: ``--then GOALS`` (repeatable) adds goal batches, run one after another on the
 same simulated robot; each is synthesized from where the previous one left the robot (also
@@ -83,7 +83,8 @@ def add_arguments(parser):
     group.add_argument('--json', action='store_true',
                        help='print {"outcome", "trace", "trace_check", "fallen", ...} as one JSON object')
     group.add_argument('--record', metavar='DIR',
-                       help='save PNG frames of key moments and timeline.png in DIR')
+                       help='save PNG frames of the motion (16 per robot second) and of key moments, and '
+                            'timeline.png, in DIR')
 
 
 def run(args) -> int:
@@ -95,10 +96,13 @@ def run(args) -> int:
     from respec.robot.files import SystemConfigError
 
     if args.engine == 'flexbe':
-        problem = _flexbe_usage_problem(args)
-        if problem:
-            print(f'execute: {problem}', file=sys.stderr)
+        if args.record:
+            print('execute: --record is not available with --engine flexbe', file=sys.stderr)
             return ExitStatus.USAGE
+        missing = _missing_flexbe_engine()
+        if missing:  # the command line is fine: a program it needs is not installed
+            print(f'execute: {missing}', file=sys.stderr)
+            return ExitStatus.UNAVAILABLE
     if args.record:
         os.environ.setdefault('MUJOCO_GL', 'egl')  # before anything imports mujoco
     initial_conditions = parse_names(args.initial_conditions)
@@ -120,9 +124,8 @@ def run(args) -> int:
     return code
 
 
-def _flexbe_usage_problem(args) -> str:
-    if args.record:
-        return '--record is not available with --engine flexbe'
+def _missing_flexbe_engine() -> str:
+    """Why the FlexBE engine cannot run here ('' when flexbe_core imports)."""
     try:
         import flexbe_core  # noqa: F401
     except ImportError as error:
@@ -298,6 +301,7 @@ def print_run(run, check, fallen: bool, wall: float, stream=sys.stdout) -> None:
     print('trace:', file=stream)
     for step in run.trace.steps:
         results = ', '.join(f"{r['capability']} {r['outcome']}" + (' (abandoned)' if r['abandoned'] else '')
+                            + (f" ({r['reason']})" if r['outcome'] != 'completed' and r.get('reason') else '')
                             for r in step.results) or '-'
         print(f'  {step.index:3d}  {step.entered_at:7.2f}-{step.ended_at:7.2f} s  {step.state:<28} '
               f'[{", ".join(step.activated)}]  {results}  => {step.state_outcome} -> {step.transition}',

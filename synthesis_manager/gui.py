@@ -110,14 +110,18 @@ class GuiServer(uvicorn.Server):
     ``on_stop`` runs first: the backend cancels its jobs and ends the event streams, which
     uvicorn's graceful shutdown would otherwise wait for. uvicorn raises the signals it
     caught again once it has stopped, and a second SIGTERM would kill the process before
-    its ROS side is shut down; here the signal has done its job and is not raised again.
+    its ROS side is shut down; here the signal has done its job and is not raised again,
+    and ``stopped_by`` keeps it for the exit status (128 + its number).
     """
 
     def __init__(self, config: uvicorn.Config, on_stop=None):
         super().__init__(config)
         self.on_stop = on_stop
+        self.stopped_by: int | None = None
 
     def handle_exit(self, sig, frame):
+        if self.stopped_by is None:
+            self.stopped_by = int(sig)
         if self.on_stop is not None:
             self.on_stop()
         super().handle_exit(sig, frame)
@@ -184,6 +188,8 @@ def run(args) -> int:
                 print(f'behavior synthesis GUI: http://{shown}:{port}/ ({backend.description}); '
                       'Ctrl-C to stop', flush=True)
                 server.run(sockets=[sock])
-        except KeyboardInterrupt:
+                if server.stopped_by is not None:
+                    return 128 + server.stopped_by
+        except KeyboardInterrupt:  # a signal before the server ran: cli.main exits with 128 + it
             pass
     return ExitStatus.OK

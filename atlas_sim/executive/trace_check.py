@@ -53,23 +53,30 @@ class TraceStep:
 
 @dataclass
 class Trace:
-    """A run: its steps and the SM outcome it ended in (None if it broke off)."""
+    """A run: its steps and the SM outcome it ended in (None if it broke off).
+
+    ``incidents``: what happened physically that should not (dicts with ``kind`` -- ``contact``
+    for the robot's body touching furniture, ``fall`` --, the robot ``time`` and a ``message``;
+    ``atlas_sim.simulator.atlas_simulator.Incident``). The check reports each as a violation.
+    """
 
     steps: list[TraceStep] = field(default_factory=list)
     outcome: str | None = None
     sm_outcome_propositions: dict[str, str] = field(
         default_factory=lambda: dict(DEFAULT_SM_OUTCOME_PROPOSITIONS))
+    incidents: list[dict] = field(default_factory=list)
 
     def to_dict(self) -> dict:
         return {'outcome': self.outcome, 'sm_outcome_propositions': dict(self.sm_outcome_propositions),
-                'steps': [asdict(step) for step in self.steps]}
+                'steps': [asdict(step) for step in self.steps], 'incidents': [dict(i) for i in self.incidents]}
 
     @classmethod
     def from_dict(cls, data: dict) -> Trace:
         return cls(steps=[TraceStep.from_dict(s) for s in data.get('steps', [])],
                    outcome=data.get('outcome'),
                    sm_outcome_propositions=dict(data.get('sm_outcome_propositions')
-                                                or DEFAULT_SM_OUTCOME_PROPOSITIONS))
+                                                or DEFAULT_SM_OUTCOME_PROPOSITIONS),
+                   incidents=[dict(i) for i in data.get('incidents', [])])
 
 
 class OutcomeTracker:
@@ -144,7 +151,7 @@ def least_violating_assignments(formulas, current: dict, next_known: dict, unkno
 
 @dataclass
 class Violation:
-    kind: str              # env_init, sys_init, env_trans, sys_trans, goal_order
+    kind: str              # env_init, sys_init, env_trans, sys_trans, goal_order, contact, fall
     step: int | None       # trace step during which it happened (None: before the first)
     transition: str        # 'start -> /look_down', '/look_down -> /manipulate', '/x -> finished'
     formulas: list[str]    # the violated formulas (infix)
@@ -196,6 +203,7 @@ def check_trace(trace: Trace, spec: GR1Specification, goals: list[str] | None = 
         remembered(p) for p in spec.sys_props if remembered(p)]
     completed_at, goal_violations = check_goal_order(trace, goals, ordered)
     violations.extend(goal_violations)
+    violations.extend(incident_violations(trace))
     return TraceCheckReport(ok=not violations, outcome=trace.outcome, violations=violations,
                             goals=goals, goals_completed_at=completed_at,
                             positions=len(checker.positions))
@@ -233,6 +241,27 @@ def check_goal_order(trace: Trace, goals: list[str], ordered: bool = True):
                 f'the run ended in {trace.outcome!r} but goal(s) {", ".join(missing)} were never '
                 f'completed{order}'))
     return completed_at, violations
+
+
+def incident_violations(trace: Trace) -> list[Violation]:
+    """Each physical incident of the run (the robot's body in furniture, a fall) as a violation
+    at the step that was running then: the specification speaks of outcomes only, so a run
+    through a table would pass it; the robot's physics must answer for what the formulas cannot."""
+    violations = []
+    for incident in trace.incidents:
+        step = step_at(trace, float(incident.get('time', 0.0)))
+        violations.append(Violation(str(incident.get('kind', 'incident')), step.index if step else None,
+                                    step.state if step else 'start', [], str(incident.get('message', ''))))
+    return violations
+
+
+def step_at(trace: Trace, time: float) -> TraceStep | None:
+    """The step running at robot ``time`` (the last one entered by then; None: before the first)."""
+    running = None
+    for step in trace.steps:
+        if step.entered_at <= time + 1e-9:
+            running = step
+    return running
 
 
 class _Checker:
@@ -422,5 +451,5 @@ def valuations_of_trace(trace: Trace, spec: GR1Specification) -> list[dict[str, 
 
 
 __all__ = ['Trace', 'TraceStep', 'OutcomeTracker', 'TraceError', 'TraceCheckReport', 'Violation',
-           'check_trace', 'check_goal_order', 'partial_evaluate', 'least_violating_assignments',
+           'check_trace', 'check_goal_order', 'incident_violations', 'step_at', 'partial_evaluate', 'least_violating_assignments',
            'valuations_of_trace']

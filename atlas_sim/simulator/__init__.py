@@ -21,7 +21,7 @@ Modules (MuJoCo is imported only by ``physics``, ``atlas_simulator``, ``renderin
 ``physics``     ``HumanoidPhysics``: model loading, targets, fall detection.
 ``atlas_simulator`` ``AtlasSimulator``, ``Request``, ``RequestResult``.
 ``operator_data`` the data operator inputs provide (template id, target pose) and its checks.
-``rendering``   ``FrameRenderer``, ``KeyFrameRecorder``, ``save_png``.
+``rendering``   ``FrameRenderer``, ``KeyFrameRecorder`` (key moments and motion frames), ``save_png``.
 ``factory``     ``make_simulator``, ``parse_faults``.
 ``node_names``  the ROS names the simulator node serves it under (shared with the FlexBE states).
 

@@ -50,6 +50,25 @@ from .physics import MODEL_PATH, FallCriteria, HumanoidPhysics
 
 
 @dataclass(frozen=True)
+class Incident:
+    """Something physical that should not happen: the robot touched furniture with its body
+    (``kind`` ``contact``; ``part`` and ``obstacle`` are the bodies) or fell (``fall``).
+
+    Runs carry them into their trace (``Trace.incidents``), where the trace check reports
+    each as a violation: a run that went through a table is not a correct run."""
+
+    kind: str
+    time: float
+    message: str
+    part: str = ""
+    obstacle: str = ""
+
+    def to_dict(self) -> Dict[str, Any]:
+        return {"kind": self.kind, "time": round(self.time, 4), "message": self.message,
+                "part": self.part, "obstacle": self.obstacle}
+
+
+@dataclass(frozen=True)
 class RequestResult:
     """Final outcome of one request."""
 
@@ -93,6 +112,11 @@ class Request:
 
 
 Listener = Callable[[str, Request], None]
+
+
+#: How far a walk may sidestep to pass beside furniture (m), and in what increments.
+MAX_DETOUR = 1.0
+DETOUR_STEP = 0.1
 
 
 class AtlasSimulator:
@@ -185,6 +209,10 @@ class AtlasSimulator:
         self._ids = itertools.count(1)
         self._fallen = False
         self._fall_reason = ""
+        #: physical incidents, in order: the first contact of each robot part with each piece of
+        #: furniture, and the fall
+        self.incidents: List[Incident] = []
+        self._touched: set = set()
         self._pace_anchor: Optional[tuple] = None
         self._push_until: Optional[tuple] = None
 
@@ -288,7 +316,7 @@ class AtlasSimulator:
         now = self.time
         motion = None if refusal else self._motion_for(name)
         if motion is not None:
-            refusal = self._busy_reason(motion)
+            refusal = self._busy_reason(motion) or self._path_refusal(name, motion)
         request = Request(next(self._ids), name, now, motion)
         if refusal:
             request.result = RequestResult(name, FAILED, refusal, now, now)
@@ -323,6 +351,33 @@ class AtlasSimulator:
                 return f"busy: {', '.join(sorted(shared))} used by {other.name}"
         return None
 
+    def _path_refusal(self, name: str, motion: Motion) -> Optional[str]:
+        """Plan a walk around furniture in its way; why it cannot go (None: it can).
+
+        A walk whose straight way comes within ``scene.clearance`` of furniture first sidesteps
+        (left and right in turn, 0.1 m more each time, up to ``MAX_DETOUR``) to where both the
+        sidestep and the walk on are free; when no such detour exists it fails, naming the
+        furniture (the robot must never walk into it)."""
+        scene = self.settings.scene
+        if motion.advance <= 0 or not scene.look_ahead:
+            return None
+        obstacle = self.physics.obstacle_ahead(motion.advance, scene.clearance)
+        if obstacle is None:
+            return None
+        for tenths in range(1, round(MAX_DETOUR / DETOUR_STEP) + 1):
+            for side in (1, -1):
+                detour = side * tenths * DETOUR_STEP
+                # a sidestep keeps the gap the robot has ahead: only what is beside it counts
+                sideways = self.physics.obstacle_ahead(abs(detour), scene.clearance, turn=side * np.pi / 2,
+                                                       side_margin=0.0)
+                if sideways is None and self.physics.obstacle_ahead(motion.advance, scene.clearance,
+                                                                    shift=detour) is None:
+                    motion.plan_detour(detour)
+                    return None
+        return (f"{name}: the way is blocked by {obstacle.body} ({obstacle.free_distance:.2f} m free ahead, "
+                f"the walk needs {motion.advance:.2f} m and {scene.clearance:.2f} m clearance; no detour "
+                f"within {MAX_DETOUR:.1f} m to either side)")
+
     @staticmethod
     def _plan_failure(request: Request, when: float, reason: str) -> None:
         request.fail_at = when
@@ -354,9 +409,11 @@ class AtlasSimulator:
         if self._push_until and self.time >= self._push_until[1] - 1e-9:
             self.physics.set_external_force(self._push_until[0], (0.0, 0.0, 0.0))
             self._push_until = None
+        self._record_contacts()
         if not self._fallen and self.physics.has_fallen():
             self._fallen = True
             self._fall_reason = self.physics.fall_reason()
+            self.incidents.append(Incident("fall", self.time, self._fall_reason))
         for request in list(self._running):
             if self._fallen:
                 finished.append(self._finish(request, FAILED, self._fall_reason))
@@ -368,6 +425,16 @@ class AtlasSimulator:
             self.physics.carry_object()
         self._pace()
         return finished
+
+    def _record_contacts(self) -> None:
+        """An incident for the first contact of each robot part with each piece of furniture."""
+        for part, obstacle in self.physics.obstacle_contacts():
+            if (part, obstacle) in self._touched:
+                continue
+            self._touched.add((part, obstacle))
+            running = ", ".join(r.name for r in self._running) or "no request"
+            self.incidents.append(Incident(
+                "contact", self.time, f"the robot's {part} ran into {obstacle} (during {running})", part, obstacle))
 
     def _check_settled(self, request: Request) -> Optional[RequestResult]:
         motion = request.motion

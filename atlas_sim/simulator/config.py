@@ -30,6 +30,8 @@ Two sections of the system file (``config/<system>.yaml``) matter here:
       scene:                        # objects by template id, reach (see atlas_sim.simulator.operator_data)
         objects: {1: pickup_object}
         reach: 1.0
+        look_ahead: true            # walks look for furniture in their way first (SceneConfig)
+        clearance: 0.02             # how close (m) a walk may come to furniture
       faults:                       # capability -> fault (see atlas_sim.simulator.faults)
         pickup_object: {fail_first: 1}
       stand_in: "..."               # set when the humanoid does not model this robot but only
@@ -82,15 +84,22 @@ class ScenarioConfig:
 
 @dataclass(frozen=True)
 class SceneConfig:
-    """The objects the robot can act on, by template id (see atlas_sim.simulator.operator_data), and its reach (m)."""
+    """The objects the robot can act on, by template id (see atlas_sim.simulator.operator_data), and its reach (m).
+
+    ``look_ahead``: a walk first looks for furniture in its way and fails at once, naming it,
+    when it would come within ``clearance`` metres of it (false: the robot walks blind and
+    runs into it; the contact is reported and the trace check counts it as a violation).
+    """
 
     objects: Dict[int, str] = field(default_factory=lambda: {1: "pickup_object"})
     reach: float = 1.0
+    look_ahead: bool = True
+    clearance: float = 0.02
 
     @classmethod
     def from_dict(cls, section: Optional[Mapping[str, Any]]) -> "SceneConfig":
         section = dict(section or {})
-        unknown = set(section) - {"objects", "reach"}
+        unknown = set(section) - {"objects", "reach", "look_ahead", "clearance"}
         if unknown:
             raise SimulationConfigError(f"unknown keys in simulation.scene: {sorted(unknown)}",
                                         item=sorted(unknown)[0])
@@ -104,7 +113,15 @@ class SceneConfig:
         if isinstance(reach, bool) or not isinstance(reach, (int, float)) or not reach > 0:
             raise SimulationConfigError(f"simulation.scene.reach must be a positive number, got {reach!r}",
                                         item="scene.reach")
-        return cls(objects=objects, reach=float(reach))
+        clearance = section.get("clearance", cls.clearance)
+        if isinstance(clearance, bool) or not isinstance(clearance, (int, float)) or not clearance >= 0:
+            raise SimulationConfigError(f"simulation.scene.clearance must be a number >= 0, got {clearance!r}",
+                                        item="scene.clearance")
+        look_ahead = section.get("look_ahead", cls.look_ahead)
+        if not isinstance(look_ahead, bool):
+            raise SimulationConfigError(f"simulation.scene.look_ahead must be true or false, got {look_ahead!r}",
+                                        item="scene.look_ahead")
+        return cls(objects=objects, reach=float(reach), look_ahead=look_ahead, clearance=float(clearance))
 
 
 @dataclass(frozen=True)

@@ -75,6 +75,11 @@ class Motion:
         return joints_of(self.groups)
 
     @property
+    def advance(self) -> float:
+        """How far (m) the motion carries the robot along its heading (0: it stays put)."""
+        return 0.0
+
+    @property
     def moves_base(self) -> bool:
         """Whether the floating base must come to rest before the motion settles."""
         return bool(self.groups & {"legs", BASE_GROUP})
@@ -134,25 +139,27 @@ class KeyframeMotion(Motion):
 
 @dataclass(frozen=True)
 class _GaitPhase:
-    """One phase of a gait: the pelvis moves between two (forward, height)
-    points while at most one foot swings between two forward positions."""
+    """One phase of a gait: the pelvis moves between two (forward, lateral, height) points while
+    at most one foot swings between two (forward, lateral) footholds."""
 
     duration: float
-    pelvis_from: Tuple[float, float]
-    pelvis_to: Tuple[float, float]
+    pelvis_from: Tuple[float, float, float]
+    pelvis_to: Tuple[float, float, float]
     swing_side: Optional[str] = None
-    foot_from: float = 0.0
-    foot_to: float = 0.0
+    foot_from: Tuple[float, float] = (0.0, 0.0)
+    foot_to: Tuple[float, float] = (0.0, 0.0)
 
 
 class GaitMotion(Motion):
-    """Steps (in place or forwards along the robot's heading).
+    """Steps (in place or forwards along the robot's heading), after sidesteps around furniture.
 
     The pelvis follows the planned path through the balance-assist weld; the
     legs get joint targets from inverse kinematics so that the stance foot
     stays put and the swing foot lifts and lands on its next foothold.  Feet
     land ``step_length / 2`` ahead of the pelvis, and a closing step brings the
-    feet side by side, so the gait ends in the stand posture.
+    feet side by side, so the gait ends in the stand posture. A ``detour`` (metres to the
+    left, negative: right; ``plan_detour``) first moves the robot sideways in steps of at most
+    ``sidestep`` metres, the foot on that side leading, so the walk passes beside an obstacle.
     """
 
     kind = "gait"
@@ -167,6 +174,7 @@ class GaitMotion(Motion):
         transfer_duration: float = 0.5,
         walk_hip_height: float = HIP_HEIGHTS["walk"],
         final_hip_height: float = HIP_HEIGHTS["stand"],
+        sidestep: float = 0.1,
     ):
         self.geometry = geometry
         self.steps = int(steps)
@@ -176,10 +184,26 @@ class GaitMotion(Motion):
         self.transfer_duration = float(transfer_duration)
         self.walk_hip_height = float(walk_hip_height)
         self.final_hip_height = float(final_hip_height)
-        closing = 1 if self.step_length != 0.0 else 0
-        duration = 2 * self.transfer_duration + (self.steps + closing) * self.step_duration
-        super().__init__(duration, groups=("legs", "torso", BASE_GROUP))
+        self.sidestep = float(sidestep)
+        self.detour = 0.0
+        super().__init__(self._duration(), groups=("legs", "torso", BASE_GROUP))
         self._phases: List[_GaitPhase] = []
+
+    def _sidesteps(self) -> int:
+        return math.ceil(abs(self.detour) / self.sidestep - 1e-9) if self.detour else 0
+
+    def _duration(self) -> float:
+        closing = 1 if self.step_length != 0.0 else 0
+        return 2 * self.transfer_duration + (2 * self._sidesteps() + self.steps + closing) * self.step_duration
+
+    @property
+    def advance(self) -> float:
+        return self.steps * self.step_length
+
+    def plan_detour(self, lateral: float) -> None:
+        """Sidestep ``lateral`` metres (positive: left) before walking on (call before start)."""
+        self.detour = float(lateral)
+        self.duration = self._duration()
 
     def start(self, physics) -> None:
         pelvis = physics.pelvis_position()
@@ -188,12 +212,10 @@ class GaitMotion(Motion):
         self._heading = np.array([math.cos(yaw), math.sin(yaw)])
         self._left = np.array([-math.sin(yaw), math.cos(yaw)])
         self._yaw = yaw
-        self._feet_forward: Dict[str, float] = {}
-        self._feet_lateral: Dict[str, float] = {}
+        self._feet: Dict[str, Tuple[float, float]] = {}
         for side in SIDES:
             offset = physics.body_position(f"{side}_foot")[:2] - self._origin
-            self._feet_forward[side] = float(offset @ self._heading)
-            self._feet_lateral[side] = float(offset @ self._left)
+            self._feet[side] = (float(offset @ self._heading), float(offset @ self._left))
         self._phases = self._plan(start_height=float(pelvis[2]))
         self._back_start = physics.targets(["back_pitch"])["back_pitch"]
         physics.set_balance_assist(True)
@@ -201,47 +223,59 @@ class GaitMotion(Motion):
     def _plan(self, start_height: float) -> List[_GaitPhase]:
         walk_height = self.geometry.pelvis_height(self.walk_hip_height)
         final_height = self.geometry.pelvis_height(self.final_hip_height)
-        feet = dict(self._feet_forward)
-        pelvis = 0.5 * (feet["left"] + feet["right"])
-        phases = [_GaitPhase(self.transfer_duration, (0.0, start_height), (pelvis, walk_height))]
+        feet = dict(self._feet)
+        forward = 0.5 * (feet["left"][0] + feet["right"][0])
+        lateral = 0.0
+        phases = [_GaitPhase(self.transfer_duration, (0.0, 0.0, start_height), (forward, lateral, walk_height))]
+
+        def swing(side, to, pelvis_to):
+            nonlocal forward, lateral
+            phases.append(_GaitPhase(self.step_duration, (forward, lateral, walk_height), pelvis_to + (walk_height,),
+                                     side, feet[side], to))
+            feet[side] = to
+            forward, lateral = pelvis_to
+
+        count = self._sidesteps()
+        leading, trailing = ("left", "right") if self.detour > 0 else ("right", "left")
+        for _ in range(count):
+            shift = self.detour / count
+            swing(leading, (feet[leading][0], feet[leading][1] + shift), (forward, lateral + shift / 2))
+            swing(trailing, (feet[trailing][0], feet[trailing][1] + shift), (forward, lateral + shift / 2))
         for step in range(self.steps):
             side = SIDES[step % 2]
-            target = pelvis + self.step_length
+            target = forward + self.step_length
             last = step == self.steps - 1
             landing = target if (last or self.step_length == 0.0) else target + 0.5 * self.step_length
-            phases.append(
-                _GaitPhase(self.step_duration, (pelvis, walk_height), (target, walk_height), side, feet[side], landing)
-            )
-            feet[side], pelvis = landing, target
+            swing(side, (landing, feet[side][1]), (target, lateral))
         if self.step_length != 0.0:
             side = SIDES[self.steps % 2]
-            phases.append(
-                _GaitPhase(self.step_duration, (pelvis, walk_height), (pelvis, walk_height), side, feet[side], pelvis)
-            )
-            feet[side] = pelvis
-        phases.append(_GaitPhase(self.transfer_duration, (pelvis, walk_height), (pelvis, final_height)))
+            swing(side, (forward, feet[side][1]), (forward, lateral))
+        phases.append(_GaitPhase(self.transfer_duration, (forward, lateral, walk_height),
+                                 (forward, lateral, final_height)))
         self._final_feet = feet
         return phases
 
     def update(self, physics, elapsed: float) -> None:
         phase, fraction, feet = self._phase_at(elapsed)
         weight = minimum_jerk(fraction)
-        forward = phase.pelvis_from[0] + weight * (phase.pelvis_to[0] - phase.pelvis_from[0])
-        height = phase.pelvis_from[1] + weight * (phase.pelvis_to[1] - phase.pelvis_from[1])
+        forward, lateral, height = (start + weight * (end - start)
+                                    for start, end in zip(phase.pelvis_from, phase.pelvis_to))
         lifts = {side: 0.0 for side in SIDES}
         if phase.swing_side is not None:
-            feet[phase.swing_side] = phase.foot_from + weight * (phase.foot_to - phase.foot_from)
+            feet[phase.swing_side] = tuple(start + weight * (end - start)
+                                           for start, end in zip(phase.foot_from, phase.foot_to))
             lifts[phase.swing_side] = self.swing_height * math.sin(math.pi * fraction)
-        position = np.append(self._origin + forward * self._heading, height)
+        position = np.append(self._origin + forward * self._heading + lateral * self._left, height)
         physics.move_pelvis_target(position, _yaw_quaternion(self._yaw))
         targets = {"back_pitch": self._back_start * (1.0 - minimum_jerk(elapsed / self.transfer_duration))}
         for side in SIDES:
-            targets.update(self._leg_targets(side, feet[side] - forward, lifts[side], height))
+            targets.update(self._leg_targets(side, feet[side][0] - forward, feet[side][1] - lateral,
+                                             lifts[side], height))
         physics.set_targets(targets)
 
     def _phase_at(self, elapsed: float):
         """The active phase, the fraction done, and foot positions at its start."""
-        feet = dict(self._feet_forward)
+        feet = dict(self._feet)
         phase_start = 0.0
         for index, phase in enumerate(self._phases):
             if elapsed < phase_start + phase.duration or index == len(self._phases) - 1:
@@ -251,10 +285,11 @@ class GaitMotion(Motion):
             phase_start += phase.duration
         raise AssertionError("gait has no phases")
 
-    def _leg_targets(self, side: str, forward: float, lift: float, pelvis_height: float) -> JointTargets:
+    def _leg_targets(self, side: str, forward: float, lateral_offset: float, lift: float,
+                     pelvis_height: float) -> JointTargets:
         geometry = self.geometry
         mirror = 1.0 if side == "left" else -1.0
-        lateral = self._feet_lateral[side] - mirror * geometry.hip_offset_y
+        lateral = lateral_offset - mirror * geometry.hip_offset_y
         down = pelvis_height + geometry.hip_offset_z - geometry.ankle_height - lift
         hip_roll = math.atan2(lateral, down)
         hip_pitch, knee, ankle_pitch = sagittal_leg_ik(geometry, forward, math.hypot(lateral, down))

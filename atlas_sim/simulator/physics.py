@@ -9,7 +9,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Iterable, Mapping, Optional
+from typing import Iterable, List, Mapping, Optional, Tuple
 
 import mujoco
 import numpy as np
@@ -17,6 +17,25 @@ import numpy as np
 from .kinematics import LegGeometry, POSTURES, JointTargets
 
 MODEL_PATH = Path(__file__).resolve().parent / "models" / "humanoid.xml"
+
+#: Bodies (with their subtrees) that may touch furniture: hands rest on a table to grasp.
+#: Any other part of the robot touching furniture is a collision (``obstacle_contacts``).
+TOUCHING_BODIES = ("left_hand", "right_hand")
+
+
+#: Where a geom is sampled for the look-ahead of walks: a 3x3x3 grid over a box, 9 points along
+#: a capsule's or cylinder's axis (each a sphere of its radius).
+_GRID = np.array([[x, y, z] for x in (-1, 0, 1) for y in (-1, 0, 1) for z in (-1, 0, 1)], dtype=float)
+_AXIS_SAMPLES = np.linspace(-1.0, 1.0, 9)
+_LIMB_TYPES = (int(mujoco.mjtGeom.mjGEOM_CAPSULE), int(mujoco.mjtGeom.mjGEOM_CYLINDER))
+
+
+@dataclass(frozen=True)
+class Obstacle:
+    """The nearest furniture in a walk's way: its body's name and the free distance to it (m)."""
+
+    body: str
+    free_distance: float
 
 
 @dataclass(frozen=True)
@@ -59,6 +78,17 @@ class HumanoidPhysics:
         self._object_mocap = self.model.body_mocapid[self._body_id("pickup_object")]
         self._hands = (self._body_id("left_hand"), self._body_id("right_hand"))
         self._weld = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_EQUALITY, "balance_assist")
+        robot_bodies = self._subtree(self._pelvis)
+        touching = set().union(*(self._subtree(self._body_id(name)) for name in TOUCHING_BODIES))
+        geom_body = self.model.geom_bodyid
+        #: the robot's geoms that must not touch furniture (all but the hands')
+        self._colliding_robot_geoms = {g for g in range(self.model.ngeom)
+                                       if geom_body[g] in robot_bodies and geom_body[g] not in touching}
+        #: furniture: colliding geoms of the scene on bodies of their own (not the robot, not the floor)
+        self._furniture_geoms = {
+            g for g in range(self.model.ngeom)
+            if geom_body[g] not in robot_bodies and geom_body[g] != 0
+            and (self.model.geom_contype[g] or self.model.geom_conaffinity[g])}
 
     # ----------------------------------------------------------- model lookup
     def _joint_id(self, name: str) -> int:
@@ -69,6 +99,22 @@ class HumanoidPhysics:
         if body < 0:
             raise KeyError(f"model has no body {name!r}")
         return body
+
+    def _subtree(self, root: int) -> set:
+        """Ids of ``root`` and every body below it."""
+        parents = self.model.body_parentid
+        return {b for b in range(self.model.nbody) if b == root or self._descends(b, root, parents)}
+
+    @staticmethod
+    def _descends(body: int, root: int, parents) -> bool:
+        while body != 0:
+            body = parents[body]
+            if body == root:
+                return True
+        return False
+
+    def _body_name(self, body: int) -> str:
+        return mujoco.mj_id2name(self.model, mujoco.mjtObj.mjOBJ_BODY, body)
 
     def _read_leg_geometry(self) -> LegGeometry:
         """Leg dimensions from the model so IK stays in sync with the MJCF."""
@@ -191,6 +237,76 @@ class HumanoidPhysics:
             self.pelvis_position()[2] < criteria.min_pelvis_height
             or math.degrees(self.torso_tilt()) > criteria.max_torso_tilt_deg
         )
+
+    # ------------------------------------------------------------- obstacles
+    def obstacle_contacts(self) -> List[Tuple[str, str]]:
+        """(robot part, furniture body) pairs touching now, robot parts other than the hands.
+
+        The robot must not touch furniture with its body: a leg in a table is a collision
+        the physics cannot make right afterwards, so the simulator reports it."""
+        pairs = []
+        for contact in self.data.contact[: self.data.ncon]:
+            geoms = (int(contact.geom1), int(contact.geom2))
+            for robot, other in (geoms, geoms[::-1]):
+                if robot in self._colliding_robot_geoms and other in self._furniture_geoms:
+                    pair = (self._body_name(self.model.geom_bodyid[robot]),
+                            self._body_name(self.model.geom_bodyid[other]))
+                    if pair not in pairs:
+                        pairs.append(pair)
+        return pairs
+
+    def _geom_spheres(self, geom: int):
+        """Sample spheres (world centres, radii) covering a geom: a limb's axis in 9 spheres of
+        its radius (its bounding box would swing far out when the limb tilts), else a grid of
+        points over its bounding box."""
+        position, frame = self.data.geom_xpos[geom], self.data.geom_xmat[geom].reshape(3, 3)
+        if int(self.model.geom_type[geom]) in _LIMB_TYPES:
+            radius, half_length = self.model.geom_size[geom, :2]
+            centres = position + np.outer(_AXIS_SAMPLES * half_length, frame[:, 2])
+            return centres, np.full(len(centres), float(radius))
+        center, half = self.model.geom_aabb[geom, :3], self.model.geom_aabb[geom, 3:]
+        return position + (center + _GRID * half) @ frame.T, np.zeros(len(_GRID))
+
+    def _walk_frame_spheres(self, geoms, origin, heading):
+        """Sample spheres of ``geoms`` as (forward, lateral, height) for a walk from ``origin``
+        along ``heading``, and their radii."""
+        spheres = [self._geom_spheres(g) for g in geoms]
+        points = np.concatenate([centres for centres, _ in spheres])
+        left = np.array([-heading[1], heading[0]])
+        planar = points[:, :2] - origin
+        return (np.stack([planar @ heading, planar @ left, points[:, 2]], axis=1),
+                np.concatenate([radii for _, radii in spheres]))
+
+    def obstacle_ahead(self, distance: float, margin: float, turn: float = 0.0, shift: float = 0.0,
+                       side_margin: Optional[float] = None) -> Optional[Obstacle]:
+        """The furniture a walk of ``distance`` metres would run into.
+
+        The walk goes ``turn`` radians left of the pelvis heading (pi/2: a sidestep to the
+        left), starting ``shift`` metres to the left of where the robot stands. Each furniture
+        geom is a footprint on the floor in the walk's frame; the robot's parts that must not
+        touch furniture, as they stand now, are swept along the walk: those beside it within
+        ``side_margin`` (default ``margin``) must stop ``margin`` short of it, whatever their
+        height (arms and legs move during and after a walk, so none may end over a table). Returns the
+        nearest body in the way and the free distance to it, or None."""
+        side_margin = margin if side_margin is None else side_margin
+        yaw = self.pelvis_yaw()
+        left = np.array([-math.sin(yaw), math.cos(yaw)])
+        heading = np.array([math.cos(yaw + turn), math.sin(yaw + turn)])
+        origin = self.pelvis_position()[:2]
+        robot, radii = self._walk_frame_spheres(sorted(self._colliding_robot_geoms), origin, heading)
+        robot[:, :2] += shift * np.array([left @ heading, left @ np.array([-heading[1], heading[0]])])
+        nearest: Optional[Obstacle] = None
+        for geom in sorted(self._furniture_geoms):
+            points, widths = self._walk_frame_spheres([geom], origin, heading)
+            low, high = (points - widths[:, None]).min(axis=0), (points + widths[:, None]).max(axis=0)
+            facing = ((robot[:, 1] + radii + side_margin > low[1]) & (robot[:, 1] - radii - side_margin < high[1])
+                      & (robot[:, 0] - radii < high[0]))
+            if not facing.any():
+                continue
+            free = float(low[0] - (robot[facing, 0] + radii[facing]).max())
+            if free < distance + margin and (nearest is None or free < nearest.free_distance):
+                nearest = Obstacle(self._body_name(self.model.geom_bodyid[geom]), max(0.0, free))
+        return nearest
 
     def fall_reason(self) -> str:
         height = self.pelvis_position()[2]

@@ -194,8 +194,11 @@ class BehaviorSynthesisServer(Node):
         self.repairer = client(ProposeRepairs, 'propose_repairs')
         self.robot_state = RobotStateListener(self, self.parameter('robot_state_topic'), callback_group=group)
         flexbe_synthesis = load_flexbe_synthesis_interface()
-        if flexbe_synthesis.fallback_reason:
-            self.get_logger().info(flexbe_synthesis.fallback_reason)
+        # Before `make flexbe` CNU's package is missing in every ordinary run: said at debug
+        # here, and once plainly when a client uses /flexbe_synthesis (where it matters).
+        self._fallback_note = flexbe_synthesis.fallback_reason
+        if self._fallback_note:
+            self.get_logger().debug(self._fallback_note)
         # rclpy keeps each result for result_timeout seconds (default 900: ~38 KB per goal).
         self.action_servers = [
             ActionServer(self, interface.action_type, interface.action_name,
@@ -231,6 +234,9 @@ class BehaviorSynthesisServer(Node):
     # --- goal execution -----------------------------------------------------------------
 
     async def execute(self, goal_handle, interface: ActionInterface):
+        if self._fallback_note and interface.action_name == 'flexbe_synthesis':
+            self.get_logger().info(self._fallback_note)
+            self._fallback_note = ''
         feedback = FeedbackChannel(goal_handle, interface.action_type.Feedback)
         outcome = PipelineOutcome()
         task = deadline = None

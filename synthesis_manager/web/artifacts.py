@@ -13,7 +13,8 @@ from respec.nesting import run_with_deep_stack
 from respec.parsing import spec_from_text_sections
 from sm_generation import SMGenerationError, export
 from sm_generation.export import render, to_dot
-from sm_generation.flexbe_behavior import behavior_package, check_behavior_name, default_behavior_name
+from sm_generation.flexbe_behavior import (behavior_module_name, behavior_package, check_behavior_name,
+                                           default_behavior_name)
 from sm_generation.for_system import behavior_flexbe_config
 from synthesis_manager.web.outcome import JobOutcome
 
@@ -47,9 +48,22 @@ def _specification(method):
     return build
 
 
+def behavior_name(request) -> str:
+    """The name of the job's behavior: the request's name when it can name one, else the goals'."""
+    return request.name if request.name and check_name(request.name) else default_behavior_name(request.goals)
+
+
+def download_filename(request, artifact: str) -> str:
+    """The file name a download is saved under: the behavior package is named after its
+    behavior (``look_down_pickup_object_flexbe_behavior.zip``), the others after the request."""
+    if artifact == 'flexbe_behavior.zip':
+        return f'{behavior_module_name(behavior_name(request))[:-len("_sm")]}_{artifact}'
+    return f'{request.name or "behavior"}_{artifact}'
+
+
 def _flexbe_behavior(outcome, request, systems) -> bytes:
     """The behavior package FlexBE's editor would save (as ``behavior-synthesis export-behavior``)."""
-    name = request.name if request.name and check_name(request.name) else default_behavior_name(request.goals)
+    name = behavior_name(request)
     package = behavior_package(list(outcome.states), behavior_flexbe_config(systems.load(request.system)), name,
                                date=time.strftime('%a %b %d %Y'))
     return package.zip_bytes()

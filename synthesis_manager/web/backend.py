@@ -25,7 +25,7 @@ from respec.robot import RobotSystem, SystemCatalog
 from respec.robot.files import SystemConfigError
 from sm_generation.state_machine import StateMachine
 from synthesis_manager.limits import BusyError
-from synthesis_manager.web.artifacts import ARTIFACTS, Artifact
+from synthesis_manager.web.artifacts import ARTIFACTS, Artifact, download_filename
 from synthesis_manager.web.errors import (ArtifactFailedError, InvalidJobRequestError, NotAvailableError,
                                           NotFoundError)
 from synthesis_manager.web.jobs import JOB_OPTIONS, Job, JobRequest, ProgressNote, checked_body, names_field
@@ -317,7 +317,7 @@ class SynthesisBackend:
                     logger.exception('building %s of job %s failed', name, job_id)
                 raise ArtifactFailedError(f'cannot make {name}: {error}',
                                           getattr(error, 'item', '') or name) from error
-            self._artifacts[key] = Artifact(content, kind.media_type, f'{job.request.name or "behavior"}_{name}')
+            self._artifacts[key] = Artifact(content, kind.media_type, download_filename(job.request, name))
         return self._artifacts[key]
 
     def state_machine(self, job_id: str) -> StateMachine:

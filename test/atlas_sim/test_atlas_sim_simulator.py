@@ -143,7 +143,8 @@ def test_walk_moves_the_base_forward():
     assert sim.execute("walk").completed
     snapshot = sim.snapshot()
     assert snapshot["base_xy"][0] - x_before > 0.4
-    assert abs(snapshot["base_xy"][1]) < 0.1
+    # the table stands in the way (issue 35): the walk sidesteps beside it, touching nothing
+    assert 0.3 < abs(snapshot["base_xy"][1]) <= 1.0 and sim.incidents == []
     assert snapshot["pelvis_height"] > 0.8
 
 

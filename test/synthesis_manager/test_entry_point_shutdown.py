@@ -3,8 +3,8 @@
 Each test starts the entry point as its own process, waits until it is provably in the
 middle of a synthesis (or, for the simulator, of an action), waits a second more, sends
 the signal and measures how long the process takes to exit. It also checks the exit code
-(0 for servers and nodes; 128 + the signal number for clients and gr1synth, after a
-client has cancelled its goal) and that the process left nothing behind: no child
+(0 for the node scripts; 128 + the signal number for every ``behavior-synthesis`` command,
+servers included, and gr1synth, after a client has cancelled its goal) and that the process left nothing behind: no child
 process, and no suite still burning CPU on a goal nobody waits for.
 
 The runaway syntheses are real requests: through ROS and gr1synth a specification whose
@@ -203,7 +203,8 @@ def stop_all(processes: dict, stop_signal) -> dict:
     return seconds
 
 
-def client_exit_code(stop_signal) -> int:
+def signal_exit_code(stop_signal) -> int:
+    """A command stopped by a signal exits with 128 + its number (README's status table)."""
     return 128 + stop_signal
 
 
@@ -262,7 +263,7 @@ def test_serve_stops_within_three_seconds_in_the_middle_of_a_runaway_synthesis(t
                 start_runaway_goal(ros)
                 assert_busy_synthesizing(process.pid)  # a second well into the synthesis
                 stop(process, stop_signal, 'serve')
-                assert process.returncode == 0, output.text()
+                assert process.returncode == signal_exit_code(stop_signal), output.text()
 
 
 @STOP_SIGNALS
@@ -312,7 +313,7 @@ def test_gui_stops_within_three_seconds_in_the_middle_of_a_runaway_job_with_its_
             assert_busy_synthesizing(process.pid)
             assert httpx.get(f'{url}api/jobs/{job}').json()['state'] == 'running'
             stop(process, stop_signal, 'gui')
-        assert process.returncode == 0, output.text()
+        assert process.returncode == signal_exit_code(stop_signal), output.text()
 
 
 @STOP_SIGNALS
@@ -328,7 +329,7 @@ def test_a_connected_gui_stops_within_three_seconds_and_cancels_its_running_job(
                 with runaway_gui_job(output.wait_for(GUI_URL).group(1)):
                     assert_busy_synthesizing(server.pid)
                     stop(gui, stop_signal, 'gui --connect')
-                assert gui.returncode == 0, output.text()
+                assert gui.returncode == signal_exit_code(stop_signal), output.text()
             assert_idle(server.pid)
             assert_no_synthesis_running(server.pid)
             stop(server, signal.SIGINT, 'serve')
@@ -366,7 +367,7 @@ def test_send_goal_stops_within_three_seconds_and_cancels_its_runaway_goal(tmp_p
                 output.wait_for('Synthesizing')
                 assert_busy_synthesizing(server.pid)
                 stop(client, stop_signal, 'send-goal')
-                assert client.returncode == client_exit_code(stop_signal), output.text()
+                assert client.returncode == signal_exit_code(stop_signal), output.text()
                 assert 'result: PREEMPTED' in output.text()
             assert_idle(server.pid)  # the goal was cancelled: the suite stopped synthesizing
             assert_no_synthesis_running(server.pid)
@@ -386,7 +387,7 @@ def test_in_process_suite_commands_stop_within_three_seconds_in_the_middle_of_a_
         output.wait_for('Synthesizing')
         assert_busy_synthesizing(process.pid)
         stop(process, stop_signal, command)
-        assert process.returncode == client_exit_code(stop_signal), output.text()
+        assert process.returncode == signal_exit_code(stop_signal), output.text()
         assert 'interrupted' in output.text()
 
 
@@ -400,7 +401,7 @@ def test_gr1synth_stops_within_three_seconds_in_the_middle_of_a_runaway_synthesi
         time.sleep(1.0)
         assert_busy(process.pid)
         stop(process, stop_signal, 'gr1synth')
-        assert process.returncode in (-stop_signal, client_exit_code(stop_signal)), output.text()
+        assert process.returncode in (-stop_signal, signal_exit_code(stop_signal)), output.text()
         assert not (tmp_path / 'strategy.json').exists()
 
 

@@ -119,7 +119,11 @@ def test_paper_task_succeeds_with_progress_states_and_downloads(client):
     import io
     import zipfile
 
-    behavior = zipfile.ZipFile(io.BytesIO(client.get(f'{base}/flexbe_behavior.zip').content))
+    download = client.get(f'{base}/flexbe_behavior.zip')
+    # saved under the behavior's name (issue 35: it was behavior_flexbe_behavior.zip)
+    assert download.headers['content-disposition'] == \
+        'attachment; filename="look_down_pickup_object_flexbe_behavior.zip"'
+    behavior = zipfile.ZipFile(io.BytesIO(download.content))
     names = behavior.namelist()  # the package export-behavior writes, behavior named after the goals
     assert 'synthesized_flexbe_behaviors/manifest/look_down_pickup_object.xml' in names
     code = behavior.read('synthesized_flexbe_behaviors/synthesized_flexbe_behaviors/look_down_pickup_object_sm.py')

@@ -74,7 +74,7 @@ def test_gui_serves_on_loopback_by_default_and_stops_on_ctrl_c():
         assert (deep.status_code, deep.json()['error']) == (400, 'TOO_DEEP')
         assert gui.poll() is None and httpx.get(f'{url}api/systems').status_code == 200
     finally:
-        assert stop(gui) == 0
+        assert stop(gui) == 130  # README: stopped by SIGINT
 
 
 def test_gui_reports_a_port_in_use():
@@ -86,7 +86,7 @@ def test_gui_reports_a_port_in_use():
         assert second.returncode == 5  # ExitStatus.UNAVAILABLE
         assert f'cannot listen on 127.0.0.1:{port}' in second.stderr
     finally:
-        assert stop(first) == 0
+        assert stop(first) == 130
 
 
 @pytest.fixture
@@ -126,5 +126,5 @@ def test_connect_joins_a_running_suite(reserved_domain, tmp_path):
         assert 'look_down_a' in finished['outcome']['ltl_specification']['sys_props']
     finally:
         if gui is not None:
-            assert stop(gui) == 0
+            assert stop(gui) == 130
         stop(suite)

@@ -165,7 +165,10 @@ class RuntimeControl:
         return forced if forced in outcomes else outcome
 
     def ask_input(self, state_path: str, prompt: str, default: Any, deadline: float | None) -> Any:
-        """The operator's answer to the ``InputState`` at ``state_path`` (None: aborted)."""
+        """The operator's answer to the ``InputState`` at ``state_path`` (None: aborted). At Full
+        autonomy nobody is asked: the robot's ``default`` answers (the unattended run)."""
+        if self.autonomy_level >= FULL:
+            return default
         self.answers.pop(state_path, None)
         self._wait(state_path, {'kind': 'input', 'state': state_path, 'prompt': prompt, 'default': default},
                    lambda: state_path in self.answers, deadline)

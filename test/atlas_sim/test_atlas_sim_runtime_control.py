@@ -151,7 +151,7 @@ def test_input_state_asks_the_operator_with_the_simulators_answer_offered():
             return [{'command': 'input', 'state': '/object_template', 'value': waiting['default']}]
         return []
 
-    control = RuntimeControl(receive)
+    control = RuntimeControl(receive, autonomy_level=HIGH)
     run = execute_state_machine(PICK, SimulatedRobot(simulator), control=control)
     assert asked == [{'kind': 'input', 'state': '/object_template', 'prompt': 'Specify desired object template',
                       'default': 1}]
@@ -162,7 +162,13 @@ def test_input_state_asks_the_operator_with_the_simulators_answer_offered():
 def test_an_aborted_or_invalid_input_fails_the_input_state(answer):
     simulator = make_simulator('atlas', initial_conditions=['stand_prep'])
     control = RuntimeControl(lambda timeout: [{'command': 'input', 'state': '/object_template', 'value': answer}]
-                             if control.waiting else [])
+                             if control.waiting else [], autonomy_level=LOW)
     run = execute_state_machine(PICK, SimulatedRobot(simulator), control=control)
     assert run.outcome == 'failed'
     assert run.trace.steps[0].results[0]['reason'] == 'operator did not provide object_template'
+
+
+def test_at_full_autonomy_the_input_takes_the_robots_default_without_asking():
+    simulator = make_simulator('atlas', initial_conditions=['stand_prep'])
+    run = execute_state_machine(PICK, SimulatedRobot(simulator), control=RuntimeControl(lambda timeout: []))
+    assert run.outcome == 'finished' and simulator.answers == {'template_id': 1} and run.operator_events == []

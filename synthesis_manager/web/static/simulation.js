@@ -123,7 +123,7 @@ function showSimulation(simulation) {
       element('td', { text: `${step.entered_at.toFixed(2)}–${step.ended_at.toFixed(2)}` }))));
   drawing.markRun(simulation.steps, running);
   controlRun(simulation);
-  showFrames(base, simulation.frames);
+  showFrames(base, simulation.frames, simulation.steps, running);
   if (simulation.check) {
     const check = simulation.check;
     $('simulation-check').textContent = check.ok

@@ -45,6 +45,7 @@ def test_play_is_motion_at_robot_speed_with_the_active_state_in_step_and_scrubbi
     assert result_code(page) == 'SUCCESS'
     page.click('#simulate')
     # no broken image while the simulator starts
+    page.wait_for_selector('#robot-view:not([hidden])')
     assert page.is_visible('#robot-starting') and page.inner_text('#robot-starting') == 'Starting the simulator…'
     assert page.is_hidden('#simulation-frame')
     page.wait_for_function("document.getElementById('simulation-status').textContent.startsWith('Outcome')",

@@ -95,6 +95,23 @@ export async function checkGoals() {
     item.classList.toggle('impossible', Boolean(finding));
     item.querySelector('.goal-warning').textContent = finding ? finding.sentence : '';
   }
+  const flagged = $('goals').querySelector('li.impossible');
+  if (flagged) revealInForm(flagged);
+}
+
+// The controls below the fields grow as a job goes on: a flagged goal stays in view.
+new ResizeObserver(() => {
+  const flagged = $('goals').querySelector('li.impossible');
+  if (flagged) revealInForm(flagged);
+}).observe($('form-fields'));
+
+// Scroll the form's fields (not the page) so that ``item`` is in view above the controls.
+function revealInForm(item) {
+  const fields = $('form-fields');
+  const area = fields.getBoundingClientRect();
+  const box = item.getBoundingClientRect();
+  if (box.bottom > area.bottom) fields.scrollTop += box.bottom - area.bottom + 8;
+  else if (box.top < area.top) fields.scrollTop -= area.top - box.top + 8;
 }
 
 // The control modes that can change to ``mode`` (its own self-loop aside).
@@ -120,7 +137,9 @@ function goalItem(name) {
 export function addGoal() {
   const name = $('goal-choice').value;
   if (!name) return;
-  $('goals').append(goalItem(name));
+  const item = goalItem(name);
+  $('goals').append(item);
+  revealInForm(item);
   updateGoalsHint();
 }
 

@@ -45,7 +45,7 @@ export function resetFrames() {
 }
 
 // Play the frames as the run went, at robot speed: a robot clock runs from the frame shown
-// (the first one after the end) and each animation frame shows the latest frame it has reached.
+// (the first one after the end) and each animation frame shows the next frame it has reached.
 export function playFrames() {
   if (player) { stopPlaying(); return; }
   if (!frameList.length) return;
@@ -57,7 +57,10 @@ export function playFrames() {
   showFrame(index);
   const tick = (now) => {
     const robotTime = startTime + (now - startWall) / 1000;
-    while (index < frameList.length - 1 && frameList[index + 1].time <= robotTime) index += 1;
+    // One frame further per animation frame (each is shown, also those of the same instant),
+    // more only to catch up when the page falls over 0.1 s behind the robot clock.
+    if (index < frameList.length - 1 && frameList[index + 1].time <= robotTime) index += 1;
+    while (index < frameList.length - 1 && frameList[index + 1].time <= robotTime - 0.1) index += 1;
     if (Number($('frame-scrubber').value) !== index) showFrame(index);
     if (index >= frameList.length - 1) { stopPlaying(); return; }
     player = requestAnimationFrame(tick);

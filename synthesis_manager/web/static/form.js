@@ -1,5 +1,6 @@
 // The request form: the system's own names to choose from, the ordered goal list with the
 // server's live goal check, and the request it makes. It owns the chosen system's choices.
+import { showAbstraction } from './abstraction.js';
 import { api } from './api.js';
 import { $, element } from './dom.js';
 import { vocabulary } from './vocabulary.js';
@@ -70,6 +71,7 @@ export function simulationSupport() {
 // achieved) and say so in the picker and the list, before anything is synthesized.
 export async function checkGoals() {
   const request = currentRequest();
+  showAbstraction(choices, request);
   const number = ++goalChecks;
   let check;
   try {

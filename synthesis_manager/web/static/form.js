@@ -101,10 +101,11 @@ export async function checkGoals() {
   if (flagged) revealInForm(flagged);
 }
 
-// The controls below the fields grow as a job goes on: a flagged goal stays in view.
+// The controls below the fields grow as a job goes on: a flagged goal (else the last goal)
+// stays in view.
 new ResizeObserver(() => {
-  const flagged = $('goals').querySelector('li.impossible');
-  if (flagged) revealInForm(flagged);
+  const shown = $('goals').querySelector('li.impossible') || $('goals').lastElementChild;
+  if (shown) revealInForm(shown);
 }).observe($('form-fields'));
 
 // Scroll the form's fields (not the page) so that ``item`` is in view above the controls.

@@ -32,6 +32,18 @@ export function showStateDetails(state) {
       row('Outcomes', element('ul', {}, ...outcomes)),
       ...(state.children.length ? [row('Contains', state.children.map((c) => `${c.name} (${c.state_class})`).join(', '))] : [])));
   fitInWindow(panel);
+  besideTheState(panel, state);
+}
+
+// The panel on the side of the drawing the clicked state is not on.
+function besideTheState(panel, state) {
+  panel.classList.remove('left');
+  const node = document.getElementById(`state:${state.name}`);
+  if (!node) return;
+  const box = node.getBoundingClientRect();
+  const area = panel.getBoundingClientRect();
+  const overlaps = box.right > area.left && box.left < area.right && box.bottom > area.top && box.top < area.bottom;
+  if (overlaps) panel.classList.add('left');
 }
 
 // The panel no taller than the part of the window below its top: all of it in view, scrolling inside.

@@ -57,7 +57,8 @@ class CommandError(ValueError):
 def needs_confirmation(required_autonomy: int, autonomy_level: int) -> bool:
     """Whether a transition waits for the operator: FlexBE takes an outcome on its own only
     when its required autonomy is below the current level
-    (``OperatableStateMachine.is_transition_allowed``), so at level Off every one waits."""
+    (``OperatableStateMachine.is_transition_allowed``), so at level Off every one waits and one
+    of Full autonomy always does (FlexBE runs unattended behaviors at level 255)."""
     return required_autonomy >= autonomy_level
 
 

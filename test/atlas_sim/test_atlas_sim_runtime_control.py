@@ -172,3 +172,26 @@ def test_at_full_autonomy_the_input_takes_the_robots_default_without_asking():
     simulator = make_simulator('atlas', initial_conditions=['stand_prep'])
     run = execute_state_machine(PICK, SimulatedRobot(simulator), control=RuntimeControl(lambda timeout: []))
     assert run.outcome == 'finished' and simulator.answers == {'template_id': 1} and run.operator_events == []
+
+
+def test_an_operator_decision_waits_with_its_suggestion_even_at_full_autonomy():
+    """The generator's decision has Full autonomy, FlexBE's "always needs an operator input"."""
+    from sm_generation.generator import DECISION_AUTONOMY
+    assert DECISION_AUTONOMY == FULL
+    machine = [root('choose_initial_state'),
+               {'state_path': '/choose_initial_state', 'state_class': 'OperatorDecisionState',
+                'outcomes': ['stand', 'nothing_to_do'], 'transitions': ['stand', 'nothing_to_do'],
+                'autonomy': [DECISION_AUTONOMY] * 2},
+               {'state_path': '/nothing_to_do', 'state_class': 'LogState', 'outcomes': ['done'],
+                'transitions': ['finished'], 'autonomy': [0]},
+               state('/stand', 'stand_a', changed='finished', failed='failed')]
+    robot = ScriptedRobot({'stand': (2, 'completed')})
+    operator = Operator(robot, script={'confirm': [{'command': 'confirm', 'state': '/choose_initial_state'}]})
+    run = execute_state_machine(machine, robot, control=operator.make(FULL))
+    assert [s['waiting']['outcome'] for s in operator.statuses if s['waiting']] == ['stand']  # the suggestion
+    assert [s.state for s in run.trace.steps] == ['/choose_initial_state', '/stand']
+    robot = ScriptedRobot({'stand': (2, 'completed')})
+    operator = Operator(robot, script={'confirm': [{'command': 'force', 'state': '/choose_initial_state',
+                                                    'outcome': 'nothing_to_do'}]})
+    run = execute_state_machine(machine, robot, control=operator.make(FULL))
+    assert [s.state for s in run.trace.steps] == ['/choose_initial_state', '/nothing_to_do'] and robot.tick == 0

@@ -8,6 +8,7 @@ import * as drawing from './drawing.js';
 import { $ } from './dom.js';
 
 let run = null;       // {id, operator, active} of the run being controlled (null: none running)
+let picking = false;  // the drawing's outcome cells force this run's outcomes
 
 function command(body) {
   if (!run) return Promise.resolve();
@@ -33,7 +34,10 @@ export function controlRun(simulation) {
   $('pause-run').setAttribute('aria-pressed', String(Boolean(operator.paused)));
   const waiting = live ? operator.waiting : null;
   ask(waiting);
-  drawing.pickOutcomes(live ? forceFromDrawing : null);
+  // The cells are this run's while it goes on, unless a play of the machine has them.
+  const mine = live && $('play-panel').hidden;
+  if (mine || picking) drawing.pickOutcomes(mine ? forceFromDrawing : null);
+  picking = mine;
   drawing.markPending(waiting && waiting.kind === 'confirm' ? waiting : null);
 }
 

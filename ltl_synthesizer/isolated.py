@@ -14,6 +14,11 @@ process. Each child runs ``niceness`` below its parent's CPU priority.
                        on_progress=print)   # function(settings, progress=...) reports as it goes
     child.kill()
 
+A caller may also speak to the work while it runs: with ``wants_commands=True`` the function is
+given ``commands=`` a callable that waits up to a timeout for what another thread of the caller
+sent with ``child.command(value)`` and returns it as a list (the GUI's operator commands to a
+running simulation). A command that arrives after the work ended is dropped.
+
 ``SynthesisProcesses`` is a pool of such children for syntheses and other solver work. Idle
 children are kept for the next call (a new one costs the start of a Python interpreter, a
 fraction of a second), but not for long: a child idle for ``idle_seconds`` is ended (its heap
@@ -62,6 +67,8 @@ SERVER_CHILD_NICENESS = 15
 #: How long an idle child is kept for the next synthesis.
 IDLE_SECONDS = 30.0
 _LENGTH_BYTES = 8
+#: Tags a message to the child that is a command to the running work, not a request.
+_COMMAND = 'command'
 #: A child that holds more than this above its fresh size after answering and releasing what
 #: it answered (heap it could not give back) is ended, and a fresh one serves the next request:
 #: a memory limit counts from a synthesis's start, so a reused child peaks within this of a
@@ -125,16 +132,19 @@ class ChildProcess:
         self.fresh = True  # has served nothing yet: its RSS is the baseline
         self.said = 'ready'  # what it said after its last answer
         self.settling = False  # releasing its last request and answer: says 'ready' or 'retire' then
+        self._writing = threading.Lock()  # a request and commands from other threads share stdin
         self.process = subprocess.Popen(
             [sys.executable, '-m', 'ltl_synthesizer.isolated', str(os.getpid()), str(niceness), preload],
             stdin=subprocess.PIPE, stdout=subprocess.PIPE,
             env={**environment, **os.environ} if environment else None)
 
     def call(self, function: Callable, args=(), kwargs=None, cancel: threading.Event | None = None,
-             deadline: float | None = None, on_progress: Callable | None = None,
+             deadline: float | None = None, on_progress: Callable | None = None, wants_commands: bool = False,
              memory_limit: int | None = None):
         """``function(*args, **kwargs)`` in this child; with ``on_progress``, ``function`` is
-        also given ``progress=`` a callable whose every value reaches ``on_progress`` here.
+        also given ``progress=`` a callable whose every value reaches ``on_progress`` here; with
+        ``wants_commands``, ``commands=`` a callable ``(timeout) -> [value, ...]`` of what
+        :meth:`command` sent meanwhile.
         The child is killed once ``cancel`` is set, at ``deadline`` (time.monotonic()) or once
         its resident memory has grown by more than ``memory_limit`` bytes since the call
         (SynthesisMemoryError, ``item`` 'memory_limit'); one that dies raises
@@ -143,7 +153,7 @@ class ChildProcess:
             if not self.settle() and self.said == 'nothing':  # its next words would be misread
                 raise self.died()
             baseline = resident_memory(self.process.pid) if memory_limit is not None else 0
-            self.send((function, tuple(args), dict(kwargs or {}), on_progress is not None))
+            self.send((function, tuple(args), dict(kwargs or {}), on_progress is not None, wants_commands))
             while True:
                 while not self.answered(POLL_SECONDS):
                     if cancel is not None and cancel.is_set():
@@ -191,8 +201,18 @@ class ChildProcess:
 
     def send(self, message) -> None:
         data = pickle.dumps(message, protocol=pickle.HIGHEST_PROTOCOL)
-        self.process.stdin.write(len(data).to_bytes(_LENGTH_BYTES, 'little') + data)
-        self.process.stdin.flush()
+        with self._writing:
+            self.process.stdin.write(len(data).to_bytes(_LENGTH_BYTES, 'little') + data)
+            self.process.stdin.flush()
+
+    def command(self, value) -> bool:
+        """Send ``value`` to the work running in this child (from any thread); False when the
+        child is gone. The work reads it through its ``commands`` callable."""
+        try:
+            self.send((_COMMAND, value))
+            return True
+        except (OSError, ValueError):  # the child died or its pipe was closed
+            return False
 
     def answered(self, timeout: float) -> bool:
         return bool(select.select([self.process.stdout], [], [], timeout)[0])
@@ -345,7 +365,8 @@ def _serve(parent_pid: int, preload: str) -> None:
     # This module runs as __main__ here: requests name the class of its imported copy.
     text_type = importlib.import_module('ltl_synthesizer.isolated').SpecificationText
     _die_with_parent(parent_pid)
-    requests = sys.stdin.buffer
+    # Unbuffered: a command must stay in the pipe, where select() sees it, until it is read.
+    requests = sys.stdin.buffer.raw
     answers = os.fdopen(os.dup(sys.stdout.fileno()), 'wb')
     sys.stdout = sys.stderr  # stray prints must not corrupt the answers
     importlib.import_module(preload)  # imported now: the first request need not wait for it
@@ -356,14 +377,30 @@ def _serve(parent_pid: int, preload: str) -> None:
         answers.write(len(data).to_bytes(_LENGTH_BYTES, 'little') + data)
         answers.flush()
 
+    def read():
+        return pickle.loads(_read_exactly(requests, int.from_bytes(_read_exactly(requests, _LENGTH_BYTES), 'little')))
+
+    def commands(timeout: float = 0.0) -> list:
+        """What the caller sent to the running work (waiting up to ``timeout`` for it)."""
+        received = []
+        while select.select([requests], [], [], 0.0 if received else timeout)[0]:
+            message = read()  # EOFError: the caller is gone; the work ends with it
+            if message[0] == _COMMAND:
+                received.append(message[1])
+        return received
+
     while True:
         try:
-            function, args, kwargs, wants_progress = pickle.loads(_read_exactly(requests, int.from_bytes(
-                _read_exactly(requests, _LENGTH_BYTES), 'little')))
+            message = read()
         except EOFError:
             return
+        if message[0] == _COMMAND:  # sent after its work ended
+            continue
+        function, args, kwargs, wants_progress, wants_commands = message
         if wants_progress:
             kwargs['progress'] = lambda value: send(('progress', value))
+        if wants_commands:
+            kwargs['commands'] = commands
         try:
             args = [argument.parsed() if isinstance(argument, text_type) else argument for argument in args]
             answer = ('result', function(*args, **kwargs))

@@ -18,6 +18,16 @@ fields, or ``sm_generation.StateInstantiation`` objects). Semantics (FlexBE's):
   states (``LogState``: returns at once; ``OperatorDecisionState``: the ``decide`` hook or
   its first outcome) take no robot time.
 
+With ``control`` (:class:`atlas_sim.executive.runtime_control.RuntimeControl`) an operator is in
+the loop as in FlexBE's Runtime Control: a transition whose required autonomy (the state's
+``autonomy`` for the outcome) is not below the control's level waits for the operator's
+confirmation; the operator may force any outcome of the active state (or of one of its
+children) at any time, pause, resume and stop; an ``InputState`` asks the operator, with the
+robot's own answer (``robot.input_default(capability)``) offered, and the answer reaches the
+robot through ``robot.give_input(capability, value)``. The robot is not stepped while the
+executive waits for the operator, so robot time stands still. Without ``control`` the run is
+unattended, as before.
+
 Activation–outcome semantics on the robot: a capability activated by a state that is
 still running from the previous state (a concurrency container returned before all its
 children did) keeps running, as its activation proposition stays true; a running request
@@ -36,18 +46,20 @@ simulator node. The machine is the tree of :mod:`sm_generation.state_machine`, l
 
 from __future__ import annotations
 
+import ast
 import re
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any, Callable
 
 from atlas_sim.executive.machine import ExecutionError, UndeclaredOutcomeError, load_machine, next_target
 from atlas_sim.executive.robot import CapabilityResult, Robot
+from atlas_sim.executive.runtime_control import RuntimeControl
 from atlas_sim.executive.trace_check import OutcomeTracker, Trace, TraceStep
 from respec.errors import ErrorCode
 from respec.naming import activated, is_activation, outcome_proposition
 from respec.robot import RobotSystem
-from sm_generation.config import flexbe_config, generation_system
+from sm_generation.config import INPUT_STATE_CLASS, flexbe_config, generation_system
 from sm_generation.instantiation import DECISION_CLASS, HELPER_STATE_CLASSES, StateInstantiation
 from sm_generation.state_machine import State
 
@@ -134,6 +146,7 @@ class ExecutionResult:
     fallen: bool
     ticks: int
     robot_started_at: float = 0.0  # robot clock at the start
+    operator_events: list = field(default_factory=list)  # the operator's commands (RuntimeControl)
 
     @property
     def duration(self) -> float:
@@ -144,7 +157,7 @@ class ExecutionResult:
         return {'outcome': self.outcome, 'trace': self.trace.to_dict(), 'robot_time': round(self.robot_time, 4),
                 'robot_started_at': round(self.robot_started_at, 4),
                 'min_pelvis_height': round(self.min_pelvis_height, 4), 'fallen': self.fallen,
-                'ticks': self.ticks}
+                'ticks': self.ticks, **({'operator_events': self.operator_events} if self.operator_events else {})}
 
 
 def entered_step(trace: Trace, state: State, parts: list[Part], snapshot: dict,
@@ -175,13 +188,14 @@ class Executive:
     def __init__(self, states, robot: Robot, mapping: StateMapping, max_robot_time: float = 600.0,
                  max_states: int = 500, max_wall_time: float | None = None,
                  decide: Callable[[str, list[str]], str] | None = None,
-                 on_tick: Callable[[Robot], None] | None = None):
+                 on_tick: Callable[[Robot], None] | None = None, control: RuntimeControl | None = None):
         self.root = load_machine(states)
         self.robot, self.mapping = robot, mapping
         self.max_robot_time, self.max_states = max_robot_time, max_states
         self.wall_deadline = None if max_wall_time is None else time.monotonic() + max_wall_time
         self.decide = decide or (lambda path, outcomes: outcomes[0])
         self.on_tick = on_tick
+        self.control = control
         self.parts = {node.state_path: mapping.part(node) for state in self.root.states
                       for node in (state.states or (state,))}
         self.trace = Trace(sm_outcome_propositions=mapping.sm_outcome_propositions())
@@ -216,7 +230,8 @@ class Executive:
                 self.trace.outcome = target
                 snapshot = self.robot.snapshot()
                 return ExecutionResult(target, self.trace, snapshot['time'], self.min_pelvis,
-                                       self.fallen or bool(snapshot.get('fallen')), self.ticks, self.start_time)
+                                       self.fallen or bool(snapshot.get('fallen')), self.ticks, self.start_time,
+                                       list(self.control.events) if self.control else [])
             current = states[target]
 
     # one top-level state ------------------------------------------------------------------------
@@ -224,10 +239,19 @@ class Executive:
     def _run_state(self, state: State) -> str:
         parts = [self.parts[node.state_path] for node in (state.states or (state,))]
         step = entered_step(self.trace, state, parts, self.robot.snapshot(), self.tracker)
+        if self.control:
+            self._ask_inputs(parts)
         self._activate(step.capabilities)
         sensors_at_entry = dict(self.tracker.sensors)
         returned: dict[str, str] = {}          # part path -> state outcome returned
         while True:
+            forced = self._forced(state, parts)
+            if forced is not None:
+                path, forced_outcome = forced
+                if path == state.state_path:
+                    outcome = forced_outcome
+                    break
+                returned[path] = forced_outcome
             for part in parts:
                 if part.node.state_path not in returned:
                     outcome = self._returned(part, sensors_at_entry)
@@ -235,12 +259,51 @@ class Executive:
                         returned[part.node.state_path] = outcome
             outcome = self._state_outcome(state, returned)
             if outcome is not None:
+                outcome = self._confirmed(state, outcome)
                 break
             self._tick(step)
         snapshot = self.robot.snapshot()
         step.ended_at, step.mode_at_exit = snapshot['time'], snapshot['mode']
         step.outcomes_at_exit = self.tracker.true_propositions()
         return outcome
+
+    # the operator (RuntimeControl) -------------------------------------------------------------
+
+    def _forced(self, state: State, parts: list[Part]) -> tuple[str, str] | None:
+        """Between robot steps: the operator's commands (pause holds here, stop raises) and an
+        outcome forced for ``state`` or one of its children, if one of theirs."""
+        if not self.control:
+            return None
+        self.control.between_ticks(state.state_path, self.wall_deadline)  # run() adds the trace to errors
+        nodes = {node.state_path: node for node in (state, *(p.node for p in parts))}
+        forced = self.control.take_forced(nodes)
+        if forced is not None and forced[1] not in nodes[forced[0]].outcomes:
+            self.control.events.append({'command': 'refused', 'reason': f'{forced[1]!r} is no outcome of '
+                                                                        f'{forced[0]!r}'})
+            return None
+        return forced
+
+    def _confirmed(self, state: State, outcome: str) -> str:
+        """``outcome``, or what the operator chose instead, once its transition may be taken."""
+        if not self.control:
+            return outcome
+        index = state.outcomes.index(outcome) if outcome in state.outcomes else -1
+        required = state.autonomy[index] if 0 <= index < len(state.autonomy) else 0
+        return self.control.confirm(state.state_path, outcome, required, list(state.outcomes), self.wall_deadline)
+
+    def _ask_inputs(self, parts: list[Part]) -> None:
+        """Ask the operator for the data of each InputState among ``parts`` before they start."""
+        for part in parts:
+            if part.kind != 'capability' or part.node.state_class != INPUT_STATE_CLASS:
+                continue
+            if part.capability in self.running and self.running[part.capability].result is None:
+                continue  # still running from the previous state: already answered
+            default_of = getattr(self.robot, 'input_default', None)
+            default = default_of(part.capability) if default_of else None
+            value = self.control.ask_input(part.node.state_path, input_prompt(part.node), default, self.wall_deadline)
+            give = getattr(self.robot, 'give_input', None)
+            if give:
+                give(part.capability, value)
 
     def _activate(self, capabilities: list[str]) -> None:
         """Start the state's capabilities, keeping those still running from the previous state."""
@@ -320,6 +383,18 @@ class Executive:
         self.abandoned = [r for r in self.abandoned if r.result is None]
 
 
+def input_prompt(node: State) -> str:
+    """What an InputState asks: its ``message`` parameter (a Python literal), or its name."""
+    if 'message' in node.parameter_names:
+        text = node.parameter_values[node.parameter_names.index('message')]
+        try:
+            value = ast.literal_eval(text)
+        except (ValueError, SyntaxError):
+            value = text
+        return str(value)
+    return node.name
+
+
 def execute_state_machine(states, robot: Robot, system: RobotSystem | str = 'atlas', **options) -> ExecutionResult:
     """Run ``states`` on ``robot`` until an SM outcome; returns the outcome and the trace.
 
@@ -328,7 +403,8 @@ def execute_state_machine(states, robot: Robot, system: RobotSystem | str = 'atl
 
     ``options``: ``max_robot_time`` (s, default 600), ``max_states`` (default 500),
     ``max_wall_time`` (s, default none),
-    ``decide(path, outcomes) -> outcome`` for operator decisions, ``on_tick(robot)``.
+    ``decide(path, outcomes) -> outcome`` for operator decisions, ``on_tick(robot)``,
+    ``control`` (a :class:`RuntimeControl`: the operator in the loop).
     Raises :class:`ExecutionError` subclasses (with ``item`` and the partial ``trace``).
     """
     return Executive(states, robot, StateMapping(generation_system(system)), **options).run()

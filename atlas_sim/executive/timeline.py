@@ -52,8 +52,29 @@ def capability_bars(trace: Trace) -> list[tuple[str, float, float, str | None]]:
     return bars
 
 
+#: Characters of a title line: a 10-inch figure holds about 110 of matplotlib's 12 pt title.
+TITLE_LINE_CHARACTERS = 100
+
+
+def wrapped_title(title: str, width: int = TITLE_LINE_CHARACTERS) -> str:
+    """``title`` broken into lines at spaces, so that a long goal list is not cut at both ends."""
+    import textwrap
+    return '\n'.join(textwrap.wrap(title, width)) or title
+
+
 def plot_timeline(trace: Trace, path: str | Path, title: str = '') -> Path:
     """Draw the timeline of ``trace`` into the PNG file ``path``."""
+    figure = timeline_figure(trace, title)
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    figure.savefig(path, dpi=100)
+    import matplotlib.pyplot as plt
+    plt.close(figure)
+    return path
+
+
+def timeline_figure(trace: Trace, title: str = ''):
+    """The matplotlib figure of :func:`plot_timeline` (the caller closes it)."""
     import matplotlib
 
     matplotlib.use('Agg')
@@ -76,10 +97,6 @@ def plot_timeline(trace: Trace, path: str | Path, title: str = '') -> Path:
     axes.set_yticks(range(len(rows)), rows)
     axes.invert_yaxis()
     axes.set_xlabel('robot time (s)')
-    axes.set_title(title or f'outcome: {trace.outcome}')
+    axes.set_title(wrapped_title(title or f'outcome: {trace.outcome}'))
     figure.tight_layout()
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    figure.savefig(path, dpi=100)
-    plt.close(figure)
-    return path
+    return figure

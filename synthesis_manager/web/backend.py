@@ -15,6 +15,7 @@ from collections import OrderedDict
 from pathlib import Path
 from typing import Callable
 
+from atlas_sim.executive.runtime_control import AUTONOMY_LEVELS, FULL, CommandError, checked_command
 from ltl_specification.diagnosis import goal_findings, impossible_next_goals
 from ltl_specification.capability_precheck import clause_text
 from ltl_specification.repair_process import RepairSearch, RepairSearchError, repair_settings
@@ -94,6 +95,7 @@ class SynthesisBackend:
         self._counter = itertools.count(1)
         self._simulations: dict[str, Simulation] = {}
         self._simulation_processes: set[SimulationProcess] = set()
+        self._simulation_children: dict[str, SimulationProcess] = {}   # running simulation id -> its child
         self._simulation_dir = tempfile.TemporaryDirectory(prefix='behavior-synthesis-gui-')
         self.can_simulate = simulation_available()
 
@@ -335,10 +337,14 @@ class SynthesisBackend:
         """Run the state machine of a finished job on atlas_sim's simulated robot."""
         job = self._job(job_id)
         body = checked_body({} if body is None else body)
-        unknown = sorted(set(body) - {'fail_first'})
+        unknown = sorted(set(body) - {'fail_first', 'autonomy'})
         if unknown:
-            raise InvalidJobRequestError(f'unknown field {quoted(unknown[0])} (fields: fail_first)', unknown[0])
+            raise InvalidJobRequestError(f'unknown field {quoted(unknown[0])} (fields: fail_first, autonomy)',
+                                         unknown[0])
         fail_first = names_field(body, 'fail_first')
+        autonomy = body.get('autonomy', FULL)
+        if autonomy not in AUTONOMY_LEVELS.values() or isinstance(autonomy, bool):
+            raise InvalidJobRequestError('autonomy is 0 (Off), 1 (Low), 2 (High) or 3 (Full)', 'autonomy')
         if not self.can_simulate:
             raise NotAvailableError('simulation needs atlas_sim and MuJoCo, which are not installed',
                                     'atlas_sim')
@@ -351,7 +357,8 @@ class SynthesisBackend:
         support = self.simulation_support(robot)
         if not support['available']:
             raise NotAvailableError(support['note'], job.request.system)
-        simulation = Simulation(id=f'{job_id}-sim{next(self._counter)}', job_id=job_id, fail_first=fail_first)
+        simulation = Simulation(id=f'{job_id}-sim{next(self._counter)}', job_id=job_id, fail_first=fail_first,
+                                operator={'autonomy': autonomy, 'paused': False, 'waiting': None})
         with self._lock:
             self._admit_simulation(job_id)
             self._simulations[simulation.id] = simulation
@@ -416,31 +423,51 @@ class SynthesisBackend:
             'system': robot.name, 'files': dict(robot.files), 'config_file': robot.config_file,
             'initial_conditions': list(request.initial_conditions), 'goals': list(request.goals),
             'ordered': not request.unordered, 'fail_first': list(simulation.fail_first),
-            'record_dir': str(self._record_dir(simulation.id)), 'max_robot_time': 300.0, 'max_wall_time': 300.0})
+            'record_dir': str(self._record_dir(simulation.id)), 'max_robot_time': 300.0, 'max_wall_time': 300.0,
+            'autonomy': simulation.operator['autonomy']})
         with self._lock:
             self._simulation_processes.add(child)
+            self._simulation_children[simulation.id] = child
         if self.stopping.is_set():
             child.stop()
 
         def progress(update):
             simulation.robot_time = update['robot_time']
-            self._update(simulation, steps=update['steps'], frames=[Path(path) for path in update['frames']])
+            self._update(simulation, steps=update['steps'], frames=[Path(path) for path in update['frames']],
+                         operator=update.get('operator') or simulation.operator)
 
         try:
             final = child.run(progress)
         finally:
             with self._lock:
                 self._simulation_processes.discard(child)
+                self._simulation_children.pop(simulation.id, None)
         if 'result' in final:
             result = final['result']
             simulation.robot_time = result['robot_time']
             self._update(simulation, outcome=result['outcome'], check=result['check'], steps=result['steps'],
                          timeline_png=Path(result['timeline']) if result['timeline'] else None,
-                         frames=[Path(path) for path in result['frames']])
+                         frames=[Path(path) for path in result['frames']],
+                         operator_events=result.get('operator_events', []))
         else:
             self._update(simulation, error=final['error'],
-                         steps=simulation.steps if final['steps'] is None else final['steps'])
-        self._update(simulation, state='finished', wall_seconds=time.monotonic() - started)
+                         steps=simulation.steps if final['steps'] is None else final['steps'],
+                         frames=[Path(path) for path in final['frames']] if final.get('frames') else simulation.frames)
+        self._update(simulation, state='finished', wall_seconds=time.monotonic() - started,
+                     operator={**simulation.operator, 'waiting': None, 'paused': False})
+
+    def simulation_command(self, simulation_id: str, body) -> Simulation:
+        """Pass an operator command (atlas_sim.executive.runtime_control) to a running simulation."""
+        simulation = self._simulation(simulation_id)
+        try:
+            command = checked_command(checked_body({} if body is None else body))
+        except CommandError as error:
+            raise InvalidJobRequestError(str(error), 'command') from None
+        with self._lock:
+            child = self._simulation_children.get(simulation_id)
+        if child is None or simulation.state == 'finished' or not child.command(command):
+            raise NotAvailableError(f'simulation {quoted(simulation_id)} is not running', simulation_id)
+        return simulation
 
     def _job(self, job_id: str) -> Job:
         with self._lock:

@@ -20,6 +20,7 @@
     POST /api/jobs/{id}/simulations          run the job's state machine on the simulated robot
     GET  /api/simulations/{id}               its trace so far, frames, outcome and trace check
     GET  /api/simulations/{id}/events        the same as server-sent events until the run ends
+    POST /api/simulations/{id}/control       an operator command to the running run (Runtime Control)
     GET  /api/simulations/{id}/frames/{n}    key frame n (PNG); .../timeline.png the timeline plot
 
 Bad input is answered with a 4xx JSON body ``{"error", "item", "message"}`` whose ``item``
@@ -167,6 +168,10 @@ def create_app(backend) -> FastAPI:
         backend.simulation_status(simulation_id)
         return _event_stream(request, lambda: backend.simulation_revision(simulation_id),
                              lambda: backend.simulation_status(simulation_id).to_dict(), _stopping(backend))
+
+    @app.post('/api/simulations/{simulation_id}/control', status_code=202)
+    def simulation_command(simulation_id: str, body=Body(None)):
+        return backend.simulation_command(simulation_id, body).to_dict()
 
     @app.get('/api/simulations/{simulation_id}/frames/{index}')
     def simulation_frame(simulation_id: str, index: int):

@@ -8,8 +8,15 @@ are added, then one final message. Frames and the timeline are files in the run'
 directory, passed by path. The child is killed when the GUI stops the run or it overruns its
 wall-time limit, and ends by itself when the GUI dies, so no run outlives the GUI.
 
+The operator is in the loop (FlexBE's Runtime Control, ``atlas_sim.executive.runtime_control``):
+``run.command({...})`` from another thread reaches the run's RuntimeControl through the child's
+command channel, and each progress message says what the run waits for (``operator``). The
+run starts at ``settings['autonomy']`` (default Full: nothing in the configs waits then, so an
+untouched run is the unattended one).
+
     run = SimulationProcess(settings)       # in the GUI, one thread per run
     final = run.run(on_progress)            # run.stop() from another thread ends it
+    run.command({'command': 'force', 'state': '/stand', 'outcome': 'failed'})
 """
 
 from __future__ import annotations
@@ -17,8 +24,10 @@ from __future__ import annotations
 import dataclasses
 import logging
 import time
+from pathlib import Path
 from typing import Callable
 
+from atlas_sim.executive.runtime_control import FULL, RuntimeControl
 from ltl_synthesizer.errors import SynthesisError
 from ltl_synthesizer.isolated import ChildProcess
 from respec.errors import INTERNAL_ERROR, CodedError
@@ -45,7 +54,7 @@ class SimulationProcess:
         self.process = self.child.process
 
     def run(self, on_progress: Callable[[dict], None]) -> dict:
-        """Wait for the run, calling ``on_progress({'robot_time', 'steps', 'frames'})`` as it
+        """Wait for the run, calling ``on_progress({'robot_time', 'steps', 'frames', 'operator'})`` as it
         advances; return its final message, ``{'result': {...}}`` or ``{'error': {'code', 'item',
         'message'}, 'steps': [...] or None}``, also when the child dies or is stopped."""
         last_steps = None
@@ -56,7 +65,7 @@ class SimulationProcess:
             on_progress(update)
 
         try:
-            return self.child.call(simulate, (self.settings,), on_progress=progress,
+            return self.child.call(simulate, (self.settings,), on_progress=progress, wants_commands=True,
                                    deadline=time.monotonic() + self.settings['max_wall_time'] + KILL_GRACE)
         except SynthesisError:  # the child died, was stopped or overran its time
             pass
@@ -67,26 +76,42 @@ class SimulationProcess:
                                      'without a result'},
                 'steps': last_steps}
 
+    def command(self, command: dict) -> bool:
+        """Send an operator command (checked by the caller) to the run; False once it has ended."""
+        return self.child.command(command)
+
     def stop(self) -> None:
         """End the child now, from any thread (the GUI stops): run() returns the error message."""
         if self.process.poll() is None:
             self.process.kill()
 
 
-def simulate(settings: dict, progress: Callable[[dict], None]) -> dict:
-    """In the child: run the machine on atlas_sim's robot, reporting ``progress``; the final message."""
-    simulator, sent = None, [0, 0]
+def simulate(settings: dict, progress: Callable[[dict], None], commands: Callable[[float], list] | None = None) -> dict:
+    """In the child: run the machine on atlas_sim's robot with the operator's ``commands``,
+    reporting ``progress``; the final message."""
+    simulator, executive, sent = None, None, [0, 0, None]
+    frames_dir = Path(settings['record_dir']) / 'frames'
+    listed = [0.0, []]
 
-    def step_added(steps, frames):  # every control tick: report only when a step or frame was added
-        if (len(steps), len(frames)) != tuple(sent):
-            sent[:] = [len(steps), len(frames)]
+    def frames(now: bool = False) -> list[str]:  # the recorder's files so far, looked up 20 times a second
+        if now or time.monotonic() - listed[0] > 0.05:
+            listed[:] = [time.monotonic(), recorded_frames(frames_dir)]
+        return listed[1]
+
+    def report(force: bool = False):  # only when a step, a frame or the operator's view changed
+        steps = executive.trace.steps if executive else []
+        found = frames(force)
+        operator = control.status() if control else None
+        if force or (len(steps), len(found), operator) != tuple(sent):
+            sent[:] = [len(steps), len(found), operator]
             progress({'robot_time': simulator.time, 'steps': [dataclasses.asdict(s) for s in steps],
-                      'frames': [str(path) for path in frames]})
+                      'frames': found, 'operator': operator})
 
+    control = RuntimeControl(commands, report=lambda status: report(force=True),
+                             autonomy_level=settings.get('autonomy', FULL)) if commands else None
     try:
-        from pathlib import Path
-
         from atlas_sim.closed_loop import run_and_check
+        from atlas_sim.executive.executor import Executive, StateMapping
         from atlas_sim.simulated_robot import SimulatedRobot
         from atlas_sim.simulator.factory import make_simulator, parse_faults
         from respec.parsing import spec_from_text_sections
@@ -96,19 +121,43 @@ def simulate(settings: dict, progress: Callable[[dict], None]) -> dict:
         system = robot_system_from_files(settings['system'], settings['files'], settings['config_file'])
         simulator = make_simulator(system, settings['initial_conditions'],
                                    faults=parse_faults(fail_first=[f'{c}:1' for c in settings['fail_first']]))
-        run = run_and_check(settings['states'], SimulatedRobot(simulator), simulator, system,
+        robot = SimulatedRobot(simulator)
+
+        def run_machine(tick):  # our Executive, with the operator in the loop
+            nonlocal executive
+
+            def on_tick(robot_now):
+                tick(robot_now)
+                report()
+            executive = Executive(settings['states'], robot, StateMapping(system),
+                                  max_robot_time=settings['max_robot_time'], max_wall_time=settings['max_wall_time'],
+                                  on_tick=on_tick, control=control)
+            return executive.run()
+
+        run = run_and_check(settings['states'], robot, simulator, system,
                             spec_from_text_sections(settings['ltl_specification']), settings['goals'],
                             ordered=settings['ordered'], record_dir=Path(settings['record_dir']),
                             max_robot_time=settings['max_robot_time'],
-                            max_wall_time=settings['max_wall_time'], on_progress=step_added)
+                            max_wall_time=settings['max_wall_time'], run_machine=run_machine)
         return {'result': {'outcome': run.result.outcome, 'check': run.check.to_dict(),
                            'timeline': str(run.timeline) if run.timeline else None,
                            'frames': [str(path) for path in run.frames], 'robot_time': simulator.time,
-                           'steps': [dataclasses.asdict(step) for step in run.result.trace.steps]}}
+                           'steps': [dataclasses.asdict(step) for step in run.result.trace.steps],
+                           'operator_events': run.result.operator_events}}
     except Exception as error:  # ExecutionError, bad faults, rendering, a missing module: reported to the GUI
         if not isinstance(error, CodedError):
             logger.exception('simulation failed')
         trace = getattr(error, 'trace', None)
         return {'error': {'code': error.code if isinstance(error, CodedError) else INTERNAL_ERROR,
                           'item': getattr(error, 'item', ''), 'message': str(error)},
-                'steps': [dataclasses.asdict(step) for step in trace.steps] if trace else None}
+                'steps': [dataclasses.asdict(step) for step in trace.steps] if trace else None,
+                'frames': frames(now=True)}
+
+
+def recorded_frames(directory: Path) -> list[str]:
+    """The frame files in ``directory`` in the order they were taken (their names start with
+    their index)."""
+    if not directory.is_dir():
+        return []
+    files = [path for path in directory.iterdir() if path.suffix == '.png' and path.name.split('_', 1)[0].isdigit()]
+    return [str(path) for path in sorted(files, key=lambda path: int(path.name.split('_', 1)[0]))]

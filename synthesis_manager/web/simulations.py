@@ -23,6 +23,8 @@ class Simulation:
     error: dict | None = None          # {'code', 'item', 'message'} if the run broke off
     check: dict | None = None          # atlas_sim trace check report
     wall_seconds: float = 0.0
+    operator: dict = field(default_factory=dict)   # RuntimeControl status: autonomy, paused, waiting
+    operator_events: list[dict] = field(default_factory=list)  # the operator's commands, once finished
     revision: int = 0
 
     def to_dict(self) -> dict:
@@ -30,7 +32,8 @@ class Simulation:
                 'state': self.state, 'steps': list(self.steps), 'robot_time': round(self.robot_time, 3),
                 'frames': [{'index': i, 'label': p.stem} for i, p in enumerate(self.frames)],
                 'timeline': self.timeline_png is not None, 'outcome': self.outcome,
-                'error': self.error, 'check': self.check, 'wall_seconds': round(self.wall_seconds, 3)}
+                'error': self.error, 'check': self.check, 'wall_seconds': round(self.wall_seconds, 3),
+                'operator': self.operator, 'operator_events': list(self.operator_events)}
 
 
 def simulation_available() -> bool:

@@ -236,3 +236,38 @@ def test_work_without_limits_of_its_own_is_killed_beyond_the_callers_memory_limi
     assert refused.value.item == 'memory_limit' and 'memory limit of 64 MB' in str(refused.value)
     assert time.monotonic() - started < 10 and child not in children_of_this_process()
     assert processes.call(exec, (grow_and_wait(16, 0.0), {}), memory_limit=64 * 2**20) is None  # a fresh child
+
+
+def echo_commands(count: int, progress, commands):
+    """In the child: report that it runs, then each command the caller sends, until ``count`` have come."""
+    received = []
+    progress({'n': -1})
+    while len(received) < count:
+        for value in commands(5.0):
+            received.append(value)
+            progress(value)
+    return received
+
+
+def test_commands_reach_the_running_work_and_late_ones_are_dropped(monkeypatch):
+    from ltl_synthesizer.isolated import ChildProcess
+    # The child imports this module to find echo_commands.
+    monkeypatch.setenv('PYTHONPATH', os.pathsep.join([str(Path(__file__).parent), os.environ.get('PYTHONPATH', '')]))
+    child = ChildProcess(preload='ltl_synthesizer.isolated')
+    try:
+        seen = []
+
+        def progress(value):  # answer each report with the next command, from another thread
+            seen.append(value)
+            threading.Thread(target=child.command, args=({'n': value['n'] + 1},)).start()
+
+        assert child.command({'n': -5})  # before the work: dropped
+        assert child.call(echo_commands, (3,), on_progress=progress, wants_commands=True,
+                          deadline=time.monotonic() + 30) == [{'n': 0}, {'n': 1}, {'n': 2}]
+        assert seen == [{'n': -1}, {'n': 0}, {'n': 1}, {'n': 2}]
+        time.sleep(0.2)  # the command sent after the third report arrives after the work ended
+        assert child.call(operator.add, (2, 3), deadline=time.monotonic() + 30) == 5
+        assert child.call(operator.add, (1, 1), deadline=time.monotonic() + 30) == 2
+    finally:
+        child.kill()
+    assert child.command({'n': 9}) is False  # the child is gone

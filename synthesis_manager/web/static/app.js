@@ -12,6 +12,7 @@
 //   state_details.js  the panel explaining a clicked state
 //   simulation.js     the closed-loop simulation view
 //   frames.js         its key frames and their player
+//   runtime_control.js the operator's side of a run (autonomy, confirm, force, input, pause, stop)
 //   repair.js         "Suggest fixes" for a refused job, and applying one
 //   play.js           playing a finished job: the environment against its machine, or the robot
 // This module only connects the page's controls to them and starts the page.
@@ -21,6 +22,7 @@ import { playFrames, showFrame, stopPlaying } from './frames.js';
 import { cancel, synthesize } from './job.js';
 import { back, closePlay, playKeys, reset, startPlay } from './play.js';
 import { onApplyFix, suggestFixes } from './repair.js';
+import { connectRuntimeControl } from './runtime_control.js';
 import { simulate } from './simulation.js';
 import { loadVocabulary } from './vocabulary.js';
 
@@ -31,6 +33,7 @@ $('cancel').addEventListener('click', cancel);
 $('simulate').addEventListener('click', () => { closePlay(); simulate(); });
 $('frame-scrubber').addEventListener('input', (event) => { stopPlaying(); showFrame(Number(event.target.value)); });
 $('play-frames').addEventListener('click', playFrames);
+connectRuntimeControl();
 $('behavior-name').addEventListener('input', () => $('behavior-name-hint').classList.remove('bad'));
 $('initial-conditions').addEventListener('change', checkGoals);
 $('unordered').addEventListener('change', checkGoals);

@@ -215,6 +215,20 @@ function outcomeBox(name, stateName) {
     || document.getElementById(`outcome:${name}`);
 }
 
+// Highlight the outcome of ``waiting`` ({state, outcome}: a transition waiting for the
+// operator's confirmation) in its state's outcome cells; null: none waits.
+export function markPending(waiting) {
+  if (!svg) return;
+  svg.querySelectorAll('.pending').forEach((g) => g.classList.remove('pending'));
+  if (!waiting) return;
+  const node = document.getElementById(`state:${waiting.state.split('/')[1]}`);
+  if (!node) return;
+  node.classList.add('pending');
+  node.querySelectorAll('text').forEach((text) => {
+    if (text.textContent.split(',').map((name) => name.trim()).includes(waiting.outcome)) text.classList.add('pending');
+  });
+}
+
 export function clear() { svg = null; viewport = null; machine = null; }
 
 // During a play the active state's outcome cells can be clicked: ``picker(names)`` gets the

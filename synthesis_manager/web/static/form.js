@@ -1,5 +1,6 @@
 // The request form: the system's own names to choose from, the ordered goal list with the
 // server's live goal check, and the request it makes. It owns the chosen system's choices.
+import { showAbstraction } from './abstraction.js';
 import { api } from './api.js';
 import { $, element } from './dom.js';
 import { vocabulary } from './vocabulary.js';
@@ -70,6 +71,7 @@ export function simulationSupport() {
 // achieved) and say so in the picker and the list, before anything is synthesized.
 export async function checkGoals() {
   const request = currentRequest();
+  showAbstraction(choices, request);
   const number = ++goalChecks;
   let check;
   try {
@@ -95,6 +97,24 @@ export async function checkGoals() {
     item.classList.toggle('impossible', Boolean(finding));
     item.querySelector('.goal-warning').textContent = finding ? finding.sentence : '';
   }
+  const flagged = $('goals').querySelector('li.impossible');
+  if (flagged) revealInForm(flagged);
+}
+
+// The controls below the fields grow as a job goes on: a flagged goal (else the last goal)
+// stays in view.
+new ResizeObserver(() => {
+  const shown = $('goals').querySelector('li.impossible') || $('goals').lastElementChild;
+  if (shown) revealInForm(shown);
+}).observe($('form-fields'));
+
+// Scroll the form's fields (not the page) so that ``item`` is in view above the controls.
+function revealInForm(item) {
+  const fields = $('form-fields');
+  const area = fields.getBoundingClientRect();
+  const box = item.getBoundingClientRect();
+  if (box.bottom > area.bottom) fields.scrollTop += box.bottom - area.bottom + 8;
+  else if (box.top < area.top) fields.scrollTop -= area.top - box.top + 8;
 }
 
 // The control modes that can change to ``mode`` (its own self-loop aside).
@@ -120,7 +140,9 @@ function goalItem(name) {
 export function addGoal() {
   const name = $('goal-choice').value;
   if (!name) return;
-  $('goals').append(goalItem(name));
+  const item = goalItem(name);
+  $('goals').append(item);
+  revealInForm(item);
   updateGoalsHint();
 }
 

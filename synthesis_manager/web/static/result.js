@@ -26,6 +26,7 @@ export function resetResult() {
 // synthesizer's own account) goes into a collapsed "Details".
 export function showBanner(code, message, good) {
   $('result').hidden = false;
+  $('abstraction').open = false;  // folded to one line above the result (a click opens it)
   $('result-banner').className = `banner ${good === null ? 'neutral' : good ? 'good' : 'bad'}`;
   $('result-code').textContent = code;
   const [sentence, ...rest] = (message || '').split('\n');

@@ -5,6 +5,7 @@ import * as drawing from './drawing.js';
 import { $, element } from './dom.js';
 import { capabilityNames, simulationSupport } from './form.js';
 import { resetFrames, showFrames } from './frames.js';
+import { controlRun, startingAutonomy } from './runtime_control.js';
 import { vocabulary } from './vocabulary.js';
 
 let offeredJob = null;        // the job whose machine the Simulate button runs
@@ -29,6 +30,7 @@ export function offerSimulation(job) {
 // A new job is on its way: no run of the old one stays on the page.
 export function withdrawSimulation() {
   offeredJob = null;
+  $('simulation-controls').hidden = true;
   resetSimulation();
 }
 
@@ -55,7 +57,8 @@ export async function simulate() {
   const failing = $('fail-first').value;
   let simulation;
   try {
-    simulation = await api('POST', `/api/jobs/${offeredJob.id}/simulations`, { fail_first: failing ? [failing] : [] });
+    simulation = await api('POST', `/api/jobs/${offeredJob.id}/simulations`,
+      { fail_first: failing ? [failing] : [], autonomy: startingAutonomy() });
   } catch (error) {
     $('simulation-status').textContent = `${error.code}: ${error.message}`;
     $('simulate').disabled = false;
@@ -81,8 +84,10 @@ export async function simulate() {
 function showSimulation(simulation) {
   const base = `/api/simulations/${simulation.id}`;
   const running = simulation.state !== 'finished';
+  const waiting = simulation.operator && simulation.operator.waiting;
   let status = simulation.steps.length === 0 ? 'Starting the simulator…'
     : `Running: ${simulation.steps.length} states, robot time ${simulation.robot_time.toFixed(2)} s`;
+  if (running && waiting) status += waiting.kind === 'resume' ? ' (paused)' : ' (waiting for you)';
   let outcomeClass = '';
   if (!running) {
     status = simulation.error
@@ -117,7 +122,8 @@ function showSimulation(simulation) {
       outcomeCell(step),
       element('td', { text: `${step.entered_at.toFixed(2)}–${step.ended_at.toFixed(2)}` }))));
   drawing.markRun(simulation.steps, running);
-  showFrames(base, simulation.frames);
+  controlRun(simulation);
+  showFrames(base, simulation.frames, simulation.steps, running);
   if (simulation.check) {
     const check = simulation.check;
     $('simulation-check').textContent = check.ok

@@ -6,8 +6,9 @@ import { vocabulary } from './vocabulary.js';
 
 export function showStateDetails(state) {
   const panel = $('state-details');
+  panel.hidden = !state;  // it floats over the drawing's corner, where a click shows it
   if (!state) {
-    panel.replaceChildren(element('p', { className: 'muted', text: 'Click a state to see its class, parameters, userdata, outcomes and autonomy.' }));
+    panel.replaceChildren();
     return;
   }
   const { state_classes: classes, autonomy_levels: levels } = vocabulary();
@@ -18,7 +19,11 @@ export function showStateDetails(state) {
   const userdata = state.userdata_keys.map((k, i) => `${k} ← ${state.userdata_remapping[i] || k}`);
   const outcomes = state.outcomes.map((o, i) => element('li', { text: `${o} → ${state.transitions[i]}` +
     (state.autonomy.length ? ` (autonomy ${levels[state.autonomy[i]] ?? state.autonomy[i]})` : '') }));
+  const close = element('button', { type: 'button', className: 'small close', 'aria-label': 'close the state details',
+    title: 'close', text: '×' });
+  close.addEventListener('click', () => showStateDetails(null));
   panel.replaceChildren(
+    close,
     element('h3', { text: state.state_path.replace(/^\//, '') }),
     element('table', { className: 'details' },
       row('Class', className),
@@ -26,4 +31,25 @@ export function showStateDetails(state) {
       row('Userdata', userdata.join(', ') || '—'),
       row('Outcomes', element('ul', {}, ...outcomes)),
       ...(state.children.length ? [row('Contains', state.children.map((c) => `${c.name} (${c.state_class})`).join(', '))] : [])));
+  fitInWindow(panel);
+  besideTheState(panel, state);
+}
+
+// The panel on the side of the drawing the clicked state is not on.
+function besideTheState(panel, state) {
+  panel.classList.remove('left');
+  const node = document.getElementById(`state:${state.name}`);
+  if (!node) return;
+  const box = node.getBoundingClientRect();
+  const area = panel.getBoundingClientRect();
+  const overlaps = box.right > area.left && box.left < area.right && box.bottom > area.top && box.top < area.bottom;
+  if (overlaps) panel.classList.add('left');
+}
+
+// The panel no taller than the part of the window below its top: all of it in view, scrolling inside.
+function fitInWindow(panel) {
+  panel.style.maxHeight = '';
+  const top = panel.getBoundingClientRect().top;
+  const room = window.innerHeight - Math.max(0, top) - 8;
+  if (panel.offsetHeight > room) panel.style.maxHeight = `${Math.max(80, room)}px`;
 }

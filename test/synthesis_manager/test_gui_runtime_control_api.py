@@ -1,0 +1,60 @@
+"""The operator in the loop over the GUI's API: autonomy, confirmations, forced outcomes,
+InputState answers and stop reach the simulation's child while it runs."""
+
+import json
+
+from test_gui_api import PAPER_TASK, backend, client, follow_simulation, run_job  # noqa: F401
+
+
+def operate(client, simulation_id, answer):
+    """Follow the run; ``answer(waiting) -> command`` for each thing it waits for. The final run."""
+    answered, last = set(), None
+    with client.stream('GET', f'/api/simulations/{simulation_id}/events', timeout=300) as response:
+        for line in response.iter_lines():
+            if not line.startswith('data: '):
+                continue
+            last = json.loads(line[len('data: '):])
+            waiting = (last.get('operator') or {}).get('waiting')
+            key = json.dumps([len(last['steps']), waiting], sort_keys=True)
+            if waiting and key not in answered:
+                answered.add(key)
+                sent = client.post(f'/api/simulations/{simulation_id}/control', json=answer(waiting))
+                assert sent.status_code == 202, sent.text
+    return last
+
+
+def test_high_autonomy_waits_for_confirmations_and_robot_time_does_not_count_the_wait(client):
+    _, job = run_job(client, PAPER_TASK)
+    unattended = follow_simulation(client, client.post(f"/api/jobs/{job['id']}/simulations", json={}).json()['id'])
+    assert unattended['operator']['autonomy'] == 3 and unattended['outcome'] == 'finished'
+    started = client.post(f"/api/jobs/{job['id']}/simulations", json={'autonomy': 2}).json()
+    asked = []
+    run = operate(client, started['id'], lambda waiting: asked.append(waiting) or (
+        {'command': 'input', 'state': waiting['state'], 'value': waiting['default']} if waiting['kind'] == 'input'
+        else {'command': 'confirm', 'state': waiting['state']}))
+    assert run['outcome'] == 'finished' and run['check']['ok'] is True
+    assert {w['kind'] for w in asked} == {'confirm', 'input'}
+    assert all(w['required'] >= 2 for w in asked if w['kind'] == 'confirm')
+    assert [s['state'] for s in run['steps']] == [s['state'] for s in unattended['steps']]
+    assert abs(run['robot_time'] - unattended['robot_time']) < 0.05
+    assert [e['command'] for e in run['operator_events']] == [w['kind'] for w in asked]
+
+
+def test_a_forced_outcome_and_an_aborted_input_change_the_run_and_stop_ends_it(client):
+    _, job = run_job(client, PAPER_TASK)
+    started = client.post(f"/api/jobs/{job['id']}/simulations", json={'autonomy': 0}).json()
+
+    def fail_first_wait(waiting):
+        if waiting['kind'] == 'input':
+            return {'command': 'input', 'state': waiting['state'], 'value': None}
+        return {'command': 'force', 'state': waiting['state'], 'outcome': waiting['outcomes'][-1]}
+    run = operate(client, started['id'], fail_first_wait)
+    assert run['outcome'] == 'failed' and run['operator_events']
+
+    started = client.post(f"/api/jobs/{job['id']}/simulations", json={'autonomy': 0}).json()
+    run = operate(client, started['id'], lambda waiting: {'command': 'stop'})
+    assert run['error']['code'] in ('PREEMPTED', -9) and 'the operator stopped the run' in run['error']['message']
+    assert client.post(f"/api/simulations/{run['id']}/control", json={'command': 'pause'}).status_code == 409
+    bad = client.post(f"/api/simulations/{run['id']}/control", json={'command': 'dance'})
+    assert bad.status_code == 422 and bad.json()['item'] == 'command'
+    assert client.post(f"/api/jobs/{job['id']}/simulations", json={'autonomy': 9}).status_code == 422

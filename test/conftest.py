@@ -148,3 +148,6 @@ def runaway_synthesis(monkeypatch):
     # The node's specification (from the request) is replaced; the rest runs as always,
     # the synthesis in the node's synthesis process.
     monkeypatch.setattr(ltl_synthesis_node, 'spec_from_text_sections', lambda sections: runaway)
+    # The strategy cache keys the request's text, which the substitution leaves as it was: an
+    # earlier answer to the same request must not stand in for the runaway.
+    monkeypatch.setattr(ltl_synthesis_node.LTLSynthesisNode, '_cache_key', lambda self, request: None)

@@ -6,6 +6,7 @@
 import { api } from './api.js';
 import * as drawing from './drawing.js';
 import { $ } from './dom.js';
+import { vocabulary } from './vocabulary.js';
 
 let run = null;       // {id, operator, active} of the run being controlled (null: none running)
 let picking = false;  // the drawing's outcome cells force this run's outcomes
@@ -57,7 +58,7 @@ function ask(waiting) {
   $('operator-confirm-row').hidden = waiting.kind !== 'confirm';
   $('operator-input-form').hidden = waiting.kind !== 'input';
   if (waiting.kind === 'confirm') {
-    const level = ['Off', 'Low', 'High', 'Full'][waiting.required] || String(waiting.required);
+    const level = vocabulary().autonomy_levels[waiting.required] || String(waiting.required);
     $('operator-question').textContent = `${state} returned “${waiting.outcome}”, a transition of ${level} ` +
       'autonomy: confirm it (or click its highlighted outcome), or click another outcome of the state to force it.';
   } else {
@@ -82,6 +83,13 @@ function forceFromDrawing(names) {
 function answer(value) {
   const waiting = run && run.operator.waiting;
   if (waiting && waiting.kind === 'input') command({ command: 'input', state: waiting.state, value });
+}
+
+// The autonomy selector's levels, as the server names them (Full, the unattended run, selected).
+export function fillAutonomyLevels() {
+  const levels = vocabulary().autonomy_levels;
+  $('autonomy').replaceChildren(...levels.map((name, level) => new Option(name, String(level), false,
+    level === levels.length - 1)));
 }
 
 export function connectRuntimeControl() {

@@ -45,7 +45,7 @@ CONDITION_SEPARATOR = '__'
 SENSOR_EVENT_SUFFIX = '_true'
 # The helper states' names (their classes: instantiation.DECISION_CLASS, NOTHING_CLASS).
 DECISION_NAME = 'choose_initial_state'
-DECISION_AUTONOMY = 3  # Full: the operator confirms where to start unless in full autonomy
+DECISION_AUTONOMY = 3  # Full: the operator confirms where to start at every level up to Full
 NOTHING_NAME = 'nothing_to_do'
 
 
@@ -250,8 +250,9 @@ def _helper_entry(state: MachineState, name: str, target_name) -> StateInstantia
         return StateInstantiation(
             state_path=f'/{name}', state_class=DECISION_CLASS,
             parameter_names=['outcomes', 'hint', 'suggestion'],
-            # The first start is suggested: FlexBE takes it in full autonomy (as our executive
-            # does), below that the operator confirms or picks another.
+            # The first start is suggested: an operator at any level up to Full confirms it or
+            # picks another (FlexBE waits on a transition whose autonomy is not below the level);
+            # unattended runs (FlexBE's level 255, our executive without an operator) take it.
             parameter_values=[repr(targets), '"Several initial states are possible: choose where to start"',
                               repr(targets[0])],
             outcomes=list(targets), transitions=list(targets), autonomy=[DECISION_AUTONOMY] * len(targets))

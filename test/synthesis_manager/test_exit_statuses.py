@@ -38,20 +38,29 @@ def started_server(command, environment):
     return process
 
 
+def stopped(process, stop_signal) -> tuple[int, float]:
+    """Send ``stop_signal`` to ``process``: its exit status and the seconds it took to exit."""
+    signalled = time.monotonic()
+    process.send_signal(stop_signal)
+    return process.wait(30), time.monotonic() - signalled
+
+
+def ended(process) -> None:
+    """Kill ``process`` if it is still running (a test that failed before stopping it)."""
+    if process.poll() is None:
+        process.kill()
+        process.wait()
+
+
 @pytest.mark.parametrize('command', ['serve', 'gui'])
 @pytest.mark.parametrize('stop_signal', [signal.SIGINT, signal.SIGTERM], ids=['SIGINT', 'SIGTERM'])
 def test_a_server_stopped_by_a_signal_exits_with_128_plus_its_number_within_three_seconds(command, stop_signal):
     with reserve_domain_id() as domain:
         process = started_server(command, prepare_ros_environment(domain, environ=dict(os.environ)))
         try:
-            signalled = time.monotonic()
-            process.send_signal(stop_signal)
-            status = process.wait(30)
-            seconds = time.monotonic() - signalled
+            status, seconds = stopped(process, stop_signal)
         finally:
-            if process.poll() is None:
-                process.kill()
-                process.wait()
+            ended(process)
     assert status == 128 + stop_signal == {signal.SIGINT: 130, signal.SIGTERM: 143}[stop_signal]
     assert seconds < STOP_WITHIN, f'{command} took {seconds:.2f} s to stop after {stop_signal.name}'
 
@@ -112,13 +121,8 @@ def test_a_gui_stopped_in_the_middle_of_a_simulation_exits_within_three_seconds(
                 assert time.monotonic() < deadline, 'the simulation recorded no frames'
                 time.sleep(0.1)
             assert httpx.get(f'{url}api/simulations/{simulation}').json()['state'] != 'finished'
-            signalled = time.monotonic()
-            process.send_signal(stop_signal)
-            status = process.wait(30)
-            seconds = time.monotonic() - signalled
+            status, seconds = stopped(process, stop_signal)
         finally:
-            if process.poll() is None:
-                process.kill()
-                process.wait()
+            ended(process)
     assert status == 128 + stop_signal
     assert seconds < STOP_WITHIN, f'the GUI took {seconds:.2f} s to stop after {stop_signal.name}'

@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import faulthandler
 import json
 import os
 import shutil
@@ -244,6 +245,9 @@ class Round:
     results: list
     expected: int
     fault: dict | None = None
+    #: Hosts whose client process, every answer written, did not exit within CLIENT_EXIT_GRACE
+    #: (its threads' stacks are in its log; it was killed).
+    hung_exits: list = field(default_factory=list)
 
     def duplicates(self) -> list:
         seen, repeated = set(), []
@@ -292,6 +296,8 @@ class Round:
                    'max_s': round(latencies[-1], 2) if latencies else None,
                    'wall_s': round(max(e['answered'] for e in self.results) - min(e['sent'] for e in self.results), 2)
                    if self.results else None}
+        if self.hung_exits:
+            figures['client processes that hung on exit'] = self.hung_exits
         if self.fault is not None:
             figures.update(fault=self.fault['fault'], recovery_s=self.recovery_seconds(),
                            **({'restart_s': self.fault['restart_seconds']} if 'restart_seconds' in self.fault else {}))
@@ -312,23 +318,40 @@ def run_round(fleet: Fleet, tag: str, clients: int, goals: int, interval: float,
     Clients are connected before a fault: a client process whose discovery was still under way
     when its host's cable was pulled once stayed without the server after the cable was back
     (Fast DDS 2.14; see docs/deployment.md), a case of its own, not the one measured here."""
-    started = [fleet.start_clients(host, count, goals, interval, tag)
+    started = [(host, *fleet.start_clients(host, count, goals, interval, tag))
                for host, count in clients_on_each_host(clients).items() if count]
     ready_by = time.monotonic() + 60.0
-    while not all(ready_marker(path).exists() for _, path in started) and time.monotonic() < ready_by:
+    while not all(ready_marker(path).exists() for _, _, path in started) and time.monotonic() < ready_by:
         time.sleep(0.02)
     fault_times = None
     if fault is not None:
         time.sleep(fault_after)
         fault_times = fault(fleet)
     deadline = time.monotonic() + timeout
-    for process, _ in started:
+    hung = []
+    for host, process, path in started:
+        while process.poll() is None and not done_marker(path).exists() and time.monotonic() < deadline:
+            time.sleep(0.05)
         try:
-            process.wait(timeout=max(1.0, deadline - time.monotonic()))
+            process.wait(timeout=CLIENT_EXIT_GRACE if done_marker(path).exists() else 1.0)
         except subprocess.TimeoutExpired:
+            if done_marker(path).exists():  # every answer is in: its exit hangs, say where
+                hung.append(host)
+                with contextlib.suppress(ProcessLookupError):
+                    os.kill(process.pid, signal.SIGUSR1)
+                time.sleep(0.5)
             kill_group(process)
-    results = [entry for _, path in started for entry in read_results(path)]
-    return Round(tag, results, clients * goals, fault_times)
+    results = [entry for _, _, path in started for entry in read_results(path)]
+    return Round(tag, results, clients * goals, fault_times, hung)
+
+
+#: Seconds a client process may take to exit once it has written every answer.
+CLIENT_EXIT_GRACE = 10.0
+
+
+def done_marker(results: Path) -> Path:
+    """The file a client process writes once every one of its goals has its answer written."""
+    return results.with_suffix('.done')
 
 
 def ready_marker(results: Path) -> Path:
@@ -390,6 +413,7 @@ def run_clients(host: int, clients: int, goals: int, interval: float, output: Pa
             thread.start()
         for thread in threads:
             thread.join()
+        done_marker(output).write_text(str(time.time()))
     return 0
 
 
@@ -403,6 +427,7 @@ def main(argv: list[str] | None = None) -> int:
     clients.add_argument('--interval', type=float, default=0.0)
     clients.add_argument('--output', type=Path, required=True)
     args = parser.parse_args(argv)
+    faulthandler.register(signal.SIGUSR1, all_threads=True)  # run_round asks where an exit hangs
     return run_clients(args.host, args.clients, args.goals, args.interval, args.output)
 
 

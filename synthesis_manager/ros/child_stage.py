@@ -24,13 +24,14 @@ import time
 from ltl_synthesizer import SynthesisCancelledError
 from ltl_synthesizer.errors import SynthesisMemoryError
 from ltl_synthesizer.isolated import SERVER_CHILD_NICENESS, SynthesisProcesses
-from respec.errors import ErrorCode
+from respec.errors import ControlFlowSignal, ErrorCode
 from synthesis_manager.ros.conversions import error_code
 from synthesis_manager.ros.worker_pool import Abandoned, WorkerPool, executor_waker
 
 
-class StageStopped(Exception):
-    """A request's work in a child ended without a value: ``error_code`` answers it."""
+class StageStopped(ControlFlowSignal):
+    """Not an error of the node: a request's work in a child was stopped by its time or memory
+    limit or by shutdown; ``error_code`` answers the request."""
 
     def __init__(self, error_code):
         super().__init__(error_code.message)

@@ -35,7 +35,7 @@ from respec.naming import DEFAULT_SM_OUTCOMES
 from respec.nesting import run_with_deep_stack
 from synthesis_manager.ros.child_stage import ChildStage, StageStopped
 from synthesis_manager.ros.conversions import error_code, msg_to_sections, sections_to_msg
-from synthesis_manager.limits import check_message, utf8_length
+from synthesis_manager.limits import check_message, check_timeout, utf8_length
 from synthesis_manager.ros.errors import reported_error
 from synthesis_manager.ros.node_main import node_main
 from synthesis_manager.ros.qos import service_qos
@@ -138,6 +138,7 @@ class LTLCompilationNode(Node):
         try:
             arrival = time.monotonic()
             check_message(request)
+            requested = check_timeout(request.timeout, 'request.timeout')  # 0: the node's own limit
             arguments = (request.system, list(request.initial_conditions), list(request.goals),
                          tuple(request.sm_outcomes) or DEFAULT_SM_OUTCOMES, not request.unordered_goals,
                          msg_to_sections(request.custom_ltl) or None,
@@ -150,7 +151,8 @@ class LTLCompilationNode(Node):
             else:
                 try:
                     sections, provenance = await self.children.run(
-                        _compiled_in_child, arguments, size=f'{custom_bytes:,} bytes of custom formulas', arrival=arrival)
+                        _compiled_in_child, arguments, size=f'{custom_bytes:,} bytes of custom formulas', arrival=arrival,
+                        requested=requested)
                 except StageStopped as stopped:
                     response.error_code = stopped.error_code
                     self.get_logger().warning(response.error_code.message)

@@ -352,11 +352,14 @@ class BehaviorSynthesisServer(Node):
         else:
             task = await self.with_initial_conditions(goal_handle, task, outcome, feedback, deadline)
             feedback('Compiling the LTL specification', 0.05)
+            # The node gets what is left of the goal's time, so that it stops a large compilation
+            # when the goal ends (its own limit otherwise; 30 s).
+            limit = deadline.stage_limit(self.parameter('compilation_timeout'), 'LTL compilation')
             compiled = await self.call(goal_handle, self.compiler, GenerateLTLSpecification.Request(
                 system=task.system, goals=task.goals, initial_conditions=task.initial_conditions,
                 sm_outcomes=task.sm_outcomes, custom_ltl=task.custom_ltl or LTLSpecification(),
-                unordered_goals=task.unordered_goals),
-                'LTL compilation', self.parameter('compilation_timeout'), deadline=deadline)
+                unordered_goals=task.unordered_goals, timeout=float(limit)),
+                'LTL compilation', limit, deadline=deadline)
             self.check(compiled.error_code)
             outcome.ltl_specification = compiled.ltl_specification
             provenance = compiled.provenance
@@ -395,10 +398,11 @@ class BehaviorSynthesisServer(Node):
             return
 
         feedback('Generating the state machine', 0.7)
+        limit = deadline.stage_limit(self.parameter('generation_timeout'), 'state machine generation')
         generated = await self.call(goal_handle, self.generator, GenerateFlexBESM.Request(
             automaton=outcome.automaton, system=task.system,
-            initial_conditions=task.initial_conditions),
-            'state machine generation', self.parameter('generation_timeout'), deadline=deadline)
+            initial_conditions=task.initial_conditions, timeout=float(limit)),
+            'state machine generation', limit, deadline=deadline)
         self.check(generated.error_code)
         outcome.states = list(generated.state_definition)
         feedback(f'Generated a state machine with {count_states(outcome.states)} states', 1.0)

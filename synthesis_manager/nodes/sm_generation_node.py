@@ -16,7 +16,7 @@ from rclpy.node import Node
 
 from respec.errors import ErrorCode
 from sm_generation import generate_state_machine
-from synthesis_manager.limits import check_message
+from synthesis_manager.limits import check_message, check_timeout
 from synthesis_manager.ros.child_stage import ChildStage, StageStopped
 from synthesis_manager.ros.conversions import error_code, msg_to_automaton, state_to_msg
 from synthesis_manager.ros.errors import reported_error
@@ -70,6 +70,7 @@ class SMGenerationNode(Node):
             # specification makes it (its strings and names are still checked).
             arrival = time.monotonic()
             check_message(request, max_list=None, max_total=None)
+            requested = check_timeout(request.timeout, 'request.timeout')  # 0: the node's own limit
             arguments = (msg_to_automaton(request.automaton), request.system)
             options = {'config_dir': self.get_parameter('config_dir').value or None,
                        'initial_conditions': list(request.initial_conditions) or None,
@@ -80,7 +81,8 @@ class SMGenerationNode(Node):
                 try:
                     states = await self.children.run(generate_state_machine, arguments, options,
                                                      size=f'{len(request.automaton.automaton):,} automaton states',
-                                                     arrival=arrival)
+                                                     arrival=arrival,
+                                                     requested=requested)
                 except StageStopped as stopped:
                     response.error_code = stopped.error_code
                     self.get_logger().warning(response.error_code.message)

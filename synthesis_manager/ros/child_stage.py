@@ -49,12 +49,15 @@ class ChildStage:
         self.pool = WorkerPool(workers, waiting, name=name)
         self.processes = SynthesisProcesses(niceness=SERVER_CHILD_NICENESS, preload=preload)
 
-    async def run(self, function, args=(), kwargs=None, size: str = '', arrival: float | None = None):
+    async def run(self, function, args=(), kwargs=None, size: str = '', arrival: float | None = None,
+                  requested: float = 0.0):
         """``function(*args, **kwargs)`` in a child, awaited; raises StageStopped with the
         answer when the time or memory limit or shutdown ends it (``size`` says how large the
-        request was, in the message; the time limit counts from ``arrival``, a time.monotonic()
-        instant, or from now)."""
+        request was, in the message; the time limit, the node's or the shorter ``requested``
+        one when it is over 0, counts from ``arrival``, a time.monotonic() instant, or from now)."""
         timeout = self.node.get_parameter('timeout').value
+        if requested > 0:
+            timeout = min(timeout, requested)
         deadline = (time.monotonic() if arrival is None else arrival) + timeout
         try:
             return await self.pool.run(self._in_child, function, args, kwargs, deadline,

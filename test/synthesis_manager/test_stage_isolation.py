@@ -178,7 +178,11 @@ def generation_service(ros, **parameters):
                                                         for name, value in parameters.items()])
     service = ros.add_node(Node, 'generation_client').create_client(GenerateFlexBESM, 'sm_generate')
     assert service.wait_for_service(timeout_sec=10)
-    return lambda message: service.call(GenerateFlexBESM.Request(automaton=message, system='atlas'), timeout_sec=120)
+    def generate(message, timeout: float = 0.0):  # timeout: the caller's limit (0: the node's own)
+        return service.call(GenerateFlexBESM.Request(automaton=message, system='atlas', timeout=timeout),
+                            timeout_sec=120)
+
+    return generate
 
 
 def test_a_large_automaton_is_generated_in_a_child_to_the_same_state_machine(ros):
@@ -213,3 +217,35 @@ def test_a_large_generation_beyond_its_memory_limit_names_the_limit(ros):
     answer = generation_service(ros, memory_limit_mb=1)(message)
     assert answer.error_code.value == answer.error_code.SM_GENERATION_FAILED, answer.error_code.message
     assert 'memory limit of 1 MB' in answer.error_code.message and 'memory_limit_mb' in answer.error_code.message
+
+
+def test_a_compilation_stops_at_the_time_its_caller_has_left(ros, tmp_path):
+    """Issue 34, item 2: the server passes what is left of the goal's time in the request; a
+    large compilation stops there, not at the node's own 30 s, so no work outlives its goal."""
+    from rclpy.node import Node
+
+    from synthesis_msgs.msg import LTLSpecification
+    from synthesis_msgs.srv import GenerateLTLSpecification
+
+    ros.add_node(LTLCompilationNode)  # its own limit: 30 s
+    service = ros.add_node(Node, 'compilation_client').create_client(GenerateLTLSpecification, 'ltl_compilation')
+    assert service.wait_for_service(timeout_sec=10)
+    request = GenerateLTLSpecification.Request(
+        system=PAPER_TASK['system'], goals=PAPER_TASK['goals'], initial_conditions=PAPER_TASK['initial_conditions'],
+        custom_ltl=LTLSpecification(sys_trans=custom_formulas(3_900_000)), timeout=1.0)
+    started = time.monotonic()
+    answer = service.call(request, timeout_sec=60)
+    assert answer.error_code.value == answer.error_code.TIMEOUT, answer.error_code.message
+    assert 'time limit (1 s for' in answer.error_code.message
+    assert time.monotonic() - started < 1.0 + 4.0  # sending and reading 3.9 MB, on a loaded machine
+    request.timeout = -1.0
+    refused = service.call(request, timeout_sec=60)
+    assert refused.error_code.value == refused.error_code.INVALID_REQUEST
+    assert 'request.timeout' in refused.error_code.message
+
+
+def test_a_generation_stops_at_the_time_its_caller_has_left(ros):
+    message, _ = chain_automaton_message(20_000)
+    answer = generation_service(ros)(message, timeout=0.5)  # the node's own limit: 30 s
+    assert answer.error_code.value == answer.error_code.TIMEOUT, answer.error_code.message
+    assert '0.5 s for 40,002 automaton states' in answer.error_code.message

@@ -10,7 +10,7 @@ BIN := $(VENV)/bin
 MSGS_BUILD := build/synthesis_msgs
 MSGS_SOURCES := $(wildcard synthesis_msgs/msg/*.msg synthesis_msgs/srv/*.srv synthesis_msgs/action/*.action) \
                 synthesis_msgs/CMakeLists.txt synthesis_msgs/cmake/wheel_include_filter.cmake synthesis_msgs/package.xml
-SYSTEM_PACKAGES := graphviz chromium
+SYSTEM_PACKAGES := graphviz chromium iproute2
 
 .PHONY: setup run test bench serve clean system-packages flexbe webui
 
@@ -175,11 +175,13 @@ webui:
 	  exec $(BIN)/python -m flexbe_webui.webui_node --port $(WEBUI_PORT) \
 	    --config_folder $(abspath $(WEBUI_CONFIG)) --config_file webui.json
 
-# Graphviz draws state machines; Chromium runs the browser tests (MuJoCo renders with EGL). Installed from Debian
-# when missing and we may (root); otherwise tell the user what to install.
+# Graphviz draws state machines; Chromium runs the browser tests (MuJoCo renders with EGL); iproute2's `ip`
+# builds the across-hosts test's network namespaces. Installed from Debian when missing and we may (root);
+# otherwise tell the user what to install.
 system-packages:
 	@missing=""; command -v dot >/dev/null || missing="$$missing graphviz"; \
 	  command -v chromium >/dev/null || missing="$$missing chromium"; \
+	  command -v ip >/dev/null || missing="$$missing iproute2"; \
 	  ldconfig -p | grep -q 'libEGL_mesa.so.0' || missing="$$missing libegl1 libegl-mesa0"; \
 	  if [ -n "$$missing" ]; then \
 	    if [ "$$(id -u)" = 0 ]; then \

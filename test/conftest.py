@@ -11,8 +11,7 @@ Markers (given here, from the folder, the fixtures a test uses and the lists bel
     mujoco   runs the MuJoCo simulator
     flexbe   runs the real FlexBE (``flexbe_sources``, ``flexbe``)
     slow     takes more than a few seconds on a 2-core machine
-    netns    builds private network namespaces (needs root and ``ip``; skipped without them
-             unless BEHAVIOR_SYNTHESIS_REQUIRE_NETNS=1, which .ci/run sets when root)
+    netns    builds private network namespaces (needs root and ``ip``; fails without them)
 
 The pure-core tests alone, in under a minute::
 

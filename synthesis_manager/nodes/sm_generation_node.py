@@ -27,6 +27,8 @@ from synthesis_msgs.srv import GenerateFlexBESM
 #: Automata with more states than this are generated in a child process (2,000 chain states
 #: took 76 ms in-process; starting the work in a child costs a few milliseconds more).
 SMALL_AUTOMATON_STATES = 2000
+#: How often requests waiting for a generation child look at their deadline.
+QUEUE_CHECK_SECONDS = 0.5
 
 
 class SMGenerationNode(Node):
@@ -52,7 +54,9 @@ class SMGenerationNode(Node):
                                    self.get_parameter('queued_generations').value, name='generation',
                                    what='state machine generation', failed=ErrorCode.SM_GENERATION_FAILED)
         group = ReentrantCallbackGroup()
-        self.create_timer(0.1, lambda: None, callback_group=group)  # waiting requests see their deadline pass
+        # Queued large requests see their deadline pass (at most this late); each tick costs
+        # the idle process a wake-up, and generations rarely queue.
+        self.create_timer(QUEUE_CHECK_SECONDS, lambda: None, callback_group=group)
         self.create_service(GenerateFlexBESM, 'sm_generate', self.on_request,
                             callback_group=group, qos_profile=service_qos())
 

@@ -20,6 +20,8 @@ from __future__ import annotations
 import errno
 import json
 import os
+import threading
+from collections import OrderedDict
 from dataclasses import dataclass, field
 from pathlib import Path
 from types import MappingProxyType
@@ -98,6 +100,45 @@ def robot_system_from_files(name: str, files: Mapping[str, str], config_file: st
     return _robot_system(name, Path(config_file or f'config/{name}.yaml'), read)
 
 
+class _ParsedSystems:
+    """Robot systems already parsed, by the texts of their files (least recently used dropped).
+
+    Every request still reads the system's files, so an edit is seen by the next request; only
+    parsing and validating unchanged texts again is saved (4.6 ms for ATLAS, three times a goal:
+    a quarter of a busy server's time in a 200-goal burst)."""
+
+    KEPT = 16
+
+    def __init__(self):
+        self._systems: OrderedDict[tuple, RobotSystem] = OrderedDict()
+        self._lock = threading.Lock()
+
+    def get(self, key: tuple, read: Callable[[str], str]) -> RobotSystem | None:
+        with self._lock:
+            system = self._systems.get(key)
+            if system is not None:
+                self._systems.move_to_end(key)
+        if system is None or not all(_reads_unchanged(read, relative, text) for relative, text in system.files.items()):
+            return None
+        return system
+
+    def put(self, key: tuple, system: RobotSystem) -> None:
+        with self._lock:
+            self._systems[key] = system
+            while len(self._systems) > self.KEPT:
+                self._systems.popitem(last=False)
+
+
+_parsed_systems = _ParsedSystems()
+
+
+def _reads_unchanged(read: Callable[[str], str], relative: str, text: str) -> bool:
+    try:
+        return read(relative) == text
+    except (OSError, UnicodeDecodeError):
+        return False  # parsed again, which names the problem
+
+
 def _robot_system(name: str, path: Path, read: Callable[[str], str]) -> RobotSystem:
     files: dict[str, str] = {}
 
@@ -109,7 +150,18 @@ def _robot_system(name: str, path: Path, read: Callable[[str], str]) -> RobotSys
                                          f'at position {error.start})', item=relative) from None
         return files[relative]
 
-    document = parse_config_text(read_and_keep(path.name), path)
+    text = read_and_keep(path.name)
+    key = (name, str(path), text)
+    system = _parsed_systems.get(key, read)
+    if system is None:
+        system = _parsed_system(name, path, text, read_and_keep, files)
+        _parsed_systems.put(key, system)
+    return system
+
+
+def _parsed_system(name: str, path: Path, text: str, read_and_keep: Callable[[str], str],
+                   files: dict[str, str]) -> RobotSystem:
+    document = parse_config_text(text, path)
     if is_capability_document(document):
         capabilities = load_capability_system(document, name, read_and_keep)
         return RobotSystem(name, path, capabilities=capabilities, sections=MappingProxyType(dict(document)),

@@ -37,6 +37,7 @@ from synthesis_manager.ros.child_stage import ChildStage, StageStopped
 from synthesis_manager.ros.conversions import error_code, msg_to_sections, sections_to_msg
 from synthesis_manager.limits import check_message, check_timeout, utf8_length
 from synthesis_manager.ros.errors import reported_error
+from synthesis_manager.ros.logs import QuickLogger
 from synthesis_manager.ros.node_main import node_main
 from synthesis_manager.ros.qos import service_qos
 from synthesis_manager.ros.robot_systems import create_systems_publisher
@@ -85,6 +86,7 @@ class LTLCompilationNode(Node):
 
     def __init__(self, **kwargs):
         super().__init__('ltl_compilation', **kwargs)
+        self.log = QuickLogger(self.get_logger())  # a line per failed request
         self.declare_parameter('config_dir', '')
         self.declare_parameter('timeout', 30.0)
         self.declare_parameter('memory_limit_mb', 2048)
@@ -155,11 +157,11 @@ class LTLCompilationNode(Node):
                         requested=requested)
                 except StageStopped as stopped:
                     response.error_code = stopped.error_code
-                    self.get_logger().warning(response.error_code.message)
+                    self.log.warning(response.error_code.message)
                     return response
         except Exception as error:  # every failure becomes an error code; the node keeps serving
             response.error_code = reported_error(error, self.get_logger(), 'LTL compilation failed')
-            self.get_logger().warning(response.error_code.message)
+            self.log.warning(response.error_code.message)
             return response
         response.ltl_specification = sections_to_msg(sections)
         response.provenance = provenance
@@ -185,7 +187,7 @@ class LTLCompilationNode(Node):
             return response
         except Exception as error:  # every failure becomes an error code; the node keeps serving
             response.error_code = reported_error(error, self.get_logger(), 'repair search failed')
-            self.get_logger().warning(response.error_code.message)
+            self.log.warning(response.error_code.message)
             return response
         response.summaries = [proposal['summary'] for proposal in repairs['proposals']]
         response.repairs = json.dumps(repairs, sort_keys=True)

@@ -34,6 +34,7 @@ from synthesis_manager.limits import (DEFAULT_MAX_GOAL_TIMEOUT, capped_timeout, 
                                       utf8_length)
 from synthesis_manager.ros.conversions import automaton_to_msg, error_code, msg_to_sections
 from synthesis_manager.ros.errors import reported_error
+from synthesis_manager.ros.logs import QuickLogger
 from synthesis_manager.ros.node_main import node_main
 from synthesis_manager.ros.qos import service_qos
 from synthesis_manager.ros.worker_pool import Abandoned, WorkerPool, executor_waker
@@ -93,6 +94,7 @@ class LTLSynthesisNode(Node):
 
     def __init__(self, **kwargs):
         super().__init__('ltl_synthesis', **kwargs)
+        self.log = QuickLogger(self.get_logger())  # a line per failed request
         self.declare_parameter('byproducts_dir', str(default_directory()))
         self.declare_parameter('keep_byproducts', DEFAULT_KEEP_LAST)
         self.declare_parameter('byproducts_max_age', 0.0)
@@ -220,7 +222,7 @@ class LTLSynthesisNode(Node):
             with self._lock:
                 self._running.pop(request_id, None)
         if response.error_code.message:
-            self.get_logger().warning(response.error_code.message)
+            self.log.warning(response.error_code.message)
         return response
 
     def _cache_key(self, request) -> str | None:

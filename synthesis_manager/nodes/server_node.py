@@ -40,6 +40,7 @@ from synthesis_manager.requests import (InvalidRequestError, SynthesisTask, task
 from synthesis_manager.ros.cnu_interface import load_flexbe_synthesis_interface
 from synthesis_manager.ros.conversions import error_code, error_name, is_empty_spec
 from synthesis_manager.ros.errors import log_internal_error
+from synthesis_manager.ros.logs import QuickLogger
 from synthesis_manager.ros.node_main import node_main
 from synthesis_manager.ros.qos import action_server_qos, service_qos
 from synthesis_manager.ros.robot_state import RobotStateListener
@@ -182,6 +183,7 @@ class BehaviorSynthesisServer(Node):
         self._accepted_goals = 0  # accepted and not finished: running, or waiting for the executor
         self._lock = threading.Lock()
         self.stages = StageCaller(self)
+        self.log = QuickLogger(self.get_logger())  # a line per failed goal
         self.log_to_flexbe = flexbe_log_publisher(self, self.parameter('flexbe_log_topic'))
         group = ReentrantCallbackGroup()
 
@@ -269,7 +271,7 @@ class BehaviorSynthesisServer(Node):
             failure = f'{outcome.code}: {outcome.message}'
             feedback(failure)
             self.log_to_flexbe(f'Behavior synthesis failed: {failure}')
-            self.get_logger().warning(failure)
+            self.log.warning(failure)
             goal_handle.abort()
         return interface.make_result(outcome)
 
@@ -292,7 +294,7 @@ class BehaviorSynthesisServer(Node):
                 unordered_goals=task.unordered_goals, time_budget=float(budget), max_proposals=MAX_SUGGESTED_FIXES),
                 'repair search', budget * REPAIR_DEADLINE_FACTOR + REPAIR_STARTUP_GRACE, deadline=deadline)
         except (CodedError, Preempted) as error:  # the refusal is the answer; the fixes were a help
-            self.get_logger().info(f'no fixes suggested: {error}'[:300])
+            self.log.info(f'no fixes suggested: {error}'[:300])
             return
         if error_name(found.error_code.value) != ErrorCode.SUCCESS or not found.summaries:
             return

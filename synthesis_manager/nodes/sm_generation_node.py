@@ -20,6 +20,7 @@ from synthesis_manager.limits import check_message, check_timeout
 from synthesis_manager.ros.child_stage import ChildStage, StageStopped
 from synthesis_manager.ros.conversions import error_code, msg_to_automaton, state_to_msg
 from synthesis_manager.ros.errors import reported_error
+from synthesis_manager.ros.logs import QuickLogger
 from synthesis_manager.ros.node_main import node_main
 from synthesis_manager.ros.qos import service_qos
 from synthesis_msgs.srv import GenerateFlexBESM
@@ -44,6 +45,7 @@ class SMGenerationNode(Node):
 
     def __init__(self, **kwargs):
         super().__init__('sm_generation', **kwargs)
+        self.log = QuickLogger(self.get_logger())  # a line per failed request
         self.declare_parameter('config_dir', '')
         self.declare_parameter('reduce', False)
         self.declare_parameter('timeout', 30.0)
@@ -89,11 +91,11 @@ class SMGenerationNode(Node):
                                                      requested=requested)
                 except StageStopped as stopped:
                     response.error_code = stopped.error_code
-                    self.get_logger().warning(response.error_code.message)
+                    self.log.warning(response.error_code.message)
                     return response
         except Exception as error:  # every failure becomes an error code; the node keeps serving
             response.error_code = reported_error(error, self.get_logger(), 'state machine generation failed')
-            self.get_logger().warning(response.error_code.message)
+            self.log.warning(response.error_code.message)
             return response
         response.state_definition = [state_to_msg(state) for state in states]
         response.error_code = error_code()

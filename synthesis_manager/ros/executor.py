@@ -9,7 +9,10 @@ on a loaded 2-core machine, and a goal's answer needs several passes (the synthe
 answers, the server takes the response, resumes the goal, sends the result). A resumption
 only checks a few conditions and yields again, so it runs inline here; callbacks starting
 (a service request, a timer, a goal's first run) still go to the pool, so blocking work
-never holds the spinning thread.
+never holds the spinning thread. A coroutine waiting on an ExecutorTurn that is not due yet
+(ros/stage_calls.py: no response, no look due) is not even resumed: with 200 goals waiting,
+resuming all of them on every wake-up took 3.5 s of the spinning thread in an 8 s burst
+(15,480 resumptions, 0.23 ms each) and goals were accepted up to 6 s after they were sent.
 """
 
 from __future__ import annotations
@@ -18,6 +21,8 @@ import inspect
 
 from rclpy.executors import (ConditionReachedException, ExternalShutdownException, MultiThreadedExecutor,
                              ShutdownException, TimeoutException)
+
+from synthesis_manager.ros.stage_calls import awaited_turn
 
 
 class SuiteExecutor(MultiThreadedExecutor):
@@ -29,6 +34,9 @@ class SuiteExecutor(MultiThreadedExecutor):
         except (ExternalShutdownException, ShutdownException, TimeoutException, ConditionReachedException):
             return
         if _suspended(handler):
+            turn = awaited_turn(handler._handler)
+            if turn is not None and not turn.due():
+                return  # nothing for it to look at yet; the executor offers it again next pass
             handler()  # resumes, checks its conditions, and yields again or ends
             if not handler.done():
                 return

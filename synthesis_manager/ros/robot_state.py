@@ -11,7 +11,7 @@ from __future__ import annotations
 import threading
 import time
 
-from synthesis_manager.ros.stage_calls import next_executor_turn
+from synthesis_manager.ros.stage_calls import WATCH_PERIOD, next_executor_turn
 from synthesis_msgs.msg import RobotState
 
 
@@ -56,4 +56,4 @@ class RobotStateListener:
                     return self._latest
             if time.monotonic() > deadline or should_stop():
                 return None
-            await next_executor_turn()
+            await next_executor_turn(lambda: self._received != seen, WATCH_PERIOD)

@@ -10,11 +10,16 @@ these happens (checked at least every WATCH_PERIOD seconds):
 - the stage's time limit passes            -> StageTimeoutError (TIMEOUT)
 - the server shuts down                    -> ServerStoppingError (BEHAVIOR_SYNTHESIS_FAILED)
 - the node serving the stage goes away     -> StageUnavailableError (SERVICE_UNAVAILABLE) naming it
-  (also when a new node took its place: the request went to the one that left)
+  (also when a new node took its place: the request went to the one that left; looked at
+  every READER_CHECK_PERIOD seconds, graph queries being the dearest of these checks)
 
 How the waiting works: rclpy's executor resumes every pending coroutine each time it wakes,
 and a node-wide watchdog timer wakes it every WATCH_PERIOD seconds; a coroutine waits by
-yielding once (:func:`next_executor_turn`) and then checks its conditions again.
+yielding once (:func:`next_executor_turn`) and then checks its conditions again. The turn says
+when resuming is worth it (its response arrived, or its next look is due): the suite's executor
+(ros/executor.py) leaves a coroutine whose turn is not due suspended, because with hundreds of
+waiting goals resuming each of them on every wake-up took the spinning thread most of its time
+and new goals waited seconds to be accepted. Any other executor just resumes it every time.
 """
 
 from __future__ import annotations
@@ -28,7 +33,7 @@ from rclpy.callback_groups import ReentrantCallbackGroup
 from respec.errors import CodedError, ControlFlowSignal, ErrorCode
 
 WATCH_PERIOD = 0.1
-READER_CHECK_PERIOD = 0.5  # seconds between two looks at who receives a pending request
+READER_CHECK_PERIOD = 0.5  # seconds between two looks at whether a pending request's node is there
 
 
 class StageFailedError(CodedError):
@@ -71,14 +76,51 @@ class Preempted(ControlFlowSignal):
     (the goal then ends cancelled, with PREEMPTED)."""
 
 
-class _NextExecutorTurn:
+class ExecutorTurn:
+    """Awaitable: gives the executor back once (its own iterator, so that an executor finds it
+    as the innermost ``cr_await`` of the suspended coroutine and can ask :meth:`due`)."""
+
+    __slots__ = ('_due', '_given')
+
+    def __init__(self, due: Callable[[], bool] | None = None):
+        self._due, self._given = due, False
+
+    def due(self) -> bool:
+        """Whether the waiting coroutine has something to look at if resumed now."""
+        return self._due is None or self._due()
+
     def __await__(self):
-        yield
+        return self
+
+    def __iter__(self):
+        return self
+
+    def __next__(self):
+        if self._given:
+            raise StopIteration
+        self._given = True
 
 
-def next_executor_turn() -> _NextExecutorTurn:
-    """Awaitable: give the executor back until it next wakes (a response, a timer tick...)."""
-    return _NextExecutorTurn()
+def next_executor_turn(ready: Callable[[], bool] | None = None, look_every: float | None = None) -> ExecutorTurn:
+    """Awaitable: give the executor back until it next wakes (a response, a timer tick...).
+
+    With ``ready`` (e.g. a future's ``done``) or ``look_every`` (seconds), resuming is only due
+    once ``ready()`` is true or that time has passed (to check cancel, deadlines, the node)."""
+    if ready is None and look_every is None:
+        return ExecutorTurn()
+    look_at = time.monotonic() + look_every if look_every is not None else float('inf')
+    if ready is None:
+        return ExecutorTurn(lambda: time.monotonic() >= look_at)
+    return ExecutorTurn(lambda: ready() or time.monotonic() >= look_at)
+
+
+def awaited_turn(coroutine) -> ExecutorTurn | None:
+    """The ExecutorTurn a suspended coroutine waits on, through nested awaits; None when it
+    waits on anything else."""
+    awaited = coroutine
+    while awaited is not None and not isinstance(awaited, ExecutorTurn):
+        awaited = getattr(awaited, 'cr_await', None)
+    return awaited
 
 
 class StageCaller:
@@ -86,6 +128,7 @@ class StageCaller:
 
     def __init__(self, node, watch_period: float = WATCH_PERIOD):
         self.node = node
+        self.watch_period = watch_period
         self._stopping = threading.Event()
         self._providers: dict[str, str] = {}
         # The timer only wakes the executor; the waiting coroutines do the checking.
@@ -115,8 +158,8 @@ class StageCaller:
             elif now > deadline:
                 failure = StageTimeoutError(f'{stage}: no answer from {client.srv_name!r} within {timeout:g} s',
                                         client.srv_name)
-            elif not client.service_is_ready() or (
-                    readers and now >= next_reader_check and not readers & self._request_readers(client.srv_name)):
+            elif now >= next_reader_check and not (client.service_is_ready() and (
+                    not readers or readers & self._request_readers(client.srv_name))):
                 self._providers.pop(client.srv_name, None)
                 failure = StageUnavailableError(f'{stage}: node {provider!r} (service '
                                            f'{self.node.resolve_service_name(client.srv_name)!r}) went '
@@ -128,7 +171,7 @@ class StageCaller:
                 if on_cancel is not None and getattr(failure, 'code', None) != ErrorCode.SERVICE_UNAVAILABLE:
                     on_cancel()  # tell the service to stop working for nobody
                 raise failure
-            await next_executor_turn()
+            await next_executor_turn(future.done, min(self.watch_period, max(0.0, deadline - now)))
         return future.result()
 
     async def _wait_for_service(self, client, stage: str, service_timeout: float, cancelled):
@@ -141,7 +184,7 @@ class StageCaller:
             if time.monotonic() > deadline:
                 raise StageUnavailableError(f'{stage}: service {client.srv_name!r} is not available '
                                        f'(waited {service_timeout:g} s)', client.srv_name)
-            await next_executor_turn()
+            await next_executor_turn(look_every=self.watch_period)
 
     def _request_readers(self, service_name: str) -> set[bytes]:
         """The endpoints that receive ``service_name``'s requests now (DDS reader ids).

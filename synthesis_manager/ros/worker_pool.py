@@ -18,7 +18,7 @@ from concurrent.futures import Future
 
 from respec.errors import ControlFlowSignal
 from synthesis_manager.limits import BusyError
-from synthesis_manager.ros.stage_calls import next_executor_turn
+from synthesis_manager.ros.stage_calls import WATCH_PERIOD, next_executor_turn
 
 
 class Abandoned(ControlFlowSignal):
@@ -82,7 +82,7 @@ class WorkerPool:
                 each_turn()
             if give_up is not None and give_up() and future.cancel():
                 raise Abandoned()
-            await next_executor_turn()
+            await next_executor_turn(future.done, WATCH_PERIOD)
         return future.result()
 
     def _work(self):

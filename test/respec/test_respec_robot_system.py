@@ -87,6 +87,29 @@ def test_a_capability_system_keeps_every_file_it_read(tmp_path, flexbe_sources):
         robot_system_from_files('vending', {'vending.yaml': vending.files['vending.yaml']})
 
 
+def test_unchanged_files_are_not_parsed_again_and_any_edit_is_seen(tmp_path, flexbe_sources):
+    """Loading reads every file of the system each time; it parses them only when a text changed."""
+    (tmp_path / 'tiny.yaml').write_text('abstraction:\n  actions: {wave: []}\n')
+    first = robot_system('tiny', tmp_path)
+    assert robot_system('tiny', tmp_path) is first
+    (tmp_path / 'tiny.yaml').write_text('abstraction:\n  actions: {waves: []}\n')  # same size, same instant
+    assert list(robot_system('tiny', tmp_path).abstraction.actions) == ['waves']
+    # A file the system file points at counts too (here CNU's capabilities, copied to be edited).
+    examples = flexbe_sources / 'flexbe_synthesis' / 'flexbe_synthesis_examples' / 'example' / 'vending_demo'
+    shutil.copy(examples / 'capabilities' / 'vending_capabilities.yaml', tmp_path / 'capabilities.yaml')
+    shutil.copy(examples / 'specs' / 'vending_demo_capabilities_spec.yaml', tmp_path / 'spec.yaml')
+    (tmp_path / 'vending.yaml').write_text('cnu_capabilities: capabilities.yaml\ncnu_spec: spec.yaml\n')
+    vending = robot_system('vending', tmp_path)
+    assert robot_system('vending', tmp_path) is vending
+    text = (tmp_path / 'capabilities.yaml').read_text()
+    (tmp_path / 'capabilities.yaml').write_text(text + '\n# edited\n')
+    edited = robot_system('vending', tmp_path)
+    assert edited is not vending and edited.files['capabilities.yaml'].endswith('# edited\n')
+    (tmp_path / 'capabilities.yaml').unlink()
+    with pytest.raises(CapabilityConfigError, match='cannot be read'):
+        robot_system('vending', tmp_path)
+
+
 def test_the_catalog_lists_and_loads_the_systems_of_its_folders(tmp_path):
     assert SystemCatalog().names() == ['atlas', 'delivery_rover', 'mobile_manipulator']
     assert isinstance(SystemCatalog().load('mobile_manipulator'), RobotSystem)

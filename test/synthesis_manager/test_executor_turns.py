@@ -1,0 +1,86 @@
+"""Waiting coroutines are resumed only when their turn is due; per-request log lines keep
+what rclpy's logger would write (ros/executor.py, ros/stage_calls.py, ros/logs.py)."""
+
+import sys
+import threading
+import time
+
+from rcl_interfaces.msg import Log
+from rclpy.logging import LoggingSeverity
+from rclpy.node import Node
+
+from synthesis_manager.ros.logs import QuickLogger
+from synthesis_manager.ros.stage_calls import ExecutorTurn, awaited_turn, next_executor_turn
+
+
+def test_the_turn_a_coroutine_waits_on_is_found_through_nested_awaits():
+    turn = next_executor_turn(lambda: False, look_every=60.0)
+
+    async def inner():
+        await turn
+
+    async def outer():
+        await inner()
+
+    coroutine = outer()
+    coroutine.send(None)
+    assert awaited_turn(coroutine) is turn and not turn.due()
+    coroutine.close()
+    assert awaited_turn(None) is None
+
+
+def test_a_turn_is_due_when_ready_or_when_its_look_is_due():
+    ready = threading.Event()
+    turn = next_executor_turn(ready.is_set, look_every=60.0)
+    assert not turn.due()
+    ready.set()
+    assert turn.due()
+    soon = next_executor_turn(look_every=0.05)
+    assert not soon.due()
+    time.sleep(0.06)
+    assert soon.due() and next_executor_turn().due() and ExecutorTurn().due()
+
+
+def test_the_suite_executor_resumes_a_waiting_coroutine_only_when_its_turn_is_due(ros):
+    node = ros.add_node(Node, 'turn_test')
+    node.create_timer(0.01, lambda: None)  # wakes the executor 100 times a second
+    ready, resumptions = threading.Event(), []
+
+    async def waiting():
+        while not ready.is_set():
+            resumptions.append(time.monotonic())
+            await next_executor_turn(ready.is_set, look_every=0.5)
+        return 'done'
+
+    task = ros.executor.create_task(waiting)
+    time.sleep(1.2)
+    # Started once, then looked again every 0.5 s: 3, not the ~100 wake-ups of the executor.
+    assert 2 <= len(resumptions) <= 4, resumptions
+    ready.set()
+    deadline = time.monotonic() + 2.0
+    while not task.done() and time.monotonic() < deadline:
+        time.sleep(0.01)
+    assert task.done() and task.result() == 'done'
+
+
+def test_quick_log_lines_reach_rosout_as_rclpy_would_write_them(ros):
+    listener = ros.add_node(Node, 'rosout_listener')
+    lines, heard = [], threading.Event()
+
+    def on_log(line):
+        if line.name == 'quick_logging':
+            lines.append(line)
+            heard.set()
+    listener.create_subscription(Log, '/rosout', on_log, 100)
+    node = ros.add_node(Node, 'quick_logging')
+    log = QuickLogger(node.get_logger())
+    time.sleep(0.5)  # discovery of /rosout
+    node.get_logger().set_level(LoggingSeverity.WARN)
+    log.info('not written: below the level')
+    expected_line = sys._getframe().f_lineno + 1
+    log.warning('a goal failed: TIMEOUT')
+    assert heard.wait(5.0)
+    time.sleep(0.2)
+    assert [(line.msg, line.level) for line in lines] == [('a goal failed: TIMEOUT', Log.WARN)]
+    assert lines[0].function == 'test_quick_log_lines_reach_rosout_as_rclpy_would_write_them'
+    assert lines[0].file == __file__ and lines[0].line == expected_line

@@ -42,7 +42,7 @@ from synthesis_manager.ros.node_main import node_main
 from synthesis_manager.ros.qos import service_qos
 from synthesis_manager.ros.robot_systems import create_systems_publisher
 from synthesis_manager.ros.worker_pool import Abandoned, WorkerPool, executor_waker
-from synthesis_msgs.srv import GenerateLTLSpecification, ProposeRepairs
+from synthesis_msgs.srv import CancelSynthesis, GenerateLTLSpecification, ProposeRepairs
 
 #: Custom formulas (bytes, all sections) up to which a request is compiled in the node's process.
 SMALL_CUSTOM_BYTES = 64 * 1024
@@ -101,8 +101,9 @@ class LTLCompilationNode(Node):
                                    self.get_parameter('queued_compilations').value, name='compilation',
                                    what='LTL compilation', failed=ErrorCode.LTL_SPEC_COMPILATION_FAILED)
         group = ReentrantCallbackGroup()
-        self.create_timer(0.1, lambda: None, callback_group=group)  # waiting requests see their deadline pass
         self.create_service(GenerateLTLSpecification, 'ltl_compilation', self.on_request,
+                            callback_group=group, qos_profile=service_qos())
+        self.create_service(CancelSynthesis, 'ltl_compilation/cancel', self.on_cancel_request,
                             callback_group=group, qos_profile=service_qos())
         self.create_service(ProposeRepairs, 'propose_repairs', self.on_repair_request,
                             callback_group=group, qos_profile=service_qos())
@@ -136,6 +137,11 @@ class LTLCompilationNode(Node):
             self._systems_publisher.publish(String(data=text))
             self._published_systems = text
 
+    def on_cancel_request(self, request, response):
+        """``ltl_compilation/cancel``: stop a large compilation by its request id (PREEMPTED)."""
+        response.cancelled = self.children.cancel(request.request_id)
+        return response
+
     async def on_request(self, request, response):
         try:
             arrival = time.monotonic()
@@ -154,7 +160,7 @@ class LTLCompilationNode(Node):
                 try:
                     sections, provenance = await self.children.run(
                         _compiled_in_child, arguments, size=f'{custom_bytes:,} bytes of custom formulas', arrival=arrival,
-                        requested=requested)
+                        requested=requested, request_id=request.request_id)
                 except StageStopped as stopped:
                     response.error_code = stopped.error_code
                     self.log.warning(response.error_code.message)
@@ -180,8 +186,9 @@ class LTLCompilationNode(Node):
                                tuple(request.sm_outcomes) or DEFAULT_SM_OUTCOMES, request.unordered_goals)
             settings = repair_settings(system, task.to_dict(), msg_to_sections(request.custom_ltl) or None, budget,
                                        request.max_proposals or DEFAULT_REPAIR_PROPOSALS)
-            repairs = await self.repairs.run(self._search_repairs, settings, wake=executor_waker(self),
-                                             give_up=self._stopping.is_set)
+            with self.children.looks.waiting():  # the search sees a shutdown
+                repairs = await self.repairs.run(self._search_repairs, settings, wake=executor_waker(self),
+                                                 give_up=self._stopping.is_set)
         except (RepairSearchError, Abandoned, SynthesisCancelledError) as error:
             response.error_code = error_code(ErrorCode.TIMEOUT, f'repair search stopped: {error or "shutdown"}')
             return response

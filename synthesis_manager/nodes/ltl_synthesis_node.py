@@ -37,6 +37,7 @@ from synthesis_manager.ros.errors import reported_error
 from synthesis_manager.ros.logs import QuickLogger
 from synthesis_manager.ros.node_main import node_main
 from synthesis_manager.ros.qos import service_qos
+from synthesis_manager.ros.stage_calls import LookTimer
 from synthesis_manager.ros.worker_pool import Abandoned, WorkerPool, executor_waker
 from synthesis_msgs.msg import FSAutomaton
 from synthesis_msgs.srv import CancelSynthesis, SynthesizeAutomaton
@@ -59,9 +60,6 @@ DEFAULT_STRATEGY_CACHE_MB = DEFAULT_MAX_BYTES / 2**20
 #: The code an answer comes from: part of every cache key, so that entries kept on disk by
 #: other code miss (ltl_synthesizer.cache.source_digest).
 ANSWERING_PACKAGES = ('respec', 'ltl_specification', 'ltl_synthesizer', 'synthesis_manager')
-
-
-WAKE_PERIOD = 0.1  # seconds
 
 
 class LTLSynthesisNode(Node):
@@ -121,8 +119,8 @@ class LTLSynthesisNode(Node):
         if self.parameter('backend') == 'builtin':
             self.synthesis_processes.prepare()
         group = ReentrantCallbackGroup()
-        # Wakes the executor, so that requests waiting for a worker see their deadline or cancel pass.
-        self.create_timer(WAKE_PERIOD, lambda: None, callback_group=group)
+        # Wakes the executor while requests wait for a worker, so they see their deadline or cancel pass.
+        self.looks = LookTimer(self)
         self.create_service(SynthesizeAutomaton, 'ltl_synthesis', self.on_request, callback_group=group,
                             qos_profile=service_qos())
         self.create_service(CancelSynthesis, 'ltl_synthesis/cancel', self.on_cancel_request,
@@ -206,10 +204,11 @@ class LTLSynthesisNode(Node):
             else:
                 try:
                     # Formulas are parsed, printed and pickled to the synthesis process on a deep stack.
-                    await self.workers.run(run_with_deep_stack, self._synthesize, request, response, cancel,
-                                           timeout, deadline, key,
-                                           wake=executor_waker(self),
-                                           give_up=lambda: cancel.is_set() or time.monotonic() > deadline)
+                    with self.looks.waiting():
+                        await self.workers.run(run_with_deep_stack, self._synthesize, request, response, cancel,
+                                               timeout, deadline, key,
+                                               wake=executor_waker(self),
+                                               give_up=lambda: cancel.is_set() or time.monotonic() > deadline)
                 except Abandoned:  # stopped while waiting for a worker
                     self._stopped(response, 'cancelled' if cancel.is_set() else 'timeout', timeout)
         except ParseError as error:  # the parsers' own code, as in every other stage

@@ -192,6 +192,8 @@ class BehaviorSynthesisServer(Node):
         self.compiler = client(GenerateLTLSpecification, 'ltl_compilation')
         self.synthesizer = client(SynthesizeAutomaton, 'ltl_synthesis')
         self.synthesis_cancel = client(CancelSynthesis, 'ltl_synthesis/cancel')
+        self.compiler_cancel = client(CancelSynthesis, 'ltl_compilation/cancel')
+        self.generator_cancel = client(CancelSynthesis, 'sm_generate/cancel')
         self.generator = client(GenerateFlexBESM, 'sm_generate')
         self.repairer = client(ProposeRepairs, 'propose_repairs')
         self.robot_state = RobotStateListener(self, self.parameter('robot_state_topic'), callback_group=group)
@@ -360,8 +362,9 @@ class BehaviorSynthesisServer(Node):
             compiled = await self.call(goal_handle, self.compiler, GenerateLTLSpecification.Request(
                 system=task.system, goals=task.goals, initial_conditions=task.initial_conditions,
                 sm_outcomes=task.sm_outcomes, custom_ltl=task.custom_ltl or LTLSpecification(),
-                unordered_goals=task.unordered_goals, timeout=float(limit)),
-                'LTL compilation', limit, deadline=deadline)
+                unordered_goals=task.unordered_goals, timeout=float(limit), request_id=goal_id),
+                'LTL compilation', limit, on_cancel=lambda: self.cancel_request(self.compiler_cancel, goal_id),
+                deadline=deadline)
             self.check(compiled.error_code)
             outcome.ltl_specification = compiled.ltl_specification
             provenance = compiled.provenance
@@ -383,7 +386,8 @@ class BehaviorSynthesisServer(Node):
                 ltl_specification=outcome.ltl_specification, spec_name=spec_name,
                 timeout=float(timeout), request_id=goal_id, provenance=provenance,
                 diagnosis_timeout=float(self.parameter('diagnosis_timeout'))),
-                'LTL synthesis', timeout + SYNTHESIS_ANSWER_GRACE, on_cancel=lambda: self.cancel_synthesis(goal_id),
+                'LTL synthesis', timeout + SYNTHESIS_ANSWER_GRACE,
+                on_cancel=lambda: self.cancel_request(self.synthesis_cancel, goal_id),
                 deadline=deadline)
         except GoalTimeoutError as passed:  # the synthesis stage's code, whoever saw the limit pass
             raise StageFailedError(error_code(ErrorCode.SYNTHESIS_TIMEOUT, str(passed))) from None
@@ -403,8 +407,9 @@ class BehaviorSynthesisServer(Node):
         limit = deadline.stage_limit(self.parameter('generation_timeout'), 'state machine generation')
         generated = await self.call(goal_handle, self.generator, GenerateFlexBESM.Request(
             automaton=outcome.automaton, system=task.system,
-            initial_conditions=task.initial_conditions, timeout=float(limit)),
-            'state machine generation', limit, deadline=deadline)
+            initial_conditions=task.initial_conditions, timeout=float(limit), request_id=goal_id),
+            'state machine generation', limit, on_cancel=lambda: self.cancel_request(self.generator_cancel, goal_id),
+            deadline=deadline)
         self.check(generated.error_code)
         outcome.states = list(generated.state_definition)
         feedback(f'Generated a state machine with {count_states(outcome.states)} states', 1.0)
@@ -417,8 +422,9 @@ class BehaviorSynthesisServer(Node):
         topic = self.robot_state.topic
         timeout = deadline.stage_limit(self.parameter('robot_state_timeout'), 'reading the robot state')
         feedback(f'Reading the initial conditions from {topic}', 0.02)
-        state = await self.robot_state.next_state_async(
-            timeout, should_stop=lambda: goal_handle.is_cancel_requested or self._stopping.is_set())
+        with self.stages.looks.waiting():
+            state = await self.robot_state.next_state_async(
+                timeout, should_stop=lambda: goal_handle.is_cancel_requested or self._stopping.is_set())
         if goal_handle.is_cancel_requested:
             raise Preempted()
         if self._stopping.is_set():
@@ -450,10 +456,12 @@ class BehaviorSynthesisServer(Node):
                 raise deadline.timed_out(stage) from None
             raise
 
-    def cancel_synthesis(self, goal_id: str):
-        """Tell the synthesizer to stop this goal's synthesis (fire and forget)."""
-        if self.synthesis_cancel.service_is_ready():
-            self.synthesis_cancel.call_async(CancelSynthesis.Request(request_id=goal_id))
+    @staticmethod
+    def cancel_request(cancel_client, goal_id: str):
+        """Tell a stage to stop its work for this goal (fire and forget; ``cancel_client`` calls
+        the stage's ``<service>/cancel``)."""
+        if cancel_client.service_is_ready():
+            cancel_client.call_async(CancelSynthesis.Request(request_id=goal_id))
 
 
 def main():

@@ -23,13 +23,12 @@ from synthesis_manager.ros.errors import reported_error
 from synthesis_manager.ros.logs import QuickLogger
 from synthesis_manager.ros.node_main import node_main
 from synthesis_manager.ros.qos import service_qos
-from synthesis_msgs.srv import GenerateFlexBESM
+from synthesis_msgs.srv import CancelSynthesis, GenerateFlexBESM
 
 #: Automata with more states than this are generated in a child process (2,000 chain states
 #: took 76 ms in-process; starting the work in a child costs a few milliseconds more).
 SMALL_AUTOMATON_STATES = 2000
 #: How often requests waiting for a generation child look at their deadline.
-QUEUE_CHECK_SECONDS = 0.5
 
 
 class SMGenerationNode(Node):
@@ -56,10 +55,9 @@ class SMGenerationNode(Node):
                                    self.get_parameter('queued_generations').value, name='generation',
                                    what='state machine generation', failed=ErrorCode.SM_GENERATION_FAILED)
         group = ReentrantCallbackGroup()
-        # Queued large requests see their deadline pass (at most this late); each tick costs
-        # the idle process a wake-up, and generations rarely queue.
-        self.create_timer(QUEUE_CHECK_SECONDS, lambda: None, callback_group=group)
         self.create_service(GenerateFlexBESM, 'sm_generate', self.on_request,
+                            callback_group=group, qos_profile=service_qos())
+        self.create_service(CancelSynthesis, 'sm_generate/cancel', self.on_cancel_request,
                             callback_group=group, qos_profile=service_qos())
 
     def stop_work(self):
@@ -69,6 +67,11 @@ class SMGenerationNode(Node):
     def destroy_node(self):
         self.children.stop()
         return super().destroy_node()
+
+    def on_cancel_request(self, request, response):
+        """``sm_generate/cancel``: stop a large generation by its request id (PREEMPTED)."""
+        response.cancelled = self.children.cancel(request.request_id)
+        return response
 
     async def on_request(self, request, response):
         try:
@@ -87,8 +90,8 @@ class SMGenerationNode(Node):
                 try:
                     states = await self.children.run(generate_state_machine, arguments, options,
                                                      size=f'{len(request.automaton.automaton):,} automaton states',
-                                                     arrival=arrival,
-                                                     requested=requested)
+                                                     arrival=arrival, requested=requested,
+                                                     request_id=request.request_id)
                 except StageStopped as stopped:
                     response.error_code = stopped.error_code
                     self.log.warning(response.error_code.message)

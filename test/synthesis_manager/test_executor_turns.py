@@ -10,7 +10,7 @@ from rclpy.logging import LoggingSeverity
 from rclpy.node import Node
 
 from synthesis_manager.ros.logs import QuickLogger
-from synthesis_manager.ros.stage_calls import ExecutorTurn, awaited_turn, next_executor_turn
+from synthesis_manager.ros.stage_calls import ExecutorTurn, LookTimer, awaited_turn, next_executor_turn
 
 
 def test_the_turn_a_coroutine_waits_on_is_found_through_nested_awaits():
@@ -61,6 +61,29 @@ def test_the_suite_executor_resumes_a_waiting_coroutine_only_when_its_turn_is_du
     while not task.done() and time.monotonic() < deadline:
         time.sleep(0.01)
     assert task.done() and task.result() == 'done'
+
+
+def test_a_look_timer_wakes_the_executor_only_while_a_coroutine_waits(ros):
+    node = ros.add_node(Node, 'look_timer_test')  # nothing else wakes this executor
+    looks = LookTimer(node, 0.05)
+    assert not looks.active
+    taken, release = [], threading.Event()
+
+    async def waiting():
+        with looks.waiting():
+            while not release.is_set():
+                taken.append(time.monotonic())
+                await next_executor_turn(look_every=0.05)
+
+    task = ros.executor.create_task(waiting)
+    time.sleep(1.0)
+    assert looks.active and len(taken) >= 8, taken
+    release.set()
+    deadline = time.monotonic() + 2.0
+    while not task.done() and time.monotonic() < deadline:
+        time.sleep(0.01)
+    time.sleep(0.2)  # its next tick turns it off
+    assert task.done() and not looks.active
 
 
 def test_quick_log_lines_reach_rosout_as_rclpy_would_write_them(ros):

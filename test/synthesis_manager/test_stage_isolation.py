@@ -249,3 +249,70 @@ def test_a_generation_stops_at_the_time_its_caller_has_left(ros):
     answer = generation_service(ros)(message, timeout=0.5)  # the node's own limit: 30 s
     assert answer.error_code.value == answer.error_code.TIMEOUT, answer.error_code.message
     assert '0.5 s for 40,002 automaton states' in answer.error_code.message
+
+
+def wait_until(condition, seconds: float) -> bool:
+    deadline = time.monotonic() + seconds
+    while not condition() and time.monotonic() < deadline:
+        time.sleep(0.02)
+    return condition()
+
+
+def test_a_cancelled_goal_stops_its_large_compilation_at_once(ros, tmp_path):
+    """Issue 34: a goal cancelled while its large compilation runs in a child stops that child
+    (the server calls ltl_compilation/cancel), instead of leaving it to work to its deadline."""
+    client = start(ros, tmp_path)
+    compiler = next(node for node in ros.nodes if isinstance(node, LTLCompilationNode))
+    huge = make_goal(**PAPER_TASK, option='ltl_compilation_only', timeout=60.0,
+                     ltl_specification={'sys_trans': custom_formulas(3_900_000)})  # about 8 s to compile
+    cancel = threading.Event()
+    answers = {}
+
+    def send():
+        answers['huge'] = client.run(huge, cancel=cancel, timeout=60)
+
+    sender = threading.Thread(target=send)
+    sender.start()
+    assert wait_until(lambda: compiler.children.running_requests, 30.0), 'the compilation never started'
+    cancel.set()
+    cancelled = time.monotonic()
+    sender.join(30)
+    assert answers['huge'].error_name == 'PREEMPTED'
+    assert wait_until(lambda: not compiler.children.running_requests, 5.0), compiler.children.running_requests
+    assert time.monotonic() - cancelled < 5.0  # not the goal's 60 s, nor the 8 s of the compilation
+
+
+def test_a_stage_request_is_cancelled_by_its_request_id(ros):
+    """ltl_compilation/cancel and sm_generate/cancel stop a large request by its id: it answers
+    PREEMPTED at once; an unknown id is not cancelled."""
+    from rclpy.node import Node
+
+    from synthesis_manager.nodes.sm_generation_node import SMGenerationNode
+    from synthesis_msgs.msg import LTLSpecification
+    from synthesis_msgs.srv import CancelSynthesis, GenerateFlexBESM, GenerateLTLSpecification
+
+    compiler, generator = ros.add_node(LTLCompilationNode), ros.add_node(SMGenerationNode)
+    client_node = ros.add_node(Node, 'cancelling_client')
+    requests = {
+        compiler: (client_node.create_client(GenerateLTLSpecification, 'ltl_compilation'),
+                   GenerateLTLSpecification.Request(
+                       system=PAPER_TASK['system'], goals=PAPER_TASK['goals'],
+                       initial_conditions=PAPER_TASK['initial_conditions'], request_id='goal-1',
+                       custom_ltl=LTLSpecification(sys_trans=custom_formulas(3_900_000)))),
+        generator: (client_node.create_client(GenerateFlexBESM, 'sm_generate'),
+                    GenerateFlexBESM.Request(automaton=chain_automaton_message(20_000)[0], system='atlas',
+                                             request_id='goal-2')),
+    }
+    for node, (service, request) in requests.items():
+        canceller = client_node.create_client(CancelSynthesis, f'{service.srv_name}/cancel')
+        assert service.wait_for_service(timeout_sec=10) and canceller.wait_for_service(timeout_sec=10)
+        assert not canceller.call(CancelSynthesis.Request(request_id='nobody'), timeout_sec=10).cancelled
+        future = service.call_async(request)
+        assert wait_until(lambda: node.children.running_requests == [request.request_id], 30.0)
+        assert canceller.call(CancelSynthesis.Request(request_id=request.request_id), timeout_sec=10).cancelled
+        cancelled = time.monotonic()
+        assert wait_until(future.done, 10.0)
+        answer = future.result()
+        assert answer.error_code.value == answer.error_code.PREEMPTED, answer.error_code.message
+        assert 'stopped: cancelled' in answer.error_code.message
+        assert time.monotonic() - cancelled < 3.0 and node.children.running_requests == []

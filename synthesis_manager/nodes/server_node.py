@@ -21,7 +21,7 @@ import time
 from dataclasses import dataclass, field, replace
 from typing import Callable
 
-from rclpy.action import ActionServer, CancelResponse, GoalResponse
+from rclpy.action import CancelResponse, GoalResponse
 from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.node import Node
 from rclpy.time import Time
@@ -37,6 +37,7 @@ from synthesis_manager.limits import (DEFAULT_MAX_GOAL_TIMEOUT, MAX_STRING_BYTES
 from synthesis_manager.nodes.atlas_sim_node import STATE_TOPIC
 from synthesis_manager.requests import (InvalidRequestError, SynthesisTask, task_from_behavior_synthesis,
                                         task_from_flexbe_synthesis)
+from synthesis_manager.ros.action_server import BurstActionServer
 from synthesis_manager.ros.cnu_interface import load_flexbe_synthesis_interface
 from synthesis_manager.ros.conversions import error_code, error_name, is_empty_spec
 from synthesis_manager.ros.errors import log_internal_error
@@ -205,7 +206,7 @@ class BehaviorSynthesisServer(Node):
             self.get_logger().debug(self._fallback_note)
         # rclpy keeps each result for result_timeout seconds (default 900: ~38 KB per goal).
         self.action_servers = [
-            ActionServer(self, interface.action_type, interface.action_name,
+            BurstActionServer(self, interface.action_type, interface.action_name,
                          self._executor_for(interface),
                          goal_callback=self.admit_goal,
                          cancel_callback=lambda _: CancelResponse.ACCEPT, callback_group=group,

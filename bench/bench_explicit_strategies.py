@@ -32,6 +32,11 @@ INSTANCES = [
     ('GenBuf, 6 senders', gr1_families.genbuf, (6, True)),
     ('gridworld 10x8 k=4', gr1_families.gridworld, (10, 8, 4, True)),
     ('gridworld 16x13 k=7', gr1_families.gridworld, (16, 13, 7, True)),
+    ('arbiter, 6 clients', gr1_families.arbiter, (6, True)),
+    ('arbiter, 8 clients', gr1_families.arbiter, (8, True)),
+    ('arbiter, 9 clients', gr1_families.arbiter, (9, True)),
+    ('lift, 6 floors', gr1_families.lift, (6, True)),
+    ('lift, 8 floors', gr1_families.lift, (8, True)),
 ]
 
 

@@ -25,6 +25,18 @@ Each family is a function ``size -> text``; ``FAMILIES`` lists the sizes the ben
   patrolling adversary walks the middle row; one goal lies on that row. Realizable: the
   adversary must reach both ends of its row infinitely often (it patrols); unrealizable: it
   may stop anywhere, e.g. on the goal.
+- ``arbiter``: a fair arbiter after Piterman, Pnueli, Sa'ar, "Synthesis of Reactive(1)
+  Designs", VMCAI 2006 (written from the paper's description): n clients raise requests
+  (inputs) and the arbiter answers with grants (outputs) by a handshake: a request changes
+  only while it is answered, a grant only while its request is pending; at most one grant at
+  a time, and every request and every release is eventually answered. Realizable: a granted
+  client eventually releases; unrealizable: that assumption dropped (a client may keep the
+  grant, so another client's request waits forever).
+- ``lift``: an elevator over n floors: each floor's call button is an input that stays
+  pressed until the lift stands at that floor, the lift (an output) moves at most one floor a
+  step and stands still while its door is held open (an input); every call is eventually
+  served. Realizable: the door is released infinitely often; unrealizable: that assumption
+  dropped (the door may stay held while another floor calls).
 """
 
 from __future__ import annotations
@@ -263,6 +275,49 @@ def gridworld(width: int, height: int, goals: int, realizable: bool = True) -> s
     return _text(lines)
 
 
+def arbiter(clients: int, realizable: bool = True) -> str:
+    """Fair arbiter of ``clients`` clients (VMCAI 2006): requests ``r<i>`` in, grants
+    ``g<i>`` out, four-phase handshake per client, mutually exclusive grants."""
+    requests = [f'r{i}' for i in range(clients)]
+    grants = [f'g{i}' for i in range(clients)]
+    pairs = list(zip(requests, grants))
+    lines = {'INPUT': requests, 'OUTPUT': grants,
+             'ENV_INIT': [f'!{r}' for r in requests],
+             'SYS_INIT': [f'!{g}' for g in grants],
+             # A client changes its request only once the arbiter has answered the last one.
+             'ENV_TRANS': [f"!({r} <-> {g}) -> ({r}' <-> {r})" for r, g in pairs],
+             # The arbiter changes a grant only to answer a pending request or release; at
+             # most one grant at a time.
+             'SYS_TRANS': [f"({r} <-> {g}) -> ({g}' <-> {g})" for r, g in pairs]
+             + [f"!{a}' | !{b}'" for k, a in enumerate(grants) for b in grants[k + 1:]],
+             # A granted client eventually releases (dropped in the unrealizable variant).
+             'ENV_LIVENESS': [f'!({r} & {g})' for r, g in pairs] if realizable else [],
+             # Every request and every release is eventually answered.
+             'SYS_LIVENESS': [f'{r} <-> {g}' for r, g in pairs]}
+    return _text(lines)
+
+
+def lift(floors: int, realizable: bool = True) -> str:
+    """An elevator over ``floors`` floors: call buttons ``b<i>`` and the door ``hold`` in,
+    the lift's ``floor`` out; every call is eventually served."""
+    buttons = [f'b{i}' for i in range(floors)]
+    env_trans = []
+    for index, button in enumerate(buttons):
+        # A call stays until the lift stands at its floor, which clears it.
+        env_trans += [f"{button} & floor != {index} -> {button}'",
+                      f"{button} & floor = {index} -> !{button}'"]
+    lines = {'INPUT': buttons + ['hold'], 'OUTPUT': [f'floor:0...{floors - 1}'],
+             'ENV_INIT': [f'!{b}' for b in buttons] + ['!hold'],
+             'SYS_INIT': ['floor = 0'],
+             'ENV_TRANS': env_trans,
+             # One floor a step at most; standing still while the door is held open.
+             'SYS_TRANS': ["floor' <= floor+1 & floor <= floor'+1", "hold -> floor' = floor"],
+             # The door is released infinitely often (dropped in the unrealizable variant).
+             'ENV_LIVENESS': ['!hold'] if realizable else [],
+             'SYS_LIVENESS': [f'!{b}' for b in buttons]}
+    return _text(lines)
+
+
 def _goal_regions(width: int, height: int, row: int, goals: int) -> list:
     """``goals`` boxes (x0, x1, y0, y1): 2x2 squares spread over the grid, alternately above
     and below the adversary's row, and one cell on that row."""
@@ -331,6 +386,11 @@ FAMILIES = {
     'gridworld': [(f'{w}x{h} k={k}', gridworld, (w, h, k, True)) for w, h, k in GRIDWORLD_SIZES],
     'gridworld_unrealizable': [(f'{w}x{h} k={k}', gridworld, (w, h, k, False))
                                for w, h, k in GRIDWORLD_SIZES],
+    'arbiter': [(f'{n} clients', arbiter, (n, True)) for n in (4, 8, 16, 24, 32, 48, 64)],
+    'arbiter_unrealizable': [(f'{n} clients', arbiter, (n, False))
+                             for n in (4, 8, 16, 24, 32, 48, 64, 96)],
+    'lift': [(f'{n} floors', lift, (n, True)) for n in (8, 16, 32, 48, 64, 96, 128)],
+    'lift_unrealizable': [(f'{n} floors', lift, (n, False)) for n in (8, 16, 32, 48, 64, 96, 128)],
 }
 
 

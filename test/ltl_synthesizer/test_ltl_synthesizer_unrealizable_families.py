@@ -1,6 +1,6 @@
-"""Issue 38: the new bench families (GenBuf, gridworld with a patrolling adversary) decide as
-designed, and our counter-strategies pass the independent check of bench/strategy_check.py,
-which also rejects broken ones."""
+"""Issue 38: the new bench families (GenBuf, gridworld with a patrolling adversary, the fair
+arbiter, the lift) decide as designed, and our counter-strategies pass the independent check
+of bench/strategy_check.py, which also rejects broken ones."""
 
 from __future__ import annotations
 
@@ -23,6 +23,8 @@ from strategy_check import check_counterstrategy, check_strategy  # noqa: E402
 SMALL = {
     'genbuf 3 senders': lambda realizable: gr1_families.genbuf(3, realizable),
     'gridworld 7x5 k=3': lambda realizable: gr1_families.gridworld(7, 5, 3, realizable),
+    'arbiter 3 clients': lambda realizable: gr1_families.arbiter(3, realizable),
+    'lift 4 floors': lambda realizable: gr1_families.lift(4, realizable),
 }
 
 

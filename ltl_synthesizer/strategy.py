@@ -198,13 +198,18 @@ def _next_valuations(game: SymbolicGame, responses) -> list[tuple]:
     """The valuations of all next-step variables (as ``game.variables``, primed) in
     ``responses``, which fixes the outputs it mentions for each input valuation: every next
     input it leaves free takes both values, every next output it does not mention is False."""
-    names = game.next_inputs + game.next_outputs
-    support = game.bdd.support(responses)
-    free_inputs = [index for index, name in enumerate(game.next_inputs) if name not in support]
+    return _valuations(game, responses, game.next_inputs + game.next_outputs, set(game.next_inputs))
+
+
+def _valuations(game: SymbolicGame, u, names: list[str], either: set[str]) -> list[tuple]:
+    """The valuations of ``names`` (tuples in that order) in ``u``, a BDD over them, read cube
+    by cube: a name of ``either`` that ``u`` leaves free takes both values, any other is False."""
+    support = game.bdd.support(u)
+    free = [index for index, name in enumerate(names) if name in either and name not in support]
     valuations = []
-    for cube in game.bdd._pick_iter(responses):
+    for cube in game.bdd._pick_iter(u):
         found = [tuple([cube.get(name, False) for name in names])]
-        for index in free_inputs:  # each free input doubles the valuations
+        for index in free:  # each free name doubles the valuations
             found += [values[:index] + (True,) + values[index + 1:] for values in found]
         valuations += found
     return valuations
@@ -378,8 +383,10 @@ class EnvironmentStrategy:
         self.game = game
         self.levels = solution.levels
         self.moves = _first_environment_moves(game, solution)
-        self.env_trans = game.env_trans()
         self.sys_trans = game.sys_trans()
+        # The environment moves that leave the system no output allowed by sys_trans, found
+        # once for all positions (per position, three BDD operations more per node).
+        self.deadlock_moves = game.env_trans() & ~(game.sys_invariant & game.system_can_respond(game.true))
         self.responses_counted = 0
         # Z_k, the union of level k's blocking sets: the outer least fixpoint's iterates.
         self.won_by_level = []
@@ -444,10 +451,10 @@ class EnvironmentStrategy:
         environment can leave the system no legal output, else one per system response to
         the environment's chosen input (only the first with ``only_first``)."""
         game = self.game
-        allowed_sys = game.bdd.let(state, self.sys_trans)
-        deadlock = self._deadlock_input(state, allowed_sys)
+        deadlock = self._deadlock_input(state)
         if deadlock is not None:
             return [(deadlock, rank)]
+        allowed_sys = game.bdd.let(state, self.sys_trans)
         assumption, goal = rank
         level = self.level_of(state)
         moves = game.bdd.let(state, self.moves[level][goal][assumption])
@@ -469,12 +476,11 @@ class EnvironmentStrategy:
             successors.append((next_values, (next_assumption, next_goal)))
         return successors
 
-    def _deadlock_input(self, state: dict, allowed_sys) -> tuple | None:
+    def _deadlock_input(self, state: dict) -> tuple | None:
         """The values of a deadlock node (chosen inputs, no outputs), if the environment can
         move so that no output satisfies sys_trans."""
         game = self.game
-        allowed_env = game.bdd.let(state, self.env_trans)
-        deadlock_inputs = game.bdd.forall(game.next_outputs, allowed_env & ~allowed_sys)
+        deadlock_inputs = game.bdd.let(state, self.deadlock_moves)
         if deadlock_inputs == game.false:
             return None
         choice, _ = game.pick(deadlock_inputs, game.next_inputs)
@@ -491,9 +497,7 @@ def _output_valuations(game: SymbolicGame, responses, only_first: bool) -> list[
     if only_first:
         return [game.pick(responses, game.next_outputs)[0]]
     names = game.next_outputs
-    outputs = game.exist_next_inputs(responses)
-    valuations = sorted(tuple(minterm[name] for name in names)
-                        for minterm in game.bdd._pick_iter(outputs, care_vars=set(names)))
+    valuations = sorted(_valuations(game, game.exist_next_inputs(responses), names, set(names)))
     return [dict(zip(names, values)) for values in valuations]
 
 

@@ -236,16 +236,17 @@ def _smallest_responses(game: SymbolicGame, moves):
 
 
 class _GoalsAt:
-    """The system goals cofactored by one position's state (over next-step variables only),
-    so that the position's transitions are split by their next step alone."""
+    """Goals (the system's, or the environment's assumptions) cofactored by one position's
+    state (and, for the environment, its chosen input), so that the position's transitions
+    are split by the rest of their next step alone."""
 
-    def __init__(self, game: SymbolicGame, state: dict[str, bool]):
-        self.game, self.state = game, state
+    def __init__(self, game: SymbolicGame, state: dict[str, bool], goals: list):
+        self.game, self.state, self.goals = game, state, goals
         self.cofactors = {}
 
     def cofactor(self, goal: int):
         if goal not in self.cofactors:
-            self.cofactors[goal] = self.game.bdd.let(self.state, self.game.sys_goals[goal])
+            self.cofactors[goal] = self.game.bdd.let(self.state, self.goals[goal])
         return self.cofactors[goal]
 
     def split_by_successor_goal(self, following, rank: int):
@@ -253,7 +254,7 @@ class _GoalsAt:
         pursued after them, as ``_successor_goal`` decides it: pairs (goal, part), each
         non-empty part of the transitions that satisfy goals rank, rank + 1, ... up to (not
         including) that goal; those that satisfy every goal keep pursuing ``rank``."""
-        goals = len(self.game.sys_goals)
+        goals = len(self.goals)
         for offset in range(goals):
             goal = (rank + offset) % goals
             satisfied = following & self.cofactor(goal)
@@ -328,7 +329,7 @@ def strategy_nodes(game: SymbolicGame, solution: SystemSolution):
         # Without the state cube, the picks below work on smaller BDDs.
         moves = game.bdd.exist(variables, goal_moves(game, steps[rank], env_moves, legal))
         successors = [numbering.number(next_values, next_rank) for next_values, next_rank
-                      in responses(moves, _GoalsAt(game, state), rank)]
+                      in responses(moves, _GoalsAt(game, state, game.sys_goals), rank)]
         yield str(numbering.index[(values, rank)]), {
             'rank': rank, 'state': [int(v) for v in values], 'trans': successors}
 
@@ -411,6 +412,7 @@ class EnvironmentStrategy:
         key = tuple(state[name] for name in self.game.variables) if values is None else values
         found = self._levels_found.get(key)
         if found is None:
+            state = dict(zip(self.game.variables, values)) if state is None else state
             low, high = 0, len(self.won_by_level) - 1
             if not self._won_at(high, state):
                 raise ValueError('the position is not won by the environment')
@@ -431,6 +433,7 @@ class EnvironmentStrategy:
         key = (values, level)
         found = self._goals_found.get(key)
         if found is None:
+            state = dict(zip(self.game.variables, values)) if state is None else state
             found = self._goals_found[key] = next(
                 j for j, blocking in enumerate(self.levels[level].blocking)
                 if self.game.evaluate(blocking, state, self._blocking_support(level, j)))
@@ -463,18 +466,40 @@ class EnvironmentStrategy:
         if only_first:  # the one-play explanation says how many answers the system had
             self.responses_counted = int(game.bdd.count(game.bdd.exist(game.next_inputs, responses),
                                                         nvars=len(game.next_outputs)))
+        input_values = tuple(chosen_input[name] for name in game.next_inputs)
         successors = []
-        next_variables = [game.to_next[name] for name in game.variables]
-        for choice in _output_valuations(game, responses, only_first):
-            transition = {**state, **chosen_input, **choice}
-            next_values = tuple(transition[name] for name in next_variables)
-            next_state = dict(zip(game.variables, next_values))
-            next_assumption = _successor_goal(game, game.env_goals, assumption, transition,
-                                              self._env_goal_supports)
-            next_level = self.level_of(next_state, next_values)
-            next_goal = goal if next_level == level else self.first_blockable_goal(next_state, next_level, next_values)
+        for output_values, next_assumption in self._responses(state, chosen_input, responses, assumption,
+                                                              only_first):
+            next_values = input_values + output_values
+            next_level = self.level_of(None, next_values)
+            next_goal = goal if next_level == level else self.first_blockable_goal(None, next_level, next_values)
             successors.append((next_values, (next_assumption, next_goal)))
         return successors
+
+    def _responses(self, state: dict, chosen_input: dict, responses, assumption: int,
+                   only_first: bool) -> list[tuple]:
+        """The system's responses to the chosen input (output values, in next_outputs order,
+        smallest first: False before True, in declared order, as repeated ``pick``s would
+        give) with the assumption pursued after each; only the first with ``only_first``.
+        The responses are split by that assumption symbolically (a few BDD operations per
+        assumption) and read off cube by cube: per response, evaluating the assumptions and
+        picking the outputs cost most of a small counter-strategy's extraction."""
+        game = self.game
+        if responses == game.false:
+            return []
+        if only_first:
+            choice = game.pick(responses, game.next_outputs)[0]
+            transition = {**state, **chosen_input, **choice}
+            return [(tuple(choice[name] for name in game.next_outputs),
+                     _successor_goal(game, game.env_goals, assumption, transition, self._env_goal_supports))]
+        names = game.next_outputs
+        assumptions_here = _GoalsAt(game, {**state, **chosen_input}, game.env_goals)
+        found = []
+        for next_assumption, part in assumptions_here.split_by_successor_goal(
+                game.exist_next_inputs(responses), assumption):
+            found += [(values, next_assumption) for values in _valuations(game, part, names, set(names))]
+        found.sort()  # one entry per output valuation: the values never tie
+        return found
 
     def _deadlock_input(self, state: dict) -> tuple | None:
         """The values of a deadlock node (chosen inputs, no outputs), if the environment can
@@ -485,20 +510,6 @@ class EnvironmentStrategy:
             return None
         choice, _ = game.pick(deadlock_inputs, game.next_inputs)
         return tuple(choice[game.to_next[name]] for name in game.inputs) + (None,) * len(game.outputs)
-
-
-def _output_valuations(game: SymbolicGame, responses, only_first: bool) -> list[dict]:
-    """The system's responses (output valuations over next outputs; the input is fixed) in
-    ``responses``, smallest first (False before True, in declared order): the order repeated
-    ``pick``s would give. All read off at once, sorted: a pick per response cost one BDD
-    operation per output (a third of a gridworld counter-strategy's time)."""
-    if responses == game.false:
-        return []
-    if only_first:
-        return [game.pick(responses, game.next_outputs)[0]]
-    names = game.next_outputs
-    valuations = sorted(_valuations(game, game.exist_next_inputs(responses), names, set(names)))
-    return [dict(zip(names, values)) for values in valuations]
 
 
 def _first_environment_moves(game: SymbolicGame, solution: EnvironmentSolution) -> list:

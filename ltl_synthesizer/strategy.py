@@ -151,29 +151,42 @@ def _successor_goal(game: SymbolicGame, goals, rank: int, transition: dict[str, 
 
 class _Responses:
     """One response per environment move in a position's ``moves`` (over next-step variables),
-    as the successor node ``(values of the next variables, goal pursued next)``, in increasing
-    order of the next inputs (False before True, in declared order): for each next input
-    valuation the smallest output valuation -- what repeated ``pick`` over inputs then outputs
-    would choose. The choice is made for all inputs at once (``_smallest_responses``: a few BDD
-    operations per output, not per move), split by the goal pursued next (a few BDD operations
-    per goal, not an evaluation per move), then read off cube by cube. The choices and the
-    valuations of each BDD are remembered: positions share them (the arbiter with 8 clients:
-    7,972 distinct moves at 11,264 positions; a lift with 8 floors: 2,284 at 7,041)."""
+    as the key of the successor node (``_node_key``: the code of the next variables' values
+    and the goal pursued next), in increasing order of the next inputs (False before True, in
+    declared order): for each next input valuation the smallest output valuation -- what
+    repeated ``pick`` over inputs then outputs would choose. The choice is made for all inputs
+    at once (``_smallest_responses``: a few BDD operations per output, not per move), split by
+    the goal pursued next (a few BDD operations per goal, not an evaluation per move), then
+    read off cube by cube. The choices and the valuations of each BDD are remembered:
+    positions share them (the arbiter with 8 clients: 7,972 distinct moves at 11,264
+    positions; a lift with 8 floors: 2,284 at 7,041)."""
 
     def __init__(self, game: SymbolicGame):
-        self.game = game
+        self.game, self.goals = game, len(game.sys_goals)
+        names = game.next_inputs + game.next_outputs
         self._smallest = _NodeMemo(lambda moves: _smallest_responses(game, moves))
-        self._valuations = _NodeMemo(lambda part: _next_valuations(game, part))
+        # Outputs the responses leave unmentioned are False (see _smallest_responses).
+        self._codes = _NodeMemo(lambda part: _codes(game, part, names, set(game.next_inputs)))
 
-    def __call__(self, moves, goals_here: '_GoalsAt', rank: int) -> list[tuple]:
+    def __call__(self, moves, goals_here: '_GoalsAt', rank: int) -> list[int]:
         chosen = self._smallest(moves)
         if chosen == self.game.false:
             return []
-        responses = []
+        goals = self.goals
+        keys, parts = [], 0
         for next_rank, part in goals_here.split_by_successor_goal(chosen, rank):
-            responses += [(values, next_rank) for values in self._valuations(part)]
-        responses.sort()  # one response per input valuation: the values never tie
-        return responses
+            keys += [code * goals + next_rank for code in self._codes(part)]  # as _node_key
+            parts += 1
+        if parts > 1:  # each part's codes are in order already
+            keys.sort()  # one response per input valuation: the codes never tie
+        return keys
+
+
+def _node_key(code: int, rank: int, goals: int) -> int:
+    """A strategy node (values coded as ``_codes`` does, goal pursued) as one integer, in the
+    order of its values: hashed and compared far faster than a tuple of booleans (numbering
+    3.1 million edges took most of the extraction of 7 free inputs)."""
+    return code * goals + rank
 
 
 class _NodeMemo:
@@ -194,25 +207,27 @@ class _NodeMemo:
         return found[1]
 
 
-def _next_valuations(game: SymbolicGame, responses) -> list[tuple]:
-    """The valuations of all next-step variables (as ``game.variables``, primed) in
-    ``responses``, which fixes the outputs it mentions for each input valuation: every next
-    input it leaves free takes both values, every next output it does not mention is False."""
-    return _valuations(game, responses, game.next_inputs + game.next_outputs, set(game.next_inputs))
-
-
-def _valuations(game: SymbolicGame, u, names: list[str], either: set[str]) -> list[tuple]:
-    """The valuations of ``names`` (tuples in that order) in ``u``, a BDD over them, read cube
-    by cube: a name of ``either`` that ``u`` leaves free takes both values, any other is False."""
+def _codes(game: SymbolicGame, u, names: list[str], either: set[str]) -> list[int]:
+    """The valuations of ``names`` in ``u`` (a BDD over them), increasing, each coded as the
+    integer whose bits are the values, the first name's the most significant (so codes
+    compare as the tuples of values do, False before True), read cube by cube: a name of
+    ``either`` that ``u`` leaves free takes both values, any other is False."""
     support = game.bdd.support(u)
-    free = [index for index, name in enumerate(names) if name in either and name not in support]
-    valuations = []
+    bits = [(name, 1 << (len(names) - 1 - index)) for index, name in enumerate(names)]
+    free = [bit for name, bit in bits if name in either and name not in support]
+    codes = []
     for cube in game.bdd._pick_iter(u):
-        found = [tuple([cube.get(name, False) for name in names])]
-        for index in free:  # each free name doubles the valuations
-            found += [values[:index] + (True,) + values[index + 1:] for values in found]
-        valuations += found
-    return valuations
+        found = [sum([bit for name, bit in bits if cube.get(name)])]
+        for bit in free:  # each free name doubles the valuations
+            found += [code | bit for code in found]
+        codes += found
+    codes.sort()
+    return codes
+
+
+def _values(code: int, count: int) -> tuple:
+    """The ``count`` values (booleans) that ``code`` codes (see ``_codes``)."""
+    return tuple(bool(code >> (count - 1 - index) & 1) for index in range(count))
 
 
 def _smallest_responses(game: SymbolicGame, moves):
@@ -279,19 +294,19 @@ def _moves_from(game: SymbolicGame, state: dict[str, bool]):
 
 
 class _Numbering:
-    """Nodes (valuation, rank) numbered in order of discovery, breadth-first: ``queue`` holds
-    the discovered nodes not yet expanded."""
+    """Nodes (by a key: valuation and rank) numbered in order of discovery, breadth-first:
+    ``queue`` holds the keys of the discovered nodes not yet expanded."""
 
     def __init__(self):
-        self.index: dict[tuple, int] = {}
+        self.index: dict = {}
         self.queue: deque = deque()
 
-    def number(self, values: tuple, rank) -> int:
-        key = (values, rank)
-        if key not in self.index:
-            self.index[key] = len(self.index)
+    def number(self, key) -> int:
+        found = self.index.get(key)
+        if found is None:
+            found = self.index[key] = len(self.index)
             self.queue.append(key)
-        return self.index[key]
+        return found
 
 
 def _strategy_json(variables, nodes: dict) -> dict:
@@ -314,23 +329,26 @@ def streamed_strategy(game: SymbolicGame, solution: SystemSolution) -> dict:
 def strategy_nodes(game: SymbolicGame, solution: SystemSolution):
     """The strategy's nodes ``(name, node)`` in increasing number (breadth-first order)."""
     steps = [[_StepMoves(game, step) for step in goal] for goal in goal_steps(game, solution)]
-    variables = game.variables
+    variables, goals = game.variables, len(game.sys_goals)
     responses = _Responses(game)
     numbering = _Numbering()
     initial = solution.winning & game.env_init & game.sys_init
-    for state in enumerate_states(game, initial, variables):
-        numbering.number(tuple(state[name] for name in variables), 0)
+    for code in _codes(game, initial, variables, set(variables)):  # smallest first
+        numbering.number(_node_key(code, 0, goals))
 
+    number = numbering.number
     while numbering.queue:
-        values, rank = numbering.queue.popleft()
+        key = numbering.queue.popleft()
         game.interrupt.check()
+        code, rank = divmod(key, goals)
+        values = _values(code, len(variables))
         state = dict(zip(variables, values))
         env_moves, legal = _moves_from(game, state)
         # Without the state cube, the picks below work on smaller BDDs.
         moves = game.bdd.exist(variables, goal_moves(game, steps[rank], env_moves, legal))
-        successors = [numbering.number(next_values, next_rank) for next_values, next_rank
-                      in responses(moves, _GoalsAt(game, state, game.sys_goals), rank)]
-        yield str(numbering.index[(values, rank)]), {
+        successors = [number(successor) for successor in
+                      responses(moves, _GoalsAt(game, state, game.sys_goals), rank)]
+        yield str(numbering.index[key]), {
             'rank': rank, 'state': [int(v) for v in values], 'trans': successors}
 
 
@@ -353,8 +371,8 @@ def extract_counterstrategy(game: SymbolicGame, solution: EnvironmentSolution,
     numbering = _Numbering()
     initial = losing_initial_positions(game, solution.winning, robotics_semantics)
     for state in enumerate_states(game, initial, game.variables, limit=1 if one_play else None):
-        numbering.number(tuple(state[name] for name in game.variables),
-                         (0, environment.first_blockable_goal(state)))
+        numbering.number((tuple(state[name] for name in game.variables),
+                          (0, environment.first_blockable_goal(state))))
     nodes: dict[str, dict] = {}
     while numbering.queue and not (one_play and len(nodes) >= play_length):
         values, rank = numbering.queue.popleft()
@@ -367,7 +385,7 @@ def extract_counterstrategy(game: SymbolicGame, solution: EnvironmentSolution,
         successors = environment.successors(dict(zip(game.variables, values)), rank, one_play)
         if one_play:
             node['responses'] = environment.responses_counted
-        node['trans'] = [numbering.number(*successor) for successor in successors]
+        node['trans'] = [numbering.number(successor) for successor in successors]
     return _strategy_json(game.variables, nodes)
 
 
@@ -497,7 +515,8 @@ class EnvironmentStrategy:
         found = []
         for next_assumption, part in assumptions_here.split_by_successor_goal(
                 game.exist_next_inputs(responses), assumption):
-            found += [(values, next_assumption) for values in _valuations(game, part, names, set(names))]
+            found += [(_values(code, len(names)), next_assumption)
+                      for code in _codes(game, part, names, set(names))]
         found.sort()  # one entry per output valuation: the values never tie
         return found
 

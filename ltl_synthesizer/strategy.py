@@ -225,6 +225,22 @@ def _codes(game: SymbolicGame, u, names: list[str], either: set[str]) -> list[in
     return codes
 
 
+#: Initial states read off at once up to this many; more are enumerated one at a time.
+MAX_INITIAL_CODES = 2**16
+
+
+def _initial_codes(game: SymbolicGame, initial):
+    """The codes (``_codes``) of the initial positions, smallest first. Beyond
+    MAX_INITIAL_CODES, one at a time, each after a look at the limits: reading off a huge set
+    at once (2^200 positions of a runaway specification) could not be stopped."""
+    variables = game.variables
+    if game.bdd.count(initial, nvars=len(variables)) <= MAX_INITIAL_CODES:
+        return _codes(game, initial, variables, set(variables))
+    bits = [1 << (len(variables) - 1 - index) for index in range(len(variables))]
+    return (sum(bit for bit, name in zip(bits, variables) if state[name])
+            for state in enumerate_states(game, initial, variables))
+
+
 def _values(code: int, count: int) -> tuple:
     """The ``count`` values (booleans) that ``code`` codes (see ``_codes``)."""
     return tuple(bool(code >> (count - 1 - index) & 1) for index in range(count))
@@ -332,8 +348,7 @@ def strategy_nodes(game: SymbolicGame, solution: SystemSolution):
     variables, goals = game.variables, len(game.sys_goals)
     responses = _Responses(game)
     numbering = _Numbering()
-    initial = solution.winning & game.env_init & game.sys_init
-    for code in _codes(game, initial, variables, set(variables)):  # smallest first
+    for code in _initial_codes(game, solution.winning & game.env_init & game.sys_init):
         numbering.number(_node_key(code, 0, goals))
 
     number = numbering.number

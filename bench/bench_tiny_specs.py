@@ -8,13 +8,17 @@ counter-strategy, and of one synthesis in the server's own synthesis processes (
 
 Fresh processes: the best CPU seconds (user + system) of ``--repeats`` runs, alternating the
 two tools. Resident: the median wall time of ``--repeats`` requests after a first one (which
-loads the modules). Table: results/tiny_specs.md.
+loads the modules), and the mean CPU time of the answering process over ``--cpu-batch``
+requests (the kernel counts CPU time in 10 ms ticks: a batch makes that fine enough; on a
+shared machine the wall time also holds the time other work took the cores). Table:
+results/tiny_specs.md.
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import os
 import statistics
 import subprocess
 import sys
@@ -47,8 +51,16 @@ def fresh_cpu(command: list[str], repeats: int) -> float:
     return min(run_timed(command, 60)['cpu'] for _ in range(repeats))
 
 
-def resident_wall(requests: list[list[str]], repeats: int) -> list[float]:
-    """Median wall seconds per request, for each request, of one resident process."""
+def process_cpu(pid: int) -> float:
+    """CPU seconds (user + system) process ``pid`` has used so far, all its threads included."""
+    with open(f'/proc/{pid}/stat') as stat:
+        fields = stat.read().rsplit(')', 1)[1].split()
+    return (int(fields[11]) + int(fields[12])) / os.sysconf('SC_CLK_TCK')
+
+
+def resident_wall(requests: list[list[str]], repeats: int, cpu_batch: int) -> tuple[list[float], float]:
+    """Median wall seconds per request, for each request, of one resident process; and the
+    mean CPU seconds per request that process spent on a batch of ``cpu_batch`` of the last."""
     process = subprocess.Popen(GR1SYNTH + ['--serve'], stdin=subprocess.PIPE,
                                stdout=subprocess.PIPE, text=True, cwd=ROOT)
 
@@ -62,18 +74,42 @@ def resident_wall(requests: list[list[str]], repeats: int) -> list[float]:
             raise RuntimeError(f'{arguments}: {answer["stderr"]}')
         return elapsed
 
+    def cpu_per_request(arguments) -> float:
+        before = process_cpu(process.pid)
+        for _ in range(cpu_batch):
+            ask(arguments)
+        return (process_cpu(process.pid) - before) / cpu_batch
+
     try:
         for arguments in requests:
             ask(arguments)  # loads what this kind of request needs
-        return [statistics.median(ask(arguments) for _ in range(repeats)) for arguments in requests]
+        walls = [statistics.median(ask(arguments) for _ in range(repeats)) for arguments in requests]
+        return walls, cpu_per_request(requests[-1])
     finally:
         process.stdin.close()
         process.wait()
 
 
-def server_child_wall(spec, repeats: int) -> float:
+def synthesis_children() -> list[int]:
+    """The synthesis processes this process started."""
+    found = []
+    for entry in filter(str.isdigit, os.listdir('/proc')):
+        try:
+            with open(f'/proc/{entry}/stat') as stat:
+                parent = int(stat.read().rsplit(')', 1)[1].split()[1])
+            with open(f'/proc/{entry}/cmdline', 'rb') as cmdline:
+                command = cmdline.read()
+        except (FileNotFoundError, ProcessLookupError):
+            continue
+        if parent == os.getpid() and b'ltl_synthesizer.isolated' in command:
+            found.append(int(entry))
+    return found
+
+
+def server_child_wall(spec, repeats: int, cpu_batch: int) -> tuple[float, float]:
     """Median wall seconds of one synthesis in the server's synthesis processes, as the
-    ``ltl_synthesis`` node asks it (its default strategy budget), the child already warm."""
+    ``ltl_synthesis`` node asks it (its default strategy budget), the child already warm; and
+    the mean CPU seconds per synthesis of the child and this caller over ``cpu_batch`` of them."""
     from ltl_synthesizer.interrupt import Limits
     from ltl_synthesizer.isolated import SERVER_CHILD_NICENESS, SynthesisProcesses
     from synthesis_manager.nodes.ltl_synthesis_node import DEFAULT_MAX_STRATEGY_EDGES
@@ -87,7 +123,12 @@ def server_child_wall(spec, repeats: int) -> float:
 
     try:
         synthesize()
-        return statistics.median(synthesize() for _ in range(repeats))
+        wall = statistics.median(synthesize() for _ in range(repeats))
+        child, = synthesis_children()  # one child serves them all
+        before = process_cpu(child) + process_cpu(os.getpid())
+        for _ in range(cpu_batch):
+            synthesize()
+        return wall, (process_cpu(child) + process_cpu(os.getpid()) - before) / cpu_batch
     finally:
         processes.close()
 
@@ -96,6 +137,8 @@ def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument('--slugs', help='slugs executable (compared when given)')
     parser.add_argument('--repeats', type=int, default=7)
+    parser.add_argument('--cpu-batch', type=int, default=40,
+                        help='requests per CPU measurement of the resident process and the server child')
     args = parser.parse_args(argv)
     from respec.parsing import parse_structuredslugs
     lines = ['# Tiny specifications: a fresh process and the resident mode', '',
@@ -106,10 +149,13 @@ def main(argv=None) -> int:
              '`--counterStrategy --jsonOutput` when not), each request answered once before. Server child: '
              'median wall milliseconds of one synthesis in the synthesis node\'s child processes '
              '(`SynthesisProcesses.synthesize`, the node\'s strategy budget), the child warm. '
-             'The machine (2 cores) was shared with other work while this ran.', '',
+             f'CPU: mean CPU milliseconds per request over {args.cpu_batch} of them (the resident '
+             'process; the child and its caller). The machine (2 cores) was shared with other work '
+             'while this ran: the wall times hold the time other work took the cores.', '',
              'Generated by `nice -n 10 python bench/bench_tiny_specs.py --slugs SLUGS`.', '',
              '| specification | verdict | ours fresh | slugs fresh | resident verdict | '
-             'resident strategy | server child |', '|---|---|---|---|---|---|---|']
+             'resident strategy | resident strategy CPU | server child | server child CPU |',
+             '|---|---|---|---|---|---|---|---|---|']
     with tempfile.TemporaryDirectory() as directory:
         for label, text in SPECS.items():
             slugsin = Path(directory) / 'tiny.slugsin'
@@ -122,12 +168,14 @@ def main(argv=None) -> int:
                 if args.slugs:
                     slugs = min(filter(None, [slugs, run_timed([args.slugs, str(slugsin)], 60)['cpu']]))
             output = str(Path(directory) / 'strategy.json')
-            verdict_wall, strategy_wall = resident_wall(
-                [[str(slugsin)], REQUESTS[realizable] + [str(slugsin), output]], args.repeats)
-            child_wall = server_child_wall(parse_structuredslugs(text, filename='t.structuredslugs'), args.repeats)
+            (verdict_wall, strategy_wall), strategy_cpu = resident_wall(
+                [[str(slugsin)], REQUESTS[realizable] + [str(slugsin), output]], args.repeats, args.cpu_batch)
+            child_wall, child_cpu = server_child_wall(parse_structuredslugs(text, filename='t.structuredslugs'),
+                                                      args.repeats, args.cpu_batch)
             row = (f"| {label} | {'realizable' if realizable else 'unrealizable'} | {ours:.3f} s | "
                    f"{f'{slugs:.3f} s' if slugs is not None else '-'} | {verdict_wall * 1000:.1f} ms | "
-                   f'{strategy_wall * 1000:.1f} ms | {child_wall * 1000:.1f} ms |')
+                   f'{strategy_wall * 1000:.1f} ms | {strategy_cpu * 1000:.1f} ms | '
+                   f'{child_wall * 1000:.1f} ms | {child_cpu * 1000:.1f} ms |')
             print(row, flush=True)
             lines.append(row)
     RESULTS.mkdir(parents=True, exist_ok=True)

@@ -91,18 +91,6 @@ class AttractorStep:
     assumption: object
     responses: object  # exists y'. sys_trans & transitions: where the step offers a move
 
-    def transitions_among(self, game: SymbolicGame, moves):
-        """The ``moves`` (a small set of transitions) that are transitions of this step.
-
-        The moves are renamed so that their targets become positions, intersected with the
-        step's position sets there, and renamed back: swapping the variables of a small set
-        is cheap, priming the large position sets is not.
-        """
-        reversed_moves = game.prime(moves)  # the moves' targets are now current variables
-        into_closer = game.prime(reversed_moves & self.closer)
-        into_waiting = game.prime(reversed_moves & self.waiting) & ~self.assumption
-        return (moves & self.goal_transitions) | into_closer | into_waiting
-
 
 @dataclass
 class SystemSolution:

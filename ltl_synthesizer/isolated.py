@@ -43,7 +43,10 @@ grown it by more (SynthesisMemoryError).
 
 from __future__ import annotations
 
+import functools
 import importlib
+import io
+import operator
 import os
 import pickle
 import select
@@ -200,7 +203,7 @@ class ChildProcess:
                                          'without an answer', item='synthesis process')
 
     def send(self, message) -> None:
-        data = pickle.dumps(message, protocol=pickle.HIGHEST_PROTOCOL)
+        data = _dumps(message)
         with self._writing:
             self.process.stdin.write(len(data).to_bytes(_LENGTH_BYTES, 'little') + data)
             self.process.stdin.flush()
@@ -419,9 +422,41 @@ def _serve(parent_pid: int, preload: str) -> None:
         send(('retire' if held > REUSE_MARGIN_BYTES else 'ready', held))
 
 
+def _dumps(message) -> bytes:
+    """``message`` pickled, formula nodes as their class and fields: through the dataclasses'
+    own pickling (which looks up their fields at every node), a tiny gridworld's specification
+    took 3.5 ms to pickle and 2.7 ms to load, 0.75 and 0.7 ms this way (the same objects, shared
+    subformulas still shared)."""
+    stream = io.BytesIO()
+    pickler = pickle.Pickler(stream, protocol=pickle.HIGHEST_PROTOCOL)
+    pickler.dispatch_table = _formula_dispatch_table()
+    pickler.dump(message)
+    return stream.getvalue()
+
+
+@functools.cache
+def _formula_dispatch_table() -> dict:
+    import copyreg
+    import dataclasses
+    from respec import ltl
+    table = copyreg.dispatch_table.copy()
+    for kind in (ltl.Const, ltl.Var, ltl.Not, ltl.And, ltl.Or, ltl.Implies, ltl.Iff, ltl.Next):
+        table[kind] = _fields_reducer(kind, [field.name for field in dataclasses.fields(kind)])
+    return table
+
+
+def _fields_reducer(kind: type, names: list[str]):
+    """A pickle reducer of ``kind``: rebuilt as ``kind(*fields)``."""
+    if len(names) == 1:
+        read = operator.attrgetter(names[0])
+        return lambda node: (kind, (read(node),))
+    read = operator.attrgetter(*names)
+    return lambda node: (kind, read(node))
+
+
 def _pickled(message) -> bytes:
     try:
-        return pickle.dumps(message, protocol=pickle.HIGHEST_PROTOCOL)
+        return _dumps(message)
     except Exception as error:  # noqa: BLE001 -- e.g. an exception that cannot be pickled
         return pickle.dumps(('error', SynthesisError(f'synthesis process: {error!r}')))
 

@@ -49,11 +49,33 @@ def goal_moves(game: SymbolicGame, steps, env_moves, legal):
         new_cases = offered & ~answered
         if new_cases == game.false:
             continue
-        moves |= step.transitions_among(game, new_cases & legal)
+        moves |= step.transitions_among(new_cases & legal)
         answered |= offered
         if answered == env_moves:
             break  # every environment move is answered
     return moves
+
+
+class _StepMoves:
+    """One attractor step (gr1.AttractorStep) as extraction uses it, at many positions: its
+    transitions ``(goal & Z') | closer' | (waiting' & !assumption)`` kept as three parts (their
+    union is never needed), the position sets primed once, on first use. Priming instead the
+    few moves of each position, twice per step and position, cost more (a variable swap is
+    about 11 us whatever the size: 0.46 of the 2.4 s of the arbiter with 8 clients)."""
+
+    def __init__(self, game: SymbolicGame, step):
+        self.game, self.step = game, step
+        self.responses = step.responses
+        self._primed = None
+
+    def transitions_among(self, moves):
+        """The ``moves`` (a small set of transitions) that are transitions of this step."""
+        if self._primed is None:
+            step = self.step
+            self._primed = (self.game.prime(step.closer),
+                            self.game.prime(step.waiting) & ~step.assumption)
+        into_closer, into_waiting = self._primed
+        return (moves & self.step.goal_transitions) | (moves & into_closer) | (moves & into_waiting)
 
 
 @dataclass
@@ -127,63 +149,152 @@ def _successor_goal(game: SymbolicGame, goals, rank: int, transition: dict[str, 
     return goal
 
 
-def _responses(game: SymbolicGame, moves):
-    """One response per environment move in ``moves`` (over next-step variables): for each
-    next input valuation, in increasing order (False before True, in declared order), the
-    smallest output valuation -- what repeated ``pick`` over inputs then outputs would
-    choose. The choice is made for all inputs at once (``_smallest_responses``: a few BDD
-    operations per output, not per move), then read off minterm by minterm: on strategies
-    that answer many inputs per state, 2x faster than a cofactor and a pick per move."""
-    bdd = game.bdd
-    chosen, free_outputs = _smallest_responses(game, moves)
-    if chosen == game.false:
-        return
-    care = set(game.next_inputs) | (bdd.support(chosen) & set(game.next_outputs))
-    responses = sorted((tuple(minterm[name] for name in game.next_inputs), minterm)
-                       for minterm in bdd._pick_iter(chosen, care_vars=care))
-    for values, minterm in responses:
-        yield dict(zip(game.next_inputs, values)), {**free_outputs, **{
-            name: minterm[name] for name in game.next_outputs if name in minterm}}
+class _Responses:
+    """One response per environment move in a position's ``moves`` (over next-step variables),
+    as the key of the successor node (``_node_key``: the code of the next variables' values
+    and the goal pursued next), in increasing order of the next inputs (False before True, in
+    declared order): for each next input valuation the smallest output valuation -- what
+    repeated ``pick`` over inputs then outputs would choose. The choice is made for all inputs
+    at once (``_smallest_responses``: a few BDD operations per output, not per move), split by
+    the goal pursued next (a few BDD operations per goal, not an evaluation per move), then
+    read off cube by cube. The choices and the valuations of each BDD are remembered:
+    positions share them (the arbiter with 8 clients: 7,972 distinct moves at 11,264
+    positions; a lift with 8 floors: 2,284 at 7,041)."""
+
+    def __init__(self, game: SymbolicGame):
+        self.game, self.goals = game, len(game.sys_goals)
+        names = game.next_inputs + game.next_outputs
+        self._smallest = _NodeMemo(lambda moves: _smallest_responses(game, moves))
+        # Outputs the responses leave unmentioned are False (see _smallest_responses).
+        self._codes = _NodeMemo(lambda part: _codes(game, part, names, set(game.next_inputs)))
+
+    def __call__(self, moves, goals_here: '_GoalsAt', rank: int) -> list[int]:
+        chosen = self._smallest(moves)
+        if chosen == self.game.false:
+            return []
+        goals = self.goals
+        keys, parts = [], 0
+        for next_rank, part in goals_here.split_by_successor_goal(chosen, rank):
+            keys += [code * goals + next_rank for code in self._codes(part)]  # as _node_key
+            parts += 1
+        if parts > 1:  # each part's codes are in order already
+            keys.sort()  # one response per input valuation: the codes never tie
+        return keys
+
+
+def _node_key(code: int, rank: int, goals: int) -> int:
+    """A strategy node (values coded as ``_codes`` does, goal pursued) as one integer, in the
+    order of its values: hashed and compared far faster than a tuple of booleans (numbering
+    3.1 million edges took most of the extraction of 7 free inputs)."""
+    return code * goals + rank
+
+
+class _NodeMemo:
+    """A function of BDDs with its results remembered by node (the BDD is kept with its result,
+    so its node is not reused for another); forgotten all at once beyond ``limit`` entries, to
+    bound the memory a huge strategy takes."""
+
+    def __init__(self, function, limit: int = 2**16):
+        self.function, self.limit = function, limit
+        self.found = {}
+
+    def __call__(self, u):
+        found = self.found.get(int(u))
+        if found is None:
+            if len(self.found) >= self.limit:
+                self.found.clear()
+            found = self.found[int(u)] = (u, self.function(u))
+        return found[1]
+
+
+def _codes(game: SymbolicGame, u, names: list[str], either: set[str]) -> list[int]:
+    """The valuations of ``names`` in ``u`` (a BDD over them), increasing, each coded as the
+    integer whose bits are the values, the first name's the most significant (so codes
+    compare as the tuples of values do, False before True), read cube by cube: a name of
+    ``either`` that ``u`` leaves free takes both values, any other is False."""
+    support = game.bdd.support(u)
+    bits = [(name, 1 << (len(names) - 1 - index)) for index, name in enumerate(names)]
+    free = [bit for name, bit in bits if name in either and name not in support]
+    codes = []
+    for cube in game.bdd._pick_iter(u):
+        found = [sum([bit for name, bit in bits if cube.get(name)])]
+        for bit in free:  # each free name doubles the valuations
+            found += [code | bit for code in found]
+        codes += found
+    codes.sort()
+    return codes
+
+
+#: Initial states read off at once up to this many; more are enumerated one at a time.
+MAX_INITIAL_CODES = 2**16
+
+
+def _initial_codes(game: SymbolicGame, initial):
+    """The codes (``_codes``) of the initial positions, smallest first. Beyond
+    MAX_INITIAL_CODES, one at a time, each after a look at the limits: reading off a huge set
+    at once (2^200 positions of a runaway specification) could not be stopped."""
+    variables = game.variables
+    if game.bdd.count(initial, nvars=len(variables)) <= MAX_INITIAL_CODES:
+        return _codes(game, initial, variables, set(variables))
+    bits = [1 << (len(variables) - 1 - index) for index in range(len(variables))]
+    return (sum(bit for bit, name in zip(bits, variables) if state[name])
+            for state in enumerate_states(game, initial, variables))
+
+
+def _values(code: int, count: int) -> tuple:
+    """The ``count`` values (booleans) that ``code`` codes (see ``_codes``)."""
+    return tuple(bool(code >> (count - 1 - index) & 1) for index in range(count))
 
 
 def _smallest_responses(game: SymbolicGame, moves):
     """``moves`` narrowed to the smallest output valuation of each input valuation, the outputs
-    decided in declared order (False when ``moves`` allows it, as ``SymbolicGame.pick``), and
-    the outputs ``moves`` leaves free (all False). Output k may be False where some move with
-    the earlier outputs' choices and output k False exists (the later outputs quantified)."""
+    decided in declared order (False when ``moves`` allows it, as ``SymbolicGame.pick``); the
+    outputs ``moves`` leaves free stay unmentioned (they are read as False). Output k may be
+    False where some move with the earlier outputs' choices and output k False exists (the
+    later outputs quantified). An output the moves already fix (all False, or all True) needs
+    no quantification: skipping it made this 2-4x faster (arbiter, moving obstacle)."""
     bdd = game.bdd
     support = bdd.support(moves)
     decided = [name for name in game.next_outputs if name in support]
-    free_outputs = {name: False for name in game.next_outputs if name not in support}
     chosen = moves
     for index, name in enumerate(decided):
-        low = ~bdd.var(name)
-        can_be_low = bdd.exist(decided[index:], chosen & low)
-        chosen &= low | ~can_be_low
-    return chosen, free_outputs
+        low_moves = chosen & ~bdd.var(name)
+        if low_moves == chosen or low_moves == game.false:
+            continue
+        can_be_low = bdd.exist(decided[index:], low_moves)
+        chosen = bdd.ite(can_be_low, low_moves, chosen)
+    return chosen
 
 
 class _GoalsAt:
-    """The system goals cofactored by one position's state (over next-step variables only),
-    so that each of the position's transitions is evaluated on its next step alone."""
+    """Goals (the system's, or the environment's assumptions) cofactored by one position's
+    state (and, for the environment, its chosen input), so that the position's transitions
+    are split by the rest of their next step alone."""
 
-    def __init__(self, game: SymbolicGame, state: dict[str, bool]):
-        self.game, self.state = game, state
+    def __init__(self, game: SymbolicGame, state: dict[str, bool], goals: list):
+        self.game, self.state, self.goals = game, state, goals
         self.cofactors = {}
 
-    def holds(self, goal: int, following: dict[str, bool]) -> bool:
+    def cofactor(self, goal: int):
         if goal not in self.cofactors:
-            self.cofactors[goal] = self.game.bdd.let(self.state, self.game.sys_goals[goal])
-        return self.game.evaluate(self.cofactors[goal], following)
+            self.cofactors[goal] = self.game.bdd.let(self.state, self.goals[goal])
+        return self.cofactors[goal]
 
-    def successor_goal(self, rank: int, following: dict[str, bool]) -> int:
-        """As ``_successor_goal``, for a transition from this position."""
-        goals = len(self.game.sys_goals)
-        goal, first_try = rank, True
-        while (goal != rank or first_try) and self.holds(goal, following):
-            goal = (goal + 1) % goals
-            first_try = False
-        return goal
+    def split_by_successor_goal(self, following, rank: int):
+        """``following`` (next steps of transitions from this position) split by the goal
+        pursued after them, as ``_successor_goal`` decides it: pairs (goal, part), each
+        non-empty part of the transitions that satisfy goals rank, rank + 1, ... up to (not
+        including) that goal; those that satisfy every goal keep pursuing ``rank``."""
+        goals = len(self.goals)
+        for offset in range(goals):
+            goal = (rank + offset) % goals
+            satisfied = following & self.cofactor(goal)
+            if satisfied != following:
+                yield goal, following & ~satisfied
+            if satisfied == self.game.false:
+                return
+            following = satisfied
+        yield rank, following
 
 
 def _moves_from(game: SymbolicGame, state: dict[str, bool]):
@@ -199,19 +310,19 @@ def _moves_from(game: SymbolicGame, state: dict[str, bool]):
 
 
 class _Numbering:
-    """Nodes (valuation, rank) numbered in order of discovery, breadth-first: ``queue`` holds
-    the discovered nodes not yet expanded."""
+    """Nodes (by a key: valuation and rank) numbered in order of discovery, breadth-first:
+    ``queue`` holds the keys of the discovered nodes not yet expanded."""
 
     def __init__(self):
-        self.index: dict[tuple, int] = {}
+        self.index: dict = {}
         self.queue: deque = deque()
 
-    def number(self, values: tuple, rank) -> int:
-        key = (values, rank)
-        if key not in self.index:
-            self.index[key] = len(self.index)
+    def number(self, key) -> int:
+        found = self.index.get(key)
+        if found is None:
+            found = self.index[key] = len(self.index)
             self.queue.append(key)
-        return self.index[key]
+        return found
 
 
 def _strategy_json(variables, nodes: dict) -> dict:
@@ -233,29 +344,26 @@ def streamed_strategy(game: SymbolicGame, solution: SystemSolution) -> dict:
 
 def strategy_nodes(game: SymbolicGame, solution: SystemSolution):
     """The strategy's nodes ``(name, node)`` in increasing number (breadth-first order)."""
-    steps = goal_steps(game, solution)
-    variables = game.variables
-    next_variables = [game.to_next[name] for name in variables]
+    steps = [[_StepMoves(game, step) for step in goal] for goal in goal_steps(game, solution)]
+    variables, goals = game.variables, len(game.sys_goals)
+    responses = _Responses(game)
     numbering = _Numbering()
-    initial = solution.winning & game.env_init & game.sys_init
-    for state in enumerate_states(game, initial, variables):
-        numbering.number(tuple(state[name] for name in variables), 0)
+    for code in _initial_codes(game, solution.winning & game.env_init & game.sys_init):
+        numbering.number(_node_key(code, 0, goals))
 
+    number = numbering.number
     while numbering.queue:
-        values, rank = numbering.queue.popleft()
+        key = numbering.queue.popleft()
         game.interrupt.check()
+        code, rank = divmod(key, goals)
+        values = _values(code, len(variables))
         state = dict(zip(variables, values))
         env_moves, legal = _moves_from(game, state)
         # Without the state cube, the picks below work on smaller BDDs.
         moves = game.bdd.exist(variables, goal_moves(game, steps[rank], env_moves, legal))
-        goals_here = _GoalsAt(game, state)
-        successors = []
-        for inputs, outputs in _responses(game, moves):
-            following = {**inputs, **outputs}
-            next_rank = goals_here.successor_goal(rank, following)
-            next_values = tuple(following[name] for name in next_variables)
-            successors.append(numbering.number(next_values, next_rank))
-        yield str(numbering.index[(values, rank)]), {
+        successors = [number(successor) for successor in
+                      responses(moves, _GoalsAt(game, state, game.sys_goals), rank)]
+        yield str(numbering.index[key]), {
             'rank': rank, 'state': [int(v) for v in values], 'trans': successors}
 
 
@@ -278,8 +386,8 @@ def extract_counterstrategy(game: SymbolicGame, solution: EnvironmentSolution,
     numbering = _Numbering()
     initial = losing_initial_positions(game, solution.winning, robotics_semantics)
     for state in enumerate_states(game, initial, game.variables, limit=1 if one_play else None):
-        numbering.number(tuple(state[name] for name in game.variables),
-                         (0, environment.first_blockable_goal(state)))
+        numbering.number((tuple(state[name] for name in game.variables),
+                          (0, environment.first_blockable_goal(state))))
     nodes: dict[str, dict] = {}
     while numbering.queue and not (one_play and len(nodes) >= play_length):
         values, rank = numbering.queue.popleft()
@@ -292,7 +400,7 @@ def extract_counterstrategy(game: SymbolicGame, solution: EnvironmentSolution,
         successors = environment.successors(dict(zip(game.variables, values)), rank, one_play)
         if one_play:
             node['responses'] = environment.responses_counted
-        node['trans'] = [numbering.number(*successor) for successor in successors]
+        node['trans'] = [numbering.number(successor) for successor in successors]
     return _strategy_json(game.variables, nodes)
 
 
@@ -309,8 +417,10 @@ class EnvironmentStrategy:
         self.game = game
         self.levels = solution.levels
         self.moves = _first_environment_moves(game, solution)
-        self.env_trans = game.env_trans()
         self.sys_trans = game.sys_trans()
+        # The environment moves that leave the system no output allowed by sys_trans, found
+        # once for all positions (per position, three BDD operations more per node).
+        self.deadlock_moves = game.env_trans() & ~(game.sys_invariant & game.system_can_respond(game.true))
         self.responses_counted = 0
         # Z_k, the union of level k's blocking sets: the outer least fixpoint's iterates.
         self.won_by_level = []
@@ -335,6 +445,7 @@ class EnvironmentStrategy:
         key = tuple(state[name] for name in self.game.variables) if values is None else values
         found = self._levels_found.get(key)
         if found is None:
+            state = dict(zip(self.game.variables, values)) if state is None else state
             low, high = 0, len(self.won_by_level) - 1
             if not self._won_at(high, state):
                 raise ValueError('the position is not won by the environment')
@@ -355,6 +466,7 @@ class EnvironmentStrategy:
         key = (values, level)
         found = self._goals_found.get(key)
         if found is None:
+            state = dict(zip(self.game.variables, values)) if state is None else state
             found = self._goals_found[key] = next(
                 j for j, blocking in enumerate(self.levels[level].blocking)
                 if self.game.evaluate(blocking, state, self._blocking_support(level, j)))
@@ -375,10 +487,10 @@ class EnvironmentStrategy:
         environment can leave the system no legal output, else one per system response to
         the environment's chosen input (only the first with ``only_first``)."""
         game = self.game
-        allowed_sys = game.bdd.let(state, self.sys_trans)
-        deadlock = self._deadlock_input(state, allowed_sys)
+        deadlock = self._deadlock_input(state)
         if deadlock is not None:
             return [(deadlock, rank)]
+        allowed_sys = game.bdd.let(state, self.sys_trans)
         assumption, goal = rank
         level = self.level_of(state)
         moves = game.bdd.let(state, self.moves[level][goal][assumption])
@@ -387,45 +499,51 @@ class EnvironmentStrategy:
         if only_first:  # the one-play explanation says how many answers the system had
             self.responses_counted = int(game.bdd.count(game.bdd.exist(game.next_inputs, responses),
                                                         nvars=len(game.next_outputs)))
+        input_values = tuple(chosen_input[name] for name in game.next_inputs)
         successors = []
-        next_variables = [game.to_next[name] for name in game.variables]
-        for choice in _output_valuations(game, responses, only_first):
-            transition = {**state, **chosen_input, **choice}
-            next_values = tuple(transition[name] for name in next_variables)
-            next_state = dict(zip(game.variables, next_values))
-            next_assumption = _successor_goal(game, game.env_goals, assumption, transition,
-                                              self._env_goal_supports)
-            next_level = self.level_of(next_state, next_values)
-            next_goal = goal if next_level == level else self.first_blockable_goal(next_state, next_level, next_values)
+        for output_values, next_assumption in self._responses(state, chosen_input, responses, assumption,
+                                                              only_first):
+            next_values = input_values + output_values
+            next_level = self.level_of(None, next_values)
+            next_goal = goal if next_level == level else self.first_blockable_goal(None, next_level, next_values)
             successors.append((next_values, (next_assumption, next_goal)))
         return successors
 
-    def _deadlock_input(self, state: dict, allowed_sys) -> tuple | None:
+    def _responses(self, state: dict, chosen_input: dict, responses, assumption: int,
+                   only_first: bool) -> list[tuple]:
+        """The system's responses to the chosen input (output values, in next_outputs order,
+        smallest first: False before True, in declared order, as repeated ``pick``s would
+        give) with the assumption pursued after each; only the first with ``only_first``.
+        The responses are split by that assumption symbolically (a few BDD operations per
+        assumption) and read off cube by cube: per response, evaluating the assumptions and
+        picking the outputs cost most of a small counter-strategy's extraction."""
+        game = self.game
+        if responses == game.false:
+            return []
+        if only_first:
+            choice = game.pick(responses, game.next_outputs)[0]
+            transition = {**state, **chosen_input, **choice}
+            return [(tuple(choice[name] for name in game.next_outputs),
+                     _successor_goal(game, game.env_goals, assumption, transition, self._env_goal_supports))]
+        names = game.next_outputs
+        assumptions_here = _GoalsAt(game, {**state, **chosen_input}, game.env_goals)
+        found = []
+        for next_assumption, part in assumptions_here.split_by_successor_goal(
+                game.exist_next_inputs(responses), assumption):
+            found += [(_values(code, len(names)), next_assumption)
+                      for code in _codes(game, part, names, set(names))]
+        found.sort()  # one entry per output valuation: the values never tie
+        return found
+
+    def _deadlock_input(self, state: dict) -> tuple | None:
         """The values of a deadlock node (chosen inputs, no outputs), if the environment can
         move so that no output satisfies sys_trans."""
         game = self.game
-        allowed_env = game.bdd.let(state, self.env_trans)
-        deadlock_inputs = game.bdd.forall(game.next_outputs, allowed_env & ~allowed_sys)
+        deadlock_inputs = game.bdd.let(state, self.deadlock_moves)
         if deadlock_inputs == game.false:
             return None
         choice, _ = game.pick(deadlock_inputs, game.next_inputs)
         return tuple(choice[game.to_next[name]] for name in game.inputs) + (None,) * len(game.outputs)
-
-
-def _output_valuations(game: SymbolicGame, responses, only_first: bool) -> list[dict]:
-    """The system's responses (output valuations over next outputs; the input is fixed) in
-    ``responses``, smallest first (False before True, in declared order): the order repeated
-    ``pick``s would give. All read off at once, sorted: a pick per response cost one BDD
-    operation per output (a third of a gridworld counter-strategy's time)."""
-    if responses == game.false:
-        return []
-    if only_first:
-        return [game.pick(responses, game.next_outputs)[0]]
-    names = game.next_outputs
-    outputs = game.exist_next_inputs(responses)
-    valuations = sorted(tuple(minterm[name] for name in names)
-                        for minterm in game.bdd._pick_iter(outputs, care_vars=set(names)))
-    return [dict(zip(names, values)) for values in valuations]
 
 
 def _first_environment_moves(game: SymbolicGame, solution: EnvironmentSolution) -> list:

@@ -271,3 +271,18 @@ def test_commands_reach_the_running_work_and_late_ones_are_dropped(monkeypatch):
     finally:
         child.kill()
     assert child.command({'n': 9}) is False  # the child is gone
+
+
+def test_specifications_reach_the_child_whole_with_their_shared_subformulas():
+    """Requests pickle formula nodes as class and fields (isolated._dumps): every kind of node
+    comes back equal, and a subformula shared by two formulas is still one object."""
+    import pickle
+
+    from respec.ltl import FALSE, conj, disj, iff, implies, neg, next_
+    from ltl_synthesizer.isolated import _dumps
+    shared = iff(var('x'), next_(var('y')))
+    spec = GR1Specification(env_props=['x'], sys_props=['y'], env_trans=[implies(shared, disj([var('x'), FALSE]))],
+                            sys_trans=[conj([shared, neg(var('y'))]), shared])
+    loaded = pickle.loads(_dumps(spec))
+    assert loaded == spec
+    assert loaded.sys_trans[1] is loaded.sys_trans[0].args[0] is loaded.env_trans[0].left

@@ -229,6 +229,9 @@ def main(argv=None) -> int:
     parser.add_argument('--in-flight', type=int, default=4, help='soak goals in progress at once')
     parser.add_argument('--warmup', type=int, default=600, help='soak goals before the RSS slope counts')
     parser.add_argument('--flood', type=int, default=10_000, help='goals of the default-QoS flood')
+    parser.add_argument('--service-attacks', default='',
+                        help="with --sections service: only the attacks whose titles contain one of these "
+                             "comma-separated words (e.g. 'burst,bombs'; 'kill', 'gr1synth', 'deep' for the others)")
     args = parser.parse_args(argv)
     sections = args.sections.split(',')
     if 'attacks' in sections:
@@ -243,17 +246,26 @@ def main(argv=None) -> int:
     report = {}
     if 'service' in sections:
         import reliability_service as service
+        words = [word for word in args.service_attacks.split(',') if word]
+
+        def chosen(title: str) -> bool:
+            return not words or any(word in title for word in words)
         with reserve_domain_id() as domain:
-            report.update({f'service: {title}': figures
-                           for title, figures in service.serve_attacks(domain, rss_kib, Serve).items()})
-            print('service: kill -9 of serve during a goal', flush=True)
-            report['service: kill -9 of serve during a goal'] = service.killed_server(domain, Serve)
-        print('service: gr1synth on a large input', flush=True)
-        report['service: gr1synth --memory-limit'] = service.gr1synth_large_input()
-        with reserve_domain_id() as domain, tempfile.TemporaryDirectory(prefix='bench-gui-') as byproducts, \
-                gui_process(domain, byproducts) as (url, gui_pid):
-            print('service: a 100,000-deep body to the GUI', flush=True)
-            report['service: GUI, 100,000-deep body'] = service.gui_deep_body(url, gui_pid, rss_kib)
+            only = [title for title in service.SERVE_ATTACKS if chosen(title)]
+            if only:
+                report.update({f'service: {title}': figures
+                               for title, figures in service.serve_attacks(domain, rss_kib, Serve, only).items()})
+            if chosen('kill -9 of serve during a goal'):
+                print('service: kill -9 of serve during a goal', flush=True)
+                report['service: kill -9 of serve during a goal'] = service.killed_server(domain, Serve)
+        if chosen('gr1synth --memory-limit'):
+            print('service: gr1synth on a large input', flush=True)
+            report['service: gr1synth --memory-limit'] = service.gr1synth_large_input()
+        if chosen('GUI, 100,000-deep body'):
+            with reserve_domain_id() as domain, tempfile.TemporaryDirectory(prefix='bench-gui-') as byproducts, \
+                    gui_process(domain, byproducts) as (url, gui_pid):
+                print('service: a 100,000-deep body to the GUI', flush=True)
+                report['service: GUI, 100,000-deep body'] = service.gui_deep_body(url, gui_pid, rss_kib)
     on_serve = set(sections) & {'idle', 'burst', 'soak', 'hostile', 'limits', 'qos'}
     with tempfile.TemporaryDirectory(prefix='bench-reliability-') as byproducts:
         if on_serve:  # the sections on one shared serve

@@ -364,7 +364,8 @@ class BehaviorSynthesisServer(Node):
                 system=task.system, goals=task.goals, initial_conditions=task.initial_conditions,
                 sm_outcomes=task.sm_outcomes, custom_ltl=task.custom_ltl or LTLSpecification(),
                 unordered_goals=task.unordered_goals, timeout=float(limit), request_id=goal_id),
-                'LTL compilation', limit, on_cancel=lambda: self.cancel_request(self.compiler_cancel, goal_id),
+                'LTL compilation', limit,
+                on_cancel=lambda: self.cancel_request(self.compiler_cancel, goal_id, goal_handle),
                 deadline=deadline)
             self.check(compiled.error_code)
             outcome.ltl_specification = compiled.ltl_specification
@@ -409,7 +410,8 @@ class BehaviorSynthesisServer(Node):
         generated = await self.call(goal_handle, self.generator, GenerateFlexBESM.Request(
             automaton=outcome.automaton, system=task.system,
             initial_conditions=task.initial_conditions, timeout=float(limit), request_id=goal_id),
-            'state machine generation', limit, on_cancel=lambda: self.cancel_request(self.generator_cancel, goal_id),
+            'state machine generation', limit,
+            on_cancel=lambda: self.cancel_request(self.generator_cancel, goal_id, goal_handle),
             deadline=deadline)
         self.check(generated.error_code)
         outcome.states = list(generated.state_definition)
@@ -457,10 +459,13 @@ class BehaviorSynthesisServer(Node):
                 raise deadline.timed_out(stage) from None
             raise
 
-    @staticmethod
-    def cancel_request(cancel_client, goal_id: str):
+    def cancel_request(self, cancel_client, goal_id: str, goal_handle=None):
         """Tell a stage to stop its work for this goal (fire and forget; ``cancel_client`` calls
-        the stage's ``<service>/cancel``)."""
+        the stage's ``<service>/cancel``). With ``goal_handle``, only for a cancelled goal or at
+        shutdown: when the goal's time runs out, that stage's own limit (what was left of it)
+        ends the work at the same moment, and a burst of timeouts needs no extra calls."""
+        if goal_handle is not None and not (goal_handle.is_cancel_requested or self._stopping.is_set()):
+            return
         if cancel_client.service_is_ready():
             cancel_client.call_async(CancelSynthesis.Request(request_id=goal_id))
 

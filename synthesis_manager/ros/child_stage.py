@@ -103,7 +103,8 @@ class ChildStage:
                                            wake=executor_waker(self.node),
                                            give_up=lambda: stop.is_set() or time.monotonic() > deadline)
         except (Abandoned, SynthesisCancelledError):  # a timeout is a cancel by the deadline
-            why = 'cancelled' if stop.cancelled.is_set() else 'shutdown' if self.stopping.is_set() else 'time limit'
+            why = ('cancelled' if stop.cancelled.is_set() else 'shutdown' if self.stopping.is_set()
+                   else 'time limit')
             raise StageStopped(error_code(ErrorCode.TIMEOUT if why == 'time limit' else ErrorCode.PREEMPTED,
                                           f'{self.what} stopped: {why} ({timeout:g} s for {size})')) from None
         except SynthesisMemoryError as error:

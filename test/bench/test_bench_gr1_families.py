@@ -28,6 +28,8 @@ def test_the_families_bench_times_ours_cold_and_resident(tmp_path, monkeypatch):
     assert 'counter-strategy ok' in rows[0]['checks']  # issue 38: checked independently
     table = (tmp_path / 'gr1_families.md').read_text()
     assert '| ours | ours resident | slugs |' in table
+    assert 'UTC, code at' in rows[0]['measured']
+    assert f"- {rows[0]['measured']}: factory" in table  # which rows come from which run
     assert (tmp_path / 'gr1_families_factory.png').stat().st_size > 0
 
 

@@ -132,6 +132,7 @@ def reset_flexbe_proxies(executor=None, node=None) -> None:
     """
     if executor is not None and node is not None:
         executor.remove_node(node)
+        _wait_for_proxy_tasks(executor)
     from flexbe_core.proxy import (ProxyActionClient, ProxyPublisher, ProxyServiceCaller,
                                    ProxySubscriberCached, shutdown_proxies)
 
@@ -141,6 +142,20 @@ def reset_flexbe_proxies(executor=None, node=None) -> None:
             registry = getattr(proxy, name, None)
             if isinstance(registry, dict):
                 registry.clear()
+
+
+def _wait_for_proxy_tasks(executor, timeout: float = 2.0) -> None:
+    """Let the work flexbe_core's proxies handed to ``executor`` run before they are cleared.
+
+    flexbe_core gives some of it to the executor as tasks of no node (a subscriber's callback
+    registered right after it subscribes), so taking the node off does not stop them; run after
+    the clearing, one found its topic gone and its TypeError ended the executor's thread (1 CI
+    run of 6)."""
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline and any(
+            not task.done() and 'flexbe_core' in (getattr(getattr(task, '_handler', None), '__module__', '') or '')
+            for task, _, _ in list(getattr(executor, '_tasks', ()))):
+        time.sleep(0.01)
 
 
 def run_on_flexbe(states, simulator, simulator_lock, domain_id: int, system: RobotSystem | str = 'atlas',

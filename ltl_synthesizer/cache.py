@@ -15,8 +15,12 @@ its own limits.
 
 On disk, each entry is one file ``<key>.entry`` in a private directory (0700, this user's,
 refused if a link), written to a new 0600 file renamed over the name (a reader never sees half
-an entry) and read without following a link. A file that is not a whole entry of this key
-(truncated, corrupted, another format) is deleted and counts as a miss.
+an entry) and read without following a link, without blocking (a FIFO planted there is never
+waited on) and only as a regular file of bounded size. Every file is signed with an HMAC under
+a key private to the server (:func:`load_cache_key`: a 0600 key file, made on first use, or one
+an operator gives a fleet), so a file written by anyone without the key, even under the right
+name with a recomputed checksum, is not an answer. A file that is not a whole, signed entry of
+this key (truncated, corrupted, forged, another format) is deleted and counts as a miss.
 """
 
 from __future__ import annotations
@@ -24,6 +28,7 @@ from __future__ import annotations
 import collections
 import contextlib
 import hashlib
+import hmac
 import json
 import os
 import stat
@@ -43,7 +48,7 @@ DEFAULT_MAX_BYTES = 64 * 2**20
 #: are bounded too.
 ENTRY_OVERHEAD_BYTES = 256
 #: Changes whenever what a key covers or how an entry is written changes: older entries miss.
-FORMAT = 'behavior-synthesis strategy cache 1'
+FORMAT = 'behavior-synthesis strategy cache 2'
 _MAGIC = (FORMAT + '\n').encode()
 _HEADER_LENGTH_BYTES = 8
 _SUFFIX = '.entry'
@@ -53,8 +58,47 @@ WAIT_POLL_SECONDS = 0.02
 Entry = Mapping[str, bytes]
 
 
+#: Bytes of a signing key (:func:`load_cache_key`).
+KEY_BYTES = 32
+
+
 class CacheDirectoryError(OSError):
-    """The cache directory is unsafe (a link, another user's, writable by others)."""
+    """The cache directory or its key file is unsafe (a link, another user's, readable or
+    writable by others) or unusable."""
+
+
+def default_key_file(directory: str | Path) -> Path:
+    """Where a cache directory's signing key lives unless an operator names one: beside the
+    directory (``<directory>.key``), not in it, so that what can only write entries never reads it."""
+    directory = Path(directory)
+    return directory.with_name(directory.name + '.key')
+
+
+def load_cache_key(path: str | Path, create: bool = True) -> bytes:
+    """The signing key in ``path``: a regular 0600 file of this user (never a link) holding
+    KEY_BYTES random bytes, written there first when missing and ``create``. Raises
+    CacheDirectoryError naming what is wrong; a fleet gives every server the same file."""
+    path = Path(path)
+    if create:
+        with contextlib.suppress(FileExistsError):
+            descriptor = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_NOFOLLOW, 0o600)
+            with os.fdopen(descriptor, 'wb') as file:
+                file.write(os.urandom(KEY_BYTES))
+    try:
+        descriptor = os.open(path, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK)
+    except OSError as error:
+        raise CacheDirectoryError(f'strategy cache key file {str(path)!r} cannot be read ({error.strerror})') from None
+    with os.fdopen(descriptor, 'rb') as file:
+        info = os.fstat(file.fileno())
+        if not stat.S_ISREG(info.st_mode):
+            raise CacheDirectoryError(f'strategy cache key file {str(path)!r} is not a regular file')
+        if info.st_uid != os.getuid() or info.st_mode & (stat.S_IRWXG | stat.S_IRWXO):
+            raise CacheDirectoryError(f'strategy cache key file {str(path)!r} must be this user\'s and 0600 '
+                                      f'(mode {stat.S_IMODE(info.st_mode):o})')
+        key = file.read(KEY_BYTES + 1)
+    if len(key) < 16:
+        raise CacheDirectoryError(f'strategy cache key file {str(path)!r} holds {len(key)} bytes, fewer than 16')
+    return key
 
 
 def cache_key(fields: Mapping[str, object]) -> str:
@@ -92,7 +136,7 @@ class CacheStatistics:
     misses: int = 0        # computed
     stored: int = 0        # answers kept
     evicted: int = 0       # entries dropped for the bound (memory)
-    corrupt: int = 0       # files on disk that were not a whole entry (deleted)
+    corrupt: int = 0       # files on disk that were not a whole, signed entry (deleted)
 
 
 class _Flight:
@@ -105,9 +149,11 @@ class _Flight:
 
 class StrategyCache:
     """Entries under keys, least recently used dropped past ``max_bytes`` (0: nothing is kept,
-    :meth:`answer` always computes); with ``directory``, kept there too, within the same bound."""
+    :meth:`answer` always computes); with ``directory``, kept there too, within the same bound,
+    each file signed with the key in ``key_file`` (default: :func:`default_key_file`)."""
 
-    def __init__(self, max_bytes: int = DEFAULT_MAX_BYTES, directory: str | Path | None = None):
+    def __init__(self, max_bytes: int = DEFAULT_MAX_BYTES, directory: str | Path | None = None,
+                 key_file: str | Path | None = None):
         if max_bytes < 0:
             raise ValueError('max_bytes must be >= 0')
         self.max_bytes = max_bytes
@@ -117,11 +163,13 @@ class StrategyCache:
         self._bytes = 0
         self._lock = threading.Lock()
         self._flights: dict[str, _Flight] = {}
+        self._signing_key = b''
         if self.directory is not None:
             problem = private_directory_problem(self.directory)
             if problem:
                 raise CacheDirectoryError(f'refusing the strategy cache directory {str(self.directory)!r}: '
                                           f'it {problem}')
+            self._signing_key = load_cache_key(key_file or default_key_file(self.directory))
 
     @property
     def enabled(self) -> bool:
@@ -231,7 +279,7 @@ class StrategyCache:
         bound. A full or read-only disk leaves the entry in memory only."""
         names = sorted(entry)
         header = json.dumps({'key': key, 'parts': [[name, len(entry[name])] for name in names],
-                             'sha256': _parts_digest(entry, names)}).encode()
+                             'hmac': _parts_signature(self._signing_key, entry, names)}).encode()
         part = None
         try:
             descriptor, part = tempfile.mkstemp(dir=self.directory, prefix='.', suffix='.part')
@@ -248,21 +296,23 @@ class StrategyCache:
         self._prune_directory()
 
     def _read(self, key: str) -> Entry | None:
-        """The entry in ``key``'s file, or None: missing, or not a whole entry of this key
-        (then deleted). A link is never followed."""
+        """The entry in ``key``'s file, or None: missing, or not a whole, signed entry of this
+        key (then deleted). A link is never followed and nothing is waited on: the file is
+        opened non-blocking and read only when it is a regular file no larger than any entry kept."""
         path = self._path(key)
         try:
-            descriptor = os.open(path, os.O_RDONLY | os.O_NOFOLLOW)
-        except OSError:  # missing, or a link (ELOOP)
-            if path.is_symlink():
+            descriptor = os.open(path, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK)
+        except OSError:  # missing, a link (ELOOP), a FIFO without a writer, a socket
+            if path.exists() or path.is_symlink():
                 self._discard(path)
             return None
         try:
             with os.fdopen(descriptor, 'rb') as file:
                 info = os.fstat(file.fileno())
-                if not stat.S_ISREG(info.st_mode) or info.st_size > self.max_bytes + 2**20:
+                limit = self.max_bytes + 2**20
+                if not stat.S_ISREG(info.st_mode) or info.st_size > limit:
                     raise ValueError('not a regular file, or larger than any entry kept')
-                entry = _parsed_entry(file.read(), key)
+                entry = _parsed_entry(file.read(limit + 1), key, self._signing_key)
                 os.utime(file.fileno())  # recently used: the directory's pruning keeps it longer
             return entry
         except (OSError, ValueError, KeyError, TypeError):
@@ -293,15 +343,16 @@ class StrategyCache:
             total -= size
 
 
-def _parts_digest(entry: Entry, names: list[str]) -> str:
-    digest = hashlib.sha256()
+def _parts_signature(signing_key: bytes, entry: Entry, names: list[str]) -> str:
+    signature = hmac.new(signing_key, digestmod=hashlib.sha256)
     for name in names:
-        digest.update(name.encode() + b'\0' + len(entry[name]).to_bytes(8, 'little') + entry[name])
-    return digest.hexdigest()
+        signature.update(name.encode() + b'\0' + len(entry[name]).to_bytes(8, 'little') + entry[name])
+    return signature.hexdigest()
 
 
-def _parsed_entry(data: bytes, key: str) -> Entry:
-    """The entry written by StrategyCache._write; ValueError when ``data`` is not one of ``key``."""
+def _parsed_entry(data: bytes, key: str, signing_key: bytes) -> Entry:
+    """The entry written by StrategyCache._write; ValueError when ``data`` is not one of ``key``
+    signed with ``signing_key``."""
     if not data.startswith(_MAGIC):
         raise ValueError('another format')
     start = len(_MAGIC) + _HEADER_LENGTH_BYTES
@@ -315,6 +366,7 @@ def _parsed_entry(data: bytes, key: str) -> Entry:
             raise ValueError('a malformed header')
         entry[name] = data[offset:offset + length]
         offset += length
-    if offset != len(data) or _parts_digest(entry, sorted(entry)) != header['sha256']:
-        raise ValueError('truncated or corrupted')
+    if offset != len(data) or not hmac.compare_digest(
+            _parts_signature(signing_key, entry, sorted(entry)), str(header['hmac'])):
+        raise ValueError('truncated, corrupted or not signed with this key')
     return entry

@@ -9,9 +9,9 @@ from dataclasses import dataclass
 from types import SimpleNamespace
 from typing import Any
 
-import yaml
 
-from respec.errors import CodedError, ErrorCode, quoted, unbuildable_value
+from respec.bounded_yaml import BoundedYamlError, load_bounded_yaml
+from respec.errors import CodedError, ErrorCode, quoted
 from respec.naming import DEFAULT_SM_OUTCOMES, parse_names
 
 OPTION_NAMES = ('ltl_compilation_only', 'ltl_synthesis_only', 'ltl_steps_only')
@@ -101,44 +101,13 @@ def byproduct_file_stem(behavior: str) -> str:
 MAX_YAML_DEPTH = 16
 
 
-class _RequestYamlLoader(yaml.SafeLoader):
-    """YAML from a request: no aliases (a few hundred bytes of nested aliases expand to
-    gigabytes) and at most MAX_YAML_DEPTH levels, both refused while composing, before any
-    value is built."""
-
-    def __init__(self, stream, item: str):
-        super().__init__(stream)
-        self.item, self.depth = item, 0
-
-    def compose_node(self, parent, index):
-        if self.check_event(yaml.AliasEvent):
-            mark = self.peek_event().start_mark
-            raise InvalidRequestError(f'{self.item}: YAML aliases (*name) are not accepted '
-                                 f'(line {mark.line + 1}, column {mark.column + 1})', self.item)
-        self.depth += 1
-        if self.depth > MAX_YAML_DEPTH:
-            raise InvalidRequestError(f'{self.item}: YAML nested deeper than {MAX_YAML_DEPTH} levels', self.item)
-        try:
-            return super().compose_node(parent, index)
-        finally:
-            self.depth -= 1
-
-
 def load_request_yaml(text: str, item: str):
     """The value of a request's YAML field ``item``; an InvalidRequestError naming it if it is not
-    valid YAML, uses aliases or nests too deeply. The message quotes none of the text."""
-    loader = _RequestYamlLoader(text, item)
+    valid YAML, uses aliases or nests deeper than MAX_YAML_DEPTH. The message quotes none of the text."""
     try:
-        return loader.get_single_data()
-    except yaml.YAMLError as error:
-        mark = getattr(error, 'problem_mark', None)
-        where = f' (line {mark.line + 1}, column {mark.column + 1})' if mark is not None else ''
-        problem = getattr(error, 'problem', None) or 'malformed'
-        raise InvalidRequestError(f'{item} is not valid YAML: {quoted(problem, 80)}{where}', item) from None
-    except ValueError as error:
-        raise InvalidRequestError(f'{item}: {unbuildable_value(error)}', item) from None
-    finally:
-        loader.dispose()
+        return load_bounded_yaml(text, MAX_YAML_DEPTH)
+    except BoundedYamlError as error:
+        raise InvalidRequestError(f'{item}: {error}', item) from None
 
 
 def parse_synthesis_options(text: str) -> dict:

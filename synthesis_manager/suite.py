@@ -38,6 +38,9 @@ def add_suite_arguments(parser):
     group.add_argument('--strategy-cache-dir', default='', metavar='DIR',
                        help='keep the strategy cache in this private directory too, so that a restarted '
                             'server finds it (default: memory only)')
+    group.add_argument('--strategy-cache-key-file', default='', metavar='FILE',
+                       help="the 0600 key that signs the cache directory's entries (default: DIR.key "
+                            'beside it, made on first use; give a fleet the same file)')
     group.add_argument('--service-timeout', type=float, default=5.0,
                        help='seconds to wait for a pipeline service to appear')
     group.add_argument('--default-system', default='',
@@ -67,7 +70,8 @@ def suite_node_factories(args=None, names=SUITE_NODE_NAMES):
             slugs_executable=getattr(args, 'slugs_executable', ''),
             timeout=getattr(args, 'synthesis_timeout', None),
             strategy_cache_mb=getattr(args, 'strategy_cache_mb', None),
-            strategy_cache_dir=getattr(args, 'strategy_cache_dir', ''))),
+            strategy_cache_dir=getattr(args, 'strategy_cache_dir', ''),
+            strategy_cache_key_file=getattr(args, 'strategy_cache_key_file', ''))),
         'sm_generation': (SMGenerationNode, overrides(config_dir=getattr(args, 'config_dir', ''))),
         'behavior_synthesis_server': (BehaviorSynthesisServer, overrides(
             synthesis_timeout=getattr(args, 'synthesis_timeout', None),

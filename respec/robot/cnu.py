@@ -51,11 +51,10 @@ import re
 from dataclasses import dataclass, field, replace
 from typing import Callable
 
-import yaml
-
-from respec.errors import ErrorCode, unbuildable_value
+from respec.bounded_yaml import BoundedYamlError, load_bounded_yaml
+from respec.errors import ErrorCode
 from respec.naming import COMPLETED, FAILED, FINISHED, activation
-from respec.robot.files import SystemConfigError
+from respec.robot.files import MAX_CONFIG_DEPTH, ConfigFileInvalidError, SystemConfigError
 
 CAPABILITIES_KEY, SPEC_KEY, MAPPINGS_KEY = 'cnu_capabilities', 'cnu_spec', 'cnu_mappings'
 PIPELINE_KEY, STATE_MACHINE_KEY = 'cnu_pipeline', 'cnu_state_machine'
@@ -320,15 +319,15 @@ def _read_yaml(document: dict, key: str, read: Callable[[str], str], system: str
         raise CapabilityConfigError(f'{system}.yaml: {key} must be a path, got {value!r}', item=key)
     try:
         text = read(value)
+    except ConfigFileInvalidError as error:  # outside the config folder, not a regular file, too large
+        raise CapabilityConfigError(f'{system}.yaml: {key}: {error}', item=key) from None
     except OSError as error:
         raise CapabilityConfigError(f'{system}.yaml: {key} {value!r} cannot be read ({error.strerror})',
                                     item=key) from None
     try:
-        return yaml.safe_load(text)
-    except yaml.YAMLError as error:
-        raise CapabilityConfigError(f'{system}.yaml: {key} {value!r} is not valid YAML: {error}', item=key) from None
-    except ValueError as error:
-        raise CapabilityConfigError(f'{system}.yaml: {key} {value!r}: {unbuildable_value(error)}', item=key) from None
+        return load_bounded_yaml(text, MAX_CONFIG_DEPTH)
+    except BoundedYamlError as error:
+        raise CapabilityConfigError(f'{system}.yaml: {key} {value!r}: {error}', item=key) from None
 
 
 def _mappings(mappings, system: str):

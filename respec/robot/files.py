@@ -16,12 +16,12 @@ from __future__ import annotations
 import argparse
 import os
 import re
+import stat
 from pathlib import Path
 from typing import Sequence, Union
 
-import yaml
-
-from respec.errors import CodedError, ErrorCode, quoted, unbuildable_value
+from respec.bounded_yaml import BoundedYamlError, load_bounded_yaml
+from respec.errors import CodedError, ErrorCode, quoted
 
 CONFIG_DIR_ENV = 'BEHAVIOR_SYNTHESIS_CONFIG_DIR'
 #: The systems shipped with the repository; always last on the search path.
@@ -29,8 +29,11 @@ SHIPPED_CONFIG_DIR = Path(__file__).resolve().parents[2] / 'config'
 #: One directory, several joined with os.pathsep (a string, as a ROS parameter holds them), or a list.
 ConfigDirs = Union[str, Path, Sequence[Union[str, Path]], None]
 _SYSTEM_NAME = re.compile(r'^[A-Za-z][A-Za-z0-9_]*$')
-# libyaml's safe loader when PyYAML was built with it (5x faster), else the pure-Python one.
-_SAFE_LOADER = getattr(yaml, 'CSafeLoader', yaml.SafeLoader)
+#: The largest robot file read (a system file, a file it references): ATLAS's is 11 KB, a
+#: 160-capability robot's capabilities about 100 KB.
+MAX_CONFIG_FILE_BYTES = 4 * 2**20
+#: Deepest nesting of mappings and lists in a robot file.
+MAX_CONFIG_DEPTH = 32
 
 
 class SystemConfigError(CodedError):
@@ -116,13 +119,42 @@ def add_config_dir_argument(parser) -> None:
 
 
 def parse_config_text(text: str, path: str | Path) -> dict:
-    """The text of the system configuration file ``path`` as a dict (errors name the file)."""
-    try:
-        document = yaml.load(text, Loader=_SAFE_LOADER)
-    except yaml.YAMLError as error:
-        raise ConfigFileInvalidError(f'{path}: not valid YAML: {error}', item=str(path)) from error
-    except ValueError as error:
-        raise ConfigFileInvalidError(f'{path}: {unbuildable_value(error)}', item=str(path)) from None
+    """The text of the system configuration file ``path`` as a dict (errors name the file, the
+    line and the column, and refuse aliases and nesting deeper than MAX_CONFIG_DEPTH)."""
+    document = load_config_yaml(text, path)
     if not isinstance(document, dict):
         raise ConfigFileInvalidError(f'{path}: expected a mapping at the top level', item=str(path))
     return document
+
+
+def load_config_yaml(text: str, path: str | Path):
+    """The value of a robot file's YAML text, within the bounds (``respec.bounded_yaml``);
+    ConfigFileInvalidError naming the file, the line and the column."""
+    try:
+        return load_bounded_yaml(text, MAX_CONFIG_DEPTH)
+    except BoundedYamlError as error:
+        raise ConfigFileInvalidError(f'{path}: {error}', item=str(path)) from None
+
+
+def read_config_file(folder: Path, relative: str) -> str:
+    """The text of the robot file ``relative`` to the config folder ``folder``, which it must
+    stay in: an absolute path, a ``..`` out of it or a symbolic link resolving outside it is
+    refused, as are anything but a regular file (opened without blocking: a FIFO is never
+    waited on) and files over MAX_CONFIG_FILE_BYTES. OSError with the reason otherwise."""
+    if not isinstance(relative, str) or not relative or Path(relative).is_absolute():
+        raise ConfigFileInvalidError(f'{quoted(relative)} must be a path relative to {folder}', item=str(relative))
+    root = Path(os.path.realpath(folder))
+    resolved = Path(os.path.realpath(folder / relative))
+    if root != resolved and root not in resolved.parents:
+        raise ConfigFileInvalidError(f'{quoted(relative)} resolves outside the config folder {folder}; '
+                                     f'robot files must stay inside it', item=str(relative))
+    descriptor = os.open(resolved, os.O_RDONLY | os.O_NONBLOCK)
+    with os.fdopen(descriptor, 'rb') as file:
+        info = os.fstat(file.fileno())
+        if not stat.S_ISREG(info.st_mode):
+            raise ConfigFileInvalidError(f'{folder / relative}: not a regular file', item=str(relative))
+        data = file.read(MAX_CONFIG_FILE_BYTES + 1)
+    if len(data) > MAX_CONFIG_FILE_BYTES:
+        raise ConfigFileInvalidError(f'{folder / relative}: larger than {MAX_CONFIG_FILE_BYTES // 2**20} MiB, '
+                                     f'the most a robot file may hold', item=str(relative))
+    return data.decode()

@@ -30,7 +30,8 @@ from typing import Callable, Mapping
 from respec.robot.abstraction import RobotAbstraction, abstraction_from_document
 from respec.robot.cnu import CapabilitySystem, is_capability_document, load_capability_system
 from respec.robot.files import (ConfigDirs, ConfigFileInvalidError, SystemConfigError, SystemNotFoundError,
-                                available_systems, parse_config_text, system_config_path)
+                                available_systems, parse_config_text, read_config_file,
+                                system_config_path)
 
 ABSTRACTION_KIND = 'abstraction'
 CAPABILITIES_KIND = 'capabilities'
@@ -86,7 +87,7 @@ class RobotSystem:
 def robot_system_from_file(path: str | Path, name: str | None = None) -> RobotSystem:
     """The robot system of one system file (its kind told by its content)."""
     path = Path(path)
-    return _robot_system(name or path.stem, path, lambda relative: (path.parent / relative).read_text())
+    return _robot_system(name or path.stem, path, lambda relative: read_config_file(path.parent, relative))
 
 
 def robot_system_from_files(name: str, files: Mapping[str, str], config_file: str | None = None) -> RobotSystem:

@@ -109,6 +109,7 @@ class LTLSynthesisNode(Node):
         self.declare_parameter('queued_syntheses', 200)
         self.declare_parameter('strategy_cache_mb', DEFAULT_STRATEGY_CACHE_MB)
         self.declare_parameter('strategy_cache_dir', '')
+        self.declare_parameter('strategy_cache_key_file', '')
         self._running: dict[str, threading.Event] = {}
         self._lock = threading.Lock()
         self.workers = WorkerPool(self.parameter('parallel_syntheses'), self.parameter('queued_syntheses'),
@@ -137,15 +138,15 @@ class LTLSynthesisNode(Node):
             self.get_logger().info(f'pruned {len(deleted)} byproduct leftovers (.part files, empty markers)')
 
     def _strategy_cache(self) -> StrategyCache:
-        """The cache of answers (strategy_cache_mb, strategy_cache_dir). An unsafe or unusable
-        directory is logged and the cache kept in memory only: answers stay right, only a
+        """The cache of answers (strategy_cache_mb, strategy_cache_dir, strategy_cache_key_file).
+        An unsafe or unusable directory or key file is logged and the cache kept in memory only: answers stay right, only a
         restart loses them."""
         max_bytes = int(self.parameter('strategy_cache_mb') * 2**20)
         directory = self.parameter('strategy_cache_dir')
         self._answering_code = (f"{source_digest(ANSWERING_PACKAGES)} dd {importlib.metadata.version('dd')}"
                                 if max_bytes > 0 else '')
         try:
-            return StrategyCache(max_bytes, directory or None)
+            return StrategyCache(max_bytes, directory or None, self.parameter('strategy_cache_key_file') or None)
         except (CacheDirectoryError, OSError) as error:
             self.get_logger().warning(f'strategy cache kept in memory only: {error}'[:300])
             return StrategyCache(max_bytes)

@@ -10,7 +10,7 @@ import time
 import pytest
 
 from ltl_synthesizer.cache import (ENTRY_OVERHEAD_BYTES, CacheDirectoryError, StrategyCache, cache_key,
-                                   entry_size, source_digest)
+                                   default_key_file, entry_size, load_cache_key, source_digest)
 
 
 def entry(text: str, size: int = 0) -> dict:
@@ -226,3 +226,86 @@ def test_a_lowered_bound_misses_entries_over_it(tmp_path):
     small = StrategyCache(max_bytes=2**20, directory=tmp_path / 'cache')
     assert small.get(key('big')) is None and small.memory_bytes == 0
     assert list((tmp_path / 'cache').iterdir()) == []
+
+
+def test_a_fifo_planted_as_an_entry_is_a_miss_at_once(tmp_path):
+    directory = tmp_path / 'cache'
+    StrategyCache(directory=directory)
+    fifo = directory / (key('a') + '.entry')
+    os.mkfifo(fifo, 0o600)
+    cache = StrategyCache(directory=directory)
+    began = time.monotonic()
+    result = []
+    reader = threading.Thread(target=lambda: result.append(cache.get(key('a'))), daemon=True)
+    reader.start()
+    reader.join(5)
+    assert not reader.is_alive(), 'reading a FIFO entry blocked'
+    assert result == [None] and time.monotonic() - began < 5
+    assert not fifo.exists() and cache.statistics.corrupt == 1
+    assert cache.answer(key('a'), lambda: entry('a')) == (entry('a'), 'computed')
+
+
+def _forged(path, text: bytes):
+    """Rewrite the entry file at ``path`` with another answer and a recomputed SHA-256 (what
+    someone who can write the directory but lacks the key can do)."""
+    import hashlib
+    import json
+    data = path.read_bytes()
+    magic_end = data.index(b'\n') + 1
+    start = magic_end + 8
+    header_end = start + int.from_bytes(data[magic_end:start], 'little')
+    header = json.loads(data[start:header_end])
+    parts = {'answer': text, 'padding': b''}
+    digest = hashlib.sha256()
+    for name in sorted(parts):
+        digest.update(name.encode() + b'\0' + len(parts[name]).to_bytes(8, 'little') + parts[name])
+    header['parts'] = [[name, len(parts[name])] for name in sorted(parts)]
+    header['hmac'] = header['sha256'] = digest.hexdigest()
+    encoded = json.dumps(header).encode()
+    path.write_bytes(data[:magic_end] + len(encoded).to_bytes(8, 'little') + encoded
+                     + b''.join(parts[name] for name in sorted(parts)))
+
+
+def test_an_entry_forged_without_the_key_is_a_miss(tmp_path):
+    directory = tmp_path / 'cache'
+    StrategyCache(directory=directory).put(key('a'), entry('a'))
+    path = directory / (key('a') + '.entry')
+    _forged(path, b'the task is impossible; call +1-555-FORGED')
+    cache = StrategyCache(directory=directory)
+    assert cache.get(key('a')) is None
+    assert cache.statistics.corrupt == 1 and not path.exists()
+
+
+def test_the_signing_key_is_a_private_file_beside_the_directory(tmp_path):
+    directory = tmp_path / 'cache'
+    StrategyCache(directory=directory).put(key('a'), entry('a'))
+    key_file = default_key_file(directory)
+    assert key_file == tmp_path / 'cache.key' and key_file.is_file()
+    assert stat.S_IMODE(os.lstat(key_file).st_mode) == 0o600
+    assert len(load_cache_key(key_file, create=False)) == 32
+    key_file.unlink()  # a new key: what the old one signed is no longer an answer
+    assert StrategyCache(directory=directory).get(key('a')) is None
+
+
+def test_a_fleet_shares_a_key_its_operator_gives(tmp_path):
+    fleet_key = tmp_path / 'fleet.key'
+    fleet_key.write_bytes(os.urandom(32))
+    fleet_key.chmod(0o600)
+    StrategyCache(directory=tmp_path / 'one', key_file=fleet_key).put(key('a'), entry('a'))
+    (tmp_path / 'two').mkdir(mode=0o700)
+    os.replace(tmp_path / 'one' / (key('a') + '.entry'), tmp_path / 'two' / (key('a') + '.entry'))
+    assert StrategyCache(directory=tmp_path / 'two', key_file=fleet_key).get(key('a')) == entry('a')
+    assert StrategyCache(directory=tmp_path / 'two').get(key('a')) is None  # its own key: not signed with it
+
+
+@pytest.mark.parametrize('problem', ['readable by others', 'a link', 'too short'])
+def test_an_unsafe_key_file_is_refused(tmp_path, problem):
+    key_file = tmp_path / 'cache.key'
+    if problem == 'a link':
+        (tmp_path / 'elsewhere').write_bytes(os.urandom(32))
+        key_file.symlink_to(tmp_path / 'elsewhere')
+    else:
+        key_file.write_bytes(os.urandom(32 if problem == 'readable by others' else 4))
+        key_file.chmod(0o644 if problem == 'readable by others' else 0o600)
+    with pytest.raises(CacheDirectoryError, match='key file'):
+        StrategyCache(directory=tmp_path / 'cache', key_file=key_file)

@@ -12,7 +12,7 @@ from respec.errors import QUOTED_CHARACTERS, quoted
 from respec.ltl import var
 from respec.nesting import MAX_FORMULA_NESTING
 from respec.parsing import ParseError, UnknownVariableError, parse_formula, parse_structuredslugs
-from synthesis_manager.requests import MAX_YAML_DEPTH, InvalidRequestError, parse_synthesis_options
+from synthesis_manager.requests import MAX_YAML_DEPTH, InvalidRequestError, load_request_yaml, parse_synthesis_options
 
 
 def alias_bomb(levels: int) -> str:
@@ -109,3 +109,11 @@ def test_an_unknown_proposition_is_quoted_by_its_start():
     with pytest.raises(UnknownVariableError) as raised:
         parse_structuredslugs('[OUTPUT]\nx\n\n[SYS_TRANS]\n' + 'y' * 60_000 + '\n')
     assert raised.value.code == 'UNKNOWN_PROPOSITION' and len(str(raised.value)) < 250
+
+
+def test_request_yaml_has_the_bounds_of_robot_files():
+    bomb = 'l0: &l0 [x]\n' + ''.join(f'l{i}: &l{i} [{", ".join([f"*l{i - 1}"] * 10)}]\n' for i in range(1, 10))
+    with pytest.raises(InvalidRequestError, match=r'synthesis_options: YAML aliases .* \(line 2, column 10\)'):
+        load_request_yaml(bomb, 'synthesis_options')
+    with pytest.raises(InvalidRequestError, match='synthesis_options: not valid YAML'):
+        load_request_yaml('a: [', 'synthesis_options')

@@ -132,7 +132,7 @@ def test_errors_reach_the_client_as_last_feedback_and_in_messages(suite):
     bad_yaml.synthesis_options = 'ltl_steps_only: [yes'
     invalid, feedback = run_with_feedback(suite.flexbe_synthesis, bad_yaml)
     assert (invalid.goal_status, invalid.error_name) == ('ABORTED', 'INVALID_REQUEST')
-    assert invalid.message.startswith('INVALID_REQUEST: synthesis_options is not valid YAML')
+    assert invalid.message.startswith('INVALID_REQUEST: synthesis_options: not valid YAML')
     assert feedback == [invalid.message]
 
     unknown_system, _ = run_with_feedback(suite.flexbe_synthesis, make_flexbe_goal(

@@ -1,0 +1,69 @@
+"""YAML from outside the suite (robot system files, request fields), read within bounds.
+
+A few hundred bytes of nested aliases (``*name``) expand to gigabytes, and deep nesting
+exhausts the stack, long before any validation can look at the value. So the text's events are
+checked first (libyaml's parser when PyYAML has it): no alias, at most ``max_depth`` levels of
+mappings and sequences; only then is the value built. Errors carry the line and column, never
+the text around them (a file's lines are not ours to repeat).
+"""
+
+from __future__ import annotations
+
+import yaml
+
+from respec.errors import quoted, unbuildable_value
+
+# libyaml's parser and safe loader when PyYAML was built with it (5x faster), else pure Python.
+_SAFE_LOADER = getattr(yaml, 'CSafeLoader', yaml.SafeLoader)
+_OPENING = (yaml.MappingStartEvent, yaml.SequenceStartEvent)
+_CLOSING = (yaml.MappingEndEvent, yaml.SequenceEndEvent)
+
+
+class BoundedYamlError(ValueError):
+    """Text that is not YAML within the bounds; ``problem`` says what, ``line``/``column``
+    (1-based, or None) where."""
+
+    def __init__(self, problem: str, line: int | None = None, column: int | None = None):
+        self.problem, self.line, self.column = problem, line, column
+        super().__init__(problem + self.where)
+
+    @property
+    def where(self) -> str:
+        return f' (line {self.line}, column {self.column})' if self.line is not None else ''
+
+
+def load_bounded_yaml(text: str, max_depth: int):
+    """The value of the YAML ``text``; BoundedYamlError when it is not valid YAML, uses an
+    alias or nests deeper than ``max_depth`` mappings and sequences."""
+    try:
+        _check_events(text, max_depth)
+        return yaml.load(text, Loader=_SAFE_LOADER)
+    except yaml.YAMLError as error:
+        mark = getattr(error, 'problem_mark', None)
+        problem = getattr(error, 'problem', None) or 'malformed'
+        if 'nesting depth' in problem:  # libyaml's own bound (1000 levels), met while it looks ahead
+            raise _located(f'YAML nested deeper than {max_depth} levels', mark) from None
+        raise _located(f'not valid YAML: {quoted(problem, 80)}', mark) from None
+    except BoundedYamlError:
+        raise
+    except (ValueError, OverflowError) as error:  # e.g. a timestamp or number no value can hold
+        raise BoundedYamlError(unbuildable_value(error)) from None
+
+
+def _check_events(text: str, max_depth: int) -> None:
+    depth = 0
+    for event in yaml.parse(text, Loader=_SAFE_LOADER):
+        if isinstance(event, yaml.AliasEvent):
+            raise _located('YAML aliases (*name) are not accepted', event.start_mark)
+        if isinstance(event, _OPENING):
+            depth += 1
+            if depth > max_depth:
+                raise _located(f'YAML nested deeper than {max_depth} levels', event.start_mark)
+        elif isinstance(event, _CLOSING):
+            depth -= 1
+
+
+def _located(problem: str, mark) -> BoundedYamlError:
+    if mark is None:
+        return BoundedYamlError(problem)
+    return BoundedYamlError(problem, mark.line + 1, mark.column + 1)

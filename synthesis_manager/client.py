@@ -15,7 +15,6 @@ from synthesis_manager.requests import InvalidRequestError
 from synthesis_manager.ros.action_client import RaceFreeActionClient
 from synthesis_manager.ros.cnu_interface import load_flexbe_synthesis_interface
 from synthesis_manager.ros.conversions import error_name, msg_to_sections, msg_to_state_dict
-from synthesis_manager.ros.harness import wait_for
 from synthesis_msgs.action import BehaviorSynthesis
 from synthesis_msgs.msg import BehaviorSynthesisRequest, LTLSpecification, SynthesisOptions
 
@@ -172,8 +171,10 @@ class SynthesisClient:
         except InvalidRequestError as refused:
             return SynthesisOutcome(refused.code.number, str(refused.code), str(refused))
         on_feedback = (lambda msg: feedback(msg.feedback.status, msg.feedback.progress)) if feedback else None
-        handle = wait_for(self.action_client.send_goal_async(goal, feedback_callback=on_feedback),
-                            timeout)
+        handle = self._accepted(self.action_client.send_goal_async(goal, feedback_callback=on_feedback),
+                                started, timeout)
+        if handle is None:
+            return self.server_lost(time.monotonic() - started)
         if not handle.accepted:
             # The server rejects goals only in a flood (see BehaviorSynthesisServer.admit_goal).
             return SynthesisOutcome(-5, 'BUSY', 'the server rejected the goal: too many goals are in '
@@ -215,6 +216,23 @@ class SynthesisClient:
         answers = [future.result() for future, _ in requests if future.done()]
         response = next((answer for answer in answers if answer.status != GOAL_STATUS_UNKNOWN), answers[0])
         return outcome_from_response(response, time.monotonic() - started)
+
+    def _accepted(self, sent, started: float, timeout: float):
+        """The goal handle of the goal request ``sent``, or None when the server left the ROS
+        graph (killed, crashed, stopped) before answering it: a stalled server must not hold a
+        caller until its timeout."""
+        answered = threading.Event()
+        sent.add_done_callback(lambda _: answered.set())
+        server_seen = time.monotonic()
+        while not answered.wait(LIVENESS_PERIOD):
+            now = time.monotonic()
+            if self.action_client.server_is_ready():
+                server_seen = now
+            elif now - server_seen >= SERVER_LOST_SECONDS:
+                return None
+            if now - started > timeout:
+                raise TimeoutError(f'the goal was not accepted within {timeout:g} s')
+        return sent.result()
 
     def server_lost(self, seconds: float) -> SynthesisOutcome:
         """The outcome of a goal whose server left the ROS graph before answering."""

@@ -68,3 +68,36 @@ def test_a_connected_gui_job_ends_with_its_dead_servers_reason(tmp_path):
                 assert state['outcome']['error_name'] == 'SERVICE_UNAVAILABLE', state['outcome']
                 assert 'went away' in state['outcome']['message']
                 assert noticed < NOTICED_WITHIN, f'{noticed:.1f} s'
+
+
+def test_a_goal_sent_to_a_stalled_server_that_dies_is_answered_within_seconds(tmp_path):
+    """Issue 48, item 5: SIGSTOP the server, send a goal, SIGKILL it 1 s later. The client
+    waited for the goal's acceptance with no liveness check (still waiting 190 s later)."""
+    import threading
+
+    from rclpy.node import Node
+
+    from synthesis_manager.client import SynthesisClient, make_goal
+    from synthesis_manager.ros.harness import RosHarness
+
+    with loopback_domain() as (domain, environment):
+        with started([BIN / 'behavior-synthesis', 'serve', '--byproducts-dir', tmp_path / 'byproducts'],
+                     environment) as (server, server_output):
+            server_output.wait_for('suite up')
+            with RosHarness(domain_id=domain) as ros:
+                client = SynthesisClient(ros.add_node(Node, 'stalled_server_client'))
+                assert client.wait_for_server(10)
+                os.killpg(server.pid, signal.SIGSTOP)
+                outcomes = []
+                sender = threading.Thread(target=lambda: outcomes.append(client.run(
+                    make_goal('atlas', 'stand_prep', ['look_down'], option='ltl_compilation_only'))), daemon=True)
+                sender.start()
+                time.sleep(1.0)  # the scenario: the server dies 1 s after the goal was sent
+                os.killpg(server.pid, signal.SIGKILL)
+                killed = time.monotonic()
+                sender.join(60)
+                noticed = time.monotonic() - killed
+    print(f'SynthesisClient: answered {noticed:.2f} s after kill -9 of a stopped serve')
+    assert not sender.is_alive(), 'the goal was never answered'
+    assert outcomes[0].error_name == 'SERVICE_UNAVAILABLE' and 'went away' in outcomes[0].message
+    assert noticed < NOTICED_WITHIN, f'{noticed:.1f} s'

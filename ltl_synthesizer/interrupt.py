@@ -91,6 +91,20 @@ def resident_memory(pid: int | None = None) -> int:
 _PAGE_SIZE = os.sysconf('SC_PAGE_SIZE') if hasattr(os, 'sysconf') else 4096
 
 
+def released_memory(collect: bool = True) -> int:
+    """This process's resident size after its garbage is collected (with ``collect``) and freed
+    heap pages go back to the system (glibc's malloc_trim; elsewhere only the collection)."""
+    if collect:
+        import gc
+        gc.collect()
+    try:
+        import ctypes
+        ctypes.CDLL('libc.so.6').malloc_trim(0)
+    except (OSError, AttributeError):
+        pass
+    return resident_memory()
+
+
 def memory_exceeded(limit: int) -> SynthesisMemoryError:
     return SynthesisMemoryError(
         f'synthesis needs more than its memory limit of {limit / 2**20:.0f} MB '

@@ -58,7 +58,7 @@ import traceback
 from typing import Callable
 
 from ltl_synthesizer.errors import SynthesisCancelledError, SynthesisError, SynthesisMemoryError, SynthesisTimeoutError
-from ltl_synthesizer.interrupt import Limits, resident_memory
+from ltl_synthesizer.interrupt import Limits, released_memory, resident_memory
 
 # How often the caller looks at its cancel flag and deadline while a child works.
 POLL_SECONDS = 0.02
@@ -373,7 +373,7 @@ def _serve(parent_pid: int, preload: str) -> None:
     answers = os.fdopen(os.dup(sys.stdout.fileno()), 'wb')
     sys.stdout = sys.stderr  # stray prints must not corrupt the answers
     importlib.import_module(preload)  # imported now: the first request need not wait for it
-    fresh = _released_memory()
+    fresh = released_memory()
 
     def send(message) -> None:
         data = _pickled(message)
@@ -417,7 +417,7 @@ def _serve(parent_pid: int, preload: str) -> None:
         del function, args, kwargs, answer
         held = resident_memory() - fresh
         if held > RELEASE_ABOVE_BYTES:  # a collection and a trim take 20-30 ms: only when it pays
-            held = _released_memory() - fresh
+            held = released_memory() - fresh
         # 'retire': the parent ends this child, a fresh one serves the next request.
         send(('retire' if held > REUSE_MARGIN_BYTES else 'ready', held))
 
@@ -459,19 +459,6 @@ def _pickled(message) -> bytes:
         return _dumps(message)
     except Exception as error:  # noqa: BLE001 -- e.g. an exception that cannot be pickled
         return pickle.dumps(('error', SynthesisError(f'synthesis process: {error!r}')))
-
-
-def _released_memory() -> int:
-    """This process's resident size after its garbage is collected and freed heap pages go
-    back to the system (glibc's malloc_trim; elsewhere only the collection)."""
-    import gc
-    gc.collect()
-    try:
-        import ctypes
-        ctypes.CDLL('libc.so.6').malloc_trim(0)
-    except (OSError, AttributeError):
-        pass
-    return resident_memory()
 
 
 def _die_with_parent(parent_pid: int) -> None:

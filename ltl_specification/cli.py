@@ -15,13 +15,12 @@ import json
 import sys
 from pathlib import Path
 
-import yaml
-
 from ltl_specification.compiler import compile_task, explain
 from ltl_specification.errors import InvalidFormulaError
 from respec.errors import CodedError, ExitStatus, exit_status_help
 from respec.naming import parse_names
 from respec.robot.files import add_config_dir_argument
+from respec.untrusted import BoundedYamlError, load_bounded_yaml, read_bounded_file
 
 FORMATS = ('structuredslugs', 'slugsin', 'json')
 
@@ -102,11 +101,22 @@ def main(argv: list[str] | None = None) -> int:
     return run(parser.parse_args(argv))
 
 
+#: The largest --custom-ltl file read: what a goal may carry in all (synthesis_manager.limits).
+MAX_CUSTOM_LTL_BYTES = 4 * 2**20
+#: A custom LTL file is a mapping of sections to lists of formulas: deeper nesting is no such file.
+MAX_CUSTOM_LTL_DEPTH = 8
+
+
 def read_custom_ltl(path: str | None):
-    """The ``--custom-ltl`` file's mapping (None without one); InvalidFormulaError if unreadable."""
+    """The ``--custom-ltl`` file's mapping (None without one); InvalidFormulaError naming the file
+    when it cannot be read, is not a regular file of at most MAX_CUSTOM_LTL_BYTES, is not UTF-8
+    or not YAML/JSON within the bounds (``respec.untrusted``)."""
     if not path:
         return None
     try:
-        return yaml.safe_load(Path(path).read_text())
-    except (OSError, yaml.YAMLError) as error:
-        raise InvalidFormulaError(f'cannot read custom LTL file {path}: {error}', item=path) from error
+        return load_bounded_yaml(read_bounded_file(path, MAX_CUSTOM_LTL_BYTES), MAX_CUSTOM_LTL_DEPTH)
+    except (OSError, BoundedYamlError) as error:
+        raise InvalidFormulaError(f'cannot read custom LTL file {path}: {error}', item=path) from None
+    except UnicodeDecodeError as error:
+        raise InvalidFormulaError(f'cannot read custom LTL file {path}: not UTF-8 text '
+                                  f'(byte {error.start})', item=path) from None

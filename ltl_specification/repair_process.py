@@ -18,24 +18,30 @@ from __future__ import annotations
 import time
 from typing import Callable
 
-from ltl_synthesizer.errors import SynthesisError
+from ltl_specification.repair import DIAGNOSIS_SHARE
+from ltl_synthesizer.errors import SynthesisError, SynthesisTimeoutError
+from ltl_synthesizer.interrupt import DEFAULT_MEMORY_LIMIT
 from ltl_synthesizer.isolated import SERVER_CHILD_NICENESS, ChildProcess
 
-#: Seconds a child may take beyond its search's time budget: the interpreter's start, the
-#: diagnosis after the search (a fifth of the budget at most) and the answer.
-STARTUP_GRACE = 20.0
+#: Seconds a child may take beyond its search's time budget and the diagnosis after it (a
+#: fifth of the budget at most): the interpreter's start (0.2-0.3 s measured) and the answer.
+#: A candidate's compilation or synthesis that outlives the deadline (one CUDD operation can
+#: run for a minute on a BDD bomb) is ended by the kill; what was verified before is kept.
+STARTUP_GRACE = 2.0
 
 
 class RepairSearchError(Exception):
     """The child ended (killed, crashed, overran its deadline) without an answer."""
 
 
-def repair_settings(system, request: dict, custom_ltl, time_budget: float, max_proposals: int) -> dict:
+def repair_settings(system, request: dict, custom_ltl, time_budget: float, max_proposals: int,
+                    memory_limit: int | None = DEFAULT_MEMORY_LIMIT) -> dict:
     """What a child needs for a search of ``request`` (``TaskRequest.to_dict()``) on ``system``
-    (a RobotSystem: its files travel, not its name)."""
+    (a RobotSystem: its files travel, not its name); ``memory_limit``: bytes the child may grow
+    by, as a synthesis may (None: no limit)."""
     return {'system': system.name, 'files': dict(system.files), 'config_file': system.config_file,
             'request': request, 'custom_ltl': custom_ltl, 'time_budget': time_budget,
-            'max_proposals': max_proposals}
+            'max_proposals': max_proposals, 'memory_limit': memory_limit}
 
 
 class RepairSearch:
@@ -45,16 +51,21 @@ class RepairSearch:
 
     def __init__(self, settings: dict):
         self.settings = settings
+        self.deadline = time.monotonic() + settings['time_budget'] * (1 + DIAGNOSIS_SHARE) + STARTUP_GRACE
         self.child = ChildProcess(niceness=SERVER_CHILD_NICENESS, preload=__name__)
 
     def run(self, on_proposal: Callable[[dict], None] | None = None) -> dict:
         """The search's ``Repairs.to_dict()``; ``on_proposal(proposal dict)`` as each is verified.
-        A refusal of the system's files is raised as the CodedError it is."""
-        deadline = time.monotonic() + self.settings['time_budget'] * 1.2 + STARTUP_GRACE
+        A refusal of the system's files is raised as the CodedError it is. The whole search,
+        its first check included, ends within its time budget, the diagnosis' share and
+        STARTUP_GRACE (counted from this object's creation), and within its memory limit."""
         try:
             return self.child.call(search, (self.settings,), on_progress=on_proposal or (lambda _: None),
-                                   deadline=deadline)
-        except SynthesisError as error:  # died, stopped or overran: SynthesisError's subclasses
+                                   deadline=self.deadline, memory_limit=self.settings.get('memory_limit'))
+        except SynthesisTimeoutError:
+            raise RepairSearchError(f'the repair search was ended at its time budget of '
+                                    f'{self.settings["time_budget"]:g} s (a check was still running)') from None
+        except SynthesisError as error:  # died, stopped, its memory limit: SynthesisError's subclasses
             raise RepairSearchError(f'the repair search ended without an answer ({error})') from error
         finally:
             self.child.kill()

@@ -19,6 +19,7 @@ import yaml
 
 from respec.automaton import Automaton, AutomatonState, automaton_from_strategy
 from respec.parsing import ParseError, parse_structuredslugs
+from respec.untrusted import BoundedYamlError, load_bounded_yaml, read_bounded_file
 from sm_generation.errors import AutomatonInvalidError
 
 
@@ -70,15 +71,15 @@ def load_automaton(path: str | Path, spec_path: str | Path | None = None) -> Aut
     ``.structuredslugs`` specification it was synthesized from (``spec_path``).
     """
     path = Path(path)
+    text = _read_text(path)
     try:
-        text = path.read_text()
-    except OSError as error:
-        raise AutomatonInvalidError(f'cannot read {path}: {error}', str(path)) from error
-    try:
-        data = json.loads(text) if path.suffix == '.json' else yaml.safe_load(text)
-    except (json.JSONDecodeError, yaml.YAMLError) as error:
-        raise AutomatonInvalidError(f'{path}: not valid YAML/JSON: {error}',
-                                    str(path)) from error
+        data = json.loads(text) if path.suffix == '.json' else load_bounded_yaml(text, MAX_AUTOMATON_DEPTH)
+    except json.JSONDecodeError as error:
+        raise AutomatonInvalidError(f'{path}: not valid JSON: {error}', str(path)) from None
+    except RecursionError:
+        raise AutomatonInvalidError(f'{path}: JSON nested deeper than an automaton is', str(path)) from None
+    except BoundedYamlError as error:
+        raise AutomatonInvalidError(f'{path}: {error}', str(path)) from None
     if isinstance(data, dict) and 'nodes' in data and 'variables' in data:
         return _automaton_from_strategy_file(data, path, spec_path)
     return automaton_from_dict(data, str(path))
@@ -90,10 +91,7 @@ def _automaton_from_strategy_file(strategy: dict, path: Path, spec_path) -> Auto
                                     '.structuredslugs specification it was synthesized from', str(path))
     spec_path = Path(spec_path)
     try:
-        spec = parse_structuredslugs(spec_path.read_text(), filename=str(spec_path))
-    except OSError as error:
-        raise AutomatonInvalidError(f'cannot read {spec_path}: {error}',
-                                    str(spec_path)) from error
+        spec = parse_structuredslugs(_read_text(spec_path), filename=str(spec_path))
     except ParseError as error:
         raise AutomatonInvalidError(str(error), error.item) from error
     return automaton_from_strategy(strategy, spec)
@@ -102,3 +100,19 @@ def _automaton_from_strategy_file(strategy: dict, path: Path, spec_path) -> Auto
 def dump_automaton(automaton: Automaton) -> str:
     """Our YAML text for ``automaton`` (deterministic)."""
     return yaml.safe_dump(automaton_to_dict(automaton), sort_keys=False, default_flow_style=None)
+
+
+#: The largest automaton or specification file read (a strategy of about 500,000 transitions).
+MAX_AUTOMATON_FILE_BYTES = 64 * 2**20
+#: An automaton file's nesting (states, their fields, valuations) is a few levels.
+MAX_AUTOMATON_DEPTH = 16
+
+
+def _read_text(path: Path) -> str:
+    """The text of an input file within the bounds (``respec.untrusted.read_bounded_file``)."""
+    try:
+        return read_bounded_file(path, MAX_AUTOMATON_FILE_BYTES)
+    except OSError as error:
+        raise AutomatonInvalidError(f'cannot read {path}: {error.strerror or error}', str(path)) from None
+    except UnicodeDecodeError as error:
+        raise AutomatonInvalidError(f'{path}: not UTF-8 text (byte {error.start})', str(path)) from None

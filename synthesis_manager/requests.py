@@ -10,7 +10,7 @@ from types import SimpleNamespace
 from typing import Any
 
 
-from respec.bounded_yaml import BoundedYamlError, load_bounded_yaml
+from respec.untrusted import BoundedYamlError, load_bounded_yaml
 from respec.errors import CodedError, ErrorCode, quoted
 from respec.naming import DEFAULT_SM_OUTCOMES, parse_names
 

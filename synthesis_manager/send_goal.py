@@ -9,12 +9,14 @@ from pathlib import Path
 
 from rclpy.node import Node
 
-from respec.errors import CodedError, ExitStatus, exit_status_help
+from respec.errors import CodedError, ExitStatus, exit_status_help, quoted
 from respec.naming import parse_names
 from respec.nesting import run_with_deep_stack
 from respec.parsing import parse_structuredslugs
 from sm_generation.instantiation import count_states
+from respec.untrusted import read_bounded_file
 from synthesis_manager.client import SynthesisClient, make_flexbe_goal, make_goal
+from synthesis_manager.limits import MAX_MESSAGE_BYTES
 from synthesis_manager.requests import InvalidRequestError
 from synthesis_manager.ros.harness import RosHarness, environment_domain_id
 from synthesis_manager.ros.namespaces import namespace_placement
@@ -96,10 +98,17 @@ def goal_from_args(args):
 
 
 def read_spec_file(path: str) -> dict:
-    """A complete specification from a .structuredslugs file or an LTLSpecification JSON dict."""
-    text = Path(path).read_text()
-    if path.endswith('.json'):
-        return json.loads(text)
+    """A complete specification from a .structuredslugs file or an LTLSpecification JSON dict
+    (at most what a goal may carry, MAX_MESSAGE_BYTES); InvalidRequestError naming the file
+    when it is not one."""
+    try:
+        text = read_bounded_file(path, MAX_MESSAGE_BYTES)
+        if path.endswith('.json'):
+            return json.loads(text)
+    except (OSError, ValueError, RecursionError) as error:  # JSONDecodeError and UnicodeDecodeError are ValueErrors
+        problem = 'JSON nested too deeply' if isinstance(error, RecursionError) else error
+        raise InvalidRequestError(f'cannot read the specification file {path}: {quoted(str(problem), 200)}',
+                                  item=path) from None
     # Its formulas may nest MAX_FORMULA_NESTING deep: read and printed on a deep stack.
     return run_with_deep_stack(lambda: parse_structuredslugs(text, filename=path).to_text_sections())
 

@@ -51,7 +51,7 @@ import re
 from dataclasses import dataclass, field, replace
 from typing import Callable
 
-from respec.bounded_yaml import BoundedYamlError, load_bounded_yaml
+from respec.untrusted import BoundedYamlError, load_bounded_yaml
 from respec.errors import ErrorCode
 from respec.naming import COMPLETED, FAILED, FINISHED, activation
 from respec.robot.files import MAX_CONFIG_DEPTH, ConfigFileInvalidError, SystemConfigError

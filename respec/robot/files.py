@@ -16,11 +16,10 @@ from __future__ import annotations
 import argparse
 import os
 import re
-import stat
 from pathlib import Path
 from typing import Sequence, Union
 
-from respec.bounded_yaml import BoundedYamlError, load_bounded_yaml
+from respec.untrusted import BoundedFileError, BoundedYamlError, load_bounded_yaml, read_bounded_file
 from respec.errors import CodedError, ErrorCode, quoted
 
 CONFIG_DIR_ENV = 'BEHAVIOR_SYNTHESIS_CONFIG_DIR'
@@ -128,7 +127,7 @@ def parse_config_text(text: str, path: str | Path) -> dict:
 
 
 def load_config_yaml(text: str, path: str | Path):
-    """The value of a robot file's YAML text, within the bounds (``respec.bounded_yaml``);
+    """The value of a robot file's YAML text, within the bounds (``respec.untrusted``);
     ConfigFileInvalidError naming the file, the line and the column."""
     try:
         return load_bounded_yaml(text, MAX_CONFIG_DEPTH)
@@ -148,13 +147,7 @@ def read_config_file(folder: Path, relative: str) -> str:
     if root != resolved and root not in resolved.parents:
         raise ConfigFileInvalidError(f'{quoted(relative)} resolves outside the config folder {folder}; '
                                      f'robot files must stay inside it', item=str(relative))
-    descriptor = os.open(resolved, os.O_RDONLY | os.O_NONBLOCK)
-    with os.fdopen(descriptor, 'rb') as file:
-        info = os.fstat(file.fileno())
-        if not stat.S_ISREG(info.st_mode):
-            raise ConfigFileInvalidError(f'{folder / relative}: not a regular file', item=str(relative))
-        data = file.read(MAX_CONFIG_FILE_BYTES + 1)
-    if len(data) > MAX_CONFIG_FILE_BYTES:
-        raise ConfigFileInvalidError(f'{folder / relative}: larger than {MAX_CONFIG_FILE_BYTES // 2**20} MiB, '
-                                     f'the most a robot file may hold', item=str(relative))
-    return data.decode()
+    try:
+        return read_bounded_file(resolved, MAX_CONFIG_FILE_BYTES)
+    except BoundedFileError as error:
+        raise ConfigFileInvalidError(f'{folder / relative}: {error.problem}', item=str(relative)) from None

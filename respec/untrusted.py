@@ -1,6 +1,10 @@
-"""YAML from outside the suite (robot system files, request fields), read within bounds.
+"""Input from outside the suite (robot files, request fields, the files a command is given),
+read within bounds.
 
-A few hundred bytes of nested aliases (``*name``) expand to gigabytes, and deep nesting
+Files: :func:`read_bounded_file` opens without blocking (a FIFO is never waited on), reads only
+regular files, and at most a given size.
+
+YAML: a few hundred bytes of nested aliases (``*name``) expand to gigabytes, and deep nesting
 exhausts the stack, long before any validation can look at the value. So the text's events are
 checked first (libyaml's parser when PyYAML has it): no alias, at most ``max_depth`` levels of
 mappings and sequences; only then is the value built. Errors carry the line and column, never
@@ -8,6 +12,10 @@ the text around them (a file's lines are not ours to repeat).
 """
 
 from __future__ import annotations
+
+import os
+import stat
+from pathlib import Path
 
 import yaml
 
@@ -67,3 +75,30 @@ def _located(problem: str, mark) -> BoundedYamlError:
     if mark is None:
         return BoundedYamlError(problem)
     return BoundedYamlError(problem, mark.line + 1, mark.column + 1)
+
+
+class BoundedFileError(OSError):
+    """A file that is not read: ``problem`` says why (not a regular file, larger than the bound)."""
+
+    def __init__(self, path: str | Path, problem: str):
+        self.path, self.problem = str(path), problem
+        super().__init__(f'{path}: {problem}')
+
+
+def read_bounded_file(path: str | Path, max_bytes: int) -> str:
+    """The UTF-8 text of the regular file ``path`` of at most ``max_bytes`` bytes. Opened
+    without blocking and checked before reading: BoundedFileError for a FIFO, a device, a
+    directory or a larger file; OSError when it cannot be opened; UnicodeDecodeError for
+    bytes that are not UTF-8 (its text is the caller's to keep out of messages)."""
+    descriptor = os.open(path, os.O_RDONLY | os.O_NONBLOCK)
+    with os.fdopen(descriptor, 'rb') as file:
+        if not stat.S_ISREG(os.fstat(file.fileno()).st_mode):
+            raise BoundedFileError(path, 'not a regular file')
+        data = file.read(max_bytes + 1)
+    if len(data) > max_bytes:
+        raise BoundedFileError(path, f'larger than {_size(max_bytes)}, the most accepted here')
+    return data.decode()
+
+
+def _size(count: int) -> str:
+    return f'{count // 2**20} MiB' if count % 2**20 == 0 else f'{count} bytes'

@@ -120,6 +120,45 @@ def synthesize_within(spec, robotics_semantics: bool, limits: Limits, options, m
 SYNTHESIZER_MODULE = 'ltl_synthesizer.synthesizer'
 
 
+class WorkingChildrenMemory:
+    """The resident memory of all this process's children while they work, together, bounded.
+
+    Each child's own limit (a synthesis' memory_limit) bounds one piece of work; eight at once
+    could still hold eight times that. Past ``limit`` bytes in all, the child holding the most
+    is ended (SynthesisMemoryError naming the sum limit), so the others go on. Read at most
+    every ``period`` seconds, whichever working child polls first."""
+
+    def __init__(self, limit: int | None = None, period: float = 0.1):
+        self.limit, self.period = limit, period
+        self._working: set[ChildProcess] = set()
+        self._lock = threading.Lock()
+        self._read_at = -float('inf')
+        self._over: ChildProcess | None = None
+        self.total = 0  # bytes, at the last reading
+
+    def working(self, child: ChildProcess, busy: bool) -> None:
+        with self._lock:
+            (self._working.add if busy else self._working.discard)(child)
+
+    def is_over(self, child: ChildProcess) -> bool:
+        """Whether ``child`` is the one to end: the working children exceed the limit together
+        and it holds the most of them."""
+        if self.limit is None:
+            return False
+        with self._lock:
+            now = time.monotonic()
+            if now - self._read_at >= self.period:
+                self._read_at = now
+                sizes = {working: resident_memory(working.process.pid) for working in self._working}
+                self.total = sum(sizes.values())
+                self._over = max(sizes, key=sizes.get) if self.total > self.limit else None
+            return self._over is child
+
+
+#: The sum limit of this process's working children (a server sets it: memory_sum_limit_mb).
+WORKING_CHILDREN_MEMORY = WorkingChildrenMemory()
+
+
 class ChildProcess:
     """One child process (``python -m ltl_synthesizer.isolated PARENT NICENESS PRELOAD``),
     spoken to through its stdin and stdout: length-prefixed pickles, a request (function,
@@ -156,9 +195,17 @@ class ChildProcess:
             if not self.settle() and self.said == 'nothing':  # its next words would be misread
                 raise self.died()
             baseline = resident_memory(self.process.pid) if memory_limit is not None else 0
+            WORKING_CHILDREN_MEMORY.working(self, True)
             self.send((function, tuple(args), dict(kwargs or {}), on_progress is not None, wants_commands))
             while True:
                 while not self.answered(POLL_SECONDS):
+                    if WORKING_CHILDREN_MEMORY.is_over(self):
+                        self.kill()
+                        raise SynthesisMemoryError(
+                            f'the work needed more memory than was left of the '
+                            f'{WORKING_CHILDREN_MEMORY.limit / 2**20:.0f} MB that all work at once may hold '
+                            f'(memory_sum_limit_mb; it held the most of {WORKING_CHILDREN_MEMORY.total / 2**20:.0f} MB)',
+                            item='memory_sum_limit')
                     if cancel is not None and cancel.is_set():
                         self.kill()
                         raise SynthesisCancelledError('cancelled')
@@ -178,6 +225,8 @@ class ChildProcess:
                 on_progress(value)
         except (EOFError, OSError, ValueError):  # the child died, or its pipes were closed
             raise self.died() from None
+        finally:
+            WORKING_CHILDREN_MEMORY.working(self, False)
         self.settling = True
         if kind == 'error':
             raise value

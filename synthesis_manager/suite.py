@@ -41,6 +41,9 @@ def add_suite_arguments(parser):
     group.add_argument('--strategy-cache-key-file', default='', metavar='FILE',
                        help="the 0600 key that signs the cache directory's entries (default: DIR.key "
                             'beside it, made on first use; give a fleet the same file)')
+    group.add_argument('--memory-sum-limit-mb', type=float, default=None, metavar='MB',
+                       help='MiB that all synthesis, compilation and repair processes at work may hold together; '
+                            'beyond it the one holding the most is ended (default 4096; 0: none)')
     group.add_argument('--service-timeout', type=float, default=5.0,
                        help='seconds to wait for a pipeline service to appear')
     group.add_argument('--default-system', default='',
@@ -71,7 +74,8 @@ def suite_node_factories(args=None, names=SUITE_NODE_NAMES):
             timeout=getattr(args, 'synthesis_timeout', None),
             strategy_cache_mb=getattr(args, 'strategy_cache_mb', None),
             strategy_cache_dir=getattr(args, 'strategy_cache_dir', ''),
-            strategy_cache_key_file=getattr(args, 'strategy_cache_key_file', ''))),
+            strategy_cache_key_file=getattr(args, 'strategy_cache_key_file', ''),
+            memory_sum_limit_mb=getattr(args, 'memory_sum_limit_mb', None))),
         'sm_generation': (SMGenerationNode, overrides(config_dir=getattr(args, 'config_dir', ''))),
         'behavior_synthesis_server': (BehaviorSynthesisServer, overrides(
             synthesis_timeout=getattr(args, 'synthesis_timeout', None),

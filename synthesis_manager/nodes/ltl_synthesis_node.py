@@ -22,7 +22,8 @@ from ltl_specification.provenance import provenance_from_json
 from ltl_synthesizer import Limits, SynthesisCancelledError, SynthesisError
 from ltl_synthesizer.cache import DEFAULT_MAX_BYTES, CacheDirectoryError, StrategyCache, cache_key, source_digest
 from ltl_synthesizer.external import run_external_synthesizer
-from ltl_synthesizer.isolated import SERVER_CHILD_NICENESS, SpecificationText, SynthesisProcesses, byproduct_texts
+from ltl_synthesizer.isolated import (SERVER_CHILD_NICENESS, WORKING_CHILDREN_MEMORY, SpecificationText,
+                                      SynthesisProcesses, byproduct_texts)
 from ltl_synthesizer.strategy import strategy_to_json
 from respec.automaton import automaton_from_strategy
 from respec.errors import CodedError, ErrorCode
@@ -55,6 +56,9 @@ LARGE_SPEC_BYTES = 64 * 1024
 #: Largest strategy (transitions) a builtin synthesis sends back: about 900 B each in the
 #: server (automaton, JSON byproduct, messages), so about 90 MB per goal at most.
 DEFAULT_MAX_STRATEGY_EDGES = 100_000
+#: The default bound of all working children's memory together (MiB; memory_sum_limit_mb): two
+#: syntheses at their own limit (memory_limit_mb 2048).
+DEFAULT_MEMORY_SUM_LIMIT_MB = 4096
 #: The strategy cache's default bound (MiB; strategy_cache_mb).
 DEFAULT_STRATEGY_CACHE_MB = DEFAULT_MAX_BYTES / 2**20
 #: The code an answer comes from: part of every cache key, so that entries kept on disk by
@@ -71,7 +75,9 @@ class LTLSynthesisNode(Node):
     ``slugs_executable``, called the original way); ``timeout`` (seconds, used when a
     request gives none; time spent waiting for a worker counts); ``robotics_semantics``;
     ``memory_limit_mb`` (per synthesis; beyond it the synthesis ends with SYNTHESIS_FAILED
-    naming the limit, not an OOM kill); ``diagnosis_timeout`` (seconds to find why an
+    naming the limit, not an OOM kill); ``memory_sum_limit_mb`` (all of this process's working
+    children together; beyond it the one holding the most ends, SYNTHESIS_FAILED naming the
+    sum limit; 0: none); ``diagnosis_timeout`` (seconds to find why an
     unrealizable specification cannot be met, used when a request gives none; never past the
     request's time limit); ``check_well_separation`` (a realizable specification's answer
     carries, as its SUCCESS message, a warning when the controller can win by forcing the
@@ -103,6 +109,7 @@ class LTLSynthesisNode(Node):
         self.declare_parameter('max_strategy_edges', DEFAULT_MAX_STRATEGY_EDGES)
         self.declare_parameter('robotics_semantics', True)
         self.declare_parameter('memory_limit_mb', 2048)
+        self.declare_parameter('memory_sum_limit_mb', DEFAULT_MEMORY_SUM_LIMIT_MB)
         self.declare_parameter('diagnosis_timeout', 20.0)
         self.declare_parameter('check_well_separation', True)
         self.declare_parameter('parallel_syntheses', 8)
@@ -115,6 +122,9 @@ class LTLSynthesisNode(Node):
         self.workers = WorkerPool(self.parameter('parallel_syntheses'), self.parameter('queued_syntheses'),
                                   name='synthesis')
         self.synthesis_processes = SynthesisProcesses(niceness=SERVER_CHILD_NICENESS)
+        # The bound of every working child of this process together (compilations, repairs and a
+        # GUI's simulations too, when they run in the same process).
+        WORKING_CHILDREN_MEMORY.limit = self.parameter('memory_sum_limit_mb') * 2**20 or None
         self.strategy_cache = self._strategy_cache()
         self._prune_leftovers()
         if self.parameter('backend') == 'builtin':

@@ -286,3 +286,24 @@ def test_specifications_reach_the_child_whole_with_their_shared_subformulas():
     loaded = pickle.loads(_dumps(spec))
     assert loaded == spec
     assert loaded.sys_trans[1] is loaded.sys_trans[0].args[0] is loaded.env_trans[0].left
+
+
+def test_working_children_together_stay_under_the_sum_limit(monkeypatch):
+    """Issue 48, item 9: three BDD bombs at once took the tree to 6.3 GB, each under its own
+    limit. Past the sum limit the child holding the most is ended; the others finish."""
+    from ltl_synthesizer import isolated
+
+    monkeypatch.setattr(isolated, 'WORKING_CHILDREN_MEMORY', isolated.WorkingChildrenMemory(limit=600 * 2**20))
+    pool = SynthesisProcesses()
+    try:
+        pool.prepare(3)
+        sizes = {'big': (400, 3.0), 'small one': (100, 1.5), 'small two': (100, 1.5)}
+        with ThreadPoolExecutor(3) as threads:
+            answers = {name: threads.submit(pool.call, exec, (grow_and_wait(megabytes, seconds), {}))
+                       for name, (megabytes, seconds) in sizes.items()}
+        with pytest.raises(SynthesisMemoryError) as refused:
+            answers['big'].result()
+        assert refused.value.item == 'memory_sum_limit' and 'all work at once may hold' in str(refused.value)
+        assert answers['small one'].result() is None and answers['small two'].result() is None
+    finally:
+        pool.close()

@@ -11,6 +11,7 @@ import traceback
 
 from respec.errors import INTERNAL_ERROR, CodedError
 from synthesis_manager.ros.conversions import error_code
+from synthesis_manager.ros.logs import bounded_line
 from synthesis_msgs.msg import SynthesisErrorCodes
 
 
@@ -23,4 +24,4 @@ def reported_error(error: BaseException, logger, what: str) -> SynthesisErrorCod
 
 
 def log_internal_error(logger, what: str, error: BaseException) -> None:
-    logger.error(f'{what}: internal error\n' + ''.join(traceback.format_exception(error)).rstrip())
+    logger.error(bounded_line(f'{what}: internal error\n' + ''.join(traceback.format_exception(error)).rstrip()))

@@ -17,8 +17,21 @@ from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
 from rclpy.logging import LoggingSeverity
 
 
+#: The longest line a node logs: a message quoting a whole input (a formula, a file) is cut,
+#: saying how much was left out (a 522 MB line once came from one request).
+MAX_LOG_LINE_CHARS = 4000
+
+
+def bounded_line(message: str, limit: int = MAX_LOG_LINE_CHARS) -> str:
+    """``message`` cut to ``limit`` characters, saying how many were left out."""
+    if len(message) <= limit:
+        return message
+    return f'{message[:limit]}... ({len(message) - limit} more characters not logged)'
+
+
 class QuickLogger:
-    """``info``, ``warning`` and ``error`` of a node's logger, without the caller lookup."""
+    """``info``, ``warning`` and ``error`` of a node's logger, without the caller lookup; each
+    line at most MAX_LOG_LINE_CHARS long."""
 
     def __init__(self, logger):
         self.logger = logger
@@ -36,5 +49,5 @@ class QuickLogger:
         if not self.logger.is_enabled_for(severity):
             return
         caller = sys._getframe(2)  # the frame that called info/warning/error
-        _rclpy.rclpy_logging_rcutils_log(severity, self.logger.name, str(message), caller.f_code.co_name,
+        _rclpy.rclpy_logging_rcutils_log(severity, self.logger.name, bounded_line(str(message)), caller.f_code.co_name,
                                          caller.f_code.co_filename, caller.f_lineno)

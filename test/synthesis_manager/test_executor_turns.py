@@ -107,3 +107,13 @@ def test_quick_log_lines_reach_rosout_as_rclpy_would_write_them(ros):
     assert [(line.msg, line.level) for line in lines] == [('a goal failed: TIMEOUT', Log.WARN)]
     assert lines[0].function == 'test_quick_log_lines_reach_rosout_as_rclpy_would_write_them'
     assert lines[0].file == __file__ and lines[0].line == expected_line
+
+
+def test_log_lines_are_bounded():
+    """Issue 48, item 3: one log line was 522 MB. A line keeps its start and says what it left out."""
+    from synthesis_manager.ros.logs import MAX_LOG_LINE_CHARS, bounded_line
+
+    assert bounded_line('short') == 'short'
+    line = bounded_line('x' * 10 * MAX_LOG_LINE_CHARS)
+    assert line.startswith('x' * MAX_LOG_LINE_CHARS) and len(line) < MAX_LOG_LINE_CHARS + 60
+    assert line.endswith(f'({9 * MAX_LOG_LINE_CHARS} more characters not logged)')

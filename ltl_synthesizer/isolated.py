@@ -67,6 +67,11 @@ CHILD_NICENESS = 5
 #: The same for a server running many syntheses at once: eight CPU-bound children at +5 on two
 #: cores outweighed their parent (it got under half a core), so its answers came late.
 SERVER_CHILD_NICENESS = 15
+#: Work that has run this long is long work: its child drops to the lowest CPU priority, so that
+#: short work started beside it (another client's goal) is not slowed by it. Such a child is
+#: not reused: without privileges its priority cannot be raised again.
+LONG_WORK_SECONDS = 2.0
+LOWEST_PRIORITY = 19
 #: How long an idle child is kept for the next synthesis.
 IDLE_SECONDS = 30.0
 _LENGTH_BYTES = 8
@@ -174,6 +179,7 @@ class ChildProcess:
         self.fresh = True  # has served nothing yet: its RSS is the baseline
         self.said = 'ready'  # what it said after its last answer
         self.settling = False  # releasing its last request and answer: says 'ready' or 'retire' then
+        self.demoted = False  # at the lowest CPU priority since long work: not reused
         self._writing = threading.Lock()  # a request and commands from other threads share stdin
         self.process = subprocess.Popen(
             [sys.executable, '-m', 'ltl_synthesizer.isolated', str(os.getpid()), str(niceness), preload],
@@ -195,6 +201,7 @@ class ChildProcess:
             if not self.settle() and self.said == 'nothing':  # its next words would be misread
                 raise self.died()
             baseline = resident_memory(self.process.pid) if memory_limit is not None else 0
+            long_work_at = time.monotonic() + LONG_WORK_SECONDS
             WORKING_CHILDREN_MEMORY.working(self, True)
             self.send((function, tuple(args), dict(kwargs or {}), on_progress is not None, wants_commands))
             while True:
@@ -219,6 +226,8 @@ class ChildProcess:
                             item='memory_limit')
                     if not self.alive():
                         raise self.died()
+                    if not self.demoted and time.monotonic() >= long_work_at:
+                        self.demote()
                 kind, value = self.receive()
                 if kind != 'progress':
                     break
@@ -276,6 +285,14 @@ class ChildProcess:
 
     def alive(self) -> bool:
         return self.process.poll() is None
+
+    def demote(self) -> None:
+        """Drop the child to the lowest CPU priority (long work: LONG_WORK_SECONDS)."""
+        self.demoted = True
+        try:
+            os.setpriority(os.PRIO_PROCESS, self.process.pid, LOWEST_PRIORITY)
+        except OSError:  # already gone
+            pass
 
     def kill(self) -> None:
         """End the child now (from any thread) and release its pipes."""
@@ -368,7 +385,7 @@ class SynthesisProcesses:
                 raise SynthesisCancelledError('cancelled') from None
             raise
         finally:
-            self._give_back(child, reusable=child.alive())  # stopped children were killed
+            self._give_back(child, reusable=child.alive() and not child.demoted)  # stopped children were killed
 
     def close(self) -> None:
         """Kill every child, busy or idle (at shutdown)."""

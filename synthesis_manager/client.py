@@ -7,9 +7,11 @@ import time
 from dataclasses import dataclass, field
 
 import yaml
+from unique_identifier_msgs.msg import UUID
 
 from respec.errors import ErrorCode
 from respec.naming import DEFAULT_SM_OUTCOMES
+from synthesis_manager.client_shares import new_origin, tagged_goal_id
 from synthesis_manager.limits import check_texts
 from synthesis_manager.requests import InvalidRequestError
 from synthesis_manager.ros.action_client import RaceFreeActionClient
@@ -154,6 +156,8 @@ class SynthesisClient:
         self.node = node
         self.action_name = action_name
         self.action_client = RaceFreeActionClient(node, action_type(action_name), action_name)
+        # Every goal id says it comes from this client: the server's per-client share (client_shares.py).
+        self.origin = new_origin()
 
     def wait_for_server(self, timeout: float = 10.0) -> bool:
         return self.action_client.wait_for_server(timeout_sec=timeout)
@@ -171,8 +175,9 @@ class SynthesisClient:
         except InvalidRequestError as refused:
             return SynthesisOutcome(refused.code.number, str(refused.code), str(refused))
         on_feedback = (lambda msg: feedback(msg.feedback.status, msg.feedback.progress)) if feedback else None
-        handle = self._accepted(self.action_client.send_goal_async(goal, feedback_callback=on_feedback),
-                                started, timeout)
+        goal_id = UUID(uuid=list(tagged_goal_id(self.origin)))
+        handle = self._accepted(self.action_client.send_goal_async(goal, feedback_callback=on_feedback,
+                                                                   goal_uuid=goal_id), started, timeout)
         if handle is None:
             return self.server_lost(time.monotonic() - started)
         if not handle.accepted:

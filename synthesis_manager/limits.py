@@ -22,7 +22,7 @@ MAX_LIST_LENGTH = 10_000
 #: Most bytes (UTF-8) of all the strings of one request together.
 MAX_MESSAGE_BYTES = 4 * 1024 * 1024
 #: The server's default cap on a goal's time limit (parameter ``max_goal_timeout``), seconds.
-DEFAULT_MAX_GOAL_TIMEOUT = 600.0
+DEFAULT_MAX_GOAL_TIMEOUT = 300.0
 #: Largest HTTP request body the web GUI reads.
 MAX_BODY_BYTES = 1024 * 1024
 #: Fields whose strings are names (of a behavior, system, proposition, outcome, file): no

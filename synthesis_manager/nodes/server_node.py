@@ -34,6 +34,7 @@ from ltl_specification.initial_conditions import (detected_status, initial_condi
                                                   reads_robot_state)
 from respec.errors import INTERNAL_ERROR, CodedError, ErrorCode
 from sm_generation.instantiation import count_states
+from synthesis_manager.client_shares import ClientShares, goal_origin
 from synthesis_manager.limits import (DEFAULT_MAX_GOAL_TIMEOUT, MAX_STRING_BYTES, BusyError, GoalDeadline,
                                       GoalTimeoutError, capped_timeout, check_message, check_timeout, utf8_length)
 from synthesis_manager.nodes.atlas_sim_node import STATE_TOPIC
@@ -47,8 +48,8 @@ from synthesis_manager.ros.logs import QuickLogger
 from synthesis_manager.ros.node_main import node_main
 from synthesis_manager.ros.qos import action_server_qos, service_qos
 from synthesis_manager.ros.robot_state import RobotStateListener
-from synthesis_manager.ros.stage_calls import (Preempted, ServerStoppingError, StageCaller, StageFailedError,
-                                              StageTimeoutError)
+from synthesis_manager.ros.stage_calls import (WATCH_PERIOD, Preempted, ServerStoppingError, StageCaller,
+                                              StageFailedError, StageTimeoutError, next_executor_turn)
 from synthesis_msgs.action import BehaviorSynthesis
 from synthesis_msgs.msg import FSAutomaton, LTLSpecification
 from synthesis_msgs.srv import (CancelSynthesis, GenerateFlexBESM, GenerateLTLSpecification, ProposeRepairs,
@@ -227,10 +228,15 @@ class BehaviorSynthesisServer(Node):
         self.declare_parameter('max_goal_timeout', DEFAULT_MAX_GOAL_TIMEOUT)
         self.declare_parameter('result_retention', 60.0)
         self.declare_parameter('repair_time_budget', 3.0)
+        self.declare_parameter('max_client_goals', 6)
+        self.declare_parameter('max_client_goal_seconds', 1200.0)
+        self.declare_parameter('max_client_waiting', 50)
         self._stopping = threading.Event()
         self._active_goals = 0
         self._accepted_goals = 0  # accepted and not finished: running, or waiting for the executor
         self.heap_trim = HeapTrim()
+        self.shares = ClientShares(self.parameter('max_client_goals'), self.parameter('max_client_goal_seconds'),
+                                   self.parameter('max_client_waiting'))
         self._lock = threading.Lock()
         self.stages = StageCaller(self)
         self.log = QuickLogger(self.get_logger())  # a line per failed goal
@@ -305,8 +311,9 @@ class BehaviorSynthesisServer(Node):
             deadline = GoalDeadline(task.timeout, started=self.accepted_at(goal_handle), requested=requested)
             if deadline.capped():
                 feedback(deadline.capped())
-            with self.admitted():
-                await self.run_pipeline(goal_handle, task, outcome, feedback, deadline)
+            async with self.client_share(goal_handle, feedback, deadline):
+                with self.admitted():
+                    await self.run_pipeline(goal_handle, task, outcome, feedback, deadline)
         except Preempted:
             outcome.fail(ErrorCode.PREEMPTED, 'cancelled by the client')
             goal_handle.canceled()
@@ -368,6 +375,33 @@ class BehaviorSynthesisServer(Node):
     def goal_finished(self):
         with self._lock:
             self._accepted_goals -= 1
+
+    @contextlib.asynccontextmanager
+    async def client_share(self, goal_handle, feedback, deadline: GoalDeadline):
+        """Run a goal within its client's share (ClientShares): until it fits, it waits, told
+        its place; its time limit (or, without one, its stages' limits) counts against the
+        client's max_client_goal_seconds."""
+        seconds = deadline.limit or sum(self.parameter(f'{stage}_timeout')
+                                        for stage in ('compilation', 'synthesis', 'generation'))
+        ticket = self.shares.join(goal_origin(goal_handle.goal_id.uuid), seconds)
+        try:
+            told = 0
+            while place := self.shares.admit(ticket):
+                if goal_handle.is_cancel_requested:
+                    raise Preempted()
+                if self._stopping.is_set():
+                    raise ServerStoppingError('the server is shutting down')
+                if deadline.passed():
+                    raise deadline.timed_out("waiting for its client's running goals to finish")
+                if place != told:
+                    told = place
+                    feedback(f'Waiting: {self.shares.running(ticket.origin)} goals of this client are running '
+                             f'(max_client_goals {self.shares.max_running}, max_client_goal_seconds '
+                             f'{self.shares.max_seconds:g}); this goal is number {place} of its waiting goals')
+                await next_executor_turn(look_every=WATCH_PERIOD)
+            yield
+        finally:
+            self.shares.leave(ticket)
 
     @contextlib.contextmanager
     def admitted(self):

@@ -310,7 +310,8 @@ def test_goal_time_limits_hold_under_load(ros, tmp_path):
     answered within a second of its limit (counted from sending); an invalid limit is refused
     at once."""
     client = start_suite(ros, tmp_path, synthesis_parameters=[Parameter('parallel_syntheses', value=2)])
-    with slow_goals_running(client, 2):
+    # The load comes from another client: this client's own share (max_client_goals) is not what is tested.
+    with slow_goals_running(SynthesisClient(ros.add_node(Node, 'load_client')), 2):
         started = time.monotonic()
         invalid = client.run(make_goal(**PAPER_TASK, timeout=-1.0), timeout=30)
         assert invalid.error_name == 'INVALID_REQUEST' and time.monotonic() - started < 1.0
@@ -405,3 +406,56 @@ def test_a_result_asked_for_after_its_retention_is_a_timeout_not_a_success(ros, 
     late = outcome_from_response(wait_for(handle.get_result_async(), 30), 0.0)
     assert (late.error_name, late.goal_status) == ('TIMEOUT', 'UNKNOWN')
     assert 'result_retention' in late.message
+
+
+def test_one_clients_runaways_leave_another_clients_goal_its_usual_latency(ros, tmp_path):
+    """Issue 48, item 1: eight goals of one client asking 1e9 s (capped) held all eight
+    synthesis workers, and another user's 30 s goal ended SYNTHESIS_TIMEOUT. A client's running
+    goals now hold at most max_client_goal_seconds (1200) of time limits together: four of the
+    eight run, the others wait, told their place."""
+    # No strategy cache: the other client's goal must be synthesized, by a free worker.
+    attacker = start_suite(ros, tmp_path, synthesis_parameters=[Parameter('strategy_cache_mb', value=0.0)])
+    victim = SynthesisClient(ros.add_node(Node, 'another_client'))
+    usual = sorted(victim.run(make_goal(**PAPER_TASK, name=f'usual{i}')).seconds for i in range(3))[1]
+    cancel, waiting, statuses = threading.Event(), threading.Event(), []
+
+    def on_feedback(status, _progress):
+        statuses.append(status)
+        if status.startswith('Waiting:'):
+            waiting.set()
+    runaways = [threading.Thread(target=attacker.run, args=(runaway_goal(1e9),),
+                                 kwargs={'cancel': cancel, 'feedback': on_feedback}) for _ in range(8)]
+    for thread in runaways:
+        thread.start()
+    try:
+        assert waiting.wait(30), statuses
+        # Long work yields the CPU: the four running ones drop to the lowest priority.
+        deadline = time.monotonic() + 30
+        while len(children_at_lowest_priority()) < 4:
+            assert time.monotonic() < deadline, 'the runaways were never demoted to the lowest CPU priority'
+            time.sleep(0.1)
+        outcome = victim.run(make_goal(**PAPER_TASK, name='during', timeout=30.0))
+        print(f'another client: {usual:.2f} s usually, {outcome.seconds:.2f} s beside 8 runaways of one client')
+        assert outcome.succeeded, outcome.message
+        # bench_reliability measures it against the 1 s target on a quiet machine; this margin
+        # also holds beside other jobs on 2 cores (before: SYNTHESIS_TIMEOUT after 30 s).
+        assert outcome.seconds < usual + 2.0
+        assert any('this goal is number 4 of its waiting goals' in status for status in statuses), statuses
+    finally:
+        cancel.set()
+        for thread in runaways:
+            thread.join(timeout=60)
+
+
+def children_at_lowest_priority() -> list[int]:
+    """This process's child processes running at nice 19."""
+    from ltl_synthesizer.isolated import LOWEST_PRIORITY
+
+    found = []
+    for entry in Path('/proc').iterdir():
+        if entry.name.isdigit():
+            with contextlib.suppress(OSError):
+                fields = (entry / 'stat').read_text().rsplit(')', 1)[1].split()
+                if int(fields[1]) == os.getpid() and int(fields[16]) == LOWEST_PRIORITY:
+                    found.append(int(entry.name))
+    return found

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import shutil
 import sys
 import tempfile
 import time
@@ -73,12 +74,21 @@ def measure(system, initial_conditions, goals, config_dir=None, library=None, re
 
 
 def write_cnu_systems(config_dir: Path, cnu: Path) -> None:
+    """A system file per example in ``config_dir``, with CNU's files copied beside it (a system
+    file's references must stay inside its config folder)."""
     examples = cnu / 'flexbe_synthesis_examples' / 'example'
+
+    def beside(source: Path) -> str:
+        relative = source.relative_to(cnu)
+        (config_dir / 'cnu' / relative).parent.mkdir(parents=True, exist_ok=True)
+        shutil.copyfile(source, config_dir / 'cnu' / relative)
+        return f'cnu/{relative.as_posix()}'
+
     for name, (capabilities, spec, mappings, *_rest) in CNU_EXAMPLES.items():
-        lines = [f'system: {name}', f'cnu_capabilities: {examples / capabilities}',
-                 f'cnu_mappings: {cnu / "flexbe_synthesis_generic" / "mappings" / mappings}']
+        lines = [f'system: {name}', f'cnu_capabilities: {beside(examples / capabilities)}',
+                 f'cnu_mappings: {beside(cnu / "flexbe_synthesis_generic" / "mappings" / mappings)}']
         if spec:
-            lines.append(f'cnu_spec: {examples / spec}')
+            lines.append(f'cnu_spec: {beside(examples / spec)}')
         # Reduction is measured both ways here, so the system's own default stays off.
         lines.append('reduce: false')
         (config_dir / f'{name}.yaml').write_text('\n'.join(lines) + '\n')

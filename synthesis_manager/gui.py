@@ -21,6 +21,7 @@ from rclpy.node import Node
 
 from respec.errors import ErrorCode, ExitStatus, exit_status_help
 from synthesis_manager.client import SynthesisClient, SynthesisOutcome, make_goal
+from synthesis_manager.http_connections import BoundedH11Protocol, install_repeat_filter, raise_descriptor_limit
 from synthesis_manager.ros.harness import RosHarness, environment_domain_id
 from synthesis_manager.ros.namespaces import namespace_placement
 from synthesis_manager.ros.robot_systems import SuiteSystems
@@ -142,10 +143,13 @@ class GuiServer(uvicorn.Server):
 def make_server(app, sock: socket.socket, on_stop=None) -> GuiServer:
     """A server for ``app`` on an already bound socket (call ``.run(sockets=[sock])``).
 
-    Requests still running a second after the server is told to stop are cut short.
+    Requests still running a second after the server is told to stop are cut short; connections
+    are bounded (``http_connections``).
     """
     host, port = sock.getsockname()[:2]
-    return GuiServer(uvicorn.Config(app, host=host, port=port, log_level='warning',
+    raise_descriptor_limit()
+    install_repeat_filter()
+    return GuiServer(uvicorn.Config(app, host=host, port=port, log_level='warning', http=BoundedH11Protocol,
                                     timeout_graceful_shutdown=1, ws='none'), on_stop=on_stop)
 
 

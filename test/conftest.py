@@ -35,6 +35,12 @@ REPOSITORY = Path(__file__).resolve().parents[1]
 DEFAULT_FLEXBE_SOURCES = REPOSITORY.parent / 'shared' / 'third_party'
 # Where `make flexbe` registers the FlexBE packages (the AMENT_PREFIX_PATH entry for them).
 FLEXBE_AMENT_PREFIX = Path(sys.prefix) / 'flexbe'
+# Tests write system files that point at CNU's example files where the sources lie; a system
+# file's references must resolve inside a config folder, so that folder is on every test's
+# (and child process's) search path, as docs/cnu.md tells users to put their FlexBE workspace.
+_CNU_FOLDER = Path(os.environ.get('FLEXBE_SOURCES') or DEFAULT_FLEXBE_SOURCES) / 'flexbe_synthesis'
+if _CNU_FOLDER.is_dir() and 'BEHAVIOR_SYNTHESIS_CONFIG_DIR' not in os.environ:
+    os.environ['BEHAVIOR_SYNTHESIS_CONFIG_DIR'] = str(_CNU_FOLDER)
 
 MARKERS = {
     'ros': 'starts ROS 2 (the ros fixture, the shell\'s nodes or its processes)',

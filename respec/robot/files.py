@@ -135,18 +135,21 @@ def load_config_yaml(text: str, path: str | Path):
         raise ConfigFileInvalidError(f'{path}: {error}', item=str(path)) from None
 
 
-def read_config_file(folder: Path, relative: str) -> str:
-    """The text of the robot file ``relative`` to the config folder ``folder``, which it must
-    stay in: an absolute path, a ``..`` out of it or a symbolic link resolving outside it is
-    refused, as are anything but a regular file (opened without blocking: a FIFO is never
-    waited on) and files over MAX_CONFIG_FILE_BYTES. OSError with the reason otherwise."""
-    if not isinstance(relative, str) or not relative or Path(relative).is_absolute():
-        raise ConfigFileInvalidError(f'{quoted(relative)} must be a path relative to {folder}', item=str(relative))
-    root = Path(os.path.realpath(folder))
+def read_config_file(folder: Path, relative: str, config_folders: Sequence[Path] = ()) -> str:
+    """The text of the robot file ``relative`` (to the system file's ``folder``, or absolute),
+    which must resolve inside ``folder`` or one of ``config_folders`` (the search path): a
+    ``..`` or a symbolic link out of them, or an absolute path elsewhere, is refused without
+    reading the target, as are anything but a regular file (opened without blocking: a FIFO is
+    never waited on) and files over MAX_CONFIG_FILE_BYTES. OSError with the reason otherwise."""
+    if not isinstance(relative, str) or not relative:
+        raise ConfigFileInvalidError(f'{quoted(relative)} must name a file', item=str(relative))
     resolved = Path(os.path.realpath(folder / relative))
-    if root != resolved and root not in resolved.parents:
-        raise ConfigFileInvalidError(f'{quoted(relative)} resolves outside the config folder {folder}; '
-                                     f'robot files must stay inside it', item=str(relative))
+    roots = [Path(os.path.realpath(root)) for root in (folder, *config_folders)]
+    if not any(resolved == root or root in resolved.parents for root in roots):
+        raise ConfigFileInvalidError(
+            f'{quoted(relative)} resolves outside the config folders ({", ".join(map(str, dict.fromkeys(roots)))}); '
+            'robot files must stay inside them: keep the file beside the system file, or add the folder '
+            'holding it with --config-dir', item=str(relative))
     try:
         return read_bounded_file(resolved, MAX_CONFIG_FILE_BYTES)
     except BoundedFileError as error:

@@ -25,12 +25,12 @@ from collections import OrderedDict
 from dataclasses import dataclass, field
 from pathlib import Path
 from types import MappingProxyType
-from typing import Callable, Mapping
+from typing import Callable, Mapping, Sequence
 
 from respec.robot.abstraction import RobotAbstraction, abstraction_from_document
 from respec.robot.cnu import CapabilitySystem, is_capability_document, load_capability_system
 from respec.robot.files import (ConfigDirs, ConfigFileInvalidError, SystemConfigError, SystemNotFoundError,
-                                available_systems, parse_config_text, read_config_file,
+                                available_systems, config_search_path, parse_config_text, read_config_file,
                                 system_config_path)
 
 ABSTRACTION_KIND = 'abstraction'
@@ -84,10 +84,14 @@ class RobotSystem:
         return self.abstraction or abstraction_from_document(self.sections, self.name)
 
 
-def robot_system_from_file(path: str | Path, name: str | None = None) -> RobotSystem:
-    """The robot system of one system file (its kind told by its content)."""
+def robot_system_from_file(path: str | Path, name: str | None = None,
+                           config_folders: Sequence[Path] | None = None) -> RobotSystem:
+    """The robot system of one system file (its kind told by its content). It and the files it
+    references must resolve inside one of ``config_folders`` (default: the file's own folder)."""
     path = Path(path)
-    return _robot_system(name or path.stem, path, lambda relative: read_config_file(path.parent, relative))
+    folders = tuple(config_folders or (path.parent,))
+    return _robot_system(name or path.stem, path,
+                         lambda relative: read_config_file(path.parent, relative, folders))
 
 
 def robot_system_from_files(name: str, files: Mapping[str, str], config_file: str | None = None) -> RobotSystem:
@@ -183,7 +187,7 @@ def robot_system(system: RobotSystem | str, config_dir: ConfigDirs = None) -> Ro
     """
     if isinstance(system, RobotSystem):
         return system
-    return robot_system_from_file(system_config_path(system, config_dir), system)
+    return robot_system_from_file(system_config_path(system, config_dir), system, config_search_path(config_dir))
 
 
 @dataclass(frozen=True)

@@ -234,7 +234,8 @@ def test_spec_file_formulas_join_the_capabilities_in_cnus_capability_pipeline(cn
     """A spec file's SYS_TRANS (CNU's own remedy for a capability that must not restart) is added."""
     example_system(tmp_path / 'plain', cnu, 'vending_demo')
     plain = compile_task('vending_demo', ['prep_pay_a'], ['soda'], config_dir=tmp_path / 'plain', state_library=library)
-    spec_file = tmp_path / 'spec.yaml'
+    (tmp_path / 'more').mkdir()
+    spec_file = tmp_path / 'more' / 'spec.yaml'  # inside the config folder, as every referenced file
     spec_file.write_text(yaml.safe_dump({'specs': {'OUTPUT': ['prep_pay_a', 'item:0...3'],
                                                    'SYS_INIT': ['prep_pay_a', 'item=0'],
                                                    'SYS_TRANS': ["pay_c' -> !prep_pay_a'"]}}))

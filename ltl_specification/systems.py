@@ -8,18 +8,20 @@ from __future__ import annotations
 
 from respec.robot import RobotSystem, robot_system
 from respec.robot.abstraction import AbstractionConfigError, RobotAbstraction
-from respec.robot.files import ConfigFileInvalidError, SystemNotFoundError
+from respec.robot.files import SystemNotFoundError
 
 from ltl_specification.errors import InvalidAbstractionError, UnknownSystemError
 
 
 def load_task_system(system: RobotSystem | str, config_dir=None) -> RobotSystem:
-    """The task's robot system, with the compiler's codes for an unknown or invalid one."""
+    """The task's robot system, with the compiler's codes for an unknown or invalid one. A file
+    that cannot be read as a robot file keeps its own CONFIG_FILE_INVALID, as every command and
+    both actions report it (ConfigFileInvalidError)."""
     try:
         return robot_system(system, config_dir)
     except SystemNotFoundError as error:
         raise UnknownSystemError(str(error), item=error.item) from error
-    except (AbstractionConfigError, ConfigFileInvalidError) as error:
+    except AbstractionConfigError as error:
         raise InvalidAbstractionError(str(error), item=error.item) from error
 
 

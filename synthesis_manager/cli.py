@@ -75,7 +75,11 @@ def main(argv: list[str] | None = None) -> int:
     if not getattr(args, 'run', None):
         parser.print_help()
         return 0 if not argv or '-h' in argv or '--help' in argv else 2
-    if getattr(args, 'goals', '') is None:  # a command of the suite's task (send-goal, demo, execute, ...)
+    if hasattr(args, 'initial_conditions') and hasattr(args, 'sm_outcomes') and args.initial_conditions is None:
+        from synthesis_manager.send_goal import fill_default_initial_conditions
+
+        fill_default_initial_conditions(args)  # a command of the suite's task (send-goal, demo, execute, ...)
+    if getattr(args, 'goals', '') is None:
         from synthesis_manager.send_goal import use_demo_goals_unless_given
 
         use_demo_goals_unless_given(args, args.command)

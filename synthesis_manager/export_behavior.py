@@ -51,13 +51,17 @@ def run(args) -> int:
 
     initial_conditions, goals = parse_names(args.initial_conditions), parse_names(args.goals)
     behavior_name = args.name or default_behavior_name(goals)
-    try:  # bad names and configurations are usage errors, found before synthesis
+    try:  # bad names on the command line are usage errors, found before synthesis
         check_behavior_name(behavior_name)
         check_package_name(args.package)
-        config = behavior_flexbe_config(generation_system(args.system, args.config_dir or None))
     except CodedError as error:
         print(f'export-behavior: {error.code}: {error}', file=sys.stderr)
         return ExitStatus.USAGE
+    try:  # a robot file refused: an error code of the pipeline, as from every command
+        config = behavior_flexbe_config(generation_system(args.system, args.config_dir or None))
+    except CodedError as error:
+        print(f'export-behavior: {error.code}: {error}', file=sys.stderr)
+        return ExitStatus.FAILED
     progress = ProgressBar(stream=sys.stderr)  # the stream of now (the default is the one at import)
     try:
         with in_process_suite(args, 'export_behavior_client') as (_, client):

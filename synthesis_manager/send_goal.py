@@ -30,8 +30,9 @@ DEMO_GOALS = 'look_down,pickup_object'
 def add_goal_arguments(parser, with_options: bool = True):
     """The task description shared by send-goal, demo and execute."""
     parser.add_argument('--system', default='atlas', help='robot system (a config/<system>.yaml)')
-    parser.add_argument('--initial-conditions', default='stand_prep',
-                        help='comma-separated initial conditions')
+    parser.add_argument('--initial-conditions', default=None,
+                        help="comma-separated initial conditions (default: the system's own: its initial_mode, "
+                             "or a capability robot's specification; '' or current: the robot's state)")
     parser.add_argument('--goals', help='comma-separated goals, in order (default: the paper\'s demo task, '
                         f'{DEMO_GOALS}, which is said on stderr)')
     parser.add_argument('--sm-outcomes', default='finished,failed',
@@ -64,6 +65,21 @@ def add_robot_namespace_argument(parser):
     parser.add_argument('--namespace', default='', metavar='NS',
                         help="the robot's ROS namespace, e.g. /robot1: its server's <NS>/behavior_synthesis "
                              '(default: the server outside any namespace)')
+
+
+def fill_default_initial_conditions(args) -> None:
+    """No --initial-conditions: the system's own (``RobotSystem.default_initial_conditions``),
+    read from the system file as this command finds it (its --config-dir); a system it cannot
+    read here (a server's own) gets none, and the server answers for it."""
+    if args.initial_conditions is not None:
+        return
+    from respec.robot import robot_system
+
+    try:
+        args.initial_conditions = ','.join(robot_system(args.system, getattr(args, 'config_dir', None) or None)
+                                           .default_initial_conditions)
+    except CodedError:
+        args.initial_conditions = ''
 
 
 def use_demo_goals_unless_given(args, command: str, stream=None) -> None:

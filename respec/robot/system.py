@@ -75,6 +75,14 @@ class RobotSystem:
             raise ConfigFileInvalidError(f'{self.name}.yaml: missing or invalid section {name!r}', item=name)
         return dict(content)
 
+    @property
+    def default_initial_conditions(self) -> list[str]:
+        """What a task on this robot starts from when it names nothing: an abstraction's
+        ``initial_mode``; a capability robot's specification gives its own (nothing to name)."""
+        if self.abstraction is not None and self.abstraction.initial_mode:
+            return [self.abstraction.initial_mode]
+        return []
+
     def has_section(self, name: str) -> bool:
         return isinstance(self.sections.get(name), Mapping)
 

@@ -126,3 +126,38 @@ def test_a_gui_stopped_in_the_middle_of_a_simulation_exits_within_three_seconds(
             ended(process)
     assert status == 128 + stop_signal
     assert seconds < STOP_WITHIN, f'the GUI took {seconds:.2f} s to stop after {stop_signal.name}'
+
+
+def test_a_broken_system_file_gets_one_code_with_its_line_and_column_from_every_command(tmp_path):
+    """Issue 45, item 5: compile said ABSTRACTION_CONFIG_INVALID, export-behavior
+    CONFIG_FILE_INVALID and exited 2, which its --help gives to a bad command line."""
+    (tmp_path / 'broken.yaml').write_text('abstraction:\n  actions: {a: [b\n')
+    task = ['--system', 'broken', '--config-dir', str(tmp_path), '--goals', 'a']
+    commands = {'compile': ['compile', *task], 'repair': ['repair', *task],
+                'export-behavior': ['export-behavior', *task, '-o', str(tmp_path / 'out')]}
+    for name, arguments in commands.items():
+        done = subprocess.run(CLI + arguments, capture_output=True, text=True, timeout=120,
+                              env=dict(os.environ, ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST'))
+        assert done.returncode == ExitStatus.FAILED, (name, done.returncode, done.stderr)
+        assert 'CONFIG_FILE_INVALID' in done.stderr and '(line 3, column 1)' in done.stderr, (name, done.stderr)
+        assert 'ABSTRACTION_CONFIG_INVALID' not in done.stderr
+        assert f'{ExitStatus.FAILED}  the input or the task was refused' in subprocess.run(
+            CLI + [name, '--help'], capture_output=True, text=True, timeout=60).stdout
+
+
+def test_a_task_naming_no_initial_conditions_starts_where_its_system_says():
+    """Issue 45, item 5: every command defaulted to ATLAS's stand_prep ("Initial condition
+    'stand_prep' names nothing of <robot>"). Now the system's own: ATLAS's initial_mode, a
+    capability robot's specification."""
+    from argparse import Namespace
+
+    from respec.robot import robot_system
+    from synthesis_manager.send_goal import fill_default_initial_conditions
+
+    assert robot_system('atlas').default_initial_conditions == ['stand_prep']
+    assert robot_system('mobile_manipulator').default_initial_conditions == ['parked']
+    assert robot_system('delivery_rover').default_initial_conditions == []
+    for system, expected in (('atlas', 'stand_prep'), ('delivery_rover', ''), ('no_such_robot', '')):
+        args = Namespace(system=system, initial_conditions=None, config_dir='')
+        fill_default_initial_conditions(args)
+        assert args.initial_conditions == expected

@@ -244,10 +244,12 @@ def diagnose(spec: GR1Specification, robotics_semantics: bool = True, limits: Li
     findings = precheck(spec, provenance) if provenance else []
     groups = provenance.groups if provenance else formula_groups(spec)
     diagnosis = Diagnosis(sentence=findings[0].sentence if findings else '', findings=findings)
+    core_groups = []
     try:
         core = unrealizable_core(spec, groups, robotics_semantics, limits)
         if core is None:
             return None
+        core_groups = core.groups
         diagnosis.core = [CoreEntry(g.equation, g.title, g.item,
                                     provenance.origin(g) if provenance else 'the specification',
                                     [to_infix(f) for f in g.formulas]) for g in core.groups]
@@ -255,9 +257,32 @@ def diagnose(spec: GR1Specification, robotics_semantics: bool = True, limits: Li
         diagnosis.play = play_in_words(steps, provenance.meanings if provenance else {})
     except SynthesisCancelledError as stopped:
         diagnosis.note = f'({CORE_NOT_COMPUTED}: {stopped.reason}.)'
+    sensors = unreported_sensors(spec, core_groups)
+    diagnosis.findings += sensors
     if not diagnosis.sentence:
-        diagnosis.sentence = _core_sentence(diagnosis.core)
+        diagnosis.sentence = sensors[0].sentence if sensors else _core_sentence(diagnosis.core)
     return diagnosis
+
+
+def unreported_sensors(spec: GR1Specification, core_groups) -> list[Finding]:
+    """The inputs the core reads that no assumption mentions: a sensor nothing reports (no
+    ENV_TRANS ties it to anything the robot does, no ENV_LIVENESS says it ever holds), so the
+    environment may hold it against the task forever and no behavior can wait it out."""
+    assumed = set().union(*(variables(f) for f in (*spec.env_init, *spec.env_trans, *spec.env_liveness)))
+    findings = []
+    for sensor in (p for p in spec.env_props if p not in assumed):
+        readers = [g for g in core_groups if any(sensor in variables(f) for f in g.formulas)]
+        if not readers:
+            continue
+        where = '; '.join(f'{g.item or g.title}: {to_infix(g.formulas[0])}' for g in readers[:2])
+        findings.append(Finding(
+            f"The task needs the sensor '{sensor}' (an input of the specification), but nothing reports it: "
+            f'no assumption ties it to what the robot does or says it ever holds, so the environment may keep '
+            f'it against the task forever and no behavior can observe it change. It is read by {where}. '
+            f"Report it from a capability's outcome (an ENV_TRANS such as "
+            f"\"<capability>_<outcome>' <-> (<capability>_a & {sensor}')\" in the spec file), or assume it "
+            f"holds infinitely often (ENV_LIVENESS: {sensor}).", 'assumptions', sensor, sensor))
+    return findings
 
 
 def _core_sentence(core: list[CoreEntry]) -> str:

@@ -26,6 +26,7 @@ item, re-run by the same compiler and synthesizer a user would run.
 
 from __future__ import annotations
 
+import contextlib
 import copy
 import itertools
 import re
@@ -36,7 +37,7 @@ from typing import Callable, Iterator, Mapping, Sequence
 import yaml
 
 from respec.errors import CodedError, ErrorCode
-from respec.naming import DEFAULT_SM_OUTCOMES, FAILED, memory, parse_names
+from respec.naming import DEFAULT_SM_OUTCOMES, FAILED, activation, memory, parse_names
 from respec.robot import RobotSystem, robot_system
 from respec.robot.files import ConfigDirs
 from respec.robot.system import robot_system_from_files
@@ -538,6 +539,7 @@ def _held_inputs(system: RobotSystem, request: TaskRequest, custom_ltl, inputs: 
 
 def _robot_candidates(system: RobotSystem, request: TaskRequest) -> Iterator[Proposal]:
     if system.is_capability_system:
+        yield from _sensor_candidates(system)
         yield from _capability_candidates(system, request)
     elif system.abstraction is not None:
         yield from _abstraction_candidates(system, request)
@@ -596,6 +598,69 @@ def _capability_candidates(system: RobotSystem, request: TaskRequest) -> Iterato
             patch = ConfigPatch(file, ('capabilities', name, 'preconditions'), remaining, preconditions)
             yield Proposal(REMOVE_PRECONDITION, f'Change the robot: {name} no longer needs {precondition!r} '
                            f'(capabilities.{name}.preconditions in {file}).', 2, True, config_patch=patch)
+
+
+def unreported_spec_inputs(capabilities) -> list[str]:
+    """The spec file's INPUTs that none of its environment formulas mentions: sensors nothing
+    reports (``ltl_specification.diagnosis.unreported_sensors`` names them in a diagnosis)."""
+    environment = ' '.join(text for section, text in capabilities.spec_formulas if section.startswith('env_'))
+    environment += ' ' + ' '.join(capabilities.spec_initial)
+    mentioned = set(re.findall(r'[A-Za-z_][A-Za-z0-9_]*', environment))
+    return [name for name in capabilities.spec_inputs if name not in mentioned]
+
+
+def _sensor_candidates(system: RobotSystem) -> Iterator[Proposal]:
+    """For a sensor nothing reports: an outcome pair of a capability whose outcomes report
+    nothing yet, bound to it (the missing binding), or the assumption that it holds infinitely
+    often; both are environment assumptions, so both are checked well-separated."""
+    from respec.robot.cnu import SPEC_KEY
+
+    capabilities = system.capabilities
+    relative = system.sections.get(SPEC_KEY)
+    if capabilities.full_spec or not isinstance(relative, str) or relative not in system.files:
+        return
+    sensors = unreported_spec_inputs(capabilities)
+    if not sensors:
+        return
+    file = _shown_file(system, relative)
+    specs = (yaml.safe_load(system.files[relative]) or {}).get('specs') or {}
+    environment = ' '.join(text for section, text in capabilities.spec_formulas if section.startswith('env_'))
+    for sensor in sensors:
+        for name, pair in _unbound_outcome_pairs(capabilities, environment):
+            a, b = (capabilities.outcome_proposition(name, outcome) for outcome in pair)
+            binding = [f"{a}' <-> ({activation(name)} & {sensor}')", f"{b}' <-> ({activation(name)} & !{sensor}')"]
+            before = list(specs.get('ENV_TRANS') or [])
+            patch = ConfigPatch(file, ('specs', 'ENV_TRANS'), [*before, *binding], before or None)
+            yield Proposal(ADD_ASSUMPTION, f'Change the robot: {name} reports the sensor {sensor} ({pair[0]} when it '
+                           f'holds, {pair[1]} when not; specs.ENV_TRANS in {file}).', 2, True, config_patch=patch)
+        liveness = [*(specs.get('ENV_LIVENESS') or []), sensor]
+        patch = ConfigPatch(file, ('specs', 'ENV_LIVENESS'), liveness, specs.get('ENV_LIVENESS'))
+        yield Proposal(ADD_ASSUMPTION, f'Assume the sensor {sensor}, which nothing reports, holds infinitely often '
+                       f'(specs.ENV_LIVENESS in {file}).', 1, True, config_patch=patch)
+        # A robot that runs one capability at a time cannot wait for a moment: once it holds, it stays.
+        stable = {**specs, 'ENV_TRANS': [*(specs.get('ENV_TRANS') or []), f"{sensor} -> {sensor}'"],
+                  'ENV_LIVENESS': liveness}
+        patch = ConfigPatch(file, ('specs',), stable, dict(specs))
+        yield Proposal(ADD_ASSUMPTION, f'Assume the sensor {sensor}, which nothing reports, eventually holds and then '
+                       f"stays so (specs.ENV_LIVENESS {sensor!r} and specs.ENV_TRANS \"{sensor} -> {sensor}'\" in "
+                       f'{file}).', 2, True, config_patch=patch)
+
+
+def _unbound_outcome_pairs(capabilities, environment: str) -> Iterator[tuple[str, tuple[str, str]]]:
+    """(capability, two of its transition outcomes) for capabilities whose outcomes no
+    environment formula mentions yet, failures left out: what could report a sensor."""
+    failure = capabilities.state_outcomes.get(FAILED)
+    for name, capability in sorted(capabilities.capabilities.items()):
+        outcomes = []
+        for flexbe_outcome in capability.declared_outcomes:
+            with contextlib.suppress(Exception):
+                outcome = capabilities.transition_outcome(name, flexbe_outcome)
+                if outcome != failure and outcome not in outcomes:
+                    outcomes.append(outcome)
+        if len(outcomes) < 2 or any(re.search(rf'\b{re.escape(capabilities.outcome_proposition(name, o))}\b',
+                                              environment) for o in outcomes):
+            continue
+        yield name, (outcomes[0], outcomes[1])
 
 
 def _success_postconditions(entry: dict, name: str, success: str) -> tuple[tuple[str, ...], list]:

@@ -71,5 +71,12 @@ def test_a_specification_without_provenance_is_diagnosed_by_its_formulas():
                                     'env_trans': [], 'env_liveness': [], 'env_init': [], 'sys_init': []})
     diagnosis = diagnose(spec)
     assert [entry.name() for entry in diagnosis.core] == ['formula sys_trans[0]', 'formula sys_liveness[0]']
-    assert diagnosis.sentence.startswith('The task cannot be done as requested')
+    # x is an input no assumption mentions, which the core reads: the sentence names it (issue 45).
+    assert diagnosis.sentence.startswith("The task needs the sensor 'x'")
+    assert 'sys_trans[0]: next(y) <-> !next(x)' in diagnosis.sentence
     assert diagnosis.play and diagnosis.play[0].startswith('start:')
+    constrained = spec_from_text_sections({'env_props': ['x'], 'sys_props': ['y'],
+                                           'sys_trans': ['next(y) <-> !next(x)'], 'sys_liveness': ['y'],
+                                           'env_trans': ["x -> next(x)"], 'env_liveness': [], 'env_init': ['x'],
+                                           'sys_init': []})
+    assert diagnose(constrained).sentence.startswith('The task cannot be done as requested')

@@ -22,6 +22,10 @@
   back and when, the server's peak RSS, a normal goal's time right after, SIGTERM's time 2 s
   into it; ``kill -9`` of serve during a goal (when send-goal notices), gr1synth
   --memory-limit 200 on a 192 MB input, and a 100,000-deep body POSTed to the GUI.
+- sharing (issue 48, full sizes; reliability_sharing.py): one client's eight runaways asking 1e9 s
+  beside another client's goal, five refused 50 MB goals and what the server keeps 5 s later, a
+  10^9-leaf alias bomb in a robot file, three BDD bombs at once against the sum limit, 1,100 idle
+  connections to a GUI with 1,024 open files, `repair --time-budget 5` on a BDD bomb.
 
 The server and GUI run as their real console entry points in separate processes on a
 reserved ROS domain; the clients are in this process. Prints a table and writes the sections
@@ -216,7 +220,7 @@ def idle_release(client, server_pid: int, idle_seconds: float = 35.0) -> dict:
             f'RSS after {idle_seconds:g} s idle MiB': rss_kib(server_pid) / 1024}
 
 
-SECTIONS = ('burst', 'soak', 'gui', 'attacks', 'idle', 'service')
+SECTIONS = ('burst', 'soak', 'gui', 'attacks', 'idle', 'service', 'sharing')
 #: The parts of 'attacks', each also selectable alone.
 ATTACKS = ('hostile', 'limits', 'qos', 'simulations')
 
@@ -232,6 +236,9 @@ def main(argv=None) -> int:
     parser.add_argument('--service-attacks', default='',
                         help="with --sections service: only the attacks whose titles contain one of these "
                              "comma-separated words (e.g. 'burst,bombs'; 'kill', 'gr1synth', 'deep' for the others)")
+    parser.add_argument('--sharing-attacks', default='',
+                        help="with --sections sharing: only the attacks whose titles contain one of these words "
+                             "(e.g. 'runaways,GUI,repair')")
     args = parser.parse_args(argv)
     sections = args.sections.split(',')
     if 'attacks' in sections:
@@ -266,6 +273,14 @@ def main(argv=None) -> int:
                     gui_process(domain, byproducts) as (url, gui_pid):
                 print('service: a 100,000-deep body to the GUI', flush=True)
                 report['service: GUI, 100,000-deep body'] = service.gui_deep_body(url, gui_pid, rss_kib)
+    if 'sharing' in sections:
+        import reliability_sharing as sharing
+        words = [word for word in args.sharing_attacks.split(',') if word]
+        titles = [*sharing.SHARING_ATTACKS, 'repair --time-budget 5 on a BDD bomb']
+        only = [title for title in titles if not words or any(word in title for word in words)]
+        with reserve_domain_id() as domain:
+            report.update({f'sharing: {title}': figures
+                           for title, figures in sharing.sharing_attacks(domain, rss_kib, only).items()})
     on_serve = set(sections) & {'idle', 'burst', 'soak', 'hostile', 'limits', 'qos'}
     with tempfile.TemporaryDirectory(prefix='bench-reliability-') as byproducts:
         if on_serve:  # the sections on one shared serve

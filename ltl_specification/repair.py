@@ -223,14 +223,15 @@ def propose_repairs(system: RobotSystem | str, request: TaskRequest, custom_ltl:
     """Verified proposals that make ``request`` (with ``custom_ltl``) possible on ``system``.
 
     ``system`` is a RobotSystem or its name (read once). Candidates are verified cheapest first
-    until ``max_proposals`` are found or ``time_budget`` seconds are spent (then the problem's
-    diagnosis gets at most a fifth of the budget more); ``on_proposal`` is
+    until ``max_proposals`` are found or four fifths of ``time_budget`` are spent (the problem's
+    diagnosis gets the rest: the budget bounds the whole); ``on_proposal`` is
     called with each one as it is verified (to show progress). ``state_library`` is the
     capability compiler's (default: the workspace's FlexBE states). Raises the system's own
     SystemConfigError when its file cannot be read.
     """
     start = time.monotonic()
-    deadline = start + time_budget
+    # The search leaves the diagnosis of the problem its share: the budget bounds the whole.
+    deadline = start + time_budget * (1 - DIAGNOSIS_SHARE)
     system = robot_system(system, config_dir)
     request = replace(request, system=system.name)
     original = attempt(system, request, custom_ltl, deadline, state_library=state_library)
@@ -269,7 +270,7 @@ def propose_repairs(system: RobotSystem | str, request: TaskRequest, custom_ltl:
         if len(repairs.proposals) >= max_proposals:
             break
     if original.code == UNREALIZABLE:   # after the search: proposals first, the core may take long
-        diagnosis_deadline = time.monotonic() + DIAGNOSIS_SHARE * time_budget
+        diagnosis_deadline = start + time_budget
         repairs.problem = f'{UNREALIZABLE}: ' + _diagnosed_sentence(system, request, custom_ltl, state_library,
                                                                     diagnosis_deadline)
     return _finish(repairs, start)

@@ -18,16 +18,15 @@ from __future__ import annotations
 import time
 from typing import Callable
 
-from ltl_specification.repair import DIAGNOSIS_SHARE
 from ltl_synthesizer.errors import SynthesisError, SynthesisTimeoutError
 from ltl_synthesizer.interrupt import DEFAULT_MEMORY_LIMIT
 from ltl_synthesizer.isolated import SERVER_CHILD_NICENESS, ChildProcess
 
-#: Seconds a child may take beyond its search's time budget and the diagnosis after it (a
-#: fifth of the budget at most): the interpreter's start (0.2-0.3 s measured) and the answer.
+#: Seconds a child may take beyond its search's time budget (the diagnosis included): the
+#: interpreter's start (0.2-0.3 s measured) and the answer.
 #: A candidate's compilation or synthesis that outlives the deadline (one CUDD operation can
 #: run for a minute on a BDD bomb) is ended by the kill; what was verified before is kept.
-STARTUP_GRACE = 2.0
+STARTUP_GRACE = 1.0
 
 
 class RepairSearchError(Exception):
@@ -51,14 +50,14 @@ class RepairSearch:
 
     def __init__(self, settings: dict):
         self.settings = settings
-        self.deadline = time.monotonic() + settings['time_budget'] * (1 + DIAGNOSIS_SHARE) + STARTUP_GRACE
+        self.deadline = time.monotonic() + settings['time_budget'] + STARTUP_GRACE
         self.child = ChildProcess(niceness=SERVER_CHILD_NICENESS, preload=__name__)
 
     def run(self, on_proposal: Callable[[dict], None] | None = None) -> dict:
         """The search's ``Repairs.to_dict()``; ``on_proposal(proposal dict)`` as each is verified.
         A refusal of the system's files is raised as the CodedError it is. The whole search,
-        its first check included, ends within its time budget, the diagnosis' share and
-        STARTUP_GRACE (counted from this object's creation), and within its memory limit."""
+        its first check and the diagnosis included, ends within its time budget and STARTUP_GRACE
+        (counted from this object's creation), and within its memory limit."""
         try:
             return self.child.call(search, (self.settings,), on_progress=on_proposal or (lambda _: None),
                                    deadline=self.deadline, memory_limit=self.settings.get('memory_limit'))

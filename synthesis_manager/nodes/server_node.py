@@ -61,8 +61,8 @@ SYNTHESIS_ANSWER_GRACE = 1.0
 # Fixes a refused goal's result suggests, and how long their search may take: its budget times
 # this (the problem's diagnosis after the search), plus a child interpreter's start.
 MAX_SUGGESTED_FIXES = 3
-REPAIR_DEADLINE_FACTOR = 1.2
-REPAIR_STARTUP_GRACE = 5.0
+REPAIR_DEADLINE_FACTOR = 1.0
+REPAIR_STARTUP_GRACE = 3.0
 
 
 @dataclass

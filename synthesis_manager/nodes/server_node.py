@@ -58,8 +58,8 @@ from synthesis_msgs.srv import (CancelSynthesis, GenerateFlexBESM, GenerateLTLSp
 
 # Seconds past synthesis_timeout the synthesis node has to answer (a goal's own limit gets none).
 SYNTHESIS_ANSWER_GRACE = 1.0
-# Fixes a refused goal's result suggests, and how long their search may take: its budget times
-# this (the problem's diagnosis after the search), plus a child interpreter's start.
+# Fixes a refused goal's result suggests, and how long their search may take: its budget (the
+# problem's diagnosis included), plus a child interpreter's start and its answer.
 MAX_SUGGESTED_FIXES = 3
 REPAIR_DEADLINE_FACTOR = 1.0
 REPAIR_STARTUP_GRACE = 3.0

@@ -60,7 +60,10 @@ def add_arguments(parser):
     add_suite_arguments(parser)
     group = parser.add_argument_group('execution')
     group.add_argument('--fail', action='append', default=[], metavar='ACTION[,ACTION]',
-                       help='capabilities that always fail (repeatable)')
+                       help='capabilities that always fail (repeatable); a capability robot: CAPABILITY[:OUTCOME], '
+                            'the outcome its state always returns (default: the one it fails with)')
+    group.add_argument('--sensor', action='append', default=[], metavar='NAME[=true|false]',
+                       help="a capability robot's sensor (a spec INPUT) as its environment reads it (repeatable)")
     group.add_argument('--fail-first', action='append', default=[], metavar='ACTION:K',
                        help='the first K attempts of ACTION fail (repeatable, comma-separated)')
     group.add_argument('--seed', type=int, default=None, help='seed of probabilistic faults')
@@ -107,10 +110,18 @@ def run(args) -> int:
         os.environ.setdefault('MUJOCO_GL', 'egl')  # before anything imports mujoco
     initial_conditions = parse_names(args.initial_conditions)
     batches = [parse_names(args.goals), *(parse_names(goals) for goals in args.then)]
+    try:
+        system = robot_system(args.system, args.config_dir or None)
+    except SystemConfigError as error:
+        print(f'execute: {error.code}: {error}', file=sys.stderr)
+        return ExitStatus.FAILED
+    if system.capabilities is not None:
+        return execute_capability_robot(args, system)
     try:  # the simulator first: a bad fault or start is a usage error, found before synthesis
+        if args.sensor:
+            raise FaultSpecError(f'--sensor is for capability robots; {system.name} reads its sensors in the simulator')
         faults = parse_faults(parse_names(args.fail), parse_names(args.fail_first))
         start = [] if asks_for_robot_state(initial_conditions) else initial_conditions
-        system = robot_system(args.system, args.config_dir or None)
         simulator = make_simulator(system, start, faults, args.seed)
     except (FaultSpecError, InitialConditionError, InvalidInitialConditionsError, SystemConfigError) as error:
         print(f'execute: {error}', file=sys.stderr)
@@ -122,6 +133,94 @@ def run(args) -> int:
     if args.json:
         print(json.dumps(report))
     return code
+
+
+def execute_capability_robot(args, system) -> int:
+    """``execute`` for a robot of CNU's capability format: its machine on the simulated capability
+    robot (``atlas_sim.executive.capability_run``), checked against its specification."""
+    from argparse import Namespace
+
+    from atlas_sim.executive.capability_run import CapabilityRun, ScriptError, parse_script
+    from respec.errors import CodedError
+    from respec.naming import parse_names
+    from respec.robot.state_library import capability_outcomes, workspace_state_library
+    from sm_generation.state_machine import StateMachine
+
+    unsupported = [flag for flag, given in (('--engine flexbe', args.engine == 'flexbe'), ('--ros-sim', args.ros_sim),
+                                            ('--record', args.record), ('--then', args.then),
+                                            ('--fail-first', args.fail_first)) if given]
+    if unsupported:
+        print(f'execute: {", ".join(unsupported)}: not available for a capability robot ({system.name}); its '
+              'machine runs on the simulated capability robot (start it onboard with start-behavior)', file=sys.stderr)
+        return ExitStatus.USAGE
+    try:
+        outcomes = capability_outcomes(system.capabilities, workspace_state_library())
+        script = parse_script(system.capabilities, outcomes, parse_names(args.fail), args.sensor)
+    except ScriptError as error:
+        print(f'execute: {error}', file=sys.stderr)
+        return ExitStatus.USAGE
+    except CodedError as error:
+        print(f'execute: {error.code}: {error}', file=sys.stderr)
+        return ExitStatus.FAILED
+    log = sys.stderr if args.json else sys.stdout
+    report = {'system': system.name, 'goals': parse_names(args.goals), 'script': {
+        'fail': script.outcomes, 'sensors': script.sensors}}
+    try:
+        with in_process_suite(args, 'execute_client') as (_, client):
+            progress = None if args.json else ProgressBar()
+            outcome = client.run(goal_from_args(Namespace(**vars(args))), feedback=progress)
+            if progress:
+                progress.close()
+    except SuiteUnavailableError as error:
+        print(f'execute: {error}', file=sys.stderr)
+        return ExitStatus.UNAVAILABLE
+    report['synthesis'] = {'error_name': outcome.error_name, 'message': outcome.message,
+                           'seconds': round(outcome.seconds, 4), 'states': len(outcome.states)}
+    if not args.json:
+        print_summary(outcome, stream=log)
+    if not outcome.succeeded:
+        print(f'execute: synthesis failed: {outcome.error_name}: {outcome.message}', file=sys.stderr)
+        report['exit_code'] = code = ExitStatus.for_error(outcome.error_name)
+        if args.json:
+            print(json.dumps(report))
+        return code
+    spec = run_with_deep_stack(spec_from_text_sections, outcome.ltl_specification)
+    run = CapabilityRun(StateMachine.from_instantiations(outcome.states), outcome.automaton, system.capabilities,
+                        spec, script).run()
+    report.update(run.to_dict())
+    if run.violations:
+        code = ExitStatus.VIOLATIONS
+    elif run.outcome is None:
+        code = ExitStatus.NOT_FINISHED
+    else:
+        code = ExitStatus.OK if run.outcome == args.expect else ExitStatus.OTHER_OUTCOME
+    report['exit_code'] = code
+    if args.json:
+        print(json.dumps(report))
+    else:
+        print_capability_run(run, stream=log)
+    if run.not_finished:
+        print(f'execute: {run.not_finished}', file=sys.stderr)
+    return code
+
+
+def print_capability_run(run, stream=sys.stdout) -> None:
+    print('trace:', file=stream)
+    shown = list(enumerate(run.steps, start=1))
+    if len(shown) > 30:  # a failure retried until the step limit: its start and its end
+        shown = [*shown[:20], None, *shown[-5:]]
+    for entry in shown:
+        if entry is None:
+            print(f'  ...  ({len(run.steps) - 25} more states)', file=stream)
+            continue
+        index, step = entry
+        print(f'  {index:3d}  {step.state:<28} {step.capability}: {step.outcome}  ({step.chosen_by})', file=stream)
+    if run.violations:
+        print('trace check: ' + '; '.join(run.violations), file=stream)
+    elif run.outcome is not None:
+        print('trace check: ok (every answer an environment move the specification allows, every next state '
+              "the strategy's move)", file=stream)
+    print(f'outcome: {run.outcome or "none"}', file=stream)
 
 
 def _missing_flexbe_engine() -> str:

@@ -265,11 +265,15 @@ def check_goal_order(trace: Trace, goals: list[str], ordered: bool = True):
         missing = [g for g in goals if completed_at[g] is None]
         if missing:
             order = ' in order' if ordered else ''
+            # A goal's state whose outcome the operator forced: the robot never reported it completed.
+            forced = [f'the operator forced {step.forced} on {step.state.lstrip("/")} at step {step.index}'
+                      for step in trace.steps if step.forced and set(step.capabilities) & set(missing)]
+            why = f' ({"; ".join(forced)}, not the robot)' if forced else ''
             violations.append(Violation(
                 'goal_order', trace.steps[-1].index if trace.steps else None,
                 f'{trace.steps[-1].state if trace.steps else "start"} -> {trace.outcome}', [],
                 f'the run ended in {trace.outcome!r} but goal(s) {", ".join(missing)} were never '
-                f'completed{order}'))
+                f'completed{order}{why}'))
     return completed_at, violations
 
 

@@ -319,3 +319,14 @@ def test_a_forced_outcome_that_breaks_an_assumption_is_the_operators_by_name(pic
     report = check_trace(trace, pickup_spec)
     assert 'the operator forced failed on look_down at step 2; the task assumed it never happens ' \
            '(look_down_x is no proposition of the specification)' in [v.message for v in report.violations]
+
+
+def test_a_goal_the_operator_forced_is_not_counted_and_the_check_says_who(pickup_spec):
+    following = [('/manipulate', ['manipulate'], [('manipulate', 'completed')]),
+                 ('/pickup_object', ['pickup_object'], [('pickup_object', 'completed')])]
+    trace = forced_failure_of_look_down(following, 'finished')
+    trace.steps[2].forced, trace.steps[2].forced_propositions = 'done', ['look_down_c']
+    report = check_trace(trace, pickup_spec)
+    assert [v.message for v in report.violations if v.kind == 'goal_order'] == [
+        "the run ended in 'finished' but goal(s) look_down, pickup_object were never completed in order "
+        '(the operator forced done on look_down at step 2, not the robot)']

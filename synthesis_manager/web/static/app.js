@@ -22,7 +22,7 @@ import { playFrames, showFrame, stopPlaying } from './frames.js';
 import { cancel, synthesize } from './job.js';
 import { back, closePlay, playKeys, reset, startPlay } from './play.js';
 import { onApplyFix, suggestFixes } from './repair.js';
-import { connectRuntimeControl, fillAutonomyLevels } from './runtime_control.js';
+import { connectRuntimeControl, fillAutonomyLevels, runKeys } from './runtime_control.js';
 import { simulate } from './simulation.js';
 import { loadVocabulary } from './vocabulary.js';
 
@@ -45,6 +45,7 @@ $('play-back').addEventListener('click', back);
 $('play-reset').addEventListener('click', reset);
 $('play-close').addEventListener('click', closePlay);
 $('graph-layout').addEventListener('keydown', playKeys);     // the panel and the drawing beside it
+$('graph-layout').addEventListener('keydown', runKeys);      // a simulation's operator, as in Play
 $('robot-play-section').addEventListener('keydown', playKeys);
 loadVocabulary().then(fillAutonomyLevels).then(loadSystems).then(() => document.body.classList.add('ready'),
   (error) => { $('status').textContent = `Cannot load the systems: ${error.message}`; });

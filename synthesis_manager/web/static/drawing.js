@@ -85,10 +85,10 @@ function enablePanning() {
     viewport.classList.add('panning');
   });
   viewport.addEventListener('pointerup', (event) => {
-    const clicked = drag && !drag.moved ? drag.target : null;
+    const clicked = drag && !drag.moved ? drag : null;
     drag = null;
     viewport.classList.remove('panning');
-    if (clicked) select(clicked);
+    if (clicked) select(clicked.target, clicked.x, clicked.y);
   });
   viewport.addEventListener('wheel', (event) => {
     event.preventDefault();
@@ -106,17 +106,63 @@ function enablePanning() {
   });
 }
 
-// A clicked SVG element -> the top-level state it belongs to (id "state:<name>"); during a play,
-// a click on an outcome cell of the active state reports that outcome instead.
-function select(target) {
+// A clicked SVG element -> the top-level state it belongs to (id "state:<name>"); during a play
+// or a run, a click anywhere in an outcome cell of the active state reports that cell's outcomes
+// instead (``x``, ``y``: where the click was, in the window).
+function select(target, x, y) {
   const node = target.closest ? target.closest('g.node') : null;
-  if (outcomePicker && node && node.classList.contains('active') && target.tagName === 'text'
-      && outcomePicker(target.textContent.split(',').map((name) => name.trim()).filter(Boolean))) return;
+  const active = outcomePicker ? svg.querySelector('g.node.active') : null;
+  const cell = active ? cellAt(active, x, y) : null;
+  if (cell && outcomePicker(cell.dataset.outcomes.split(','))) return;
   svg.querySelectorAll('g.node.selected').forEach((g) => g.classList.remove('selected'));
   if (!node || !node.id.startsWith('state:')) { if (onSelect) onSelect(null); return; }
   node.classList.add('selected');
   const name = node.id.slice('state:'.length);
   if (onSelect) onSelect(machine.children.find((state) => state.name === name) || null);
+}
+
+// Graphviz draws a table cell of a state's label as its background polygon, then its border,
+// then its text lines. Each polygon whose text names outcomes of the state is marked as that
+// outcome cell (data-outcomes), so the whole cell can be clicked.
+function markOutcomeCells(node, state) {
+  let cell = null;
+  let names = [];
+  const close = () => {
+    if (cell && names.length && names.every((name) => state.outcomes.includes(name))) {
+      cell.classList.add('outcome-cell');
+      cell.dataset.outcomes = names.join(',');
+    }
+    cell = null;
+    names = [];
+  };
+  for (const child of node.children) {
+    if (child.tagName === 'polygon') { close(); cell = child; }
+    else if (child.tagName === 'text' && cell) names.push(...child.textContent.split(',').map((n) => n.trim()).filter(Boolean));
+    else if (child.tagName !== 'polyline') close();
+  }
+  close();
+}
+
+// The outcome cell of ``node`` at window point (x, y); the cell's highlighted border (drawn
+// half outside it) counts as the cell.
+function cellAt(node, x, y) {
+  if (x === undefined) return null;
+  const border = 3;
+  return [...node.querySelectorAll('polygon.outcome-cell')].find((cell) => {
+    const box = cell.getBoundingClientRect();
+    return x >= box.left - border && x <= box.right + border && y >= box.top - border && y <= box.bottom + border;
+  }) || null;
+}
+
+// The outcomes of top-level state ``path`` ('/look_down') in the order FlexBE lists them ([] unknown).
+export function outcomesOf(path) {
+  const state = machine && machine.children.find((node) => node.state_path === path);
+  return state ? [...state.outcomes] : [];
+}
+
+// Focus the drawing (keys 1-9 force outcomes there) without scrolling the page.
+export function focusDrawing() {
+  if (viewport) viewport.focus({ preventScroll: true });
 }
 
 // Draw ``svgText`` in ``container``; ``tree`` is the machine's root node, and ``selectCallback``
@@ -136,6 +182,8 @@ export function show(container, svgText, tree, selectCallback) {
   svg.querySelectorAll('g > title').forEach((title) => title.remove());
   // States are reached with Tab and explained with Enter, as with a click.
   svg.querySelectorAll('g.node[id^="state:"]').forEach((node) => {
+    const state = tree.children.find((child) => child.name === node.id.slice('state:'.length));
+    if (state) markOutcomeCells(node, state);
     node.setAttribute('tabindex', '0');
     node.setAttribute('role', 'button');
     node.setAttribute('aria-label', `state ${node.id.slice('state:'.length)}: show its details`);
@@ -181,6 +229,23 @@ export function markRun(steps, running) {
   }
   const current = svg.querySelector('g.node.active, g.node.ended');
   if (current) revealNode(current);  // follow the robot through a machine larger than the view
+  afterMarking.forEach((callback) => callback());
+}
+
+const afterMarking = [];
+// Call ``callback`` each time the run or play marked on the drawing changed.
+export function whenMarked(callback) { afterMarking.push(callback); }
+
+// Pan so that ``node`` is not under ``rect`` (a panel over the drawing), by the shorter of a
+// move to its left or below it.
+export function moveOutFrom(node, rect) {
+  if (!svg) return;
+  const box = node.getBoundingClientRect();
+  const left = box.right - rect.left + 8;   // px to move the node left
+  const down = rect.bottom - box.top + 8;   // px to move it down
+  if (left <= down) view.x += left / scale();
+  else view.y -= down / scale();
+  apply();
 }
 
 // Mark a play of the environment on the drawing as markRun marks a simulation: ``history`` the

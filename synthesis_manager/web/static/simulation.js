@@ -65,8 +65,10 @@ export async function simulate() {
     return;
   }
   showSimulation(simulation);
-  // Follow the robot: the drawing and the robot side by side, in view.
+  // Follow the robot: the drawing and the robot side by side, in view; the keys (1-9 force an
+  // outcome, + and - zoom) go to the drawing, not to the page's body (Simulate is disabled now).
   $('graph-section').scrollIntoView({ block: 'start', behavior: 'instant' });
+  drawing.focusDrawing();
   const end = () => {
     simulationEvents = null;
     $('simulate').disabled = false;

@@ -10,7 +10,6 @@ from typing import Callable
 from respec.nesting import run_with_deep_stack
 from respec.parsing import spec_from_text_sections
 from sm_generation import SMGenerationError, export
-from sm_generation.export import to_dot
 from sm_generation.flexbe_behavior import (behavior_module_name, behavior_package, check_behavior_name,
                                            default_behavior_name)
 from sm_generation.for_system import behavior_flexbe_config
@@ -34,7 +33,7 @@ def _export(kind):
 def _picture(fmt):
     def build(outcome, *_) -> bytes:
         draw = picture.render_svg if fmt == 'svg' else picture.render_png
-        return draw(to_dot(list(outcome.states)))
+        return draw(picture.picture_dot(list(outcome.states)))
     return build
 
 
@@ -107,8 +106,8 @@ ARTIFACTS = {
                                        _has_states, _export('to_yaml')),
     'state_machine.json': ArtifactKind('State machine (StateInstantiation list, JSON)', 'application/json',
                                        _has_states, _export('to_json')),
-    'state_machine.dot': ArtifactKind('Picture source (Graphviz DOT)', 'text/vnd.graphviz',
-                                      _has_states, _export('to_dot')),
+    'state_machine.dot': ArtifactKind('Picture source (Graphviz DOT)', 'text/vnd.graphviz', _has_states,
+                                      lambda outcome, *_: picture.picture_dot(list(outcome.states)).encode()),
     'state_machine.svg': ArtifactKind('Picture (SVG)', 'image/svg+xml', _has_states, _picture('svg')),
     'state_machine.png': ArtifactKind('Picture (PNG)', 'image/png', _has_states, _picture('png')),
     'specification.structuredslugs': ArtifactKind('Specification (.structuredslugs)', 'text/plain',

@@ -17,6 +17,7 @@
 //   play.js           playing a finished job: the environment against its machine, or the robot
 // This module only connects the page's controls to them and starts the page.
 import { $ } from './dom.js';
+import { foldForm } from './drawing.js';
 import { addGoal, checkGoals, fillForm, loadChoices, loadSystems } from './form.js';
 import { playFrames, showFrame, stopPlaying } from './frames.js';
 import { cancel, synthesize } from './job.js';
@@ -31,6 +32,7 @@ $('add-goal').addEventListener('click', addGoal);
 $('request-form').addEventListener('submit', synthesize);
 $('cancel').addEventListener('click', cancel);
 $('simulate').addEventListener('click', () => { closePlay(); simulate(); });
+$('show-form').addEventListener('click', () => foldForm(false));
 $('frame-scrubber').addEventListener('input', (event) => { stopPlaying(); showFrame(Number(event.target.value)); });
 $('play-frames').addEventListener('click', playFrames);
 connectRuntimeControl();

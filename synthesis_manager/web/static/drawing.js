@@ -8,7 +8,8 @@ const ZOOM_STEP = 1.25;
 const MIN_SCALE = 0.1;   // px per SVG unit (Graphviz units are points)
 const MAX_SCALE = 6;
 const NATURAL_SCALE = 4 / 3;  // 1 pt = 4/3 px: "100 %"
-const READABLE_SCALE = 0.85;  // below this 14 pt labels fall under about 12 px
+const MIN_TEXT_PX = 11;       // no text of the drawing is shown smaller, unless the user zooms out
+const FOLD_FORM_BELOW_PX = 1600;  // window widths at which a run or play folds the form away
 
 let svg = null;
 let viewport = null;
@@ -17,6 +18,7 @@ let view = null;     // the part shown now
 let machine = null;  // the shown machine's tree: its root node
 let onSelect = null;
 let outcomePicker = null;  // during a play: (outcome names of the clicked cell) => whether one was taken
+let readableScale = 1;     // px per SVG unit at which the drawing's smallest text is MIN_TEXT_PX
 
 function scale() { return viewport.clientWidth / view.w; }
 
@@ -44,8 +46,8 @@ function zoomAt(factor, clientX, clientY) {
 // top, around the initial state (drag or zoom out for the rest).
 function fit(readableOnly = true) {
   let s = Math.min(viewport.clientWidth / full.w, viewport.clientHeight / full.h);
-  const shrunk = readableOnly && s < READABLE_SCALE;
-  if (shrunk) s = READABLE_SCALE;
+  const shrunk = readableOnly && s < readableScale;
+  if (shrunk) s = readableScale;
   view = { x: full.x, y: full.y, w: viewport.clientWidth / s, h: 0 };
   const start = svg.querySelector('[id="start"]');
   if (view.w > full.w) view.x = full.x - (view.w - full.w) / 2;  // centre narrow drawings
@@ -201,9 +203,39 @@ export function show(container, svgText, tree, selectCallback) {
     button('Fit', 'show the whole machine', () => fit(false)),
     button('100 %', 'natural size', natural));
   container.replaceChildren(tools, viewport);
+  const smallest = Math.min(...[...svg.querySelectorAll('text')].map((t) => parseFloat(t.getAttribute('font-size')) || 14));
+  readableScale = MIN_TEXT_PX / smallest;
   enablePanning();
+  sizeViewport();
   fit();
 }
+
+// The drawing as high as the window below the section's header row: once the section is
+// scrolled to the window's top (after Synthesize, Simulate, Play), all of it is in view.
+function sizeViewport() {
+  const section = document.getElementById('graph-section');
+  const above = viewport.getBoundingClientRect().top - section.getBoundingClientRect().top;
+  const below = 16;  // the section's padding and border, and a margin
+  viewport.style.height = `${Math.max(300, Math.floor(window.innerHeight - above - below))}px`;
+}
+
+// Scroll the page so that the drawing's section starts at the window's top.
+export function scrollIntoView() {
+  const section = document.getElementById('graph-section');
+  if (section && !section.hidden) section.scrollIntoView({ block: 'start', behavior: 'instant' });
+}
+
+// During a run or a play, fold the request form away on windows where it would squeeze the
+// drawing (false: unfold it); the drawing is sized and fitted again.
+export function foldForm(fold) {
+  const folded = fold && window.innerWidth < FOLD_FORM_BELOW_PX;
+  document.body.classList.toggle('form-folded', folded);
+  const button = document.getElementById('show-form');
+  if (button) button.hidden = !folded;
+  if (svg) { sizeViewport(); fit(); }
+}
+
+window.addEventListener('resize', () => { if (svg) { sizeViewport(); fit(); } });
 
 // Mark the simulation on the drawing: the states visited, the transitions taken and the
 // active state (the last one; "ended" once the run has finished).
@@ -305,5 +337,5 @@ export function pickOutcomes(picker) {
 
 // Fit the drawing to its viewport again (it changed size), if one is shown.
 export function refit(readableOnly = true) {
-  if (svg) fit(readableOnly);
+  if (svg) { sizeViewport(); fit(readableOnly); }
 }

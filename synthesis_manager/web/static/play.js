@@ -48,13 +48,22 @@ export async function startPlay(asRobot) {
     $('robot-play-section').hidden = false;
   } else {
     $('graph-layout').append(panel);
+    // The panel takes the robot's place beside the drawing (the run's table stays below).
+    $('graph-layout').classList.remove('simulating');
+    $('robot-view').hidden = true;
     $('graph-layout').classList.add('playing');
+  }
+  panel.hidden = false;
+  if (!asRobot) {  // the drawing beside the panel, as wide as the window lets it be, in view
+    drawing.foldForm(true);
+    drawing.scrollIntoView();
+    drawing.refit();
   }
   $('play-title').textContent = asRobot ? 'You play the robot against the environment'
     : 'You play the environment against the machine';
   panel.hidden = false;
   await step([]);
-  panel.scrollIntoView({ block: 'nearest' });
+  if (asRobot) panel.scrollIntoView({ block: 'nearest' });
   panel.focus({ preventScroll: true });
 }
 

@@ -105,6 +105,8 @@ async function drawStateMachine(job) {
   }
   drawing.show($('graph'), await picture.text(), await machine.json(), showStateDetails);
   showStateDetails(null);
+  drawing.scrollIntoView();  // the machine in view and fitted, the verdict beside it in the form's panel
+  drawing.refit();
 }
 
 function showDownloads(job) {

@@ -94,9 +94,12 @@ def test_playing_the_robot_of_an_unrealizable_task_until_it_loses(page):
     panel = page.locator('#play-panel')
     page.wait_for_selector('#play-choices button.play-choice')
     assert panel.is_visible() and page.is_visible('#robot-play-section')
-    assert page.inner_text('#play-position').startswith('Step 0: ')
+    assert page.inner_text('#play-position').startswith('Step 0 of at most 12: ')
     assert 'now in stand_prep' in page.inner_text('#play-position')
-    assert 'Why it cannot win: the environment keeps system goal 1' in page.inner_text('#play-verdict')
+    assert 'Why it cannot win: the environment keeps goal 1 (the state machine ends finished or' in \
+        page.inner_text('#play-verdict')
+    first = page.locator('#play-choices button.play-choice').first.inner_text()
+    assert first.endswith(' starts') and '_a' not in first  # progress first, in the task's words
     dead_ends = page.locator('#play-choices .play-choice.dead-end')
     assert dead_ends.count() >= 1 and not dead_ends.first.is_visible()   # folded: they lose at once
     page.click('#play-choices details.dead-ends summary')
@@ -110,16 +113,19 @@ def test_playing_the_robot_of_an_unrealizable_task_until_it_loses(page):
         page.keyboard.press(str(number))
 
     page.focus('#play-panel')
+    assert 'loop: it returns to a position of this play' in page.inner_text('#play-choices')
     press_choice('keep every output as it is')
     page.wait_for_function("document.querySelector('#play-position').textContent.startsWith('Step 1')")
-    assert page.locator('#play-choices .play-choice.repeats').count() >= 1
-    assert 'loop: it returns to a position of this play' in page.inner_text('#play-choices')
+    assert page.inner_text('#play-verdict').startswith(
+        'Verdict: the environment wins: the robot came back to a position of this play')
+    assert page.locator('#play-choices button').count() == 0   # the play is over
     page.keyboard.press('Backspace')                    # back
     page.wait_for_function("document.querySelector('#play-position').textContent.startsWith('Step 0')")
 
     page.click('#play-choices details.dead-ends summary')
     page.locator('#play-choices .play-choice.dead-end').first.click()   # the environment answers: stuck
-    page.wait_for_function("document.querySelector('#play-verdict').textContent.startsWith('The robot lost')")
+    page.wait_for_function("document.querySelector('#play-verdict').textContent.startsWith("
+                           "'Verdict: the environment wins')")
     assert 'deadlock' in page.inner_text('#play-verdict')
     assert page.locator('#play-choices button').count() == 0
     assert page.locator('#play-history li').count() == 1

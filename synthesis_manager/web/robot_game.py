@@ -14,7 +14,7 @@ from __future__ import annotations
 import re
 
 from respec.ltl import Or, Var, partial_evaluate, to_infix
-from respec.naming import activated
+from respec.naming import DEFAULT_SM_OUTCOMES, activated
 
 MAX_GAME_MOVES = 12
 ACTIVATION_STARTS = ' starts'
@@ -87,7 +87,9 @@ class _Words:
     """The task's words for propositions (``Provenance.meanings``), goals and moves."""
 
     def __init__(self, spec, meanings: dict):
-        self.meanings = dict(meanings)
+        # The state machine's outcomes in words where the task's meanings have none (CNU's robots).
+        self.meanings = {**{o: f'the state machine ends {o}' for o in DEFAULT_SM_OUTCOMES if o in spec.sys_props},
+                         **meanings}
         self.names = set(spec.env_props) | set(spec.sys_props)
 
     def off(self, name: str) -> str:

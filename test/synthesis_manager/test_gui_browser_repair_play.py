@@ -199,14 +199,15 @@ def test_a_capability_robot_asked_to_drive_and_not_to_drive_is_played_and_fixed(
     assert result_code(page) == 'SPEC_UNSYNTHESIZABLE'
     page.click('#play-robot')
     page.wait_for_selector('#play-choices button.play-choice')
-    assert 'Why it cannot win: the environment keeps system goal 1' in page.inner_text('#play-verdict')
+    assert 'Why it cannot win: the environment keeps goal 1 (the state machine ends finished or the state ' \
+        'machine ends failed)' in page.inner_text('#play-verdict')
     steps = 0
-    while not page.locator('#play-choices .play-choice.repeats').count():   # until a move closes a loop
+    while not page.inner_text('#play-verdict').startswith('Verdict: '):   # progress first, until the play ends
         page.locator('#play-choices button.play-choice').first.click()
         steps += 1
-        page.wait_for_function(f"document.querySelector('#play-position').textContent.startsWith('Step {steps}:')")
-        assert steps < 12 and 'The robot lost' not in page.inner_text('#play-verdict')
-    assert 'loop: it returns to a position of this play' in page.inner_text('#play-choices')
+        page.wait_for_function(f"document.querySelector('#play-position').textContent.startsWith('Step {steps} ')")
+        assert steps <= 12
+    assert page.inner_text('#play-verdict').startswith('Verdict: the environment wins: ')
 
     page.click('#suggest-fixes')
     dropped = page.locator('li.proposal[data-kind="drop_goal"]').first
@@ -214,3 +215,38 @@ def test_a_capability_robot_asked_to_drive_and_not_to_drive_is_played_and_fixed(
     dropped.locator('button.apply-fix').click()
     page.wait_for_function("document.querySelector('#result-code').textContent === 'SUCCESS'", timeout=120_000)
     assert len(goals_in_form(page)) == 1
+
+
+@pytest.mark.parametrize('size', [{'width': 1280, 'height': 720}, {'width': 1920, 'height': 1080}],
+                         ids=lambda s: f"{s['width']}x{s['height']}")
+def test_playing_the_robot_progress_first_ends_with_a_verdict_in_view_and_readable(gui, browser_context, size):  # noqa: F811
+    with open_page(browser_context, gui[0], viewport=size) as page:
+        choose_task(page, ['look_down', 'stand_prep'])
+        page.click('#synthesize')
+        assert result_code(page) == 'SPEC_UNSYNTHESIZABLE'
+        page.click('#play-robot')
+        page.wait_for_selector('#play-choices button.play-choice')
+        assert 'a play ends within 12 moves' in page.inner_text('#play-prompt')
+        said = set()
+        for step in range(13):
+            page.wait_for_function("n => document.querySelector('#play-position').textContent.startsWith(`Step ${n} `)",
+                                   arg=step)
+            verdict = page.inner_text('#play-verdict')
+            assert verdict not in said or not verdict  # no line said at every step
+            said.add(verdict)
+            if verdict.startswith('Verdict: '):
+                break
+            # the first offered move is progress, in the task's words, readable, in view
+            first = page.locator('#play-choices button.play-choice').first
+            words = first.inner_text()
+            assert '_a off' not in words and 'dead-end' not in (first.get_attribute('class') or '')
+            box = first.bounding_box()
+            assert box['y'] >= 0 and box['y'] + box['height'] <= size['height'], box
+            assert page.evaluate("e => parseFloat(getComputedStyle(e).fontSize)", first.element_handle()) >= 11
+            first.click()
+        verdict = page.inner_text('#play-verdict')
+        assert verdict.startswith('Verdict: the environment wins: ') or verdict == 'Verdict: you reached every goal.'
+        box = page.locator('#play-verdict').bounding_box()
+        assert box['y'] >= 0 and box['y'] + box['height'] <= size['height'], box
+        assert page.locator('#play-choices button').count() == 0
+        assert page.locator('#play-history li').count() <= 12

@@ -70,7 +70,7 @@ $(VENV)/.project-installed: pyproject.toml | $(BIN)/python
 $(GRAPHVIZ_WASM)/.installed:
 	@command -v npm >/dev/null && command -v node >/dev/null || { echo "$(NEEDS_NODE)" >&2; exit 1; }
 	@echo "installing $(VIZ_JS) (Graphviz compiled to WebAssembly, for the GUI's drawings) into $(GRAPHVIZ_WASM)"
-	mkdir -p $(GRAPHVIZ_WASM) && npm install --prefix $(GRAPHVIZ_WASM) --no-audit --no-fund --loglevel=error $(VIZ_JS)
+	mkdir -p $(GRAPHVIZ_WASM) && npm install --prefix $(GRAPHVIZ_WASM) --no-audit --no-fund --no-update-notifier --loglevel=error $(VIZ_JS)
 	touch $@
 
 # Plain cmake against the wheels: the ament index is the venv prefix, and the generated

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import re
 
+from ltl_specification.play import PlayError
 from respec.ltl import Or, Var, partial_evaluate, to_infix
 from respec.naming import DEFAULT_SM_OUTCOMES, activated
 
@@ -25,6 +26,8 @@ _BLOCKED = re.compile(r'system goal (\d+) \(')
 def game_turn(play, spec, meanings: dict, moves: list[int]) -> dict:
     """The turn after ``moves`` as the page shows it (RobotTurn's fields, reworded and ordered,
     plus ``verdict``, ``max_moves`` and ``goals``)."""
+    if len(moves) > MAX_GAME_MOVES:
+        raise PlayError(f'a play ends within {MAX_GAME_MOVES} moves; {len(moves)} were sent')
     turn = play.turn(moves).to_dict()
     raw_blocked = turn['blocked_goal']
     words = _Words(spec, meanings)
@@ -119,7 +122,8 @@ class _Words:
         index = _blocked_index(text)
         if index is None or index >= len(goals):
             return text or ''
-        return f'the environment keeps goal {index + 1} ({goals[index]}) from ever holding, whichever move the robot makes'
+        return (f'the environment keeps goal {index + 1} ({goals[index]}) from ever holding, '
+                'whichever move the robot makes')
 
 
 def _disjuncts(formula) -> list:

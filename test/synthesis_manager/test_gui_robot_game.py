@@ -49,3 +49,9 @@ def test_progress_moves_come_first_then_loops_then_dead_ends(wrong_order):
     loop = next(m for m in turn['moves'] if m['repeats'])
     assert turn_after(wrong_order, [loop['index']])['verdict'].startswith(
         'the environment wins: the robot came back to a position of this play')
+
+
+def test_a_play_longer_than_the_bound_is_refused(wrong_order):
+    from ltl_specification.play import PlayError
+    with pytest.raises(PlayError, match='a play ends within 12 moves; 13 were sent'):
+        turn_after(wrong_order, [0] * (MAX_GAME_MOVES + 1))

@@ -89,3 +89,28 @@ def test_without_dot_the_job_says_the_page_makes_the_png_and_the_server_says_why
         urllib.request.urlopen(f'{url}api/jobs/{job_id}/artifacts/state_machine.png')
     message = json.load(refused.value)['message']
     assert "Graphviz' 'dot' is not installed: the page makes the PNG from its drawing" in message
+
+
+def test_without_dot_the_twelve_goal_machine_is_drawn_whole_at_1920x1080(gui_without_dot, browser_context):  # noqa: F811
+    from test_gui_browser_newcomer import TWELVE_GOALS
+
+    size = {'width': 1920, 'height': 1080}
+    with open_page(browser_context, gui_without_dot[0], viewport=size) as page:
+        choose_task(page, TWELVE_GOALS)
+        page.click('#synthesize')
+        assert result_code(page, timeout=200_000) == 'SUCCESS'
+        page.wait_for_selector('.graph-viewport svg g.node')
+        drawing = page.evaluate("""() => {
+          const box = (e) => { const r = e.getBoundingClientRect(); return [r.left, r.top, r.right, r.bottom]; };
+          const svg = document.querySelector('.graph-viewport svg');
+          return {viewport: box(document.querySelector('.graph-viewport')),
+                  nodes: [...svg.querySelectorAll('g.node')].map((n) => [n.id, box(n)]),
+                  smallest: Math.min(...[...svg.querySelectorAll('text')].map((t) =>
+                    parseFloat(getComputedStyle(t).fontSize) * svg.getScreenCTM().a))}; }""")
+        left, top, right, bottom = drawing['viewport']
+        assert bottom <= size['height'] and right <= size['width']
+        states = [node for node, _ in drawing['nodes'] if node.startswith('state:')]
+        assert len(states) >= 20
+        for node, (x0, y0, x1, y1) in drawing['nodes']:  # fitted: every box in view
+            assert left - 1 <= x0 and x1 <= right + 1 and top - 1 <= y0 and y1 <= bottom + 1, node
+        assert drawing['smallest'] >= 11

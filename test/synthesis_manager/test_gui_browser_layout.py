@@ -85,6 +85,12 @@ def test_the_machine_in_view_fitted_and_readable_after_synthesize_during_and_aft
         assert min(font['px'] for font in drawing['fonts']) >= 11 - 1e-6
         in_view(page, 'g.node.active', size)
         in_view(page, '#play-panel', size)
+        # Below 1600 px the run and the play folded the form away; its button brings it back.
+        folded = size['width'] < 1600
+        assert page.is_hidden('#request-form') == folded and page.is_visible('#show-form') == folded
+        if folded:
+            page.click('#show-form')
+            assert page.is_visible('#synthesize') and page.is_hidden('#show-form')
 
 
 @pytest.mark.parametrize('size', SIZES, **BY_SIZE)

@@ -88,7 +88,9 @@ export async function simulate() {
 // run stopped in it, ended when the run did.
 function stepTimes(step, simulation, running) {
   const ended = Boolean(step.state_outcome) || step.ended_at > step.entered_at;
-  const end = ended ? step.ended_at.toFixed(2) : running ? '…' : `${simulation.robot_time.toFixed(2)} (stopped)`;
+  // The run's robot time is reported with its frames, so it may lag the step's entry by a frame.
+  const stopped = Math.max(step.entered_at, simulation.robot_time);
+  const end = ended ? step.ended_at.toFixed(2) : running ? '…' : `${stopped.toFixed(2)} (stopped)`;
   return `${step.entered_at.toFixed(2)}–${end}`;
 }
 

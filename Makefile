@@ -12,6 +12,13 @@ MSGS_SOURCES := $(wildcard synthesis_msgs/msg/*.msg synthesis_msgs/srv/*.srv syn
                 synthesis_msgs/CMakeLists.txt synthesis_msgs/cmake/wheel_include_filter.cmake synthesis_msgs/package.xml
 SYSTEM_PACKAGES := graphviz chromium iproute2
 
+# Graphviz compiled to WebAssembly, which draws the GUI's state machines where Graphviz' `dot` is
+# not installed (synthesis_manager/web/picture.py): from npm, so setup needs Node.js with npm.
+GRAPHVIZ_WASM := build/graphviz-wasm
+VIZ_JS := @viz-js/viz@3.31.0
+NEEDS_NODE := make setup needs Node.js and npm: the GUI draws state machines with Graphviz compiled to \
+  WebAssembly ($(VIZ_JS), from npm). Install them (sudo apt-get install nodejs npm) and run make again.
+
 .PHONY: setup run test bench serve clean system-packages flexbe webui
 
 # FlexBE: the folder holding flexbe_behavior_engine/ (and flexbe_webui/, rosidl_runtime_py/).
@@ -38,7 +45,7 @@ FLEXBE_PREFIX := $(VENV)/flexbe
 ROS2CLI_PREFIX := $(VENV)/ros2cli
 ROS2CLI_PACKAGES := ros2cli ros2action ros2topic ros2service ros2node ros2interface ros2pkg
 
-setup: $(VENV)/.project-installed $(VENV)/.msgs-installed
+setup: $(VENV)/.project-installed $(VENV)/.msgs-installed $(GRAPHVIZ_WASM)/.installed
 
 run: setup
 	$(BIN)/behavior-synthesis demo
@@ -58,6 +65,12 @@ $(BIN)/python:
 
 $(VENV)/.project-installed: pyproject.toml | $(BIN)/python
 	$(BIN)/python -m pip install --quiet -e '.[msgs-build,test,flexbe]'
+	touch $@
+
+$(GRAPHVIZ_WASM)/.installed:
+	@command -v npm >/dev/null && command -v node >/dev/null || { echo "$(NEEDS_NODE)" >&2; exit 1; }
+	@echo "installing $(VIZ_JS) (Graphviz compiled to WebAssembly, for the GUI's drawings) into $(GRAPHVIZ_WASM)"
+	mkdir -p $(GRAPHVIZ_WASM) && npm install --prefix $(GRAPHVIZ_WASM) --no-audit --no-fund --no-update-notifier --loglevel=error $(VIZ_JS)
 	touch $@
 
 # Plain cmake against the wheels: the ament index is the venv prefix, and the generated

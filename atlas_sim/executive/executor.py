@@ -172,6 +172,16 @@ def entered_step(trace: Trace, state: State, parts: list[Part], snapshot: dict,
     return step
 
 
+def _record_forced(step: TraceStep, path: str, outcome: str, parts) -> None:
+    """Note on ``step`` the outcome the operator forced on ``path`` (the state or one of its
+    children) and the outcome propositions that outcome stands for (trace_check reads them as
+    reported)."""
+    step.forced = outcome if path == step.state else f'{outcome} (on {path})'
+    step.forced_propositions = sorted({
+        proposition for part in parts if part.node.state_path == path or path == step.state and len(parts) == 1
+        for proposition, outcomes in (part.output_mapping or {}).items() if outcome in outcomes})
+
+
 @dataclass
 class _Running:
     """A started request of the robot and what has been seen of it."""
@@ -248,6 +258,7 @@ class Executive:
             forced = self._forced(state, parts)
             if forced is not None:
                 path, forced_outcome = forced
+                _record_forced(step, path, forced_outcome, parts)
                 if path == state.state_path:
                     outcome = forced_outcome
                     break
@@ -259,7 +270,10 @@ class Executive:
                         returned[part.node.state_path] = outcome
             outcome = self._state_outcome(state, returned)
             if outcome is not None:
-                outcome = self._confirmed(state, outcome)
+                chosen = self._confirmed(state, outcome)
+                if chosen != outcome:  # the operator forced another outcome at the waiting transition
+                    _record_forced(step, state.state_path, chosen, parts)
+                outcome = chosen
                 break
             self._tick(step)
         snapshot = self.robot.snapshot()

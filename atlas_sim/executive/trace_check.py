@@ -45,6 +45,11 @@ class TraceStep:
     results: list[dict] = field(default_factory=list)
     state_outcome: str = ''
     transition: str = ''
+    # The outcome the operator forced on this state ('' none) and the outcome propositions it
+    # stands for (a forced 'failed' on look_down: look_down_f): the check reads the forced outcome
+    # as the environment's report, so the machine is judged on how it answered it.
+    forced: str = ''
+    forced_propositions: list[str] = field(default_factory=list)
 
     @classmethod
     def from_dict(cls, data: dict) -> TraceStep:
@@ -173,12 +178,11 @@ class TraceCheckReport:
                 'violations': [asdict(v) for v in self.violations]}
 
     def summary(self) -> str:
+        """The check in words, each violation's message as the GUI shows it."""
         if self.ok:
             return f'trace check: ok ({self.positions} positions, goals {self.goals_completed_at})'
         lines = [f'trace check: {len(self.violations)} violation(s)']
-        for v in self.violations:
-            lines.append(f'  {v.kind} at step {v.step} ({v.transition}): {v.message}')
-            lines.extend(f'    {formula}' for formula in v.formulas)
+        lines.extend(f'  {v.kind}: {v.message}' for v in self.violations)
         return '\n'.join(lines)
 
 
@@ -188,6 +192,32 @@ class _Position:
     step: int | None
     env: dict[str, bool]
     visible_sys: dict[str, bool]   # activations (unless hidden) and SM outcomes
+    forced_by: TraceStep | None = None  # the step whose operator-forced outcome set this env
+
+
+def formula_name(section: str, formulas: list, formula) -> str:
+    """A formula of the specification by name: its section and place there, then the formula
+    ('sys_trans 7: look_down_a & !look_down_c -> next(look_down_a)'); places count from 1 as
+    the GUI's specification lists them."""
+    return f'{section} {formulas.index(formula) + 1}: {to_infix(formula)}'
+
+
+def _names(section: str, formulas: list, chosen) -> str:
+    return '; '.join(formula_name(section, formulas, f) for f in chosen)
+
+
+def forced_outcome_message(step: TraceStep, assumptions: str) -> str:
+    """A forced outcome that broke the environment's assumptions, told as the operator's choice."""
+    return (f'the operator forced {step.forced} on {step.state.lstrip("/")} at step {step.index}; '
+            f'the task assumed {assumptions}')
+
+
+def broken_guarantee_message(transition: str, guarantees: str) -> str:
+    return f'the state machine broke a guarantee of the specification ({transition}): {guarantees}'
+
+
+def broken_assumption_message(transition: str, assumptions: str) -> str:
+    return f'the robot (the environment) broke an assumption of the specification ({transition}): {assumptions}'
 
 
 def check_trace(trace: Trace, spec: GR1Specification, goals: list[str] | None = None,
@@ -235,11 +265,15 @@ def check_goal_order(trace: Trace, goals: list[str], ordered: bool = True):
         missing = [g for g in goals if completed_at[g] is None]
         if missing:
             order = ' in order' if ordered else ''
+            # A goal's state whose outcome the operator forced: the robot never reported it completed.
+            forced = [f'the operator forced {step.forced} on {step.state.lstrip("/")} at step {step.index}'
+                      for step in trace.steps if step.forced and set(step.capabilities) & set(missing)]
+            why = f' ({"; ".join(forced)}, not the robot)' if forced else ''
             violations.append(Violation(
                 'goal_order', trace.steps[-1].index if trace.steps else None,
                 f'{trace.steps[-1].state if trace.steps else "start"} -> {trace.outcome}', [],
                 f'the run ended in {trace.outcome!r} but goal(s) {", ".join(missing)} were never '
-                f'completed{order}'))
+                f'completed{order}{why}'))
     return completed_at, violations
 
 
@@ -309,20 +343,37 @@ class _Checker:
                 raise TraceError(f'step {step.index} activates {unknown[0]!r}, which is not a system '
                                  'proposition of the specification', item=unknown[0])
         positions = [_Position('start', None, self._env(steps[0].outcomes_at_entry), self._sys([]))]
-        positions += [_Position(s.state, s.index, self._env(s.outcomes_at_entry), self._sys(s.activated))
-                      for s in steps]
+        previous = None
+        for s in steps:
+            positions.append(self._entered(s.state, s.index, s.outcomes_at_entry, self._sys(s.activated), previous))
+            previous = s
         last = steps[-1]
         if self.trace.outcome is not None:
             prop = self.trace.sm_outcome_propositions.get(self.trace.outcome, self.trace.outcome)
             if prop not in self.sm_props:
                 raise TraceError(f'the run ended in {self.trace.outcome!r}, whose proposition {prop!r} '
                                  'is not a system proposition of the specification', item=self.trace.outcome)
-            positions.append(_Position(self.trace.outcome, last.index, self._env(last.outcomes_at_exit),
-                                       self._sys(None, prop)))
+            positions.append(self._entered(self.trace.outcome, last.index, last.outcomes_at_exit,
+                                           self._sys(None, prop), last))
         elif last.transition:  # broke off after the last state ended: its outcomes are still known
-            positions.append(_Position(last.transition, last.index, self._env(last.outcomes_at_exit),
-                                       self._sys(None)))
+            positions.append(self._entered(last.transition, last.index, last.outcomes_at_exit,
+                                           self._sys(None), last))
         return positions
+
+    def _entered(self, label, index, outcomes, visible_sys, after: TraceStep | None) -> _Position:
+        """The position entered with ``outcomes`` true after step ``after``; when the operator forced
+        that step's outcome, what it forced counts as reported (the other outcomes of the same
+        capabilities as not)."""
+        env = self._env(outcomes)
+        if after is None or not after.forced_propositions:
+            return _Position(label, index, env, visible_sys)
+        forced = set(after.forced_propositions)
+        capabilities = {p.rsplit('_', 1)[0] for p in forced}
+        for p in env:
+            if p.rsplit('_', 1)[0] in capabilities and p not in forced:
+                env[p] = False
+        env.update({p: True for p in forced if p in env})
+        return _Position(label, index, env, visible_sys, forced_by=after)
 
     def _hidden(self, position: _Position) -> list[str]:
         return [p for p in self.spec.sys_props if p not in position.visible_sys]
@@ -338,7 +389,8 @@ class _Checker:
         false_env = [f for f in self.spec.env_init if partial_evaluate(f, current, {}) is False]
         if false_env:
             violations.append(self._violation('env_init', first, first, false_env,
-                                              'the robot did not start as the specification assumes'))
+                                              'the robot did not start as the specification assumes: '
+                                              + _names('env_init', self.spec.env_init, false_env)))
         # The hidden variables are current-step ones here: evaluate SYS_INIT as a next step.
         cost, assignments = least_violating_assignments(
             [Next(f) for f in self.spec.sys_init], {}, current, self._hidden(first))
@@ -346,14 +398,28 @@ class _Checker:
             starts = [({**current, **a}, {}) for a in assignments]
             blamed = self._blame([(f, f) for f in self.spec.sys_init], starts)
             violations.append(self._violation('sys_init', first, first, blamed,
-                                              'the state machine did not start as the specification requires'))
+                                              'the state machine did not start as the specification requires: '
+                                              + _names('sys_init', self.spec.sys_init, blamed)))
         hidden = [{**current, **a} for a in assignments]  # full valuations of the current position
         for source, target in zip(self.positions, self.positions[1:]):
+            violations.extend(self._unknown_forced(source, target))
             violations.extend(self._env_violations(source, target, hidden))
             hidden, violation = self._advance(source, target, hidden, last=target is self.positions[-1])
             if violation:
                 violations.append(violation)
         return violations
+
+    def _unknown_forced(self, source, target) -> list[Violation]:
+        """A forced outcome whose proposition the specification does not have: the task assumed
+        that outcome never happens."""
+        forced = target.forced_by
+        if forced is None or source.forced_by is forced:
+            return []
+        unknown = [p for p in forced.forced_propositions if p not in self.spec.env_props]
+        if not unknown:
+            return []
+        return [self._violation('forced_outcome', source, target, [], forced_outcome_message(
+            forced, f'it never happens ({", ".join(unknown)} is no proposition of the specification)'))]
 
     def _env_violations(self, source, target, valuations) -> list[Violation]:
         false_everywhere = None
@@ -364,8 +430,13 @@ class _Checker:
         if not false_everywhere:
             return []
         formulas = [f for f in self.spec.env_trans if f in false_everywhere]
+        assumptions = _names('env_trans', self.spec.env_trans, formulas)
+        forced = target.forced_by or source.forced_by
+        if forced is not None:  # the operator's choice, not the robot's nor the machine's
+            return [self._violation('forced_outcome', source, target, formulas,
+                                    forced_outcome_message(forced, assumptions))]
         return [self._violation('env_trans', source, target, formulas,
-                                'the robot broke an assumption of the specification')]
+                                broken_assumption_message(_transition(source, target), assumptions))]
 
     def _successors(self, valuations, target: _Position, first_only: bool = False):
         """Cost and full valuations of ``target`` reachable from ``valuations`` under SYS_TRANS."""
@@ -395,8 +466,8 @@ class _Checker:
             return via_idle, None
         pairs = [(v, r) for v in valuations for r in reached]
         blamed = self._blame(self.sys_checks, pairs)
-        return reached, self._violation('sys_trans', source, target, blamed,
-                                        'the state machine broke a guarantee of the specification')
+        return reached, self._violation('sys_trans', source, target, blamed, broken_guarantee_message(
+            _transition(source, target), _names('sys_trans', self.spec.sys_trans, blamed)))
 
     def _via_idle(self, valuations, target: _Position):
         """Valuations of ``target`` reached through idle positions (nothing activated)."""
@@ -433,9 +504,13 @@ class _Checker:
 
     @staticmethod
     def _violation(kind, source: _Position, target: _Position, formulas, message) -> Violation:
-        transition = source.label if source is target else f'{source.label} -> {target.label}'
+        transition = _transition(source, target)
         step = target.step if kind.endswith('init') else (source.step if source.step is not None else target.step)
         return Violation(kind, step, transition, [to_infix(f) for f in formulas], message)
+
+
+def _transition(source: _Position, target: _Position) -> str:
+    return source.label if source is target else f'{source.label} -> {target.label}'
 
 
 def _with_invariants(formulas) -> list[tuple[Formula, Formula]]:
@@ -451,5 +526,6 @@ def valuations_of_trace(trace: Trace, spec: GR1Specification) -> list[dict[str, 
 
 
 __all__ = ['Trace', 'TraceStep', 'OutcomeTracker', 'TraceError', 'TraceCheckReport', 'Violation',
-           'check_trace', 'check_goal_order', 'incident_violations', 'step_at', 'partial_evaluate', 'least_violating_assignments',
+           'check_trace', 'check_goal_order', 'formula_name', 'forced_outcome_message',
+           'broken_guarantee_message', 'broken_assumption_message', 'incident_violations', 'step_at', 'partial_evaluate', 'least_violating_assignments',
            'valuations_of_trace']

@@ -7,6 +7,10 @@
     vocabulary    the Python names the page needs (GET /api/vocabulary)
     simulations   a closed-loop run's record
     artifacts     the downloads built from a finished job
+    picture       the machine's SVG: Graphviz' dot, else Graphviz compiled to WebAssembly with Node
+                  (render_dot.mjs; @viz-js/viz from npm, installed by `make setup`)
+    plays         playing a finished job: the environment against its machine, or the robot
+    robot_game    playing the robot as a game with an end (words, order, verdict)
     errors        request errors answered as 4xx/5xx JSON
     guards        what is refused before any route (foreign Host, large body, non-JSON POST)
     static/       index.html, style.css and the page's ES modules (app.js first)

@@ -3,19 +3,17 @@
 from __future__ import annotations
 
 import json
-import tempfile
 import time
 from dataclasses import dataclass
-from pathlib import Path
 from typing import Callable
 
 from respec.nesting import run_with_deep_stack
 from respec.parsing import spec_from_text_sections
 from sm_generation import SMGenerationError, export
-from sm_generation.export import render, to_dot
 from sm_generation.flexbe_behavior import (behavior_module_name, behavior_package, check_behavior_name,
                                            default_behavior_name)
 from sm_generation.for_system import behavior_flexbe_config
+from synthesis_manager.web import picture
 from synthesis_manager.web.outcome import JobOutcome
 
 
@@ -34,9 +32,8 @@ def _export(kind):
 
 def _picture(fmt):
     def build(outcome, *_) -> bytes:
-        with tempfile.TemporaryDirectory(prefix='behavior-synthesis-gui-') as directory:
-            path = render(to_dot(list(outcome.states)), Path(directory) / f'state_machine.{fmt}')
-            return path.read_bytes()
+        draw = picture.render_svg if fmt == 'svg' else picture.render_png
+        return draw(picture.picture_dot(list(outcome.states)))
     return build
 
 
@@ -109,8 +106,8 @@ ARTIFACTS = {
                                        _has_states, _export('to_yaml')),
     'state_machine.json': ArtifactKind('State machine (StateInstantiation list, JSON)', 'application/json',
                                        _has_states, _export('to_json')),
-    'state_machine.dot': ArtifactKind('Picture source (Graphviz DOT)', 'text/vnd.graphviz',
-                                      _has_states, _export('to_dot')),
+    'state_machine.dot': ArtifactKind('Picture source (Graphviz DOT)', 'text/vnd.graphviz', _has_states,
+                                      lambda outcome, *_: picture.picture_dot(list(outcome.states)).encode()),
     'state_machine.svg': ArtifactKind('Picture (SVG)', 'image/svg+xml', _has_states, _picture('svg')),
     'state_machine.png': ArtifactKind('Picture (PNG)', 'image/png', _has_states, _picture('png')),
     'specification.structuredslugs': ArtifactKind('Specification (.structuredslugs)', 'text/plain',
@@ -128,6 +125,11 @@ ARTIFACTS = {
 
 def available_artifacts(outcome: JobOutcome) -> list[str]:
     return [name for name, kind in ARTIFACTS.items() if kind.present(outcome)]
+
+
+def made_in_page(names: list[str]) -> list[str]:
+    """The downloads among ``names`` the page makes from its drawing (the PNG when ``dot`` is missing)."""
+    return ['state_machine.png'] if 'state_machine.png' in names and picture.png_in_page() else []
 
 
 def download_labels(names: list[str]) -> dict[str, str]:

@@ -12,7 +12,7 @@ from respec.naming import DEFAULT_SM_OUTCOMES, parse_names
 from respec.spec import SECTIONS
 from sm_generation.instantiation import StateInstantiation, count_states
 from synthesis_manager.limits import oversized_strings, too_long
-from synthesis_manager.web.artifacts import available_artifacts, download_labels
+from synthesis_manager.web.artifacts import available_artifacts, download_labels, made_in_page
 from synthesis_manager.web.errors import InvalidCharacterError, InvalidJobRequestError, NotFoundError
 from synthesis_manager.web.outcome import JobOutcome
 
@@ -244,7 +244,8 @@ class Job:
                 'summary': asdict(ResultSummary.of(outcome)) if outcome else None,
                 'stages': [asdict(stage) for stage in stage_timings(self.timeline, self.finished_after)]
                 if outcome else [],
-                'artifacts': artifacts, 'download_labels': download_labels(artifacts)}
+                'artifacts': artifacts, 'download_labels': download_labels(artifacts),
+                'made_in_page': made_in_page(artifacts)}
 
 
 def stage_timings(timeline: list[ProgressNote], total_seconds: float) -> list[StageTiming]:

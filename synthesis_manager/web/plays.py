@@ -21,6 +21,7 @@ from sm_generation.play import MachinePlayError, play_machine
 from sm_generation.state_machine import StateMachine
 from synthesis_manager.web.errors import GuiRequestError, InvalidJobRequestError, NotAvailableError
 from synthesis_manager.web.jobs import Job
+from synthesis_manager.web.robot_game import game_turn
 
 ROBOT, ENVIRONMENT = 'robot', 'environment'   # whom the user plays
 KEPT_COUNTER_STRATEGIES = 4
@@ -48,7 +49,7 @@ class Plays:
     def __init__(self, robot_system):
         self.robot_system = robot_system
         self._lock = threading.Lock()
-        self._counter_strategies: OrderedDict[str, tuple[RobotPlay, threading.Lock]] = OrderedDict()
+        self._counter_strategies: OrderedDict[str, tuple[RobotPlay, threading.Lock, object]] = OrderedDict()
 
     def turn(self, job: Job, moves: list) -> dict:
         """The turn after ``moves``, with ``play`` saying whom the user plays."""
@@ -71,14 +72,14 @@ class Plays:
     def _robot_turn(self, job: Job, moves: list) -> dict:
         if not all(isinstance(move, int) and not isinstance(move, bool) for move in moves):
             raise InvalidJobRequestError('the moves of a robot play are move indices (integers)', 'moves')
-        play, lock = self._counter_strategy(job)
+        play, lock, spec = self._counter_strategy(job)
         with lock:
             try:
-                return play.turn(moves).to_dict()
+                return game_turn(play, spec, play.meanings, moves)
             except PlayError as error:
                 raise MoveError(str(error), 'moves') from error
 
-    def _counter_strategy(self, job: Job) -> tuple[RobotPlay, threading.Lock]:
+    def _counter_strategy(self, job: Job) -> tuple[RobotPlay, threading.Lock, object]:
         with self._lock:
             if job.id in self._counter_strategies:
                 self._counter_strategies.move_to_end(job.id)
@@ -92,7 +93,7 @@ class Plays:
         except (CodedError, PlayError) as error:  # e.g. the system's files changed since the job
             raise NotAvailableError(f'cannot play job {quoted(job.id)}: {error}', job.id) from error
         with self._lock:
-            self._counter_strategies[job.id] = (play, threading.Lock())
+            self._counter_strategies[job.id] = (play, threading.Lock(), spec)
             while len(self._counter_strategies) > KEPT_COUNTER_STRATEGIES:
                 self._counter_strategies.popitem(last=False)
             return self._counter_strategies[job.id]

@@ -85,6 +85,8 @@ def test_forcing_another_outcome_at_a_waiting_transition_takes_it():
     operator = Operator(robot, script={'confirm': [{'command': 'force', 'state': '/stand', 'outcome': 'failed'}]})
     run = execute_state_machine(STAND_THEN_LOOK, robot, control=operator.make(HIGH))
     assert run.outcome == 'failed' and run.trace.steps[0].state_outcome == 'failed'
+    # The trace says who chose it, and what the choice stands for (the trace check reads it so).
+    assert (run.trace.steps[0].forced, run.trace.steps[0].forced_propositions) == ('failed', ['stand_f'])
 
 
 def test_an_outcome_forced_while_the_state_runs_ends_it_at_once():
@@ -93,6 +95,7 @@ def test_an_outcome_forced_while_the_state_runs_ends_it_at_once():
     run = execute_state_machine(STAND_THEN_LOOK, robot, control=operator.make(FULL))
     assert run.outcome == 'failed' and robot.tick == 4
     assert run.trace.steps[0].ended_at == pytest.approx(0.4)
+    assert (run.trace.steps[0].forced, run.trace.steps[0].forced_propositions) == ('failed', ['stand_f'])
 
 
 def test_an_outcome_the_state_does_not_have_is_refused_and_the_run_goes_on():

@@ -7,7 +7,7 @@ import pytest
 from atlas_sim.executive.trace_check import (OutcomeTracker, Trace, TraceError, TraceStep, check_trace,
                                    least_violating_assignments, partial_evaluate, valuations_of_trace)
 from ltl_specification import compile_task
-from respec.ltl import var
+from respec.ltl import to_infix, var
 from respec.parsing import parse_formula
 
 MODES = ['stand_prep', 'stand', 'manipulate', 'step', 'walk']
@@ -275,3 +275,58 @@ def test_least_violating_assignments_prunes_and_counts():
     assert cost == 0 and found == [{'m': True, 'f': False}, {'m': True, 'f': True}]
     cost, found = least_violating_assignments(formulas, {'a': False}, {'f': True}, ['m'])
     assert cost == 1 and len(found) == 2
+
+
+# --- who broke what: the machine, the robot or the operator ------------------------------------
+
+def forced_failure_of_look_down(following, outcome, forced=True):
+    """object_template, stand, then look_down, on which the operator forced 'failed' before the
+    robot reported anything, then ``following``."""
+    trace = make_trace(PICKUP_IN_ORDER[:2] + [('/look_down', ['look_down'], [])] + following, outcome)
+    if forced:
+        trace.steps[2].forced, trace.steps[2].forced_propositions = 'failed', ['look_down_f']
+    return trace
+
+
+def test_a_machine_answering_a_forced_failure_is_not_blamed_and_a_broken_guarantee_is_named(pickup_spec):
+    # The machine ends in 'failed' after the operator forced look_down's failure: it did right.
+    assert check_trace(forced_failure_of_look_down([], 'failed'), pickup_spec).ok
+    # The same run with nobody forcing anything: the machine ended in failed with nothing failed.
+    report = check_trace(forced_failure_of_look_down([], 'failed', forced=False), pickup_spec)
+    assert kinds(report) == ['sys_trans']
+    guarantee = next(i for i, f in enumerate(pickup_spec.sys_trans, 1) if to_infix(f).startswith('failed <->'))
+    assert report.violations[0].message == (
+        'the state machine broke a guarantee of the specification (/look_down -> failed): '
+        f'sys_trans {guarantee}: {to_infix(pickup_spec.sys_trans[guarantee - 1])}')
+    assert report.violations[0].message in report.summary()
+
+
+def test_a_forced_outcome_that_breaks_an_assumption_is_the_operators_by_name(pickup_spec):
+    retrying = compile_task('atlas', ['stand_prep'], ['look_down', 'pickup_object'], sm_outcomes=['finished'])
+    following = [('/object_template_1', ['object_template'], [('object_template', 'completed')]),
+                 ('/look_down_1', ['look_down'], [('look_down', 'completed')])]
+    report = check_trace(forced_failure_of_look_down(following, None), retrying)
+    assumption = next(i for i, f in enumerate(retrying.env_trans, 1)
+                      if to_infix(f) == 'look_down_f & !look_down_a -> next(look_down_f)')
+    assert kinds(report) == ['forced_outcome'] and report.violations[0].step == 3
+    assert report.violations[0].message == (
+        'the operator forced failed on look_down at step 2; the task assumed '
+        f'env_trans {assumption}: look_down_f & !look_down_a -> next(look_down_f)')
+    assert 'forced_outcome: the operator forced failed on look_down at step 2' in report.summary()
+    # Forced on a state the trace says it has no such outcome for: the task assumed it never happens.
+    trace = forced_failure_of_look_down([], 'failed')
+    trace.steps[2].forced_propositions = ['look_down_x']
+    report = check_trace(trace, pickup_spec)
+    assert 'the operator forced failed on look_down at step 2; the task assumed it never happens ' \
+           '(look_down_x is no proposition of the specification)' in [v.message for v in report.violations]
+
+
+def test_a_goal_the_operator_forced_is_not_counted_and_the_check_says_who(pickup_spec):
+    following = [('/manipulate', ['manipulate'], [('manipulate', 'completed')]),
+                 ('/pickup_object', ['pickup_object'], [('pickup_object', 'completed')])]
+    trace = forced_failure_of_look_down(following, 'finished')
+    trace.steps[2].forced, trace.steps[2].forced_propositions = 'done', ['look_down_c']
+    report = check_trace(trace, pickup_spec)
+    assert [v.message for v in report.violations if v.kind == 'goal_order'] == [
+        "the run ended in 'finished' but goal(s) look_down, pickup_object were never completed in order "
+        '(the operator forced done on look_down at step 2, not the robot)']

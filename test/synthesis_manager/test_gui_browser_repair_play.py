@@ -94,9 +94,12 @@ def test_playing_the_robot_of_an_unrealizable_task_until_it_loses(page):
     panel = page.locator('#play-panel')
     page.wait_for_selector('#play-choices button.play-choice')
     assert panel.is_visible() and page.is_visible('#robot-play-section')
-    assert page.inner_text('#play-position').startswith('Step 0: ')
+    assert page.inner_text('#play-position').startswith('Step 0 of at most 12: ')
     assert 'now in stand_prep' in page.inner_text('#play-position')
-    assert 'Why it cannot win: the environment keeps system goal 1' in page.inner_text('#play-verdict')
+    assert 'Why it cannot win: the environment keeps goal 1 (the state machine ends finished or' in \
+        page.inner_text('#play-verdict')
+    first = page.locator('#play-choices button.play-choice').first.inner_text()
+    assert first.endswith(' starts') and '_a' not in first  # progress first, in the task's words
     dead_ends = page.locator('#play-choices .play-choice.dead-end')
     assert dead_ends.count() >= 1 and not dead_ends.first.is_visible()   # folded: they lose at once
     page.click('#play-choices details.dead-ends summary')
@@ -110,16 +113,19 @@ def test_playing_the_robot_of_an_unrealizable_task_until_it_loses(page):
         page.keyboard.press(str(number))
 
     page.focus('#play-panel')
+    assert 'loop: it returns to a position of this play' in page.inner_text('#play-choices')
     press_choice('keep every output as it is')
     page.wait_for_function("document.querySelector('#play-position').textContent.startsWith('Step 1')")
-    assert page.locator('#play-choices .play-choice.repeats').count() >= 1
-    assert 'loop: it returns to a position of this play' in page.inner_text('#play-choices')
+    assert page.inner_text('#play-verdict').startswith(
+        'Verdict: the environment wins: the robot came back to a position of this play')
+    assert page.locator('#play-choices button').count() == 0   # the play is over
     page.keyboard.press('Backspace')                    # back
     page.wait_for_function("document.querySelector('#play-position').textContent.startsWith('Step 0')")
 
     page.click('#play-choices details.dead-ends summary')
     page.locator('#play-choices .play-choice.dead-end').first.click()   # the environment answers: stuck
-    page.wait_for_function("document.querySelector('#play-verdict').textContent.startsWith('The robot lost')")
+    page.wait_for_function("document.querySelector('#play-verdict').textContent.startsWith("
+                           "'Verdict: the environment wins')")
     assert 'deadlock' in page.inner_text('#play-verdict')
     assert page.locator('#play-choices button').count() == 0
     assert page.locator('#play-history li').count() == 1
@@ -193,14 +199,15 @@ def test_a_capability_robot_asked_to_drive_and_not_to_drive_is_played_and_fixed(
     assert result_code(page) == 'SPEC_UNSYNTHESIZABLE'
     page.click('#play-robot')
     page.wait_for_selector('#play-choices button.play-choice')
-    assert 'Why it cannot win: the environment keeps system goal 1' in page.inner_text('#play-verdict')
+    assert 'Why it cannot win: the environment keeps goal 1 (the state machine ends finished or the state ' \
+        'machine ends failed)' in page.inner_text('#play-verdict')
     steps = 0
-    while not page.locator('#play-choices .play-choice.repeats').count():   # until a move closes a loop
+    while not page.inner_text('#play-verdict').startswith('Verdict: '):   # progress first, until the play ends
         page.locator('#play-choices button.play-choice').first.click()
         steps += 1
-        page.wait_for_function(f"document.querySelector('#play-position').textContent.startsWith('Step {steps}:')")
-        assert steps < 12 and 'The robot lost' not in page.inner_text('#play-verdict')
-    assert 'loop: it returns to a position of this play' in page.inner_text('#play-choices')
+        page.wait_for_function(f"document.querySelector('#play-position').textContent.startsWith('Step {steps} ')")
+        assert steps <= 12
+    assert page.inner_text('#play-verdict').startswith('Verdict: the environment wins: ')
 
     page.click('#suggest-fixes')
     dropped = page.locator('li.proposal[data-kind="drop_goal"]').first
@@ -208,3 +215,38 @@ def test_a_capability_robot_asked_to_drive_and_not_to_drive_is_played_and_fixed(
     dropped.locator('button.apply-fix').click()
     page.wait_for_function("document.querySelector('#result-code').textContent === 'SUCCESS'", timeout=120_000)
     assert len(goals_in_form(page)) == 1
+
+
+@pytest.mark.parametrize('size', [{'width': 1280, 'height': 720}, {'width': 1920, 'height': 1080}],
+                         ids=lambda s: f"{s['width']}x{s['height']}")
+def test_playing_the_robot_progress_first_ends_with_a_verdict_in_view_and_readable(gui, browser_context, size):  # noqa: F811
+    with open_page(browser_context, gui[0], viewport=size) as page:
+        choose_task(page, ['look_down', 'stand_prep'])
+        page.click('#synthesize')
+        assert result_code(page) == 'SPEC_UNSYNTHESIZABLE'
+        page.click('#play-robot')
+        page.wait_for_selector('#play-choices button.play-choice')
+        assert 'a play ends within 12 moves' in page.inner_text('#play-prompt')
+        said = set()
+        for step in range(13):
+            page.wait_for_function("n => document.querySelector('#play-position').textContent.startsWith(`Step ${n} `)",
+                                   arg=step)
+            verdict = page.inner_text('#play-verdict')
+            assert verdict not in said or not verdict  # no line said at every step
+            said.add(verdict)
+            if verdict.startswith('Verdict: '):
+                break
+            # the first offered move is progress, in the task's words, readable, in view
+            first = page.locator('#play-choices button.play-choice').first
+            words = first.inner_text()
+            assert '_a off' not in words and 'dead-end' not in (first.get_attribute('class') or '')
+            box = first.bounding_box()
+            assert box['y'] >= 0 and box['y'] + box['height'] <= size['height'], box
+            assert page.evaluate("e => parseFloat(getComputedStyle(e).fontSize)", first.element_handle()) >= 11
+            first.click()
+        verdict = page.inner_text('#play-verdict')
+        assert verdict.startswith('Verdict: the environment wins: ') or verdict == 'Verdict: you reached every goal.'
+        box = page.locator('#play-verdict').bounding_box()
+        assert box['y'] >= 0 and box['y'] + box['height'] <= size['height'], box
+        assert page.locator('#play-choices button').count() == 0
+        assert page.locator('#play-history li').count() <= 12

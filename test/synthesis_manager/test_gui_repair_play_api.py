@@ -1,6 +1,7 @@
 """The GUI's "Suggest fixes" (POST /api/repair) and play (POST /api/jobs/{id}/play) against the
 real in-process pipeline, for ATLAS and a CNU capability robot (issue 33, items 2 and 3)."""
 
+import re
 import shutil
 import threading
 from concurrent.futures import ThreadPoolExecutor
@@ -120,14 +121,35 @@ def test_playing_the_robot_of_an_unrealizable_job_until_it_loses(client):
     assert start.status_code == 200, start.text
     turn = start.json()
     assert turn['play'] == 'robot' and turn['step'] == 0 and 'now in stand_prep' in turn['happened']
-    assert turn['blocked_goal'].startswith('the environment keeps system goal 1')
+    # A game with an end, in the task's words: the goal it cannot reach named once, progress first.
+    assert turn['blocked_goal'] == ('the environment keeps goal 1 (the state machine ends finished or the state '
+                                    'machine ends failed) from ever holding, whichever move the robot makes')
+    assert turn['max_moves'] == 12 and turn['verdict'] == ''
+    assert turn['goals'] == [{'words': 'the state machine ends finished or the state machine ends failed',
+                              'reached': False}]
+    assert turn['moves'][0]['words'].endswith(' starts') and not turn['moves'][0]['repeats']
+    ranks = [2 if m['dead_end'] else 1 if m['repeats'] else 0 for m in turn['moves']]
+    assert ranks == sorted(ranks)  # live moves, then loops, then dead ends
     dead_end = next(move for move in turn['moves'] if move['dead_end'])
     lost = play(client, job['id'], [dead_end['index']]).json()
     assert lost['lost'] and 'deadlock' in lost['lost'] and lost['moves'] == []
+    assert lost['verdict'] == f"the environment wins: {lost['lost']}"
     keep = next(m for m in turn['moves'] if m['words'] == 'keep every output as it is')
+    assert keep['repeats']
     again = play(client, job['id'], [keep['index']]).json()
-    assert next(m for m in again['moves'] if m['words'] == 'keep every output as it is')['repeats']
-    assert again['history'] == ['nothing changes']
+    assert again['verdict'].startswith('the environment wins: the robot came back to a position of this play')
+    assert again['moves'] == [] and again['history'] == ['nothing changes']
+    # Progress moves until the end: a verdict within the bound, no line said twice, no raw "_a off".
+    moves, said = [], {turn['blocked_goal']}
+    while not turn['verdict']:
+        assert len(moves) <= turn['max_moves']
+        moves.append(turn['moves'][0]['index'])
+        turn = play(client, job['id'], moves).json()
+        assert not turn['blocked_goal'] or turn['blocked_goal'] not in said
+        said.add(turn['blocked_goal'])
+        assert all(not re.search(r'\b\w+_a off\b', m['words']) for m in turn['moves'])
+        assert all(not re.search(r'\b\w+_a off\b', line) for line in turn['history'])
+    assert turn['verdict'].startswith('the environment wins: ') and turn['moves'] == []
 
     wrong = play(client, job['id'], [999])
     assert wrong.status_code == 400
@@ -184,7 +206,7 @@ def test_a_capability_robot_plays_both_ways_and_is_repaired(client):
         moves.append(turn['moves'][0]['index'])
         turn = play(client, refused['id'], moves).json()
         assert not (turn['values']['finished'] or turn['values']['failed'])
-    assert turn['lost'] or any(move['repeats'] for move in turn['moves'])
+    assert turn['verdict'].startswith('the environment wins: ')  # the play has an end
 
     repairs = client.post('/api/repair', json=ROVER_CONTRADICTION).json()
     dropped = next(p for p in repairs['proposals'] if p['kind'] == 'drop_goal')

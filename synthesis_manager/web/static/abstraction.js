@@ -7,8 +7,10 @@
 import { $, element } from './dom.js';
 
 const SVG = 'http://www.w3.org/2000/svg';
-const NODE_W = 118;
+const MIN_NODE_W = 118;
+const CHAR_W = 7.3;    // px per character of the 12 px monospace labels (style.css)
 const NODE_H = 24;
+let NODE_W = MIN_NODE_W;  // wide enough for the system's longest name ("footstep_execution")
 
 function svgElement(tag, attributes = {}, ...children) {
   const node = document.createElementNS(SVG, tag);
@@ -23,12 +25,14 @@ function arrowMarker(id) {
 }
 
 // Modes on the path from ``start`` through each of ``targets`` (shortest changes between
-// them): {modes: Set, edges: Set of 'a->b'}.
+// them): {modes: Set, edges: Set of 'a->b', visits: the modes in the order the robot is in
+// them, each once per visit}.
 export function modePath(modes, start, targets) {
   const next = new Map(modes.map((m) => [m.name, m.next]));
-  const path = { modes: new Set(start ? [start] : []), edges: new Set() };
+  const path = { modes: new Set(start ? [start] : []), edges: new Set(), visits: start ? [start] : [] };
   let here = start;
   for (const target of targets) {
+    if (!here && next.has(target)) path.visits.push(target);
     if (!here || here === target || !next.has(target)) { here = here || target; continue; }
     const from = new Map([[here, null]]);
     const queue = [here];
@@ -39,10 +43,13 @@ export function modePath(modes, start, targets) {
       }
     }
     if (!from.has(target)) continue;  // unreachable: the goal check says why
+    const route = [];
     for (let mode = target; from.get(mode) !== null; mode = from.get(mode)) {
       path.edges.add(`${from.get(mode)}->${mode}`);
       path.modes.add(mode);
+      route.unshift(mode);
     }
+    path.visits.push(...route);
     here = target;
   }
   return path;
@@ -168,6 +175,8 @@ export function showAbstraction(choices, request) {
           element('code', { text: a.name }), ` needs ${a.preconditions.join('; ') || 'nothing'}`))));
     return;
   }
+  NODE_W = Math.max(MIN_NODE_W, Math.ceil(16 + CHAR_W * Math.max(...[...modeNames, ...choices.actions.map((a) => a.name)]
+    .map((name) => name.length))));
   const completed = new Set(request.initial_conditions);
   const start = request.initial_conditions.find((c) => modeNames.includes(c)) || null;
   const byName = new Map(choices.actions.map((a) => [a.name, a]));
@@ -180,6 +189,6 @@ export function showAbstraction(choices, request) {
     element('figure', {}, drawPreconditions(choices.actions, modeNames, needed, goals, completed),
       element('figcaption', { text: 'Preconditions: an arrow from what an action needs to the action' })));
   $('abstraction-path').textContent = goals.length
-    ? `Task path: ${[start, ...targets].filter(Boolean).join(' → ')} (modes); goals ${goals.join(', ')}`
+    ? `Task path: ${path.visits.join(' → ')} (modes); goals ${goals.join(', ')}`
     : 'Add goals to see the task\'s path.';
 }

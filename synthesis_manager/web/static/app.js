@@ -17,12 +17,13 @@
 //   play.js           playing a finished job: the environment against its machine, or the robot
 // This module only connects the page's controls to them and starts the page.
 import { $ } from './dom.js';
+import { foldForm } from './drawing.js';
 import { addGoal, checkGoals, fillForm, loadChoices, loadSystems } from './form.js';
 import { playFrames, showFrame, stopPlaying } from './frames.js';
 import { cancel, synthesize } from './job.js';
 import { back, closePlay, playKeys, reset, startPlay } from './play.js';
 import { onApplyFix, suggestFixes } from './repair.js';
-import { connectRuntimeControl, fillAutonomyLevels } from './runtime_control.js';
+import { connectRuntimeControl, fillAutonomyLevels, runKeys } from './runtime_control.js';
 import { simulate } from './simulation.js';
 import { loadVocabulary } from './vocabulary.js';
 
@@ -31,6 +32,7 @@ $('add-goal').addEventListener('click', addGoal);
 $('request-form').addEventListener('submit', synthesize);
 $('cancel').addEventListener('click', cancel);
 $('simulate').addEventListener('click', () => { closePlay(); simulate(); });
+$('show-form').addEventListener('click', () => foldForm(false));
 $('frame-scrubber').addEventListener('input', (event) => { stopPlaying(); showFrame(Number(event.target.value)); });
 $('play-frames').addEventListener('click', playFrames);
 connectRuntimeControl();
@@ -45,6 +47,7 @@ $('play-back').addEventListener('click', back);
 $('play-reset').addEventListener('click', reset);
 $('play-close').addEventListener('click', closePlay);
 $('graph-layout').addEventListener('keydown', playKeys);     // the panel and the drawing beside it
+$('graph-layout').addEventListener('keydown', runKeys);      // a simulation's operator, as in Play
 $('robot-play-section').addEventListener('keydown', playKeys);
 loadVocabulary().then(fillAutonomyLevels).then(loadSystems).then(() => document.body.classList.add('ready'),
   (error) => { $('status').textContent = `Cannot load the systems: ${error.message}`; });

@@ -8,7 +8,8 @@ const ZOOM_STEP = 1.25;
 const MIN_SCALE = 0.1;   // px per SVG unit (Graphviz units are points)
 const MAX_SCALE = 6;
 const NATURAL_SCALE = 4 / 3;  // 1 pt = 4/3 px: "100 %"
-const READABLE_SCALE = 0.85;  // below this 14 pt labels fall under about 12 px
+const MIN_TEXT_PX = 11;       // no text of the drawing is shown smaller, unless the user zooms out
+const FOLD_FORM_BELOW_PX = 1600;  // window widths at which a run or play folds the form away
 
 let svg = null;
 let viewport = null;
@@ -17,6 +18,7 @@ let view = null;     // the part shown now
 let machine = null;  // the shown machine's tree: its root node
 let onSelect = null;
 let outcomePicker = null;  // during a play: (outcome names of the clicked cell) => whether one was taken
+let readableScale = 1;     // px per SVG unit at which the drawing's smallest text is MIN_TEXT_PX
 
 function scale() { return viewport.clientWidth / view.w; }
 
@@ -44,8 +46,8 @@ function zoomAt(factor, clientX, clientY) {
 // top, around the initial state (drag or zoom out for the rest).
 function fit(readableOnly = true) {
   let s = Math.min(viewport.clientWidth / full.w, viewport.clientHeight / full.h);
-  const shrunk = readableOnly && s < READABLE_SCALE;
-  if (shrunk) s = READABLE_SCALE;
+  const shrunk = readableOnly && s < readableScale;
+  if (shrunk) s = readableScale;
   view = { x: full.x, y: full.y, w: viewport.clientWidth / s, h: 0 };
   const start = svg.querySelector('[id="start"]');
   if (view.w > full.w) view.x = full.x - (view.w - full.w) / 2;  // centre narrow drawings
@@ -85,10 +87,10 @@ function enablePanning() {
     viewport.classList.add('panning');
   });
   viewport.addEventListener('pointerup', (event) => {
-    const clicked = drag && !drag.moved ? drag.target : null;
+    const clicked = drag && !drag.moved ? drag : null;
     drag = null;
     viewport.classList.remove('panning');
-    if (clicked) select(clicked);
+    if (clicked) select(clicked.target, clicked.x, clicked.y);
   });
   viewport.addEventListener('wheel', (event) => {
     event.preventDefault();
@@ -106,17 +108,63 @@ function enablePanning() {
   });
 }
 
-// A clicked SVG element -> the top-level state it belongs to (id "state:<name>"); during a play,
-// a click on an outcome cell of the active state reports that outcome instead.
-function select(target) {
+// A clicked SVG element -> the top-level state it belongs to (id "state:<name>"); during a play
+// or a run, a click anywhere in an outcome cell of the active state reports that cell's outcomes
+// instead (``x``, ``y``: where the click was, in the window).
+function select(target, x, y) {
   const node = target.closest ? target.closest('g.node') : null;
-  if (outcomePicker && node && node.classList.contains('active') && target.tagName === 'text'
-      && outcomePicker(target.textContent.split(',').map((name) => name.trim()).filter(Boolean))) return;
+  const active = outcomePicker ? svg.querySelector('g.node.active') : null;
+  const cell = active ? cellAt(active, x, y) : null;
+  if (cell && outcomePicker(cell.dataset.outcomes.split(','))) return;
   svg.querySelectorAll('g.node.selected').forEach((g) => g.classList.remove('selected'));
   if (!node || !node.id.startsWith('state:')) { if (onSelect) onSelect(null); return; }
   node.classList.add('selected');
   const name = node.id.slice('state:'.length);
   if (onSelect) onSelect(machine.children.find((state) => state.name === name) || null);
+}
+
+// Graphviz draws a table cell of a state's label as its background polygon, then its border,
+// then its text lines. Each polygon whose text names outcomes of the state is marked as that
+// outcome cell (data-outcomes), so the whole cell can be clicked.
+function markOutcomeCells(node, state) {
+  let cell = null;
+  let names = [];
+  const close = () => {
+    if (cell && names.length && names.every((name) => state.outcomes.includes(name))) {
+      cell.classList.add('outcome-cell');
+      cell.dataset.outcomes = names.join(',');
+    }
+    cell = null;
+    names = [];
+  };
+  for (const child of node.children) {
+    if (child.tagName === 'polygon') { close(); cell = child; }
+    else if (child.tagName === 'text' && cell) names.push(...child.textContent.split(',').map((n) => n.trim()).filter(Boolean));
+    else if (child.tagName !== 'polyline') close();
+  }
+  close();
+}
+
+// The outcome cell of ``node`` at window point (x, y); the cell's highlighted border (drawn
+// half outside it) counts as the cell.
+function cellAt(node, x, y) {
+  if (x === undefined) return null;
+  const border = 3;
+  return [...node.querySelectorAll('polygon.outcome-cell')].find((cell) => {
+    const box = cell.getBoundingClientRect();
+    return x >= box.left - border && x <= box.right + border && y >= box.top - border && y <= box.bottom + border;
+  }) || null;
+}
+
+// The outcomes of top-level state ``path`` ('/look_down') in the order FlexBE lists them ([] unknown).
+export function outcomesOf(path) {
+  const state = machine && machine.children.find((node) => node.state_path === path);
+  return state ? [...state.outcomes] : [];
+}
+
+// Focus the drawing (keys 1-9 force outcomes there) without scrolling the page.
+export function focusDrawing() {
+  if (viewport) viewport.focus({ preventScroll: true });
 }
 
 // Draw ``svgText`` in ``container``; ``tree`` is the machine's root node, and ``selectCallback``
@@ -136,6 +184,8 @@ export function show(container, svgText, tree, selectCallback) {
   svg.querySelectorAll('g > title').forEach((title) => title.remove());
   // States are reached with Tab and explained with Enter, as with a click.
   svg.querySelectorAll('g.node[id^="state:"]').forEach((node) => {
+    const state = tree.children.find((child) => child.name === node.id.slice('state:'.length));
+    if (state) markOutcomeCells(node, state);
     node.setAttribute('tabindex', '0');
     node.setAttribute('role', 'button');
     node.setAttribute('aria-label', `state ${node.id.slice('state:'.length)}: show its details`);
@@ -153,9 +203,39 @@ export function show(container, svgText, tree, selectCallback) {
     button('Fit', 'show the whole machine', () => fit(false)),
     button('100 %', 'natural size', natural));
   container.replaceChildren(tools, viewport);
+  const smallest = Math.min(...[...svg.querySelectorAll('text')].map((t) => parseFloat(t.getAttribute('font-size')) || 14));
+  readableScale = MIN_TEXT_PX / smallest;
   enablePanning();
+  sizeViewport();
   fit();
 }
+
+// The drawing as high as the window below the section's header row: once the section is
+// scrolled to the window's top (after Synthesize, Simulate, Play), all of it is in view.
+function sizeViewport() {
+  const section = document.getElementById('graph-section');
+  const above = viewport.getBoundingClientRect().top - section.getBoundingClientRect().top;
+  const below = 16;  // the section's padding and border, and a margin
+  viewport.style.height = `${Math.max(300, Math.floor(window.innerHeight - above - below))}px`;
+}
+
+// Scroll the page so that the drawing's section starts at the window's top.
+export function scrollIntoView() {
+  const section = document.getElementById('graph-section');
+  if (section && !section.hidden) section.scrollIntoView({ block: 'start', behavior: 'instant' });
+}
+
+// During a run or a play, fold the request form away on windows where it would squeeze the
+// drawing (false: unfold it); the drawing is sized and fitted again.
+export function foldForm(fold) {
+  const folded = fold && window.innerWidth < FOLD_FORM_BELOW_PX;
+  document.body.classList.toggle('form-folded', folded);
+  const button = document.getElementById('show-form');
+  if (button) button.hidden = !folded;
+  if (svg) { sizeViewport(); fit(); }
+}
+
+window.addEventListener('resize', () => { if (svg) { sizeViewport(); fit(); } });
 
 // Mark the simulation on the drawing: the states visited, the transitions taken and the
 // active state (the last one; "ended" once the run has finished).
@@ -181,6 +261,23 @@ export function markRun(steps, running) {
   }
   const current = svg.querySelector('g.node.active, g.node.ended');
   if (current) revealNode(current);  // follow the robot through a machine larger than the view
+  afterMarking.forEach((callback) => callback());
+}
+
+const afterMarking = [];
+// Call ``callback`` each time the run or play marked on the drawing changed.
+export function whenMarked(callback) { afterMarking.push(callback); }
+
+// Pan so that ``node`` is not under ``rect`` (a panel over the drawing), by the shorter of a
+// move to its left or below it.
+export function moveOutFrom(node, rect) {
+  if (!svg) return;
+  const box = node.getBoundingClientRect();
+  const left = box.right - rect.left + 8;   // px to move the node left
+  const down = rect.bottom - box.top + 8;   // px to move it down
+  if (left <= down) view.x += left / scale();
+  else view.y -= down / scale();
+  apply();
 }
 
 // Mark a play of the environment on the drawing as markRun marks a simulation: ``history`` the
@@ -240,5 +337,5 @@ export function pickOutcomes(picker) {
 
 // Fit the drawing to its viewport again (it changed size), if one is shown.
 export function refit(readableOnly = true) {
-  if (svg) fit(readableOnly);
+  if (svg) { sizeViewport(); fit(readableOnly); }
 }

@@ -97,24 +97,24 @@ export async function checkGoals() {
     item.classList.toggle('impossible', Boolean(finding));
     item.querySelector('.goal-warning').textContent = finding ? finding.sentence : '';
   }
+  revealFlaggedGoal();
+}
+
+// A goal flagged red stays in view above the form's controls, also as they grow (the job's
+// timeline) or the result's banner comes.
+export function revealFlaggedGoal() {
   const flagged = $('goals').querySelector('li.impossible');
   if (flagged) revealInForm(flagged);
 }
+new ResizeObserver(revealFlaggedGoal).observe($('request-form').querySelector('section.controls'));
 
-// The controls below the fields grow as a job goes on: a flagged goal (else the last goal)
-// stays in view.
-new ResizeObserver(() => {
-  const shown = $('goals').querySelector('li.impossible') || $('goals').lastElementChild;
-  if (shown) revealInForm(shown);
-}).observe($('form-fields'));
-
-// Scroll the form's fields (not the page) so that ``item`` is in view above the controls.
+// Scroll the page so that ``item`` (a goal) is in view above the form's controls, which stay at
+// the window's bottom (the form has no scroll of its own).
 function revealInForm(item) {
-  const fields = $('form-fields');
-  const area = fields.getBoundingClientRect();
   const box = item.getBoundingClientRect();
-  if (box.bottom > area.bottom) fields.scrollTop += box.bottom - area.bottom + 8;
-  else if (box.top < area.top) fields.scrollTop -= area.top - box.top + 8;
+  const floor = Math.min(window.innerHeight, $('request-form').querySelector('section.controls').getBoundingClientRect().top);
+  if (box.bottom > floor - 8) window.scrollBy({ top: box.bottom - floor + 8, behavior: 'instant' });
+  else if (box.top < 8) window.scrollBy({ top: box.top - 8, behavior: 'instant' });
 }
 
 // The control modes that can change to ``mode`` (its own self-loop aside).
@@ -140,6 +140,13 @@ function goalItem(name) {
 export function addGoal() {
   const name = $('goal-choice').value;
   if (!name) return;
+  const goals = [...$('goals').children].map((goal) => goal.dataset.goal);
+  if (goals.includes(name)) {  // one memory proposition per goal: the same goal twice cannot be asked
+    $('form-problem').textContent = duplicateGoal(name, goals);
+    $('goal-choice').focus();
+    return;
+  }
+  $('form-problem').textContent = '';
   const item = goalItem(name);
   $('goals').append(item);
   revealInForm(item);
@@ -173,6 +180,8 @@ export function requestProblem(request) {
   if (!request.goals.length) {
     return { field: 'goal-choice', message: 'Add at least one goal: pick it in the list and press “Add goal”.' };
   }
+  const repeated = request.goals.find((goal, index) => request.goals.indexOf(goal) !== index);
+  if (repeated) return { field: 'goal-choice', message: duplicateGoal(repeated, request.goals) };
   const custom = customLtl();
   $('custom-ltl-problem').textContent = custom.problem;
   if (custom.problem) {
@@ -184,6 +193,11 @@ export function requestProblem(request) {
     return { field: 'behavior-name', message: `Behavior name “${name.value}”: ${$('behavior-name-hint').textContent.trim()}` };
   }
   return null;
+}
+
+function duplicateGoal(name, goals) {
+  return `“${name}” is already goal ${goals.indexOf(name) + 1}: each goal can be asked once ` +
+    '(remove it there to move it, or reorder with ↑ ↓).';
 }
 
 // The custom LTL field: empty, or a JSON object of sections to lists of formulas (the server

@@ -1,8 +1,9 @@
 // Running a job: send the form's request, follow the job's progress (server-sent events,
 // reconnecting when the stream breaks), cancel it, and hand the finished job to the result.
 import { api, streamEvents } from './api.js';
+import { foldForm } from './drawing.js';
 import { $, element, formatSeconds } from './dom.js';
-import { currentRequest, requestProblem } from './form.js';
+import { currentRequest, requestProblem, revealFlaggedGoal } from './form.js';
 import { resetResult, resultWord, showBanner, showRequestError, showResult } from './result.js';
 import { vocabulary } from './vocabulary.js';
 
@@ -25,12 +26,15 @@ export async function synthesize(event) {
     return;
   }
   stopFollowing();
+  foldForm(false);
   resetResult();
   let job;
   try {
     job = await api('POST', '/api/jobs', request);
   } catch (error) {
     setRunning(false);
+    $('progress').value = 1;
+    $('progress').classList.add('refused');
     $('status').textContent = 'The request was not accepted.';
     showRequestError(error);
     return;
@@ -101,6 +105,7 @@ function setRunning(running) {
   document.body.classList.toggle('running', running);
   clearInterval(elapsedTimer);
   if (running) {
+    $('progress').classList.remove('refused');
     $('progress').removeAttribute('value');  // indeterminate: no stage knows how long it takes
     elapsedTimer = setInterval(showElapsed, 200);
     showElapsed();
@@ -114,7 +119,12 @@ function showElapsed() {
 function showProgress(job) {
   if (job.id === shownProgress.id && job.revision < shownProgress.revision) return;
   shownProgress = { id: job.id, revision: job.revision };
-  if (job.state === 'finished') $('progress').value = job.progress;
+  // A finished job's bar is full, whether it succeeded or was refused at some stage (the
+  // banner says which); red when refused.
+  if (job.state === 'finished') {
+    $('progress').value = 1;
+    $('progress').classList.toggle('refused', !(job.summary && job.summary.succeeded));
+  }
   $('status').textContent = job.state === 'finished' ? resultWord(job.status) : job.status;
   $('timeline').replaceChildren(...job.timeline.map((entry) => element('li', {},
     element('span', { className: 'time', text: formatSeconds(entry.seconds) }),
@@ -128,4 +138,5 @@ function finish(job) {
   $('elapsed').textContent = formatSeconds(job.summary.seconds);
   currentJob = null;
   showResult(job);
+  revealFlaggedGoal();
 }

@@ -48,13 +48,22 @@ export async function startPlay(asRobot) {
     $('robot-play-section').hidden = false;
   } else {
     $('graph-layout').append(panel);
+    // The panel takes the robot's place beside the drawing (the run's table stays below).
+    $('graph-layout').classList.remove('simulating');
+    $('robot-view').hidden = true;
     $('graph-layout').classList.add('playing');
+  }
+  panel.hidden = false;
+  if (!asRobot) {  // the drawing beside the panel, as wide as the window lets it be, in view
+    drawing.foldForm(true);
+    drawing.scrollIntoView();
+    drawing.refit();
   }
   $('play-title').textContent = asRobot ? 'You play the robot against the environment'
     : 'You play the environment against the machine';
   panel.hidden = false;
   await step([]);
-  panel.scrollIntoView({ block: 'nearest' });
+  if (asRobot) panel.scrollIntoView({ block: 'nearest' });
   panel.focus({ preventScroll: true });
 }
 
@@ -116,19 +125,24 @@ function pickFromDrawing(names) {
   return true;
 }
 
-// The robot's side: what happened, what the environment does next, the moves and why they lose.
+// The robot's side, a game with an end: what happened, what the environment does next, the
+// moves (progress first) and why they lose, and the verdict once the play is over (a deadlock,
+// a loop, every goal reached, or the most moves a play has).
 function showRobotTurn() {
-  $('play-position').textContent = `Step ${turn.step}: ${turn.happened}.`;
-  $('play-environment-next').textContent = turn.lost ? '' : `The environment does next: ${turn.environment_next}.`;
-  $('play-verdict').className = 'bad';
-  $('play-verdict').textContent = turn.lost ? `The robot lost: ${turn.lost}`
+  $('play-position').textContent = `Step ${turn.step} of at most ${turn.max_moves}: ${turn.happened}.`;
+  const over = Boolean(turn.verdict);
+  $('play-environment-next').textContent = over ? '' : `The environment does next: ${turn.environment_next}.`;
+  const won = turn.verdict === 'you reached every goal';
+  $('play-verdict').className = won ? 'good' : 'bad';
+  $('play-verdict').textContent = over ? `Verdict: ${turn.verdict}.`
     : turn.blocked_goal ? `Why it cannot win: ${turn.blocked_goal}.` : '';
-  $('play-prompt').textContent = turn.moves.length
-    ? `Choose the robot's response (keys 1–${Math.min(9, turn.moves.length)}):`
-    : 'No move is left. Back or Reset to try other moves.';
+  $('play-prompt').textContent = over ? 'The play is over: Back or Reset to try other moves.'
+    : `Choose the robot's response (keys 1–${Math.min(9, turn.moves.length)}); a play ends within ` +
+      `${turn.max_moves} moves. Goals: ${turn.goals.map((goal, index) =>
+        `${index + 1} ${goal.words}${goal.reached ? ' (reached)' : ''}`).join('; ')}.`;
   const items = turn.moves.map((move, index) => choice(index + 1, move.words, move.dead_end
     ? 'dead end: the environment can answer so that no response is allowed'
-    : move.repeats ? 'loop: it returns to a position of this play, so the play goes round forever' : '',
+    : move.repeats ? 'loop: it returns to a position of this play, which ends the play (the environment wins)' : '',
   move.index, move.dead_end ? 'dead-end' : move.repeats ? 'repeats' : ''));
   // Dead ends (listed last) lose at once: folded, so that the moves worth trying stand out.
   const live = items.filter((_, index) => !turn.moves[index].dead_end);

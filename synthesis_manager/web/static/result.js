@@ -105,6 +105,8 @@ async function drawStateMachine(job) {
   }
   drawing.show($('graph'), await picture.text(), await machine.json(), showStateDetails);
   showStateDetails(null);
+  drawing.scrollIntoView();  // the machine in view and fitted, the verdict beside it in the form's panel
+  drawing.refit();
 }
 
 function showDownloads(job) {
@@ -112,10 +114,43 @@ function showDownloads(job) {
   $('export-flexbe-offer').hidden = !exportable;  // the button and its caption, or neither
   if (exportable) $('export-flexbe').href = `/api/jobs/${job.id}/artifacts/flexbe_behavior.zip`;
   const listed = job.artifacts.filter((name) => name !== 'flexbe_behavior.zip');  // offered once, above
-  $('downloads').replaceChildren(...listed.map((name) => element('li', {},
-    element('a', { href: `/api/jobs/${job.id}/artifacts/${name}`, download: '', 'data-artifact': name,
-      text: job.download_labels[name] || name }))));
+  $('downloads').replaceChildren(...listed.map((name) => {
+    const link = element('a', { href: `/api/jobs/${job.id}/artifacts/${name}`, download: '', 'data-artifact': name,
+      text: job.download_labels[name] || name });
+    if ((job.made_in_page || []).includes(name)) {
+      link.addEventListener('click', (event) => { event.preventDefault(); downloadPng(job, name); });
+    }
+    return element('li', {}, link);
+  }));
   $('downloads-section').hidden = job.artifacts.length === 0;
+}
+
+// The PNG when the server has no Graphviz `dot` to make it: the server's SVG (its WebAssembly
+// Graphviz) rasterized here at twice its natural size, with the browser's fonts.
+async function downloadPng(job, name) {
+  const response = await fetch(`/api/jobs/${job.id}/artifacts/state_machine.svg?inline=1`);
+  if (!response.ok) return;
+  const url = URL.createObjectURL(new Blob([await response.text()], { type: 'image/svg+xml' }));
+  try {
+    const image = new Image();
+    image.src = url;
+    await image.decode();
+    const canvas = document.createElement('canvas');
+    canvas.width = image.naturalWidth * 2;
+    canvas.height = image.naturalHeight * 2;
+    const context = canvas.getContext('2d');
+    context.fillStyle = 'white';
+    context.fillRect(0, 0, canvas.width, canvas.height);
+    context.drawImage(image, 0, 0, canvas.width, canvas.height);
+    const png = await new Promise((resolve) => canvas.toBlob(resolve, 'image/png'));
+    const save = element('a', { href: URL.createObjectURL(png), download: `${job.request.name || 'behavior'}_${name}` });
+    document.body.append(save);
+    save.click();
+    save.remove();
+    setTimeout(() => URL.revokeObjectURL(save.href), 10_000);
+  } finally {
+    URL.revokeObjectURL(url);
+  }
 }
 
 function showSpecification(sections) {

@@ -5,7 +5,7 @@
 // what the run waits for comes back in the run's events (simulation.operator).
 import { api } from './api.js';
 import * as drawing from './drawing.js';
-import { $ } from './dom.js';
+import { $, element } from './dom.js';
 import { vocabulary } from './vocabulary.js';
 
 let run = null;       // {id, operator, active} of the run being controlled (null: none running)
@@ -40,6 +40,33 @@ export function controlRun(simulation) {
   if (mine || picking) drawing.pickOutcomes(mine ? forceFromDrawing : null);
   picking = mine;
   drawing.markPending(waiting && waiting.kind === 'confirm' ? waiting : null);
+  offerOutcomes(mine ? run.active : null);
+}
+
+// The active state's outcomes as numbered buttons (keys 1-9), as Play lists them.
+function offerOutcomes(active) {
+  const outcomes = active ? drawing.outcomesOf(active) : [];
+  const box = $('operator-outcomes');
+  box.hidden = outcomes.length === 0;
+  const key = `${active}:${outcomes.join(',')}`;
+  if (box.dataset.offered === key) return;
+  box.dataset.offered = key;
+  $('operator-outcome-buttons').replaceChildren(...outcomes.map((outcome, index) => {
+    const button = element('button', { type: 'button', className: 'small operator-outcome', 'data-outcome': outcome,
+      text: index < 9 ? `${index + 1} ${outcome}` : outcome });
+    button.addEventListener('click', () => forceFromDrawing([outcome]));
+    return button;
+  }));
+}
+
+// Keys 1-9 during a run force the active state's outcomes, in the order its buttons list them.
+export function runKeys(event) {
+  if (!run || !run.active || !$('play-panel').hidden || !/^[1-9]$/.test(event.key)) return;
+  if (event.target.closest && event.target.closest('textarea, input, select')) return;
+  const outcome = drawing.outcomesOf(run.active)[Number(event.key) - 1];
+  if (!outcome) return;
+  event.preventDefault();
+  forceFromDrawing([outcome]);
 }
 
 function ask(waiting) {

@@ -65,8 +65,11 @@ export async function simulate() {
     return;
   }
   showSimulation(simulation);
-  // Follow the robot: the drawing and the robot side by side, in view.
-  $('graph-section').scrollIntoView({ block: 'start', behavior: 'instant' });
+  // Follow the robot: the drawing and the robot side by side, in view; the keys (1-9 force an
+  // outcome, + and - zoom) go to the drawing, not to the page's body (Simulate is disabled now).
+  drawing.scrollIntoView();
+  drawing.refit();
+  drawing.focusDrawing();
   const end = () => {
     simulationEvents = null;
     $('simulate').disabled = false;
@@ -79,6 +82,16 @@ export async function simulate() {
       (last) => { end(); showSimulation(last); },
       (error) => { end(); $('simulation-status').textContent = `${error.code}: ${error.message}`; }),
   });
+}
+
+// When a step ran in robot time: a step that has not ended runs on ("1.50–…") or, once the
+// run stopped in it, ended when the run did.
+function stepTimes(step, simulation, running) {
+  const ended = Boolean(step.state_outcome) || step.ended_at > step.entered_at;
+  // The run's robot time is reported with its frames, so it may lag the step's entry by a frame.
+  const stopped = Math.max(step.entered_at, simulation.robot_time);
+  const end = ended ? step.ended_at.toFixed(2) : running ? '…' : `${stopped.toFixed(2)} (stopped)`;
+  return `${step.entered_at.toFixed(2)}–${end}`;
 }
 
 function showSimulation(simulation) {
@@ -104,7 +117,7 @@ function showSimulation(simulation) {
   $('robot-view').hidden = false;
   if (!$('graph-layout').classList.contains('simulating')) {
     $('graph-layout').classList.add('simulating');
-    drawing.refit();  // the drawing just got narrower
+    drawing.foldForm(true);  // the drawing just got narrower: give it the form's width
   }
   const machineOutcomes = Object.values(vocabulary().sm_outcomes);
   const outcomeCell = (step) => {
@@ -120,7 +133,7 @@ function showSimulation(simulation) {
       element('td', { text: step.capabilities.join(', ') }),
       element('td', { text: step.results.map((r) => `${r.capability} ${r.outcome}`).join(', ') }),
       outcomeCell(step),
-      element('td', { text: `${step.entered_at.toFixed(2)}–${step.ended_at.toFixed(2)}` }))));
+      element('td', { text: stepTimes(step, simulation, running) }))));
   drawing.markRun(simulation.steps, running);
   controlRun(simulation);
   showFrames(base, simulation.frames, simulation.steps, running);

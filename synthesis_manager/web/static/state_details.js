@@ -1,6 +1,7 @@
 // The panel explaining the state clicked on the drawing, as FlexBE's editor does: class,
 // parameters, userdata, outcomes with their targets and autonomy, and a container's states.
 // ``state`` is a node of the machine's tree (GET /api/jobs/{id}/state-machine).
+import * as drawing from './drawing.js';
 import { $, element } from './dom.js';
 import { vocabulary } from './vocabulary.js';
 
@@ -8,6 +9,7 @@ export function showStateDetails(state) {
   const panel = $('state-details');
   panel.hidden = !state;  // it floats over the drawing's corner, where a click shows it
   if (!state) {
+    shownState = null;
     panel.replaceChildren();
     return;
   }
@@ -31,20 +33,38 @@ export function showStateDetails(state) {
       row('Userdata', userdata.join(', ') || '—'),
       row('Outcomes', element('ul', {}, ...outcomes)),
       ...(state.children.length ? [row('Contains', state.children.map((c) => `${c.name} (${c.state_class})`).join(', '))] : [])));
+  shownState = state.name;
   fitInWindow(panel);
-  besideTheState(panel, state);
+  keepClear(panel);
 }
 
-// The panel on the side of the drawing the clicked state is not on.
-function besideTheState(panel, state) {
-  panel.classList.remove('left');
-  const node = document.getElementById(`state:${state.name}`);
-  if (!node) return;
+let shownState = null;  // the name of the state the panel explains
+
+function overlaps(node, panel) {
   const box = node.getBoundingClientRect();
   const area = panel.getBoundingClientRect();
-  const overlaps = box.right > area.left && box.left < area.right && box.bottom > area.top && box.top < area.bottom;
-  if (overlaps) panel.classList.add('left');
+  return box.right > area.left && box.left < area.right && box.bottom > area.top && box.top < area.bottom;
 }
+
+// The panel on a side of the drawing where it covers neither the active state of a run or play
+// nor, if it can, the state it explains; when both sides would cover the active state, the
+// drawing moves it out from under the panel.
+function keepClear(panel) {
+  const active = document.querySelector('#graph g.node.active');
+  const clicked = shownState ? document.getElementById(`state:${shownState}`) : null;
+  const wanted = [[active, clicked].filter(Boolean), [active].filter(Boolean)];
+  for (const nodes of wanted) {
+    for (const left of [false, true]) {
+      panel.classList.toggle('left', left);
+      if (nodes.every((node) => !overlaps(node, panel))) return;
+    }
+  }
+  panel.classList.remove('left');
+  if (active) drawing.moveOutFrom(active, panel.getBoundingClientRect());
+}
+
+// After each move of a run or play: the panel still clear of the active state.
+drawing.whenMarked(() => { if (!$('state-details').hidden) keepClear($('state-details')); });
 
 // The panel no taller than the part of the window below its top: all of it in view, scrolling inside.
 function fitInWindow(panel) {

@@ -13,6 +13,7 @@ from pathlib import Path
 from respec.errors import ExitStatus, exit_status_help
 from sm_generation import StateInstantiation
 from sm_generation.export import render, to_dot, to_json, to_yaml
+from synthesis_manager.web.picture import render_svg
 from synthesis_manager.send_goal import ProgressBar, add_goal_arguments, goal_from_args, print_summary
 from synthesis_manager.suite import SuiteUnavailableError, add_suite_arguments, in_process_suite
 
@@ -35,12 +36,15 @@ def write_artifacts(outcome, directory: Path) -> list[Path]:
         path = directory / name
         path.write_text(text)
         written.append(path)
-    for suffix in ('svg', 'png'):
+    # The SVG as the GUI draws it (dot, else Graphviz compiled to WebAssembly: no system package
+    # needed); the PNG needs dot. Either may be missing: say so and carry on.
+    for suffix, write in (('svg', lambda path: path.write_bytes(render_svg(to_dot(states)))),
+                          ('png', lambda path: render(to_dot(states), path))):
         path = directory / f'state_machine.{suffix}'
         try:
-            render(to_dot(states), path)
+            write(path)
             written.append(path)
-        except Exception as error:  # Graphviz is optional: say so and carry on
+        except Exception as error:
             print(f'(no {suffix} picture: {error})', file=sys.stderr)
     return written
 

@@ -137,6 +137,7 @@ class CacheStatistics:
     stored: int = 0        # answers kept
     evicted: int = 0       # entries dropped for the bound (memory)
     corrupt: int = 0       # files on disk that were not a whole, signed entry (deleted)
+    rejected: int = 0      # of those, whole entries whose check found a problem (deleted too)
 
 
 class _Flight:
@@ -185,8 +186,10 @@ class StrategyCache:
         with self._lock:
             return len(self._entries)
 
-    def get(self, key: str) -> Entry | None:
-        """The entry of ``key`` (from memory, else from the directory), or None."""
+    def get(self, key: str, check: Callable[[Entry], str | None] | None = None) -> Entry | None:
+        """The entry of ``key`` (from memory, else from the directory), or None. An entry read
+        from the directory is served only when ``check(entry)`` finds no problem (it names one:
+        the file is then deleted, a miss)."""
         if not self.enabled:
             return None
         with self._lock:
@@ -196,6 +199,11 @@ class StrategyCache:
                 self.statistics.hits += 1
                 return entry
         entry = self._read(key) if self.directory is not None else None
+        if entry is not None and check is not None and check(entry):
+            self._discard(self._path(key))
+            with self._lock:
+                self.statistics.rejected += 1
+            entry = None
         if entry is not None:
             if entry_size(entry) <= self.max_bytes:  # a bound lowered since it was written
                 self._remember(key, entry)
@@ -217,17 +225,18 @@ class StrategyCache:
         return True
 
     def answer(self, key: str, compute: Callable[[], Entry | None],
-               give_up: Callable[[], bool] | None = None) -> tuple[Entry | None, str]:
+               give_up: Callable[[], bool] | None = None,
+               check: Callable[[Entry], str | None] | None = None) -> tuple[Entry | None, str]:
         """The entry of ``key`` and how it came: ``('hit')`` kept, ``('shared')`` computed
         for an identical request running at the same time (waited for), ``('computed')`` by
         ``compute()`` here, which returns the entry to keep or None when its answer must not be
         kept (then the caller's answer is whatever ``compute`` left, and the entry is None).
         While waiting for another request, ``give_up()`` (its own cancel, its deadline) ends
-        the wait: ``(None, 'gave up')``."""
+        the wait: ``(None, 'gave up')``. ``check``: as for :meth:`get`."""
         if not self.enabled:
             return compute(), 'computed'
         while True:
-            entry = self.get(key)
+            entry = self.get(key, check)
             if entry is not None:
                 return entry, 'hit'
             with self._lock:

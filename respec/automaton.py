@@ -80,3 +80,37 @@ def _initial_nodes(strategy: dict, spec: GR1Specification) -> list[str]:
     except KeyError as unknown:
         raise AutomatonError(f'an initial condition mentions {unknown.args[0]!r}, which is not a '
                              'variable of the strategy', item=unknown.args[0]) from None
+
+
+def strategy_move_problems(strategy: dict, spec: GR1Specification, seconds: float = 0.5) -> list[str]:
+    """What in a slugs JSON ``strategy`` its ``spec`` forbids: no initial node, or a move that
+    breaks a transition formula (ENV_TRANS or SYS_TRANS, on both steps' whole valuations).
+    Moves are checked for up to ``seconds`` (a strategy of thousands of moves is checked in
+    part); empty when nothing was found. Liveness is not checked (see bench/strategy_check.py)."""
+    import time
+
+    names = list(strategy.get('variables', ()))
+    if names != list(spec.env_props) + list(spec.sys_props):
+        return ["its variables are not the specification's inputs then outputs"]
+    nodes = strategy.get('nodes') or {}
+    try:
+        if not _initial_nodes(strategy, spec):
+            return ['no node satisfies the initial conditions']
+    except AutomatonError as error:
+        return [str(error)]
+    valuations = {str(name): {v: bool(x) for v, x in zip(names, node['state'])} for name, node in nodes.items()}
+    formulas = [('env_trans', index, f) for index, f in enumerate(spec.env_trans)] + \
+               [('sys_trans', index, f) for index, f in enumerate(spec.sys_trans)]
+    stop = time.monotonic() + seconds
+    for name, node in nodes.items():
+        current = valuations[str(name)]
+        for successor in node['trans']:
+            following = valuations.get(str(successor))
+            if following is None:
+                return [f'node {name} has an unknown successor {successor}']
+            for section, index, formula in formulas:
+                if not evaluate(formula, current, following):
+                    return [f'the move {name} -> {successor} breaks {section}[{index}]']
+        if time.monotonic() > stop:
+            break
+    return []

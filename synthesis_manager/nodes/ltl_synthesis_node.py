@@ -9,6 +9,7 @@ settings, and the diagnosis leads the answer's message (ltl_specification.diagno
 from __future__ import annotations
 
 import importlib.metadata
+import json
 import threading
 import time
 import uuid
@@ -25,7 +26,7 @@ from ltl_synthesizer.external import run_external_synthesizer
 from ltl_synthesizer.isolated import (SERVER_CHILD_NICENESS, WORKING_CHILDREN_MEMORY, SpecificationText,
                                       SynthesisProcesses, byproduct_texts)
 from ltl_synthesizer.strategy import strategy_to_json
-from respec.automaton import automaton_from_strategy
+from respec.automaton import automaton_from_strategy, strategy_move_problems
 from respec.errors import CodedError, ErrorCode
 from respec.nesting import run_with_deep_stack
 from respec.parsing import ParseError, spec_from_text_sections
@@ -33,7 +34,7 @@ from respec.spec import GR1Specification
 from synthesis_manager.byproducts import DEFAULT_KEEP_LAST, EXTENSIONS, ByproductStore, default_directory
 from synthesis_manager.limits import (DEFAULT_MAX_GOAL_TIMEOUT, capped_timeout, check_message, check_timeout,
                                       utf8_length)
-from synthesis_manager.ros.conversions import automaton_to_msg, error_code, msg_to_sections
+from synthesis_manager.ros.conversions import automaton_to_msg, error_code, msg_to_automaton, msg_to_sections
 from synthesis_manager.ros.errors import reported_error
 from synthesis_manager.ros.logs import QuickLogger
 from synthesis_manager.ros.node_main import node_main
@@ -209,7 +210,8 @@ class LTLSynthesisNode(Node):
             # A large specification's key is computed in the worker: hashing megabytes here would
             # hold the executor thread (3.9 MB: 26 ms).
             key = None if _is_large(msg_to_sections(request.ltl_specification)) else self._cache_key(request)
-            cached = self.strategy_cache.get(key) if key else None
+            cached = self.strategy_cache.get(key, lambda entry: self._loaded_entry_problem(entry, request)) \
+                if key else None
             if cached is not None:  # answered here: no worker, no synthesis process
                 self._answer_from_cache(cached, request, response)
             else:
@@ -258,6 +260,30 @@ class LTLSynthesisNode(Node):
             'check_well_separation': self.parameter('check_well_separation'),
             'max_strategy_edges': self.parameter('max_strategy_edges')})
 
+    def _loaded_entry_problem(self, entry, request) -> str | None:
+        """What is wrong with a realizable answer read back from the cache directory (None:
+        nothing found): its strategy's moves against the request's specification
+        (``respec.automaton.strategy_move_problems``), and its automaton against its strategy.
+        An unrealizable verdict is signed but not re-checked (that would be a synthesis); nor
+        is a specification over 64 KB, which this thread does not parse."""
+        sections = msg_to_sections(request.ltl_specification)
+        if entry.get('synthesizable') != b'1' or _is_large(sections):
+            return None
+        try:
+            spec = spec_from_text_sections(sections)
+            strategy = json.loads(entry['json'])
+            problems = strategy_move_problems(strategy, spec)
+            # Compared as automata: equal messages' CDR bytes may differ in their padding.
+            if not problems and msg_to_automaton(deserialize_message(entry['automaton'], FSAutomaton)) \
+                    != automaton_from_strategy(strategy, spec):
+                problems = ['its automaton is not the one of its strategy']
+        except (KeyError, ValueError, CodedError) as error:
+            problems = [f'it cannot be read back ({error!r:.100})']
+        if problems:
+            self.get_logger().warning(f'strategy cache: an entry read from the directory is not served: '
+                                      f'{problems[0]}')
+        return problems[0] if problems else None
+
     def _answer_from_cache(self, entry, request, response):
         """Answer ``request`` with a kept answer: its byproduct files written again under this
         request's spec_name, the response byte-identical to the synthesis it was kept from."""
@@ -286,7 +312,8 @@ class LTLSynthesisNode(Node):
             return
         entry, how = self.strategy_cache.answer(
             key, lambda: self._synthesize_fresh(request, response, cancel, timeout, deadline, keep=True),
-            give_up=lambda: cancel.is_set() or time.monotonic() > deadline)
+            give_up=lambda: cancel.is_set() or time.monotonic() > deadline,
+            check=lambda entry: self._loaded_entry_problem(entry, request))
         if how == 'gave up':
             self._stopped(response, 'cancelled' if cancel.is_set() else 'timeout', timeout)
         elif how != 'computed':

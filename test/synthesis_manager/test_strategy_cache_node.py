@@ -252,3 +252,29 @@ def test_a_large_specification_is_kept_too(fresh_and_cached):
     assert answer_of(cached.call(request)) == expected  # its key computed in a worker: a hit
     assert cached.statistics.misses == 1 and cached.statistics.hits == 1
     assert cached.byproduct('large.slugsin') == fresh.byproduct('large.slugsin')
+
+
+def test_an_entry_signed_with_a_stolen_key_but_not_a_winning_strategy_is_not_served(tmp_path):
+    """Issue 48, item 6: a loaded strategy is checked against its specification before it is
+    served; whoever holds the key can sign anything, but a strategy whose moves break the
+    specification is a miss, synthesized again."""
+    from ltl_synthesizer.cache import StrategyCache
+
+    cache_dir = tmp_path / 'strategy-cache'
+    request = request_for(REALIZABLE)
+    with RosHarness() as ros:
+        service = SynthesisService(ros, tmp_path, 'first', strategy_cache_dir=str(cache_dir))
+        honest = answer_of(service.call(request))
+        key = service.node._cache_key(request)
+    thief = StrategyCache(directory=cache_dir)  # the key file beside the directory: the thief has it
+    entry = dict(thief.get(key))
+    strategy = json.loads(entry['json'])
+    first = next(iter(strategy['nodes']))
+    strategy['nodes'][first]['trans'] = [list(strategy['nodes'])[-1]]  # a move the specification forbids
+    entry['json'] = json.dumps(strategy).encode()
+    thief.put(key, entry)
+    with RosHarness() as ros:
+        service = SynthesisService(ros, tmp_path, 'restarted', strategy_cache_dir=str(cache_dir))
+        assert answer_of(service.call(request)) == honest
+        statistics = service.statistics
+    assert statistics.rejected == 1 and statistics.disk_hits == 0 and statistics.misses == 1

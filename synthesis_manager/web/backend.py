@@ -46,6 +46,21 @@ REPAIR_MAX_PROPOSALS = 5
 GoalRunner = Callable[[JobRequest, Callable[[str, float], None], threading.Event], JobOutcome]
 
 
+
+@dataclasses.dataclass
+class RepairRun:
+    """A running repair search (``SynthesisBackend.start_repair``): its answers, and a stop."""
+
+    answers: queue.Queue = dataclasses.field(default_factory=queue.Queue)
+    stopped: threading.Event = dataclasses.field(default_factory=threading.Event)
+    search: RepairSearch | None = None
+
+    def stop(self) -> None:
+        """End the search now (its child is killed); no answer comes after."""
+        self.stopped.set()
+        if self.search is not None:
+            self.search.stop()
+
 class SynthesisBackend:
     """Jobs run by ``run_goal(request, feedback, cancel) -> JobOutcome`` in worker threads.
 
@@ -185,7 +200,7 @@ class SynthesisBackend:
     def repair(self, body) -> dict:
         """Verified changes that make a job's request possible (``ltl_specification.repair``), as
         ``Repairs.to_dict()`` (see :meth:`start_repair`)."""
-        answers = self.start_repair(body)
+        answers = self.start_repair(body).answers
         while True:
             kind, value = answers.get()
             if kind == 'error':
@@ -193,11 +208,12 @@ class SynthesisBackend:
             if kind == 'result':
                 return value
 
-    def start_repair(self, body) -> queue.Queue:
+    def start_repair(self, body) -> RepairRun:
         """Start searching for fixes of a job's request: in a child process (ltl_specification.repair_process)
         on the robot system the GUI has (perhaps a remote suite's), for at most
-        ``repair_time_budget`` seconds. The queue gets ``('proposal', dict)`` as each proposal is
-        verified, then ``('result', Repairs.to_dict())`` or ``('error', GuiRequestError)``.
+        ``repair_time_budget`` seconds. Its ``answers`` queue gets ``('proposal', dict)`` as each
+        proposal is verified, then ``('result', Repairs.to_dict())`` or ``('error', GuiRequestError)``;
+        ``stop()`` ends it (a client that went away).
 
         Beyond max_repairs at once: BusyError (429, Retry-After), nothing is searched."""
         from ltl_specification.repair import TaskRequest
@@ -213,19 +229,20 @@ class SynthesisBackend:
                            request.unordered)
         settings = repair_settings(robot, task.to_dict(), request.custom_ltl, self.repair_time_budget,
                                    REPAIR_MAX_PROPOSALS)
-        answers = queue.Queue()
-        threading.Thread(target=self._search_repairs, args=(settings, answers), name='gui-repair',
+        run = RepairRun()
+        threading.Thread(target=self._search_repairs, args=(settings, run), name='gui-repair',
                          daemon=True).start()
-        return answers
+        return run
 
-    def _search_repairs(self, settings: dict, answers: queue.Queue):
+    def _search_repairs(self, settings: dict, run: RepairRun):
         """One search, its slot released when it ends, however it ends."""
+        answers = run.answers
         search = None
         try:
-            search = RepairSearch(settings)
+            search = run.search = RepairSearch(settings)
             with self._lock:
                 self._repair_searches.add(search)
-            if self.stopping.is_set():
+            if self.stopping.is_set() or run.stopped.is_set():
                 search.stop()
             answers.put(('result', search.run(lambda proposal: answers.put(('proposal', proposal)))))
         except CodedError as error:  # the system's files as the compiler refuses them

@@ -209,19 +209,23 @@ def _stopping(backend) -> Callable[[], bool]:
     return stopping.is_set if stopping is not None else (lambda: False)
 
 
-def _repair_stream(request: Request, answers, stopping: Callable[[], bool]):
+def _repair_stream(request: Request, run, stopping: Callable[[], bool]):
     """A repair search's answers as JSON lines: ``{"proposal": ...}`` as each is verified, then
-    ``{"result": ...}`` (Repairs.to_dict()) or ``{"error": {...}}`` (a 4xx/5xx answer's body)."""
+    ``{"result": ...}`` (Repairs.to_dict()) or ``{"error": {...}}`` (a 4xx/5xx answer's body).
+    A client that goes away stops the search (``run``: backend.RepairRun)."""
     async def lines():
-        while not stopping() and not await request.is_disconnected():
-            try:
-                kind, value = answers.get_nowait()
-            except queue.Empty:
-                await asyncio.sleep(0.05)
-                continue
-            yield json.dumps({kind: value.to_dict() if kind == 'error' else value}) + '\n'
-            if kind != 'proposal':
-                return
+        try:
+            while not stopping() and not await request.is_disconnected():
+                try:
+                    kind, value = run.answers.get_nowait()
+                except queue.Empty:
+                    await asyncio.sleep(0.05)
+                    continue
+                yield json.dumps({kind: value.to_dict() if kind == 'error' else value}) + '\n'
+                if kind != 'proposal':
+                    return
+        finally:
+            run.stop()  # after its answer this does nothing; before it, nobody is left to hear it
 
     return StreamingResponse(lines(), media_type=NDJSON, headers={'Cache-Control': 'no-cache'})
 

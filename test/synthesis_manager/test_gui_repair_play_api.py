@@ -314,3 +314,25 @@ def test_stopping_the_gui_ends_a_running_search_at_once():
         with pytest.raises(RepairSearchError):
             answer.result(timeout=10)
     assert time.monotonic() - started < 2.0 and search.child.process.poll() is not None
+
+
+def test_a_client_that_goes_away_stops_its_search(gui):
+    """Issue 48, item 7: a client disconnecting did not stop its search (a BDD bomb's ran to its
+    hard kill). The stream's end stops it: its child is killed at once."""
+    import time
+
+    backend, _ = gui
+    pairs = 26
+    xs, ys = [f'x{i}' for i in range(pairs)], [f'y{i}' for i in range(pairs)]
+    bomb = {'env_props': xs, 'sys_props': ys,
+            'sys_trans': [' | '.join(xs + ys + ['!x0']), ' & '.join(f"(next(y{i}) <-> x{i})" for i in range(pairs))]}
+    run = backend.start_repair({**WRONG_ORDER, 'custom_ltl': bomb})
+    deadline = time.monotonic() + 10
+    while run.search is None or run.search.child.process.poll() is not None:
+        assert time.monotonic() < deadline, 'the search never started'
+        time.sleep(0.05)
+    child = run.search.child.process
+    stopped = time.monotonic()
+    run.stop()
+    child.wait(timeout=5)
+    assert time.monotonic() - stopped < 2.0

@@ -44,6 +44,15 @@ FLEXBE_PREFIX := $(VENV)/flexbe
 # kept off the venv's PATH so a user's own ROS 2 `ros2` is never shadowed.
 ROS2CLI_PREFIX := $(VENV)/ros2cli
 ROS2CLI_PACKAGES := ros2cli ros2action ros2topic ros2service ros2node ros2interface ros2pkg
+# `ros2 launch` beside it: the pinned launch (3.4.3) and launch_ros with ros2launch (0.26.6), pure
+# Python; launch_ros imports composition_interfaces (2.0.2), an interface package built like
+# synthesis_msgs. Our launch package (behavior_synthesis_bringup: share/behavior_synthesis_bringup/launch and its
+# ament index entry) installs into the same prefix, which the `ros2` launcher appends to AMENT_PREFIX_PATH
+# (a sourced workspace's own copy comes first).
+LAUNCH_PACKAGES := launch/launch launch/launch_xml launch/launch_yaml launch_ros/launch_ros launch_ros/ros2launch
+COMPOSITION_INTERFACES := $(FLEXBE_SOURCES)/composition_interfaces/composition_interfaces
+COMPOSITION_INTERFACES_BUILD := build/composition_interfaces
+LAUNCH_PACKAGE := behavior_synthesis_bringup
 
 setup: $(VENV)/.project-installed $(VENV)/.msgs-installed $(GRAPHVIZ_WASM)/.installed
 
@@ -142,6 +151,14 @@ $(VENV)/.flexbe-synthesis-msgs-installed: $(INTERFACES_WRAPPER) $(VENV)/.flexbe-
 	$(call build_interfaces,flexbe_synthesis_msgs,$(FLEXBE_SYNTHESIS_MSGS),action_msgs;flexbe_msgs,$(FLEXBE_SYNTHESIS_MSGS_BUILD))
 	touch $@
 
+# launch_ros's composition_interfaces the same way, against the rcl_interfaces wheel.
+$(VENV)/.composition-interfaces-installed: $(INTERFACES_WRAPPER) $(VENV)/.project-installed \
+    $(wildcard $(COMPOSITION_INTERFACES)/package.xml $(COMPOSITION_INTERFACES)/srv/*)
+	@test -f "$(COMPOSITION_INTERFACES)/package.xml" || \
+	  { echo "composition_interfaces not found under FLEXBE_SOURCES (got '$(FLEXBE_SOURCES)')" >&2; exit 1; }
+	$(call build_interfaces,composition_interfaces,$(COMPOSITION_INTERFACES),rcl_interfaces,$(COMPOSITION_INTERFACES_BUILD))
+	touch $@
+
 $(WEBUI_SITE)/.installed: | $(BIN)/python
 	rm -rf $(WEBUI_SITE)
 	$(BIN)/python -m pip install --quiet --no-deps --target $(WEBUI_SITE) \
@@ -150,19 +167,23 @@ $(WEBUI_SITE)/.installed: | $(BIN)/python
 
 # The `ros2` launcher: the prefix's site-packages (ros2cli and rosidl_runtime_py, which its
 # `send_goal` needs to fill messages) on PYTHONPATH, the venv's Python (rclpy and the interfaces).
-$(ROS2CLI_PREFIX)/.installed: $(VENV)/.project-installed \
-    $(wildcard $(addprefix $(FLEXBE_SOURCES)/ros2cli/,$(addsuffix /setup.py,$(ROS2CLI_PACKAGES))))
-	@test -f "$(FLEXBE_SOURCES)/ros2cli/ros2cli/setup.py" || \
-	  { echo "ros2cli sources not found under FLEXBE_SOURCES (got '$(FLEXBE_SOURCES)')" >&2; exit 1; }
-	rm -rf $(ROS2CLI_PREFIX) && mkdir -p build
+$(ROS2CLI_PREFIX)/.installed: $(VENV)/.project-installed $(VENV)/.composition-interfaces-installed \
+    $(wildcard $(addprefix $(FLEXBE_SOURCES)/ros2cli/,$(addsuffix /setup.py,$(ROS2CLI_PACKAGES)))) \
+    $(wildcard $(addprefix $(FLEXBE_SOURCES)/,$(addsuffix /setup.py,$(LAUNCH_PACKAGES)))) \
+    $(LAUNCH_PACKAGE)/setup.py $(LAUNCH_PACKAGE)/package.xml $(wildcard $(LAUNCH_PACKAGE)/launch/*.py $(LAUNCH_PACKAGE)/$(LAUNCH_PACKAGE)/*.py)
+	@test -f "$(FLEXBE_SOURCES)/ros2cli/ros2cli/setup.py" -a -f "$(FLEXBE_SOURCES)/launch_ros/ros2launch/setup.py" || \
+	  { echo "ros2cli or launch_ros sources not found under FLEXBE_SOURCES (got '$(FLEXBE_SOURCES)')" >&2; exit 1; }
+	rm -rf $(ROS2CLI_PREFIX) build/$(LAUNCH_PACKAGE) && mkdir -p build && cp -r $(LAUNCH_PACKAGE) build/$(LAUNCH_PACKAGE)
 	$(BIN)/python -m pip install --quiet --no-deps --no-build-isolation --prefix $(ROS2CLI_PREFIX) \
 	  $(addprefix $(FLEXBE_SOURCES)/ros2cli/,$(ROS2CLI_PACKAGES)) $(FLEXBE_SOURCES)/rosidl_runtime_py \
+	  $(addprefix $(FLEXBE_SOURCES)/,$(LAUNCH_PACKAGES)) build/$(LAUNCH_PACKAGE) \
 	  > build/ros2cli-install.log 2>&1 || { cat build/ros2cli-install.log >&2; exit 1; }
 	@site=$$($(BIN)/python -c 'import sysconfig; print(sysconfig.get_path("purelib", vars={"base": "$(abspath $(ROS2CLI_PREFIX))"}))'); \
-	  printf '#!/bin/sh\n# The pinned ros2cli (Jazzy 0.32.2), written by `make flexbe`.\nPYTHONPATH="%s$${PYTHONPATH:+:$$PYTHONPATH}" exec "%s" "%s" "$$@"\n' \
-	    "$$site" "$(abspath $(BIN))/python" "$(abspath $(ROS2CLI_PREFIX))/bin/ros2" > $(ROS2CLI_PREFIX)/ros2; \
+	  printf '#!/bin/sh\n# The pinned ros2cli (Jazzy 0.32.2) with ros2launch (0.26.6), written by `make flexbe`.\nPYTHONPATH="%s$${PYTHONPATH:+:$$PYTHONPATH}" AMENT_PREFIX_PATH="$${AMENT_PREFIX_PATH:+$$AMENT_PREFIX_PATH:}%s" exec "%s" "%s" "$$@"\n' \
+	    "$$site" "$(abspath $(ROS2CLI_PREFIX))" "$(abspath $(BIN))/python" "$(abspath $(ROS2CLI_PREFIX))/bin/ros2" > $(ROS2CLI_PREFIX)/ros2; \
 	  chmod +x $(ROS2CLI_PREFIX)/ros2
 	$(ROS2CLI_PREFIX)/ros2 action --help > /dev/null
+	BEHAVIOR_SYNTHESIS=$(abspath $(BIN))/behavior-synthesis $(ROS2CLI_PREFIX)/ros2 launch $(LAUNCH_PACKAGE) suite.launch.py --show-args > /dev/null
 	touch $@
 
 # The pinned FlexBE WebUI (4.0.3) wired to this suite, for users without a FlexBE install:

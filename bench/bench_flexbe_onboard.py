@@ -10,8 +10,9 @@ reach an outcome. Each run exports nothing new: the behavior is exported and ins
 a user without colcon does), then every run starts fresh processes on a domain of its own (the
 robot at speed 20, the headless operator, ``flexbe_onboard.start_behavior``), starts the behavior
 as be_launcher does, and waits for its end on ``flexbe/status``. A run with no end within
-``--hang-after`` seconds counts as hung. Figures: outcomes, hangs, the runs that gave up on a
-capability (the onboard log names it), and the distribution of the behavior's run time (from the
+``--hang-after`` seconds counts as hung. Figures: outcomes, hangs, the runs in which a finished
+capability's result was late and asked for again, the runs that gave up on a capability (the
+onboard log names both), and the distribution of the behavior's run time (from the
 BehaviorSelection to its end) and of the whole run (start-up included).
 """
 
@@ -35,6 +36,7 @@ BEHAVIOR = 'Bench Five Goals'
 FIVE_GOALS = ['--system', 'atlas', '--initial-conditions', 'stand_prep',
               '--goals', 'look_down,pregrasp,pickup_object,approach_object,footstep_execution']
 GAVE_UP = 'giving up on it'  # CapabilityRequest's log line when a result never came
+ASKED_AGAIN = 'asking for it again'  # its line when a finished goal's result is late and asked for again
 
 
 def one_run(prefix: Path, flexbe_prefix: Path, logs: Path, hang_after: float) -> dict:
@@ -61,9 +63,11 @@ def one_run(prefix: Path, flexbe_prefix: Path, logs: Path, hang_after: float) ->
             behavior_seconds = time.perf_counter() - selected
         finally:
             system.stop()
-        gave_up = [line for line in (operator.log_text() + '\n' + system.log('onboard')).splitlines() if GAVE_UP in line]
+        lines = (operator.log_text() + '\n' + system.log('onboard')).splitlines()
+        gave_up = [line for line in lines if GAVE_UP in line]
+        asked_again = [line for line in lines if ASKED_AGAIN in line]
     return {'outcome': outcome, 'behavior_s': behavior_seconds, 'total_s': time.perf_counter() - started,
-            'gave_up': gave_up[:1]}
+            'gave_up': gave_up[:1], 'asked_again': asked_again[:1]}
 
 
 def distribution(values: list[float]) -> str:
@@ -78,10 +82,12 @@ def report(runs: list[dict], hang_after: float) -> str:
     for run in runs:
         outcomes[run['outcome']] = outcomes.get(run['outcome'], 0) + 1
     ended = [r for r in runs if r['outcome'] != 'hung']
-    lines = [f'| runs | reached an outcome | hung (no end within {hang_after:g} s) | outcomes | gave up on a capability |',
-             '|---|---|---|---|---|',
+    lines = [f'| runs | reached an outcome | hung (no end within {hang_after:g} s) | outcomes | '
+             'asked again for a late result | gave up on a capability |',
+             '|---|---|---|---|---|---|',
              f"| {len(runs)} | {len(ended)} | {outcomes.get('hung', 0)} | "
              + ', '.join(f'{name} {count}' for name, count in sorted(outcomes.items())) + ' | '
+             + str(sum(1 for r in runs if r['asked_again'])) + ' | '
              + str(sum(1 for r in runs if r['gave_up'])) + ' |',
              '',
              '| seconds (min / median / p90 / max) | value |',
@@ -89,9 +95,11 @@ def report(runs: list[dict], hang_after: float) -> str:
     if ended:
         lines.append(f"| behavior run (BehaviorSelection to end) | {distribution([r['behavior_s'] for r in ended])} |")
     lines.append(f"| whole run (processes up, run, stopped) | {distribution([r['total_s'] for r in runs])} |")
-    for run in runs:
+    for number, run in enumerate(runs, 1):
+        if run['asked_again']:
+            lines.append(f"\nrun {number}, {run['outcome']}, asked again: {run['asked_again'][0].strip()}")
         if run['gave_up']:
-            lines.append(f"\ngave up: {run['gave_up'][0].strip()}")
+            lines.append(f"\nrun {number}, {run['outcome']}, gave up: {run['gave_up'][0].strip()}")
     return '\n'.join(lines) + '\n'
 
 

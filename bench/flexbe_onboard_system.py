@@ -27,12 +27,16 @@ from rclpy.node import Node
 BIN = Path(sys.executable).parent
 
 
-def exported_and_installed(work: Path, export_arguments, package='synthesized_flexbe_behaviors', environment=None):
-    """``export-behavior`` with ``export_arguments``, its package installed into a prefix with pip (no colcon)."""
+def exported_and_installed(work: Path, export_arguments, package='synthesized_flexbe_behaviors', environment=None,
+                           edit=None):
+    """``export-behavior`` with ``export_arguments``, its package installed into a prefix with pip (no colcon);
+    ``edit(package_folder)``, when given, changes the exported files first."""
     exported = subprocess.run([str(BIN / 'behavior-synthesis'), 'export-behavior', *export_arguments,
                                '--package', package, '-o', str(work / 'src')],
                               capture_output=True, text=True, timeout=120, env=environment)
     assert exported.returncode == 0, exported.stderr
+    if edit:
+        edit(work / 'src' / package)
     prefix = work / 'install'
     pip = subprocess.run([sys.executable, '-m', 'pip', 'install', '--quiet', '--no-deps', '--no-build-isolation',
                           '--no-index', '--prefix', str(prefix), str(work / 'src' / package)],

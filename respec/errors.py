@@ -158,7 +158,7 @@ class ExitStatus(enum.IntEnum):
     OUT_OF_MEMORY = 4, 'a memory limit was exceeded (`gr1synth --memory-limit`)'
     UNAVAILABLE = 5, ('a server, node or port the command needs is missing or busy, or a program it needs is '
                       'not installed (the FlexBE engine of `execute --engine flexbe`)')
-    OTHER_OUTCOME = 6, '`execute`: the behavior ended in another outcome than `--expect`'
+    OTHER_OUTCOME = 6, '`execute`, `start-behavior`: the behavior ended in another outcome than `--expect`'
     VIOLATIONS = 7, '`execute`: the trace check found violations, or the robot fell'
     NOT_FINISHED = 8, '`execute`: the run could not finish (robot-time limit, a state it cannot run)'
 

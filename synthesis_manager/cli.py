@@ -29,6 +29,8 @@ SUBCOMMANDS = {
     'export-behavior': ('synthesis_manager.export_behavior', 'synthesize a behavior and write it as a FlexBE '
                         'behavior package'),
     'gui': ('synthesis_manager.gui', 'serve the synthesis web GUI on 127.0.0.1'),
+    'start-behavior': ('synthesis_manager.start_behavior', 'start an installed FlexBE behavior on the onboard '
+                       'engine and say how it ended'),
 }
 
 # Commands running nodes for others, which take standard ROS arguments after --ros-args.

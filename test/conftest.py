@@ -61,9 +61,10 @@ MODULE_MARKERS = {
                'test_atlas_sim_closed_loop_ros', 'test_atlas_sim_node', 'test_flexbe_engine', 'test_readme_flexbe',
                'test_atlas_sim_obstacles', 'test_atlas_sim_motion_frames'),
     'ros': ('test_colcon_route', 'test_flexbe_engine', 'test_flexbe_onboard', 'test_flexbe_states', 'test_flexbe_webui',
-            'test_cnu_capabilities', 'test_readme_commands', 'test_readme_flexbe'),
+            'test_cnu_capabilities', 'test_readme_commands', 'test_readme_flexbe', 'test_ros2_launch',
+            'test_start_behavior'),
     'slow': ('test_bench_gr1_families', 'test_colcon_route', 'test_readme_commands', 'test_readme_flexbe',
-             'test_fleet_hosts'),
+             'test_fleet_hosts', 'test_start_behavior'),
     'netns': ('test_fleet_hosts',),
 }
 FIXTURE_MARKERS = {'ros': 'ros', 'flexbe': 'flexbe', 'flexbe_sources': 'flexbe'}

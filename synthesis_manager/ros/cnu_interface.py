@@ -20,19 +20,30 @@ from synthesis_msgs.msg import OutcomeCondition, StateInstantiation
 CNU_PACKAGE = 'flexbe_synthesis_msgs'
 FALLBACK_TYPE = 'synthesis_msgs/FlexBESynthesis'
 
-# Our error names without a same-named constant in CNU's SynthesisErrorCode go to the generic
-# failure of their stage (the result's messages keep the precise name): (lowest value of the
-# stage's range in our SynthesisErrorCodes, CNU's constant).
+# Our codes that CNU's SynthesisErrorCode has under another name: the same meaning, CNU's
+# constant (docs/cnu.md, "Error codes on /flexbe_synthesis").
+CNU_EQUIVALENTS = {
+    'LTL_SPEC_COMPILATION_FAILED': 'SPEC_COMPILATION_FAILED',
+    'UNKNOWN_SYSTEM': 'NO_SYSTEM_CONFIG',             # the system has no configuration
+    'ABSTRACTION_CONFIG_INVALID': 'CONFIG_FILE_INVALID',  # a system's file is malformed or contradicts itself
+    'INVALID_SPEC_NAME': 'INVALID_REQUEST',           # the request's name cannot name byproducts
+}
+
+# Our error names without a constant of the same meaning in CNU's SynthesisErrorCode go to the
+# generic failure of their stage (the result's messages keep the precise name): (lowest value
+# of the stage's range in our SynthesisErrorCodes, CNU's constant).
 _STAGE_FAILURES = ((-9, 'BEHAVIOR_SYNTHESIS_FAILED'), (-19, 'SPEC_COMPILATION_FAILED'),
                    (-29, 'SYNTHESIS_FAILED'), (-49, 'SM_GENERATION_FAILED'))
 
 
 def cnu_error_name(code: ErrorCode, cnu_names) -> str:
-    """The CNU constant for our error ``code``: the same-named one when CNU has it, else its
-    stage's generic failure."""
+    """The CNU constant for our error ``code``: the same-named one when CNU has it, else the one
+    of the same meaning (CNU_EQUIVALENTS), else its stage's generic failure."""
     code = ErrorCode(code)
     if code.name in cnu_names:
         return code.name
+    if CNU_EQUIVALENTS.get(code.name) in cnu_names:
+        return CNU_EQUIVALENTS[code.name]
     return next((failure for lowest, failure in _STAGE_FAILURES if code.number >= lowest), 'FAILURE')
 
 

@@ -1,10 +1,10 @@
 """The colcon route of docs/flexbe.md, without a ROS installation, as CI can run it.
 
-A workspace whose ``src/`` holds ``synthesis_msgs``, our two FlexBE packages and an exported
-behavior package is built with ``colcon build`` (colcon-common-extensions from PyPI) in the
+A workspace whose ``src/`` holds ``synthesis_msgs``, our two FlexBE packages, the launch package
+``behavior_synthesis_bringup`` and an exported behavior package is built with ``colcon build`` (colcon-common-extensions from PyPI) in the
 environment docs/flexbe.md gives; after ``source install/setup.bash`` the packages import from
-the workspace and flexbe_core's BehaviorLibrary, as the onboard executive uses it, finds the
-behavior and its source there.
+the workspace, ``ros2 launch`` finds the suite's launch file there (the ament index), and
+flexbe_core's BehaviorLibrary, as the onboard executive uses it, finds the behavior and its source there.
 """
 
 import os
@@ -21,6 +21,9 @@ pytestmark = pytest.mark.usefixtures('flexbe')
 REPOSITORY = Path(__file__).resolve().parents[2]
 DOCS = REPOSITORY / 'docs' / 'flexbe.md'
 BEHAVIOR = 'Colcon Pickup'
+# Our ROS packages in a user's workspace (README, "Use it from FlexBE", step 1).
+WORKSPACE_PACKAGES = ('synthesis_msgs', 'atlas_sim/flexbe/atlas_sim_flexbe_states',
+                      'atlas_sim/flexbe/atlas_sim_flexbe_behaviors', 'behavior_synthesis_bringup')
 FIND_BEHAVIOR = f'''
 import rclpy
 from rclpy.node import Node
@@ -30,6 +33,13 @@ library = BehaviorLibrary(Node('colcon_route_check'))
 key, entry = library.find_behavior({BEHAVIOR!r})
 print(entry['package'], library.get_sourcecode_filepath(key))
 rclpy.shutdown()
+'''
+
+
+FIND_LAUNCH_FILE = '''
+from pathlib import Path
+from ament_index_python.packages import get_package_share_directory
+print(Path(get_package_share_directory('behavior_synthesis_bringup')) / 'launch' / 'suite.launch.py')
 '''
 
 
@@ -48,8 +58,7 @@ def test_the_documented_colcon_build_installs_packages_flexbe_finds(tmp_path, fl
     assert colcon.exists(), 'colcon is not installed: it comes with the test extra (pyproject.toml)'
     source = tmp_path / 'ws' / 'src'
     source.mkdir(parents=True)
-    for package in ('synthesis_msgs', 'atlas_sim/flexbe/atlas_sim_flexbe_states',
-                    'atlas_sim/flexbe/atlas_sim_flexbe_behaviors'):
+    for package in WORKSPACE_PACKAGES:
         shutil.copytree(REPOSITORY / package, source / Path(package).name)
     exported = subprocess.run([str(Path(sys.executable).parent / 'behavior-synthesis'), 'export-behavior',
                                '--system', 'atlas', '--initial-conditions', 'stand_prep',
@@ -62,11 +71,14 @@ def test_the_documented_colcon_build_installs_packages_flexbe_finds(tmp_path, fl
         environment = prepare_ros_environment(domain, environ={key: value for key, value in os.environ.items()
                                                                if key not in ('AMENT_PREFIX_PATH', 'PYTHONPATH')})
         script = '\n'.join(['set -e', f'REPO={REPOSITORY}', 'cd ws', *commands,
-                            f'{sys.executable} -c "{FIND_BEHAVIOR}"'])
+                            f'{sys.executable} -c "{FIND_LAUNCH_FILE}"', f'{sys.executable} -c "{FIND_BEHAVIOR}"'])
         built = subprocess.run(['bash', '-c', script], cwd=tmp_path, env=environment, capture_output=True,
                                text=True, timeout=1200)
     assert built.returncode == 0, (built.stdout[-3000:], built.stderr[-3000:])
-    assert 'Summary: 4 packages finished' in built.stdout
+    assert 'Summary: 5 packages finished' in built.stdout
+    # `ros2 launch behavior_synthesis_bringup suite.launch.py` finds its file in the workspace
+    (launch_file,) = [Path(line) for line in built.stdout.splitlines() if line.endswith('/launch/suite.launch.py')]
+    assert launch_file.is_file() and launch_file.resolve().is_relative_to((tmp_path / 'ws' / 'install').resolve())
     package, source_file = built.stdout.strip().splitlines()[-1].split(' ', 1)
     install = tmp_path / 'ws' / 'install'
     assert package == 'synthesized_flexbe_behaviors'

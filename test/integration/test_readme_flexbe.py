@@ -1,15 +1,18 @@
 """README's "Use it from FlexBE" section runs as written, in order, against the pinned FlexBE.
 
 Its commands are taken from the README, in order, and run in one bash shell from the
-repository, as a user pastes them: the behavior package is exported and installed, the suite
-(``serve``) and the WebUI (``make webui``) start, then the robot, the operator, FlexBE's onboard
-executive, the waits for the action servers, and ``be_launcher``. What a user runs in a terminal
-of its own (the two servers) or leaves running until Ctrl-C (``be_launcher``) runs in the
-background here. The test changes only where things go: ``/tmp/`` becomes its scratch folder,
-``F`` the FlexBE sources under test, and the shell gets a reserved ROS domain. It checks that
-the suite and the WebUI come up (the WebUI on port 8000, as the section says) and that the
-behavior ends ``finished`` on ``flexbe/status``. The section's WebUI clicks (synthesize, the
-manual imports, save) are test/integration/test_flexbe_webui.py's.
+repository, as a user pastes them, on the section's test case (the pinned FlexBE, ros2cli and
+``ros2 launch`` of `make flexbe`, its ``export PATH=...`` line): the behavior package is
+exported and installed, the suite (``ros2 launch ... suite.launch.py``) and the WebUI (``make
+webui``) start, then the robot, the operator and FlexBE's onboard engine (``ros2 launch ...
+atlas_onboard.launch.py``), and ``start-behavior`` starts the behavior and must print
+``finished``. What a user runs in a terminal of its own (the launches, the WebUI) runs in the
+background here. The lines of a user's own ROS installation (``source``, the workspace's
+``colcon build``) are test/integration/test_colcon_route.py's, with the same packages. The test
+changes only where things go: ``/tmp/`` becomes its scratch folder and ``ROS_DOMAIN_ID`` a
+reserved domain. It checks that the suite and the WebUI come up (the WebUI on port 8000, as the
+section says) and that the behavior ends ``finished`` on ``flexbe/status``. The section's WebUI
+clicks (synthesize, the manual imports, save) are test/integration/test_flexbe_webui.py's.
 """
 
 import contextlib
@@ -30,21 +33,23 @@ from test_readme_commands import flexbe_section, readme_commands
 REPOSITORY = Path(__file__).resolve().parents[2]
 README = REPOSITORY / 'README.md'
 # Commands a user leaves running (a terminal of their own, or until Ctrl-C): run in the background.
-LONG_RUNNING = (re.compile(r'behavior-synthesis serve\b'), re.compile(r'^make webui\b'),
-                re.compile(r'be_launcher\b'))
+LONG_RUNNING = (re.compile(r'^ros2 launch\b'), re.compile(r'^make webui\b'))
+# A user's own ROS installation and workspace (no ROS installation here; test_colcon_route.py
+# builds the same packages with colcon).
+USERS_OWN_INSTALL = re.compile(r'^(source |mkdir -p ~/flexbe_ws|cp -r .* ~/flexbe_ws/src/$|\(cd ~/flexbe_ws )')
 
 
 def section_commands() -> list[str]:
     return readme_commands(flexbe_section(README.read_text(encoding='utf-8')))
 
 
-def as_script(commands: list[str], scratch: Path, flexbe_sources: Path) -> str:
+def as_script(commands: list[str], scratch: Path, domain: int) -> str:
     """The commands as one bash script: stop at the first failing one, long-running ones in the background."""
     lines = ['set -e']
     for command in commands:
-        command = command.replace('/tmp/', f'{scratch}/')
-        if command.startswith('F='):
-            command = f'F={flexbe_sources}'
+        if USERS_OWN_INSTALL.search(command):
+            continue
+        command = re.sub(r'\bROS_DOMAIN_ID=\d+', f'ROS_DOMAIN_ID={domain}', command.replace('/tmp/', f'{scratch}/'))
         if any(pattern.search(command) for pattern in LONG_RUNNING) and not command.endswith('&'):
             command = f'{command} &'
         lines.append(command)
@@ -55,12 +60,18 @@ def as_script(commands: list[str], scratch: Path, flexbe_sources: Path) -> str:
 def test_the_section_names_every_step_in_order():
     """The steps the section promises are there, in the order that works."""
     commands = section_commands()
-    order = ['export-behavior', 'pip install', 'behavior-synthesis serve', 'make webui', 'atlas-sim-node',
-             'atlas-sim-operator', 'flexbe_onboard.start_behavior', '/atlas_sim/execute/_action',
-             '/flexbe/behavior_input/_action', 'be_launcher']
+    order = ['source /opt/ros/jazzy', 'colcon build', 'source ~/flexbe_ws/install', 'ROS_DOMAIN_ID=',
+             '.venv/ros2cli', 'export-behavior', 'pip install', 'PYTHONPATH=', 'suite.launch.py', 'make webui',
+             'atlas_onboard.launch.py', 'start-behavior']
     positions = [next((i for i, c in enumerate(commands) if step in c), None) for step in order]
     assert None not in positions, dict(zip(order, positions))
     assert positions == sorted(positions), dict(zip(order, positions))
+    assert not any('python3.' in command or 'third_party' in command for command in commands), commands
+    # the workspace holds what the colcon route builds
+    from test_colcon_route import WORKSPACE_PACKAGES
+
+    (copy,) = [command for command in commands if command.startswith('cp -r ')]
+    assert copy.split()[2:-1] == list(WORKSPACE_PACKAGES), copy
 
 
 def webui_answers() -> bool:
@@ -74,7 +85,7 @@ def test_the_section_runs_in_order_to_a_finished_behavior(ros, flexbe, flexbe_so
     from flexbe_msgs.msg import BEStatus
 
     script = tmp_path / 'use_it_from_flexbe.sh'
-    script.write_text(as_script(section_commands(), tmp_path, flexbe_sources), encoding='utf-8')
+    script.write_text(as_script(section_commands(), tmp_path, ros.domain_id), encoding='utf-8')
     log_path = tmp_path / 'shell.log'
     environment = dict(os.environ, ROS_DOMAIN_ID=str(ros.domain_id), FLEXBE_SOURCES=str(flexbe_sources))
     operator = Operator(ros)
@@ -106,6 +117,10 @@ def test_the_section_runs_in_order_to_a_finished_behavior(ros, flexbe, flexbe_so
                 time.sleep(0.2)
             assert finished_line.search(output()), output()[-4000:]
             assert 'suite up' in output(), output()[-4000:]
+            # start-behavior's own word: the outcome on its stdout
+            while not re.search(r'^finished$', output(), flags=re.M) and time.monotonic() < deadline_for_log:
+                time.sleep(0.2)
+            assert re.search(r'^finished$', output(), flags=re.M), output()[-4000:]
             while not up['webui'] and time.monotonic() < deadline:
                 up['webui'] = webui_answers()
                 time.sleep(0.5)

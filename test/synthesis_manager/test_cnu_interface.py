@@ -33,10 +33,12 @@ CNU_STAGES = ('BEHAVIOR_SYNTHESIS_FAILED', 'SPEC_COMPILATION_FAILED', 'SYNTHESIS
     ('UNKNOWN_PROPOSITION', 'SPEC_COMPILATION_FAILED'),
     ('LTL_SPEC_COMPILATION_FAILED', 'SPEC_COMPILATION_FAILED'),
     ('SYNTHESIS_TIMEOUT', 'SYNTHESIS_FAILED'), ('FAILURE', 'FAILURE'),
+    ('UNKNOWN_SYSTEM', 'NO_SYSTEM_CONFIG'), ('ABSTRACTION_CONFIG_INVALID', 'CONFIG_FILE_INVALID'),
+    ('INVALID_SPEC_NAME', 'INVALID_REQUEST'),
 ])
 def test_our_error_names_map_to_cnus_constant_or_their_stages_failure(name, expected):
     cnu_names = {'SUCCESS', 'FAILURE', 'PREEMPTED', 'INVALID_REQUEST', 'SPEC_UNSYNTHESIZABLE',
-                 'AUTOMATON_INVALID', *CNU_STAGES}
+                 'AUTOMATON_INVALID', 'NO_SYSTEM_CONFIG', 'CONFIG_FILE_INVALID', *CNU_STAGES}
     assert cnu_error_name(name, cnu_names) == expected
 
 
@@ -97,7 +99,7 @@ def test_cnu_type_is_offered_and_states_copy_field_by_field(cnu_package):
         assert type(code) is SynthesisErrorCode and code.value in cnu.values()
         if name in cnu:
             assert code.value == cnu[name]
-    assert interface.error_code('UNKNOWN_SYSTEM').value == SynthesisErrorCode.SPEC_COMPILATION_FAILED
+    assert interface.error_code('UNKNOWN_SYSTEM').value == SynthesisErrorCode.NO_SYSTEM_CONFIG
 
 
 def start_suite(ros, byproducts_dir):
@@ -210,6 +212,127 @@ def test_bad_goals_get_cnus_error_codes_and_a_message(plain_cnu_client):
     assert spec_file.result.error_code.value == SynthesisErrorCode.INVALID_REQUEST == -2
     (message,) = spec_file.result.messages
     assert message.startswith('INVALID_REQUEST:') and 'mine.yaml' in message
+
+
+# --- docs/cnu.md's error table, row by row, through the real action server ---------------------
+
+CNU_ERROR_TABLE_HEADING = '## Error codes on /flexbe_synthesis'
+
+
+def documented_cnu_codes() -> dict[str, str]:
+    """docs/cnu.md's table: each of our codes (a row may list several) -> CNU's constant."""
+    from pathlib import Path
+
+    text = (Path(__file__).resolve().parents[2] / 'docs' / 'cnu.md').read_text()
+    section = text.split(CNU_ERROR_TABLE_HEADING, 1)[1].split('\n## ', 1)[0]
+    table = {}
+    for line in section.splitlines():
+        cells = [cell.strip() for cell in line.strip().strip('|').split('|')]
+        if len(cells) >= 2 and cells[0].startswith('`'):
+            for ours in cells[0].split('`')[1::2]:
+                table[ours] = ours if cells[1].startswith('the same name') else cells[1].split('`')[1]
+    return table
+
+
+def test_docs_table_gives_every_code_of_ours_its_cnu_code(cnu_package):
+    from flexbe_synthesis_msgs.msg import SynthesisErrorCode
+
+    interface = load_flexbe_synthesis_interface()
+    cnu = constants(SynthesisErrorCode)
+    table = documented_cnu_codes()
+    assert sorted(table) == sorted(constants(SynthesisErrorCodes))
+    assert {ours: interface.error_code(ours).value for ours in table} == {ours: cnu[name] for ours, name in table.items()}
+
+
+@pytest.fixture(scope='module')
+def broken_robots(tmp_path_factory):
+    """A config folder with a malformed system file and a system whose CNU capability file is malformed."""
+    folder = tmp_path_factory.mktemp('broken_robots')
+    (folder / 'broken.yaml').write_text('system: broken\nabstraction: [unclosed\n')
+    (folder / 'capabilities').mkdir()
+    (folder / 'capabilities' / 'bad.yaml').write_text('capabilities: [oops\n')
+    (folder / 'bad_capabilities.yaml').write_text('system: bad_capabilities\ncnu_capabilities: capabilities/bad.yaml\n')
+    return folder
+
+
+@pytest.fixture(scope='module')
+def broken_robots_suite(broken_robots, tmp_path_factory):
+    from synthesis_manager.ros.harness import RosHarness
+
+    with RosHarness() as ros:
+        args = Namespace(config_dir=str(broken_robots), byproducts_dir=str(tmp_path_factory.mktemp('byproducts')),
+                         backend='builtin', slugs_executable='slugs', synthesis_timeout=60.0, service_timeout=2.0,
+                         default_system='')
+        for factory in suite_node_factories(args):
+            ros.add_node(factory)
+        yield ros
+
+
+@pytest.fixture
+def broken_robots_client(cnu_package, broken_robots_suite):
+    client = PlainCnuClient(broken_robots_suite)
+    yield client
+    client.close()
+
+
+def refused(client, goal, cnu_name: str, our_name: str, *words: str):
+    """Runs ``goal``; asserts it is aborted with CNU's ``cnu_name`` and ``OUR_NAME: ...`` naming ``words``."""
+    from action_msgs.msg import GoalStatus
+    from flexbe_synthesis_msgs.msg import SynthesisErrorCode
+
+    response = client.run(goal)
+    messages = list(response.result.messages)
+    assert response.status == GoalStatus.STATUS_ABORTED, messages
+    assert response.result.error_code.value == getattr(SynthesisErrorCode, cnu_name), messages
+    assert messages and messages[0].startswith(f'{our_name}: '), messages
+    assert all(word in messages[0] for word in words), messages
+    assert list(response.result.states) == []
+    assert documented_cnu_codes()[our_name] == cnu_name
+
+
+def test_row_unknown_system_is_no_system_config(broken_robots_client):
+    refused(broken_robots_client, broken_robots_client.goal(['stand_prep'], ['look_down'], system_name='r2d2'),
+            'NO_SYSTEM_CONFIG', 'UNKNOWN_SYSTEM', "'r2d2'")
+
+
+def test_row_malformed_system_file_is_config_file_invalid(broken_robots_client):
+    refused(broken_robots_client, broken_robots_client.goal(['stand_prep'], ['look_down'], system_name='broken'),
+            'CONFIG_FILE_INVALID', 'ABSTRACTION_CONFIG_INVALID', 'broken.yaml', 'not valid YAML')
+    refused(broken_robots_client, broken_robots_client.goal(['x'], ['x'], system_name='bad_capabilities'),
+            'CONFIG_FILE_INVALID', 'ABSTRACTION_CONFIG_INVALID', 'capabilities/bad.yaml', 'not valid YAML')
+
+
+def test_row_same_names_keep_their_code(broken_robots_client):
+    refused(broken_robots_client, broken_robots_client.goal(['stand_prep'], ['look_down'],
+                                                           specification_file_name='mine.yaml'),
+            'INVALID_REQUEST', 'INVALID_REQUEST', 'mine.yaml')
+
+
+def test_row_compilation_refusals_are_spec_compilation_failed(broken_robots_client):
+    refused(broken_robots_client, broken_robots_client.goal(['stand_prep'], ['fly_away']),
+            'SPEC_COMPILATION_FAILED', 'UNKNOWN_PROPOSITION', "'fly_away'")
+
+
+def test_row_synthesis_timeout_is_synthesis_failed(broken_robots_client, runaway_synthesis):
+    refused(broken_robots_client, broken_robots_client.goal(['stand_prep'], ['look_down'], synthesis_timeout_s=1.0),
+            'SYNTHESIS_FAILED', 'SYNTHESIS_TIMEOUT')
+
+
+def test_row_a_missing_pipeline_node_is_behavior_synthesis_failed(cnu_package, tmp_path):
+    """Only the server runs: the compilation service never appears."""
+    from synthesis_manager.ros.harness import RosHarness
+
+    with RosHarness() as ros:
+        args = Namespace(config_dir='', byproducts_dir=str(tmp_path), backend='builtin', slugs_executable='slugs',
+                         synthesis_timeout=60.0, service_timeout=0.5, default_system='')
+        for factory in suite_node_factories(args, ['behavior_synthesis_server']):
+            ros.add_node(factory)
+        client = PlainCnuClient(ros)
+        try:
+            refused(client, client.goal(['stand_prep'], ['look_down']), 'BEHAVIOR_SYNTHESIS_FAILED',
+                    'SERVICE_UNAVAILABLE')
+        finally:
+            client.close()
 
 
 def test_cancel_from_an_unmodified_cnu_client(plain_cnu_client, runaway_synthesis):

@@ -65,7 +65,7 @@ def test_a_server_stopped_by_a_signal_exits_with_128_plus_its_number_within_thre
     assert seconds < STOP_WITHIN, f'{command} took {seconds:.2f} s to stop after {stop_signal.name}'
 
 
-@pytest.mark.parametrize('command', ['serve', 'gui', 'demo', 'execute', 'send-goal', 'export-behavior'])
+@pytest.mark.parametrize('command', ['serve', 'gui', 'demo', 'execute', 'send-goal', 'export-behavior', 'start-behavior'])
 def test_each_help_lists_the_signal_statuses_and_the_readme_says_the_same(command):
     shown = subprocess.run(CLI + [command, '--help'], capture_output=True, text=True, timeout=60)
     assert shown.returncode == 0, shown.stderr

@@ -138,7 +138,7 @@ def test_errors_reach_the_client_as_last_feedback_and_in_messages(suite):
     unknown_system, _ = run_with_feedback(suite.flexbe_synthesis, make_flexbe_goal(
         system='r2d2', initial_conditions=['stand_prep'], goals=['look_down']))
     assert unknown_system.message.startswith('UNKNOWN_SYSTEM:') and 'r2d2' in unknown_system.message
-    assert unknown_system.error_code == SynthesisErrorCode.SPEC_COMPILATION_FAILED
+    assert unknown_system.error_code == SynthesisErrorCode.NO_SYSTEM_CONFIG
 
     spec_file = make_flexbe_goal(**PAPER_TASK)
     spec_file.request.specification_file_name = 'mine.yaml'

@@ -16,7 +16,6 @@ A goal's ``timeout`` counts its whole pipeline from acceptance (synthesis_manage
 from __future__ import annotations
 
 import contextlib
-import math
 import threading
 import time
 from dataclasses import dataclass, field, replace
@@ -141,40 +140,23 @@ def forget_goal_request(goal_handle) -> None:
 
 
 class HeapTrim:
-    """Give freed heap pages back to the system after goals (what a big goal's strings left),
-    at most once per ``interval`` seconds (a trim takes 1-9 ms): a goal ending sooner after the
-    last trim has one made when the interval is over."""
+    """Give freed heap pages back to the system after goals (what a big goal's strings left):
+    PERIOD seconds after the last goal ended (a trim takes 1-9 ms; a burst gets one, after it).
+    A node timer, idle between goals, not a thread: one started while the process shuts down
+    would never run, and its starter would wait for it forever."""
 
-    def __init__(self, interval: float = 1.0):
-        self.interval = interval
-        self._last = -math.inf
-        self._pending: threading.Timer | None = None
-        self._lock = threading.Lock()
+    PERIOD = 1.0
+
+    def __init__(self, node: Node):
+        self.timer = node.create_timer(self.PERIOD, self._trim)
+        self.timer.cancel()
 
     def __call__(self) -> None:
-        with self._lock:
-            wait = self._last + self.interval - time.monotonic()
-            if wait <= 0:
-                self._last = time.monotonic()
-            elif self._pending is None:
-                self._pending = threading.Timer(wait, self._deferred)
-                self._pending.daemon = True
-                self._pending.start()
-                return
-            else:
-                return
-        released_memory(collect=False)
+        self.timer.reset()
 
-    def _deferred(self) -> None:
-        with self._lock:
-            self._pending = None
-            self._last = time.monotonic()
+    def _trim(self) -> None:
+        self.timer.cancel()
         released_memory(collect=False)
-
-    def cancel(self) -> None:
-        with self._lock:
-            if self._pending is not None:
-                self._pending.cancel()
 
 
 def flexbe_log_publisher(node: Node, topic: str) -> Callable[[str], None]:
@@ -234,7 +216,7 @@ class BehaviorSynthesisServer(Node):
         self._stopping = threading.Event()
         self._active_goals = 0
         self._accepted_goals = 0  # accepted and not finished: running, or waiting for the executor
-        self.heap_trim = HeapTrim()
+        self.heap_trim = HeapTrim(self)
         self.shares = ClientShares(self.parameter('max_client_goals'), self.parameter('max_client_goal_seconds'),
                                    self.parameter('max_client_waiting'))
         self._lock = threading.Lock()
@@ -283,7 +265,6 @@ class BehaviorSynthesisServer(Node):
     def stop_work(self):
         """Make goals that are waiting on a stage give up (at shutdown)."""
         self._stopping.set()
-        self.heap_trim.cancel()
         self.stages.stop()
 
     def destroy_node(self):

@@ -101,3 +101,36 @@ def test_a_goal_sent_to_a_stalled_server_that_dies_is_answered_within_seconds(tm
     assert not sender.is_alive(), 'the goal was never answered'
     assert outcomes[0].error_name == 'SERVICE_UNAVAILABLE' and 'went away' in outcomes[0].message
     assert noticed < NOTICED_WITHIN, f'{noticed:.1f} s'
+
+
+def test_sigterm_ends_serve_within_three_seconds_with_one_clients_goals_running_and_waiting(tmp_path):
+    """A goal that ended while the server shut down started a thread (the heap trim), which a
+    finalizing interpreter never runs: serve hung on SIGTERM with eight runaways of one client
+    (bench_reliability --sections sharing found it)."""
+    import threading
+
+    from rclpy.node import Node
+
+    from synthesis_manager.client import SynthesisClient, make_goal
+    from synthesis_manager.ros.harness import RosHarness
+
+    with loopback_domain() as (domain, environment):
+        with started([BIN / 'behavior-synthesis', 'serve', '--byproducts-dir', tmp_path / 'byproducts'],
+                     environment) as (server, server_output):
+            server_output.wait_for('suite up')
+            with RosHarness(domain_id=domain) as ros:
+                client = SynthesisClient(ros.add_node(Node, 'sigterm_client'))
+                assert client.wait_for_server(10)
+                waiting = threading.Event()
+                for _ in range(8):
+                    threading.Thread(target=client.run, daemon=True, kwargs={
+                        'feedback': lambda status, _: status.startswith('Waiting:') and waiting.set()},
+                        args=(make_goal('atlas', [], [], option='ltl_synthesis_only', ltl_specification=RUNAWAY_SPEC,
+                                        timeout=1e9),)).start()
+                assert waiting.wait(30)
+                signalled = time.monotonic()
+                server.send_signal(signal.SIGTERM)
+                server.wait(30)
+                took = time.monotonic() - signalled
+    print(f'serve exited {took:.2f} s after SIGTERM')
+    assert took < 3.0 and server.returncode == 128 + signal.SIGTERM

@@ -126,12 +126,13 @@ SYNTHESIZER_MODULE = 'ltl_synthesizer.synthesizer'
 
 
 class WorkingChildrenMemory:
-    """The resident memory of all this process's children while they work, together, bounded.
+    """The resident memory of this process and all its children (the tree), bounded while any
+    child works.
 
     Each child's own limit (a synthesis' memory_limit) bounds one piece of work; eight at once
-    could still hold eight times that. Past ``limit`` bytes in all, the child holding the most
-    is ended (SynthesisMemoryError naming the sum limit), so the others go on. Read at most
-    every ``period`` seconds, whichever working child polls first."""
+    could still hold eight times that. Past ``limit`` bytes in all, the working child holding
+    the most is ended (SynthesisMemoryError naming the sum limit), so the others go on. Read at
+    most every ``period`` seconds, whichever working child polls first."""
 
     def __init__(self, limit: int | None = None, period: float = 0.1):
         self.limit, self.period = limit, period
@@ -155,13 +156,27 @@ class WorkingChildrenMemory:
             if now - self._read_at >= self.period:
                 self._read_at = now
                 sizes = {working: resident_memory(working.process.pid) for working in self._working}
-                self.total = sum(sizes.values())
+                others = [pid for pid in _child_pids() if pid not in {w.process.pid for w in sizes}]
+                self.total = (sum(sizes.values()) + resident_memory()
+                              + sum(resident_memory(pid) for pid in others))
                 self._over = max(sizes, key=sizes.get) if self.total > self.limit else None
             return self._over is child
 
 
-#: The sum limit of this process's working children (a server sets it: memory_sum_limit_mb).
+#: The sum limit of this process's tree (a server sets it: memory_sum_limit_mb).
 WORKING_CHILDREN_MEMORY = WorkingChildrenMemory()
+
+
+def _child_pids() -> list[int]:
+    """This process's child processes (of every thread: each thread's children are its own)."""
+    pids = []
+    for task in os.scandir('/proc/self/task') if os.path.isdir('/proc/self/task') else ():
+        try:
+            with open(os.path.join(task.path, 'children')) as children:
+                pids += [int(pid) for pid in children.read().split()]
+        except OSError:  # the thread ended meanwhile
+            continue
+    return pids
 
 
 class ChildProcess:
@@ -211,7 +226,8 @@ class ChildProcess:
                         raise SynthesisMemoryError(
                             f'the work needed more memory than was left of the '
                             f'{WORKING_CHILDREN_MEMORY.limit / 2**20:.0f} MB that all work at once may hold '
-                            f'(memory_sum_limit_mb; it held the most of {WORKING_CHILDREN_MEMORY.total / 2**20:.0f} MB)',
+                            f'(memory_sum_limit_mb; it held the most of the {WORKING_CHILDREN_MEMORY.total / 2**20:.0f} MB '
+                            'the server and its processes held)',
                             item='memory_sum_limit')
                     if cancel is not None and cancel.is_set():
                         self.kill()

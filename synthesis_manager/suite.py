@@ -42,8 +42,8 @@ def add_suite_arguments(parser):
                        help="the 0600 key that signs the cache directory's entries (default: DIR.key "
                             'beside it, made on first use; give a fleet the same file)')
     group.add_argument('--memory-sum-limit-mb', type=float, default=None, metavar='MB',
-                       help='MiB that all synthesis, compilation and repair processes at work may hold together; '
-                            'beyond it the one holding the most is ended (default 4096; 0: none)')
+                       help='MiB that the suite and all its synthesis, compilation and repair processes may hold together; '
+                            'beyond it the working one holding the most is ended (default 4096; 0: none)')
     group.add_argument('--service-timeout', type=float, default=5.0,
                        help='seconds to wait for a pipeline service to appear')
     group.add_argument('--default-system', default='',

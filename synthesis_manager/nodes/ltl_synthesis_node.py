@@ -76,8 +76,8 @@ class LTLSynthesisNode(Node):
     ``slugs_executable``, called the original way); ``timeout`` (seconds, used when a
     request gives none; time spent waiting for a worker counts); ``robotics_semantics``;
     ``memory_limit_mb`` (per synthesis; beyond it the synthesis ends with SYNTHESIS_FAILED
-    naming the limit, not an OOM kill); ``memory_sum_limit_mb`` (all of this process's working
-    children together; beyond it the one holding the most ends, SYNTHESIS_FAILED naming the
+    naming the limit, not an OOM kill); ``memory_sum_limit_mb`` (this process and all its children
+    together; beyond it the working child holding the most ends, SYNTHESIS_FAILED naming the
     sum limit; 0: none); ``diagnosis_timeout`` (seconds to find why an
     unrealizable specification cannot be met, used when a request gives none; never past the
     request's time limit); ``check_well_separation`` (a realizable specification's answer
@@ -123,8 +123,8 @@ class LTLSynthesisNode(Node):
         self.workers = WorkerPool(self.parameter('parallel_syntheses'), self.parameter('queued_syntheses'),
                                   name='synthesis')
         self.synthesis_processes = SynthesisProcesses(niceness=SERVER_CHILD_NICENESS)
-        # The bound of every working child of this process together (compilations, repairs and a
-        # GUI's simulations too, when they run in the same process).
+        # The bound of this process's whole tree (compilations, repairs and a GUI's simulations
+        # too, when they run in the same process).
         WORKING_CHILDREN_MEMORY.limit = self.parameter('memory_sum_limit_mb') * 2**20 or None
         self.strategy_cache = self._strategy_cache()
         self._prune_leftovers()

@@ -3,7 +3,7 @@
 import { api, streamEvents } from './api.js';
 import * as drawing from './drawing.js';
 import { $, element } from './dom.js';
-import { capabilityNames, simulationSupport } from './form.js';
+import { capabilityNames, sensors, simulationSupport } from './form.js';
 import { resetFrames, showFrames } from './frames.js';
 import { controlRun, startingAutonomy } from './runtime_control.js';
 import { vocabulary } from './vocabulary.js';
@@ -24,6 +24,18 @@ export function offerSimulation(job) {
   }
   $('fail-first').replaceChildren(element('option', { value: '', text: 'nothing (no faults)' }),
     ...capabilityNames().map((name) => element('option', { value: name, text: name })));
+  // A capability robot's sensors: free (the environment reads what the assumptions allow), or
+  // held true or false for the whole run.
+  $('simulation-sensors').replaceChildren(...sensors().map((sensor) => {
+    const id = `simulation-sensor-${sensor.name}`;
+    return element('span', { className: 'inline' },
+      element('label', { for: id, className: 'inline-label', text: sensor.name,
+        title: `a sensor, reported by ${sensor.reported_by.join(', ') || 'no capability'}` }),
+      element('select', { id, name: 'simulation-sensor', 'data-sensor': sensor.name },
+        element('option', { value: '', text: 'as the environment reads it' }),
+        element('option', { value: 'true', text: 'true' }), element('option', { value: 'false', text: 'false' })));
+  }));
+  $('simulation-sensors').hidden = !sensors().length;
   $('simulation-section').hidden = false;
 }
 
@@ -58,7 +70,7 @@ export async function simulate() {
   let simulation;
   try {
     simulation = await api('POST', `/api/jobs/${offeredJob.id}/simulations`,
-      { fail_first: failing ? [failing] : [], autonomy: startingAutonomy() });
+      { fail_first: failing ? [failing] : [], autonomy: startingAutonomy(), ...simulationSensors() });
   } catch (error) {
     $('simulation-status').textContent = `${error.code}: ${error.message}`;
     $('simulate').disabled = false;
@@ -82,6 +94,12 @@ export async function simulate() {
       (last) => { end(); showSimulation(last); },
       (error) => { end(); $('simulation-status').textContent = `${error.code}: ${error.message}`; }),
   });
+}
+
+// The sensors the operator set for the run (a capability robot's), if it has any.
+function simulationSensors() {
+  const held = [...document.querySelectorAll('select[name="simulation-sensor"]')].filter((s) => s.value);
+  return held.length ? { sensors: Object.fromEntries(held.map((s) => [s.dataset.sensor, s.value === 'true'])) } : {};
 }
 
 // When a step ran in robot time: a step that has not ended runs on ("1.50–…") or, once the
@@ -131,7 +149,8 @@ function showSimulation(simulation) {
       element('td', { text: String(step.index) }),
       element('td', { text: step.state.replace(/^\//, '') }),
       element('td', { text: step.capabilities.join(', ') }),
-      element('td', { text: step.results.map((r) => `${r.capability} ${r.outcome}`).join(', ') }),
+      element('td', { text: step.results.map((r) => `${r.capability} ${r.outcome}`).join(', ') +
+        (step.chosen_by && step.state_outcome ? ` (chosen by ${step.chosen_by})` : '') }),
       outcomeCell(step),
       element('td', { text: stepTimes(step, simulation, running) }))));
   drawing.markRun(simulation.steps, running);

@@ -76,7 +76,7 @@ class ModeRobotView:
         if section.get('stand_in'):
             return {'available': False,
                     'note': f'No simulation for {self.robot.name}: {" ".join(str(section["stand_in"]).split())}'}
-        return {'available': True, 'note': ''}
+        return {'available': True, 'note': '', 'frames': True, 'simulator': 'atlas_sim: MuJoCo humanoid'}
 
 
 class CapabilityRobotView:
@@ -167,7 +167,8 @@ class CapabilityRobotView:
 
     def simulation_support(self, can_simulate: bool) -> dict:
         del can_simulate  # no physics: nothing to install
-        return {'available': True, 'note': '', 'sensors': list(self.capabilities.spec_inputs)}
+        return {'available': True, 'note': '', 'frames': False, 'sensors': list(self.capabilities.spec_inputs),
+                'simulator': 'a simulated capability robot: each state answers one of its outcomes, no physics'}
 
 
 def robot_view(robot: RobotSystem) -> ModeRobotView | CapabilityRobotView:

@@ -38,7 +38,9 @@ def test_the_form_offers_what_the_capabilities_make_true_and_the_sensor_with_its
     assert graph['drive']['needs'] == [{'name': 'battery_ok', 'negated': False, 'text': 'battery_ok'}]
     assert {(m['text'], m['outcome']) for m in graph['check_battery']['makes']} == {('battery_ok', 'completed'),
                                                                                      ('!battery_ok', 'low')}
-    assert choices['simulation'] == {'available': True, 'note': '', 'sensors': ['battery_low']}
+    assert choices['simulation'] == {'available': True, 'note': '', 'frames': False, 'sensors': ['battery_low'],
+                                     'simulator': 'a simulated capability robot: each state answers one of its '
+                                                  'outcomes, no physics'}
     check = client.post('/api/goal-check', json={'system': 'delivery_rover', 'goals': []}).json()
     assert check['impossible_next'] == {}   # every goal offered can come first
     atlas = client.get('/api/systems/atlas').json()

@@ -254,33 +254,53 @@ function showCapabilityGraph(graph, request, goals) {
   const nodes = [...new Set(names)];
   const label = (id) => id.split(':').slice(1).join(':');
   NODE_W = Math.max(MIN_NODE_W, Math.ceil(16 + CHAR_W * Math.max(...nodes.map((n) => label(n).length))));
+  // Top to bottom, a row per level (the panel is wider than tall, the graph deeper than wide).
   const level = capabilityLevels(nodes, edges);
-  const columns = [];
-  for (const node of nodes) (columns[level.get(node)] = columns[level.get(node)] || []).push(node);
-  const GAP = 46;
+  const rows = [];
+  for (const node of nodes) (rows[level.get(node)] = rows[level.get(node)] || []).push(node);
+  const COLUMN_W = NODE_W + 40;
+  const ROW_H = NODE_H + 36;
+  const widest = Math.max(...rows.map((row) => row.length));
+  const width = 12 + widest * COLUMN_W + 60;  // room on the right for the edges that go back up
+  const height = 12 + rows.length * ROW_H;
   const place = new Map();
-  columns.forEach((column, c) => column.forEach((node, r) => place.set(node, { x: 6 + c * (NODE_W + GAP), y: 6 + r * (NODE_H + 22) })));
-  const width = 12 + columns.length * (NODE_W + GAP);
-  const height = 12 + Math.max(...columns.map((c) => c.length)) * (NODE_H + 22);
+  rows.forEach((row, r) => row.forEach((node, c) => place.set(node, {
+    x: 6 + (widest - row.length) * COLUMN_W / 2 + c * COLUMN_W, y: 6 + r * ROW_H })));
   const holding = new Set([...graph.initially, ...request.initial_conditions]);
   const on = capabilityPath(graph, goals, holding);
   const svg = svgElement('svg', { id: 'capability-graph', viewBox: `0 0 ${width} ${height}`, width, height, role: 'img',
     'aria-label': 'capability graph' }, arrowMarker('capability-arrow'));
+  const pairs = new Map();  // edges between the same two nodes are drawn apart
+  edges.forEach((edge) => {
+    const pair = [edge.from, edge.to].sort().join('|');
+    pairs.set(pair, [...(pairs.get(pair) || []), edge]);
+  });
   for (const edge of edges) {
     const a = place.get(edge.from);
     const b = place.get(edge.to);
-    const back = b.x <= a.x;
-    const [x1, y1] = back ? [a.x, a.y + NODE_H / 2] : [a.x + NODE_W, a.y + NODE_H / 2];
-    const [x2, y2] = back ? [b.x + NODE_W, b.y + NODE_H / 2] : [b.x, b.y + NODE_H / 2];
-    const bend = back ? -40 : 20;
+    const siblings = pairs.get([edge.from, edge.to].sort().join('|'));
+    const spread = (siblings.indexOf(edge) - (siblings.length - 1) / 2) * 26;
+    const back = b.y <= a.y;
+    let d;
+    let labelAt;
+    if (back) {  // up the right side
+      const [x1, y1, x2, y2] = [a.x + NODE_W, a.y + NODE_H / 2, b.x + NODE_W, b.y + NODE_H / 2];
+      const out = Math.max(x1, x2) + 40 + spread;
+      d = `M${x1},${y1} C${out},${y1} ${out},${y2} ${x2 + 2},${y2}`;
+      labelAt = { x: out - 4, y: (y1 + y2) / 2 };
+    } else {
+      const [x1, y1, x2, y2] = [a.x + NODE_W / 2 + spread, a.y + NODE_H, b.x + NODE_W / 2 + spread, b.y];
+      d = `M${x1},${y1} C${x1},${y1 + 18} ${x2},${y2 - 18} ${x2},${y2 - 2}`;
+      // a label beside its edge, on the left of the left one of a pair
+      labelAt = { x: (x1 + x2) / 2 + (spread < 0 ? -6 : 6), y: (y1 + y2) / 2 + 4, anchor: spread < 0 ? 'end' : 'start' };
+    }
     const id = `${edge.from}->${edge.to}`;
     const classes = ['edge', edge.kind, edge.negated ? 'negated' : '', on.edges.has(id) ? 'on-path' : ''].filter(Boolean).join(' ');
-    svg.append(svgElement('path', { id: `capability-edge:${id}:${edge.label}`, class: classes,
-      d: `M${x1},${y1} C${x1 + bend},${y1 + (back ? 30 : 0)} ${x2 - bend},${y2 + (back ? 30 : 0)} ${x2 - (back ? -2 : 2)},${y2}`,
+    svg.append(svgElement('path', { id: `capability-edge:${id}:${edge.label}`, class: classes, d,
       'marker-end': 'url(#capability-arrow)' }));
     if (edge.label) {
-      svg.append(svgElement('text', { class: 'edge-label', x: (x1 + x2) / 2, y: (y1 + y2) / 2 - 4 + (back ? 22 : 0),
-        'text-anchor': 'middle' }, edge.label));
+      svg.append(svgElement('text', { class: 'edge-label', x: labelAt.x, y: labelAt.y, 'text-anchor': labelAt.anchor || 'start' },
+        edge.label));
     }
   }
   for (const node of nodes) {

@@ -17,6 +17,7 @@ export function offerSimulation(job) {
   const support = simulationSupport();
   $('simulation-note').textContent = support.note;
   $('simulation-note').hidden = support.available;
+  if (support.simulator) $('simulator-name').textContent = `(${support.simulator})`;
   $('simulation-controls').hidden = !support.available;
   if (!support.available) {
     $('simulation-section').hidden = false;
@@ -116,15 +117,18 @@ function showSimulation(simulation) {
   const base = `/api/simulations/${simulation.id}`;
   const running = simulation.state !== 'finished';
   const waiting = simulation.operator && simulation.operator.waiting;
+  // A robot simulated without physics (a capability robot) has neither frames nor robot time.
+  const physics = simulationSupport().frames;
+  const robotTime = physics ? `, robot time ${simulation.robot_time.toFixed(2)} s` : '';
   let status = simulation.steps.length === 0 ? 'Starting the simulator…'
-    : `Running: ${simulation.steps.length} states, robot time ${simulation.robot_time.toFixed(2)} s`;
+    : `Running: ${simulation.steps.length} states${robotTime}`;
   if (running && waiting) status += waiting.kind === 'resume' ? ' (paused)' : ' (waiting for you)';
   let outcomeClass = '';
   if (!running) {
     status = simulation.error
       ? `Stopped: ${simulation.error.code}: ${simulation.error.message}`
-      : `Outcome: ${simulation.outcome} after ${simulation.steps.length} states ` +
-        `(robot time ${simulation.robot_time.toFixed(2)} s, wall time ${simulation.wall_seconds.toFixed(2)} s)`;
+      : `Outcome: ${simulation.outcome} after ${simulation.steps.length} states (` +
+        `${physics ? `robot time ${simulation.robot_time.toFixed(2)} s, ` : ''}wall time ${simulation.wall_seconds.toFixed(2)} s)`;
     outcomeClass = simulation.error ? 'bad' : `outcome-${simulation.outcome}`;
   }
   $('simulation-status').textContent = status;
@@ -133,6 +137,7 @@ function showSimulation(simulation) {
   $('simulation-live').className = `status ${outcomeClass}`;
   $('simulation-view').hidden = false;
   $('robot-view').hidden = false;
+  $('robot-view').classList.toggle('no-frames', !physics);
   if (!$('graph-layout').classList.contains('simulating')) {
     $('graph-layout').classList.add('simulating');
     drawing.foldForm(true);  // the drawing just got narrower: give it the form's width
@@ -152,7 +157,7 @@ function showSimulation(simulation) {
       element('td', { text: step.results.map((r) => `${r.capability} ${r.outcome}`).join(', ') +
         (step.chosen_by && step.state_outcome ? ` (chosen by ${step.chosen_by})` : '') }),
       outcomeCell(step),
-      element('td', { text: stepTimes(step, simulation, running) }))));
+      element('td', { text: physics ? stepTimes(step, simulation, running) : '—' }))));
   drawing.markRun(simulation.steps, running);
   controlRun(simulation);
   showFrames(base, simulation.frames, simulation.steps, running);

@@ -82,3 +82,23 @@ def test_simulate_a_capability_robot_unattended_and_with_the_operator_forcing_ou
         "The operator forced 'low' on check_battery at step 1 with battery_low=false; the task assumed env_trans")
     refused = client.post(f"/api/jobs/{job['id']}/simulations", json={'sensors': {'sonar': True}})
     assert refused.status_code == 422 and refused.json()['item'] == 'sonar'
+
+
+def test_the_shelf_picker_on_the_same_surfaces(client):
+    """config/shelf_picker, the second shipped capability robot: its sensor and its grasp that fails."""
+    choices = client.get('/api/systems/shelf_picker').json()
+    assert choices['sensors'] == [{'name': 'item_on_shelf', 'reported_by': ['look']}]
+    assert [g['name'] for g in choices['goal_groups'][0]['items']] == ['item_seen', '!item_seen', 'grasp', 'place']
+    _, job = run_job(client, {'system': 'shelf_picker', 'goals': ['place']})
+    assert job['outcome']['error_name'] == 'SUCCESS', job['outcome']['message']
+    run = follow_simulation(client, client.post(f"/api/jobs/{job['id']}/simulations",
+                                                json={'fail_first': ['grasp']}).json()['id'])
+    assert run['outcome'] == 'failed' and run['check']['ok'] is True
+    assert [(s['capabilities'][0], s['state_outcome'], s['chosen_by']) for s in run['steps']] == [
+        ('look', 'seen', 'the robot'), ('grasp', 'failed', 'the script')]
+    started = client.post(f"/api/jobs/{job['id']}/simulations", json={'autonomy': 0}).json()
+    answers = iter(['empty', 'seen', 'done', 'done'])   # the shelf is empty at first, then restocked
+    run = operate(client, started['id'], lambda waiting: {'command': 'force', 'state': waiting['state'],
+                                                          'outcome': next(answers)})
+    assert run['outcome'] == 'finished' and run['check']['ok'] is True
+    assert [s['state_outcome'] for s in run['steps']] == ['empty', 'seen', 'done', 'done']

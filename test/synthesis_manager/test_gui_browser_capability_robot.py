@@ -3,7 +3,9 @@ Chromium at 1280x720 against a real `behavior-synthesis gui` with the FlexBE wor
 AMENT_PREFIX_PATH (issue 45): the form built from the robot, its capability graph with the task's
 path, synthesis, a simulation with Runtime Control (the operator forces the battery check's
 `low` and a failing drive; the outcomes and the trace check, worded with who chose), and
-"Suggest fixes" repairing a refused rover task."""
+"Suggest fixes" repairing a refused rover task. With $BEHAVIOR_SYNTHESIS_DOCS_SHOTS set to a
+directory, the graph and the run waiting for the operator are also written there
+(docs/gui-capability-graph.png, docs/gui-capability-run.png)."""
 
 import pytest
 
@@ -105,6 +107,7 @@ def test_synthesize_then_simulate_with_runtime_control_forcing_low_and_a_failing
                                "document.getElementById('operator-question').textContent !== asked",
                                arg=page.inner_text('#operator-question'), timeout=60_000)
         asked = page.inner_text('#operator-question')
+    docs_shot(page, 'gui-capability-run.png')
     force(page, 'failed')                  # the drive fails
     page.wait_for_function(STATUS_DONE, timeout=60_000)
     status = page.inner_text('#simulation-status')
@@ -115,8 +118,6 @@ def test_synthesize_then_simulate_with_runtime_control_forcing_low_and_a_failing
     last = rows.last.inner_text()
     assert 'drive failed (chosen by the operator)' in last and 'failed → failed' in last
     assert page.inner_text('#simulation-check').startswith('Trace check against the specification: ok')
-    page.locator('#simulation-check').scroll_into_view_if_needed()
-    docs_shot(page, 'gui-capability-run.png')
 
     # the battery held not low, the operator's `low` breaks an assumption: the check says who
     page.select_option('#simulation-sensor-battery_low', 'false')

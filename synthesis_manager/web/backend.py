@@ -338,8 +338,8 @@ class SynthesisBackend:
         with self._lock:
             self._admit_simulation(job_id)
             self._simulations[simulation.id] = simulation
-        threading.Thread(target=self._simulate, args=(simulation, job, robot, view.simulator), name=f'gui-{simulation.id}',
-                         daemon=True).start()
+        threading.Thread(target=self._simulate, args=(simulation, job, robot, view.simulator),
+                         name=f'gui-{simulation.id}', daemon=True).start()
         return simulation
 
     def _admit_simulation(self, job_id: str):

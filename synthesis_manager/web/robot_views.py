@@ -72,7 +72,8 @@ class ModeRobotView:
         try:
             section = self.robot.section('simulation')
         except SystemConfigError:
-            return {'available': False, 'note': f'{self.robot.name} has no simulation section: atlas_sim cannot run it.'}
+            return {'available': False,
+                    'note': f'{self.robot.name} has no simulation section: atlas_sim cannot run it.'}
         if section.get('stand_in'):
             return {'available': False,
                     'note': f'No simulation for {self.robot.name}: {" ".join(str(section["stand_in"]).split())}'}
@@ -146,7 +147,8 @@ class CapabilityRobotView:
             if section != 'env_trans' or '<->' not in text or sensor not in words:
                 continue
             for name in self.capabilities.capabilities:
-                outcomes = {self.capabilities.outcome_proposition(name, t) for t in self.capabilities.transition_outcomes}
+                outcomes = {self.capabilities.outcome_proposition(name, outcome)
+                            for outcome in self.capabilities.transition_outcomes}
                 if words & outcomes and name not in found:
                     found.append(name)
         return found

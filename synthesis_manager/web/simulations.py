@@ -29,7 +29,8 @@ class Simulation:
     revision: int = 0
 
     def to_dict(self) -> dict:
-        return {'id': self.id, 'job_id': self.job_id, 'fail_first': list(self.fail_first), 'sensors': dict(self.sensors),
+        return {'id': self.id, 'job_id': self.job_id, 'fail_first': list(self.fail_first),
+                'sensors': dict(self.sensors),
                 'state': self.state, 'steps': list(self.steps), 'robot_time': round(self.robot_time, 3),
                 'frames': [{'index': i, 'label': p.stem} for i, p in enumerate(self.frames)],
                 'timeline': self.timeline_png is not None, 'outcome': self.outcome,

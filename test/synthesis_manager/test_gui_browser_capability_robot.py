@@ -54,7 +54,8 @@ def test_the_form_and_the_capability_graph_come_from_the_robot(page):
     # no control-mode heading; the robot's memories and sensor to start from, nothing checked
     assert page.is_hidden('#initial-control-modes')
     assert 'Control mode' not in page.inner_text('#initial-conditions')
-    starts = page.locator('input[name="initial-condition"]').evaluate_all('boxes => boxes.map(b => [b.value, b.checked])')
+    starts = page.locator('input[name="initial-condition"]').evaluate_all(
+        'boxes => boxes.map(b => [b.value, b.checked])')
     assert starts == [['battery_ok', False], ['battery_low', False]]
     assert 'starts as its spec says (check_battery_a)' in page.inner_text('#initial-note')
     assert page.inner_text('#robot-sensor-list') == 'battery_low reported by check_battery'

@@ -107,7 +107,7 @@ class CapabilityRun:
         self.nodes = {str(state['name']): state for state in automaton.get('states', automaton.get('automaton', ()))}
         self.initial = list(automaton['initial_states'])
         self.choose = choose  # (state path, outcomes) -> an outcome or None: the operator's choice
-        self.proposed = ''    # what the robot (or the script) answers for the state ``choose`` is asked about
+        self._asked = None    # (capability, state, node) ``choose`` is asked about
         self.result = CapabilityRunResult(None, [])  # the run so far (its steps), for a caller's progress
         self.sensors = dict(script.sensors)  # the sensors now: the script's, as the environment changes them
         self.max_steps = max_steps
@@ -154,7 +154,7 @@ class CapabilityRun:
         when the choice breaks an assumption: the violation is added to ``result``)."""
         chosen = None
         if self.choose:
-            self.proposed = self._proposal(capability, state, node)
+            self._asked = (capability, state, node)
             chosen = self.choose(state.state_path, list(state.outcomes))
         if chosen is not None:
             candidates, chosen_by = [chosen], CHOSEN_BY_OPERATOR
@@ -172,6 +172,12 @@ class CapabilityRun:
         outcome = candidates[0]
         result.violations.append(self._broken_assumption(node, capability, outcome, chosen_by, len(result.steps) + 1))
         return outcome, chosen_by, None
+
+    @property
+    def proposed(self) -> str:
+        """What the robot (or the script) answers for the state ``choose`` is asked about, with
+        the sensors as they are now (``choose`` may change ``sensors``: an operator's)."""
+        return self._proposal(*self._asked) if self._asked else ''
 
     def _proposal(self, capability: str, state: State, node: dict) -> str:
         """The outcome the script gives ``capability``, else the robot's first one the sensors allow."""

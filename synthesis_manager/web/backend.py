@@ -334,7 +334,7 @@ class SynthesisBackend:
                                          f'(sensors: {", ".join(support.get("sensors", ())) or "none"})', unknown[0])
         simulation = Simulation(id=f'{job_id}-sim{next(self._counter)}', job_id=job_id, fail_first=fail_first,
                                 operator={'autonomy': autonomy, 'paused': False, 'waiting': None},
-                                sensors=dict(sensors))
+                                sensors=dict(sensors), sensor_names=tuple(support.get('sensors', ())))
         with self._lock:
             self._admit_simulation(job_id)
             self._simulations[simulation.id] = simulation
@@ -441,6 +441,9 @@ class SynthesisBackend:
             command = checked_command(checked_body({} if body is None else body))
         except CommandError as error:
             raise InvalidJobRequestError(str(error), 'command') from None
+        if command['command'] == 'sensor' and command['name'] not in simulation.sensor_names:
+            raise InvalidJobRequestError(f'{quoted(command["name"])} is no sensor of this run\'s robot '
+                                         f'(sensors: {", ".join(simulation.sensor_names) or "none"})', command['name'])
         with self._lock:
             child = self._simulation_children.get(simulation_id)
         if child is None or simulation.state == 'finished' or not child.command(command):

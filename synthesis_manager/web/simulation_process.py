@@ -163,7 +163,7 @@ def simulate_capability_robot(settings: dict, progress: Callable[[dict], None],
     (``atlas_sim.executive.capability_run``, no physics) with the operator's ``commands``: each
     state's answer waits for the operator where the autonomy level asks it (confirm it, or force
     another outcome: CapabilityRun's ``choose``), ``fail_first`` capabilities answer their failure,
-    ``sensors`` are as the operator set them. Reports the steps as atlas_sim's trace steps, and
+    ``sensors`` are held as the operator set them (at the start, or by a ``sensor`` command). Reports the steps as atlas_sim's trace steps, and
     the trace check with each violation worded with who chose the answer."""
     machine_steps: list[dict] = []
     control = RuntimeControl(commands, report=lambda status: report(), autonomy_level=settings.get('autonomy', FULL)) \
@@ -198,12 +198,22 @@ def simulate_capability_robot(settings: dict, progress: Callable[[dict], None],
         by_path = {state.state_path: (state, capability_of(state, capabilities)) for state in machine.states}
         deadline = time.monotonic() + settings['max_wall_time']
 
+        def take_sensors():  # the operator's sensor changes, from this answer on
+            for name, value in control.sensors.items():
+                if value is None:
+                    run.sensors.pop(name, None)
+                else:
+                    run.sensors[name] = value
+            control.sensors.clear()
+
         def choose(path: str, outcomes: list[str]) -> str | None:
-            """The operator's outcome for the state at ``path``, or None: the robot's own."""
+            """The operator's outcome for the state at ``path``, or None: the robot's own (with
+            the sensors as the operator left them when the answer was confirmed)."""
             report(pending=path)
             if control is None:
                 return None
             control.between_ticks(path, deadline)
+            take_sensors()
             forced = control.take_forced([path])
             if forced:
                 return forced[1] if forced[1] in outcomes else None
@@ -211,6 +221,7 @@ def simulate_capability_robot(settings: dict, progress: Callable[[dict], None],
             required = capabilities.capabilities[capability].autonomy.get(run.proposed, 0) if capability else 0
             before = len(control.events)
             answer = control.confirm(path, run.proposed, required, outcomes, deadline)
+            take_sensors()
             forced_now = any(event.get('command') == 'force' and event.get('state') == path
                              for event in control.events[before:])
             return answer if forced_now else None

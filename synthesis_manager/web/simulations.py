@@ -15,6 +15,7 @@ class Simulation:
     job_id: str
     fail_first: tuple[str, ...] = ()   # capabilities whose first attempt fails (a capability robot's: always)
     sensors: dict = field(default_factory=dict)  # a capability robot's sensors as the run starts
+    sensor_names: tuple[str, ...] = ()  # the sensors an operator may set (a capability robot's)
     state: str = 'running'             # running -> finished
     steps: list[dict] = field(default_factory=list)  # atlas_sim TraceStep dicts so far
     robot_time: float = 0.0

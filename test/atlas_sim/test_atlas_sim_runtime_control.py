@@ -131,8 +131,11 @@ def test_a_wait_ends_at_the_wall_time_limit():
 
 def test_commands_are_checked():
     assert checked_command({'command': 'pause'}) == {'command': 'pause'}
+    sensor = {'command': 'sensor', 'name': 'battery_low', 'value': None}   # a capability robot's, freed
+    assert checked_command(sensor) == sensor
     for bad in [{'command': 'dance'}, {'command': 'autonomy', 'level': 7}, {'command': 'force', 'state': '/a'},
-                {'command': 'confirm'}, 'pause']:
+                {'command': 'confirm'}, 'pause', {'command': 'sensor', 'name': 'battery_low', 'value': 1},
+                {'command': 'sensor', 'value': True}]:
         with pytest.raises(CommandError):
             checked_command(bad)
 

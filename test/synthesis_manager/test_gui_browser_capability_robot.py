@@ -131,6 +131,19 @@ def test_synthesize_then_simulate_with_runtime_control_forcing_low_and_a_failing
                             'with battery_low=false; the task assumed env_trans'), check
     assert page.locator('#simulation-check.bad').count() == 1
 
+    # the operator sets the sensor during a run: the robot answers by it
+    page.select_option('#simulation-sensor-battery_low', '')
+    page.click('#simulate')
+    wait_for_question(page, 'check_battery returned “ok”')
+    page.select_option('#simulation-sensor-battery_low', 'true')
+    page.click('#operator-confirm')
+    page.wait_for_selector('#simulation-steps tr[data-state] >> nth=0')
+    page.wait_for_function("(document.querySelector('#simulation-steps tr[data-state]') || {}).innerText"
+                           "?.includes('check_battery low (chosen by the robot)')", timeout=60_000)
+    page.click('#stop-run')
+    page.wait_for_function(STATUS_DONE, timeout=60_000)
+    assert 'the operator stopped the run' in page.inner_text('#simulation-status')
+
 
 def test_suggest_fixes_repairs_a_refused_rover_task(page):
     add_goals(page, ['drive', '!drive'])

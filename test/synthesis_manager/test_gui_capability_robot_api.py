@@ -102,3 +102,27 @@ def test_the_shelf_picker_on_the_same_surfaces(client):
                                                           'outcome': next(answers)})
     assert run['outcome'] == 'finished' and run['check']['ok'] is True
     assert [s['state_outcome'] for s in run['steps']] == ['empty', 'seen', 'done', 'done']
+
+
+def test_the_operator_sets_a_sensor_during_a_run_and_the_robot_answers_by_it(client):
+    _, job = run_job(client, ROVER_TASK)
+    started = client.post(f"/api/jobs/{job['id']}/simulations", json={'autonomy': 0}).json()
+    refused = client.post(f"/api/simulations/{started['id']}/control",
+                          json={'command': 'sensor', 'name': 'sonar', 'value': True})
+    assert refused.status_code == 422 and refused.json()['item'] == 'sonar'
+    asked = []
+
+    def answer(waiting):  # at the first answer the battery reads low; confirm what the robot says
+        if not asked:
+            sent = client.post(f"/api/simulations/{started['id']}/control",
+                               json={'command': 'sensor', 'name': 'battery_low', 'value': True})
+            assert sent.status_code == 202, sent.text
+        asked.append(waiting)
+        return {'command': 'confirm', 'state': waiting['state']}
+    run = operate(client, started['id'], answer)
+    assert run['outcome'] == 'finished' and run['check']['ok'] is True, run
+    steps = [(s['capabilities'][0], s['state_outcome'], s['chosen_by']) for s in run['steps']]
+    # the robot read the sensor the operator set: low, so it charged (which leaves the battery not low)
+    assert steps[:2] == [('check_battery', 'low', 'the robot'), ('charge', 'done', 'the robot')], steps
+    assert steps[-1] == ('hand_over', 'done', 'the robot')
+    assert {'command': 'sensor', 'name': 'battery_low', 'value': True} in run['operator_events']

@@ -5,7 +5,7 @@ import * as drawing from './drawing.js';
 import { $, element } from './dom.js';
 import { capabilityNames, sensors, simulationSupport } from './form.js';
 import { resetFrames, showFrames } from './frames.js';
-import { controlRun, startingAutonomy } from './runtime_control.js';
+import { command, controlRun, startingAutonomy } from './runtime_control.js';
 import { vocabulary } from './vocabulary.js';
 
 let offeredJob = null;        // the job whose machine the Simulate button runs
@@ -37,6 +37,11 @@ export function offerSimulation(job) {
         element('option', { value: 'true', text: 'true' }), element('option', { value: 'false', text: 'false' })));
   }));
   $('simulation-sensors').hidden = !sensors().length;
+  // During a run a change holds from the state's next answer on (Runtime Control's sensor command).
+  for (const select of $('simulation-sensors').querySelectorAll('select')) {
+    select.addEventListener('change', () => command({ command: 'sensor', name: select.dataset.sensor,
+      value: select.value ? select.value === 'true' : null }));
+  }
   $('simulation-section').hidden = false;
 }
 

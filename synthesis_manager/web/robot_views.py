@@ -77,7 +77,8 @@ class ModeRobotView:
         if section.get('stand_in'):
             return {'available': False,
                     'note': f'No simulation for {self.robot.name}: {" ".join(str(section["stand_in"]).split())}'}
-        return {'available': True, 'note': '', 'frames': True, 'simulator': 'atlas_sim: MuJoCo humanoid'}
+        return {'available': True, 'note': '', 'frames': True, 'simulator': 'atlas_sim: MuJoCo humanoid',
+                'faults': 'the first attempt of this capability fails (fault injection)'}
 
 
 class CapabilityRobotView:
@@ -170,7 +171,8 @@ class CapabilityRobotView:
     def simulation_support(self, can_simulate: bool) -> dict:
         del can_simulate  # no physics: nothing to install
         return {'available': True, 'note': '', 'frames': False, 'sensors': list(self.capabilities.spec_inputs),
-                'simulator': 'a simulated capability robot: each state answers one of its outcomes, no physics'}
+                'simulator': 'a simulated capability robot: each state answers one of its outcomes, no physics',
+                'faults': 'this capability answers the outcome it fails with, every time (fault injection)'}
 
 
 def robot_view(robot: RobotSystem) -> ModeRobotView | CapabilityRobotView:

@@ -7,6 +7,10 @@ path, synthesis, a simulation with Runtime Control (the operator forces the batt
 directory, the graph and the run waiting for the operator are also written there
 (docs/gui-capability-graph.png, docs/gui-capability-run.png)."""
 
+import io
+import zipfile
+from pathlib import Path
+
 import pytest
 
 from test_gui_browser import browser_context, gui_server, open_page, result_code  # noqa: F401
@@ -92,7 +96,13 @@ def test_synthesize_then_simulate_with_runtime_control_forcing_low_and_a_failing
     page.click('#synthesize')
     assert result_code(page) == 'SUCCESS'
     page.wait_for_selector('.graph-viewport svg g.node')
+    with page.expect_download() as download_info:  # the behavior package, on FlexBE's own states
+        page.click('a[data-artifact="flexbe_behavior.zip"]')
+    package = zipfile.ZipFile(io.BytesIO(Path(download_info.value.path()).read_bytes()))
+    code = next(package.read(name).decode() for name in package.namelist() if name.endswith('_sm.py'))
+    assert 'from flexbe_states.operator_decision_state import OperatorDecisionState' in code
     assert page.is_visible('#simulation-controls') and page.is_hidden('#simulation-note')
+    assert 'every time' in page.get_attribute('label[for="fail-first"]', 'title')
     assert page.is_visible('#simulation-sensor-battery_low')
     assert 'simulated capability robot' in page.inner_text('#simulator-name')
 

@@ -40,7 +40,9 @@ def test_the_form_offers_what_the_capabilities_make_true_and_the_sensor_with_its
                                                                                      ('!battery_ok', 'low')}
     assert choices['simulation'] == {'available': True, 'note': '', 'frames': False, 'sensors': ['battery_low'],
                                      'simulator': 'a simulated capability robot: each state answers one of its '
-                                                  'outcomes, no physics'}
+                                                  'outcomes, no physics',
+                                     'faults': 'this capability answers the outcome it fails with, every time '
+                                               '(fault injection)'}
     check = client.post('/api/goal-check', json={'system': 'delivery_rover', 'goals': []}).json()
     assert check['impossible_next'] == {}   # every goal offered can come first
     atlas = client.get('/api/systems/atlas').json()

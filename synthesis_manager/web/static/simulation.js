@@ -18,6 +18,7 @@ export function offerSimulation(job) {
   $('simulation-note').textContent = support.note;
   $('simulation-note').hidden = support.available;
   if (support.simulator) $('simulator-name').textContent = `(${support.simulator})`;
+  if (support.faults) document.querySelector('label[for="fail-first"]').title = support.faults;
   $('simulation-controls').hidden = !support.available;
   if (!support.available) {
     $('simulation-section').hidden = false;

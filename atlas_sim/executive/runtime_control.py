@@ -157,17 +157,28 @@ class RuntimeControl:
         return None
 
     def confirm(self, state_path: str, outcome: str, required: int, outcomes: list[str],
-                deadline: float | None) -> str:
+                deadline: float | None, until: Callable[[], bool] | None = None) -> str | None:
         """The outcome ``state_path`` goes on with once its transition on ``outcome`` (of
         ``required`` autonomy) may be taken: at once when the level allows it, else when the
-        operator confirms it, raises the level, or forces another outcome instead."""
+        operator confirms it, raises the level, or forces another outcome instead. None when
+        ``until()`` ended the wait first (a capability robot's sensor changed: the caller asks again)."""
         if not needs_confirmation(required, self.autonomy_level) and state_path not in self.forced:
             return outcome
         self.confirmed.discard(state_path)
+        interrupted = []
+
+        def done() -> bool:
+            if (state_path in self.confirmed or state_path in self.forced
+                    or not needs_confirmation(required, self.autonomy_level)):
+                return True
+            if until is not None and until():
+                interrupted.append(True)
+                return True
+            return False
         self._wait(state_path, {'kind': 'confirm', 'state': state_path, 'outcome': outcome, 'required': required,
-                                'outcomes': list(outcomes)},
-                   lambda: (state_path in self.confirmed or state_path in self.forced
-                            or not needs_confirmation(required, self.autonomy_level)), deadline)
+                                'outcomes': list(outcomes)}, done, deadline)
+        if interrupted:
+            return None
         self.confirmed.discard(state_path)
         forced = self.forced.pop(state_path, None)
         return forced if forced in outcomes else outcome

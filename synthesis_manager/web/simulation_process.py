@@ -208,7 +208,7 @@ def simulate_capability_robot(settings: dict, progress: Callable[[dict], None],
 
         def choose(path: str, outcomes: list[str]) -> str | None:
             """The operator's outcome for the state at ``path``, or None: the robot's own (with
-            the sensors as the operator left them when the answer was confirmed)."""
+            the sensors as the operator set them: a change while the answer waits asks again)."""
             report(pending=path)
             if control is None:
                 return None
@@ -217,11 +217,15 @@ def simulate_capability_robot(settings: dict, progress: Callable[[dict], None],
             forced = control.take_forced([path])
             if forced:
                 return forced[1] if forced[1] in outcomes else None
-            state, capability = by_path[path]
-            required = capabilities.capabilities[capability].autonomy.get(run.proposed, 0) if capability else 0
+            capability = by_path[path][1]
             before = len(control.events)
-            answer = control.confirm(path, run.proposed, required, outcomes, deadline)
-            take_sensors()
+            answer = None
+            while answer is None:  # asked again with the robot's new answer when the operator sets a sensor
+                proposed = run.proposed
+                required = capabilities.capabilities[capability].autonomy.get(proposed, 0) if capability else 0
+                answer = control.confirm(path, proposed, required, outcomes, deadline,
+                                         until=lambda: bool(control.sensors))
+                take_sensors()
             forced_now = any(event.get('command') == 'force' and event.get('state') == path
                              for event in control.events[before:])
             return answer if forced_now else None

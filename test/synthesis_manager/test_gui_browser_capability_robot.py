@@ -146,6 +146,7 @@ def test_synthesize_then_simulate_with_runtime_control_forcing_low_and_a_failing
     page.click('#simulate')
     wait_for_question(page, 'check_battery returned “ok”')
     page.select_option('#simulation-sensor-battery_low', 'true')
+    wait_for_question(page, 'check_battery returned “low”')   # asked again: the robot reads the sensor
     page.click('#operator-confirm')
     page.wait_for_selector('#simulation-steps tr[data-state] >> nth=0')
     page.wait_for_function("(document.querySelector('#simulation-steps tr[data-state]') || {}).innerText"

@@ -108,8 +108,7 @@ class CapabilityRobotView:
                 {'label': 'Made true by a capability', 'items': [
                     {'name': goal, 'hint': f'set by {", ".join(setters)}'} for goal, setters in self.goals().items()]},
                 {'label': 'Must not hold at the end', 'items': [
-                    {'name': f'!{goal}', 'hint': f'{goal} is false at the end'} for goal in self.goals()
-                    if not goal.startswith('!') and f'!{goal}' not in self.goals()]}],
+                    {'name': goal, 'hint': f'{goal[1:]} is false at the end'} for goal in self.negated_goals()]}],
             'default_initial_conditions': list(self.robot.default_initial_conditions),
             'sensors': [{'name': name, 'reported_by': self.reporters(name)} for name in capabilities.spec_inputs],
             'capability_graph': self.graph(),
@@ -125,6 +124,12 @@ class CapabilityRobotView:
                 for literal in literals:
                     goals.setdefault(clause_text((literal,)), []).append(f'{name} on {outcome}')
         return goals
+
+    def negated_goals(self) -> list[str]:
+        """What may also be asked not to hold at the end (CNU's goals may be negated): the
+        negation of each goal no capability makes false itself."""
+        goals = self.goals()
+        return [f'!{goal}' for goal in goals if not goal.startswith('!') and f'!{goal}' not in goals]
 
     def graph(self) -> dict:
         """The capability graph: each capability with the propositions its preconditions need
@@ -164,9 +169,8 @@ class CapabilityRobotView:
                 'initial values.' if spec else 'Unchecked, the robot starts with its memories at their initial values.')
 
     def impossible_next(self, initial_conditions, goals, strict_order: bool) -> dict[str, str]:
-        made = list(self.goals())
         return impossible_next_goals(self.robot, initial_conditions, goals, strict_order,
-                                     candidates=[*made, *(f'!{g}' for g in made if not g.startswith('!'))])
+                                     candidates=[*self.goals(), *self.negated_goals()])
 
     def simulation_support(self, can_simulate: bool) -> dict:
         del can_simulate  # no physics: nothing to install

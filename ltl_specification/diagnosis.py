@@ -147,12 +147,14 @@ def goal_findings(system, initial_conditions, goals, strict_order: bool = True,
 
 
 def impossible_next_goals(system, initial_conditions, goals, strict_order: bool = True,
-                          config_dir=None) -> dict[str, str]:
-    """For every action or mode that is not a goal yet: why it cannot be the next goal (if so)."""
+                          config_dir=None, candidates=None) -> dict[str, str]:
+    """For every one of ``candidates`` that is not a goal yet (default: the abstraction's actions
+    and modes; a capability robot's view gives what its capabilities make true): why it cannot
+    be the next goal (if so)."""
     system = load_task_system(system, config_dir)
     impossible = {}
-    candidates = list(system.capabilities.capabilities) if system.is_capability_system else \
-        load_task_abstraction(system).items()
+    if candidates is None:
+        candidates = load_task_abstraction(system).items()
     for candidate in candidates:
         if candidate in goals:
             continue

@@ -107,6 +107,8 @@ class CapabilityRun:
         self.nodes = {str(state['name']): state for state in automaton.get('states', automaton.get('automaton', ()))}
         self.initial = list(automaton['initial_states'])
         self.choose = choose  # (state path, outcomes) -> an outcome or None: the operator's choice
+        self._asked = None    # (capability, state, node) ``choose`` is asked about
+        self.result = CapabilityRunResult(None, [])  # the run so far (its steps), for a caller's progress
         self.sensors = dict(script.sensors)  # the sensors now: the script's, as the environment changes them
         self.max_steps = max_steps
         self.outcome_propositions = {capabilities.outcome_proposition(name, outcome)
@@ -115,7 +117,7 @@ class CapabilityRun:
 
     def run(self) -> CapabilityRunResult:
         states = {state.name: state for state in self.machine.states}
-        result = CapabilityRunResult(None, [])
+        result = self.result = CapabilityRunResult(None, [])
         node = self._initial_node()
         if node is None:
             result.violations.append('no initial state of the strategy has the sensors the script sets '
@@ -150,7 +152,10 @@ class CapabilityRun:
     def _answer(self, state: State, capability: str, node: dict, result: CapabilityRunResult):
         """The outcome answered for ``state``, who chose it and the strategy's next node (None
         when the choice breaks an assumption: the violation is added to ``result``)."""
-        chosen = self.choose(state.state_path, list(state.outcomes)) if self.choose else None
+        chosen = None
+        if self.choose:
+            self._asked = (capability, state, node)
+            chosen = self.choose(state.state_path, list(state.outcomes))
         if chosen is not None:
             candidates, chosen_by = [chosen], CHOSEN_BY_OPERATOR
         elif capability in self.script.outcomes:
@@ -167,6 +172,19 @@ class CapabilityRun:
         outcome = candidates[0]
         result.violations.append(self._broken_assumption(node, capability, outcome, chosen_by, len(result.steps) + 1))
         return outcome, chosen_by, None
+
+    @property
+    def proposed(self) -> str:
+        """What the robot (or the script) answers for the state ``choose`` is asked about, with
+        the sensors as they are now (``choose`` may change ``sensors``: an operator's)."""
+        return self._proposal(*self._asked) if self._asked else ''
+
+    def _proposal(self, capability: str, state: State, node: dict) -> str:
+        """The outcome the script gives ``capability``, else the robot's first one the sensors allow."""
+        if capability in self.script.outcomes:
+            return self.script.outcomes[capability]
+        preferred = self._preferred(capability, state)
+        return next((o for o in preferred if self._successor(node, capability, o, False) is not None), preferred[0])
 
     def _preferred(self, capability: str, state: State) -> list[str]:
         """The capability's outcomes, its success first and its failure last."""

@@ -12,6 +12,7 @@ so a GUI in another process can send them):
     {'command': 'force', 'state': '/stand', 'outcome': 'failed'}
     {'command': 'input', 'state': '/object_template', 'value': 1}   # None: the operator aborts
     {'command': 'pause'} / {'command': 'resume'} / {'command': 'stop'}
+    {'command': 'sensor', 'name': 'battery_low', 'value': True}   # a capability robot's; None: free
 
 While the executive waits for the operator (a confirmation, an answer, a pause) it does not
 step the robot, so the robot's clock stands still: the run's robot time is the robot's work
@@ -35,7 +36,7 @@ OFF, LOW, HIGH, FULL = 0, 1, 2, 3
 AUTONOMY_LEVELS = {'Off': OFF, 'Low': LOW, 'High': HIGH, 'Full': FULL}
 #: How long one wait for a command lasts before the executive looks at its limits again (s).
 WAIT_POLL_SECONDS = 0.05
-COMMANDS = ('autonomy', 'confirm', 'force', 'input', 'pause', 'resume', 'stop')
+COMMANDS = ('autonomy', 'confirm', 'force', 'input', 'pause', 'resume', 'stop', 'sensor')
 
 
 class OperatorStopError(ExecutionError):
@@ -73,6 +74,9 @@ def checked_command(command: Any) -> dict:
         raise CommandError(f'{kind}: state names the state (its path)')
     if kind == 'force' and not isinstance(command.get('outcome'), str):
         raise CommandError('force: outcome names one of the state\'s outcomes')
+    value = command.get('value')
+    if kind == 'sensor' and (not isinstance(command.get('name'), str) or not (value is None or isinstance(value, bool))):
+        raise CommandError('sensor: name names the sensor, value is true, false or null (as the environment reads it)')
     return command
 
 
@@ -90,6 +94,7 @@ class RuntimeControl:
         self.forced: dict[str, str] = {}       # state path -> outcome the operator forced
         self.confirmed: set[str] = set()       # states whose waiting transition was confirmed
         self.answers: dict[str, Any] = {}      # state path -> the operator's input
+        self.sensors: dict[str, bool | None] = {}  # a capability robot's sensors the operator set (None: freed)
         self.waiting: dict | None = None       # what the run waits for, as the GUI shows it
         self.events: list[dict] = []           # what the operator did, in order
 
@@ -117,6 +122,8 @@ class RuntimeControl:
             self.forced[command['state']] = command['outcome']
         elif kind == 'confirm':
             self.confirmed.add(command['state'])
+        elif kind == 'sensor':
+            self.sensors[command['name']] = command['value']
         else:
             self.answers[command['state']] = command.get('value')
         self.events.append(dict(command))
@@ -150,17 +157,28 @@ class RuntimeControl:
         return None
 
     def confirm(self, state_path: str, outcome: str, required: int, outcomes: list[str],
-                deadline: float | None) -> str:
+                deadline: float | None, until: Callable[[], bool] | None = None) -> str | None:
         """The outcome ``state_path`` goes on with once its transition on ``outcome`` (of
         ``required`` autonomy) may be taken: at once when the level allows it, else when the
-        operator confirms it, raises the level, or forces another outcome instead."""
+        operator confirms it, raises the level, or forces another outcome instead. None when
+        ``until()`` ended the wait first (a capability robot's sensor changed: the caller asks again)."""
         if not needs_confirmation(required, self.autonomy_level) and state_path not in self.forced:
             return outcome
         self.confirmed.discard(state_path)
+        interrupted = []
+
+        def done() -> bool:
+            if (state_path in self.confirmed or state_path in self.forced
+                    or not needs_confirmation(required, self.autonomy_level)):
+                return True
+            if until is not None and until():
+                interrupted.append(True)
+                return True
+            return False
         self._wait(state_path, {'kind': 'confirm', 'state': state_path, 'outcome': outcome, 'required': required,
-                                'outcomes': list(outcomes)},
-                   lambda: (state_path in self.confirmed or state_path in self.forced
-                            or not needs_confirmation(required, self.autonomy_level)), deadline)
+                                'outcomes': list(outcomes)}, done, deadline)
+        if interrupted:
+            return None
         self.confirmed.discard(state_path)
         forced = self.forced.pop(state_path, None)
         return forced if forced in outcomes else outcome

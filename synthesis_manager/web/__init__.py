@@ -5,7 +5,9 @@
     jobs          what the page asks for (JobRequest), a job's record, progress and summary
     outcome       JobOutcome: what a job ended with, typed until a route makes JSON of it
     vocabulary    the Python names the page needs (GET /api/vocabulary)
+    robot_views   what each surface asks of a robot, answered per kind (modes, capabilities)
     simulations   a closed-loop run's record
+    simulation_process  a run in its child process (atlas_sim's ATLAS, or a capability robot)
     artifacts     the downloads built from a finished job
     picture       the machine's SVG: Graphviz' dot, else Graphviz compiled to WebAssembly with Node
                   (render_dot.mjs; @viz-js/viz from npm, installed by `make setup`)

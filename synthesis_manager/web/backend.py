@@ -16,21 +16,18 @@ from pathlib import Path
 from typing import Callable
 
 from atlas_sim.executive.runtime_control import AUTONOMY_LEVELS, FULL, CommandError, checked_command
-from ltl_specification.diagnosis import goal_findings, impossible_next_goals
-from ltl_specification.capability_precheck import clause_text
+from ltl_specification.diagnosis import goal_findings
 from ltl_specification.repair_process import RepairSearch, RepairSearchError, repair_settings
-from ltl_specification.systems import load_task_abstraction
 from respec.errors import INTERNAL_ERROR, CodedError, ErrorCode, quoted
-from respec.naming import DEFAULT_SM_OUTCOMES, FINISHED
 from respec.robot import RobotSystem, SystemCatalog
-from respec.robot.files import SystemConfigError
 from sm_generation.state_machine import StateMachine
 from synthesis_manager.limits import BusyError
 from synthesis_manager.web.artifacts import ARTIFACTS, Artifact, download_filename
 from synthesis_manager.web.errors import (ArtifactFailedError, InvalidJobRequestError, NotAvailableError,
                                           NotFoundError)
-from synthesis_manager.web.jobs import JOB_OPTIONS, Job, JobRequest, ProgressNote, checked_body, names_field
+from synthesis_manager.web.jobs import Job, JobRequest, ProgressNote, checked_body, names_field
 from synthesis_manager.web.outcome import JobOutcome
+from synthesis_manager.web.robot_views import common_choices, robot_view
 from synthesis_manager.web.plays import Plays, play_body_moves
 from synthesis_manager.web.simulation_process import SimulationProcess
 from synthesis_manager.web.simulations import Simulation, simulation_available
@@ -127,44 +124,17 @@ class SynthesisBackend:
         return self.catalog.load(system)
 
     def choices(self, system: str) -> dict:
-        """The control modes and actions of ``system``, in file order, with their relations (a
-        capability robot's capabilities are its actions; it has no control modes)."""
+        """What the form offers for ``system`` and what the abstraction panel draws, as its view
+        (web/robot_views.py) answers, with whether the GUI can simulate it."""
         try:
             robot = self.robot_system(system)
-            if robot.is_capability_system:
-                modes = {}
-                actions = {name: [clause_text(clause) for clause in capability.preconditions]
-                           for name, capability in robot.capabilities.capabilities.items()}
-            else:
-                abstraction = load_task_abstraction(robot)
-                modes, actions = abstraction.control_modes, abstraction.actions
+            view = robot_view(robot)
+            choices = common_choices(robot, view)
         except NotFoundError:
             raise
         except CodedError as error:
             raise NotAvailableError(str(error), error.item or system) from error
-        return {
-            'system': system,
-            'control_modes': [{'name': m, 'next': list(n)} for m, n in modes.items()],
-            'actions': [{'name': a, 'preconditions': list(p)} for a, p in actions.items()],
-            'default_initial_conditions': list(modes)[:1],
-            'sm_outcome_choices': [list(DEFAULT_SM_OUTCOMES), [FINISHED]],
-            'options': list(JOB_OPTIONS),
-            'simulation': self.simulation_support(robot),
-            # A capability robot's goal may also be that something does not hold ('!drive').
-            'negated_goals': robot.is_capability_system,
-        }
-
-    def simulation_support(self, robot: RobotSystem) -> dict:
-        """Whether atlas_sim can run the system's machines, and if not, why (in plain words)."""
-        if not self.can_simulate:
-            return {'available': False, 'note': 'Simulation needs atlas_sim and MuJoCo, which are not installed.'}
-        try:
-            section = robot.section('simulation')
-        except SystemConfigError:
-            return {'available': False, 'note': f'{robot.name} has no simulation section: atlas_sim cannot run it.'}
-        if section.get('stand_in'):
-            return {'available': False, 'note': f'No simulation for {robot.name}: {" ".join(str(section["stand_in"]).split())}'}
-        return {'available': True, 'note': ''}
+        return {**choices, 'simulation': view.simulation_support(self.can_simulate)}
 
     def goal_check(self, body) -> dict:
         """The request form's live check: chosen goals that can never be achieved, and why each
@@ -190,7 +160,7 @@ class SynthesisBackend:
         try:
             robot = self.catalog.load(system)
             findings = goal_findings(robot, initial_conditions, goals, strict_order)
-            impossible = impossible_next_goals(robot, initial_conditions, goals, strict_order)
+            impossible = robot_view(robot).impossible_next(initial_conditions, goals, strict_order)
         except CodedError as error:  # e.g. an invalid abstraction: the synthesis will say it
             raise NotAvailableError(str(error), error.item or system) from error
         return {'findings': [dataclasses.asdict(f) for f in findings], 'impossible_next': impossible}
@@ -354,33 +324,39 @@ class SynthesisBackend:
         """Run the state machine of a finished job on atlas_sim's simulated robot."""
         job = self._job(job_id)
         body = checked_body({} if body is None else body)
-        unknown = sorted(set(body) - {'fail_first', 'autonomy'})
+        unknown = sorted(set(body) - {'fail_first', 'autonomy', 'sensors'})
         if unknown:
-            raise InvalidJobRequestError(f'unknown field {quoted(unknown[0])} (fields: fail_first, autonomy)',
+            raise InvalidJobRequestError(f'unknown field {quoted(unknown[0])} (fields: fail_first, autonomy, sensors)',
                                          unknown[0])
         fail_first = names_field(body, 'fail_first')
+        sensors = body.get('sensors', {})
+        if not isinstance(sensors, dict) or not all(isinstance(v, bool) for v in sensors.values()):
+            raise InvalidJobRequestError('sensors is an object of sensor names to true or false', 'sensors')
         autonomy = body.get('autonomy', FULL)
         if autonomy not in AUTONOMY_LEVELS.values() or isinstance(autonomy, bool):
             raise InvalidJobRequestError('autonomy is 0 (Off), 1 (Low), 2 (High) or 3 (Full)', 'autonomy')
-        if not self.can_simulate:
-            raise NotAvailableError('simulation needs atlas_sim and MuJoCo, which are not installed',
-                                    'atlas_sim')
         if not (job.finished and job.outcome.states):
             raise NotAvailableError(f'job {quoted(job_id)} has no state machine to simulate', job_id)
         try:
             robot = self.catalog.load(job.request.system)
         except CodedError as error:
             raise NotAvailableError(str(error), error.item or job.request.system) from error
-        support = self.simulation_support(robot)
+        view = robot_view(robot)
+        support = view.simulation_support(self.can_simulate)
         if not support['available']:
             raise NotAvailableError(support['note'], job.request.system)
+        unknown = sorted(set(sensors) - set(support.get('sensors', ())))
+        if unknown:
+            raise InvalidJobRequestError(f'{quoted(unknown[0])} is no sensor of {job.request.system} '
+                                         f'(sensors: {", ".join(support.get("sensors", ())) or "none"})', unknown[0])
         simulation = Simulation(id=f'{job_id}-sim{next(self._counter)}', job_id=job_id, fail_first=fail_first,
-                                operator={'autonomy': autonomy, 'paused': False, 'waiting': None})
+                                operator={'autonomy': autonomy, 'paused': False, 'waiting': None},
+                                sensors=dict(sensors), sensor_names=tuple(support.get('sensors', ())))
         with self._lock:
             self._admit_simulation(job_id)
             self._simulations[simulation.id] = simulation
-        threading.Thread(target=self._simulate, args=(simulation, job, robot), name=f'gui-{simulation.id}',
-                         daemon=True).start()
+        threading.Thread(target=self._simulate, args=(simulation, job, robot, view.simulator),
+                         name=f'gui-{simulation.id}', daemon=True).start()
         return simulation
 
     def _admit_simulation(self, job_id: str):
@@ -430,9 +406,10 @@ class SynthesisBackend:
             raise NotFoundError(f'unknown simulation {quoted(simulation_id)}', simulation_id)
         return simulation
 
-    def _simulate(self, simulation: Simulation, job: Job, robot: RobotSystem):
-        """Run ``simulation`` of ``job`` on ``robot`` in its child process (web/simulation_process.py),
-        following it. The child gets the system's files as read here, not a path to read them again."""
+    def _simulate(self, simulation: Simulation, job: Job, robot: RobotSystem, simulator: str):
+        """Run ``simulation`` of ``job`` on ``robot`` in its child process (web/simulation_process.py,
+        its function ``simulator``: the robot view's), following it. The child gets the system's
+        files as read here, not a path to read them again."""
         request, started = job.request, time.monotonic()
         child = SimulationProcess({
             'states': [state.to_dict() for state in job.outcome.states],
@@ -441,7 +418,8 @@ class SynthesisBackend:
             'initial_conditions': list(request.initial_conditions), 'goals': list(request.goals),
             'ordered': not request.unordered, 'fail_first': list(simulation.fail_first),
             'record_dir': str(self._record_dir(simulation.id)), 'max_robot_time': 300.0, 'max_wall_time': 300.0,
-            'autonomy': simulation.operator['autonomy']})
+            'autonomy': simulation.operator['autonomy'], 'automaton': job.outcome.automaton,
+            'sensors': dict(simulation.sensors)}, simulator)
         with self._lock:
             self._simulation_processes.add(child)
             self._simulation_children[simulation.id] = child
@@ -480,6 +458,9 @@ class SynthesisBackend:
             command = checked_command(checked_body({} if body is None else body))
         except CommandError as error:
             raise InvalidJobRequestError(str(error), 'command') from None
+        if command['command'] == 'sensor' and command['name'] not in simulation.sensor_names:
+            raise InvalidJobRequestError(f'{quoted(command["name"])} is no sensor of this run\'s robot '
+                                         f'(sensors: {", ".join(simulation.sensor_names) or "none"})', command['name'])
         with self._lock:
             child = self._simulation_children.get(simulation_id)
         if child is None or simulation.state == 'finished' or not child.command(command):

@@ -46,10 +46,13 @@ logger = logging.getLogger(__name__)
 
 
 class SimulationProcess:
-    """One run in its child process (``settings``: see :func:`simulate`)."""
+    """One run in its child process (``settings``: see :func:`simulate`), by ``simulator``: the
+    name of this module's function that runs it (``simulate``: atlas_sim's ATLAS;
+    ``simulate_capability_robot``: a capability robot without physics)."""
 
-    def __init__(self, settings: dict):
+    def __init__(self, settings: dict, simulator: str = 'simulate'):
         self.settings = settings
+        self.simulator = globals()[simulator]
         self.child = ChildProcess(preload=__name__, environment=CHILD_ENVIRONMENT)
         self.process = self.child.process
 
@@ -65,7 +68,7 @@ class SimulationProcess:
             on_progress(update)
 
         try:
-            return self.child.call(simulate, (self.settings,), on_progress=progress, wants_commands=True,
+            return self.child.call(self.simulator, (self.settings,), on_progress=progress, wants_commands=True,
                                    deadline=time.monotonic() + self.settings['max_wall_time'] + KILL_GRACE)
         except SynthesisError:  # the child died, was stopped or overran its time
             pass
@@ -152,6 +155,113 @@ def simulate(settings: dict, progress: Callable[[dict], None], commands: Callabl
                           'item': getattr(error, 'item', ''), 'message': str(error)},
                 'steps': [dataclasses.asdict(step) for step in trace.steps] if trace else None,
                 'frames': frames(now=True)}
+
+
+def simulate_capability_robot(settings: dict, progress: Callable[[dict], None],
+                              commands: Callable[[float], list] | None = None) -> dict:
+    """In the child: run a capability robot's machine on the simulated capability robot
+    (``atlas_sim.executive.capability_run``, no physics) with the operator's ``commands``: each
+    state's answer waits for the operator where the autonomy level asks it (confirm it, or force
+    another outcome: CapabilityRun's ``choose``), ``fail_first`` capabilities answer their failure,
+    ``sensors`` are held as the operator set them (at the start, or by a ``sensor`` command). Reports the steps as atlas_sim's trace steps, and
+    the trace check with each violation worded with who chose the answer."""
+    machine_steps: list[dict] = []
+    control = RuntimeControl(commands, report=lambda status: report(), autonomy_level=settings.get('autonomy', FULL)) \
+        if commands else None
+    run, active = None, ['', -1]   # the state being answered and the steps taken before it
+
+    def report(pending: str = ''):
+        steps = capability_steps(run.result.steps, machine) if run else []
+        if pending:
+            active[:] = [pending, len(steps)]
+        pending = active[0] if active[1] == len(steps) else ''
+        if pending:
+            steps.append({'index': len(steps), 'state': pending, 'capabilities': [by_path[pending][1]],
+                          'activated': [by_path[pending][1]], 'results': [], 'state_outcome': '', 'transition': '',
+                          'entered_at': 0.0, 'ended_at': 0.0})
+        machine_steps[:] = steps
+        progress({'robot_time': 0.0, 'steps': steps, 'frames': [], 'operator': control.status() if control else None})
+
+    try:
+        from atlas_sim.executive.capability_run import CapabilityRun, capability_of, parse_script
+        from respec.parsing import spec_from_text_sections
+        from respec.robot import robot_system_from_files
+        from respec.robot.state_library import capability_outcomes, workspace_state_library
+        from sm_generation.state_machine import StateMachine
+
+        system = robot_system_from_files(settings['system'], settings['files'], settings['config_file'])
+        capabilities = system.capabilities
+        script = parse_script(capabilities, capability_outcomes(capabilities, workspace_state_library()),
+                              list(settings['fail_first']),
+                              [f'{name}={"true" if value else "false"}' for name, value in settings['sensors'].items()])
+        machine = StateMachine.from_instantiations(settings['states'])
+        by_path = {state.state_path: (state, capability_of(state, capabilities)) for state in machine.states}
+        deadline = time.monotonic() + settings['max_wall_time']
+
+        def take_sensors():  # the operator's sensor changes, from this answer on
+            for name, value in control.sensors.items():
+                if value is None:
+                    run.sensors.pop(name, None)
+                else:
+                    run.sensors[name] = value
+            control.sensors.clear()
+
+        def choose(path: str, outcomes: list[str]) -> str | None:
+            """The operator's outcome for the state at ``path``, or None: the robot's own (with
+            the sensors as the operator set them: a change while the answer waits asks again)."""
+            report(pending=path)
+            if control is None:
+                return None
+            control.between_ticks(path, deadline)
+            take_sensors()
+            forced = control.take_forced([path])
+            if forced:
+                return forced[1] if forced[1] in outcomes else None
+            capability = by_path[path][1]
+            before = len(control.events)
+            answer = None
+            while answer is None:  # asked again with the robot's new answer when the operator sets a sensor
+                proposed = run.proposed
+                required = capabilities.capabilities[capability].autonomy.get(proposed, 0) if capability else 0
+                answer = control.confirm(path, proposed, required, outcomes, deadline,
+                                         until=lambda: bool(control.sensors))
+                take_sensors()
+            forced_now = any(event.get('command') == 'force' and event.get('state') == path
+                             for event in control.events[before:])
+            return answer if forced_now else None
+
+        spec = spec_from_text_sections(settings['ltl_specification'])
+        run = CapabilityRun(machine, settings['automaton'], capabilities, spec, script, choose=choose)
+        result = run.run()
+        steps = capability_steps(result.steps, machine)
+        if result.not_finished and not result.violations:
+            return {'error': {'code': 'TIMEOUT', 'item': steps[-1]['state'] if steps else '',
+                              'message': result.not_finished}, 'steps': steps}
+        violations = [{'kind': 'guarantee' if 'broke a guarantee' in text else 'assumption', 'message': text}
+                      for text in result.violations]
+        return {'result': {'outcome': result.outcome, 'robot_time': 0.0, 'steps': steps, 'timeline': None, 'frames': [],
+                           'check': {'ok': not violations, 'outcome': result.outcome, 'positions': len(steps),
+                                     'goals': list(settings['goals']), 'goals_completed_at': {},
+                                     'violations': violations},
+                           'operator_events': control.events if control else []}}
+    except Exception as error:  # a bad script, the operator's stop, a missing state class: reported to the GUI
+        if not isinstance(error, CodedError):
+            logger.exception('capability simulation failed')
+        return {'error': {'code': error.code if isinstance(error, CodedError) else INTERNAL_ERROR,
+                          'item': getattr(error, 'item', ''), 'message': str(error)},
+                'steps': machine_steps or None}
+
+
+def capability_steps(steps, machine) -> list[dict]:
+    """A capability run's steps (CapabilityRun's RunStep) as the page shows atlas_sim's trace
+    steps: the state, its capability, the outcome it answered (and who chose it) and where the
+    machine went on. No physics: no robot time passes."""
+    by_path = {state.state_path: state for state in machine.states}
+    return [{'index': index, 'state': step.state, 'capabilities': [step.capability], 'activated': [step.capability],
+             'results': [{'capability': step.capability, 'outcome': step.outcome}], 'state_outcome': step.outcome,
+             'transition': by_path[step.state].next_target(step.outcome), 'chosen_by': step.chosen_by,
+             'forced': step.outcome if step.chosen_by == 'the operator' else '', 'entered_at': 0.0, 'ended_at': 0.0}
+            for index, step in enumerate(steps)]
 
 
 def recorded_frames(directory: Path) -> list[str]:

@@ -13,7 +13,9 @@ class Simulation:
 
     id: str
     job_id: str
-    fail_first: tuple[str, ...] = ()   # capabilities whose first attempt fails
+    fail_first: tuple[str, ...] = ()   # capabilities whose first attempt fails (a capability robot's: always)
+    sensors: dict = field(default_factory=dict)  # a capability robot's sensors as the run starts
+    sensor_names: tuple[str, ...] = ()  # the sensors an operator may set (a capability robot's)
     state: str = 'running'             # running -> finished
     steps: list[dict] = field(default_factory=list)  # atlas_sim TraceStep dicts so far
     robot_time: float = 0.0
@@ -29,6 +31,7 @@ class Simulation:
 
     def to_dict(self) -> dict:
         return {'id': self.id, 'job_id': self.job_id, 'fail_first': list(self.fail_first),
+                'sensors': dict(self.sensors),
                 'state': self.state, 'steps': list(self.steps), 'robot_time': round(self.robot_time, 3),
                 'frames': [{'index': i, 'label': p.stem} for i, p in enumerate(self.frames)],
                 'timeline': self.timeline_png is not None, 'outcome': self.outcome,

@@ -130,3 +130,22 @@ def test_execute_runs_the_delivery_rover_and_names_a_scripted_failure(flexbe):
     assert "drive answered 'failed'" in stderr and '--fail drive:failed' in stderr
     status, report, _ = execute('--fail', 'check_battery:low', '--sensor', 'battery_low=false')
     assert status == 7 and "The script answered 'low' on check_battery" in report['trace_check']['violations'][0]
+
+
+@pytest.mark.flexbe
+def test_execute_runs_the_shelf_picker_the_second_shipped_capability_robot(flexbe):
+    """config/shelf_picker (issue 45, item 6): its look reports a sensor and its grasp can fail."""
+    environment = dict(os.environ, AMENT_PREFIX_PATH=str(flexbe), ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST')
+
+    def execute(*arguments):
+        done = subprocess.run([CLI, 'execute', '--system', 'shelf_picker', '--goals', 'place', '--json', *arguments],
+                              capture_output=True, text=True, timeout=300, env=environment)
+        return done.returncode, json.loads(done.stdout), done.stderr
+
+    status, report, _ = execute()
+    assert status == 0 and report['outcome'] == 'finished' and report['trace_check']['ok']
+    assert [step['capability'] for step in report['steps']] == ['look', 'grasp', 'place']
+    status, report, _ = execute('--fail', 'grasp')          # the grasp fails: the machine ends failed
+    assert status == 6 and report['outcome'] == 'failed' and report['steps'][-1]['chosen_by'] == 'the script'
+    status, report, stderr = execute('--sensor', 'item_on_shelf=false')   # never restocked: looks forever
+    assert status == 8 and "look answered 'empty' 200 times" in stderr

@@ -129,10 +129,26 @@ def test_a_wait_ends_at_the_wall_time_limit():
     assert limit.value.item == '/stand' and 'waited for the operator: confirm' in str(limit.value)
 
 
+def test_a_sensor_set_while_a_confirmation_waits_ends_the_wait_to_ask_again():
+    """A capability robot's run: the operator's sensor changes the robot's answer, so the wait
+    for the old one ends (None) and the caller asks again; a confirmation then goes on."""
+    commands = [[{'command': 'sensor', 'name': 'battery_low', 'value': True}],
+                [{'command': 'confirm', 'state': '/check'}]]
+    control = RuntimeControl(lambda timeout: commands.pop(0) if commands else [], autonomy_level=OFF)
+    assert control.confirm('/check', 'ok', 0, ['ok', 'low'], None, until=lambda: bool(control.sensors)) is None
+    assert control.sensors == {'battery_low': True}
+    control.sensors.clear()
+    assert control.confirm('/check', 'low', 0, ['ok', 'low'], None, until=lambda: bool(control.sensors)) == 'low'
+    assert control.waiting is None
+
+
 def test_commands_are_checked():
     assert checked_command({'command': 'pause'}) == {'command': 'pause'}
+    sensor = {'command': 'sensor', 'name': 'battery_low', 'value': None}   # a capability robot's, freed
+    assert checked_command(sensor) == sensor
     for bad in [{'command': 'dance'}, {'command': 'autonomy', 'level': 7}, {'command': 'force', 'state': '/a'},
-                {'command': 'confirm'}, 'pause']:
+                {'command': 'confirm'}, 'pause', {'command': 'sensor', 'name': 'battery_low', 'value': 1},
+                {'command': 'sensor', 'value': True}]:
         with pytest.raises(CommandError):
             checked_command(bad)
 

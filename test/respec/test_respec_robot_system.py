@@ -111,11 +111,11 @@ def test_unchanged_files_are_not_parsed_again_and_any_edit_is_seen(tmp_path, fle
 
 
 def test_the_catalog_lists_and_loads_the_systems_of_its_folders(tmp_path):
-    assert SystemCatalog().names() == ['atlas', 'delivery_rover', 'mobile_manipulator']
+    assert SystemCatalog().names() == ['atlas', 'delivery_rover', 'mobile_manipulator', 'shelf_picker']
     assert isinstance(SystemCatalog().load('mobile_manipulator'), RobotSystem)
     (tmp_path / 'tiny.yaml').write_text('abstraction:\n  actions: {wave: []}\n')
     catalog = SystemCatalog(tmp_path)  # adds to the shipped systems
-    assert catalog.names() == ['atlas', 'delivery_rover', 'mobile_manipulator', 'tiny']
+    assert catalog.names() == ['atlas', 'delivery_rover', 'mobile_manipulator', 'shelf_picker', 'tiny']
     assert catalog.load('tiny').abstraction.actions == {'wave': ()}
     assert catalog.load('atlas') == robot_system('atlas')
     # Loading reads afresh: an edit is seen by the next request.
@@ -137,7 +137,8 @@ def test_config_directories_add_to_the_shipped_systems_and_shadow_in_order(tmp_p
     joined = os.pathsep.join([str(first), str(second)])
     assert config_search_path(joined) == (first, second, CONFIG)
     assert config_search_path([first, str(second)]) == config_search_path(joined)
-    assert SystemCatalog(joined).names() == ['atlas', 'delivery_rover', 'mobile_manipulator', 'robot_b', 'tiny']
+    assert SystemCatalog(joined).names() == ['atlas', 'delivery_rover', 'mobile_manipulator', 'robot_b', 'shelf_picker',
+                                              'tiny']
     assert list(robot_system('tiny', joined).abstraction.actions) == ['wave']     # the first directory's
     assert list(robot_system('tiny', [second, first]).abstraction.actions) == ['nod']
     assert robot_system('atlas', joined).path == second / 'atlas.yaml'          # shadows config/atlas.yaml

@@ -45,12 +45,15 @@ def test_modes_and_preconditions_drawn_with_the_task_path_following_the_form(pag
     assert ids(page, '#mode-graph g.node', 'mode:') == ['driving', 'manipulating', 'parked']
 
 
-def test_a_capability_system_says_it_has_no_mode_graph_and_lists_its_preconditions(page):
+def test_a_capability_system_draws_its_capability_graph_instead_of_modes(page):
     page.select_option('#system', 'delivery_rover')
-    page.wait_for_selector('#abstraction-none')
-    assert 'delivery_rover is a capability system: it has no control modes' in page.inner_text('#abstraction-none')
+    page.wait_for_selector('#capability-graph')
     assert page.locator('#mode-graph').count() == 0
-    assert 'drive needs battery_ok' in page.inner_text('#abstraction-graphs')
+    # drive needs battery_ok, which the battery check (on completed) and the charge set
+    for edge in ('prop:battery_ok->cap:drive:', 'cap:check_battery->prop:battery_ok:completed',
+                 'cap:check_battery->prop:battery_ok:low: not', 'cap:charge->prop:battery_ok:completed',
+                 'cap:check_battery->sensor:battery_low:reports'):
+        assert page.locator(f'path[id="capability-edge:{edge}"]').count() == 1, edge
 
 
 def test_the_abstraction_folds_to_one_line_once_a_result_is_shown(page):

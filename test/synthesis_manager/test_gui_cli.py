@@ -112,7 +112,7 @@ def test_connect_joins_a_running_suite(reserved_domain, tmp_path):
         url = wait_for_line(gui, URL_LINE).group(1)
         assert f'ROS_DOMAIN_ID {reserved_domain}' in httpx.get(f'{url}api/info').json()['description']
         assert httpx.get(f'{url}api/systems').json()['systems'] == ['arm_only', 'atlas', 'delivery_rover',
-                                                                    'mobile_manipulator']
+                                                                    'mobile_manipulator', 'shelf_picker']
         arm = httpx.get(f'{url}api/systems/arm_only').json()
         assert [mode['name'] for mode in arm['control_modes']] == ['rest', 'reach']
         check = httpx.post(f'{url}api/goal-check', json={'system': 'arm_only', 'initial_conditions': ['rest'],

@@ -28,7 +28,8 @@ def test_a_client_sees_the_suite_systems_and_their_edits(ros, tmp_path):
     (tmp_path / 'broken.yaml').write_text('abstraction: [not, a, mapping]\n')
     ros.add_node(LTLCompilationNode, parameter_overrides=[Parameter('config_dir', value=str(tmp_path))])
     systems = SuiteSystems(ros.add_node(Node, 'systems_client'))
-    assert wait_for(lambda: systems.names() == ['atlas', 'broken', 'delivery_rover', 'mobile_manipulator'])  # added to config/'s
+    assert wait_for(lambda: systems.names() == ['atlas', 'broken', 'delivery_rover', 'mobile_manipulator',
+                                                'shelf_picker'])  # added to config/'s
     assert systems.load('atlas') == robot_system('atlas', tmp_path)
     try:
         systems.load('broken')

@@ -164,15 +164,8 @@ export function showAbstraction(choices, request) {
   const modes = choices.control_modes;
   const modeNames = modes.map((m) => m.name);
   const goals = request.goals.filter((g) => !g.startsWith('!'));
-  if (!modes.length) {
-    $('abstraction-path').textContent = goals.length ? `goals ${goals.join(', ')}` : '';
-    $('abstraction-graphs').replaceChildren(
-      element('p', { className: 'muted', id: 'abstraction-none',
-        text: `${choices.system} is a capability system: it has no control modes, so there is no mode graph; ` +
-          'its capabilities need these clauses first:' }),
-      element('ul', { className: 'abstraction-clauses' }, ...choices.actions.map((a) =>
-        element('li', { className: goals.includes(a.name) ? 'goal' : '' },
-          element('code', { text: a.name }), ` needs ${a.preconditions.join('; ') || 'nothing'}`))));
+  if (choices.capability_graph) {
+    showCapabilityGraph(choices.capability_graph, request, request.goals);
     return;
   }
   NODE_W = Math.max(MIN_NODE_W, Math.ceil(16 + CHAR_W * Math.max(...[...modeNames, ...choices.actions.map((a) => a.name)]
@@ -190,5 +183,143 @@ export function showAbstraction(choices, request) {
       element('figcaption', { text: 'Preconditions: an arrow from what an action needs to the action' })));
   $('abstraction-path').textContent = goals.length
     ? `Task path: ${path.visits.join(' → ')} (modes); goals ${goals.join(', ')}`
+    : 'Add goals to see the task\'s path.';
+}
+
+// The capability graph's nodes ('cap:NAME', 'prop:NAME', 'sensor:NAME') and edges (needs: a
+// proposition to the capability whose precondition reads it; makes: a capability to what an
+// outcome of it sets; reports: a capability to the sensor its outcome reports).
+function capabilityEdges(graph, sensors) {
+  const edges = [];
+  for (const c of graph.capabilities) {
+    for (const need of c.needs) edges.push({ from: `prop:${need.name}`, to: `cap:${c.name}`, kind: 'needs', negated: need.negated, label: need.negated ? 'not' : '' });
+    for (const make of c.makes) edges.push({ from: `cap:${c.name}`, to: `prop:${make.name}`, kind: 'makes', negated: make.negated, label: `${make.outcome}${make.negated ? ': not' : ''}` });
+  }
+  for (const sensor of sensors) {
+    for (const name of sensor.reported_by) edges.push({ from: `cap:${name}`, to: `sensor:${sensor.name}`, kind: 'reports', negated: false, label: 'reports' });
+  }
+  return edges;
+}
+
+// Columns by the shortest way from what needs nothing (back edges, such as a charge that makes
+// its own precondition false again, go leftwards).
+function capabilityLevels(nodes, edges) {
+  const level = new Map();
+  const targets = new Set(edges.map((e) => e.to));
+  const queue = nodes.filter((n) => !targets.has(n));
+  queue.forEach((n) => level.set(n, 0));
+  while (queue.length) {
+    const node = queue.shift();
+    for (const edge of edges.filter((e) => e.from === node && !level.has(e.to))) {
+      level.set(edge.to, level.get(node) + 1);
+      queue.push(edge.to);
+    }
+  }
+  nodes.filter((n) => !level.has(n)).forEach((n) => level.set(n, 0));  // a cycle nothing enters
+  return level;
+}
+
+// What the goals need: the propositions they name, the capabilities that set them, what those
+// need that does not hold at the start, and so on back.
+function capabilityPath(graph, goals, holding) {
+  const on = { nodes: new Set(), edges: new Set() };
+  const visit = (name, negated) => {
+    const id = `prop:${name}`;
+    const key = `${id}:${negated}`;
+    if (on.nodes.has(key)) return;
+    on.nodes.add(key);
+    on.nodes.add(id);
+    if (!negated && holding.has(name)) return;
+    for (const c of graph.capabilities.filter((c) => c.makes.some((m) => m.name === name && m.negated === negated))) {
+      on.edges.add(`cap:${c.name}->${id}`);
+      if (on.nodes.has(`cap:${c.name}`)) continue;
+      on.nodes.add(`cap:${c.name}`);
+      for (const need of c.needs) {
+        on.edges.add(`prop:${need.name}->cap:${c.name}`);
+        visit(need.name, need.negated);
+      }
+    }
+  };
+  goals.forEach((goal) => visit(goal.replace(/^!/, ''), goal.startsWith('!')));
+  return on;
+}
+
+function showCapabilityGraph(graph, request, goals) {
+  const sensors = graph.sensors;
+  const edges = capabilityEdges(graph, sensors);
+  const names = [...graph.capabilities.map((c) => `cap:${c.name}`),
+    ...new Set(edges.filter((e) => e.from.startsWith('prop:')).map((e) => e.from)
+      .concat(edges.filter((e) => e.to.startsWith('prop:')).map((e) => e.to))),
+    ...sensors.map((s) => `sensor:${s.name}`)];
+  const nodes = [...new Set(names)];
+  const label = (id) => id.split(':').slice(1).join(':');
+  NODE_W = Math.max(MIN_NODE_W, Math.ceil(16 + CHAR_W * Math.max(...nodes.map((n) => label(n).length))));
+  // Top to bottom, a row per level (the panel is wider than tall, the graph deeper than wide).
+  const level = capabilityLevels(nodes, edges);
+  const rows = [];
+  for (const node of nodes) (rows[level.get(node)] = rows[level.get(node)] || []).push(node);
+  const COLUMN_W = NODE_W + 40;
+  const ROW_H = NODE_H + 36;
+  const widest = Math.max(...rows.map((row) => row.length));
+  const width = 12 + widest * COLUMN_W + 60;  // room on the right for the edges that go back up
+  const height = 12 + rows.length * ROW_H;
+  const place = new Map();
+  rows.forEach((row, r) => row.forEach((node, c) => place.set(node, {
+    x: 6 + (widest - row.length) * COLUMN_W / 2 + c * COLUMN_W, y: 6 + r * ROW_H })));
+  const holding = new Set([...graph.initially, ...request.initial_conditions]);
+  const on = capabilityPath(graph, goals, holding);
+  const svg = svgElement('svg', { id: 'capability-graph', viewBox: `0 0 ${width} ${height}`, width, height, role: 'img',
+    'aria-label': 'capability graph' }, arrowMarker('capability-arrow'));
+  const pairs = new Map();  // edges between the same two nodes are drawn apart
+  edges.forEach((edge) => {
+    const pair = [edge.from, edge.to].sort().join('|');
+    pairs.set(pair, [...(pairs.get(pair) || []), edge]);
+  });
+  for (const edge of edges) {
+    const a = place.get(edge.from);
+    const b = place.get(edge.to);
+    const siblings = pairs.get([edge.from, edge.to].sort().join('|'));
+    const spread = (siblings.indexOf(edge) - (siblings.length - 1) / 2) * 26;
+    const back = b.y <= a.y;
+    let d;
+    let labelAt;
+    if (back) {  // up the right side
+      const [x1, y1, x2, y2] = [a.x + NODE_W, a.y + NODE_H / 2, b.x + NODE_W, b.y + NODE_H / 2];
+      const out = Math.max(x1, x2) + 40 + spread;
+      d = `M${x1},${y1} C${out},${y1} ${out},${y2} ${x2 + 2},${y2}`;
+      labelAt = { x: out - 4, y: (y1 + y2) / 2 };
+    } else {
+      const [x1, y1, x2, y2] = [a.x + NODE_W / 2 + spread, a.y + NODE_H, b.x + NODE_W / 2 + spread, b.y];
+      d = `M${x1},${y1} C${x1},${y1 + 18} ${x2},${y2 - 18} ${x2},${y2 - 2}`;
+      // a label beside its edge, on the left of the left one of a pair
+      labelAt = { x: (x1 + x2) / 2 + (spread < 0 ? -6 : 6), y: (y1 + y2) / 2 + 4, anchor: spread < 0 ? 'end' : 'start' };
+    }
+    const id = `${edge.from}->${edge.to}`;
+    const classes = ['edge', edge.kind, edge.negated ? 'negated' : '', on.edges.has(id) ? 'on-path' : ''].filter(Boolean).join(' ');
+    svg.append(svgElement('path', { id: `capability-edge:${id}:${edge.label}`, class: classes, d,
+      'marker-end': 'url(#capability-arrow)' }));
+    if (edge.label) {
+      svg.append(svgElement('text', { class: 'edge-label', x: labelAt.x, y: labelAt.y, 'text-anchor': labelAt.anchor || 'start' },
+        edge.label));
+    }
+  }
+  for (const node of nodes) {
+    const { x, y } = place.get(node);
+    const kind = node.split(':')[0];
+    const name = label(node);
+    const classes = ['node', { cap: 'capability', prop: 'proposition', sensor: 'sensor' }[kind],
+      on.nodes.has(node) ? 'on-path' : '', kind === 'prop' && goals.some((g) => g.replace(/^!/, '') === name) ? 'goal' : '',
+      kind === 'prop' && holding.has(name) ? 'done' : ''].filter(Boolean).join(' ');
+    svg.append(svgElement('g', { id: `capability-${kind}:${name}`, class: classes },
+      svgElement('rect', { x, y, width: NODE_W, height: NODE_H, rx: kind === 'cap' ? 3 : 12 }),
+      svgElement('text', { x: x + NODE_W / 2, y: y + 16, 'text-anchor': 'middle' }, name)));
+  }
+  $('abstraction-graphs').replaceChildren(element('figure', {}, svg, element('figcaption', {
+    text: 'Capabilities (squared) and the propositions (rounded) their preconditions read and their outcomes set; ' +
+      'a sensor is reported by a capability\'s outcome' })));
+  const path = graph.capabilities.map((c) => c.name).filter((c) => on.nodes.has(`cap:${c}`))
+    .sort((a, b) => level.get(`cap:${a}`) - level.get(`cap:${b}`));
+  $('abstraction-path').textContent = goals.length
+    ? `Task path: ${path.join(' → ') || 'nothing to run'} (capabilities); goals ${request.goals.join(', ')}`
     : 'Add goals to see the task\'s path.';
 }

@@ -24,38 +24,47 @@ export async function loadSystems() {
 
 export async function loadChoices() {
   choices = await api('GET', `/api/systems/${encodeURIComponent($('system').value)}`);
-  // The robot starts in one control mode (radio buttons); any actions may be completed already.
+  // What the robot may start from, as its view offers it: one control mode (radio buttons) and
+  // completed actions, or a capability robot's memories and sensors (checkboxes); a group
+  // with nothing to offer is not shown.
   const choice = (type, group, name, hint, checked) => {
     const box = element('input', { type, value: name, name: group });
     box.checked = checked;
     return element('label', { className: 'choice', title: hint }, box, ` ${name}`);
   };
   const defaults = new Set(choices.default_initial_conditions);
-  $('initial-control-modes').replaceChildren(
-    element('span', { className: 'group-title', text: 'Control mode (one)' }),
-    ...choices.control_modes.map((m) => choice('radio', 'initial-mode', m.name, `next: ${m.next.join(', ') || '—'}`,
-      defaults.has(m.name))));
-  $('initial-actions').replaceChildren(
-    element('span', { className: 'group-title', text: 'Actions (already completed)' }),
-    ...choices.actions.map((a) => choice('checkbox', 'initial-condition', a.name,
-      `needs: ${a.preconditions.join(', ') || 'nothing'}`, defaults.has(a.name))));
+  const groupOf = (type) => choices.initial_groups.filter((g) => g.type === type && g.items.length).flatMap((g) => [
+    element('span', { className: 'group-title', text: g.title }),
+    ...g.items.map((item) => choice(type, type === 'radio' ? 'initial-mode' : 'initial-condition', item.name, item.hint,
+      defaults.has(item.name)))]);
+  $('initial-control-modes').replaceChildren(...groupOf('radio'));
+  $('initial-actions').replaceChildren(...groupOf('checkbox'),
+    ...(choices.initial_note ? [element('p', { className: 'muted', id: 'initial-note', text: choices.initial_note })] : []));
+  $('initial-control-modes').hidden = !$('initial-control-modes').children.length;
+  showSensors(choices.sensors);
 
-  const group = (label, items, hint) => element('optgroup', { label },
-    ...items.map((item) => element('option', { value: item.name, title: hint(item), text: item.name })));
-  const negated = choices.negated_goals
-    ? [group('Must not hold at the end', choices.actions.map((a) => ({ name: `!${a.name}` })), (a) => `${a.name.slice(1)} is false`)]
-    : [];
-  $('goal-choice').replaceChildren(...[
-    group('Actions', choices.actions, (a) => `needs: ${a.preconditions.join(', ') || 'nothing'}`),
-    group('Control modes', choices.control_modes, (m) => `reached from: ${predecessors(m.name).join(', ') || 'no other mode'}`),
-    ...negated].filter((optgroup) => optgroup.children.length));  // a capability robot has no modes
+  // The goals the robot can be asked for: its actions and modes, or what its capabilities make true.
+  $('goal-choice').replaceChildren(...choices.goal_groups.filter((g) => g.items.length).map((g) => element('optgroup',
+    { label: g.label }, ...g.items.map((item) => element('option', { value: item.name, title: item.hint, text: item.name })))));
   $('goals').replaceChildren();
   updateGoalsHint();
 }
 
-// The names a simulation can make fail first: the system's actions, then its control modes.
+// The names a simulation can make fail: the system's actions then control modes, or its capabilities.
 export function capabilityNames() {
-  return [...choices.actions, ...choices.control_modes].map((c) => c.name);
+  return choices.failure_names;
+}
+
+// The robot's sensors (a capability robot's spec INPUTs), each with the capabilities that report it.
+export function sensors() {
+  return choices.sensors;
+}
+
+function showSensors(list) {
+  $('robot-sensors').hidden = !list.length;
+  $('robot-sensor-list').replaceChildren(...list.map((sensor) => element('li', { 'data-sensor': sensor.name },
+    element('code', { text: sensor.name }),
+    ` reported by ${sensor.reported_by.join(', ') || 'no capability (the diagnosis says what to add)'}`)));
 }
 
 export function repairTimeBudget() {
@@ -115,11 +124,6 @@ function revealInForm(item) {
   const floor = Math.min(window.innerHeight, $('request-form').querySelector('section.controls').getBoundingClientRect().top);
   if (box.bottom > floor - 8) window.scrollBy({ top: box.bottom - floor + 8, behavior: 'instant' });
   else if (box.top < 8) window.scrollBy({ top: box.top - 8, behavior: 'instant' });
-}
-
-// The control modes that can change to ``mode`` (its own self-loop aside).
-function predecessors(mode) {
-  return choices.control_modes.filter((m) => m.name !== mode && m.next.includes(mode)).map((m) => m.name);
 }
 
 function goalItem(name) {

@@ -11,7 +11,8 @@ import { vocabulary } from './vocabulary.js';
 let run = null;       // {id, operator, active} of the run being controlled (null: none running)
 let picking = false;  // the drawing's outcome cells force this run's outcomes
 
-function command(body) {
+// Send ``body`` to the run being controlled (nothing when none runs).
+export function command(body) {
   if (!run) return Promise.resolve();
   return api('POST', `/api/simulations/${run.id}/control`, body).catch((error) => {
     $('operator-question').textContent = `${error.code}: ${error.message}`;

@@ -3,9 +3,9 @@
 import { api, streamEvents } from './api.js';
 import * as drawing from './drawing.js';
 import { $, element } from './dom.js';
-import { capabilityNames, simulationSupport } from './form.js';
+import { capabilityNames, sensors, simulationSupport } from './form.js';
 import { resetFrames, showFrames } from './frames.js';
-import { controlRun, startingAutonomy } from './runtime_control.js';
+import { command, controlRun, startingAutonomy } from './runtime_control.js';
 import { vocabulary } from './vocabulary.js';
 
 let offeredJob = null;        // the job whose machine the Simulate button runs
@@ -17,6 +17,8 @@ export function offerSimulation(job) {
   const support = simulationSupport();
   $('simulation-note').textContent = support.note;
   $('simulation-note').hidden = support.available;
+  if (support.simulator) $('simulator-name').textContent = `(${support.simulator})`;
+  if (support.faults) document.querySelector('label[for="fail-first"]').title = support.faults;
   $('simulation-controls').hidden = !support.available;
   if (!support.available) {
     $('simulation-section').hidden = false;
@@ -24,6 +26,23 @@ export function offerSimulation(job) {
   }
   $('fail-first').replaceChildren(element('option', { value: '', text: 'nothing (no faults)' }),
     ...capabilityNames().map((name) => element('option', { value: name, text: name })));
+  // A capability robot's sensors: free (the environment reads what the assumptions allow), or
+  // held true or false for the whole run.
+  $('simulation-sensors').replaceChildren(...sensors().map((sensor) => {
+    const id = `simulation-sensor-${sensor.name}`;
+    return element('span', { className: 'inline' },
+      element('label', { for: id, className: 'inline-label', text: sensor.name,
+        title: `a sensor, reported by ${sensor.reported_by.join(', ') || 'no capability'}` }),
+      element('select', { id, name: 'simulation-sensor', 'data-sensor': sensor.name },
+        element('option', { value: '', text: 'as the environment reads it' }),
+        element('option', { value: 'true', text: 'true' }), element('option', { value: 'false', text: 'false' })));
+  }));
+  $('simulation-sensors').hidden = !sensors().length;
+  // During a run a change holds from the state's next answer on (Runtime Control's sensor command).
+  for (const select of $('simulation-sensors').querySelectorAll('select')) {
+    select.addEventListener('change', () => command({ command: 'sensor', name: select.dataset.sensor,
+      value: select.value ? select.value === 'true' : null }));
+  }
   $('simulation-section').hidden = false;
 }
 
@@ -58,7 +77,7 @@ export async function simulate() {
   let simulation;
   try {
     simulation = await api('POST', `/api/jobs/${offeredJob.id}/simulations`,
-      { fail_first: failing ? [failing] : [], autonomy: startingAutonomy() });
+      { fail_first: failing ? [failing] : [], autonomy: startingAutonomy(), ...simulationSensors() });
   } catch (error) {
     $('simulation-status').textContent = `${error.code}: ${error.message}`;
     $('simulate').disabled = false;
@@ -84,6 +103,12 @@ export async function simulate() {
   });
 }
 
+// The sensors the operator set for the run (a capability robot's), if it has any.
+function simulationSensors() {
+  const held = [...document.querySelectorAll('select[name="simulation-sensor"]')].filter((s) => s.value);
+  return held.length ? { sensors: Object.fromEntries(held.map((s) => [s.dataset.sensor, s.value === 'true'])) } : {};
+}
+
 // When a step ran in robot time: a step that has not ended runs on ("1.50–…") or, once the
 // run stopped in it, ended when the run did.
 function stepTimes(step, simulation, running) {
@@ -98,15 +123,18 @@ function showSimulation(simulation) {
   const base = `/api/simulations/${simulation.id}`;
   const running = simulation.state !== 'finished';
   const waiting = simulation.operator && simulation.operator.waiting;
+  // A robot simulated without physics (a capability robot) has neither frames nor robot time.
+  const physics = simulationSupport().frames;
+  const robotTime = physics ? `, robot time ${simulation.robot_time.toFixed(2)} s` : '';
   let status = simulation.steps.length === 0 ? 'Starting the simulator…'
-    : `Running: ${simulation.steps.length} states, robot time ${simulation.robot_time.toFixed(2)} s`;
+    : `Running: ${simulation.steps.length} states${robotTime}`;
   if (running && waiting) status += waiting.kind === 'resume' ? ' (paused)' : ' (waiting for you)';
   let outcomeClass = '';
   if (!running) {
     status = simulation.error
       ? `Stopped: ${simulation.error.code}: ${simulation.error.message}`
-      : `Outcome: ${simulation.outcome} after ${simulation.steps.length} states ` +
-        `(robot time ${simulation.robot_time.toFixed(2)} s, wall time ${simulation.wall_seconds.toFixed(2)} s)`;
+      : `Outcome: ${simulation.outcome} after ${simulation.steps.length} states (` +
+        `${physics ? `robot time ${simulation.robot_time.toFixed(2)} s, ` : ''}wall time ${simulation.wall_seconds.toFixed(2)} s)`;
     outcomeClass = simulation.error ? 'bad' : `outcome-${simulation.outcome}`;
   }
   $('simulation-status').textContent = status;
@@ -115,6 +143,7 @@ function showSimulation(simulation) {
   $('simulation-live').className = `status ${outcomeClass}`;
   $('simulation-view').hidden = false;
   $('robot-view').hidden = false;
+  $('robot-view').classList.toggle('no-frames', !physics);
   if (!$('graph-layout').classList.contains('simulating')) {
     $('graph-layout').classList.add('simulating');
     drawing.foldForm(true);  // the drawing just got narrower: give it the form's width
@@ -131,9 +160,10 @@ function showSimulation(simulation) {
       element('td', { text: String(step.index) }),
       element('td', { text: step.state.replace(/^\//, '') }),
       element('td', { text: step.capabilities.join(', ') }),
-      element('td', { text: step.results.map((r) => `${r.capability} ${r.outcome}`).join(', ') }),
+      element('td', { text: step.results.map((r) => `${r.capability} ${r.outcome}`).join(', ') +
+        (step.chosen_by && step.state_outcome ? ` (chosen by ${step.chosen_by})` : '') }),
       outcomeCell(step),
-      element('td', { text: stepTimes(step, simulation, running) }))));
+      element('td', { text: physics ? stepTimes(step, simulation, running) : '—' }))));
   drawing.markRun(simulation.steps, running);
   controlRun(simulation);
   showFrames(base, simulation.frames, simulation.steps, running);

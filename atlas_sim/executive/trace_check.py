@@ -154,6 +154,10 @@ def least_violating_assignments(formulas, current: dict, next_known: dict, unkno
 
 # --- the check -------------------------------------------------------------------------------
 
+#: Violations the robot reports (incidents of the run), told with the step they happened in.
+INCIDENT_KINDS = ('contact', 'fall')
+
+
 @dataclass
 class Violation:
     kind: str              # env_init, sys_init, env_trans, sys_trans, goal_order, contact, fall
@@ -182,7 +186,9 @@ class TraceCheckReport:
         if self.ok:
             return f'trace check: ok ({self.positions} positions, goals {self.goals_completed_at})'
         lines = [f'trace check: {len(self.violations)} violation(s)']
-        lines.extend(f'  {v.kind}: {v.message}' for v in self.violations)
+        for v in self.violations:  # an incident's sentence says what, not where (a formula's says both)
+            where = f' at step {v.step} ({v.transition})' if v.kind in INCIDENT_KINDS else ''
+            lines.append(f'  {v.kind}{where}: {v.message}')
         return '\n'.join(lines)
 
 

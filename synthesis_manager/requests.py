@@ -38,6 +38,8 @@ def selected_option(options) -> str | None:
 
 # What the FlexBE WebUI sends as `system` unless configured otherwise: "the robot at hand".
 SYSTEM_WIDE = 'system_wide'
+# The system of requests naming none (the server's default_system, `serve --default-system`).
+DEFAULT_SYSTEM = 'atlas'
 # Byproduct file stems must satisfy the synthesizer's spec-name rule (<= 100 characters).
 MAX_STEM_LENGTH = 100
 _PLAIN_CHARACTER = re.compile(r'[A-Za-z0-9_]')

@@ -17,7 +17,7 @@ from sm_generation.instantiation import count_states
 from respec.untrusted import read_bounded_file
 from synthesis_manager.client import SynthesisClient, make_flexbe_goal, make_goal
 from synthesis_manager.limits import MAX_MESSAGE_BYTES
-from synthesis_manager.requests import InvalidRequestError
+from synthesis_manager.requests import DEFAULT_SYSTEM, InvalidRequestError, resolve_system
 from synthesis_manager.ros.harness import RosHarness, environment_domain_id
 from synthesis_manager.ros.namespaces import namespace_placement
 from synthesis_manager.summary import spec_size, state_machine_tree
@@ -75,8 +75,9 @@ def fill_default_initial_conditions(args) -> None:
         return
     from respec.robot import robot_system
 
+    system = resolve_system(args.system, getattr(args, 'default_system', '') or DEFAULT_SYSTEM)
     try:
-        args.initial_conditions = ','.join(robot_system(args.system, getattr(args, 'config_dir', None) or None)
+        args.initial_conditions = ','.join(robot_system(system, getattr(args, 'config_dir', None) or None)
                                            .default_initial_conditions)
     except CodedError:
         args.initial_conditions = ''

@@ -37,8 +37,8 @@ from synthesis_manager.client_shares import ClientShares, goal_origin
 from synthesis_manager.limits import (DEFAULT_MAX_GOAL_TIMEOUT, MAX_STRING_BYTES, BusyError, GoalDeadline,
                                       GoalTimeoutError, capped_timeout, check_message, check_timeout, utf8_length)
 from synthesis_manager.nodes.atlas_sim_node import STATE_TOPIC
-from synthesis_manager.requests import (InvalidRequestError, SynthesisTask, task_from_behavior_synthesis,
-                                        task_from_flexbe_synthesis)
+from synthesis_manager.requests import (DEFAULT_SYSTEM, InvalidRequestError, SynthesisTask,
+                                        task_from_behavior_synthesis, task_from_flexbe_synthesis)
 from synthesis_manager.ros.action_server import BurstActionServer
 from synthesis_manager.ros.cnu_interface import load_flexbe_synthesis_interface
 from synthesis_manager.ros.conversions import error_code, error_name, is_empty_spec
@@ -196,7 +196,7 @@ class BehaviorSynthesisServer(Node):
 
     def __init__(self, **kwargs):
         super().__init__('behavior_synthesis_server', **kwargs)
-        self.declare_parameter('default_system', 'atlas')
+        self.declare_parameter('default_system', DEFAULT_SYSTEM)
         self.declare_parameter('config_dir', '')  # the compilation node's: which systems are CNU's
         self.declare_parameter('service_timeout', 5.0)
         self.declare_parameter('compilation_timeout', 30.0)

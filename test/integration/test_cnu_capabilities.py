@@ -339,7 +339,8 @@ def test_export_without_a_flexbe_workspace_says_what_to_set_before_synthesis(cnu
     code = main(['export-behavior', '--system', 'vending_demo', '--config-dir', str(tmp_path),
                  '--initial-conditions', 'prep_pay_a', '--goals', 'soda', '-o', str(tmp_path / 'out')])
     error = capsys.readouterr().err
-    assert code == 2 and 'CONFIG_VARIABLE_CONFIG_INVALID' in error and '`make flexbe`' in error
+    # A robot file the workspace cannot serve is refused input: exit 1, as --help and every command say.
+    assert code == 1 and 'CONFIG_VARIABLE_CONFIG_INVALID' in error and '`make flexbe`' in error
     assert not (tmp_path / 'out').exists()
 
 

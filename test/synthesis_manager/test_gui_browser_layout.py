@@ -164,14 +164,14 @@ def test_abstraction_labels_inside_their_boxes_the_task_path_once_per_visit_and_
 @pytest.mark.parametrize('size', SIZES, **BY_SIZE)
 def test_a_stopped_run_shows_when_each_step_ran(gui, browser_context, size):  # noqa: F811
     with open_page(browser_context, gui[0], viewport=size) as page:
-        choose_task(page, ['look_down'])
+        # The paper's task runs for several robot seconds: long enough to be stopped in its first states.
+        choose_task(page, ['look_down', 'pickup_object'])
         page.click('#synthesize')
         assert result_code(page) == 'SUCCESS'
         page.wait_for_selector('.graph-viewport svg g.node')
         page.click('#simulate')
         page.wait_for_selector('#runtime-control:not([hidden])', timeout=60_000)
         page.wait_for_selector('g.node.active', timeout=120_000)
-        page.wait_for_timeout(500)
         page.click('#stop-run')
         page.wait_for_function(STATUS_DONE, timeout=120_000)
         assert 'the operator stopped the run' in page.inner_text('#simulation-status')

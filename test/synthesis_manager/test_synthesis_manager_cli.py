@@ -129,7 +129,7 @@ def test_send_goal_without_a_server_says_what_it_waits_for_at_once_and_that_it_u
 
 
 @pytest.mark.parametrize('command, defaults', [
-    ('send-goal', ['(default: atlas)', '(default: stand_prep)', '(default: finished,failed)',
+    ('send-goal', ['(default: atlas)', "(default: the system's own", '(default: finished,failed)',
                    '(default: 120.0)', "(default: the paper's demo task, look_down,pickup_object"]),
     ('execute', ['(default: atlas)', '(default: 10.0)', '(default: 300.0)',
                  '--verbose', 'Exit status:']),

@@ -190,15 +190,11 @@ def measure_gridworlds(args, directory: Path, rows: list, series: dict) -> None:
         given_up = set()
         for width, height in args.grids:
             text = capability_robots.per_cell_gridworld(width, height, 8, realizable)
-            structured = directory / f'{family}_{width}x{height}.structuredslugs'
-            structured.write_text(text)
             slugsin = directory / f'{family}_{width}x{height}.slugsin'
-            converted = subprocess.run([python, '-m', 'ltl_synthesizer', '--convert', str(structured)],
-                                       cwd=ROOT, capture_output=True, text=True, check=True)
-            slugsin.write_text(converted.stdout)
+            slugsin.write_text(text)
             row = {'family': family, 'size': width * height, 'label': f'{family} {width}x{height}',
                    'props': f'{math.ceil(math.log2(width * height))} + {math.ceil(math.log2(width * height))} bits',
-                   'kb': len(converted.stdout) // 1024}
+                   'kb': len(text) // 1024}
             results = {}
             for tool, command in (('gr1synth', [python, '-m', 'ltl_synthesizer', '--sysInitRoboticsSemantics',
                                                 str(slugsin)]),

@@ -18,7 +18,7 @@ the request has empty initial conditions and asks for ``finished,failed``.
 - ``mix``: a chain whose capabilities alternately retry, with a sensor, a diamond in the middle
   and a fan-out of the last quarter's capabilities as goals.
 
-``per_cell_gridworld`` writes the other family of issue 44 as structuredslugs text: one
+``per_cell_gridworld`` writes the other family of issue 44 as slugsin text: one
 ENV_TRANS and one SYS_TRANS line per cell over binary-encoded positions (one integer each
 for the robot and the adversary, both on the same grid graph), the no-swap conjunct
 ``!((rob' = adv) & (adv' = rob))``, 8 goal regions.
@@ -195,14 +195,20 @@ SHAPES = {'chain': chain, 'retry': retry, 'sensor': sensor, 'fanout': fanout, 'd
 def per_cell_gridworld(width: int, height: int, goals: int = 8, realizable: bool = True) -> str:
     """A robot (``rob``) must visit ``goals`` regions infinitely often on a ``width`` x
     ``height`` grid; an adversary (``adv``) moves on the same grid graph. Positions are cell
-    numbers (binary-encoded integers); each cell has one ENV_TRANS line (the adversary's
-    moves from it) and one SYS_TRANS line (the robot's). The two never share a cell nor swap.
+    numbers, binary-encoded as structured slugs stores integers (``rob@0.0.303``, ``rob@1``,
+    ...); each cell has one ENV_TRANS line (the adversary's moves from it) and one SYS_TRANS
+    line (the robot's). The two never share a cell nor swap: ``rob' != adv'`` and
+    ``!((rob' = adv) & (adv' = rob))``. Written as slugsin directly: structured slugs'
+    comparison of two 9-bit integers (over 2^16 valuations) is too large for our parser.
 
     Realizable: the goal regions are 2x2 squares and the adversary must return to its home
     corner infinitely often. Unrealizable: one goal region is a single cell and the adversary
     may stay on it forever.
     """
     cells = width * height
+    width_bits = max(1, (cells - 1).bit_length())
+    rob = [f'rob@0.0.{cells - 1}'] + [f'rob@{k}' for k in range(1, width_bits)]
+    adv = [f'adv@0.0.{cells - 1}'] + [f'adv@{k}' for k in range(1, width_bits)]
 
     def cell(x, y):
         return y * width + x
@@ -215,9 +221,12 @@ def per_cell_gridworld(width: int, height: int, goals: int = 8, realizable: bool
     for y in range(height):
         for x in range(width):
             here = cell(x, y)
-            env_trans.append(f'adv = {here} -> (' + ' | '.join(f"adv' = {m}" for m in moves(x, y)) + ')')
-            sys_trans.append(f'rob = {here} -> (' + ' | '.join(f"rob' = {m}" for m in moves(x, y)) + ')')
-    sys_trans += ["rob' != adv'", "!((rob' = adv) & (adv' = rob))"]
+            env_trans.append(_implies(_equals(adv, here), _any([_equals(adv, m, True) for m in moves(x, y)])))
+            sys_trans.append(_implies(_equals(rob, here), _any([_equals(rob, m, True) for m in moves(x, y)])))
+    same_next = _all([f"! ^ {r}' {a}'" for r, a in zip(rob, adv)])
+    swap = _all([f"! ^ {r}' {a}" for r, a in zip(rob, adv)] + [f"! ^ {a}' {r}" for r, a in zip(rob, adv)])
+    sys_trans += [f'! {same_next}', f'! {swap}', _at_most(rob, cells - 1, True)]
+    env_trans.append(_at_most(adv, cells - 1, True))
     regions = []
     for index in range(goals):
         x0 = min(width - 2, round(index * (width - 2) / max(goals - 1, 1)))
@@ -225,11 +234,46 @@ def per_cell_gridworld(width: int, height: int, goals: int = 8, realizable: bool
         regions.append([cell(x0, y0), cell(x0 + 1, y0), cell(x0, y0 + 1), cell(x0 + 1, y0 + 1)])
     if not realizable:
         regions[-1] = [cell(width // 2, height // 2)]
-    home = cell(0, height - 1) if realizable else None
-    lines = {'INPUT': [f'adv:0...{cells - 1}'], 'OUTPUT': [f'rob:0...{cells - 1}'],
-             'ENV_INIT': [f'adv = {cell(width // 2, height // 2)}'], 'SYS_INIT': ['rob = 0'],
-             'ENV_TRANS': env_trans, 'SYS_TRANS': sys_trans,
-             'ENV_LIVENESS': [f'adv = {home}'] if realizable else [],
-             'SYS_LIVENESS': ['(' + ' | '.join(f'rob = {c}' for c in region) + ')' for region in regions]}
-    order = ['INPUT', 'OUTPUT', 'ENV_INIT', 'SYS_INIT', 'ENV_TRANS', 'SYS_TRANS', 'ENV_LIVENESS', 'SYS_LIVENESS']
-    return ''.join(f'[{section}]\n' + ''.join(f'{line}\n' for line in lines[section]) + '\n' for section in order)
+    sections = {
+        'INPUT': adv, 'OUTPUT': rob,
+        'ENV_INIT': [_equals(adv, cell(width // 2, height // 2))], 'SYS_INIT': [_equals(rob, 0)],
+        'ENV_TRANS': env_trans, 'SYS_TRANS': sys_trans,
+        'ENV_LIVENESS': [_equals(adv, cell(0, height - 1))] if realizable else [],
+        'SYS_LIVENESS': [_any([_equals(rob, c) for c in region]) for region in regions]}
+    return ''.join(f'[{section}]\n' + ''.join(f'{line}\n' for line in lines) + '\n'
+                   for section, lines in sections.items())
+
+
+def _equals(bits: list[str], value: int, next_step: bool = False) -> str:
+    mark = "'" if next_step else ''
+    return _all([f'{b}{mark}' if value >> k & 1 else f'! {b}{mark}' for k, b in enumerate(bits)])
+
+
+def _at_most(bits: list[str], bound: int, next_step: bool = False) -> str:
+    """value <= bound, most significant bit first (slugsin prefix)."""
+    mark = "'" if next_step else ''
+    formula = '1'
+    for k, b in enumerate(bits):  # least significant first: each step wraps the lower bits
+        formula = f'| ! {b}{mark} {formula}' if bound >> k & 1 else f'& ! {b}{mark} {formula}'
+    return formula
+
+
+def _all(parts: list[str]) -> str:
+    return _nary('&', parts, '1')
+
+
+def _any(parts: list[str]) -> str:
+    return _nary('|', parts, '0')
+
+
+def _nary(operator: str, parts: list[str], empty: str) -> str:
+    if not parts:
+        return empty
+    text = parts[-1]
+    for part in reversed(parts[:-1]):
+        text = f'{operator} {part} {text}'
+    return text
+
+
+def _implies(left: str, right: str) -> str:
+    return f'| ! {left} {right}'

@@ -19,6 +19,7 @@ from ltl_synthesizer.cudd_import import cudd
 from respec.spec import GR1Specification
 
 from ltl_synthesizer.interrupt import Interrupt
+from ltl_synthesizer.ordering import static_order
 from ltl_synthesizer.policy import Options, cluster_limit
 from ltl_synthesizer.translation import Translator, check_declarations, declare_pair, primed
 
@@ -77,6 +78,9 @@ class SymbolicGame:
         # action's activation and its outcomes) sit together and the relations stay small.
         if options.variable_order == 'declared':
             for name in self.variables:
+                declare_pair(self.bdd, name)
+        elif options.variable_order == 'structure':
+            for name in static_order(spec):
                 declare_pair(self.bdd, name)
         elif options.variable_order != 'affinity':
             raise ValueError(f'unknown variable order {options.variable_order!r}')

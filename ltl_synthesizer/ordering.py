@@ -26,7 +26,7 @@ proposition's current and next copies stay adjacent (``translation.declare_pair`
 
 from __future__ import annotations
 
-from respec.ltl import And, Const, Next, Not, Or, Var, children
+from respec.ltl import And, Next, Not, Or, Var, children
 from respec.spec import GR1Specification
 
 # Most FORCE iterations, and how many in a row may fail to shorten the total span.
@@ -88,37 +88,30 @@ def _conjuncts(spec: GR1Specification) -> list:
     return result
 
 
-def _supports(conjuncts: list) -> list[frozenset] | None:
-    """Each conjunct's propositions (current or next), in order of appearance; shared
-    subformulas are walked once. None when the formulas are larger than MAX_FORMULA_NODES."""
-    memo: dict[int, tuple] = {}
+def _supports(conjuncts: list) -> list[tuple] | None:
+    """Each conjunct's propositions (current or next), in order of appearance, each conjunct's
+    DAG walked once (a walk per conjunct: memoized supports of nested subformulas would take
+    quadratic space on a long nested disjunction). None when the walks would visit more than
+    MAX_FORMULA_NODES nodes in all."""
     walked = 0
     result = []
     for root in conjuncts:
-        stack = [(root, False)]
+        names: dict[str, None] = {}
+        seen = set()
+        stack = [root]
         while stack:
-            node, expanded = stack.pop()
-            if id(node) in memo:
-                continue
+            node = stack.pop()
             if isinstance(node, Var):
-                memo[id(node)] = (node.name,)
+                names[node.name] = None
                 continue
-            if isinstance(node, Const):
-                memo[id(node)] = ()
+            if id(node) in seen:
                 continue
-            kids = children(node)
-            if expanded:
-                names = {}
-                for child in kids:
-                    names.update(dict.fromkeys(memo[id(child)]))
-                memo[id(node)] = tuple(names)
-                continue
+            seen.add(id(node))
             walked += 1
             if walked > MAX_FORMULA_NODES:
                 return None
-            stack.append((node, True))
-            stack.extend((child, False) for child in reversed(kids) if id(child) not in memo)
-        result.append(memo[id(root)])
+            stack.extend(reversed(children(node)))
+        result.append(tuple(names))
     return result
 
 

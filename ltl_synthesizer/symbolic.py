@@ -72,10 +72,10 @@ class SymbolicGame:
         self.true = self.bdd.true
         self.false = self.bdd.false
 
-        # The static variable order: 'declared', or 'affinity': propositions in order of first
-        # use in the safety formulas, then the goals and initial conditions (variables are
-        # declared as the translator meets them), so that propositions used together (an
-        # action's activation and its outcomes) sit together and the relations stay small.
+        # The static variable order: 'structure' (the default; ordering.static_order: integers
+        # compared interleaved, FORCE over the conjuncts), 'declared', or 'affinity':
+        # propositions in order of first use in the safety formulas, then the goals and initial
+        # conditions (variables are declared as the translator meets them).
         if options.variable_order == 'declared':
             for name in self.variables:
                 declare_pair(self.bdd, name)

@@ -4,7 +4,7 @@ In the order of first use, the propositions a specification keeps together can e
 apart, and then a conjunct over them is exponential where it could be linear. Two shapes
 are common (issue 44):
 
-- integers (structured slugs' bit-blasted ``x@0.0.7``, ``x@1``, ...) that one conjunct
+- wide integers (structured slugs' bit-blasted ``x@0.0.7``, ``x@1``, ...) that one conjunct
   compares: with all of the robot's position bits above all of the adversary's, "the two do
   not swap cells", ``!((rob' = adv) & (adv' = rob))``, is 786,429 nodes; with the bits of
   equal weight next to each other it is 108. Integers compared with each other form one
@@ -35,8 +35,15 @@ FORCE_PATIENCE = 4
 # Larger formula DAGs (in nodes) keep the order of first use: the support walk would cost
 # more than it could save on specifications whose conjuncts are that large.
 MAX_FORMULA_NODES = 2_000_000
-# Integers compared in a conjunct over at most this many units are interleaved.
-COMPARISON_UNITS = 3
+# Integers compared in a conjunct over at most this many units (integers only) are interleaved:
+# two, as in "rob' != adv'" (cinderella's sums over three buckets, interleaved, made its relations
+# 5x larger and its solve 0.12 -> 0.45 s).
+COMPARISON_UNITS = 2
+# ... when both have at least this many bits: separated, a comparison of two such integers at
+# the next step and now (the no-swap conjunct) takes 3 x 2^(2 x bits) nodes, 786,429 at 9
+# bits. Narrower integers keep their first-use places, where the sifting passes place them
+# better than interleaved (evasion 48x16, 6-bit positions: 3.4 s, interleaved 6.6 s).
+MIN_INTERLEAVED_BITS = 8
 SECTIONS = ('sys_trans', 'env_trans', 'sys_liveness', 'env_liveness', 'env_init', 'sys_init')
 
 
@@ -58,7 +65,11 @@ def static_order(spec: GR1Specification) -> list[str]:
         return _first_use(propositions, [])
     first_use = _first_use(propositions, supports)
     unit_of = {name: integer_bit(name)[0] if integer_bit(name) else name for name in propositions}
-    blocks = _compared_integers(supports, unit_of)
+    widths: dict[str, int] = {}
+    for name in propositions:
+        if integer_bit(name):
+            widths[unit_of[name]] = widths.get(unit_of[name], 0) + 1
+    blocks = _compared_integers(supports, unit_of, widths)
     unit_of = {name: blocks.get(unit, unit) for name, unit in unit_of.items()}
     units = list(dict.fromkeys(unit_of[name] for name in first_use))
     index = {unit: k for k, unit in enumerate(units)}
@@ -120,9 +131,10 @@ def _first_use(propositions: list[str], supports: list) -> list[str]:
     return [name for name in seen if name in set(propositions)] + [p for p in propositions if p not in seen]
 
 
-def _compared_integers(supports: list, unit_of: dict) -> dict[str, str]:
+def _compared_integers(supports: list, unit_of: dict, widths: dict[str, int]) -> dict[str, str]:
     """Integer -> the block (its first member's name, tagged) of the integers compared with it:
-    those sharing a conjunct over at most COMPARISON_UNITS units, all of them integers."""
+    those sharing a conjunct over at most COMPARISON_UNITS units, all of them integers of at
+    least MIN_INTERLEAVED_BITS bits (``widths``)."""
     parent: dict[str, str] = {}
 
     def root(unit):
@@ -132,7 +144,8 @@ def _compared_integers(supports: list, unit_of: dict) -> dict[str, str]:
 
     for support in supports:
         units = dict.fromkeys(unit_of[name] for name in support if name in unit_of)
-        integers = [unit for unit in units if _is_integer_unit(unit, support, unit_of)]
+        integers = [unit for unit in units if _is_integer_unit(unit, support, unit_of)
+                    and widths.get(unit, 0) >= MIN_INTERLEAVED_BITS]
         if 2 <= len(units) <= COMPARISON_UNITS and len(integers) == len(units):
             first = root(integers[0])
             for other in integers[1:]:

@@ -38,8 +38,12 @@ class SynthesisTimeoutError(SynthesisCancelledError):
 
     code = ErrorCode.SYNTHESIS_TIMEOUT
 
-    def __init__(self, reason: str = 'timeout'):
+    def __init__(self, reason: str = 'timeout', during: str = ''):
         super().__init__(reason)
+        # What the synthesis was doing, and how large its task was (Interrupt.during()).
+        self.during = during
+        if during:
+            self.args = (f'synthesis {reason} while {during}',)
 
 
 class SynthesisMemoryError(SynthesisError):

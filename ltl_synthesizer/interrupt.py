@@ -60,17 +60,27 @@ class Interrupt:
         self.memory_limit = memory_limit
         self._baseline_memory = resident_memory() if memory_limit is not None else 0
         self._memory_checked_at = time.monotonic()
+        # What the work is doing and its size measure, named when a limit stops it (the
+        # synthesizer sets them: 'solving the game', '80 inputs and 82 outputs (...)').
+        self.stage = ''
+        self.size = ''
+
+    def during(self) -> str:
+        """The stage and the size measure, as a limit's message names them ('' unknown)."""
+        if not self.stage:
+            return ''
+        return f'{self.stage} ({self.size})' if self.size else self.stage
 
     def check(self) -> None:
         if self.cancel is not None and self.cancel.is_set():
             raise SynthesisCancelledError('cancelled')
         now = time.monotonic()
         if self.deadline is not None and now >= self.deadline:
-            raise SynthesisTimeoutError()
+            raise SynthesisTimeoutError(during=self.during())
         if self.memory_limit is not None and now - self._memory_checked_at >= self.MEMORY_CHECK_SECONDS:
             self._memory_checked_at = now
             if resident_memory() - self._baseline_memory > self.memory_limit:
-                raise memory_exceeded(self.memory_limit)
+                raise memory_exceeded(self.memory_limit, self.during())
 
     __call__ = check
 
@@ -105,7 +115,8 @@ def released_memory(collect: bool = True) -> int:
     return resident_memory()
 
 
-def memory_exceeded(limit: int) -> SynthesisMemoryError:
+def memory_exceeded(limit: int, during: str = '') -> SynthesisMemoryError:
+    where = f' while {during}' if during else ''
     return SynthesisMemoryError(
-        f'synthesis needs more than its memory limit of {limit / 2**20:.0f} MB '
+        f'synthesis needs more than its memory limit of {limit / 2**20:.0f} MB{where} '
         '(memory_limit); simplify the specification or raise the limit', item='memory_limit')

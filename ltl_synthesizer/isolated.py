@@ -62,6 +62,9 @@ from ltl_synthesizer.interrupt import Limits, released_memory, resident_memory
 
 # How often the caller looks at its cancel flag and deadline while a child works.
 POLL_SECONDS = 0.02
+# How long past its deadline a child may take to report its timeout before it is killed (its
+# interrupt checks at least every few milliseconds, beyond one BDD operation).
+DEADLINE_GRACE_SECONDS = 0.3
 #: How much lower the children's CPU priority is than their parent's (by default).
 CHILD_NICENESS = 5
 #: The same for a server running many syntheses at once: eight CPU-bound children at +5 on two
@@ -232,7 +235,9 @@ class ChildProcess:
                     if cancel is not None and cancel.is_set():
                         self.kill()
                         raise SynthesisCancelledError('cancelled')
-                    if deadline is not None and time.monotonic() >= deadline:
+                    # Past the deadline the child has DEADLINE_GRACE_SECONDS to report its own
+                    # timeout, which names what it was doing and how large the task was.
+                    if deadline is not None and time.monotonic() >= deadline + DEADLINE_GRACE_SECONDS:
                         self.kill()
                         raise SynthesisTimeoutError()
                     if memory_limit is not None and resident_memory(self.process.pid) - baseline > memory_limit:

@@ -36,6 +36,15 @@ SIFTED_RELATION_NODES = 1000
 # lose up to 2x to sifting, cinderella (many variables, small BDDs) 4x
 # (bench/bench_gr1_families.py, bench_goals.py).
 DYNAMIC_REORDERING_FROM_NODES = 100_000
+# A game whose safety relations, in the static order, have at most this many BDD nodes per
+# proposition is "compact": the static order (ordering.static_order) already keeps every
+# conjunct small, so the sifting pass has little to find, and the reachability restriction
+# only complicates the iterates (capability robots, issue 44: a chain of 80 capabilities
+# solves in 3.6 s without them, 11 s with the restriction, over 100 s with the dynamic sifting
+# that its 10^5 live nodes set off). Compact games sift only once the BDDs hold
+# COMPACT_REORDERING_FROM_NODES nodes (some 400 MB: a guard against running out of memory).
+COMPACT_NODES_PER_PROPOSITION = 20
+COMPACT_REORDERING_FROM_NODES = 10_000_000
 # With many system goals (GenBuf: one per sender), dynamic sifting from the start still pays,
 # but CUDD's default growth bound (1.2: a variable keeps moving while the BDDs are at most
 # 20% larger) makes each pass over the many variables cost most of the solve (GenBuf 48
@@ -45,6 +54,10 @@ DYNAMIC_REORDERING_FROM_NODES = 100_000
 MANY_SYSTEM_GOALS = 16
 MANY_GOALS_SIFTING_GROWTH = 1.02
 REORDERING_CHECK_PERIOD = 4
+# Reading CUDD's statistics scans its unique table and cache (a 1.4M-node chain of 80
+# capabilities: 8 of its 12 s went to looking every 4 steps); the period between looks
+# doubles up to this many steps, so a solve that stays small pays for few looks.
+REORDERING_CHECK_MAX_PERIOD = 256
 # Small pure safety games over wide integers (moving obstacle: few variables, large BDDs) need
 # sifting too, but CUDD's automatic sifting strikes in the middle of a relational product,
 # when its intermediate results (7x the fixpoint iterate) are alive, and so costs the most
@@ -76,7 +89,9 @@ class Options:
     # Most BDD nodes in a cluster of conjoined safety formulas; None = automatic:
     # SAFETY_GAME_CLUSTER_LIMIT for pure safety games, else DEFAULT_CLUSTER_LIMIT.
     cluster_limit: int | None = None
-    variable_order: str = 'affinity'  # 'affinity' (co-occurrence) or 'declared'
+    # 'structure' (ordering.static_order: integers compared interleaved, FORCE over the
+    # conjuncts), 'affinity' (order of first use in the formulas) or 'declared'.
+    variable_order: str = 'structure'
     # Solve only on positions reachable from the initial ones; None = automatic: on for games
     # of more than SMALL_GAME_PROPOSITIONS propositions with some liveness goal.
     reachable_only: bool | None = None
@@ -94,6 +109,7 @@ class Plan:
     reachable_only: bool
     reordering: str  # NEVER, FROM_START, ONCE_LARGE or BETWEEN_ITERATIONS
     sifting_growth: float | None = None  # CUDD's max growth during sifting; None: its default
+    reordering_from_nodes: int = DYNAMIC_REORDERING_FROM_NODES  # ONCE_LARGE's threshold
 
 
 def cluster_limit(has_liveness: bool, options: Options) -> int:
@@ -106,15 +122,16 @@ def cluster_limit(has_liveness: bool, options: Options) -> int:
 def plan(game, options: Options) -> Plan:
     """The plan for ``game`` (a SymbolicGame), from its shape and the options the caller set."""
     large = len(game.variables) > SMALL_GAME_PROPOSITIONS
+    compact = is_compact(game, options)
     # A pure safety game is solved by one greatest fixpoint, no dearer than the
     # reachability search itself (cinderella: 0.01 s solving after 2.5 s of search).
-    reachable_only = large and game.has_liveness
+    reachable_only = large and game.has_liveness and not compact
     # The static order cannot know that e.g. a memory proposition belongs next to its
     # action's activation and outcomes; one sifting pass on the relations finds such
     # placements (3x faster multi-goal solving) for a few milliseconds. Few propositions but
     # wide integers (grids, counters) also make large relations, whose bits the static order
     # cannot place well (moving obstacle 16x16: 3x faster).
-    sift_once = large or game.relation_nodes >= SIFTED_RELATION_NODES
+    sift_once = (large or game.relation_nodes >= SIFTED_RELATION_NODES) and not compact
     if options.reordering is not None:
         reordering = FROM_START if options.reordering else NEVER
     elif len(game.sys_goals) > 1:
@@ -128,7 +145,15 @@ def plan(game, options: Options) -> Plan:
         sift_once=sift_once if options.sift_once is None else options.sift_once,
         reachable_only=reachable_only if options.reachable_only is None else options.reachable_only,
         reordering=reordering,
-        sifting_growth=MANY_GOALS_SIFTING_GROWTH if many_goals else None)
+        sifting_growth=MANY_GOALS_SIFTING_GROWTH if many_goals else None,
+        reordering_from_nodes=COMPACT_REORDERING_FROM_NODES if compact else DYNAMIC_REORDERING_FROM_NODES)
+
+
+def is_compact(game, options: Options) -> bool:
+    """Whether the static order left the safety relations compact (see
+    COMPACT_NODES_PER_PROPOSITION); only the structural order is trusted to."""
+    return options.variable_order == 'structure' and \
+        game.relation_nodes <= COMPACT_NODES_PER_PROPOSITION * len(game.variables)
 
 
 class ReorderingSwitch:
@@ -138,11 +163,13 @@ class ReorderingSwitch:
     the BDDs have grown (BETWEEN_ITERATIONS). ``observe(responses)`` is called before every
     enforceable-predecessor step with the BDD it is about to quantify."""
 
-    def __init__(self, game, planned: str):
+    def __init__(self, game, planned: str, from_nodes: int = DYNAMIC_REORDERING_FROM_NODES):
         self.game = game
         self.planned = planned
+        self.from_nodes = from_nodes
         self.on = planned in (FROM_START, BETWEEN_ITERATIONS)
         self._observed = 0
+        self._period = self._next_look = REORDERING_CHECK_PERIOD
         self._sifted_at = SIFT_BETWEEN_ITERATIONS_FROM_NODES
         if planned == FROM_START:
             game.bdd.configure(reordering=True)
@@ -151,10 +178,12 @@ class ReorderingSwitch:
         if not self.on and self.planned == ONCE_LARGE:
             # Reading CUDD's statistics scans its unique table: look every few steps only.
             self._observed += 1
-            if self._observed % REORDERING_CHECK_PERIOD == 0 and \
-                    self.game.statistics()['bdd_nodes'] > DYNAMIC_REORDERING_FROM_NODES:
-                self.on = True
-                self.game.bdd.configure(reordering=True)
+            if self._observed >= self._next_look:
+                self._next_look += self._period
+                self._period = min(2 * self._period, REORDERING_CHECK_MAX_PERIOD)
+                if self.game.statistics()['bdd_nodes'] > self.from_nodes:
+                    self.on = True
+                    self.game.bdd.configure(reordering=True)
         elif self.on and self.planned == BETWEEN_ITERATIONS:
             # The DAG size of one BDD, not the manager's node count (a scan of its tables).
             if len(responses) > SIFT_BETWEEN_ITERATIONS_GROWTH * self._sifted_at:

@@ -44,7 +44,8 @@ def goal_moves(game: SymbolicGame, steps, env_moves, legal):
     holds the position: that step answers every environment move.
     """
     moves = answered = game.false
-    for step in steps:
+    unanswered = env_moves
+    for step in steps.offering(lambda: unanswered):
         offered = step.responses & env_moves
         new_cases = offered & ~answered
         if new_cases == game.false:
@@ -53,7 +54,56 @@ def goal_moves(game: SymbolicGame, steps, env_moves, legal):
         answered |= offered
         if answered == env_moves:
             break  # every environment move is answered
+        unanswered = env_moves & ~answered
     return moves
+
+
+class _GoalSteps:
+    """One goal's attractor steps (``_StepMoves``) by increasing rank, and the unions of the
+    responses of halves, quarters, ... of them (built on first use, only for many steps), so
+    that a position skips, a range at a time, the steps that offer none of its environment
+    moves. A capability robot of N capabilities has O(N^2) steps of which a position uses a
+    few: scanning them one by one took most of its extraction (80 capabilities: 3.4 of 4.1 s)."""
+
+    def __init__(self, game: SymbolicGame, steps: list):
+        self.game, self.steps = game, steps
+        self._unions = {}
+
+    def offering(self, unanswered):
+        """The steps, in order, without ranges none of whose responses meets the environment
+        moves ``unanswered()`` (asked again as the scan goes on: the moves no earlier step
+        answers); a skipped step would offer no new case, and goal_moves passes over those."""
+        if len(self.steps) <= INDEXED_STEPS:
+            yield from self.steps
+            return
+        stack = [(0, len(self.steps))]
+        while stack:
+            low, high = stack.pop()
+            if self._union(low, high) & unanswered() == self.game.false:
+                continue
+            if high - low <= INDEXED_STEPS:
+                yield from self.steps[low:high]
+                continue
+            middle = (low + high) // 2
+            stack += [(middle, high), (low, middle)]
+
+    def _union(self, low: int, high: int):
+        found = self._unions.get((low, high))
+        if found is None:
+            if high - low <= INDEXED_STEPS:
+                found = self.game.false
+                for step in self.steps[low:high]:
+                    found |= step.responses
+            else:
+                middle = (low + high) // 2
+                found = self._union(low, middle) | self._union(middle, high)
+            self._unions[(low, high)] = found
+        return found
+
+
+# Goals with at most this many attractor steps are scanned step by step (and so are ranges of
+# this many steps): an index would cost more than it saves.
+INDEXED_STEPS = 16
 
 
 class _StepMoves:
@@ -344,7 +394,7 @@ def streamed_strategy(game: SymbolicGame, solution: SystemSolution) -> dict:
 
 def strategy_nodes(game: SymbolicGame, solution: SystemSolution):
     """The strategy's nodes ``(name, node)`` in increasing number (breadth-first order)."""
-    steps = [[_StepMoves(game, step) for step in goal] for goal in goal_steps(game, solution)]
+    steps = [_GoalSteps(game, [_StepMoves(game, step) for step in goal]) for goal in goal_steps(game, solution)]
     variables, goals = game.variables, len(game.sys_goals)
     responses = _Responses(game)
     numbering = _Numbering()

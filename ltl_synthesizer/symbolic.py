@@ -19,6 +19,7 @@ from ltl_synthesizer.cudd_import import cudd
 from respec.spec import GR1Specification
 
 from ltl_synthesizer.interrupt import Interrupt
+from ltl_synthesizer.ordering import static_order
 from ltl_synthesizer.policy import Options, cluster_limit
 from ltl_synthesizer.translation import Translator, check_declarations, declare_pair, primed
 
@@ -71,12 +72,15 @@ class SymbolicGame:
         self.true = self.bdd.true
         self.false = self.bdd.false
 
-        # The static variable order: 'declared', or 'affinity': propositions in order of first
-        # use in the safety formulas, then the goals and initial conditions (variables are
-        # declared as the translator meets them), so that propositions used together (an
-        # action's activation and its outcomes) sit together and the relations stay small.
+        # The static variable order: 'structure' (the default; ordering.static_order: integers
+        # compared interleaved, FORCE over the conjuncts), 'declared', or 'affinity':
+        # propositions in order of first use in the safety formulas, then the goals and initial
+        # conditions (variables are declared as the translator meets them).
         if options.variable_order == 'declared':
             for name in self.variables:
+                declare_pair(self.bdd, name)
+        elif options.variable_order == 'structure':
+            for name in static_order(spec):
                 declare_pair(self.bdd, name)
         elif options.variable_order != 'affinity':
             raise ValueError(f'unknown variable order {options.variable_order!r}')

@@ -63,7 +63,7 @@ class Solved:
     def environment(self) -> EnvironmentSolution:
         """The environment's side of an unrealizable game (solved once, when first asked)."""
         if self._environment is None:
-            with _memory_failures_reported(self.interrupt.memory_limit):
+            with _memory_failures_reported(self.interrupt, "solving the environment's game"):
                 self._environment = solve_environment_game(self.solver)
         return self._environment
 
@@ -92,12 +92,15 @@ def solve(spec: GR1Specification, robotics_semantics: bool = True, limits: Limit
     formulas outside the declared propositions or GR(1).
     """
     interrupt = limits.interrupt()
-    with _memory_failures_reported(interrupt.memory_limit):
+    interrupt.size = f'{len(spec.env_props)} inputs and {len(spec.sys_props)} outputs'
+    with _memory_failures_reported(interrupt, 'building the game'):
         start = time.perf_counter()
         interrupt.check()
         game = SymbolicGame(spec, options, interrupt)
         solver = Solver(game, options)
         built = time.perf_counter()
+        interrupt.stage = 'solving the game'
+        interrupt.size = game_size(game)
 
         def still_possible(winning):
             return initial_positions_win(game, winning, robotics_semantics)
@@ -130,7 +133,7 @@ def explicit_strategy(solved: Solved, max_edges: int | None = None) -> dict:
     shape). With ``max_edges``, StrategyTooLargeError as soon as the nodes extracted so far have
     more transitions: a strategy too large to use is not extracted to the end."""
     from ltl_synthesizer.strategy import streamed_strategy
-    with _memory_failures_reported(solved.interrupt.memory_limit):
+    with _memory_failures_reported(solved.interrupt, 'extracting the strategy'):
         strategy = streamed_strategy(solved.game, _realizable(solved).solution)
         nodes, edges = {}, 0
         for name, node in strategy['nodes']:
@@ -148,7 +151,7 @@ def stream_strategy(solved: Solved) -> dict:
     """The strategy with its ``nodes`` an iterator, made while it is read
     (``strategy_json_chunks`` writes them out; memory holds no edges)."""
     from ltl_synthesizer.strategy import streamed_strategy
-    with _memory_failures_reported(solved.interrupt.memory_limit):
+    with _memory_failures_reported(solved.interrupt, 'extracting the strategy'):
         return streamed_strategy(solved.game, _realizable(solved).solution)
 
 
@@ -156,7 +159,7 @@ def counter_strategy(solved: Solved) -> dict:
     """The environment's explicit counter-strategy of an unrealizable game."""
     from ltl_synthesizer.strategy import extract_counterstrategy
     environment = _unrealizable(solved).environment()
-    with _memory_failures_reported(solved.interrupt.memory_limit):
+    with _memory_failures_reported(solved.interrupt, 'extracting the counter-strategy'):
         return extract_counterstrategy(solved.game, environment, solved.robotics_semantics)
 
 
@@ -164,7 +167,7 @@ def explain(solved: Solved) -> str:
     """Why an unrealizable game is lost: losing initial states, a blocked goal, a play."""
     from ltl_synthesizer.explanation import explain_unrealizable
     environment = _unrealizable(solved).environment()
-    with _memory_failures_reported(solved.interrupt.memory_limit):
+    with _memory_failures_reported(solved.interrupt, 'explaining why it is unrealizable'):
         return explain_unrealizable(solved.game, solved.solution, environment, solved.robotics_semantics)
 
 
@@ -201,12 +204,20 @@ def _unrealizable(solved: Solved) -> Solved:
     return solved
 
 
+def game_size(game: SymbolicGame) -> str:
+    """The size measure a limit's message names: what the work is as large as."""
+    return (f'{len(game.inputs)} inputs and {len(game.outputs)} outputs: {2 * len(game.variables)} BDD '
+            f'variables, safety relations of {game.relation_nodes:,} nodes')
+
+
 @contextmanager
-def _memory_failures_reported(memory_limit: int | None):
-    """CUDD fails an operation beyond its memory limit; dd reports that as a NULL node."""
+def _memory_failures_reported(interrupt: Interrupt, stage: str):
+    """Runs ``stage`` (named by a limit that stops it, with the interrupt's size measure).
+    CUDD fails an operation beyond its memory limit; dd reports that as a NULL node."""
+    interrupt.stage = stage
     try:
         yield
     except ValueError as error:
-        if memory_limit is not None and 'NULL' in str(error):
-            raise memory_exceeded(memory_limit) from error
+        if interrupt.memory_limit is not None and 'NULL' in str(error):
+            raise memory_exceeded(interrupt.memory_limit, interrupt.during()) from error
         raise

@@ -129,7 +129,7 @@ def check_well_separation(spec: GR1Specification, limits: Limits = Limits(),
                           game: SymbolicGame | None = None) -> WellSeparation:
     """Whether ``spec`` is well-separated (see the module doc), naming the assumptions involved
     when it is not; ``game``: the game of ``spec`` if one is built already (a solved one)."""
-    game = game or SymbolicGame(spec, None, limits.interrupt())
+    game = game or SymbolicGame(spec, None, _interrupt(spec, limits))
     if game.env_init == game.false:
         return WellSeparation(False, ['env_init (unsatisfiable: the environment breaks it at once)'])
     if is_well_separated(game):
@@ -141,12 +141,20 @@ def check_well_separation(spec: GR1Specification, limits: Limits = Limits(),
                           involved)
 
 
+def _interrupt(spec: GR1Specification, limits: Limits):
+    """The limits' check, naming this stage and the specification's size when they stop it."""
+    interrupt = limits.interrupt()
+    interrupt.stage = 'checking well-separation'
+    interrupt.size = f'{len(spec.env_props)} inputs and {len(spec.sys_props)} outputs'
+    return interrupt
+
+
 def _forces_violation(spec: GR1Specification, kept: list[tuple[str, int]], limits: Limits) -> bool:
     """Whether the system can force a violation when only the assumptions ``kept`` are assumed
     (ENV_INIT always is)."""
     restricted = replace(spec, env_trans=[spec.env_trans[i] for s, i in kept if s == 'env_trans'],
                          env_liveness=[spec.env_liveness[i] for s, i in kept if s == 'env_liveness'])
-    game = SymbolicGame(restricted, None, limits.interrupt())
+    game = SymbolicGame(restricted, None, _interrupt(spec, limits))
     return cheating_initial_positions(game) != game.false
 
 

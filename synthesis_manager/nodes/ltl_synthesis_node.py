@@ -335,7 +335,7 @@ class LTLSynthesisNode(Node):
                 structuredslugs, slugsin, inputs, outputs = self.synthesis_processes.call(
                     byproduct_texts, (spec,), cancel=cancel, deadline=deadline)
             except SynthesisCancelledError as stopped:
-                return self._stopped(response, stopped.reason, timeout)
+                return self._stopped(response, stopped.reason, timeout, getattr(stopped, 'during', ''))
             variables = GR1Specification(env_props=inputs, sys_props=outputs)  # what the automaton names
         else:
             spec = variables = spec_from_text_sections(sections)
@@ -352,7 +352,7 @@ class LTLSynthesisNode(Node):
                         cancel, deadline, self.parameter('memory_limit_mb') * 2**20),
                         max_strategy_edges=self.parameter('max_strategy_edges'))
                 except SynthesisCancelledError as stopped:
-                    return self._stopped(response, stopped.reason, timeout)
+                    return self._stopped(response, stopped.reason, timeout, getattr(stopped, 'during', ''))
                 realizable, strategy, explanation = result.realizable, result.strategy, result.explanation
             elif backend == 'slugs':
                 realizable, strategy, stderr = run_external_synthesizer(
@@ -371,7 +371,7 @@ class LTLSynthesisNode(Node):
                 try:
                     message, diagnosed = self._diagnosed(details, spec, request, robotics, cancel, deadline)
                 except SynthesisCancelledError as stopped:
-                    return self._stopped(response, stopped.reason, timeout)
+                    return self._stopped(response, stopped.reason, timeout, getattr(stopped, 'during', ''))
                 response.error_code = error_code(ErrorCode.SPEC_UNSYNTHESIZABLE, message)
                 if not (keep and diagnosed):
                     return None
@@ -385,7 +385,7 @@ class LTLSynthesisNode(Node):
         try:
             warning, checked = self._well_separation_warning(spec, request, cancel, deadline)
         except SynthesisCancelledError as stopped:
-            return self._stopped(response, stopped.reason, timeout)
+            return self._stopped(response, stopped.reason, timeout, getattr(stopped, 'during', ''))
         response.automaton = automaton_to_msg(automaton_from_strategy(strategy, variables))
         response.error_code = error_code(ErrorCode.SUCCESS, warning)
         if not (keep and checked):
@@ -452,9 +452,11 @@ class LTLSynthesisNode(Node):
             return None
 
     @staticmethod
-    def _stopped(response, reason: str, timeout: float):
+    def _stopped(response, reason: str, timeout: float, during: str = ''):
+        """``during``: the stage the synthesis was in and its size measure, when it said."""
         code = ErrorCode.SYNTHESIS_TIMEOUT if reason == 'timeout' else ErrorCode.PREEMPTED
-        response.error_code = error_code(code, f'synthesis stopped: {reason} (time limit {timeout:g} s)')
+        where = f' while {during}' if during else ''
+        response.error_code = error_code(code, f'synthesis stopped: {reason}{where} (time limit {timeout:g} s)')
 
 
 def _is_large(sections: dict) -> bool:

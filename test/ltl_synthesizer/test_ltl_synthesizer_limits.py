@@ -7,6 +7,7 @@ import pytest
 
 from ltl_synthesizer import (Interrupt, Limits, SynthesisCancelledError, SynthesisMemoryError, is_realizable,
                              synthesize)
+from ltl_synthesizer.policy import Options
 from respec.ltl import conj, disj, iff, neg, next_, var
 from respec.parsing import parse_structuredslugs
 from respec.spec import GR1Specification
@@ -56,9 +57,20 @@ def test_the_verdict_alone_of_the_runaway_is_immediate():
 def test_the_memory_limit_ends_a_blow_up_with_a_clear_error():
     limit = 48 * 2**20
     with pytest.raises(SynthesisMemoryError) as raised:
-        synthesize(exponential_spec(), limits=Limits(memory_limit=limit))
+        # The order of first use (the structural order pairs x_i with y_i: no blow-up).
+        synthesize(exponential_spec(), limits=Limits(memory_limit=limit), options=Options(variable_order='affinity'))
     assert raised.value.code == 'SYNTHESIS_FAILED' and raised.value.item == 'memory_limit'
     assert 'memory limit of 48 MB' in str(raised.value)
+    # The stage it ran into the limit in, and the size measure of the task.
+    assert 'while building the game (20 inputs and 20 outputs)' in str(raised.value)
+
+
+def test_a_timeout_names_the_stage_and_the_size_of_the_task():
+    with pytest.raises(SynthesisCancelledError) as raised:
+        synthesize(runaway_spec(), limits=Limits(deadline=time.monotonic() + 0.5))
+    assert raised.value.code == 'SYNTHESIS_TIMEOUT' and raised.value.reason == 'timeout'
+    assert str(raised.value).startswith('synthesis timeout while extracting the strategy (100 inputs and 100 '
+                                        'outputs: 400 BDD variables, safety relations of '), str(raised.value)
 
 
 def test_unrealizable_runaway_explanation_is_bounded_too():

@@ -1,0 +1,289 @@
+"""Capability robots of realistic size and the per-cell gridworld (issue 44): our whole pipeline,
+our synthesizer alone and slugs, side by side in one run, with the fitted growth exponents.
+
+    python bench/bench_capability_scale.py --slugs /tmp/slugs/src/slugs [--timeout 60]
+        [--shapes chain,retry] [--sizes 10,20,40] [--grids 7x5,19x16] [--markdown FILE]
+
+For every capability robot (bench/capability_robots.py: N capabilities bound to FlexBE's
+OperatorDecisionState, a request with no initial conditions, the goal, outcomes finished,failed)
+and size N, each in a fresh process, wall seconds:
+
+- "pipeline": what export-behavior / the synthesis node does for the request, in one process:
+  compile the task, synthesize (robotics semantics, explicit strategy), the well-separation
+  check, the automaton, the FlexBE machine (stage seconds in the notes);
+- "gr1synth": ``python -m ltl_synthesizer --sysInitRoboticsSemantics`` on the compiled slugsin
+  (realizability only, as slugs' default);
+- "slugs": slugs with the same flag on the same file.
+
+The per-cell gridworld rows (capability_robots.per_cell_gridworld) have no pipeline (no robot):
+gr1synth and slugs only. Verdicts are compared on every row both tools finish. A tool that
+runs into the time cap is not run on the shape's larger sizes. The growth exponent is the
+least-squares slope of log(seconds) over log(N) on the rows with N >= 20 that finished.
+Timings are wall seconds on a shared 2-core machine: noisy.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+import signal
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path[:0] = [str(ROOT), str(ROOT / 'bench')]
+
+import capability_robots  # noqa: E402
+
+RESULTS = ROOT / 'bench' / 'results' / 'capability_scale.md'
+SIZES = [10, 20, 40, 80, 160]
+GRIDS = [(7, 5), (13, 10), (19, 16), (21, 18)]
+MEMORY_LIMIT = 2 * 2**30
+
+
+def run_wall(command: list[str], timeout: float) -> dict:
+    """Run ``command`` in its own session; wall seconds, exit status, stdout, timeout."""
+    start = time.monotonic()
+    process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, cwd=ROOT,
+                               start_new_session=True, text=True)
+    try:
+        out, err = process.communicate(timeout=timeout)
+        timed_out = False
+    except subprocess.TimeoutExpired:
+        os.killpg(process.pid, signal.SIGKILL)
+        out, err = process.communicate()
+        timed_out = True
+    return {'seconds': time.monotonic() - start, 'timeout': timed_out, 'code': process.returncode,
+            'out': out, 'err': err}
+
+
+def verdict_of(text: str) -> bool | None:
+    if 'RESULT: Specification is realizable.' in text:
+        return True
+    if 'RESULT: Specification is unrealizable.' in text:
+        return False
+    return None
+
+
+def pipeline_child(config_dir: str, shape: str, size: int, slugsin: str) -> None:
+    """The pipeline of one request (run in a fresh process): prints its stages as JSON."""
+    from ltl_specification import compile_task
+    from ltl_specification.diagnosis import explain_well_separation
+    from ltl_synthesizer import synthesize
+    from ltl_synthesizer.interrupt import Limits
+    from respec.automaton import automaton_from_strategy
+    from sm_generation import generate_state_machine
+
+    robot = capability_robots.SHAPES[shape](size)
+    stages = {}
+    start = time.perf_counter()
+    spec = compile_task(robot.name, robot.initial_conditions, robot.goals,
+                        sm_outcomes=capability_robots.REQUEST_OUTCOMES, config_dir=config_dir,
+                        state_library=capability_robots.STATE_LIBRARY)
+    text = spec.to_slugsin()
+    stages['compile'] = time.perf_counter() - start
+    Path(slugsin).write_text(text)
+    mark = time.perf_counter()
+    result = synthesize(spec, True, Limits(memory_limit=MEMORY_LIMIT))
+    stages['synthesize'] = time.perf_counter() - mark
+    report = {'realizable': result.realizable, 'env': len(spec.env_props), 'sys': len(spec.sys_props),
+              'strategy_nodes': result.stats.get('strategy_nodes', 0)}
+    if result.realizable:
+        mark = time.perf_counter()
+        explain_well_separation(spec, None, Limits(memory_limit=MEMORY_LIMIT))
+        stages['well_separation'] = time.perf_counter() - mark
+        mark = time.perf_counter()
+        automaton = automaton_from_strategy(result.strategy, spec)
+        states = generate_state_machine(automaton, robot.name, config_dir,
+                                        state_library=capability_robots.STATE_LIBRARY)
+        stages['generate'] = time.perf_counter() - mark
+        report['machine_states'] = len(states)
+    report['stages'] = stages
+    print(json.dumps(report))
+
+
+def fitted_exponent(points: list[tuple[int, float]]) -> float | None:
+    """Least-squares slope of log(seconds) over log(N), on N >= 20."""
+    points = [(n, s) for n, s in points if n >= 20 and s > 0]
+    if len(points) < 2:
+        return None
+    xs = [math.log(n) for n, _ in points]
+    ys = [math.log(s) for _, s in points]
+    mean_x, mean_y = sum(xs) / len(xs), sum(ys) / len(ys)
+    denominator = sum((x - mean_x) ** 2 for x in xs)
+    return sum((x - mean_x) * (y - mean_y) for x, y in zip(xs, ys)) / denominator if denominator else None
+
+
+def cell(result: dict | None, timeout: float) -> str:
+    if result is None:
+        return 'skipped'
+    if result['timeout']:
+        return f'> {timeout:g}'
+    if result.get('failed'):
+        return f"failed ({result['failed']})"
+    return f"{result['seconds']:.2f}"
+
+
+def measure_capabilities(args, directory: Path, rows: list, series: dict) -> None:
+    python = sys.executable
+    for shape in args.shapes:
+        given_up = set()
+        for size in args.sizes:
+            robot = capability_robots.SHAPES[shape](size)
+            robot.write(directory)
+            slugsin = directory / f'{robot.name}.slugsin'
+            row = {'family': shape, 'size': size, 'label': f'{shape} N={size}'}
+            results = {}
+            if 'pipeline' not in given_up:
+                run = run_wall([python, __file__, '--pipeline-child', str(directory), shape, str(size),
+                                str(slugsin)], args.timeout)
+                if not run['timeout'] and run['code'] == 0:
+                    report = json.loads(run['out'].strip().splitlines()[-1])
+                    run.update(report)
+                    row['verdict'] = report['realizable']
+                    row['props'] = f"{report['env']} / {report['sys']}"
+                    row['stages'] = report['stages']
+                elif not run['timeout']:
+                    run['failed'] = (run['err'].strip().splitlines() or ['?'])[-1][:80]
+                results['pipeline'] = run
+            if not slugsin.exists():  # the pipeline did not get as far as compiling: compile here
+                subprocess.run([python, '-c', _COMPILE_ONLY, str(directory), shape, str(size), str(slugsin)],
+                               cwd=ROOT, check=True)
+            for tool, command in (('gr1synth', [python, '-m', 'ltl_synthesizer', '--sysInitRoboticsSemantics',
+                                                str(slugsin)]),
+                                  ('slugs', [args.slugs, '--sysInitRoboticsSemantics', str(slugsin)])):
+                if tool in given_up:
+                    continue
+                run = run_wall(command, args.timeout)
+                if not run['timeout']:
+                    run['verdict'] = verdict_of(run['out'] + run['err'])
+                    if run['verdict'] is None:
+                        run['failed'] = (run['err'].strip().splitlines() or ['no verdict'])[-1][:80]
+                results[tool] = run
+            _finish_row(row, results, given_up, series)
+            rows.append(row)
+            print(_row_line(row, args.timeout), flush=True)
+
+
+_COMPILE_ONLY = '''
+import sys
+sys.path[:0] = ['.', 'bench']
+import capability_robots
+from ltl_specification import compile_task
+directory, shape, size, out = sys.argv[1], sys.argv[2], int(sys.argv[3]), sys.argv[4]
+robot = capability_robots.SHAPES[shape](size)
+spec = compile_task(robot.name, robot.initial_conditions, robot.goals, sm_outcomes=capability_robots.REQUEST_OUTCOMES,
+                    config_dir=directory, state_library=capability_robots.STATE_LIBRARY)
+open(out, 'w').write(spec.to_slugsin())
+'''
+
+
+def measure_gridworlds(args, directory: Path, rows: list, series: dict) -> None:
+    python = sys.executable
+    for realizable in (True, False):
+        family = 'gridworld' if realizable else 'gridworld_unrealizable'
+        given_up = set()
+        for width, height in args.grids:
+            text = capability_robots.per_cell_gridworld(width, height, 8, realizable)
+            slugsin = directory / f'{family}_{width}x{height}.slugsin'
+            slugsin.write_text(text)
+            row = {'family': family, 'size': width * height, 'label': f'{family} {width}x{height}',
+                   'props': f'{math.ceil(math.log2(width * height))} + {math.ceil(math.log2(width * height))} bits',
+                   'kb': len(text) // 1024}
+            results = {}
+            for tool, command in (('gr1synth', [python, '-m', 'ltl_synthesizer', '--sysInitRoboticsSemantics',
+                                                str(slugsin)]),
+                                  ('slugs', [args.slugs, '--sysInitRoboticsSemantics', str(slugsin)])):
+                if tool in given_up:
+                    continue
+                run = run_wall(command, args.timeout)
+                if not run['timeout']:
+                    run['verdict'] = verdict_of(run['out'] + run['err'])
+                results[tool] = run
+            _finish_row(row, results, given_up, series)
+            rows.append(row)
+            print(_row_line(row, args.timeout), flush=True)
+
+
+def _finish_row(row: dict, results: dict, given_up: set, series: dict) -> None:
+    row['results'] = results
+    verdicts = {tool: r.get('verdict', r.get('realizable')) for tool, r in results.items()
+                if not r['timeout'] and not r.get('failed')}
+    verdicts = {tool: v for tool, v in verdicts.items() if v is not None}
+    row['agree'] = len(set(verdicts.values())) <= 1
+    if 'verdict' not in row and verdicts:
+        row['verdict'] = next(iter(verdicts.values()))
+    for tool, run in results.items():
+        if run['timeout']:
+            given_up.add(tool)
+        elif not run.get('failed'):
+            series.setdefault((row['family'], tool), []).append((row['size'], run['seconds']))
+
+
+def _row_line(row: dict, timeout: float) -> str:
+    results = row['results']
+    verdict = {True: 'realizable', False: 'unrealizable'}.get(row.get('verdict'), '?')
+    if not row['agree']:
+        verdict += ' (VERDICTS DIFFER)'
+    stages = ', '.join(f'{k} {v:.2f}' for k, v in row.get('stages', {}).items())
+    return (f"| {row['label']} | {row.get('props', '')} | {verdict} | "
+            + ' | '.join(cell(results.get(tool), timeout) for tool in ('pipeline', 'gr1synth', 'slugs'))
+            + f' | {stages} |')
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument('--pipeline-child', nargs=4, help=argparse.SUPPRESS)
+    parser.add_argument('--slugs', default='/tmp/slugs/src/slugs')
+    parser.add_argument('--timeout', type=float, default=60.0, help='wall seconds per run (default 60)')
+    parser.add_argument('--shapes', default=','.join(capability_robots.SHAPES))
+    parser.add_argument('--sizes', default=','.join(map(str, SIZES)))
+    parser.add_argument('--grids', default=','.join(f'{w}x{h}' for w, h in GRIDS), help="'' for none")
+    parser.add_argument('--markdown', help=f'write the table here (e.g. {RESULTS.relative_to(ROOT)})')
+    args = parser.parse_args()
+    if args.pipeline_child:
+        config_dir, shape, size, slugsin = args.pipeline_child
+        pipeline_child(config_dir, shape, int(size), slugsin)
+        return
+    args.shapes = [s for s in args.shapes.split(',') if s]
+    args.sizes = [int(s) for s in args.sizes.split(',') if s]
+    args.grids = [tuple(int(v) for v in g.split('x')) for g in args.grids.split(',') if g]
+    header = ('| task | env / sys props | verdict | pipeline (s) | gr1synth (s) | slugs (s) | pipeline stages (s) |\n'
+              '|---|---|---|---|---|---|---|')
+    print(header, flush=True)
+    rows, series = [], {}
+    with tempfile.TemporaryDirectory() as directory:
+        measure_capabilities(args, Path(directory), rows, series)
+        measure_gridworlds(args, Path(directory), rows, series)
+    exponents = ['| family | pipeline | gr1synth | slugs |', '|---|---|---|---|']
+    for family in dict.fromkeys(row['family'] for row in rows):
+        values = []
+        for tool in ('pipeline', 'gr1synth', 'slugs'):
+            slope = fitted_exponent(series.get((family, tool), []))
+            values.append('-' if slope is None else f'{slope:.1f}')
+        exponents.append(f'| {family} | ' + ' | '.join(values) + ' |')
+    print('\nFitted growth exponent (seconds ~ N^k over N >= 20; gridworld: over cells):')
+    print('\n'.join(exponents))
+    differing = [row['label'] for row in rows if not row['agree']]
+    print('verdicts differ on: ' + (', '.join(differing) if differing else 'no row'))
+    if args.markdown:
+        commit = subprocess.run(['git', 'rev-parse', '--short', 'HEAD'], cwd=ROOT, capture_output=True,
+                                text=True).stdout.strip()
+        lines = [_row_line(row, args.timeout) for row in rows]
+        Path(args.markdown).write_text(
+            f'# Capability robots and the per-cell gridworld (issue 44)\n\n'
+            f"Written by `bench/bench_capability_scale.py --timeout {args.timeout:g}` on "
+            f"{time.strftime('%Y-%m-%d %H:%M', time.gmtime())} UTC, code at {commit}; wall seconds, "
+            f'each run a fresh process, on the shared 2-core machine (noisy). slugs built from source.\n\n'
+            + header + '\n' + '\n'.join(lines) + '\n\nFitted growth exponent (seconds ~ N^k over N >= 20; '
+            'gridworld: over cells):\n\n' + '\n'.join(exponents) + '\n\nVerdicts differ on: '
+            + (', '.join(differing) if differing else 'no row') + '.\n')
+
+
+if __name__ == '__main__':
+    main()

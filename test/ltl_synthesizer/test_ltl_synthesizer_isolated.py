@@ -293,10 +293,13 @@ def test_working_children_together_stay_under_the_sum_limit(monkeypatch):
     limit. Past the sum limit the child holding the most is ended; the others finish."""
     from ltl_synthesizer import isolated
 
-    monkeypatch.setattr(isolated, 'WORKING_CHILDREN_MEMORY', isolated.WorkingChildrenMemory(limit=600 * 2**20))
     pool = SynthesisProcesses()
     try:
         pool.prepare(3)
+        pool.call(os.getpid)  # the children have started: the tree as it is before the work
+        tree = isolated.resident_memory() + sum(isolated.resident_memory(pid) for pid in isolated._child_pids())
+        # The work may add 450 MB to the tree (the test process, whatever its size, and its children).
+        monkeypatch.setattr(isolated, 'WORKING_CHILDREN_MEMORY', isolated.WorkingChildrenMemory(limit=tree + 450 * 2**20))
         sizes = {'big': (400, 3.0), 'small one': (100, 1.5), 'small two': (100, 1.5)}
         with ThreadPoolExecutor(3) as threads:
             answers = {name: threads.submit(pool.call, exec, (grow_and_wait(megabytes, seconds), {}))

@@ -3,6 +3,7 @@
 connected to it stayed "running" 150 s. Now the goal ends SERVICE_UNAVAILABLE (exit 5) once
 the action server has left the ROS graph for SERVER_LOST_SECONDS."""
 
+import contextlib
 import json
 import os
 import signal
@@ -17,6 +18,27 @@ from test_synthesis_manager_reliability import RUNAWAY_SPEC
 
 NOTICED_WITHIN = SERVER_LOST_SECONDS + 3.5  # the DDS lease (1 s), its discovery, a loaded machine
 UNAVAILABLE_STATUS = 5  # README's exit status table: a server the command needs is missing
+
+
+@contextlib.contextmanager
+def serve_with_clients(tmp_path, *actions: str):
+    """``serve`` in a process of its own, and a SynthesisClient here for each action name
+    (``behavior_synthesis``, ``flexbe_synthesis``), each of its own client, its server up."""
+    from rclpy.node import Node
+
+    from synthesis_manager.client import SynthesisClient
+    from synthesis_manager.ros.harness import RosHarness
+
+    with loopback_domain() as (domain, environment):
+        with started([BIN / 'behavior-synthesis', 'serve', '--byproducts-dir', tmp_path / 'byproducts'],
+                     environment) as (server, output):
+            output.wait_for('suite up')
+            with RosHarness(domain_id=domain) as ros:
+                clients = [SynthesisClient(ros.add_node(Node, f'client_{index}'), action)
+                           for index, action in enumerate(actions or ('behavior_synthesis',))]
+                for client in clients:
+                    assert client.wait_for_server(30)
+                yield server, clients
 
 
 def kill_server(server) -> float:
@@ -75,28 +97,19 @@ def test_a_goal_sent_to_a_stalled_server_that_dies_is_answered_within_seconds(tm
     waited for the goal's acceptance with no liveness check (still waiting 190 s later)."""
     import threading
 
-    from rclpy.node import Node
+    from synthesis_manager.client import make_goal
 
-    from synthesis_manager.client import SynthesisClient, make_goal
-    from synthesis_manager.ros.harness import RosHarness
-
-    with loopback_domain() as (domain, environment):
-        with started([BIN / 'behavior-synthesis', 'serve', '--byproducts-dir', tmp_path / 'byproducts'],
-                     environment) as (server, server_output):
-            server_output.wait_for('suite up')
-            with RosHarness(domain_id=domain) as ros:
-                client = SynthesisClient(ros.add_node(Node, 'stalled_server_client'))
-                assert client.wait_for_server(10)
-                os.killpg(server.pid, signal.SIGSTOP)
-                outcomes = []
-                sender = threading.Thread(target=lambda: outcomes.append(client.run(
-                    make_goal('atlas', 'stand_prep', ['look_down'], option='ltl_compilation_only'))), daemon=True)
-                sender.start()
-                time.sleep(1.0)  # the scenario: the server dies 1 s after the goal was sent
-                os.killpg(server.pid, signal.SIGKILL)
-                killed = time.monotonic()
-                sender.join(60)
-                noticed = time.monotonic() - killed
+    with serve_with_clients(tmp_path) as (server, (client,)):
+        os.killpg(server.pid, signal.SIGSTOP)
+        outcomes = []
+        sender = threading.Thread(target=lambda: outcomes.append(client.run(
+            make_goal('atlas', 'stand_prep', ['look_down'], option='ltl_compilation_only'))), daemon=True)
+        sender.start()
+        time.sleep(1.0)  # the scenario: the server dies 1 s after the goal was sent
+        os.killpg(server.pid, signal.SIGKILL)
+        killed = time.monotonic()
+        sender.join(60)
+        noticed = time.monotonic() - killed
     print(f'SynthesisClient: answered {noticed:.2f} s after kill -9 of a stopped serve')
     assert not sender.is_alive(), 'the goal was never answered'
     assert outcomes[0].error_name == 'SERVICE_UNAVAILABLE' and 'went away' in outcomes[0].message
@@ -109,28 +122,19 @@ def test_sigterm_ends_serve_within_three_seconds_with_one_clients_goals_running_
     (bench_reliability --sections sharing found it)."""
     import threading
 
-    from rclpy.node import Node
+    from synthesis_manager.client import make_goal
 
-    from synthesis_manager.client import SynthesisClient, make_goal
-    from synthesis_manager.ros.harness import RosHarness
-
-    with loopback_domain() as (domain, environment):
-        with started([BIN / 'behavior-synthesis', 'serve', '--byproducts-dir', tmp_path / 'byproducts'],
-                     environment) as (server, server_output):
-            server_output.wait_for('suite up')
-            with RosHarness(domain_id=domain) as ros:
-                client = SynthesisClient(ros.add_node(Node, 'sigterm_client'))
-                assert client.wait_for_server(10)
-                waiting = threading.Event()
-                for _ in range(8):
-                    threading.Thread(target=client.run, daemon=True, kwargs={
-                        'feedback': lambda status, _: status.startswith('Waiting:') and waiting.set()},
-                        args=(make_goal('atlas', [], [], option='ltl_synthesis_only', ltl_specification=RUNAWAY_SPEC,
-                                        timeout=1e9),)).start()
-                assert waiting.wait(30)
-                signalled = time.monotonic()
-                server.send_signal(signal.SIGTERM)
-                server.wait(30)
-                took = time.monotonic() - signalled
+    with serve_with_clients(tmp_path) as (server, (client,)):
+        waiting = threading.Event()
+        for _ in range(8):
+            threading.Thread(target=client.run, daemon=True, kwargs={
+                'feedback': lambda status, _: status.startswith('Waiting:') and waiting.set()},
+                args=(make_goal('atlas', [], [], option='ltl_synthesis_only', ltl_specification=RUNAWAY_SPEC,
+                                timeout=1e9),)).start()
+        assert waiting.wait(30)
+        signalled = time.monotonic()
+        server.send_signal(signal.SIGTERM)
+        server.wait(30)
+        took = time.monotonic() - signalled
     print(f'serve exited {took:.2f} s after SIGTERM')
     assert took < 3.0 and server.returncode == 128 + signal.SIGTERM

@@ -126,15 +126,18 @@ def test_sigterm_ends_serve_within_three_seconds_with_one_clients_goals_running_
 
     with serve_with_clients(tmp_path) as (server, (client,)):
         waiting = threading.Event()
-        for _ in range(8):
-            threading.Thread(target=client.run, daemon=True, kwargs={
-                'feedback': lambda status, _: status.startswith('Waiting:') and waiting.set()},
-                args=(make_goal('atlas', [], [], option='ltl_synthesis_only', ltl_specification=RUNAWAY_SPEC,
-                                timeout=1e9),)).start()
+        senders = [threading.Thread(target=client.run, daemon=True, kwargs={
+            'feedback': lambda status, _: status.startswith('Waiting:') and waiting.set()},
+            args=(make_goal('atlas', [], [], option='ltl_synthesis_only', ltl_specification=RUNAWAY_SPEC,
+                            timeout=1e9),)) for _ in range(8)]
+        for sender in senders:
+            sender.start()
         assert waiting.wait(30)
         signalled = time.monotonic()
         server.send_signal(signal.SIGTERM)
         server.wait(30)
         took = time.monotonic() - signalled
+        for sender in senders:  # each notices the server gone (SERVICE_UNAVAILABLE) before its node is
+            sender.join(30)
     print(f'serve exited {took:.2f} s after SIGTERM')
     assert took < 3.0 and server.returncode == 128 + signal.SIGTERM

@@ -25,7 +25,7 @@ SUBCOMMANDS = {
     'compile': ('ltl_specification.cli', 'compile a task into a GR(1) specification (no ROS)'),
     'repair': ('ltl_specification.repair_cli', 'propose verified changes that make a refused task possible (no ROS)'),
     'generate-sm': ('sm_generation.cli', 'turn an automaton into a FlexBE state machine (no ROS)'),
-    'execute': ('synthesis_manager.execute', 'synthesize a behavior and run it on the simulated ATLAS'),
+    'execute': ('synthesis_manager.execute', 'synthesize a behavior and run it on the simulated robot (ATLAS, or a capability robot)'),
     'export-behavior': ('synthesis_manager.export_behavior', 'synthesize a behavior and write it as a FlexBE '
                         'behavior package'),
     'gui': ('synthesis_manager.gui', 'serve the synthesis web GUI on 127.0.0.1'),

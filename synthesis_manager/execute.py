@@ -1,4 +1,8 @@
-"""``behavior-synthesis execute``: synthesize a behavior, run it on the simulated ATLAS, check the run.
+"""``behavior-synthesis execute``: synthesize a behavior, run it on the simulated robot, check the run.
+
+The simulated robot is ATLAS's MuJoCo humanoid for a robot of our own format, and a simulated
+capability robot (each state answers an outcome, no physics: ``execute_capability_robot``) for
+a robot in CNU's capability format.
 
 The task goes through the ``/behavior_synthesis`` action with the suite's nodes running
 in-process (as ``demo`` does); the returned state machine runs on the MuJoCo simulator

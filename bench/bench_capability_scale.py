@@ -154,17 +154,7 @@ def measure_capabilities(args, directory: Path, rows: list, series: dict) -> Non
             if not slugsin.exists():  # the pipeline did not get as far as compiling: compile here
                 subprocess.run([python, '-c', _COMPILE_ONLY, str(directory), shape, str(size), str(slugsin)],
                                cwd=ROOT, check=True)
-            for tool, command in (('gr1synth', [python, '-m', 'ltl_synthesizer', '--sysInitRoboticsSemantics',
-                                                str(slugsin)]),
-                                  ('slugs', [args.slugs, '--sysInitRoboticsSemantics', str(slugsin)])):
-                if tool in given_up:
-                    continue
-                run = run_wall(command, args.timeout)
-                if not run['timeout']:
-                    run['verdict'] = verdict_of(run['out'] + run['err'])
-                    if run['verdict'] is None:
-                        run['failed'] = (run['err'].strip().splitlines() or ['no verdict'])[-1][:80]
-                results[tool] = run
+            results.update(solved_by_both(slugsin, args, given_up))
             _finish_row(row, results, given_up, series)
             rows.append(row)
             print(_row_line(row, args.timeout), flush=True)
@@ -183,8 +173,25 @@ open(out, 'w').write(spec.to_slugsin())
 '''
 
 
+def solved_by_both(slugsin: Path, args, given_up: set) -> dict:
+    """gr1synth's and slugs' runs on ``slugsin`` (those not given up on), each with its verdict
+    or, when it gave none, its last line of errors."""
+    results = {}
+    for tool, command in (('gr1synth', [sys.executable, '-m', 'ltl_synthesizer', '--sysInitRoboticsSemantics',
+                                        str(slugsin)]),
+                          ('slugs', [args.slugs, '--sysInitRoboticsSemantics', str(slugsin)])):
+        if tool in given_up:
+            continue
+        run = run_wall(command, args.timeout)
+        if not run['timeout']:
+            run['verdict'] = verdict_of(run['out'] + run['err'])
+            if run['verdict'] is None:
+                run['failed'] = (run['err'].strip().splitlines() or ['no verdict'])[-1][:80]
+        results[tool] = run
+    return results
+
+
 def measure_gridworlds(args, directory: Path, rows: list, series: dict) -> None:
-    python = sys.executable
     for realizable in (True, False):
         family = 'gridworld' if realizable else 'gridworld_unrealizable'
         given_up = set()
@@ -195,16 +202,7 @@ def measure_gridworlds(args, directory: Path, rows: list, series: dict) -> None:
             row = {'family': family, 'size': width * height, 'label': f'{family} {width}x{height}',
                    'props': f'{math.ceil(math.log2(width * height))} + {math.ceil(math.log2(width * height))} bits',
                    'kb': len(text) // 1024}
-            results = {}
-            for tool, command in (('gr1synth', [python, '-m', 'ltl_synthesizer', '--sysInitRoboticsSemantics',
-                                                str(slugsin)]),
-                                  ('slugs', [args.slugs, '--sysInitRoboticsSemantics', str(slugsin)])):
-                if tool in given_up:
-                    continue
-                run = run_wall(command, args.timeout)
-                if not run['timeout']:
-                    run['verdict'] = verdict_of(run['out'] + run['err'])
-                results[tool] = run
+            results = solved_by_both(slugsin, args, given_up)
             _finish_row(row, results, given_up, series)
             rows.append(row)
             print(_row_line(row, args.timeout), flush=True)

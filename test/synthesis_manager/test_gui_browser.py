@@ -82,6 +82,35 @@ def result_code(page, timeout=120_000):
     return page.inner_text('#result-code')
 
 
+def synthesize(page, goals, expected='SUCCESS'):
+    """Choose ATLAS's task of ``goals`` from stand_prep, press Synthesize, check its code."""
+    choose_task(page, goals)
+    page.click('#synthesize')
+    assert result_code(page) == expected
+
+
+STATUS_DONE = "document.getElementById('simulation-status').textContent.match(/^(Outcome|Stopped)/)"
+
+
+def stop_a_running_simulation(page) -> str:
+    """Simulate the machine shown, stop the run as soon as a state is active; the status then."""
+    page.click('#simulate')
+    page.wait_for_selector('#runtime-control:not([hidden])', timeout=60_000)
+    page.wait_for_selector('g.node.active', timeout=120_000)
+    page.click('#stop-run')
+    page.wait_for_function(STATUS_DONE, timeout=120_000)
+    return page.inner_text('#simulation-status')
+
+
+@contextmanager
+def flexbe_gui_server(tmp_path_factory, flexbe, name):
+    """``gui_server`` with the FlexBE workspace on AMENT_PREFIX_PATH (a capability robot's state classes)."""
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setenv('AMENT_PREFIX_PATH', str(flexbe))
+        with gui_server(tmp_path_factory.mktemp(name)) as served:
+            yield served
+
+
 def test_paper_task_shows_progress_draws_the_machine_and_downloads_yaml(page, tmp_path):
     assert page.is_checked('input[name="initial-mode"][value="stand_prep"]')  # the default
     choose_task(page, ['look_down', 'pickup_object'])

@@ -13,21 +13,18 @@ from pathlib import Path
 
 import pytest
 
-from test_gui_browser import browser_context, gui_server, open_page, result_code  # noqa: F401
+from test_gui_browser import STATUS_DONE, browser_context, flexbe_gui_server, open_page, result_code  # noqa: F401
 from test_gui_browser_newcomer import docs_shot
 
 pytestmark = pytest.mark.browser
 
 SIZE = {'width': 1280, 'height': 720}
-STATUS_DONE = "document.getElementById('simulation-status').textContent.match(/^(Outcome|Stopped)/)"
 
 
 @pytest.fixture(scope='module')
 def gui(tmp_path_factory, flexbe):
-    with pytest.MonkeyPatch.context() as patch:
-        patch.setenv('AMENT_PREFIX_PATH', str(flexbe))  # the delivery rover's FlexBE state classes
-        with gui_server(tmp_path_factory.mktemp('gui-capability-robot')) as served:
-            yield served
+    with flexbe_gui_server(tmp_path_factory, flexbe, 'gui-capability-robot') as served:  # the rover's state classes
+        yield served
 
 
 @pytest.fixture

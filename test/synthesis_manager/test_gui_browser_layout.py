@@ -8,14 +8,14 @@ import re
 
 import pytest
 
-from test_gui_browser import browser_context, choose_task, gui, open_page, result_code  # noqa: F401
+from test_gui_browser import (STATUS_DONE, browser_context, choose_task, gui, open_page,  # noqa: F401
+                              stop_a_running_simulation, synthesize)
 from test_gui_browser_newcomer import TWELVE_GOALS
 
 pytestmark = pytest.mark.browser
 
 SIZES = [{'width': 1280, 'height': 720}, {'width': 1920, 'height': 1080}]
 BY_SIZE = {'ids': lambda s: f"{s['width']}x{s['height']}"}
-STATUS_DONE = "document.getElementById('simulation-status').textContent.match(/^(Outcome|Stopped)/)"
 # Every node of the drawing (states, outcome boxes) and its texts' sizes on the screen.
 DRAWING = """() => {
   const svg = document.querySelector('.graph-viewport svg');
@@ -62,9 +62,7 @@ def assert_drawn_whole_and_readable(page, size, minimum_states=5):
 def test_the_machine_in_view_fitted_and_readable_after_synthesize_during_and_after_a_run(
         gui, browser_context, size):  # noqa: F811
     with open_page(browser_context, gui[0], viewport=size) as page:
-        choose_task(page, ['look_down', 'pickup_object'])
-        page.click('#synthesize')
-        assert result_code(page) == 'SUCCESS'
+        synthesize(page, ['look_down', 'pickup_object'])
         page.wait_for_selector('.graph-viewport svg g[id="state:stand"]')
         assert_drawn_whole_and_readable(page, size)
         in_view(page, '#simulate', size)
@@ -122,9 +120,7 @@ def test_the_form_has_no_scroll_of_its_own_and_the_panel_covers_no_field(gui, br
 @pytest.mark.parametrize('size', SIZES, **BY_SIZE)
 def test_a_goal_flagged_red_after_an_error_stays_in_view_above_the_panel(gui, browser_context, size):  # noqa: F811
     with open_page(browser_context, gui[0], viewport=size) as page:
-        choose_task(page, ['look_down', 'stand_prep'])
-        page.click('#synthesize')
-        assert result_code(page) == 'SPEC_UNSYNTHESIZABLE'
+        synthesize(page, ['look_down', 'stand_prep'], 'SPEC_UNSYNTHESIZABLE')
         page.wait_for_selector('#goals li.impossible')
         flagged = in_view(page, '#goals li.impossible', size)
         controls = page.locator('form section.controls').bounding_box()
@@ -165,16 +161,9 @@ def test_abstraction_labels_inside_their_boxes_the_task_path_once_per_visit_and_
 def test_a_stopped_run_shows_when_each_step_ran(gui, browser_context, size):  # noqa: F811
     with open_page(browser_context, gui[0], viewport=size) as page:
         # The paper's task runs for several robot seconds: long enough to be stopped in its first states.
-        choose_task(page, ['look_down', 'pickup_object'])
-        page.click('#synthesize')
-        assert result_code(page) == 'SUCCESS'
+        synthesize(page, ['look_down', 'pickup_object'])
         page.wait_for_selector('.graph-viewport svg g.node')
-        page.click('#simulate')
-        page.wait_for_selector('#runtime-control:not([hidden])', timeout=60_000)
-        page.wait_for_selector('g.node.active', timeout=120_000)
-        page.click('#stop-run')
-        page.wait_for_function(STATUS_DONE, timeout=120_000)
-        assert 'the operator stopped the run' in page.inner_text('#simulation-status')
+        assert 'the operator stopped the run' in stop_a_running_simulation(page)
         times = page.locator('#simulation-steps tr td:last-child').all_inner_texts()
         assert times and re.fullmatch(r'\d+\.\d\d–\d+\.\d\d \(stopped\)', times[-1]), times
         start, end = (float(t) for t in re.findall(r'\d+\.\d\d', times[-1]))

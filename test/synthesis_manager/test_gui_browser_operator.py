@@ -5,12 +5,11 @@ trace check tells the operator's choice from the machine's."""
 
 import pytest
 
-from test_gui_browser import browser_context, choose_task, gui, open_page, result_code  # noqa: F401
+from test_gui_browser import STATUS_DONE, browser_context, choose_task, gui, open_page, result_code  # noqa: F401
 
 pytestmark = pytest.mark.browser
 
 SIZES = [{'width': 1280, 'height': 720}, {'width': 1920, 'height': 1080}]
-STATUS_DONE = "document.getElementById('simulation-status').textContent.match(/^(Outcome|Stopped)/)"
 
 
 def synthesized(page):

@@ -7,16 +7,15 @@ import re
 
 import pytest
 
-from test_gui_browser import browser_context, choose_task, gui_server, open_page, result_code  # noqa: F401
+from test_gui_browser import (browser_context, choose_task, flexbe_gui_server, open_page,  # noqa: F401
+                              result_code, synthesize)
 from test_gui_browser_newcomer import docs_shot
 
 
 @pytest.fixture(scope='module')
 def gui(tmp_path_factory, flexbe):
-    with pytest.MonkeyPatch.context() as patch:
-        patch.setenv('AMENT_PREFIX_PATH', str(flexbe))  # the delivery rover's FlexBE state classes
-        with gui_server(tmp_path_factory.mktemp('gui-repair-play')) as served:
-            yield served
+    with flexbe_gui_server(tmp_path_factory, flexbe, 'gui-repair-play') as served:  # the rover's state classes
+        yield served
 
 
 @pytest.fixture
@@ -221,9 +220,7 @@ def test_a_capability_robot_asked_to_drive_and_not_to_drive_is_played_and_fixed(
                          ids=lambda s: f"{s['width']}x{s['height']}")
 def test_playing_the_robot_progress_first_ends_with_a_verdict_in_view_and_readable(gui, browser_context, size):  # noqa: F811
     with open_page(browser_context, gui[0], viewport=size) as page:
-        choose_task(page, ['look_down', 'stand_prep'])
-        page.click('#synthesize')
-        assert result_code(page) == 'SPEC_UNSYNTHESIZABLE'
+        synthesize(page, ['look_down', 'stand_prep'], 'SPEC_UNSYNTHESIZABLE')
         page.click('#play-robot')
         page.wait_for_selector('#play-choices button.play-choice')
         assert 'a play ends within 12 moves' in page.inner_text('#play-prompt')

@@ -3,9 +3,9 @@ answer InputState with the system's default offered, force an outcome while paus
 
 import pytest
 
-from test_gui_browser import browser_context, choose_task, gui, open_page, result_code  # noqa: F401
+from test_gui_browser import (STATUS_DONE, browser_context, choose_task, gui, open_page,  # noqa: F401
+                              result_code, stop_a_running_simulation)
 
-STATUS_DONE = "document.getElementById('simulation-status').textContent.match(/^(Outcome|Stopped)/)"
 
 
 @pytest.fixture
@@ -62,9 +62,4 @@ def test_force_an_outcome_while_paused_then_stop_a_run(page):
     row = page.locator(f'#simulation-steps tr[data-state="/{active}"] td.outcome')
     assert row.inner_text().startswith('failed')
 
-    page.click('#simulate')
-    page.wait_for_selector('#runtime-control:not([hidden])', timeout=60_000)
-    page.wait_for_selector('g.node.active', timeout=120_000)
-    page.click('#stop-run')
-    page.wait_for_function(STATUS_DONE, timeout=120_000)
-    assert 'the operator stopped the run' in page.inner_text('#simulation-status')
+    assert 'the operator stopped the run' in stop_a_running_simulation(page)

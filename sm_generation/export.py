@@ -92,14 +92,17 @@ def to_dot(states: list[StateInstantiation]) -> str:
     machine_outcomes = machine.outcomes
     names = {s.name for s in top}
     columns = _grid(top, machine.initial_state_name)
-    lines = ['digraph state_machine {', '  rankdir=TB;', '  nodesep=0.35;', f'  ranksep={0.3 if columns else 0.55};',
+    # A grid is drawn tighter, so that a 12-goal machine fits a 1280x720 window at 11 px text.
+    lines = ['digraph state_machine {', '  rankdir=TB;', f'  nodesep={0.2 if columns else 0.35};',
+             f'  ranksep={0.2 if columns else 0.55};',
              '  graph [fontname="Helvetica", bgcolor="transparent"];',
              '  node [shape=plain, fontname="Helvetica", fontsize=14];',
              '  edge [fontname="Helvetica", fontsize=12, color="#4a5560", arrowsize=0.8];']
     column_of = {state: index for index, column in enumerate(columns) for state in column}
     for state in top:
         failing = _failing_groups(state, names)
-        label = _container_label(state, failing) if state.states else _state_label(state, failing)
+        label = (_container_label(state, failing) if state.states else
+                 _state_label(state, failing, padding=4 if columns else 5))
         css = f'state column-{column_of[state.name]}' if columns else 'state'  # its failure outcome's copy
         lines.append(f'  {_quote("state:" + state.name)} [id={_quote("state:" + state.name)}, '
                      f'class="{css}", label=<{label}>];')
@@ -213,9 +216,9 @@ def _outcome_cells(state: StateInstantiation, failing: set[int] = frozenset()) -
     return ''.join(cells)
 
 
-def _state_label(state: StateInstantiation, failing: set[int] = frozenset()) -> str:
+def _state_label(state: StateInstantiation, failing: set[int] = frozenset(), padding: int = 5) -> str:
     columns = max(1, len(outcome_groups(state)))
-    return (f'<TABLE BORDER="1" CELLBORDER="0" CELLSPACING="0" CELLPADDING="5" STYLE="ROUNDED" BGCOLOR="white">'
+    return (f'<TABLE BORDER="1" CELLBORDER="0" CELLSPACING="0" CELLPADDING="{padding}" STYLE="ROUNDED" BGCOLOR="white">'
             f'<TR><TD COLSPAN="{columns}"><B>{_html(state.name)}</B></TD></TR>'
             f'<TR><TD COLSPAN="{columns}"><FONT POINT-SIZE="11" COLOR="#5a6570">{_html(_class_label(state))}'
             f'</FONT></TD></TR><TR>{_outcome_cells(state, failing)}</TR></TABLE>')

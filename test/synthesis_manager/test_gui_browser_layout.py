@@ -171,3 +171,13 @@ def test_a_stopped_run_shows_when_each_step_ran(gui, browser_context, size):  # 
         for earlier in times[:-1]:
             start, end = (float(t) for t in earlier.split('–'))
             assert end >= start, times
+
+
+@pytest.mark.parametrize('size', SIZES, **BY_SIZE)
+def test_the_twelve_goal_machine_opens_whole_and_readable(gui, browser_context, size):  # noqa: F811
+    """The README's largest task: its 27 states and outcome boxes all in view right after
+    Synthesize, no text under 11 px (the grid layout is drawn tight enough for 1280x720)."""
+    with open_page(browser_context, gui[0], viewport=size) as page:
+        synthesize(page, TWELVE_GOALS)
+        page.wait_for_selector('.graph-viewport svg g[id="state:footstep_goal_1"]')
+        assert_drawn_whole_and_readable(page, size, minimum_states=20)

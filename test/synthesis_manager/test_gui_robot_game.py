@@ -55,3 +55,38 @@ def test_a_play_longer_than_the_bound_is_refused(wrong_order):
     from ltl_specification.play import PlayError
     with pytest.raises(PlayError, match='a play ends within 12 moves; 13 were sent'):
         turn_after(wrong_order, [0] * (MAX_GAME_MOVES + 1))
+
+
+# A robot that may wave once only: the environment wins in the long run (the goal cannot hold
+# again and again), but a play in which the robot waves has reached every goal.
+WAVE_ONCE = """[INPUT]
+door_open
+
+[OUTPUT]
+wave
+waved
+
+[SYS_INIT]
+!wave
+!waved
+
+[SYS_TRANS]
+waved' <-> (waved | wave)
+waved -> !wave'
+
+[SYS_LIVENESS]
+wave
+"""
+
+
+def test_a_play_in_which_every_goal_holds_ends_you_reached_every_goal():
+    from respec.parsing.specifications import parse_structuredslugs
+
+    spec = parse_structuredslugs(WAVE_ONCE)
+    play = RobotPlay(spec, {'wave': 'the robot waves'})
+    first = game_turn(play, spec, play.meanings, [])
+    assert first['verdict'] == '' and first['goals'] == [{'words': 'the robot waves', 'reached': False}]
+    assert first['moves'][0]['words'] == 'the robot waves'  # the progress move comes first
+    turn = game_turn(play, spec, play.meanings, [first['moves'][0]['index']])
+    assert turn['verdict'] == 'you reached every goal'
+    assert turn['goals'] == [{'words': 'the robot waves', 'reached': True}] and turn['moves'] == []

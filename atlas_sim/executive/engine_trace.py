@@ -29,7 +29,7 @@ from __future__ import annotations
 import contextlib
 import threading
 
-from atlas_sim.executive.executor import ExecutionResult, StateMapping, entered_step
+from atlas_sim.executive.executor import ExecutionResult, StateMapping, entered_step, record_forced
 from atlas_sim.executive.machine import load_machine, next_target
 from atlas_sim.executive.trace_check import OutcomeTracker, Trace, TraceStep
 from respec.robot import RobotSystem
@@ -75,13 +75,16 @@ class EngineTraceRecorder:
             self._observe(snapshot)
             self._current = entered_step(self.trace, self.states[name], self.parts[name], snapshot, self.tracker)
 
-    def returned(self, name: str, outcome: str) -> None:
-        """Top-level state ``name`` returned ``outcome``."""
+    def returned(self, name: str, outcome: str, forced: bool = False) -> None:
+        """Top-level state ``name`` returned ``outcome`` (``forced``: the operator's choice, sent
+        as FlexBE's transition command, not the state's own result)."""
         target = next_target(self.states[name], outcome)
         snapshot = self._snapshot()
         with self._lock:
             self._observe(snapshot)
             step = self._current
+            if forced:
+                record_forced(step, step.state, outcome, self.parts[name])
             step.state_outcome, step.transition = outcome, target
             step.ended_at, step.mode_at_exit = snapshot['time'], snapshot['mode']
             step.outcomes_at_exit = self.tracker.true_propositions()

@@ -172,7 +172,7 @@ def entered_step(trace: Trace, state: State, parts: list[Part], snapshot: dict,
     return step
 
 
-def _record_forced(step: TraceStep, path: str, outcome: str, parts) -> None:
+def record_forced(step: TraceStep, path: str, outcome: str, parts) -> None:
     """Note on ``step`` the outcome the operator forced on ``path`` (the state or one of its
     children) and the outcome propositions that outcome stands for (trace_check reads them as
     reported)."""
@@ -258,7 +258,7 @@ class Executive:
             forced = self._forced(state, parts)
             if forced is not None:
                 path, forced_outcome = forced
-                _record_forced(step, path, forced_outcome, parts)
+                record_forced(step, path, forced_outcome, parts)
                 if path == state.state_path:
                     outcome = forced_outcome
                     break
@@ -272,7 +272,7 @@ class Executive:
             if outcome is not None:
                 chosen = self._confirmed(state, outcome)
                 if chosen != outcome:  # the operator forced another outcome at the waiting transition
-                    _record_forced(step, state.state_path, chosen, parts)
+                    record_forced(step, state.state_path, chosen, parts)
                 outcome = chosen
                 break
             self._tick(step)

@@ -106,7 +106,9 @@ def observe_top_level_states(machine, recorder: EngineTraceRecorder) -> None:
     """Report the top-level states' starts and outcomes to ``recorder``.
 
     The engine calls ``execute`` of the current state once per tick; a state starts with its
-    first call after an outcome (or ever) and ends with the call returning an outcome.
+    first call after an outcome (or ever) and ends with the call returning an outcome. An
+    outcome the operator forced (FlexBE's ``flexbe/command/transition``) is the one flexbe_core's
+    ManuallyTransitionableState notes as requested in that call.
     """
     for state in machine._states:  # noqa: SLF001 - flexbe_core keeps no public list
         original = state.execute
@@ -119,7 +121,8 @@ def observe_top_level_states(machine, recorder: EngineTraceRecorder) -> None:
             outcome = _original(*args, **kwargs)
             if outcome is not None and outcome != PREEMPTED:
                 _running['now'] = False
-                recorder.returned(_state.name, outcome)
+                forced = getattr(_state, '_manual_transition_requested', None) == outcome
+                recorder.returned(_state.name, outcome, forced=forced)
             return outcome
         state.execute = observed
 

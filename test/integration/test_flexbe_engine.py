@@ -103,6 +103,37 @@ def test_retry_until_finished_on_the_flexbe_engine(ros):
     assert simulator.snapshot()['holding_object']
 
 
+def test_an_outcome_the_operator_forces_on_the_engine_is_the_operators_in_the_trace(ros):
+    """Autonomy Off: the first state waits for the operator, who forces ``failed`` with FlexBE's
+    transition command (as the WebUI's Runtime Control does); the trace says who chose it."""
+    import threading
+
+    from flexbe_msgs.msg import OutcomeRequest
+
+    from synthesis_manager.ros.flexbe_engine import run_on_flexbe
+
+    spec, states = synthesized(*PICKUP)
+    first = next(s for s in states if s.state_path == '/' + states[0].initial_state_name)
+    simulator = make_simulator('atlas', initial_conditions=PICKUP[0])
+    node = ros.add_node(AtlasSimNode, simulator=simulator, parameter_overrides=[
+        Parameter('speed', value=20.0), Parameter('state_rate', value=50.0)])
+    operator = ros.add_node(Node, 'forcing_operator')
+    commands = operator.create_publisher(OutcomeRequest, 'flexbe/command/transition', 10)
+    done = {}
+    runner = threading.Thread(target=lambda: done.update(run=run_on_flexbe(
+        states, simulator, node.lock, ros.domain_id, autonomy=0, max_wall_time=60.0)))
+    runner.start()
+    while runner.is_alive():  # the command is read while the state waits (buffered until then)
+        commands.publish(OutcomeRequest(outcome=first.outcomes.index('failed'), target=first.name))
+        runner.join(timeout=0.5)
+    run = done['run']
+    assert run.outcome == 'failed'
+    step = run.trace.steps[0]
+    assert (step.state, step.state_outcome, step.forced) == (first.state_path, 'failed', 'failed')
+    report = check_trace(run.trace, spec, goals=PICKUP[1])
+    assert f'the operator forced failed on {first.name} at step 0' in report.summary()
+
+
 def run_cli(capsys, *arguments):
     from synthesis_manager.cli import main
 

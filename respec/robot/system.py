@@ -27,11 +27,13 @@ from pathlib import Path
 from types import MappingProxyType
 from typing import Callable, Mapping, Sequence
 
+import yaml
+
 from respec.robot.abstraction import RobotAbstraction, abstraction_from_document
-from respec.robot.cnu import CapabilitySystem, is_capability_document, load_capability_system
+from respec.robot.cnu import SYSTEM_FILE_KEYS, CapabilitySystem, is_capability_document, load_capability_system
 from respec.robot.files import (ConfigDirs, ConfigFileInvalidError, SystemConfigError, SystemNotFoundError,
-                                available_systems, config_search_path, parse_config_text, read_config_file,
-                                system_config_path)
+                                available_systems, config_search_path, load_config_yaml, parse_config_text,
+                                read_config_file, system_config_path)
 
 ABSTRACTION_KIND = 'abstraction'
 CAPABILITIES_KIND = 'capabilities'
@@ -231,8 +233,25 @@ def catalog_to_json(catalog: SystemCatalog) -> str:
             entries.append({'name': name, 'error': {'code': error.code.name, 'message': str(error),
                                                     'item': error.item}})
             continue
-        entries.append({'name': name, 'config_file': system.config_file, 'files': dict(system.files)})
+        entries.append({'name': name, 'config_file': system.config_file, 'files': served_files(system)})
     return json.dumps({'systems': entries}, sort_keys=True)
+
+
+# The system file's sections a suite serves; anything else in it (notes, other tools' keys) stays.
+SERVED_SECTIONS = ('system', 'abstraction', 'flexbe', 'simulation', *SYSTEM_FILE_KEYS)
+
+
+def served_files(system: RobotSystem) -> dict[str, str]:
+    """What a client needs to rebuild ``system`` (``robot_system_from_files``), not its files: each
+    file's parsed content written out again, so no comment or formatting leaves the server, and of
+    the system file only the sections the suite reads (SERVED_SECTIONS)."""
+    served = {}
+    for relative, text in system.files.items():
+        content = load_config_yaml(text, relative)
+        if relative == system.path.name and isinstance(content, dict):
+            content = {key: value for key, value in content.items() if key in SERVED_SECTIONS}
+        served[relative] = yaml.safe_dump(content, sort_keys=False, allow_unicode=True)
+    return served
 
 
 @dataclass(frozen=True)

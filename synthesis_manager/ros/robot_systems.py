@@ -1,7 +1,8 @@
 """The suite's robot systems on ROS: the compilation node serves them, a GUI elsewhere reads them.
 
 The topic ``robot_systems`` (std_msgs/String, latched) carries ``respec.robot.catalog_to_json``
-of the compilation node's config directory: every system's files as text. A GUI attached to a
+of the compilation node's config directory: what rebuilds every system (its files' parsed
+content written out again, not the files' text: ``respec.robot.system.served_files``). A GUI attached to a
 running suite (``gui --connect``) builds its RobotSystems from them, so it shows and checks the
 systems the suite synthesizes for, never config files of its own machine.
 """

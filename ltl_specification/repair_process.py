@@ -22,11 +22,14 @@ from ltl_synthesizer.errors import SynthesisError, SynthesisTimeoutError
 from ltl_synthesizer.interrupt import DEFAULT_MEMORY_LIMIT
 from ltl_synthesizer.isolated import SERVER_CHILD_NICENESS, ChildProcess
 
-#: Seconds a child may take beyond its search's time budget (the diagnosis included): the
-#: interpreter's start (0.2-0.3 s measured) and the answer.
-#: A candidate's compilation or synthesis that outlives the deadline (one CUDD operation can
-#: run for a minute on a BDD bomb) is ended by the kill; what was verified before is kept.
-STARTUP_GRACE = 1.0
+#: Seconds a child may take beyond its search's time budget to answer (the kill comes
+#: isolated.DEADLINE_GRACE_SECONDS later still: 0.5 s in all). The budget counts from
+#: the search's creation in the parent, so the child's start (0.2-0.3 s measured) comes out of
+#: it, not on top of it (``search`` stops at ``ends_at``, a time.monotonic() value: one clock for
+#: every process of the machine). A candidate's compilation or synthesis that outlives the
+#: deadline (one CUDD operation can run for a minute on a BDD bomb) is ended by the kill; what
+#: was verified before is kept.
+ANSWER_GRACE = 0.2
 
 
 class RepairSearchError(Exception):
@@ -49,14 +52,15 @@ class RepairSearch:
     ``max_proposals``."""
 
     def __init__(self, settings: dict):
-        self.settings = settings
-        self.deadline = time.monotonic() + settings['time_budget'] + STARTUP_GRACE
+        ends_at = time.monotonic() + settings['time_budget']
+        self.settings = {**settings, 'ends_at': ends_at}
+        self.deadline = ends_at + ANSWER_GRACE
         self.child = ChildProcess(niceness=SERVER_CHILD_NICENESS, preload=__name__)
 
     def run(self, on_proposal: Callable[[dict], None] | None = None) -> dict:
         """The search's ``Repairs.to_dict()``; ``on_proposal(proposal dict)`` as each is verified.
         A refusal of the system's files is raised as the CodedError it is. The whole search,
-        its first check and the diagnosis included, ends within its time budget and STARTUP_GRACE
+        its first check and the diagnosis included, ends within its time budget and ANSWER_GRACE
         (counted from this object's creation), and within its memory limit."""
         try:
             return self.child.call(search, (self.settings,), on_progress=on_proposal or (lambda _: None),
@@ -82,6 +86,7 @@ def search(settings: dict, progress: Callable[[dict], None]) -> dict:
 
     system = robot_system_from_files(settings['system'], settings['files'], settings['config_file'])
     repairs = propose_repairs(system, TaskRequest.from_dict(settings['request']), settings['custom_ltl'],
-                              time_budget=settings['time_budget'], max_proposals=settings['max_proposals'],
+                              time_budget=max(0.0, settings['ends_at'] - time.monotonic()),
+                              max_proposals=settings['max_proposals'],
                               on_proposal=lambda proposal: progress(proposal.to_dict()))
     return repairs.to_dict()

@@ -299,7 +299,7 @@ def test_a_search_past_its_deadline_is_killed(monkeypatch):
 
     from ltl_synthesizer import isolated
 
-    monkeypatch.setattr(repair_process, 'STARTUP_GRACE', 0.0)
+    monkeypatch.setattr(repair_process, 'ANSWER_GRACE', 0.0)
     monkeypatch.setattr(isolated, 'DEADLINE_GRACE_SECONDS', 0.0)  # no time to report its own timeout
     search = repair_process.RepairSearch(search_settings(time_budget=0.01))
     with pytest.raises(repair_process.RepairSearchError, match='ended at its time budget'):

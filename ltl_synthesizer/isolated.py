@@ -135,7 +135,9 @@ class WorkingChildrenMemory:
     Each child's own limit (a synthesis' memory_limit) bounds one piece of work; eight at once
     could still hold eight times that. Past ``limit`` bytes in all, the working child holding
     the most is ended (SynthesisMemoryError naming the sum limit), so the others go on. Read at
-    most every ``period`` seconds, whichever working child polls first."""
+    most every ``period`` seconds, whichever working child polls first; a tree that grew since
+    the last reading is judged by where it will be at the next, so that it never passes the
+    limit between two readings (a BDD bomb grows about 10 MiB in 0.1 s)."""
 
     def __init__(self, limit: int | None = None, period: float = 0.1):
         self.limit, self.period = limit, period
@@ -144,6 +146,7 @@ class WorkingChildrenMemory:
         self._read_at = -float('inf')
         self._over: ChildProcess | None = None
         self.total = 0  # bytes, at the last reading
+        self.growth = 0  # bytes the tree grew between the last two readings (0 if it shrank)
 
     def working(self, child: ChildProcess, busy: bool) -> None:
         with self._lock:
@@ -157,12 +160,13 @@ class WorkingChildrenMemory:
         with self._lock:
             now = time.monotonic()
             if now - self._read_at >= self.period:
+                recent = now - self._read_at < 2 * self.period  # growth over one period, not since long ago
                 self._read_at = now
                 sizes = {working: resident_memory(working.process.pid) for working in self._working}
                 others = [pid for pid in _child_pids() if pid not in {w.process.pid for w in sizes}]
-                self.total = (sum(sizes.values()) + resident_memory()
-                              + sum(resident_memory(pid) for pid in others))
-                self._over = max(sizes, key=sizes.get) if self.total > self.limit else None
+                total = sum(sizes.values()) + resident_memory() + sum(resident_memory(pid) for pid in others)
+                self.growth, self.total = (max(0, total - self.total) if recent else 0), total
+                self._over = max(sizes, key=sizes.get) if sizes and total + self.growth > self.limit else None
             return self._over is child
 
 

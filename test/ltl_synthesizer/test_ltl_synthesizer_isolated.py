@@ -310,3 +310,33 @@ def test_working_children_together_stay_under_the_sum_limit(monkeypatch):
         assert answers['small one'].result() is None and answers['small two'].result() is None
     finally:
         pool.close()
+
+
+def test_a_growing_tree_is_stopped_before_it_passes_the_sum_limit(monkeypatch):
+    """The tree is read every ``period``: a child growing 100 MB per reading toward a 350 MB
+    limit is ended at the reading of 300 MB (the next would be 400), not after passing it; a
+    first reading after a pause does not count the pause's growth."""
+    from types import SimpleNamespace
+
+    from ltl_synthesizer import isolated
+
+    class Child:  # what the sum limit reads of a ChildProcess
+        process = SimpleNamespace(pid=7)
+
+    readings = {'child': 0}
+    monkeypatch.setattr(isolated, 'resident_memory', lambda pid=None: readings['child'] if pid == 7 else 0)
+    monkeypatch.setattr(isolated, '_child_pids', lambda: [7])
+    clock = {'now': 100.0}
+    monkeypatch.setattr(isolated.time, 'monotonic', lambda: clock['now'])
+    memory = isolated.WorkingChildrenMemory(limit=350, period=0.1)
+    child = Child()
+    memory.working(child, True)
+    verdicts = []
+    for size in (100, 200, 300):
+        clock['now'] += 0.125
+        readings['child'] = size
+        verdicts.append(memory.is_over(child))
+    assert verdicts == [False, False, True] and memory.growth == 100
+    clock['now'] += 60  # a minute later, 340 MB: under the limit, and no growth is known
+    readings['child'] = 340
+    assert not memory.is_over(child) and memory.growth == 0

@@ -19,7 +19,7 @@ VIZ_JS := @viz-js/viz@3.31.0
 NEEDS_NODE := make setup needs Node.js and npm: the GUI draws state machines with Graphviz compiled to \
   WebAssembly ($(VIZ_JS), from npm). Install them (sudo apt-get install nodejs npm) and run make again.
 
-.PHONY: setup run test bench serve clean system-packages flexbe webui
+.PHONY: setup run test bench serve clean system-packages flexbe webui lint lint-js
 
 # FlexBE: the folder holding flexbe_behavior_engine/ (and flexbe_webui/, rosidl_runtime_py/).
 FLEXBE_SOURCES ?= $(if $(wildcard ../shared/third_party/flexbe_behavior_engine),$(abspath ../shared/third_party))
@@ -59,8 +59,20 @@ setup: $(VENV)/.project-installed $(VENV)/.msgs-installed $(GRAPHVIZ_WASM)/.inst
 run: setup
 	$(BIN)/behavior-synthesis demo
 
-test: setup system-packages $(if $(FLEXBE_SOURCES),flexbe)
+test: setup system-packages $(if $(FLEXBE_SOURCES),flexbe) lint
 	$(if $(FLEXBE_SOURCES),FLEXBE_SOURCES=$(abspath $(FLEXBE_SOURCES))) $(BIN)/python -m pytest -q
+
+# Static checks (docs/testing.md): `make lint` runs them all; each also runs alone.
+lint: lint-js
+
+# The GUI's ES modules, with ESLint from npm (package.json, package-lock.json; eslint.config.mjs).
+lint-js: node_modules/.installed
+	node_modules/.bin/eslint synthesis_manager/web/static synthesis_manager/web/render_dot.mjs
+
+node_modules/.installed: package.json package-lock.json
+	@command -v npm >/dev/null && command -v node >/dev/null || { echo "$(NEEDS_NODE)" >&2; exit 1; }
+	npm ci --no-audit --no-fund --no-update-notifier --loglevel=error
+	touch $@
 
 bench: setup
 	$(BIN)/python bench/run_all.py

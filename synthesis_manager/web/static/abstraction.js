@@ -230,7 +230,7 @@ function capabilityPath(graph, goals, holding) {
     on.nodes.add(key);
     on.nodes.add(id);
     if (!negated && holding.has(name)) return;
-    for (const c of graph.capabilities.filter((c) => c.makes.some((m) => m.name === name && m.negated === negated))) {
+    for (const c of graph.capabilities.filter((capability) => capability.makes.some((m) => m.name === name && m.negated === negated))) {
       on.edges.add(`cap:${c.name}->${id}`);
       if (on.nodes.has(`cap:${c.name}`)) continue;
       on.nodes.add(`cap:${c.name}`);

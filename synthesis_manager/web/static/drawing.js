@@ -86,7 +86,7 @@ function enablePanning() {
     apply();
     viewport.classList.add('panning');
   });
-  viewport.addEventListener('pointerup', (event) => {
+  viewport.addEventListener('pointerup', () => {
     const clicked = drag && !drag.moved ? drag : null;
     drag = null;
     viewport.classList.remove('panning');

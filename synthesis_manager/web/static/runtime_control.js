@@ -132,7 +132,7 @@ export function connectRuntimeControl() {
     event.preventDefault();
     const text = $('operator-input').value.trim();
     let value;
-    try { value = JSON.parse(text); } catch (error) { value = text; }  // the run says what it makes of it
+    try { value = JSON.parse(text); } catch { value = text; }  // the run says what it makes of it
     answer(value);
   });
   $('operator-abort').addEventListener('click', () => answer(null));

@@ -9,7 +9,7 @@ Modules:
     instantiation  StateInstantiation / OutcomeCondition (fields of flexbe_msgs)
     config         the validated ``flexbe:`` section of config/<system>.yaml
     automaton_io   reading and writing automata (our YAML/JSON, slugs strategies)
-    machine        automaton -> abstract machine (observations, pass-through, exits)
+    abstract_machine  automaton -> AbstractMachine, the automaton-shaped intermediate (observations, exits)
     reduction      merging bisimilar states
     layout         positions for the FlexBE editor
     generator      the engine: automaton + FlexBE mapping -> StateInstantiation list

@@ -34,8 +34,8 @@ from sm_generation.config import FlexBEConfig, StateConfig
 from sm_generation.errors import SMGenerationError
 from sm_generation.instantiation import DECISION_CLASS, NOTHING_CLASS, OutcomeCondition, StateInstantiation
 from sm_generation.layout import inner_positions, layered_positions
-from sm_generation.machine import (
-    DECISION, NOTHING_TO_DO, AutomatonView, Machine, MachineState, Target, build_machine)
+from sm_generation.abstract_machine import (
+    DECISION, NOTHING_TO_DO, AutomatonView, AbstractMachine, AbstractState, Target, build_machine)
 from sm_generation.reduction import bisimulation_blocks, reduce_machine, target_class
 
 _LOG = logging.getLogger(__name__)
@@ -75,14 +75,14 @@ def generate_from_config(automaton, config: FlexBEConfig, initial_conditions: li
     return entries
 
 
-def userdata_from_outside(machine: Machine) -> list[str]:
+def userdata_from_outside(machine: AbstractMachine) -> list[str]:
     """The keys the machine's states read and none of them writes: the root's input keys."""
     parts = [part for state in machine.states.values() for part in state.parts]
     written = {key for part in parts for key in part.writes}
     return sorted({key for part in parts for key in part.reads} - written)
 
 
-def machine_from_view(view: AutomatonView, initial_conditions: list[str] | None) -> Machine:
+def machine_from_view(view: AutomatonView, initial_conditions: list[str] | None) -> AbstractMachine:
     """The abstract machine, with a helper state when the start needs one."""
     starts = list(dict.fromkeys(view.resolve(name) for name in view.initial_candidates(initial_conditions)))
     if len(starts) > 1:
@@ -97,7 +97,7 @@ def machine_from_view(view: AutomatonView, initial_conditions: list[str] | None)
     machine = build_machine(view, starts)
     helper = DECISION if len(starts) > 1 else NOTHING_TO_DO
     transitions = [((('', f'choice{index}'),), target) for index, target in enumerate(starts)]
-    start = MachineState(key=f'<{helper}>', parts=(), transitions=transitions, helper=helper)
+    start = AbstractState(key=f'<{helper}>', parts=(), transitions=transitions, helper=helper)
     machine.states = {start.key: start, **machine.states}
     machine.initial = start.key
     return machine
@@ -105,7 +105,7 @@ def machine_from_view(view: AutomatonView, initial_conditions: list[str] | None)
 
 # --- naming -----------------------------------------------------------------------------
 
-def _base_name(state: MachineState) -> str:
+def _base_name(state: AbstractState) -> str:
     if state.helper == DECISION:
         return DECISION_NAME
     if state.helper == NOTHING_TO_DO:
@@ -113,7 +113,7 @@ def _base_name(state: MachineState) -> str:
     return NAME_SEPARATOR.join(part.label for part in state.parts)
 
 
-def _assign_names(machine: Machine) -> dict[str, str]:
+def _assign_names(machine: AbstractMachine) -> dict[str, str]:
     bases = {key: _base_name(state) for key, state in machine.states.items()}
     counts: dict[str, int] = {}
     for base in bases.values():
@@ -136,7 +136,7 @@ def _assign_names(machine: Machine) -> dict[str, str]:
 
 # --- StateInstantiation entries -----------------------------------------------------------
 
-def _instantiate(machine: Machine) -> list[StateInstantiation]:
+def _instantiate(machine: AbstractMachine) -> list[StateInstantiation]:
     names = _assign_names(machine)
 
     def target_name(target: Target) -> str:
@@ -172,7 +172,7 @@ def _part_entry(part: StateConfig, path: str) -> StateInstantiation:
         userdata_keys=list(part.userdata_keys), userdata_remapping=list(part.userdata_remapping))
 
 
-def _single_entry(state: MachineState, path: str, target_name) -> StateInstantiation:
+def _single_entry(state: AbstractState, path: str, target_name) -> StateInstantiation:
     part = state.parts[0]
     entry = _part_entry(part, path)
     by_proposition = {observation[0][1]: target for observation, target in state.transitions}
@@ -185,7 +185,7 @@ def _single_entry(state: MachineState, path: str, target_name) -> StateInstantia
     return entry
 
 
-def _concurrency_entries(state: MachineState, name: str, target_name) -> list[StateInstantiation]:
+def _concurrency_entries(state: AbstractState, name: str, target_name) -> list[StateInstantiation]:
     parts = {part.proposition: part for part in state.parts}
     labels = _inner_labels(state.parts)
     container = StateInstantiation(state_path=f'/{name}', state_class=StateInstantiation.CLASS_CONCURRENCY)
@@ -244,7 +244,7 @@ def _combinations(choices: list[tuple[str, ...]]) -> list[tuple[str, ...]]:
     return result
 
 
-def _helper_entry(state: MachineState, name: str, target_name) -> StateInstantiation:
+def _helper_entry(state: AbstractState, name: str, target_name) -> StateInstantiation:
     targets = [target_name(target) for _, target in state.transitions]
     if state.helper == DECISION:
         return StateInstantiation(

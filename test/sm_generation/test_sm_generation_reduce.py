@@ -11,7 +11,7 @@ from sm_generation import generate_state_machine, load_automaton, validate_state
 from respec.robot import robot_system
 from sm_generation.config import StateConfig, flexbe_config
 from sm_generation.generator import machine_from_view
-from sm_generation.machine import AutomatonView, Machine, MachineState
+from sm_generation.abstract_machine import AutomatonView, AbstractMachine, AbstractState
 from sm_generation.reduction import bisimulation_blocks
 from sm_generation.traces import TRUNCATED, runs
 
@@ -110,8 +110,8 @@ def machines(draw):
     for key in keys:
         part = draw(st.sampled_from(_PARTS))
         chosen = draw(st.lists(st.sampled_from(_OBSERVATIONS), unique=True, max_size=2))
-        states[key] = MachineState(key, (part,), [(o, draw(targets)) for o in sorted(chosen)])
-    return Machine(states=states, initial='0', outcomes=['finished', 'failed'])
+        states[key] = AbstractState(key, (part,), [(o, draw(targets)) for o in sorted(chosen)])
+    return AbstractMachine(states=states, initial='0', outcomes=['finished', 'failed'])
 
 
 @settings(max_examples=200, deadline=None)

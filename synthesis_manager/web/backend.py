@@ -310,13 +310,13 @@ class SynthesisBackend:
         return self._artifacts[key]
 
     def state_machine(self, job_id: str) -> StateMachine:
-        """The job's state machine as the tree sm_generation builds from its list."""
+        """The job's state machine (its tree, as the job's outcome holds it)."""
         job = self._job(job_id)
         if not job.finished:
             raise NotAvailableError(f'job {quoted(job_id)} has not finished yet', job_id)
-        if not job.outcome.states:
+        if job.outcome.machine is None:
             raise NotAvailableError(f'job {quoted(job_id)} ({job.outcome.error_name}) has no state machine', job_id)
-        return StateMachine.from_instantiations(job.outcome.states)
+        return job.outcome.machine
 
     # simulations ------------------------------------------------------------------------
 
@@ -335,7 +335,7 @@ class SynthesisBackend:
         autonomy = body.get('autonomy', FULL)
         if autonomy not in AUTONOMY_LEVELS.values() or isinstance(autonomy, bool):
             raise InvalidJobRequestError('autonomy is 0 (Off), 1 (Low), 2 (High) or 3 (Full)', 'autonomy')
-        if not (job.finished and job.outcome.states):
+        if not (job.finished and job.outcome.machine is not None):
             raise NotAvailableError(f'job {quoted(job_id)} has no state machine to simulate', job_id)
         try:
             robot = self.catalog.load(job.request.system)
@@ -412,7 +412,7 @@ class SynthesisBackend:
         files as read here, not a path to read them again."""
         request, started = job.request, time.monotonic()
         child = SimulationProcess({
-            'states': [state.to_dict() for state in job.outcome.states],
+            'machine': job.outcome.machine,
             'ltl_specification': job.outcome.ltl_specification,
             'system': robot.name, 'files': dict(robot.files), 'config_file': robot.config_file,
             'initial_conditions': list(request.initial_conditions), 'goals': list(request.goals),

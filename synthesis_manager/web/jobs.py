@@ -188,6 +188,7 @@ class ResultSummary:
     def of(cls, outcome: JobOutcome) -> 'ResultSummary':
         sections = outcome.ltl_specification
         automaton_states = len(outcome.automaton_states)
+        entries = list(outcome.machine.walk()) if outcome.machine else []
         if outcome.error_name == ErrorCode.SPEC_UNSYNTHESIZABLE:
             realizable = False
         elif automaton_states:
@@ -201,10 +202,9 @@ class ResultSummary:
             output_propositions=len(sections.get('sys_props', [])),
             formulas=sum(len(lines) for name, lines in sections.items() if not name.endswith('_props')),
             automaton_states=automaton_states,
-            state_machine_states=count_states(outcome.states),
-            state_instantiations=len(outcome.states),
-            concurrency_containers=sum(1 for s in outcome.states
-                                       if s.state_class == StateInstantiation.CLASS_CONCURRENCY),
+            state_machine_states=count_states(entries),
+            state_instantiations=len(entries),
+            concurrency_containers=sum(1 for s in entries if s.state_class == StateInstantiation.CLASS_CONCURRENCY),
             seconds=round(outcome.seconds, 4),
         )
 

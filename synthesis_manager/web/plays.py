@@ -18,7 +18,6 @@ from ltl_specification import compile_task
 from ltl_specification.play import PlayError, RobotPlay
 from respec.errors import CodedError, ErrorCode, quoted
 from sm_generation.play import MachinePlayError, play_machine
-from sm_generation.state_machine import StateMachine
 from synthesis_manager.web.errors import GuiRequestError, InvalidJobRequestError, NotAvailableError
 from synthesis_manager.web.jobs import Job
 from synthesis_manager.web.robot_game import game_turn
@@ -54,7 +53,7 @@ class Plays:
     def turn(self, job: Job, moves: list) -> dict:
         """The turn after ``moves``, with ``play`` saying whom the user plays."""
         outcome = job.outcome
-        if outcome.states:
+        if outcome.machine is not None:
             return {'play': ENVIRONMENT, **self._machine_turn(job, moves)}
         if outcome.error_name == ErrorCode.SPEC_UNSYNTHESIZABLE:
             return {'play': ROBOT, **self._robot_turn(job, moves)}
@@ -65,7 +64,7 @@ class Plays:
         if not all(isinstance(move, str) for move in moves):
             raise InvalidJobRequestError('the moves of a machine play are outcome names', 'moves')
         try:
-            return play_machine(StateMachine.from_instantiations(job.outcome.states), moves).to_dict()
+            return play_machine(job.outcome.machine, moves).to_dict()
         except MachinePlayError as error:
             raise MoveError(str(error), 'moves') from error
 

@@ -38,8 +38,9 @@ def test_exported_behavior_loads_in_flexbe_core_and_create_builds_the_machine(ro
 
     from synthesis_manager.ros.flexbe_engine import load_behavior_class, reset_flexbe_proxies
 
-    _, states = synthesized(*PICKUP)
-    package = behavior_package(states, flexbe_config(robot_system('atlas')), 'Look Down And Pickup')
+    _, machine = synthesized(*PICKUP)
+    package = behavior_package(machine, flexbe_config(robot_system('atlas')), 'Look Down And Pickup')
+    states = machine.to_instantiations()
     behavior_class, _ = load_behavior_class(package, tmp_path)
     node = ros.add_node(Node, 'flexbe_create_test')
     set_node(node)

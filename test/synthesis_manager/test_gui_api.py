@@ -293,9 +293,9 @@ def test_a_simulation_runs_the_system_the_gui_was_served_not_a_local_file(tmp_pa
     files = {'served_atlas.yaml': yaml.safe_dump(document, sort_keys=False)}
     served = robot_system_from_files('served_atlas', files, 'suite/served_atlas.yaml')
     spec = compile_task(served, ['stand_prep'], ['walk'])
-    states = generate_state_machine(automaton_from_strategy(synthesize(spec).strategy, spec), served,
-                                    initial_conditions=['stand_prep'])
-    final = simulate({'states': [state.to_dict() for state in states], 'ltl_specification': spec.to_text_sections(),
+    machine = generate_state_machine(automaton_from_strategy(synthesize(spec).strategy, spec), served,
+                                     initial_conditions=['stand_prep'])
+    final = simulate({'machine': machine, 'ltl_specification': spec.to_text_sections(),
                       'system': served.name, 'files': dict(served.files), 'config_file': served.config_file,
                       'initial_conditions': ['stand_prep'], 'goals': ['walk'], 'ordered': True, 'fail_first': [],
                       'record_dir': str(tmp_path), 'max_robot_time': 300.0, 'max_wall_time': 300.0},

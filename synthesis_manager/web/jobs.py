@@ -262,3 +262,11 @@ def stage_timings(timeline: list[ProgressNote], total_seconds: float) -> list[St
         end = timeline[index + 1].seconds if index + 1 < len(timeline) else total_seconds
         stages.append(StageTiming(note.status, round(max(0.0, end - note.seconds), 4)))
     return stages
+
+
+def update_record(record, lock: threading.Lock, **changes) -> None:
+    """Change a Job or Simulation under ``lock`` and bump its revision (what the event streams watch)."""
+    with lock:
+        for name, value in changes.items():
+            setattr(record, name, value)
+        record.revision += 1

@@ -222,14 +222,14 @@ def test_unknown_names_in_urls_are_404_and_the_server_keeps_serving(client):
 
 
 def test_cancel_a_job_before_it_is_sent(client, backend):
-    backend.job_gate.clear()  # hold new jobs in the queue
+    backend.jobs.gate.clear()  # hold new jobs in the queue
     try:
         job = client.post('/api/jobs', json=PAPER_TASK).json()
         assert client.get(f"/api/jobs/{job['id']}").json()['state'] == 'queued'
         assert client.post(f"/api/jobs/{job['id']}/cancel", json={}).status_code == 202
         _, final = follow(client, job['id'])
     finally:
-        backend.job_gate.set()
+        backend.jobs.gate.set()
     assert final['outcome']['error_name'] == 'PREEMPTED'
     # nothing reached the pipeline: the timeline holds only the cancel
     assert [entry['status'] for entry in final['timeline']] == ['Cancel requested', 'Cancelled']

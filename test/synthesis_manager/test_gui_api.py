@@ -376,6 +376,25 @@ def test_the_state_machine_is_served_as_a_tree_of_the_listed_states(client):
     assert missing.status_code == 409 and missing.json()['item'] == compiled['id']
 
 
+def test_drawings_and_plays_read_the_tree_the_job_holds_without_rebuilding_it(client, backend, monkeypatch):
+    """The result's list becomes the tree once, when it arrives; drawings and play steps reuse it."""
+    from sm_generation.state_machine import StateMachine
+
+    _, job = run_job(client, PAPER_TASK)
+    held = backend.jobs.job(job['id']).outcome.machine
+    builds = []
+    real = StateMachine.from_instantiations.__func__
+    monkeypatch.setattr(StateMachine, 'from_instantiations',
+                        classmethod(lambda cls, states: builds.append(len(states)) or real(cls, states)))
+    first = client.get(f"/api/jobs/{job['id']}/state-machine").json()
+    assert client.get(f"/api/jobs/{job['id']}/state-machine").json() == first == held.to_dict()
+    start = client.post(f"/api/jobs/{job['id']}/play", json={'moves': []}).json()
+    step = client.post(f"/api/jobs/{job['id']}/play", json={'moves': [start['outcomes'][0]]})
+    assert step.status_code == 200, step.text
+    assert backend.jobs.state_machine(job['id']) is held
+    assert builds == []
+
+
 def test_the_page_is_es_modules_served_as_javascript(client):
     from synthesis_manager.web.routes import STATIC_DIR
 

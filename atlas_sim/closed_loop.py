@@ -19,6 +19,7 @@ from atlas_sim.executive.trace_check import TraceCheckReport, TraceStep, check_t
 from atlas_sim.simulator.rendering import KeyFrameRecorder
 from respec.robot import RobotSystem
 from respec.spec import GR1Specification
+from sm_generation.state_machine import StateMachine
 
 FRAME_WIDTH, FRAME_HEIGHT = 480, 360
 
@@ -34,13 +35,14 @@ class CheckedRun:
     timeline: Path | None = None
 
 
-def run_and_check(states, robot, simulator, system: RobotSystem, spec: GR1Specification, goals: list[str], *,
+def run_and_check(machine: StateMachine, robot, simulator, system: RobotSystem, spec: GR1Specification,
+                  goals: list[str], *,
                   ordered: bool = True, record_dir: str | Path | None = None,
                   max_robot_time: float = 300.0, max_wall_time: float | None = None,
                   on_progress: Callable[[list[TraceStep], list[Path]], None] | None = None,
                   view=None, lock=None,
                   run_machine: Callable[[Callable], ExecutionResult] | None = None) -> CheckedRun:
-    """Run ``states`` on ``robot`` (driving ``simulator``), then check and plot the run.
+    """Run ``machine`` on ``robot`` (driving ``simulator``), then check and plot the run.
 
     The simulator's incidents (the robot's body in furniture, a fall) go into the trace, so the
     check reports them as violations.
@@ -75,7 +77,7 @@ def run_and_check(states, robot, simulator, system: RobotSystem, spec: GR1Specif
     started = time.monotonic()
     try:
         if run_machine is None:
-            executive = Executive(states, robot, StateMapping(system), max_robot_time=max_robot_time,
+            executive = Executive(machine, robot, StateMapping(system), max_robot_time=max_robot_time,
                                   max_wall_time=max_wall_time, on_tick=tick)
             result = executive.run()
         else:

@@ -102,7 +102,7 @@ def pipeline_child(config_dir: str, shape: str, size: int, slugsin: str) -> None
         states = generate_state_machine(automaton, robot.name, config_dir,
                                         state_library=capability_robots.STATE_LIBRARY)
         stages['generate'] = time.perf_counter() - mark
-        report['machine_states'] = len(states)
+        report['machine_states'] = len(states.to_instantiations())
     report['stages'] = stages
     print(json.dumps(report))
 

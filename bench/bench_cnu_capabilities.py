@@ -53,8 +53,8 @@ ATLAS_TASKS = [
 ]
 
 
-def top_level(states) -> int:
-    return sum(1 for s in states if s.state_path != '/' and s.state_path.count('/') == 1 and s.state_class != ':OUTCOME')
+def top_level(machine) -> int:
+    return len(machine.states)
 
 
 def measure(system, initial_conditions, goals, config_dir=None, library=None, repeat=3):

@@ -66,7 +66,7 @@ def main() -> None:
     def row(label, automaton, system='atlas'):
         plain_time, plain = timed(lambda: generate_state_machine(automaton, system))
         reduced_time, reduced = timed(lambda: generate_state_machine(automaton, system, reduce=True))
-        top = lambda states: sum(1 for s in states if s.parent_path == '/' and s.state_class != ':OUTCOME')  # noqa: E731
+        top = lambda machine: len(machine.states)  # noqa: E731
         print(f'{label:42s} {len(automaton.states):11d} {top(plain):9d} {plain_time * 1e3:9.2f} '
               f'{top(reduced):8d} {reduced_time * 1e3:9.2f}')
 

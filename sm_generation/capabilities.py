@@ -31,13 +31,14 @@ from sm_generation.config import FlexBEConfig, StateConfig
 from sm_generation.errors import StateConfigInvalidError
 from sm_generation.generator import generate_from_config
 from sm_generation.instantiation import StateInstantiation
+from sm_generation.state_machine import StateMachine
 
 DEFAULT_AUTONOMY = 1
 _UNSAFE = re.compile(r'[^A-Za-z0-9_]+')
 
 
 def generate_capability_machine(automaton, system: CapabilitySystem, library: Mapping[str, StateClass],
-                                reduce: bool | None = None) -> list[StateInstantiation]:
+                                reduce: bool | None = None) -> StateMachine:
     """The FlexBE state machine implementing ``automaton`` on a capability system."""
     outcomes = capability_outcomes(system, library)
     flexbe_automaton, variants = _with_parameter_variants(automaton, system, _reported_inputs(system, outcomes))

@@ -49,23 +49,23 @@ def run(args: argparse.Namespace) -> int:
         initial_conditions = parse_names(args.initial_conditions)
     try:
         automaton = load_automaton(args.automaton, args.spec)
-        states = generate_state_machine(automaton, args.system, args.config_dir, initial_conditions, args.reduce)
+        machine = generate_state_machine(automaton, args.system, args.config_dir, initial_conditions, args.reduce)
     except SMGenerationError as error:
         print(f'error: {error.code}: {error} (item: {error.item})', file=sys.stderr)
         return ExitStatus.FAILED
-    problems = validate_state_machine(states)
+    problems = validate_state_machine(machine.to_instantiations())
     if problems:  # would be a bug in this package; report rather than write a broken file
         print('error: SM_GENERATION_FAILED: generated machine is inconsistent:\n  ' + '\n  '.join(problems),
               file=sys.stderr)
         return ExitStatus.FAILED
     if fmt in RENDER_FORMATS:
         try:
-            render(to_dot(states), args.output, fmt)
+            render(to_dot(machine), args.output, fmt)
         except RenderError as error:
             print(f'error: {error} (item: {error.item})', file=sys.stderr)
             return ExitStatus.FAILED
         return ExitStatus.OK
-    text = {'yaml': to_yaml, 'json': to_json, 'dot': to_dot}[fmt](states)
+    text = {'yaml': to_yaml, 'json': to_json, 'dot': to_dot}[fmt](machine)
     if args.output is None:
         sys.stdout.write(text)
     else:

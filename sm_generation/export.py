@@ -1,6 +1,7 @@
-"""Writing a StateInstantiation list as YAML, JSON or a Graphviz drawing.
+"""Writing a state machine as YAML, JSON or a Graphviz drawing.
 
-YAML and JSON hold the 16 fields of every entry (``to_dict``) in list order, so the same
+YAML and JSON hold its StateInstantiation list (the 16 fields of every entry, ``to_dict``, in
+list order; ``from_text`` reads the list back), so the same
 machine always gives the same bytes. ``to_dot`` draws the machine as the FlexBE editor
 shows behaviors (states as boxes with their outcomes along the bottom, containers holding
 their states, the machine's outcomes at the bottom); ``render`` runs Graphviz' ``dot``
@@ -33,13 +34,15 @@ class RenderError(CodedError):
     code = ErrorCode.SM_GENERATION_FAILED
 
 
-def to_yaml(states: list[StateInstantiation]) -> str:
-    return yaml.safe_dump([s.to_dict() for s in states], sort_keys=False, default_flow_style=None,
+def to_yaml(machine: StateMachine) -> str:
+    """The machine's StateInstantiation list as YAML."""
+    return yaml.safe_dump([s.to_dict() for s in machine.to_instantiations()], sort_keys=False, default_flow_style=None,
                           width=100, allow_unicode=True)
 
 
-def to_json(states: list[StateInstantiation]) -> str:
-    return json.dumps([s.to_dict() for s in states], indent=2, ensure_ascii=False) + '\n'
+def to_json(machine: StateMachine) -> str:
+    """The machine's StateInstantiation list as JSON."""
+    return json.dumps([s.to_dict() for s in machine.to_instantiations()], indent=2, ensure_ascii=False) + '\n'
 
 
 def from_text(text: str) -> list[StateInstantiation]:
@@ -68,7 +71,7 @@ def outcome_groups(state: StateInstantiation) -> list[tuple[str, list[str]]]:
     return list(targets.items())
 
 
-def to_dot(states: list[StateInstantiation]) -> str:
+def to_dot(machine: StateMachine) -> str:
     """Graphviz DOT text of the machine, drawn the way the FlexBE editor shows behaviors.
 
     Every state is a box with its name, its class and, along its bottom edge, its outcomes;
@@ -87,7 +90,6 @@ def to_dot(states: list[StateInstantiation]) -> str:
     SVG elements get ids ``state:<name>``, ``outcome:<name>`` (copies: ``outcome:<name>:<column>``)
     and ``edge:<state>-><target>``, so a page can find, highlight and explain them.
     """
-    machine = StateMachine.from_instantiations(states)
     top = list(machine.states)
     machine_outcomes = machine.outcomes
     names = {s.name for s in top}

@@ -1,6 +1,6 @@
 """A synthesized state machine as a FlexBE behavior package (ROS-free).
 
-``behavior_package(states, config, name)`` writes what the FlexBE editor's "Save Behavior"
+``behavior_package(machine, config, name)`` writes what the FlexBE editor's "Save Behavior"
 writes for a behavior, and around it what colcon needs to install it (ament_python):
 
     <package>/package.xml                    exports <flexbe_behaviors/>
@@ -112,13 +112,12 @@ def check_behavior_name(name: str) -> str:
 
 # --- the package ---------------------------------------------------------------------------------
 
-def behavior_package(states: list[StateInstantiation], config: FlexBEConfig, behavior_name: str,
+def behavior_package(machine: StateMachine, config: FlexBEConfig, behavior_name: str,
                      package: str = DEFAULT_PACKAGE, description: str = '', author: str = 'behavior-synthesis',
                      date: str = '') -> BehaviorPackage:
-    """The behavior package for ``states`` (a generated StateInstantiation list)."""
+    """The behavior package for ``machine`` (a generated state machine)."""
     check_package_name(package)
     check_behavior_name(behavior_name)
-    machine = StateMachine.from_instantiations(states)
     description = description or f'Synthesized for {config.system}.'
     module = behavior_module_name(behavior_name)
     class_name = behavior_class_name(behavior_name)

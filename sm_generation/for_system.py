@@ -16,13 +16,14 @@ from respec.robot.state_library import capability_outcomes, workspace_state_libr
 from sm_generation.capabilities import capability_flexbe_config, generate_capability_machine
 from sm_generation.config import FlexBEConfig, flexbe_config, generation_system
 from sm_generation.generator import generate_from_config
-from sm_generation.instantiation import StateInstantiation
+from sm_generation.state_machine import StateMachine
 
 
 def generate_state_machine(automaton, system: RobotSystem | str, config_dir: str | Path | None = None,
                            initial_conditions: list[str] | None = None,
-                           reduce: bool = False, state_library=None) -> list[StateInstantiation]:
-    """The FlexBE state machine implementing ``automaton`` on ``system``.
+                           reduce: bool = False, state_library=None) -> StateMachine:
+    """The FlexBE state machine implementing ``automaton`` on ``system``, as its tree (its
+    StateInstantiation list, FlexBE's wire format, is ``to_instantiations()``).
 
     ``system`` is a RobotSystem, or the name of one in ``config_dir`` (default ``config/``).
     A system described by CNU capability files takes its state classes from ``state_library``

@@ -1,7 +1,7 @@
-"""The generator's engine: automaton + FlexBE mapping -> StateInstantiation list
+"""The generator's engine: automaton + FlexBE mapping -> the ``StateMachine`` tree
 (``sm_generation.for_system.generate_state_machine`` is the front door that picks the mapping).
 
-The list, in order:
+The tree, in the order of its StateInstantiation list (``to_instantiations``):
 
 1. the root (``state_path='/'``, ``:STATEMACHINE``): ``initial_state_name`` is the first
    state to run, ``outcomes`` the machine's outcomes (e.g. ``finished``, ``failed``);
@@ -34,9 +34,10 @@ from sm_generation.config import FlexBEConfig, StateConfig
 from sm_generation.errors import SMGenerationError
 from sm_generation.instantiation import DECISION_CLASS, NOTHING_CLASS, OutcomeCondition, StateInstantiation
 from sm_generation.layout import inner_positions, layered_positions
-from sm_generation.machine import (
-    DECISION, NOTHING_TO_DO, AutomatonView, Machine, MachineState, Target, build_machine)
+from sm_generation.abstract_machine import (
+    DECISION, NOTHING_TO_DO, AutomatonView, AbstractMachine, AbstractState, Target, build_machine)
 from sm_generation.reduction import bisimulation_blocks, reduce_machine, target_class
+from sm_generation.state_machine import State, StateMachine
 
 _LOG = logging.getLogger(__name__)
 
@@ -50,7 +51,7 @@ NOTHING_NAME = 'nothing_to_do'
 
 
 def generate_from_config(automaton, config: FlexBEConfig, initial_conditions: list[str] | None = None,
-                         reduce: bool = False) -> list[StateInstantiation]:
+                         reduce: bool = False) -> StateMachine:
     """The FlexBE state machine implementing ``automaton`` with the FlexBE mapping ``config``.
 
     Initial state: the automaton's ``initial_states`` (kept only if they satisfy the
@@ -70,19 +71,19 @@ def generate_from_config(automaton, config: FlexBEConfig, initial_conditions: li
                      'FlexBE cannot take it, so it is left out', source, target)
     if reduce:
         machine = reduce_machine(machine)
-    entries = _instantiate(machine)
-    entries[0].input_keys = userdata_from_outside(machine)
-    return entries
+    root = _instantiate(machine)
+    root.input_keys = userdata_from_outside(machine)
+    return root
 
 
-def userdata_from_outside(machine: Machine) -> list[str]:
+def userdata_from_outside(machine: AbstractMachine) -> list[str]:
     """The keys the machine's states read and none of them writes: the root's input keys."""
     parts = [part for state in machine.states.values() for part in state.parts]
     written = {key for part in parts for key in part.writes}
     return sorted({key for part in parts for key in part.reads} - written)
 
 
-def machine_from_view(view: AutomatonView, initial_conditions: list[str] | None) -> Machine:
+def machine_from_view(view: AutomatonView, initial_conditions: list[str] | None) -> AbstractMachine:
     """The abstract machine, with a helper state when the start needs one."""
     starts = list(dict.fromkeys(view.resolve(name) for name in view.initial_candidates(initial_conditions)))
     if len(starts) > 1:
@@ -97,7 +98,7 @@ def machine_from_view(view: AutomatonView, initial_conditions: list[str] | None)
     machine = build_machine(view, starts)
     helper = DECISION if len(starts) > 1 else NOTHING_TO_DO
     transitions = [((('', f'choice{index}'),), target) for index, target in enumerate(starts)]
-    start = MachineState(key=f'<{helper}>', parts=(), transitions=transitions, helper=helper)
+    start = AbstractState(key=f'<{helper}>', parts=(), transitions=transitions, helper=helper)
     machine.states = {start.key: start, **machine.states}
     machine.initial = start.key
     return machine
@@ -105,7 +106,7 @@ def machine_from_view(view: AutomatonView, initial_conditions: list[str] | None)
 
 # --- naming -----------------------------------------------------------------------------
 
-def _base_name(state: MachineState) -> str:
+def _base_name(state: AbstractState) -> str:
     if state.helper == DECISION:
         return DECISION_NAME
     if state.helper == NOTHING_TO_DO:
@@ -113,7 +114,7 @@ def _base_name(state: MachineState) -> str:
     return NAME_SEPARATOR.join(part.label for part in state.parts)
 
 
-def _assign_names(machine: Machine) -> dict[str, str]:
+def _assign_names(machine: AbstractMachine) -> dict[str, str]:
     bases = {key: _base_name(state) for key, state in machine.states.items()}
     counts: dict[str, int] = {}
     for base in bases.values():
@@ -134,9 +135,11 @@ def _assign_names(machine: Machine) -> dict[str, str]:
     return names
 
 
-# --- StateInstantiation entries -----------------------------------------------------------
+# --- the tree's nodes -----------------------------------------------------------
 
-def _instantiate(machine: Machine) -> list[StateInstantiation]:
+def _instantiate(machine: AbstractMachine) -> StateMachine:
+    """The tree of ``machine``: the root owns its states (a concurrency container its inner
+    states) and the ``:OUTCOME`` entries placing its outcomes."""
     names = _assign_names(machine)
 
     def target_name(target: Target) -> str:
@@ -145,34 +148,35 @@ def _instantiate(machine: Machine) -> list[StateInstantiation]:
 
     edges = {names[key]: [target_name(t) for _, t in state.transitions] for key, state in machine.states.items()}
     positions = layered_positions(edges, names[machine.initial], machine.outcomes)
-    root = StateInstantiation(
+    root = StateMachine(
         state_path='/', state_class=StateInstantiation.CLASS_STATEMACHINE,
         initial_state_name=names[machine.initial], outcomes=list(machine.outcomes),
         transitions=list(machine.outcomes), autonomy=[0] * len(machine.outcomes), position=[0.0, 0.0])
-    entries = [root]
+    states = []
     for key, state in machine.states.items():
         name = names[key]
         if state.helper:
-            new = [_helper_entry(state, name, target_name)]
+            node = _helper_entry(state, name, target_name)
         elif len(state.parts) == 1:
-            new = [_single_entry(state, f'/{name}', target_name)]
+            node = _single_entry(state, f'/{name}', target_name)
         else:
-            new = _concurrency_entries(state, name, target_name)
-        new[0].position = positions[name]
-        entries.extend(new)
-    entries.extend(StateInstantiation(state_path=f'/{outcome}', state_class=StateInstantiation.CLASS_OUTCOME,
-                                      position=positions[outcome]) for outcome in machine.outcomes)
-    return entries
+            node = _concurrency_container(state, name, target_name)
+        node.position = positions[name]
+        states.append(node)
+    root.states = tuple(states)
+    root.outcome_entries = tuple(State(state_path=f'/{outcome}', state_class=StateInstantiation.CLASS_OUTCOME,
+                                       position=positions[outcome]) for outcome in machine.outcomes)
+    return root
 
 
-def _part_entry(part: StateConfig, path: str) -> StateInstantiation:
-    return StateInstantiation(
+def _part_entry(part: StateConfig, path: str) -> State:
+    return State(
         state_path=path, state_class=part.state_class, behavior_class=part.behavior_class,
         parameter_names=list(part.parameter_names), parameter_values=list(part.parameter_values),
         userdata_keys=list(part.userdata_keys), userdata_remapping=list(part.userdata_remapping))
 
 
-def _single_entry(state: MachineState, path: str, target_name) -> StateInstantiation:
+def _single_entry(state: AbstractState, path: str, target_name) -> State:
     part = state.parts[0]
     entry = _part_entry(part, path)
     by_proposition = {observation[0][1]: target for observation, target in state.transitions}
@@ -185,10 +189,10 @@ def _single_entry(state: MachineState, path: str, target_name) -> StateInstantia
     return entry
 
 
-def _concurrency_entries(state: MachineState, name: str, target_name) -> list[StateInstantiation]:
+def _concurrency_container(state: AbstractState, name: str, target_name) -> StateMachine:
     parts = {part.proposition: part for part in state.parts}
     labels = _inner_labels(state.parts)
-    container = StateInstantiation(state_path=f'/{name}', state_class=StateInstantiation.CLASS_CONCURRENCY)
+    container = StateMachine(state_path=f'/{name}', state_class=StateInstantiation.CLASS_CONCURRENCY)
     first_use: dict[tuple[str, str], str] = {}  # (inner state, outcome) -> first container outcome
     for observation, target in state.transitions:
         outcome_name = _container_outcome(observation)
@@ -207,7 +211,7 @@ def _concurrency_entries(state: MachineState, name: str, target_name) -> list[St
     container.input_keys, container.output_keys = list(keys), list(keys)
     container.initial_state_name = labels[state.parts[0].proposition]
 
-    entries = [container]
+    inner_states = []
     for part, position in zip(state.parts, inner_positions(len(state.parts))):
         inner = _part_entry(part, f'/{name}/{labels[part.proposition]}')
         inner.position = position
@@ -216,8 +220,9 @@ def _concurrency_entries(state: MachineState, name: str, target_name) -> list[St
                 inner.outcomes.append(outcome)
                 inner.transitions.append(first_use[(labels[part.proposition], outcome)])
                 inner.autonomy.append(part.autonomy[outcome])
-        entries.append(inner)
-    return entries
+        inner_states.append(inner)
+    container.states = tuple(inner_states)
+    return container
 
 
 def _container_outcome(observation) -> str:
@@ -244,10 +249,10 @@ def _combinations(choices: list[tuple[str, ...]]) -> list[tuple[str, ...]]:
     return result
 
 
-def _helper_entry(state: MachineState, name: str, target_name) -> StateInstantiation:
+def _helper_entry(state: AbstractState, name: str, target_name) -> State:
     targets = [target_name(target) for _, target in state.transitions]
     if state.helper == DECISION:
-        return StateInstantiation(
+        return State(
             state_path=f'/{name}', state_class=DECISION_CLASS,
             parameter_names=['outcomes', 'hint', 'suggestion'],
             # The first start is suggested: an operator at any level up to Full confirms it or
@@ -257,7 +262,7 @@ def _helper_entry(state: MachineState, name: str, target_name) -> StateInstantia
                               repr(targets[0])],
             outcomes=list(targets), transitions=list(targets), autonomy=[DECISION_AUTONOMY] * len(targets))
     if state.helper == NOTHING_TO_DO:
-        return StateInstantiation(
+        return State(
             state_path=f'/{name}', state_class=NOTHING_CLASS, parameter_names=['text', 'severity'],
             parameter_values=[f'"Nothing to do: the task ends with {targets[0]}"', 'Logger.REPORT_HINT'],
             outcomes=['done'], transitions=targets[:1], autonomy=[0])

@@ -13,10 +13,10 @@ from __future__ import annotations
 
 from collections import defaultdict, deque
 
-from sm_generation.machine import Machine, MachineState, Target
+from sm_generation.abstract_machine import AbstractMachine, AbstractState, Target
 
 
-def bisimulation_blocks(machine: Machine) -> dict[str, int]:
+def bisimulation_blocks(machine: AbstractMachine) -> dict[str, int]:
     """Block number of every state; equal numbers mean equivalent states."""
     keys = list(machine.states)
     # Machine outcomes take part as states without transitions, one block each.
@@ -67,7 +67,7 @@ def bisimulation_blocks(machine: Machine) -> dict[str, int]:
     return {key: numbers.setdefault(block_of[('state', key)], len(numbers)) for key in keys}
 
 
-def _local_signature(state: MachineState) -> tuple:
+def _local_signature(state: AbstractState) -> tuple:
     return (state.helper, tuple(part.proposition for part in state.parts),
             tuple(observation for observation, _ in state.transitions))
 
@@ -78,7 +78,7 @@ def target_class(target: Target, blocks: dict[str, int]) -> tuple:
     return (kind, blocks[name]) if kind == 'state' else (kind, name)
 
 
-def reduce_machine(machine: Machine) -> Machine:
+def reduce_machine(machine: AbstractMachine) -> AbstractMachine:
     """The quotient machine: one state per equivalence block, reachable part only."""
     blocks = bisimulation_blocks(machine)
     representative: dict[int, str] = {}
@@ -90,7 +90,7 @@ def reduce_machine(machine: Machine) -> Machine:
         return (kind, representative[blocks[name]]) if kind == 'state' else target
 
     initial = representative[blocks[machine.initial]]
-    states: dict[str, MachineState] = {}
+    states: dict[str, AbstractState] = {}
     queue = deque([initial])
     while queue:
         key = queue.popleft()
@@ -98,6 +98,6 @@ def reduce_machine(machine: Machine) -> Machine:
             continue
         original = machine.states[key]
         transitions = [(observation, retarget(target)) for observation, target in original.transitions]
-        states[key] = MachineState(key=key, parts=original.parts, transitions=transitions, helper=original.helper)
+        states[key] = AbstractState(key=key, parts=original.parts, transitions=transitions, helper=original.helper)
         queue.extend(name for _, (kind, name) in transitions if kind == 'state')
-    return Machine(states=states, initial=initial, outcomes=machine.outcomes, dropped=machine.dropped)
+    return AbstractMachine(states=states, initial=initial, outcomes=machine.outcomes, dropped=machine.dropped)

@@ -1,9 +1,10 @@
-"""The synthesized state machine as one tree, built once from its StateInstantiation list (ROS-free).
+"""The synthesized state machine as one tree, the form in which it travels (ROS-free).
 
 FlexBE sends and stores a behavior as a flat list of StateInstantiations whose paths place
 them (``/`` the machine, ``/name`` its states, ``/container/name`` a container's states);
 its engine runs a tree (flexbe_core's ``StateMachine``: a container is a state that owns
-its states). This module is the one place the list becomes that tree:
+its states). The generator builds this tree; the list is the wire format only, and this
+module is the one place a list becomes the tree again:
 
     machine = StateMachine.from_instantiations(states)   # validated; SMGenerationError
     machine.to_instantiations() == states                # for every list the generator makes

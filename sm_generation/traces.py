@@ -36,9 +36,8 @@ def _moves(state: State) -> tuple[tuple, list[tuple]]:
     return tuple(sorted(parts.values())), moves
 
 
-def runs(states: list[StateInstantiation], depth: int) -> set[tuple]:
-    """All runs of at most ``depth`` steps: tuples of steps, then ('exit', outcome) or TRUNCATED."""
-    root = StateMachine.from_instantiations(states)
+def runs(root: StateMachine, depth: int) -> set[tuple]:
+    """All runs of ``root`` of at most ``depth`` steps: tuples of steps, then ('exit', outcome) or TRUNCATED."""
     top = {s.name: s for s in root.states}
     moves = {name: _moves(state) for name, state in top.items()}
     result: set[tuple] = set()

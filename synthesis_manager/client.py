@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 import threading
 import time
 from dataclasses import dataclass, field
@@ -11,6 +12,7 @@ from unique_identifier_msgs.msg import UUID
 
 from respec.errors import ErrorCode
 from respec.naming import DEFAULT_SM_OUTCOMES
+from sm_generation.state_machine import StateMachine
 from synthesis_manager.client_shares import new_origin, tagged_goal_id
 from synthesis_manager.limits import check_texts
 from synthesis_manager.requests import InvalidRequestError
@@ -55,6 +57,13 @@ class SynthesisOutcome:
     @property
     def succeeded(self) -> bool:
         return self.error_name == ErrorCode.SUCCESS
+
+    @functools.cached_property
+    def machine(self) -> StateMachine | None:
+        """The result's state machine as its tree, built once (None without one): the one place a
+        StateInstantiation list from the wire becomes the tree. Raises SMGenerationError if the
+        server sent a list that is no runnable machine."""
+        return StateMachine.from_instantiations(self.states) if self.states else None
 
     def to_dict(self) -> dict:
         return {'error_code': self.error_code, 'error_name': self.error_name,

@@ -11,7 +11,6 @@ import sys
 from pathlib import Path
 
 from respec.errors import ExitStatus, exit_status_help
-from sm_generation import StateInstantiation
 from sm_generation.export import render, to_dot, to_json, to_yaml
 from synthesis_manager.web.picture import render_svg
 from synthesis_manager.send_goal import ProgressBar, add_goal_arguments, goal_from_args, print_summary
@@ -29,17 +28,17 @@ def add_arguments(parser):
 
 def write_artifacts(outcome, directory: Path) -> list[Path]:
     """StateInstantiation YAML/JSON and pictures of the state machine (byproducts are already there)."""
-    states = [StateInstantiation.from_dict(s) for s in outcome.states]
+    machine = outcome.machine
     written = []
-    for name, text in (('state_machine.yaml', to_yaml(states)), ('state_machine.json', to_json(states)),
-                       ('state_machine.dot', to_dot(states))):
+    for name, text in (('state_machine.yaml', to_yaml(machine)), ('state_machine.json', to_json(machine)),
+                       ('state_machine.dot', to_dot(machine))):
         path = directory / name
         path.write_text(text)
         written.append(path)
     # The SVG as the GUI draws it (dot, else Graphviz compiled to WebAssembly: no system package
     # needed); the PNG needs dot. Either may be missing: say so and carry on.
-    for suffix, write in (('svg', lambda path: path.write_bytes(render_svg(to_dot(states)))),
-                          ('png', lambda path: render(to_dot(states), path))):
+    for suffix, write in (('svg', lambda path: path.write_bytes(render_svg(to_dot(machine)))),
+                          ('png', lambda path: render(to_dot(machine), path))):
         path = directory / f'state_machine.{suffix}'
         try:
             write(path)

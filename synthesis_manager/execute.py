@@ -45,7 +45,7 @@ import sys
 from pathlib import Path
 
 from atlas_sim.closed_loop import DeferredEvents, run_and_check
-from atlas_sim.executive.machine import ExecutionError
+from atlas_sim.executive.errors import ExecutionError
 from respec.errors import ExitStatus, exit_status_help
 from respec.nesting import run_with_deep_stack
 from respec.parsing import spec_from_text_sections
@@ -148,7 +148,6 @@ def execute_capability_robot(args, system) -> int:
     from respec.errors import CodedError
     from respec.naming import parse_names
     from respec.robot.state_library import capability_outcomes, workspace_state_library
-    from sm_generation.state_machine import StateMachine
 
     unsupported = [flag for flag, given in (('--engine flexbe', args.engine == 'flexbe'), ('--ros-sim', args.ros_sim),
                                             ('--record', args.record), ('--then', args.then),
@@ -189,7 +188,7 @@ def execute_capability_robot(args, system) -> int:
             print(json.dumps(report))
         return code
     spec = run_with_deep_stack(spec_from_text_sections, outcome.ltl_specification)
-    run = CapabilityRun(StateMachine.from_instantiations(outcome.states), outcome.automaton, system.capabilities,
+    run = CapabilityRun(outcome.machine, outcome.automaton, system.capabilities,
                         spec, script).run()
     report.update(run.to_dict())
     if run.violations:
@@ -370,10 +369,10 @@ def _execute(args, system, outcome, robot, simulator, goals, report, log, sim_no
         from synthesis_manager.ros.flexbe_engine import run_on_flexbe
 
         run_machine = lambda _tick: run_on_flexbe(  # noqa: E731
-            outcome.states, simulator, sim_node.lock, domain_id, system,
+            outcome.machine, simulator, sim_node.lock, domain_id, system,
             max_wall_time=args.max_robot_time * 10 + 60, verbose=args.verbose)
     try:
-        run = run_and_check(outcome.states, robot, simulator, system,
+        run = run_and_check(outcome.machine, robot, simulator, system,
                             run_with_deep_stack(spec_from_text_sections, outcome.ltl_specification), goals,
                             ordered=not args.unordered, record_dir=record,
                             max_robot_time=args.max_robot_time, max_wall_time=args.max_robot_time * 10 + 60,

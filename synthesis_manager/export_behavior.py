@@ -43,7 +43,7 @@ def add_arguments(parser):
 def run(args) -> int:
     from respec.errors import CodedError
     from respec.naming import parse_names
-    from sm_generation import SMGenerationError, StateInstantiation
+    from sm_generation import SMGenerationError
     from sm_generation.config import generation_system
     from sm_generation.for_system import behavior_flexbe_config
     from sm_generation.flexbe_behavior import (behavior_package, check_behavior_name, check_package_name,
@@ -74,11 +74,10 @@ def run(args) -> int:
     if not outcome.succeeded:
         print(f'export-behavior: synthesis failed: {outcome.error_name}: {outcome.message}', file=sys.stderr)
         return ExitStatus.for_error(outcome.error_name)
-    states = [StateInstantiation.from_dict(s) for s in outcome.states]
     description = (args.description or f'Synthesized for {args.system}: from {", ".join(initial_conditions)}, '
                    f'achieve {", ".join(goals)}.')
     try:
-        package = behavior_package(states, config, behavior_name, args.package, description=description,
+        package = behavior_package(outcome.machine, config, behavior_name, args.package, description=description,
                                    date=time.strftime('%a %b %d %Y'))
     except SMGenerationError as error:
         print(f'export-behavior: {error.code}: {error}', file=sys.stderr)

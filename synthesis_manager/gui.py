@@ -69,7 +69,7 @@ class RosGoalRunner:
                              option=request.option, name=request.name, unordered=request.unordered,
                              ltl_specification=request.custom_ltl)
             outcome = self.client.run(goal, feedback=feedback, cancel=cancel, timeout=self.goal_timeout)
-        return JobOutcome.from_dict(outcome.to_dict())
+        return JobOutcome.from_result(outcome.to_dict(), outcome.machine)
 
 
 @contextlib.contextmanager

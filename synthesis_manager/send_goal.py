@@ -163,7 +163,7 @@ def print_summary(outcome, stream=sys.stdout):
     if outcome.states:
         print(f'state machine: {count_states(outcome.states)} states '
               f'({len(outcome.states)} StateInstantiation entries):', file=stream)
-        print(state_machine_tree(outcome.states), file=stream)
+        print(state_machine_tree(outcome.machine), file=stream)
 
 
 def run(args) -> int:

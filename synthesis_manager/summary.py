@@ -1,4 +1,4 @@
-"""Human-readable summaries of synthesis results (ROS-free; works on plain dicts)."""
+"""Human-readable summaries of synthesis results (ROS-free)."""
 
 from __future__ import annotations
 
@@ -6,13 +6,12 @@ from sm_generation.instantiation import StateInstantiation
 from sm_generation.state_machine import State, StateMachine
 
 
-def state_machine_tree(states: list[dict]) -> str:
+def state_machine_tree(machine: StateMachine) -> str:
     """The state machine as an indented tree: containers, their states and transitions.
 
         /  (:STATEMACHINE, initial: stand, outcomes: finished, failed)
           stand  [ChangeControlModeActionState]  changed -> look_down, failed -> failed
 
-    ``states``: the StateInstantiation list (dicts or objects).
     """
     lines = []
 
@@ -35,7 +34,7 @@ def state_machine_tree(states: list[dict]) -> str:
         for child in node.children:
             show(child, depth + 1)
 
-    show(StateMachine.from_instantiations(states), 0)
+    show(machine, 0)
     return '\n'.join(lines)
 
 

@@ -4,7 +4,7 @@ Robot-agnostic: it drives anything with the ``Robot`` protocol and reads the mac
 ``sm_generation``'s :class:`~sm_generation.state_machine.StateMachine` tree.
 
 ``robot``        the ``Robot`` protocol, ``CapabilityResult``.
-``machine``      the executive's errors; ``load_machine`` (the shared tree), ``next_target``.
+``errors``       the executive's errors; ``next_target``.
 ``executor``     runs a synthesized state machine on a robot (``execute_state_machine``).
 ``engine_trace`` the same trace from a run on another engine (the real FlexBE).
 ``trace_check``  checks an executed trace against the specification and the goal order.

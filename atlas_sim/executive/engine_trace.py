@@ -30,16 +30,17 @@ import contextlib
 import threading
 
 from atlas_sim.executive.executor import ExecutionResult, StateMapping, entered_step, record_forced
-from atlas_sim.executive.machine import load_machine, next_target
+from atlas_sim.executive.errors import next_target
 from atlas_sim.executive.trace_check import OutcomeTracker, Trace, TraceStep
 from respec.robot import RobotSystem
+from sm_generation.state_machine import StateMachine
 
 
 class EngineTraceRecorder:
-    """Builds the trace of one run of ``states`` on ``simulator`` (see the module docstring)."""
+    """Builds the trace of one run of ``machine`` on ``simulator`` (see the module docstring)."""
 
-    def __init__(self, states, simulator, system: RobotSystem, simulator_lock=None):
-        self.root = load_machine(states)
+    def __init__(self, machine: StateMachine, simulator, system: RobotSystem, simulator_lock=None):
+        self.root = machine
         self.mapping = StateMapping(system)
         self.simulator = simulator
         self.simulator_lock = simulator_lock or contextlib.nullcontext()

@@ -36,11 +36,11 @@ whatever it still reports is recorded, so the trace check sees it.
 
 The robot is anything with the :class:`atlas_sim.executive.robot.Robot` protocol: ``SimulatedRobot`` drives
 an ``AtlasSimulator`` directly; ``synthesis_manager.nodes.atlas_sim_robot.RosRobot`` drives the
-simulator node. The machine is the tree of :mod:`sm_generation.state_machine`, loaded by
-:mod:`atlas_sim.executive.machine`.
+simulator node. The machine is the tree of :mod:`sm_generation.state_machine`, as generated (or
+as a message's list became it where it arrived).
 
     sim = make_simulator('atlas', initial_conditions=['stand_prep'])
-    run = execute_state_machine(states, SimulatedRobot(sim), system='atlas')
+    run = execute_state_machine(machine, SimulatedRobot(sim), system='atlas')
     run.outcome, run.trace                  # 'finished', Trace (see atlas_sim.executive.trace_check)
 """
 
@@ -52,7 +52,7 @@ import time
 from dataclasses import dataclass, field
 from typing import Any, Callable
 
-from atlas_sim.executive.machine import ExecutionError, UndeclaredOutcomeError, load_machine, next_target
+from atlas_sim.executive.errors import ExecutionError, UndeclaredOutcomeError, next_target
 from atlas_sim.executive.robot import CapabilityResult, Robot
 from atlas_sim.executive.runtime_control import RuntimeControl
 from atlas_sim.executive.trace_check import OutcomeTracker, Trace, TraceStep
@@ -61,7 +61,7 @@ from respec.naming import activated, is_activation, outcome_proposition
 from respec.robot import RobotSystem
 from sm_generation.config import INPUT_STATE_CLASS, flexbe_config, generation_system
 from sm_generation.instantiation import DECISION_CLASS, HELPER_STATE_CLASSES, StateInstantiation
-from sm_generation.state_machine import State
+from sm_generation.state_machine import State, StateMachine
 
 BEHAVIOR = StateInstantiation.CLASS_BEHAVIOR
 
@@ -195,11 +195,11 @@ class _Running:
 class Executive:
     """Runs one state machine on one robot; see :func:`execute_state_machine`."""
 
-    def __init__(self, states, robot: Robot, mapping: StateMapping, max_robot_time: float = 600.0,
+    def __init__(self, machine: StateMachine, robot: Robot, mapping: StateMapping, max_robot_time: float = 600.0,
                  max_states: int = 500, max_wall_time: float | None = None,
                  decide: Callable[[str, list[str]], str] | None = None,
                  on_tick: Callable[[Robot], None] | None = None, control: RuntimeControl | None = None):
-        self.root = load_machine(states)
+        self.root = machine
         self.robot, self.mapping = robot, mapping
         self.max_robot_time, self.max_states = max_robot_time, max_states
         self.wall_deadline = None if max_wall_time is None else time.monotonic() + max_wall_time
@@ -409,8 +409,9 @@ def input_prompt(node: State) -> str:
     return node.name
 
 
-def execute_state_machine(states, robot: Robot, system: RobotSystem | str = 'atlas', **options) -> ExecutionResult:
-    """Run ``states`` on ``robot`` until an SM outcome; returns the outcome and the trace.
+def execute_state_machine(machine: StateMachine, robot: Robot, system: RobotSystem | str = 'atlas',
+                          **options) -> ExecutionResult:
+    """Run ``machine`` on ``robot`` until an SM outcome; returns the outcome and the trace.
 
     ``system`` is a RobotSystem, or the name of one in config/ (another folder's system:
     ``respec.robot.robot_system(name, config_dir)``).
@@ -421,7 +422,7 @@ def execute_state_machine(states, robot: Robot, system: RobotSystem | str = 'atl
     ``control`` (a :class:`RuntimeControl`: the operator in the loop).
     Raises :class:`ExecutionError` subclasses (with ``item`` and the partial ``trace``).
     """
-    return Executive(states, robot, StateMapping(generation_system(system)), **options).run()
+    return Executive(machine, robot, StateMapping(generation_system(system)), **options).run()
 
 
 __all__ = ['execute_state_machine', 'Executive', 'ExecutionResult', 'StateMapping', 'UnmappedStateError',

@@ -20,7 +20,7 @@ alone, whatever the operator's reaction time (the simulated world is frozen mean
 robot would hold its posture). A wait ends at the executive's wall-time limit like any run.
 
     control = RuntimeControl(receive=queue_reader, report=print, autonomy_level=HIGH)
-    execute_state_machine(states, robot, control=control)
+    execute_state_machine(machine, robot, control=control)
 """
 
 from __future__ import annotations
@@ -28,7 +28,7 @@ from __future__ import annotations
 import time
 from typing import Any, Callable
 
-from atlas_sim.executive.machine import ExecutionError
+from atlas_sim.executive.errors import ExecutionError
 from respec.errors import ErrorCode
 
 #: FlexBE's autonomy levels (flexbe_core.Autonomy), the operator's names for them.

@@ -100,7 +100,7 @@ class SMGenerationNode(Node):
             response.error_code = reported_error(error, self.get_logger(), 'state machine generation failed')
             self.log.warning(response.error_code.message)
             return response
-        response.state_definition = [state_to_msg(state) for state in states]
+        response.state_definition = [state_to_msg(state) for state in states.to_instantiations()]
         response.error_code = error_code()
         return response
 

@@ -36,7 +36,7 @@ from atlas_sim.simulator.operator_data import answers_by_request_type, flexbe_in
 from respec.robot import RobotSystem
 from sm_generation.config import flexbe_config, generation_system, input_request_capabilities
 from sm_generation.flexbe_behavior import behavior_package
-from sm_generation.instantiation import StateInstantiation
+from sm_generation.state_machine import StateMachine
 
 FULL_AUTONOMY = 3
 BEHAVIOR_INPUT_ACTION = 'flexbe/behavior_input'
@@ -161,10 +161,10 @@ def _wait_for_proxy_tasks(executor, timeout: float = 2.0) -> None:
         time.sleep(0.01)
 
 
-def run_on_flexbe(states, simulator, simulator_lock, domain_id: int, system: RobotSystem | str = 'atlas',
+def run_on_flexbe(machine: StateMachine, simulator, simulator_lock, domain_id: int, system: RobotSystem | str = 'atlas',
                   behavior_name: str = 'Synthesized Behavior', autonomy: int = FULL_AUTONOMY,
                   max_wall_time: float = 600.0, verbose: bool = False):
-    """Run ``states`` (StateInstantiation objects or dicts) on FlexBE; returns an ExecutionResult.
+    """Run ``machine`` on FlexBE; returns an ExecutionResult.
 
     ``system`` is a RobotSystem, or the name of one in config/. The simulator node must be
     running on ``domain_id`` around ``simulator``. Raises
@@ -177,11 +177,10 @@ def run_on_flexbe(states, simulator, simulator_lock, domain_id: int, system: Rob
 
     from synthesis_manager.ros.harness import RosHarness
 
-    states = [s if isinstance(s, StateInstantiation) else StateInstantiation.from_dict(s) for s in states]
     system = generation_system(system)
     config = flexbe_config(system)
-    package = behavior_package(states, config, behavior_name, date=time.strftime('%a %b %d %Y'))
-    recorder = EngineTraceRecorder(states, simulator, system, simulator_lock)
+    package = behavior_package(machine, config, behavior_name, date=time.strftime('%a %b %d %Y'))
+    recorder = EngineTraceRecorder(machine, simulator, system, simulator_lock)
     notes = sys.stderr if verbose else open(os.devnull, 'w')  # noqa: SIM115 - closed below
     try:  # flexbe_core prints progress notes: keep them off stdout, which is the command's output
         with contextlib.redirect_stdout(notes), tempfile.TemporaryDirectory(prefix='flexbe_behavior_') as directory, \

@@ -26,14 +26,14 @@ class Artifact:
 
 def _export(kind):
     def build(outcome, *_) -> bytes:
-        return getattr(export, kind)(list(outcome.states)).encode()
+        return getattr(export, kind)(outcome.machine).encode()
     return build
 
 
 def _picture(fmt):
     def build(outcome, *_) -> bytes:
         draw = picture.render_svg if fmt == 'svg' else picture.render_png
-        return draw(picture.picture_dot(list(outcome.states)))
+        return draw(picture.picture_dot(outcome.machine))
     return build
 
 
@@ -61,7 +61,7 @@ def download_filename(request, artifact: str) -> str:
 def _flexbe_behavior(outcome, request, systems) -> bytes:
     """The behavior package FlexBE's editor would save (as ``behavior-synthesis export-behavior``)."""
     name = behavior_name(request)
-    package = behavior_package(list(outcome.states), behavior_flexbe_config(systems.load(request.system)), name,
+    package = behavior_package(outcome.machine, behavior_flexbe_config(systems.load(request.system)), name,
                                date=time.strftime('%a %b %d %Y'))
     return package.zip_bytes()
 
@@ -75,8 +75,8 @@ def check_name(name: str) -> bool:
     return True
 
 
-def _has_states(outcome: JobOutcome) -> bool:
-    return bool(outcome.states)
+def _has_machine(outcome: JobOutcome) -> bool:
+    return outcome.machine is not None
 
 
 def _has_specification(outcome: JobOutcome) -> bool:
@@ -103,13 +103,13 @@ class ArtifactKind:
 
 ARTIFACTS = {
     'state_machine.yaml': ArtifactKind('State machine (StateInstantiation list, YAML)', 'application/yaml',
-                                       _has_states, _export('to_yaml')),
+                                       _has_machine, _export('to_yaml')),
     'state_machine.json': ArtifactKind('State machine (StateInstantiation list, JSON)', 'application/json',
-                                       _has_states, _export('to_json')),
-    'state_machine.dot': ArtifactKind('Picture source (Graphviz DOT)', 'text/vnd.graphviz', _has_states,
-                                      lambda outcome, *_: picture.picture_dot(list(outcome.states)).encode()),
-    'state_machine.svg': ArtifactKind('Picture (SVG)', 'image/svg+xml', _has_states, _picture('svg')),
-    'state_machine.png': ArtifactKind('Picture (PNG)', 'image/png', _has_states, _picture('png')),
+                                       _has_machine, _export('to_json')),
+    'state_machine.dot': ArtifactKind('Picture source (Graphviz DOT)', 'text/vnd.graphviz', _has_machine,
+                                      lambda outcome, *_: picture.picture_dot(outcome.machine).encode()),
+    'state_machine.svg': ArtifactKind('Picture (SVG)', 'image/svg+xml', _has_machine, _picture('svg')),
+    'state_machine.png': ArtifactKind('Picture (PNG)', 'image/png', _has_machine, _picture('png')),
     'specification.structuredslugs': ArtifactKind('Specification (.structuredslugs)', 'text/plain',
                                                   _has_specification, _specification('to_structuredslugs')),
     'specification.slugsin': ArtifactKind('Specification (.slugsin)', 'text/plain',
@@ -119,7 +119,7 @@ ARTIFACTS = {
     'result.json': ArtifactKind('Whole result (JSON)', 'application/json', lambda outcome: True,
                                 lambda outcome, *_: _json_file(outcome.to_dict())),
     'flexbe_behavior.zip': ArtifactKind('FlexBE behavior package (.zip, as export-behavior writes it)',
-                                        'application/zip', _has_states, _flexbe_behavior),
+                                        'application/zip', _has_machine, _flexbe_behavior),
 }
 
 

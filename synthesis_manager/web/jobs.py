@@ -188,6 +188,7 @@ class ResultSummary:
     def of(cls, outcome: JobOutcome) -> 'ResultSummary':
         sections = outcome.ltl_specification
         automaton_states = len(outcome.automaton_states)
+        entries = list(outcome.machine.walk()) if outcome.machine else []
         if outcome.error_name == ErrorCode.SPEC_UNSYNTHESIZABLE:
             realizable = False
         elif automaton_states:
@@ -201,10 +202,9 @@ class ResultSummary:
             output_propositions=len(sections.get('sys_props', [])),
             formulas=sum(len(lines) for name, lines in sections.items() if not name.endswith('_props')),
             automaton_states=automaton_states,
-            state_machine_states=count_states(outcome.states),
-            state_instantiations=len(outcome.states),
-            concurrency_containers=sum(1 for s in outcome.states
-                                       if s.state_class == StateInstantiation.CLASS_CONCURRENCY),
+            state_machine_states=count_states(entries),
+            state_instantiations=len(entries),
+            concurrency_containers=sum(1 for s in entries if s.state_class == StateInstantiation.CLASS_CONCURRENCY),
             seconds=round(outcome.seconds, 4),
         )
 
@@ -262,3 +262,11 @@ def stage_timings(timeline: list[ProgressNote], total_seconds: float) -> list[St
         end = timeline[index + 1].seconds if index + 1 < len(timeline) else total_seconds
         stages.append(StageTiming(note.status, round(max(0.0, end - note.seconds), 4)))
     return stages
+
+
+def update_record(record, lock: threading.Lock, **changes) -> None:
+    """Change a Job or Simulation under ``lock`` and bump its revision (what the event streams watch)."""
+    with lock:
+        for name, value in changes.items():
+            setattr(record, name, value)
+        record.revision += 1

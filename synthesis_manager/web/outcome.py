@@ -1,8 +1,10 @@
 """``JobOutcome``: what a GUI job ended with, typed until the HTTP answer turns it into JSON.
 
 The synthesis action's result arrives as ``SynthesisOutcome`` (synthesis_manager.client, ROS
-side); the GUI's runner hands it over as a JobOutcome, and the backend, the result summary and
-the downloads read its fields. Only the routes (and ``result.json``) call :meth:`to_dict`.
+side), its state machine already a tree (``SynthesisOutcome.machine``); the GUI's runner hands it
+over as a JobOutcome, and the backend, the result summary, the drawing, the plays, the simulations
+and the downloads read its fields and that tree. Only the routes (and ``result.json``) call
+:meth:`to_dict`, where the tree becomes the StateInstantiation list again.
 """
 
 from __future__ import annotations
@@ -10,7 +12,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from respec.errors import ErrorCode
-from sm_generation.instantiation import StateInstantiation
+from sm_generation.state_machine import StateMachine
 
 
 @dataclass(frozen=True)
@@ -24,7 +26,7 @@ class JobOutcome:
     error_code: int
     error_name: str
     message: str
-    states: tuple[StateInstantiation, ...] = ()
+    machine: StateMachine | None = None  # the state machine, if the result has one
     ltl_specification: dict[str, list[str]] = field(default_factory=dict)  # text sections
     automaton: dict = field(default_factory=dict)                          # client.automaton_to_dict
     seconds: float = 0.0
@@ -36,10 +38,11 @@ class JobOutcome:
         return cls(ErrorCode(error_name).number, error_name, message, seconds=round(seconds, 4))
 
     @classmethod
-    def from_dict(cls, data: dict) -> 'JobOutcome':
-        """Inverse of :meth:`to_dict` (also reads ``SynthesisOutcome.to_dict()``)."""
+    def from_result(cls, data: dict, machine: StateMachine | None) -> 'JobOutcome':
+        """The outcome of an action's result: ``data`` as ``SynthesisOutcome.to_dict()`` gives it
+        (its ``states`` list left aside), ``machine`` the tree of that list."""
         return cls(error_code=data['error_code'], error_name=data['error_name'], message=data['message'],
-                   states=tuple(StateInstantiation.from_dict(state) for state in data.get('states') or ()),
+                   machine=machine,
                    ltl_specification=data.get('ltl_specification') or {},
                    automaton=data.get('automaton') or {}, seconds=data.get('seconds', 0.0),
                    goal_status=data.get('goal_status'))
@@ -59,7 +62,7 @@ class JobOutcome:
     def to_dict(self) -> dict:
         """The JSON of ``outcome`` in a job (and of ``result.json``)."""
         result = {'error_code': self.error_code, 'error_name': self.error_name, 'message': self.message,
-                  'states': [state.to_dict() for state in self.states],
+                  'states': [state.to_dict() for state in self.machine.to_instantiations()] if self.machine else [],
                   'ltl_specification': self.ltl_specification, 'automaton': self.automaton,
                   'seconds': round(self.seconds, 4)}
         if self.goal_status is not None:

@@ -29,10 +29,10 @@ MIN_POINT_SIZE = 12
 _POINT_SIZE = re.compile(r'POINT-SIZE="(\d+(?:\.\d+)?)"')
 
 
-def picture_dot(states) -> str:
+def picture_dot(machine) -> str:
     """The DOT text the GUI draws and offers (``sm_generation.export.to_dot``), its smallest
     labels raised to MIN_POINT_SIZE so that Graphviz lays the boxes out around them."""
-    return _POINT_SIZE.sub(lambda m: f'POINT-SIZE="{max(float(m.group(1)), MIN_POINT_SIZE):g}"', to_dot(states))
+    return _POINT_SIZE.sub(lambda m: f'POINT-SIZE="{max(float(m.group(1)), MIN_POINT_SIZE):g}"', to_dot(machine))
 
 
 def wasm_package() -> Path:

@@ -18,9 +18,11 @@ from ltl_specification import compile_task
 from ltl_specification.play import PlayError, RobotPlay
 from respec.errors import CodedError, ErrorCode, quoted
 from sm_generation.play import MachinePlayError, play_machine
-from sm_generation.state_machine import StateMachine
+from synthesis_manager.limits import BusyError
 from synthesis_manager.web.errors import GuiRequestError, InvalidJobRequestError, NotAvailableError
-from synthesis_manager.web.jobs import Job
+from synthesis_manager.web.job_queue import JobQueue
+from synthesis_manager.web.jobs import Job, checked_body
+from synthesis_manager.web.request_form import GOAL_CHECK_RETRY_AFTER
 from synthesis_manager.web.robot_game import game_turn
 
 ROBOT, ENVIRONMENT = 'robot', 'environment'   # whom the user plays
@@ -44,17 +46,39 @@ def play_body_moves(body) -> list:
 
 
 class Plays:
-    """The plays of a backend's jobs; ``robot_system(name)`` loads the job's RobotSystem."""
+    """The plays of ``jobs``' finished jobs; ``robot_system(name)`` loads the job's RobotSystem.
 
-    def __init__(self, robot_system):
+    A play is computed in the request's thread, like the goal check (it solves the
+    environment's game once): at most ``max_at_once`` at once."""
+
+    def __init__(self, robot_system, jobs: JobQueue, max_at_once: int = 2):
         self.robot_system = robot_system
+        self.jobs = jobs
+        self.max_at_once = max_at_once
+        self._slots = threading.BoundedSemaphore(max_at_once)
         self._lock = threading.Lock()
         self._counter_strategies: OrderedDict[str, tuple[RobotPlay, threading.Lock, object]] = OrderedDict()
+
+    def play(self, job_id: str, body) -> dict:
+        """The turn of a play of a finished job after the body's ``moves``.
+
+        Beyond max_at_once plays at once: BusyError (429, Retry-After)."""
+        job = self.jobs.job(job_id)
+        moves = play_body_moves(checked_body({} if body is None else body))
+        if not job.finished:
+            raise NotAvailableError(f'job {quoted(job_id)} has not finished yet', job_id)
+        if not self._slots.acquire(blocking=False):
+            raise BusyError(f'{self.max_at_once} plays are being computed (at most {self.max_at_once} at once); '
+                            'try again in a moment', 'plays', retry_after=GOAL_CHECK_RETRY_AFTER)
+        try:
+            return self.turn(job, moves)
+        finally:
+            self._slots.release()
 
     def turn(self, job: Job, moves: list) -> dict:
         """The turn after ``moves``, with ``play`` saying whom the user plays."""
         outcome = job.outcome
-        if outcome.states:
+        if outcome.machine is not None:
             return {'play': ENVIRONMENT, **self._machine_turn(job, moves)}
         if outcome.error_name == ErrorCode.SPEC_UNSYNTHESIZABLE:
             return {'play': ROBOT, **self._robot_turn(job, moves)}
@@ -65,7 +89,7 @@ class Plays:
         if not all(isinstance(move, str) for move in moves):
             raise InvalidJobRequestError('the moves of a machine play are outcome names', 'moves')
         try:
-            return play_machine(StateMachine.from_instantiations(job.outcome.states), moves).to_dict()
+            return play_machine(job.outcome.machine, moves).to_dict()
         except MachinePlayError as error:
             raise MoveError(str(error), 'moves') from error
 

@@ -31,13 +31,14 @@ a foreign Host header (421), a body over 1 MB (413), a POST whose body is not de
 naming the field (web.jobs.checked_body); a new job while too many are unfinished is 503 BUSY,
 a simulation, goal check, repair search or play while too many run is 429 BUSY with Retry-After.
 
-The backend returns records (Job with its web.outcome.JobOutcome, Simulation, the job's
-sm_generation StateMachine); the routes turn them into JSON with their ``to_dict``.
-
-The backend does the work: :class:`synthesis_manager.web.backend.SynthesisBackend` keeps
-the jobs, validates requests and builds the downloads; the synthesis itself is a
-``run_goal`` callable given to it (``gui.RosGoalRunner`` sends the goal to
-``/behavior_synthesis``).
+The backend does the work: :class:`synthesis_manager.web.backend.SynthesisBackend` holds one
+object per concern (``backend.jobs``, ``.downloads``, ``.simulations``, ``.repairs``, ``.plays``,
+``.form``; see web/backend.py), and each route calls one of them. They validate requests and
+return records (Job with its web.outcome.JobOutcome, Simulation, the job's sm_generation
+StateMachine); the routes turn them into JSON with their ``to_dict``. The synthesis itself is a
+``run_goal`` callable given to the backend (``gui.RosGoalRunner`` sends the goal to
+``/behavior_synthesis``). A new route: its URL and answer here, its work in the concern's
+module (a new concern: a module of its own, held by the backend); docs/design.md has an example.
 """
 
 from __future__ import annotations
@@ -69,7 +70,7 @@ mimetypes.add_type('text/javascript', '.js')
 
 
 def create_app(backend) -> FastAPI:
-    """The GUI's FastAPI app around ``backend`` (a SynthesisBackend or the same methods)."""
+    """The GUI's FastAPI app around ``backend`` (a SynthesisBackend)."""
     # No Swagger/ReDoc pages: they load third-party code from a CDN. The schema stays available.
     app = FastAPI(title='Behavior synthesis', docs_url=None, redoc_url=None, openapi_url='/api/openapi.json')
     app.mount('/static', StaticFiles(directory=STATIC_DIR), name='static')
@@ -94,9 +95,8 @@ def create_app(backend) -> FastAPI:
 
     @app.get('/api/info')
     def info():
-        return {'description': getattr(backend, 'description', ''),
-                'simulation': bool(getattr(backend, 'can_simulate', False)),
-                'repair_time_budget': getattr(backend, 'repair_time_budget', 0)}
+        return {'description': backend.description, 'simulation': bool(backend.simulations.available),
+                'repair_time_budget': backend.repairs.time_budget}
 
     @app.get('/api/vocabulary')
     def names():
@@ -108,34 +108,34 @@ def create_app(backend) -> FastAPI:
 
     @app.get('/api/systems/{system}')
     def choices(system: str):
-        return backend.choices(system)
+        return backend.form.choices(system)
 
     @app.post('/api/jobs', status_code=202)
     def start_job(body=Body(None)):
-        return backend.start_job(body).to_dict()
+        return backend.jobs.start(body).to_dict()
 
     @app.get('/api/jobs/{job_id}')
     def job_status(job_id: str):
-        return backend.job_status(job_id).to_dict()
+        return backend.jobs.job(job_id).to_dict()
 
     @app.post('/api/jobs/{job_id}/cancel', status_code=202)
     def cancel_job(job_id: str):
-        return backend.cancel_job(job_id).to_dict()
+        return backend.jobs.cancel(job_id).to_dict()
 
     @app.get('/api/jobs/{job_id}/events')
     async def job_events(job_id: str, request: Request):
-        backend.job_status(job_id)  # unknown job: 404 now rather than an empty stream
-        return _event_stream(request, lambda: backend.job_revision(job_id),
-                             lambda: backend.job_status(job_id).to_dict(), _stopping(backend))
+        backend.jobs.job(job_id)  # unknown job: 404 now rather than an empty stream
+        return _event_stream(request, lambda: backend.jobs.revision(job_id),
+                             lambda: backend.jobs.job(job_id).to_dict(), _stopping(backend))
 
     @app.get('/api/jobs/{job_id}/state-machine')
     def state_machine(job_id: str):
-        return backend.state_machine(job_id).to_dict()
+        return backend.jobs.state_machine(job_id).to_dict()
 
     @app.get('/api/jobs/{job_id}/artifacts/{name}')
     def artifact(job_id: str, name: str, request: Request, inline: bool = False):
         try:
-            return _file_response(backend.artifact(job_id, name), inline)
+            return _file_response(backend.downloads.artifact(job_id, name), inline)
         except NotFoundError as error:
             if 'text/html' not in request.headers.get('accept', ''):
                 raise
@@ -143,43 +143,43 @@ def create_app(backend) -> FastAPI:
 
     @app.post('/api/goal-check')
     def goal_check(body=Body(None)):
-        return backend.goal_check(body)
+        return backend.form.goal_check(body)
 
     @app.post('/api/repair')
     def repair(request: Request, body=Body(None)):
         if NDJSON not in request.headers.get('accept', ''):
-            return backend.repair(body)
-        return _repair_stream(request, backend.start_repair(body), _stopping(backend))
+            return backend.repairs.repair(body)
+        return _repair_stream(request, backend.repairs.start(body), _stopping(backend))
 
     @app.post('/api/jobs/{job_id}/play')
     def play(job_id: str, body=Body(None)):
-        return backend.play(job_id, body)
+        return backend.plays.play(job_id, body)
 
     @app.post('/api/jobs/{job_id}/simulations', status_code=202)
     def start_simulation(job_id: str, body=Body(None)):
-        return backend.start_simulation(job_id, body).to_dict()
+        return backend.simulations.start(job_id, body).to_dict()
 
     @app.get('/api/simulations/{simulation_id}')
     def simulation_status(simulation_id: str):
-        return backend.simulation_status(simulation_id).to_dict()
+        return backend.simulations.status(simulation_id).to_dict()
 
     @app.get('/api/simulations/{simulation_id}/events')
     async def simulation_events(simulation_id: str, request: Request):
-        backend.simulation_status(simulation_id)
-        return _event_stream(request, lambda: backend.simulation_revision(simulation_id),
-                             lambda: backend.simulation_status(simulation_id).to_dict(), _stopping(backend))
+        backend.simulations.status(simulation_id)
+        return _event_stream(request, lambda: backend.simulations.revision(simulation_id),
+                             lambda: backend.simulations.status(simulation_id).to_dict(), _stopping(backend))
 
     @app.post('/api/simulations/{simulation_id}/control', status_code=202)
     def simulation_command(simulation_id: str, body=Body(None)):
-        return backend.simulation_command(simulation_id, body).to_dict()
+        return backend.simulations.command(simulation_id, body).to_dict()
 
     @app.get('/api/simulations/{simulation_id}/frames/{index}')
     def simulation_frame(simulation_id: str, index: int):
-        return _file_response(backend.simulation_frame(simulation_id, index), inline=True)
+        return _file_response(backend.simulations.frame(simulation_id, index), inline=True)
 
     @app.get('/api/simulations/{simulation_id}/timeline.png')
     def simulation_timeline(simulation_id: str):
-        return _file_response(backend.simulation_timeline(simulation_id), inline=True)
+        return _file_response(backend.simulations.timeline(simulation_id), inline=True)
 
     return app
 
@@ -204,15 +204,14 @@ def _file_response(found: Artifact, inline: bool) -> Response:
 
 
 def _stopping(backend) -> Callable[[], bool]:
-    """Whether ``backend`` is stopping (a backend without ``stopping`` never is)."""
-    stopping = getattr(backend, 'stopping', None)
-    return stopping.is_set if stopping is not None else (lambda: False)
+    """Whether ``backend`` is stopping."""
+    return backend.stopping.is_set
 
 
 def _repair_stream(request: Request, run, stopping: Callable[[], bool]):
     """A repair search's answers as JSON lines: ``{"proposal": ...}`` as each is verified, then
     ``{"result": ...}`` (Repairs.to_dict()) or ``{"error": {...}}`` (a 4xx/5xx answer's body).
-    A client that goes away stops the search (``run``: backend.RepairRun)."""
+    A client that goes away stops the search (``run``: web.repairs.RepairRun)."""
     async def lines():
         try:
             while not stopping() and not await request.is_disconnected():

@@ -4,7 +4,8 @@ MuJoCo with its off-screen renderer grew the GUI process by ~280 MiB on its firs
 crash in native code would have ended the GUI with it. Each run therefore has a child process
 of its own (``ltl_synthesizer.isolated.ChildProcess``, the project's one process runner, which
 preloads this module): the run's settings go in, progress comes back as steps and key frames
-are added, then one final message. Frames and the timeline are files in the run's record
+are added, then one final message (the state machine goes in as its tree, pickled with the rest).
+Frames and the timeline are files in the run's record
 directory, passed by path. The child is killed when the GUI stops the run or it overruns its
 wall-time limit, and ends by itself when the GUI dies, so no run outlives the GUI.
 
@@ -132,12 +133,12 @@ def simulate(settings: dict, progress: Callable[[dict], None], commands: Callabl
             def on_tick(robot_now):
                 tick(robot_now)
                 report()
-            executive = Executive(settings['states'], robot, StateMapping(system),
+            executive = Executive(settings['machine'], robot, StateMapping(system),
                                   max_robot_time=settings['max_robot_time'], max_wall_time=settings['max_wall_time'],
                                   on_tick=on_tick, control=control)
             return executive.run()
 
-        run = run_and_check(settings['states'], robot, simulator, system,
+        run = run_and_check(settings['machine'], robot, simulator, system,
                             spec_from_text_sections(settings['ltl_specification']), settings['goals'],
                             ordered=settings['ordered'], record_dir=Path(settings['record_dir']),
                             max_robot_time=settings['max_robot_time'],
@@ -187,14 +188,12 @@ def simulate_capability_robot(settings: dict, progress: Callable[[dict], None],
         from respec.parsing import spec_from_text_sections
         from respec.robot import robot_system_from_files
         from respec.robot.state_library import capability_outcomes, workspace_state_library
-        from sm_generation.state_machine import StateMachine
-
         system = robot_system_from_files(settings['system'], settings['files'], settings['config_file'])
         capabilities = system.capabilities
         script = parse_script(capabilities, capability_outcomes(capabilities, workspace_state_library()),
                               list(settings['fail_first']),
                               [f'{name}={"true" if value else "false"}' for name, value in settings['sensors'].items()])
-        machine = StateMachine.from_instantiations(settings['states'])
+        machine = settings['machine']
         by_path = {state.state_path: (state, capability_of(state, capabilities)) for state in machine.states}
         deadline = time.monotonic() + settings['max_wall_time']
 

@@ -22,7 +22,6 @@ from respec.robot import robot_system
 from respec.robot.state_library import StateClass, capability_outcomes
 from sm_generation import generate_state_machine
 from sm_generation.automaton_io import automaton_to_dict
-from sm_generation.state_machine import StateMachine
 
 CLI = str(Path(sys.executable).parent / 'behavior-synthesis')
 LIBRARY = {'LogState': StateClass('LogState', 'flexbe_states', ('text',), ('text',), outcomes=('done',)),
@@ -63,7 +62,7 @@ def cart(tmp_path):
 def run(system, sm_outcomes=('finished', 'failed'), fails=(), sensors=(), choose=None):
     spec = compile_task(system, [], ['move'], sm_outcomes=list(sm_outcomes), state_library=LIBRARY)
     automaton = automaton_from_strategy(synthesize(spec).strategy, spec)
-    machine = StateMachine.from_instantiations(generate_state_machine(automaton, system, state_library=LIBRARY))
+    machine = generate_state_machine(automaton, system, state_library=LIBRARY)
     script = parse_script(system.capabilities, capability_outcomes(system.capabilities, LIBRARY), list(fails),
                           list(sensors))
     return CapabilityRun(machine, automaton_to_dict(automaton), system.capabilities, spec, script, choose=choose).run()

@@ -26,9 +26,9 @@ def synthesize_machine(initial_conditions, goals, sm_outcomes=('finished', 'fail
     result = synthesize(spec)
     assert result.realizable, result.explanation
     automaton = automaton_from_strategy(result.strategy, spec)
-    states = generate_state_machine(automaton, 'atlas', initial_conditions=initial_conditions)
-    assert validate_state_machine(states) == []
-    return spec, states
+    machine = generate_state_machine(automaton, 'atlas', initial_conditions=initial_conditions)
+    assert validate_state_machine(machine.to_instantiations()) == []
+    return spec, machine
 
 
 def run_task(initial_conditions, goals, sm_outcomes=('finished', 'failed'), **fault_lists):

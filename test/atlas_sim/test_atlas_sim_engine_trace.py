@@ -25,11 +25,11 @@ def machine():
     return spec, generate_state_machine(automaton, 'atlas', initial_conditions=INITIAL)
 
 
-def drive(states, simulator, recorder):
+def drive(machine, simulator, recorder):
     """Run the top-level states one by one like an engine: enter, request, wait, return."""
     outcomes = {'changed': 'completed', 'failed': 'failed'}
-    by_name = {s.name: s for s in states if s.parent_path == '/' and s.state_class != ':OUTCOME'}
-    current = states[0].initial_state_name
+    by_name = {s.name: s for s in machine.states}
+    current = machine.initial_state_name
     while current in by_name:
         state = by_name[current]
         recorder.entered(current)

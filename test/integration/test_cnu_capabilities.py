@@ -19,7 +19,7 @@ from respec.robot.cnu import CapabilityConfigError
 from ltl_specification.errors import UnknownPropositionError
 from respec.ltl import conj, evaluate, to_infix
 from respec.robot.state_library import StateClass, StateClassError, workspace_state_library
-from sm_generation import generate_state_machine, validate_state_machine
+from sm_generation import StateMachine, generate_state_machine, validate_state_machine
 
 from cnu_example_pairs import example_pairs, write_system_file
 
@@ -89,7 +89,7 @@ def synthesized(config_dir, name, library):
     result = synthesize(spec)
     assert result.realizable
     automaton = automaton_from_strategy(result.strategy, spec)
-    states = generate_state_machine(automaton, name, config_dir, state_library=library)
+    states = generate_state_machine(automaton, name, config_dir, state_library=library).to_instantiations()
     return spec, result.strategy, states
 
 
@@ -164,7 +164,7 @@ def test_all_of_cnus_example_pairs_succeed_with_at_most_cnus_state_count(cnu, li
         assert result.realizable, pair.launch
         assert strategy_violations(spec, result.strategy) == [], pair.launch
         automaton = automaton_from_strategy(result.strategy, spec)
-        states = generate_state_machine(automaton, request['system_name'], config_dir, state_library=library)
+        states = generate_state_machine(automaton, request['system_name'], config_dir, state_library=library).to_instantiations()
         never_exits = ['/: a container needs outcomes'] if not states[0].outcomes else []
         assert validate_state_machine(states) == never_exits, pair.launch
         assert states[0].outcomes == request['outcomes'], pair.launch
@@ -182,7 +182,7 @@ def test_a_given_machine_is_generated_as_given(cnu, library, tmp_path):
     write_system_file(tmp_path, pair)
     spec = compile_task('hello_world', [], [], config_dir=tmp_path, state_library=library)
     automaton = automaton_from_strategy(synthesize(spec).strategy, spec)
-    states = generate_state_machine(automaton, 'hello_world', tmp_path, state_library=library)
+    states = generate_state_machine(automaton, 'hello_world', tmp_path, state_library=library).to_instantiations()
     given = yaml.safe_load(pair.files['cnu_state_machine'].read_text())
     assert states[0].initial_state_name == given['sm']['initial_state']
     assert [(s.name, s.state_class, dict(zip(s.parameter_names, s.parameter_values)), s.outcomes, s.transitions,
@@ -298,7 +298,7 @@ def test_at_var_parameters_take_the_value_the_strategy_chose(library, tmp_path):
     for goal, value in (('item=2', "'cake'"), ('item=1', "'tea'")):
         spec = compile_task('shop', [], ['give', goal], config_dir=tmp_path, state_library=library)
         automaton = automaton_from_strategy(synthesize(spec).strategy, spec)
-        states = generate_state_machine(automaton, 'shop', tmp_path, state_library=library)
+        states = generate_state_machine(automaton, 'shop', tmp_path, state_library=library).to_instantiations()
         give = next(s for s in top_level_states(states) if s.state_class == 'LogState' and s.name.startswith('give'))
         assert give.name == f'give_{value.strip(chr(39))}'
         assert dict(zip(give.parameter_names, give.parameter_values)) == {'text': value}
@@ -395,7 +395,7 @@ def test_cnu_behaviors_run_on_the_real_flexbe_engine(cnu, library, tmp_path):
         example_system(tmp_path, cnu, name)
         _, _, states = synthesized(tmp_path, name, library)
         config = behavior_flexbe_config(robot_system(name, tmp_path), library)
-        package = behavior_package(states, config, f'CNU {name.replace("_", " ")}')
+        package = behavior_package(StateMachine.from_instantiations(states), config, f'CNU {name.replace("_", " ")}')
         behavior_class, checksum = load_behavior_class(package, tmp_path / name)
         with RosHarness(default_context=True) as ros:  # flexbe_core uses rclpy's global context
             outcome, visited = run_behavior(ros, behavior_class, checksum, name)
@@ -493,7 +493,7 @@ def rover_machine(library, sm_outcomes, config_dir=None):
     assert result.realizable
     assert strategy_violations(spec, result.strategy) == []
     automaton = automaton_from_strategy(result.strategy, spec)
-    states = generate_state_machine(automaton, 'delivery_rover', config_dir, state_library=library)
+    states = generate_state_machine(automaton, 'delivery_rover', config_dir, state_library=library).to_instantiations()
     assert validate_state_machine(states) == []
     return spec, {s.state_path: s for s in states}
 

@@ -38,8 +38,9 @@ def test_exported_behavior_loads_in_flexbe_core_and_create_builds_the_machine(ro
 
     from synthesis_manager.ros.flexbe_engine import load_behavior_class, reset_flexbe_proxies
 
-    _, states = synthesized(*PICKUP)
-    package = behavior_package(states, flexbe_config(robot_system('atlas')), 'Look Down And Pickup')
+    _, machine = synthesized(*PICKUP)
+    package = behavior_package(machine, flexbe_config(robot_system('atlas')), 'Look Down And Pickup')
+    states = machine.to_instantiations()
     behavior_class, _ = load_behavior_class(package, tmp_path)
     node = ros.add_node(Node, 'flexbe_create_test')
     set_node(node)
@@ -112,8 +113,8 @@ def test_an_outcome_the_operator_forces_on_the_engine_is_the_operators_in_the_tr
 
     from synthesis_manager.ros.flexbe_engine import run_on_flexbe
 
-    spec, states = synthesized(*PICKUP)
-    first = next(s for s in states if s.state_path == '/' + states[0].initial_state_name)
+    spec, machine = synthesized(*PICKUP)
+    first = next(s for s in machine.states if s.name == machine.initial_state_name)
     simulator = make_simulator('atlas', initial_conditions=PICKUP[0])
     node = ros.add_node(AtlasSimNode, simulator=simulator, parameter_overrides=[
         Parameter('speed', value=20.0), Parameter('state_rate', value=50.0)])
@@ -121,7 +122,7 @@ def test_an_outcome_the_operator_forces_on_the_engine_is_the_operators_in_the_tr
     commands = operator.create_publisher(OutcomeRequest, 'flexbe/command/transition', 10)
     done = {}
     runner = threading.Thread(target=lambda: done.update(run=run_on_flexbe(
-        states, simulator, node.lock, ros.domain_id, autonomy=0, max_wall_time=60.0)))
+        machine, simulator, node.lock, ros.domain_id, autonomy=0, max_wall_time=60.0)))
     runner.start()
     while runner.is_alive():  # the command is read while the state waits (buffered until then)
         commands.publish(OutcomeRequest(outcome=first.outcomes.index('failed'), target=first.name))

@@ -140,6 +140,7 @@ def exported_behavior(tmp_path_factory):
     states = generate_state_machine(automaton_from_strategy(synthesize(spec).strategy, spec), 'atlas',
                                     initial_conditions=initial)
     package = behavior_package(states, flexbe_config(robot_system('atlas')), 'Look Down Pickup Object')
+    states = states.to_instantiations()
     work = tmp_path_factory.mktemp('exported')
     folder = package.write(work / 'src')
     prefix = work / 'install'

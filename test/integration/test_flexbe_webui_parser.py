@@ -63,8 +63,9 @@ def reading_of(parsed):
 
 @pytest.mark.parametrize('automaton', ['concurrent.yaml', 'two_behaviors.yaml'])
 def test_the_editor_parser_reads_an_exported_behavior_as_generated(parser, automaton):
-    states = generate_state_machine(load_automaton(AUTOMATA / automaton), 'atlas')
-    package = behavior_package(states, flexbe_config(robot_system('atlas')), 'Parsed Behavior')
+    machine = generate_state_machine(load_automaton(AUTOMATA / automaton), 'atlas')
+    package = behavior_package(machine, flexbe_config(robot_system('atlas')), 'Parsed Behavior')
+    states = machine.to_instantiations()
     answer = parser(package.files[f'{package.package}/{package.module}.py'])
     assert answer['warnings'] == []
     parsed = answer['result']
@@ -108,8 +109,9 @@ def test_the_editor_parser_reads_an_exported_behavior_as_generated(parser, autom
 def test_the_editor_parser_reads_the_paper_task_and_atlas_sim_behaviors(parser):
     spec = compile_task('atlas', ['stand_prep'], ['look_down', 'pickup_object'])
     automaton = automaton_from_strategy(synthesize(spec).strategy, spec)
-    states = generate_state_machine(automaton, 'atlas', initial_conditions=['stand_prep'])
-    package = behavior_package(states, flexbe_config(robot_system('atlas')), 'Look Down Pickup Object')
+    machine = generate_state_machine(automaton, 'atlas', initial_conditions=['stand_prep'])
+    package = behavior_package(machine, flexbe_config(robot_system('atlas')), 'Look Down Pickup Object')
+    states = machine.to_instantiations()
     answer = parser(package.files[f'{package.package}/{package.module}.py'])
     assert answer['warnings'] == []
     top = [s.name for s in states if s.parent_path == '/' and s.state_class != ':OUTCOME']

@@ -56,10 +56,10 @@ def test_paper_second_demo_from_the_state_after_the_first_task():
     assert 'manipulate_c' in env_init and '!stand_c' in env_init
     result = synthesize(spec)
     assert result.realizable
-    states = generate_state_machine(automaton_from_strategy(result.strategy, spec), 'atlas',
-                                    initial_conditions=initial_conditions)
-    top = {s.name: s for s in states if s.parent_path == '/' and s.state_class != ':OUTCOME'}
-    path, current = [], states[0].initial_state_name
+    machine = generate_state_machine(automaton_from_strategy(result.strategy, spec), 'atlas',
+                                     initial_conditions=initial_conditions)
+    top = {s.name: s for s in machine.states}
+    path, current = [], machine.initial_state_name
     while current in top and current not in path:  # every state succeeding: its first outcome
         path.append(current)
         current = top[current].transitions[0]

@@ -14,7 +14,7 @@ ATLAS = Path(__file__).resolve().parents[2] / 'config' / 'atlas.yaml'
 
 def fails(automaton_file, code, item, system='atlas', config_dir=None, **kwargs):
     with pytest.raises(SMGenerationError) as caught:
-        generate_state_machine(load_automaton(AUTOMATA / automaton_file), system, config_dir, **kwargs)
+        generate_state_machine(load_automaton(AUTOMATA / automaton_file), system, config_dir, **kwargs).to_instantiations()
     assert caught.value.code == code, str(caught.value)
     assert caught.value.item == item
     return caught.value
@@ -147,5 +147,5 @@ def test_constant_unobserved_input_is_harmless():
     data = yaml.safe_load((AUTOMATA / 'invalid' / 'unobserved_input.yaml').read_text())
     data['automaton'][2]['input_valuation'][3] = 0  # door_open never changes now
     from sm_generation.automaton_io import automaton_from_dict
-    states = generate_state_machine(automaton_from_dict(data), 'atlas')
+    states = generate_state_machine(automaton_from_dict(data), 'atlas').to_instantiations()
     assert [s.name for s in states if s.parent_path == '/'] == ['stand', 'finished', 'failed']

@@ -7,6 +7,7 @@ import pytest
 
 from sm_generation import generate_state_machine, load_automaton
 from sm_generation import export
+from sm_generation.state_machine import StateMachine
 from sm_generation.cli import main
 from sm_generation.export import RenderError, from_text, render, to_dot, to_json, to_yaml
 
@@ -19,8 +20,8 @@ def concurrent():
 
 
 def test_yaml_and_json_round_trip(concurrent):
-    assert from_text(to_yaml(concurrent)) == concurrent
-    assert from_text(to_json(concurrent)) == concurrent
+    assert from_text(to_yaml(concurrent)) == concurrent.to_instantiations()
+    assert from_text(to_json(concurrent)) == concurrent.to_instantiations()
     entries = json.loads(to_json(concurrent))
     assert all(len(entry) == 16 for entry in entries)
     assert entries[0]['state_path'] == '/'
@@ -40,7 +41,7 @@ def test_dot_draws_states_containers_outcomes_and_start(concurrent):
 
 def test_dot_merges_parallel_transitions_into_one_outcome_cell_and_arrow(concurrent):
     dot = to_dot(concurrent)
-    pregrasp_pose = next(s for s in concurrent if s.name == 'pregrasp_pose')
+    pregrasp_pose = next(s for s in concurrent.walk() if s.name == 'pregrasp_pose')
     assert pregrasp_pose.transitions.count('failed') == 2  # 'failed' and 'not_available'
     assert '>failed, not_available<' in dot
     arrows = [line for line in dot.splitlines() if line.startswith('  "state:pregrasp_pose":')]
@@ -73,10 +74,10 @@ def test_a_long_machine_wraps_its_main_path_into_columns_with_a_failure_rail(twe
     import xml.etree.ElementTree as ET
 
     dot = to_dot(twelve_goals)
-    top = [s for s in twelve_goals if s.parent_path == '/' and s.state_class != ':OUTCOME']
+    top = list(twelve_goals.states)
     assert len(top) > export.WRAP_AFTER
-    columns = export._grid(top, twelve_goals[0].initial_state_name)
-    assert len(columns) >= 3 and columns[0][0] == twelve_goals[0].initial_state_name
+    columns = export._grid(top, twelve_goals.initial_state_name)
+    assert len(columns) >= 3 and columns[0][0] == twelve_goals.initial_state_name
     assert sorted(sum(columns, [])) == sorted(s.name for s in top)  # every state once
     # one failure outcome per column, no dashed arrow funnelling into one node
     failed_nodes = re.findall(r'^    "(outcome:failed(?::\d+)?)" \[', dot, flags=re.M)
@@ -93,10 +94,10 @@ def test_a_long_machine_wraps_its_main_path_into_columns_with_a_failure_rail(twe
 
 
 def test_dot_labels_behaviours_and_escapes_quotes():
-    states = generate_state_machine(load_automaton(AUTOMATA / 'two_behaviors.yaml'), 'atlas')
+    states = generate_state_machine(load_automaton(AUTOMATA / 'two_behaviors.yaml'), 'atlas').to_instantiations()
     states[2].state_path = '/say "hi"'
     states[1].transitions = ['say "hi"', 'failed']
-    dot = to_dot(states)
+    dot = to_dot(StateMachine.from_instantiations(states))
     assert '[Grasp Object]' in dot
     assert '"state:say \\"hi\\""' in dot and '<B>say &quot;hi&quot;</B>' in dot
 
@@ -122,7 +123,7 @@ def test_render_rejects_other_formats(concurrent, tmp_path):
 def test_cli_writes_yaml_to_stdout(capsys):
     assert main(['--system', 'atlas', '--automaton', str(AUTOMATA / 'look_down.yaml')]) == 0
     out = capsys.readouterr().out
-    assert from_text(out) == generate_state_machine(load_automaton(AUTOMATA / 'look_down.yaml'), 'atlas')
+    assert from_text(out) == generate_state_machine(load_automaton(AUTOMATA / 'look_down.yaml'), 'atlas').to_instantiations()
 
 
 def test_cli_formats_from_suffix_and_flag(tmp_path):

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-from sm_generation import SMGenerationError, generate_state_machine, load_automaton
+from sm_generation import SMGenerationError, StateMachine, generate_state_machine, load_automaton
 from respec.robot import robot_system
 from sm_generation.config import flexbe_config, parse_flexbe_config
 from sm_generation.flexbe_behavior import (behavior_class_name, behavior_module_name, behavior_package,
@@ -22,8 +22,8 @@ DATE = 'Sun Nov 22 2026'
 
 
 def export(automaton='concurrent.yaml', name='Look Down And Pickup', **kwargs):
-    states = generate_state_machine(load_automaton(AUTOMATA / automaton), 'atlas')
-    return states, behavior_package(states, flexbe_config(robot_system('atlas')), name, date=DATE, **kwargs)
+    machine = generate_state_machine(load_automaton(AUTOMATA / automaton), 'atlas')
+    return machine.to_instantiations(), behavior_package(machine, flexbe_config(robot_system('atlas')), name, date=DATE, **kwargs)
 
 
 def create_method(code):
@@ -97,7 +97,7 @@ def test_keys_read_but_written_by_no_state_are_the_roots_input_keys_with_their_d
     assert "OperatableStateMachine(outcomes=['finished', 'failed'], input_keys=['template_id'])" in code
     assert '_state_machine.userdata.template_id = None' in code
     with_default = dataclasses.replace(flexbe_config(robot_system('atlas')), userdata={'template_id': '1'})
-    code = behavior_package(states, with_default, 'Pickup And Grasp', date=DATE).files[
+    code = behavior_package(StateMachine.from_instantiations(states), with_default, 'Pickup And Grasp', date=DATE).files[
         'synthesized_flexbe_behaviors/pickup_and_grasp_sm.py']
     assert '_state_machine.userdata.template_id = 1' in code
 
@@ -107,7 +107,7 @@ def test_keys_written_in_the_machine_are_not_input_keys():
     states, _ = export('concurrent.yaml')
     assert states[0].input_keys == []
     assert generate_from_config(load_automaton(AUTOMATA / 'concurrent.yaml'),
-                                flexbe_config(robot_system('atlas')))[0].input_keys == []
+                                flexbe_config(robot_system('atlas'))).input_keys == []
 
 
 def test_writes_must_name_remapped_keys():
@@ -165,7 +165,7 @@ def test_bad_names_are_rejected_with_the_item(kwargs, item):
 
 
 def test_a_class_without_a_package_names_the_state():
-    states = generate_state_machine(load_automaton(AUTOMATA / 'concurrent.yaml'), 'atlas')
+    machine = generate_state_machine(load_automaton(AUTOMATA / 'concurrent.yaml'), 'atlas')
     config = flexbe_config(robot_system('atlas'))
     bare = parse_flexbe_config({'sm_outcomes': config.sm_outcomes, 'states': {
         proposition: {'class_decl': {'name': s.state_class, 'behavior_class': s.behavior_class,
@@ -174,7 +174,7 @@ def test_a_class_without_a_package_names_the_state():
                       'output_mapping': {k: list(v) for k, v in s.output_mapping.items()}}
         for proposition, s in config.states.items()}}, 'atlas')
     with pytest.raises(SMGenerationError) as error:
-        behavior_package(states, bare, 'No Packages')
+        behavior_package(machine, bare, 'No Packages')
     assert error.value.code == 'CONFIG_VARIABLE_CONFIG_INVALID' and error.value.item.startswith('/')
 
 

@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 import yaml
 
-from sm_generation import (Automaton, AutomatonState, StateInstantiation, generate_state_machine,
+from sm_generation import (Automaton, AutomatonState, StateInstantiation, StateMachine, generate_state_machine,
                            load_automaton, validate_state_machine)
 from sm_generation.automaton_io import automaton_from_dict, automaton_to_dict, dump_automaton
 from sm_generation.export import to_yaml
@@ -21,13 +21,13 @@ REPO_CONFIG = Path(__file__).resolve().parents[2] / 'config'
 
 
 def generate(name, system='atlas', **kwargs):
-    states = generate_state_machine(load_automaton(AUTOMATA / name), system, **kwargs)
-    assert validate_state_machine(states) == []
-    return states
+    machine = generate_state_machine(load_automaton(AUTOMATA / name), system, **kwargs)
+    assert validate_state_machine(machine.to_instantiations()) == []
+    return machine
 
 
-def by_path(states):
-    return {s.state_path: s for s in states}
+def by_path(machine):
+    return {s.state_path: s for s in machine.walk()}
 
 
 def edges(state):
@@ -37,7 +37,7 @@ def edges(state):
 @pytest.mark.parametrize('path', VALID, ids=lambda p: p.stem)
 @pytest.mark.parametrize('reduce', [False, True])
 def test_every_fixture_gives_a_consistent_machine(path, reduce):
-    states = generate_state_machine(load_automaton(path), 'atlas', reduce=reduce)
+    states = generate_state_machine(load_automaton(path), 'atlas', reduce=reduce).to_instantiations()
     assert validate_state_machine(states) == []
     root = states[0]
     assert root.state_path == '/' and root.state_class == ':STATEMACHINE'
@@ -138,9 +138,9 @@ def test_two_behaviors_in_one_task():
 
 
 def test_several_initial_states_with_the_same_behaviour_pick_the_first():
-    states = generate('initial_same_behaviour.yaml')
-    assert states[0].initial_state_name == 'stand'
-    assert [s.name for s in states if s.state_class == 'ChangeControlModeActionState'] == ['stand']
+    machine = generate('initial_same_behaviour.yaml')
+    assert machine.initial_state_name == 'stand'
+    assert [s.name for s in machine.walk() if s.state_class == 'ChangeControlModeActionState'] == ['stand']
 
 
 def test_several_initial_states_with_different_behaviours_ask_the_operator():
@@ -165,17 +165,17 @@ def test_initial_state_deduced_from_initial_conditions():
     automaton = load_automaton(AUTOMATA / 'no_initial_states.yaml')
     assert automaton.initial_states == []
     # no hint: the state that activates nothing and that nothing enters
-    assert generate_state_machine(automaton, 'atlas')[0].initial_state_name == 'stand'
-    assert generate_state_machine(automaton, 'atlas', initial_conditions=['stand_prep'])[0].initial_state_name == 'stand'
+    assert generate_state_machine(automaton, 'atlas').initial_state_name == 'stand'
+    assert generate_state_machine(automaton, 'atlas', initial_conditions=['stand_prep']).initial_state_name == 'stand'
     # starting from stand: state '6' (stand_c true) is passed through to look_down
     from_stand = generate_state_machine(automaton, 'atlas', initial_conditions=['stand'])
-    assert from_stand[0].initial_state_name == 'look_down'
-    assert [s.name for s in from_stand if s.parent_path == '/'] == ['look_down', 'finished', 'failed']
+    assert from_stand.initial_state_name == 'look_down'
+    assert [s.name for s in from_stand.walk() if s.parent_path == '/'] == ['look_down', 'finished', 'failed']
     # manipulate is configured but not in this automaton (irrelevant to the task): no constraint
-    assert generate_state_machine(automaton, 'atlas', initial_conditions=['stand_prep', 'manipulate'])[0] \
+    assert generate_state_machine(automaton, 'atlas', initial_conditions=['stand_prep', 'manipulate']) \
         .initial_state_name == 'stand'
     # a proposition name works as well
-    assert generate_state_machine(automaton, 'atlas', initial_conditions=['stand_c'])[0].initial_state_name == 'look_down'
+    assert generate_state_machine(automaton, 'atlas', initial_conditions=['stand_c']).initial_state_name == 'look_down'
 
 
 def test_pass_through_state_in_the_middle():
@@ -193,7 +193,7 @@ def test_reduce_merges_bisimilar_states():
 
 
 def test_names_clash_get_numbered_in_breadth_first_order():
-    states = [s.name for s in generate('sensors.yaml') if s.parent_path == '/']
+    states = [s.name for s in generate('sensors.yaml').walk() if s.parent_path == '/']
     assert states.index('object_template_1') < states.index('object_template_2')
 
 
@@ -207,7 +207,7 @@ def test_positions_are_layered_from_the_initial_state():
     a = inner['/object_template_and_stand/object_template'].position
     b = inner['/object_template_and_stand/stand'].position
     assert a != b and a[1] == b[1]
-    top = [s.position for s in generate('sensors.yaml') if s.parent_path == '/']
+    top = [s.position for s in generate('sensors.yaml').walk() if s.parent_path == '/']
     assert len({tuple(p) for p in top}) == len(top)  # no two states on top of each other
 
 
@@ -285,9 +285,10 @@ def test_automaton_file_round_trip(tmp_path):
     assert automaton_to_dict(load_automaton(tmp_path / 'a.json')) == automaton_to_dict(automaton)
 
 
-def test_returns_state_instantiations():
-    states = generate('two_behaviors.yaml')
-    assert all(isinstance(s, StateInstantiation) for s in states)
+def test_returns_the_tree_whose_list_is_plain_state_instantiations():
+    machine = generate('two_behaviors.yaml')
+    assert isinstance(machine, StateMachine) and machine.state_path == '/'
+    assert all(type(s) is StateInstantiation for s in machine.to_instantiations())
 
 
 def test_silent_change_of_activations_is_left_out_and_reported(caplog):
@@ -298,9 +299,9 @@ def test_silent_change_of_activations_is_left_out_and_reported(caplog):
     data['automaton'].append({'name': '2x', 'output_valuation': [0, 1, 0, 0],
                               'input_valuation': [1, 0, 0, 0, 0, 0], 'transitions': ['2x', '3', '4']})
     with caplog.at_level('WARNING', logger='sm_generation.generator'):
-        states = generate_state_machine(automaton_from_dict(data), 'atlas')
-    assert validate_state_machine(states) == []
-    assert to_yaml(states) == to_yaml(generate('look_down.yaml'))
+        machine = generate_state_machine(automaton_from_dict(data), 'atlas')
+    assert validate_state_machine(machine.to_instantiations()) == []
+    assert to_yaml(machine) == to_yaml(generate('look_down.yaml'))
     assert any('1 -> 2x' in record.getMessage() for record in caplog.records)
 
 

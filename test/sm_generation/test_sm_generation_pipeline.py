@@ -49,7 +49,8 @@ TASKS = [
                          ids=[f'{t[0]}:{t[2]}' for t in TASKS])
 def test_paper_tasks_give_valid_machines(system, initial_conditions, goals, expected):
     spec, _, automaton = synthesized(system, initial_conditions, goals)
-    states = generate_state_machine(automaton, system, initial_conditions=[initial_conditions])
+    machine = generate_state_machine(automaton, system, initial_conditions=[initial_conditions])
+    states = machine.to_instantiations()
     assert validate_state_machine(states) == []
     assert states[0].outcomes == ['finished', 'failed']
     path, end = main_path(states)
@@ -60,13 +61,13 @@ def test_paper_tasks_give_valid_machines(system, initial_conditions, goals, expe
     if expected is not None:
         assert path == expected
     reduced = generate_state_machine(automaton, system, initial_conditions=[initial_conditions], reduce=True)
-    assert validate_state_machine(reduced) == []
-    assert runs(reduced, 8) == runs(states, 8)
+    assert validate_state_machine(reduced.to_instantiations()) == []
+    assert runs(reduced, 8) == runs(machine, 8)
 
 
 def test_two_behaviours_survive():
     _, _, automaton = synthesized('atlas', 'stand_prep', 'pickup_object, grasp_object')
-    states = generate_state_machine(automaton, 'atlas')
+    states = generate_state_machine(automaton, 'atlas').to_instantiations()
     behaviours = {s.behavior_class for s in states if s.state_class == ':BEHAVIOR'}
     assert behaviours == {'Pickup Object', 'Grasp Object'}
 
@@ -81,15 +82,14 @@ def test_pipeline_is_deterministic():
 def test_retry_without_failed_outcome_and_reduction():
     """With sm_outcomes [finished] only, failures are retried; reduction folds the copies."""
     _, _, automaton = synthesized('atlas', 'stand_prep', 'look_down', ('finished',))
-    states = generate_state_machine(automaton, 'atlas')
-    assert validate_state_machine(states) == []
-    assert states[0].outcomes == ['finished']
+    machine = generate_state_machine(automaton, 'atlas')
+    assert validate_state_machine(machine.to_instantiations()) == []
+    assert machine.outcomes == ['finished']
     reduced = generate_state_machine(automaton, 'atlas', reduce=True)
-    top = {s.name: dict(zip(s.outcomes, s.transitions)) for s in reduced
-           if s.parent_path == '/' and s.state_class != ':OUTCOME'}
+    top = {s.name: dict(zip(s.outcomes, s.transitions)) for s in reduced.states}
     assert top == {'stand': {'changed': 'look_down', 'failed': 'stand'},
                    'look_down': {'done': 'finished', 'failed': 'look_down'}}
-    assert runs(reduced, 8) == runs(states, 8)
+    assert runs(reduced, 8) == runs(machine, 8)
 
 
 def test_cli_reads_a_slugs_strategy_with_its_spec(tmp_path):
@@ -99,4 +99,4 @@ def test_cli_reads_a_slugs_strategy_with_its_spec(tmp_path):
     out = tmp_path / 'task.yaml'
     assert main(['--system', 'atlas', '--automaton', str(tmp_path / 'task.json'),
                  '--spec', str(tmp_path / 'task.structuredslugs'), '-o', str(out)]) == 0
-    assert from_text(out.read_text()) == generate_state_machine(automaton, 'atlas')
+    assert from_text(out.read_text()) == generate_state_machine(automaton, 'atlas').to_instantiations()

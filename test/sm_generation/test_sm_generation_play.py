@@ -13,7 +13,7 @@ AUTOMATA = Path(__file__).resolve().parents[1] / 'automata'
 @pytest.fixture(scope='module')
 def concurrent():
     return StateMachine.from_instantiations(
-        generate_state_machine(load_automaton(AUTOMATA / 'concurrent.yaml'), 'atlas'))
+        generate_state_machine(load_automaton(AUTOMATA / 'concurrent.yaml'), 'atlas').to_instantiations())
 
 
 def test_the_play_starts_at_the_initial_state_with_its_outcomes(concurrent):

@@ -11,7 +11,7 @@ from sm_generation import generate_state_machine, load_automaton, validate_state
 from respec.robot import robot_system
 from sm_generation.config import StateConfig, flexbe_config
 from sm_generation.generator import machine_from_view
-from sm_generation.machine import AutomatonView, Machine, MachineState
+from sm_generation.abstract_machine import AutomatonView, AbstractMachine, AbstractState
 from sm_generation.reduction import bisimulation_blocks
 from sm_generation.traces import TRUNCATED, runs
 
@@ -20,15 +20,15 @@ DEPTH = 6
 
 
 def test_runs_of_a_small_machine():
-    states = generate_state_machine(load_automaton(AUTOMATA / 'look_down.yaml'), 'atlas')
+    machine = generate_state_machine(load_automaton(AUTOMATA / 'look_down.yaml'), 'atlas')
     stand = ('ChangeControlModeActionState', '', ('"stand"',))
     look = ('TiltHeadState', '', ('-45.0',))
-    assert runs(states, DEPTH) == {
+    assert runs(machine, DEPTH) == {
         (((stand,), ((stand, 'changed'),)), ((look,), ((look, 'done'),)), ('exit', 'finished')),
         (((stand,), ((stand, 'changed'),)), ((look,), ((look, 'failed'),)), ('exit', 'failed')),
         (((stand,), ((stand, 'failed'),)), ('exit', 'failed')),
     }
-    assert runs(states, 1) == {
+    assert runs(machine, 1) == {
         (((stand,), ((stand, 'changed'),)), TRUNCATED),
         (((stand,), ((stand, 'failed'),)), ('exit', 'failed')),
     }
@@ -39,8 +39,8 @@ def test_reduced_machine_has_the_same_runs(path):
     automaton = load_automaton(path)
     plain = generate_state_machine(automaton, 'atlas')
     reduced = generate_state_machine(automaton, 'atlas', reduce=True)
-    assert validate_state_machine(reduced) == []
-    assert len(reduced) <= len(plain)
+    assert validate_state_machine(reduced.to_instantiations()) == []
+    assert len(reduced.to_instantiations()) <= len(plain.to_instantiations())
     assert runs(reduced, DEPTH) == runs(plain, DEPTH)
 
 
@@ -63,10 +63,10 @@ def test_bisimilar_loop_copies_are_merged():
     automaton = _loop_automaton()
     plain = generate_state_machine(automaton, 'atlas')
     reduced = generate_state_machine(automaton, 'atlas', reduce=True)
-    assert [s.name for s in plain if s.parent_path == '/'] == ['stand', 'look_down_1', 'look_down_2',
+    assert [s.name for s in plain.walk() if s.parent_path == '/'] == ['stand', 'look_down_1', 'look_down_2',
                                                                'finished', 'failed']
-    assert [s.name for s in reduced if s.parent_path == '/'] == ['stand', 'look_down', 'finished', 'failed']
-    look = next(s for s in reduced if s.name == 'look_down')
+    assert [s.name for s in reduced.walk() if s.parent_path == '/'] == ['stand', 'look_down', 'finished', 'failed']
+    look = next(s for s in reduced.walk() if s.name == 'look_down')
     assert dict(zip(look.outcomes, look.transitions)) == {'done': 'finished', 'failed': 'look_down'}
     assert runs(reduced, 8) == runs(plain, 8)
 
@@ -110,8 +110,8 @@ def machines(draw):
     for key in keys:
         part = draw(st.sampled_from(_PARTS))
         chosen = draw(st.lists(st.sampled_from(_OBSERVATIONS), unique=True, max_size=2))
-        states[key] = MachineState(key, (part,), [(o, draw(targets)) for o in sorted(chosen)])
-    return Machine(states=states, initial='0', outcomes=['finished', 'failed'])
+        states[key] = AbstractState(key, (part,), [(o, draw(targets)) for o in sorted(chosen)])
+    return AbstractMachine(states=states, initial='0', outcomes=['finished', 'failed'])
 
 
 @settings(max_examples=200, deadline=None)

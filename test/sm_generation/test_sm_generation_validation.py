@@ -13,7 +13,7 @@ AUTOMATA = Path(__file__).resolve().parents[1] / 'automata'
 
 @pytest.fixture(scope='module')
 def concurrent():
-    return generate_state_machine(load_automaton(AUTOMATA / 'concurrent.yaml'), 'atlas')
+    return generate_state_machine(load_automaton(AUTOMATA / 'concurrent.yaml'), 'atlas').to_instantiations()
 
 
 def broken(states, path, **changes):

@@ -40,7 +40,7 @@ def test_pickup_task_over_ros(ros, fail, expected):
         Parameter('initial_conditions', value='stand_prep'), Parameter('fail', value=fail)])
     robot = RosRobot(ros.add_node(Node, 'executive'))
     robot.wait_until_ready()
-    run = execute_state_machine(outcome.states, robot, max_wall_time=60.0)
+    run = execute_state_machine(outcome.machine, robot, max_wall_time=60.0)
     assert run.outcome == expected
     report = check_trace(run.trace, spec, goals=goals)
     assert report.ok, report.summary()

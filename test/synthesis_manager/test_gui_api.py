@@ -222,14 +222,14 @@ def test_unknown_names_in_urls_are_404_and_the_server_keeps_serving(client):
 
 
 def test_cancel_a_job_before_it_is_sent(client, backend):
-    backend.job_gate.clear()  # hold new jobs in the queue
+    backend.jobs.gate.clear()  # hold new jobs in the queue
     try:
         job = client.post('/api/jobs', json=PAPER_TASK).json()
         assert client.get(f"/api/jobs/{job['id']}").json()['state'] == 'queued'
         assert client.post(f"/api/jobs/{job['id']}/cancel", json={}).status_code == 202
         _, final = follow(client, job['id'])
     finally:
-        backend.job_gate.set()
+        backend.jobs.gate.set()
     assert final['outcome']['error_name'] == 'PREEMPTED'
     # nothing reached the pipeline: the timeline holds only the cancel
     assert [entry['status'] for entry in final['timeline']] == ['Cancel requested', 'Cancelled']
@@ -293,9 +293,9 @@ def test_a_simulation_runs_the_system_the_gui_was_served_not_a_local_file(tmp_pa
     files = {'served_atlas.yaml': yaml.safe_dump(document, sort_keys=False)}
     served = robot_system_from_files('served_atlas', files, 'suite/served_atlas.yaml')
     spec = compile_task(served, ['stand_prep'], ['walk'])
-    states = generate_state_machine(automaton_from_strategy(synthesize(spec).strategy, spec), served,
-                                    initial_conditions=['stand_prep'])
-    final = simulate({'states': [state.to_dict() for state in states], 'ltl_specification': spec.to_text_sections(),
+    machine = generate_state_machine(automaton_from_strategy(synthesize(spec).strategy, spec), served,
+                                     initial_conditions=['stand_prep'])
+    final = simulate({'machine': machine, 'ltl_specification': spec.to_text_sections(),
                       'system': served.name, 'files': dict(served.files), 'config_file': served.config_file,
                       'initial_conditions': ['stand_prep'], 'goals': ['walk'], 'ordered': True, 'fail_first': [],
                       'record_dir': str(tmp_path), 'max_robot_time': 300.0, 'max_wall_time': 300.0},
@@ -374,6 +374,25 @@ def test_the_state_machine_is_served_as_a_tree_of_the_listed_states(client):
     _, compiled = run_job(client, {**PAPER_TASK, 'option': 'ltl_compilation_only'})
     missing = client.get(f"/api/jobs/{compiled['id']}/state-machine")
     assert missing.status_code == 409 and missing.json()['item'] == compiled['id']
+
+
+def test_drawings_and_plays_read_the_tree_the_job_holds_without_rebuilding_it(client, backend, monkeypatch):
+    """The result's list becomes the tree once, when it arrives; drawings and play steps reuse it."""
+    from sm_generation.state_machine import StateMachine
+
+    _, job = run_job(client, PAPER_TASK)
+    held = backend.jobs.job(job['id']).outcome.machine
+    builds = []
+    real = StateMachine.from_instantiations.__func__
+    monkeypatch.setattr(StateMachine, 'from_instantiations',
+                        classmethod(lambda cls, states: builds.append(len(states)) or real(cls, states)))
+    first = client.get(f"/api/jobs/{job['id']}/state-machine").json()
+    assert client.get(f"/api/jobs/{job['id']}/state-machine").json() == first == held.to_dict()
+    start = client.post(f"/api/jobs/{job['id']}/play", json={'moves': []}).json()
+    step = client.post(f"/api/jobs/{job['id']}/play", json={'moves': [start['outcomes'][0]]})
+    assert step.status_code == 200, step.text
+    assert backend.jobs.state_machine(job['id']) is held
+    assert builds == []
 
 
 def test_the_page_is_es_modules_served_as_javascript(client):

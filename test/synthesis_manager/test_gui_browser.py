@@ -205,7 +205,7 @@ def test_a_request_without_goals_is_refused_in_the_page_without_asking_the_serve
 
 def test_cancel_a_queued_job(page, gui):
     _, backend = gui
-    backend.job_gate.clear()  # jobs wait before being sent: cancel is deterministic
+    backend.jobs.gate.clear()  # jobs wait before being sent: cancel is deterministic
     try:
         choose_task(page, ['look_down'])
         page.click('#synthesize')
@@ -214,7 +214,7 @@ def test_cancel_a_queued_job(page, gui):
         page.click('#cancel')
         assert result_code(page) == 'CANCELLED'  # neutral, not an error
     finally:
-        backend.job_gate.set()
+        backend.jobs.gate.set()
     assert 'cancelled' in page.inner_text('#result-message')
     # one word for it on the whole page (ROS calls it PREEMPTED)
     page.wait_for_function("document.getElementById('status').textContent === 'CANCELLED'", timeout=10_000)
@@ -231,7 +231,7 @@ def test_a_cancel_reply_arriving_after_the_result_does_not_roll_the_timeline_bac
     _, backend = gui
     held = []
     page.route('**/api/jobs/*/cancel', lambda route: held.append((route, route.fetch())))
-    backend.job_gate.clear()
+    backend.jobs.gate.clear()
     try:
         choose_task(page, ['look_down'])
         page.click('#synthesize')
@@ -240,7 +240,7 @@ def test_a_cancel_reply_arriving_after_the_result_does_not_roll_the_timeline_bac
         page.wait_for_function("document.querySelector('#timeline').innerText.includes('Cancelled')",
                                timeout=10_000)
     finally:
-        backend.job_gate.set()
+        backend.jobs.gate.set()
     assert len(held) == 1
     route, stale_reply = held[0]
     assert stale_reply.json()['state'] != 'finished'  # the reply really is older than the page

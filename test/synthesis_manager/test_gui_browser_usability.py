@@ -278,7 +278,7 @@ def concurrent_machine(request, feedback, cancel):
     from sm_generation import generate_state_machine, load_automaton
 
     automaton = load_automaton(Path(__file__).resolve().parents[1] / 'automata' / 'concurrent.yaml')
-    return JobOutcome(1, 'SUCCESS', '', states=tuple(generate_state_machine(automaton, 'atlas')))
+    return JobOutcome(1, 'SUCCESS', '', machine=generate_state_machine(automaton, 'atlas'))
 
 
 def test_a_concurrency_container_names_its_states_when_clicked(browser_context):  # noqa: F811

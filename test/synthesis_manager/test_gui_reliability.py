@@ -15,7 +15,7 @@ import pytest
 from synthesis_manager.cli import build_parser
 from synthesis_manager.gui import background_server, ros_backend
 from synthesis_manager.limits import MAX_BODY_BYTES
-from synthesis_manager.web import backend as backend_module
+from synthesis_manager.web import request_form as request_form_module
 from synthesis_manager.web.guards import json_nesting_exceeds
 from synthesis_manager.web.routes import create_app
 from synthesis_manager.web.simulation_process import CHILD_ENVIRONMENT, SimulationProcess
@@ -96,19 +96,19 @@ def test_twenty_jobs_at_once_all_finish(gui):
 
 def test_jobs_beyond_the_limit_are_busy(gui):
     backend, url = gui
-    backend.job_gate.clear()  # new jobs wait unsent, so they stay unfinished
-    limit = backend.max_unfinished_jobs
+    backend.jobs.gate.clear()  # new jobs wait unsent, so they stay unfinished
+    limit = backend.jobs.max_unfinished
     try:
-        backend.max_unfinished_jobs = 3
+        backend.jobs.max_unfinished = 3
         ids = [request(url, 'POST', '/api/jobs', PAPER_TASK)[1]['id'] for _ in range(3)]
         status, error = request(url, 'POST', '/api/jobs', PAPER_TASK)
         assert status == 503
         assert error['error'] == 'BUSY'
     finally:
-        backend.max_unfinished_jobs = limit
+        backend.jobs.max_unfinished = limit
         for job_id in ids:
             request(url, 'POST', f'/api/jobs/{job_id}/cancel')
-        backend.job_gate.set()
+        backend.jobs.gate.set()
     assert all(wait_until_finished(url, job_id)['outcome']['error_name'] == 'PREEMPTED' for job_id in ids)
 
 
@@ -154,13 +154,13 @@ def post_raw(url, path, body: bytes, content_type):
 def test_posts_a_cross_site_form_could_send_are_refused(gui):
     """Forms (urlencoded, multipart, text/plain) need no CORS preflight: no POST may act on them."""
     backend, url = gui
-    jobs_before = len(backend._jobs)
+    jobs_before = len(backend.jobs._jobs)
     for content_type, body in [(None, b''), ('text/plain', b'{}'), ('application/x-www-form-urlencoded', b'a=1'),
                                ('multipart/form-data; boundary=x', b'--x--')]:
         for path in ('/api/jobs', '/api/jobs/any/simulations', '/api/jobs/any/cancel'):
             status, _, error = post_raw(url, path, body, content_type)
             assert (status, error['error'], error['item']) == (415, 'UNSUPPORTED_MEDIA_TYPE', 'content-type'), path
-    assert len(backend._jobs) == jobs_before
+    assert len(backend.jobs._jobs) == jobs_before
     assert post_raw(url, '/api/goal-check', json.dumps({'system': 'atlas', 'goals': ['look_down']}).encode(),
                     'application/json; charset=utf-8')[0] == 200
 
@@ -174,20 +174,20 @@ def test_simulations_are_bounded_at_once_and_per_job(gui):
     assert job['outcome']['error_name'] == 'SUCCESS'
     # The job already ran as many simulations as it keeps: the oldest ones make room.
     old = [Simulation(id=f"{job['id']}-old{i}", job_id=job['id'], state='finished')
-           for i in range(backend.max_simulations_per_job)]
-    backend._simulations.update({run.id: run for run in old})
+           for i in range(backend.simulations.max_per_job)]
+    backend.simulations._runs.update({run.id: run for run in old})
 
     with ThreadPoolExecutor(6) as pool:
         answers = list(pool.map(lambda _: post_raw(url, f"/api/jobs/{job['id']}/simulations", b'{}',
                                                    'application/json'), range(6)))
     started = [body for status, _, body in answers if status == 202]
     refused = [(headers, body) for status, headers, body in answers if status == 429]
-    assert len(started) == backend.max_running_simulations == 2
+    assert len(started) == backend.simulations.max_running == 2
     assert len(refused) == 4
     assert all(int(headers['retry-after']) > 0 and body['error'] == 'BUSY' and body['item'] == 'simulations'
                for headers, body in refused)
-    runs_of_job = [run.id for run in list(backend._simulations.values()) if run.job_id == job['id']]
-    assert len(runs_of_job) == backend.max_simulations_per_job
+    runs_of_job = [run.id for run in list(backend.simulations._runs.values()) if run.job_id == job['id']]
+    assert len(runs_of_job) == backend.simulations.max_per_job
     assert request(url, 'GET', f"/api/simulations/{old[0].id}")[0] == 404  # the oldest were forgotten
 
     deadline = time.monotonic() + 300
@@ -340,24 +340,24 @@ def test_the_nesting_scan_counts_brackets_outside_strings(body, deeper):
 def test_goal_checks_beyond_the_limit_are_busy_with_retry_after(gui, monkeypatch):
     backend, url = gui
     running, release = threading.Semaphore(0), threading.Event()
-    real_findings = backend_module.goal_findings
+    real_findings = request_form_module.goal_findings
 
     def slow_findings(*args):
         running.release()
         release.wait(30)
         return real_findings(*args)
 
-    monkeypatch.setattr(backend_module, 'goal_findings', slow_findings)
+    monkeypatch.setattr(request_form_module, 'goal_findings', slow_findings)
     check = {'system': 'atlas', 'initial_conditions': [], 'goals': ['look_down']}
-    with ThreadPoolExecutor(backend.max_goal_checks) as pool:
-        held = [pool.submit(request, url, 'POST', '/api/goal-check', check) for _ in range(backend.max_goal_checks)]
+    with ThreadPoolExecutor(backend.form.max_goal_checks) as pool:
+        held = [pool.submit(request, url, 'POST', '/api/goal-check', check) for _ in range(backend.form.max_goal_checks)]
         try:
             for _ in held:
                 assert running.acquire(timeout=30)
             status, headers, error = post_raw(url, '/api/goal-check', json.dumps(check).encode(), 'application/json')
         finally:
             release.set()
-        assert [future.result()[0] for future in held] == [200] * backend.max_goal_checks
+        assert [future.result()[0] for future in held] == [200] * backend.form.max_goal_checks
     assert (status, error['error'], error['code'], error['item']) == (429, 'BUSY', 'BUSY', 'goal-check')
     assert {name.lower(): value for name, value in headers.items()}['retry-after'] == '1'
     assert request(url, 'POST', '/api/goal-check', check)[0] == 200  # a slot is free again

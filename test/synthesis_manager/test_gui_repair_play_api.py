@@ -12,7 +12,8 @@ from fastapi.testclient import TestClient
 from respec.robot import SystemCatalog
 from respec.robot.system import ServedCatalog, catalog_to_json
 from synthesis_manager.gui import ros_backend
-from synthesis_manager.web import backend as backend_module
+from synthesis_manager.web import plays as plays_module
+from synthesis_manager.web import repairs as repairs_module
 from synthesis_manager.web.backend import SynthesisBackend
 from synthesis_manager.web.routes import create_app
 
@@ -265,11 +266,11 @@ def busy_while_the_slots_are_held(monkeypatch, owner, method: str, slots: int, s
 def test_repairs_beyond_the_limit_are_busy(monkeypatch):
     backend = SynthesisBackend(run_goal=None, max_repairs=1)
     with TestClient(create_app(backend)) as client:
-        held, busy = busy_while_the_slots_are_held(monkeypatch, backend_module.RepairSearch, 'run', 1,
+        held, busy = busy_while_the_slots_are_held(monkeypatch, repairs_module.RepairSearch, 'run', 1,
                                                    lambda: client.post('/api/repair', json=WRONG_ORDER))
         assert [answer.status_code for answer in held] == [200]
         assert (busy.status_code, busy.json()['error'], busy.json()['item']) == (429, 'BUSY', 'repairs')
-        assert busy.headers['retry-after'] == str(int(backend.repair_time_budget))
+        assert busy.headers['retry-after'] == str(int(backend.repairs.time_budget))
         monkeypatch.undo()
         assert client.post('/api/repair', json=WRONG_ORDER).status_code == 200   # the slot is free again
 
@@ -277,9 +278,9 @@ def test_repairs_beyond_the_limit_are_busy(monkeypatch):
 def test_plays_beyond_the_limit_are_busy(gui, monkeypatch):
     backend, client = gui
     _, job = run_job(client, WRONG_ORDER)
-    held, busy = busy_while_the_slots_are_held(monkeypatch, backend_module.Plays, 'turn', backend.max_goal_checks,
+    held, busy = busy_while_the_slots_are_held(monkeypatch, plays_module.Plays, 'turn', backend.plays.max_at_once,
                                                lambda: play(client, job['id'], []))
-    assert [answer.status_code for answer in held] == [200] * backend.max_goal_checks
+    assert [answer.status_code for answer in held] == [200] * backend.plays.max_at_once
     assert (busy.status_code, busy.json()['error'], busy.json()['item']) == (429, 'BUSY', 'plays')
     assert busy.headers['retry-after'] == '1'
 
@@ -332,7 +333,7 @@ def test_a_client_that_goes_away_stops_its_search(gui):
     xs, ys = [f'x{i}' for i in range(pairs)], [f'y{i}' for i in range(pairs)]
     bomb = {'env_props': xs, 'sys_props': ys,
             'sys_trans': [' | '.join(xs + ys + ['!x0']), ' & '.join(f"(next(y{i}) <-> x{i})" for i in range(pairs))]}
-    run = backend.start_repair({**WRONG_ORDER, 'custom_ltl': bomb})
+    run = backend.repairs.start({**WRONG_ORDER, 'custom_ltl': bomb})
     deadline = time.monotonic() + 10
     while run.search is None or run.search.child.process.poll() is not None:
         assert time.monotonic() < deadline, 'the search never started'

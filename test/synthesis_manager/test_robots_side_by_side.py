@@ -58,7 +58,7 @@ def test_two_robots_synthesize_and_run_at_once_with_one_synthesis_service(ros, t
         outcome = clients[namespace].run(make_goal('atlas', 'current', goals), timeout=120.0,
                                          feedback=lambda status, _: statuses.append(status))
         detected = next(filter(None, map(initial_conditions_in_status, statuses)), None)
-        run = execute_state_machine(outcome.states, robots[namespace], max_wall_time=120.0) \
+        run = execute_state_machine(outcome.machine, robots[namespace], max_wall_time=120.0) \
             if outcome.succeeded else None
         results[namespace] = outcome, detected, run
 

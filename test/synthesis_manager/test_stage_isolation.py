@@ -196,7 +196,7 @@ def test_a_large_automaton_is_generated_in_a_child_to_the_same_state_machine(ros
     assert len(message.automaton) > SMALL_AUTOMATON_STATES
     answer = generation_service(ros)(message)
     assert answer.error_code.value == 1, answer.error_code.message
-    assert list(answer.state_definition) == [state_to_msg(state) for state in generate_state_machine(automaton, 'atlas')]
+    assert list(answer.state_definition) == [state_to_msg(state) for state in generate_state_machine(automaton, 'atlas').to_instantiations()]
 
 
 def test_a_large_generation_stops_at_its_time_and_memory_limits(ros):

@@ -55,7 +55,7 @@ def synthesize(client, initial_conditions, goals):
 
 
 def execute(outcome, robot, goals):
-    run = execute_state_machine(outcome.states, robot, max_wall_time=120.0)
+    run = execute_state_machine(outcome.machine, robot, max_wall_time=120.0)
     report = check_trace(run.trace, spec_from_text_sections(outcome.ltl_specification), goals=goals)
     assert report.ok, report.summary()
     return run

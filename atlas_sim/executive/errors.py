@@ -1,15 +1,14 @@
-"""The state machine as the executive runs it: the shared tree, and the executive's errors (ROS-free).
+"""The executive's errors, and where a state's outcome leads (ROS-free).
 
-The tree is :class:`sm_generation.state_machine.StateMachine`; a list it refuses is refused here
-as :class:`MachineInvalidError`, an error of the run (with the trace so far, none yet).
+The executive runs the tree :class:`sm_generation.state_machine.StateMachine` as it is handed
+over; a StateInstantiation list becomes that tree where it arrives (a message, a file).
 """
 
 from __future__ import annotations
 
 from atlas_sim.executive.trace_check import Trace
 from respec.errors import CodedError, ErrorCode
-from sm_generation.errors import SMGenerationError
-from sm_generation.state_machine import State, StateMachine
+from sm_generation.state_machine import State
 
 
 class ExecutionError(CodedError):
@@ -22,24 +21,10 @@ class ExecutionError(CodedError):
         self.trace = trace
 
 
-class MachineInvalidError(ExecutionError):
-    """The StateInstantiation list is not a machine this executive can run."""
-
-    code = ErrorCode.INVALID_REQUEST
-
-
 class UndeclaredOutcomeError(ExecutionError):
     """A state returned an outcome that it does not declare (so it has no transition)."""
 
     code = ErrorCode.AUTOMATON_INVALID
-
-
-def load_machine(states) -> StateMachine:
-    """The tree of ``states`` (StateInstantiations or their dicts), validated."""
-    try:
-        return StateMachine.from_instantiations(states)
-    except SMGenerationError as error:
-        raise MachineInvalidError(str(error), item=error.item) from error
 
 
 def next_target(state: State, outcome: str, trace: Trace | None = None) -> str:

@@ -1,4 +1,6 @@
-"""From a synthesized automaton to an abstract FlexBE machine (before names and layout).
+"""From a synthesized automaton to the ``AbstractMachine``: the automaton-shaped intermediate of
+generation, FlexBE states and their observed transitions before names, paths and layout (the
+generator turns it into the ``StateMachine`` tree).
 
 Semantics (the activation–outcomes paradigm, paper Sec. IV–V):
 
@@ -15,7 +17,7 @@ Semantics (the activation–outcomes paradigm, paper Sec. IV–V):
   If it keeps the same activations (a "stay", including self-loops), the FlexBE state
   simply keeps running, so its observations are collected too (after the direct ones).
   A silent step that changes the activations cannot be triggered by FlexBE and is dropped
-  (listed in ``Machine.dropped``).
+  (listed in ``AbstractMachine.dropped``).
 * A state where an SM-outcome proposition (``finished``/``failed``) is true is an exit:
   transitions into it go to that outcome of the machine.
 * A state that activates nothing is *passed through*: transitions into it go to the first
@@ -48,7 +50,7 @@ NOTHING_TO_DO = 'nothing_to_do'
 
 
 @dataclass
-class MachineState:
+class AbstractState:
     """One state of the abstract machine; ``key`` is the automaton state it stands for."""
 
     key: str
@@ -58,10 +60,10 @@ class MachineState:
 
 
 @dataclass
-class Machine:
+class AbstractMachine:
     """States in breadth-first order from ``initial``; ``outcomes`` of the whole machine."""
 
-    states: dict[str, MachineState]
+    states: dict[str, AbstractState]
     initial: str
     outcomes: list[str]
     dropped: list[tuple[str, str]] = field(default_factory=list)  # silent steps FlexBE cannot take
@@ -308,9 +310,9 @@ def _normalized(state, name: str) -> _State:
                   tuple(dict.fromkeys(str(t) for t in state.transitions)))
 
 
-def build_machine(view: AutomatonView, start: list[Target]) -> Machine:
+def build_machine(view: AutomatonView, start: list[Target]) -> AbstractMachine:
     """The machine reachable from ``start`` targets (breadth-first, transition order)."""
-    states: dict[str, MachineState] = {}
+    states: dict[str, AbstractState] = {}
     queue = deque(key for kind, key in start if kind == 'state')
     while queue:
         key = queue.popleft()
@@ -318,7 +320,7 @@ def build_machine(view: AutomatonView, start: list[Target]) -> Machine:
             continue
         transitions = [(observation, view.resolve(successor))
                        for observation, successor in view.observed_transitions(key)]
-        states[key] = MachineState(key=key, parts=view.parts(key, transitions), transitions=transitions)
+        states[key] = AbstractState(key=key, parts=view.parts(key, transitions), transitions=transitions)
         queue.extend(target for kind, target in (t for _, t in transitions) if kind == 'state')
     first = next((key for kind, key in start if kind == 'state'), '')
-    return Machine(states=states, initial=first, outcomes=view.machine_outcomes(), dropped=view.dropped)
+    return AbstractMachine(states=states, initial=first, outcomes=view.machine_outcomes(), dropped=view.dropped)

@@ -131,8 +131,12 @@ def test_an_outcome_the_operator_forces_on_the_engine_is_the_operators_in_the_tr
     assert run.outcome == 'failed'
     step = run.trace.steps[0]
     assert (step.state, step.state_outcome, step.forced) == (first.state_path, 'failed', 'failed')
+    assert step.forced_propositions == [f'{first.name}_f']  # read as reported: the operator's failure
+    # Never blamed on the machine: whether the robot had changed mode when the operator said
+    # failed decides whether the task's assumptions hold; if not, the check says who broke them.
     report = check_trace(run.trace, spec, goals=PICKUP[1])
-    assert f'the operator forced failed on {first.name} at step 0' in report.summary()
+    assert all(v.kind == 'forced_outcome' and v.message.startswith(f'the operator forced failed on {first.name} at step 0')
+               for v in report.violations), report.summary()
 
 
 def run_cli(capsys, *arguments):

@@ -24,7 +24,7 @@ from respec.robot.abstraction import RobotAbstraction
 from respec.components import (SOURCE_ACTIONS, SOURCE_CONTROL_MODES, SOURCE_GOALS, SOURCE_INITIAL_CONDITIONS,
                                SOURCE_SM_OUTCOMES, FormulaGroup)
 from respec.ltl import to_infix
-from respec.naming import activation, memory, outcome_proposition
+from respec.naming import BEHAVIOR_CLASS, activation, memory, outcome_proposition
 from respec.parsing import ParseError, parse_formula
 
 from ltl_specification.pertinence import Pertinence
@@ -130,7 +130,7 @@ def _flexbe_state(flexbe_states: Mapping, proposition: str) -> tuple[str, dict[s
     if not isinstance(entry, Mapping) or not isinstance(entry.get('class_decl'), Mapping):
         return '', {}
     declaration = entry['class_decl']
-    state_class = declaration.get('behavior_class') if declaration.get('name') == ':BEHAVIOR' else declaration.get('name')
+    state_class = declaration.get('behavior_class') if declaration.get('name') == BEHAVIOR_CLASS else declaration.get('name')
     mapping = entry.get('output_mapping') if isinstance(entry.get('output_mapping'), Mapping) else {}
     returns = {str(name): ' or '.join(map(str, outcomes)) for name, outcomes in mapping.items()
                if isinstance(outcomes, (list, tuple)) and outcomes}

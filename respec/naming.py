@@ -17,6 +17,10 @@ COMPLETED = 'completed'
 FINISHED, FAILED = 'finished', 'failed'
 #: The state machine's outcomes when a request names none.
 DEFAULT_SM_OUTCOMES = (FINISHED, FAILED)
+#: FlexBE's StateInstantiation ``state_class`` markers of what is not a state class: the
+#: containers, an embedded behavior (its class is ``behavior_class``) and an outcome.
+STATEMACHINE_CLASS, CONCURRENCY_CLASS, PRIORITY_CLASS = ':STATEMACHINE', ':CONCURRENCY', ':PRIORITY'
+BEHAVIOR_CLASS, OUTCOME_CLASS = ':BEHAVIOR', ':OUTCOME'
 
 # The original takes comma-separated names; the FlexBE WebUI may also send a list-like text
 # ("['look_down', 'pickup_object']") or space-separated names. Accept all of them.

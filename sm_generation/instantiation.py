@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field, fields
 
+from respec.naming import BEHAVIOR_CLASS, CONCURRENCY_CLASS, OUTCOME_CLASS, PRIORITY_CLASS, STATEMACHINE_CLASS
 
 @dataclass
 class OutcomeCondition:
@@ -34,11 +35,11 @@ class StateInstantiation:
     ``/name`` a state in it, ``/container/name`` a state inside a container.
     """
 
-    CLASS_STATEMACHINE = ':STATEMACHINE'
-    CLASS_CONCURRENCY = ':CONCURRENCY'
-    CLASS_PRIORITY = ':PRIORITY'
-    CLASS_BEHAVIOR = ':BEHAVIOR'
-    CLASS_OUTCOME = ':OUTCOME'
+    CLASS_STATEMACHINE = STATEMACHINE_CLASS
+    CLASS_CONCURRENCY = CONCURRENCY_CLASS
+    CLASS_PRIORITY = PRIORITY_CLASS
+    CLASS_BEHAVIOR = BEHAVIOR_CLASS
+    CLASS_OUTCOME = OUTCOME_CLASS
 
     state_path: str = ''
     state_class: str = ''

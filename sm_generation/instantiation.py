@@ -11,6 +11,7 @@ from dataclasses import dataclass, field, fields
 
 from respec.naming import BEHAVIOR_CLASS, CONCURRENCY_CLASS, OUTCOME_CLASS, PRIORITY_CLASS, STATEMACHINE_CLASS
 
+
 @dataclass
 class OutcomeCondition:
     """A conjunction: holds when every ``state_name[i]`` has returned ``state_outcome[i]``."""

@@ -44,8 +44,9 @@ from dataclasses import dataclass, field, fields
 from pathlib import Path
 from typing import Mapping, Sequence
 
-from respec.robot import RobotSystem
+from respec.robot import RobotSystem, for_description
 from respec.robot.abstraction import RobotAbstraction
+from respec.robot.cnu import CapabilitySystem
 from respec.components import (
     SOURCE_CUSTOM, FormulaGroup, action_groups, action_specification, control_mode_groups,
     control_mode_specification, goal_groups, goal_specification, initial_conditions_groups,
@@ -116,15 +117,28 @@ def compile_task(system: RobotSystem | str, initial_conditions: Sequence[str] | 
     alone, at once (for callers that only need the verdict).
     """
     system = load_task_system(system, config_dir)
-    if system.is_capability_system:
-        library = workspace_state_library() if state_library is None else state_library
-        initial_conditions = _names(initial_conditions, 'initial conditions', InvalidInitialConditionsError)
-        goals = _names(goals, 'goals', InvalidGoalsError)
-        check_capability_names(system, initial_conditions)   # first: the sentence names the entry to change
-        spec = compile_capability_task(system.capabilities, library, initial_conditions, goals, custom_ltl,
-                                       _names(sm_outcomes, 'state-machine outcomes', InvalidSmOutcomesError))
-        check_capability_task(system, initial_conditions, goals)   # once the files' own errors are ruled out
-        return CompiledSpecification(**_spec_fields(spec))
+    # a file without an abstraction: section: the mode compiler names what is missing
+    compile_for = for_description(_COMPILERS, system, missing=_compiled_for_modes)
+    return compile_for(system, initial_conditions, goals, sm_outcomes, strict_order, custom_ltl, state_library,
+                       explain_refusal)
+
+
+def _compiled_for_capabilities(system: RobotSystem, initial_conditions, goals, sm_outcomes, strict_order,
+                               custom_ltl, state_library, explain_refusal) -> CompiledSpecification:
+    del strict_order, explain_refusal  # CNU's goals hold together; its refusals come from the pre-check
+    library = workspace_state_library() if state_library is None else state_library
+    initial_conditions = _names(initial_conditions, 'initial conditions', InvalidInitialConditionsError)
+    goals = _names(goals, 'goals', InvalidGoalsError)
+    check_capability_names(system, initial_conditions)   # first: the sentence names the entry to change
+    spec = compile_capability_task(system.capabilities, library, initial_conditions, goals, custom_ltl,
+                                   _names(sm_outcomes, 'state-machine outcomes', InvalidSmOutcomesError))
+    check_capability_task(system, initial_conditions, goals)   # once the files' own errors are ruled out
+    return CompiledSpecification(**_spec_fields(spec))
+
+
+def _compiled_for_modes(system: RobotSystem, initial_conditions, goals, sm_outcomes, strict_order,
+                        custom_ltl, state_library, explain_refusal) -> CompiledSpecification:
+    del state_library  # the abstraction's flexbe: section names its states
     abstraction = load_task_abstraction(system)
     sm_outcomes = _check_sm_outcomes(sm_outcomes)
     goals = _check_goals(abstraction, goals)
@@ -153,6 +167,9 @@ def compile_task(system: RobotSystem | str, initial_conditions: Sequence[str] | 
     if unreachable:
         raise _impossible_goals(compiled, *unreachable[0], explain=explain_refusal)
     return compiled
+
+
+_COMPILERS = {RobotAbstraction: _compiled_for_modes, CapabilitySystem: _compiled_for_capabilities}
 
 
 def _flexbe_states(system: RobotSystem) -> dict:

@@ -38,6 +38,9 @@ from dataclasses import asdict, dataclass, field
 from respec.components import SOURCE_CUSTOM, FormulaGroup
 from respec.ltl import Formula, evaluate, mentions_next, to_infix, variables
 from respec.naming import activation
+from respec.robot import RobotSystem, for_description
+from respec.robot.abstraction import RobotAbstraction
+from respec.robot.cnu import CapabilitySystem
 from respec.spec import FORMULA_SECTIONS, GR1Specification
 from ltl_synthesizer.errors import SynthesisCancelledError
 from ltl_synthesizer.explanation import without_play
@@ -134,9 +137,19 @@ def goal_findings(system, initial_conditions, goals, strict_order: bool = True,
     skipped (compilation reports them).
     """
     system = load_task_system(system, config_dir)
-    if system.is_capability_system:  # a goal no capability can make true, as the compiler refuses it
-        return [Finding(str(error), 'frame axiom', f'postconditions in {capability_file(system)}', error.item)
-                for error in unreachable_goals(system, initial_conditions, goals)]
+    findings_for = for_description(_GOAL_FINDINGS, system, missing=_mode_goal_findings)
+    return findings_for(system, initial_conditions, goals, strict_order)
+
+
+def _capability_goal_findings(system: RobotSystem, initial_conditions, goals, strict_order: bool) -> list[Finding]:
+    """A goal no capability can make true, as the compiler refuses it."""
+    del strict_order  # CNU's goals hold together at the end
+    return [Finding(str(error), 'frame axiom', f'postconditions in {capability_file(system)}', error.item)
+            for error in unreachable_goals(system, initial_conditions, goals)]
+
+
+def _mode_goal_findings(system: RobotSystem, initial_conditions, goals, strict_order: bool) -> list[Finding]:
+    """A goal mode no route from the initial mode reaches (as the compiler refuses it)."""
     abstraction = load_task_abstraction(system)
     modes = [i for i in initial_conditions if abstraction.kind_of(i) == 'control_mode']
     initial_mode = modes[0] if modes else abstraction.initial_mode
@@ -144,6 +157,9 @@ def goal_findings(system, initial_conditions, goals, strict_order: bool = True,
         return []
     known = [g for g in goals if abstraction.kind_of(g) is not None]
     return unreachable_goal_modes(abstraction, known, initial_mode, strict_order, system.config_file)
+
+
+_GOAL_FINDINGS = {RobotAbstraction: _mode_goal_findings, CapabilitySystem: _capability_goal_findings}
 
 
 def impossible_next_goals(system, initial_conditions, goals, strict_order: bool = True,

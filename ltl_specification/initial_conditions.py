@@ -57,7 +57,7 @@ def reads_robot_state(initial_conditions: Sequence[str], system, config_dir=None
     if CURRENT in initial_conditions:
         return True
     try:
-        return not robot_system(system, config_dir).is_capability_system
+        return robot_system(system, config_dir).reads_robot_state_by_default
     except CodedError:  # an unknown or broken system: compiling the task reports it
         return True
 

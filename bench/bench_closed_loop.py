@@ -10,6 +10,7 @@ Runs the closed-loop tasks directly on the simulator and through the simulator n
 from __future__ import annotations
 
 import time
+from respec.robot import robot_system
 
 # name, initial conditions, goals, SM outcomes, faults
 TASKS = [
@@ -31,9 +32,9 @@ def synthesized_machine(initial_conditions, goals, sm_outcomes):
     from respec.automaton import automaton_from_strategy
     from sm_generation import generate_state_machine
 
-    spec = compile_task('atlas', initial_conditions, goals, sm_outcomes=sm_outcomes)
+    spec = compile_task(robot_system('atlas'), initial_conditions, goals, sm_outcomes=sm_outcomes)
     automaton = automaton_from_strategy(synthesize(spec).strategy, spec)
-    return spec, generate_state_machine(automaton, 'atlas', initial_conditions=initial_conditions)
+    return spec, generate_state_machine(automaton, robot_system('atlas'), initial_conditions=initial_conditions)
 
 
 def run_direct(states, initial_conditions, faults):

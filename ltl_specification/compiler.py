@@ -41,7 +41,6 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass, field, fields
-from pathlib import Path
 from typing import Mapping, Sequence
 
 from respec.robot import RobotSystem, for_description
@@ -72,7 +71,7 @@ from ltl_specification.errors import (
 )
 from ltl_specification.pertinence import Pertinence, infer_pertinence, mode_distances
 from ltl_specification.provenance import Provenance, task_provenance
-from ltl_specification.systems import load_task_abstraction, load_task_system
+from ltl_specification.systems import load_task_abstraction
 
 SUPPORTED_SM_OUTCOMES = (DEFAULT_SM_OUTCOMES, (FINISHED,))
 
@@ -87,19 +86,19 @@ class CompiledSpecification(GR1Specification):
         return explain(self)
 
 
-def compile_task(system: RobotSystem | str, initial_conditions: Sequence[str] | str, goals: Sequence[str] | str,
+def compile_task(system: RobotSystem, initial_conditions: Sequence[str] | str, goals: Sequence[str] | str,
                  sm_outcomes: Sequence[str] = DEFAULT_SM_OUTCOMES, strict_order: bool = True,
                  custom_ltl: Mapping[str, Sequence[str]] | None = None,
-                 config_dir: str | Path | None = None,
                  state_library: Mapping[str, StateClass] | None = None,
                  explain_refusal: bool = True) -> CompiledSpecification:
     """Compile the GR(1) specification of reaching ``goals`` from ``initial_conditions``.
 
-    ``system`` is a RobotSystem, or the name of one in ``config_dir`` (default ``config/``).
-    A system described by CNU capability files (``respec.robot.cnu``) is compiled by
-    ``ltl_specification.capabilities``; its state classes are checked against
-    ``state_library`` (default: the FlexBE state packages on ``AMENT_PREFIX_PATH``); its mappings
-    name the ``sm_outcomes`` (CNU's request semantics), and ``strict_order`` does not apply;
+    ``system`` is a RobotSystem (a name becomes one at the edge: ``respec.robot.robot_system``
+    inside ``ltl_specification.systems.task_system_errors``). A system described by CNU
+    capability files (``respec.robot.cnu``) is compiled by ``ltl_specification.capabilities``;
+    its state classes are checked against ``state_library`` (default: the FlexBE state packages
+    on ``AMENT_PREFIX_PATH``); its mappings name the ``sm_outcomes`` (CNU's request semantics),
+    and ``strict_order`` does not apply;
     ``ltl_specification.capability_precheck`` refuses, before synthesis, an initial condition
     that names nothing of it, a goal no capability can make true and a precondition nothing
     establishes.
@@ -116,7 +115,6 @@ def compile_task(system: RobotSystem | str, initial_conditions: Sequence[str] | 
     up to its REFUSAL_DIAGNOSIS_SECONDS); ``explain_refusal=False`` refuses with the sentence
     alone, at once (for callers that only need the verdict).
     """
-    system = load_task_system(system, config_dir)
     # a file without an abstraction: section: the mode compiler names what is missing
     compile_for = for_description(_COMPILERS, system, missing=_compiled_for_modes)
     return compile_for(system, initial_conditions, goals, sm_outcomes, strict_order, custom_ltl, state_library,

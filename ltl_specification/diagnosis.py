@@ -49,7 +49,7 @@ from ltl_synthesizer.unrealizable_core import environment_play, unrealizable_cor
 from ltl_synthesizer.well_separation import check_well_separation
 
 from ltl_specification.capability_precheck import capability_file, unreachable_goals
-from ltl_specification.systems import load_task_abstraction, load_task_system
+from ltl_specification.systems import load_task_abstraction
 from ltl_specification.provenance import Provenance
 from ltl_specification.reachability import Finding, unreachable_goal_modes
 
@@ -129,14 +129,11 @@ def precheck(spec: GR1Specification, provenance: Provenance | None = None) -> li
     return findings
 
 
-def goal_findings(system, initial_conditions, goals, strict_order: bool = True,
-                  config_dir=None) -> list[Finding]:
+def goal_findings(system: RobotSystem, initial_conditions, goals, strict_order: bool = True) -> list[Finding]:
     """The goal part of the pre-check, without compiling (cheap enough to run as a form changes).
 
-    ``system`` is a RobotSystem or its name. Names that are not actions or modes of it are
-    skipped (compilation reports them).
+    Names that are not actions or modes of ``system`` are skipped (compilation reports them).
     """
-    system = load_task_system(system, config_dir)
     findings_for = for_description(_GOAL_FINDINGS, system, missing=_mode_goal_findings)
     return findings_for(system, initial_conditions, goals, strict_order)
 
@@ -162,12 +159,11 @@ def _mode_goal_findings(system: RobotSystem, initial_conditions, goals, strict_o
 _GOAL_FINDINGS = {RobotAbstraction: _mode_goal_findings, CapabilitySystem: _capability_goal_findings}
 
 
-def impossible_next_goals(system, initial_conditions, goals, strict_order: bool = True,
-                          config_dir=None, candidates=None) -> dict[str, str]:
+def impossible_next_goals(system: RobotSystem, initial_conditions, goals, strict_order: bool = True,
+                          candidates=None) -> dict[str, str]:
     """For every one of ``candidates`` that is not a goal yet (default: the abstraction's actions
     and modes; a capability robot's view gives what its capabilities make true): why it cannot
     be the next goal (if so)."""
-    system = load_task_system(system, config_dir)
     impossible = {}
     if candidates is None:
         candidates = load_task_abstraction(system).items()

@@ -38,10 +38,9 @@ import yaml
 
 from respec.errors import CodedError, ErrorCode
 from respec.naming import DEFAULT_SM_OUTCOMES, FAILED, activation, memory, parse_names
-from respec.robot import RobotSystem, for_description, robot_system
+from respec.robot import RobotSystem, for_description
 from respec.robot.abstraction import RobotAbstraction
 from respec.robot.cnu import CapabilitySystem
-from respec.robot.files import ConfigDirs
 from respec.robot.system import robot_system_from_files
 from ltl_synthesizer.errors import SynthesisCancelledError
 from ltl_synthesizer.interrupt import Limits
@@ -217,24 +216,22 @@ def attempt(system: RobotSystem, request: TaskRequest, custom_ltl: Mapping | Non
 
 # --- the search --------------------------------------------------------------------------------
 
-def propose_repairs(system: RobotSystem | str, request: TaskRequest, custom_ltl: Mapping | None = None,
-                    config_dir: ConfigDirs = None, time_budget: float = DEFAULT_TIME_BUDGET,
+def propose_repairs(system: RobotSystem, request: TaskRequest, custom_ltl: Mapping | None = None,
+                    time_budget: float = DEFAULT_TIME_BUDGET,
                     max_proposals: int = DEFAULT_MAX_PROPOSALS,
                     on_proposal: Callable[[Proposal], None] | None = None,
                     state_library: Mapping | None = None) -> Repairs:
     """Verified proposals that make ``request`` (with ``custom_ltl``) possible on ``system``.
 
-    ``system`` is a RobotSystem or its name (read once). Candidates are verified cheapest first
+    Candidates are verified cheapest first
     until ``max_proposals`` are found or four fifths of ``time_budget`` are spent (the problem's
     diagnosis gets the rest: the budget bounds the whole); ``on_proposal`` is
     called with each one as it is verified (to show progress). ``state_library`` is the
-    capability compiler's (default: the workspace's FlexBE states). Raises the system's own
-    SystemConfigError when its file cannot be read.
+    capability compiler's (default: the workspace's FlexBE states).
     """
     start = time.monotonic()
     # The search leaves the diagnosis of the problem its share: the budget bounds the whole.
     deadline = start + time_budget * (1 - DIAGNOSIS_SHARE)
-    system = robot_system(system, config_dir)
     request = replace(request, system=system.name)
     original = attempt(system, request, custom_ltl, deadline, state_library=state_library)
     repairs = Repairs(request, original.realizable, original.problem)

@@ -1,7 +1,8 @@
 """sm_generation: synthesized automata -> FlexBE state machines (ROS-free).
 
     >>> from sm_generation import generate_state_machine, load_automaton, validate_state_machine
-    >>> states = generate_state_machine(load_automaton('test/automata/look_down.yaml'), 'atlas')
+    >>> from respec.robot import robot_system
+    >>> states = generate_state_machine(load_automaton('test/automata/look_down.yaml'), robot_system('atlas'))
     >>> validate_state_machine(states)
     []
 

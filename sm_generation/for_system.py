@@ -9,30 +9,28 @@ with the FlexBE side of that mapping (``behavior_flexbe_config``).
 
 from __future__ import annotations
 
-from pathlib import Path
 
 from respec.robot import RobotSystem, for_description
 from respec.robot.abstraction import RobotAbstraction
 from respec.robot.cnu import CapabilitySystem
 from respec.robot.state_library import capability_outcomes, workspace_state_library
 from sm_generation.capabilities import capability_flexbe_config, generate_capability_machine
-from sm_generation.config import FlexBEConfig, flexbe_config, generation_system
+from sm_generation.config import FlexBEConfig, flexbe_config
 from sm_generation.generator import generate_from_config
 from sm_generation.instantiation import StateInstantiation
 
 
-def generate_state_machine(automaton, system: RobotSystem | str, config_dir: str | Path | None = None,
-                           initial_conditions: list[str] | None = None,
+def generate_state_machine(automaton, system: RobotSystem, initial_conditions: list[str] | None = None,
                            reduce: bool = False, state_library=None) -> list[StateInstantiation]:
     """The FlexBE state machine implementing ``automaton`` on ``system``.
 
-    ``system`` is a RobotSystem, or the name of one in ``config_dir`` (default ``config/``).
-    A system described by CNU capability files takes its state classes from ``state_library``
-    (default: the FlexBE state packages on ``AMENT_PREFIX_PATH``) and is reduced unless its
-    system file says ``reduce: false``. How the initial state is chosen and what ``reduce``
-    does: ``sm_generation.generator.generate_from_config``. Raises ``SMGenerationError``.
+    A name becomes ``system`` at the edge (``respec.robot.robot_system`` inside
+    ``sm_generation.config.generation_system_errors``). A system described by CNU capability
+    files takes its state classes from ``state_library`` (default: the FlexBE state packages on
+    ``AMENT_PREFIX_PATH``) and is reduced unless its system file says ``reduce: false``. How the
+    initial state is chosen and what ``reduce`` does:
+    ``sm_generation.generator.generate_from_config``. Raises ``SMGenerationError``.
     """
-    system = generation_system(system, config_dir)
     generate = for_description(_GENERATORS, system, missing=_generated_from_flexbe_section)
     return generate(automaton, system, initial_conditions, reduce, state_library)
 

@@ -58,8 +58,8 @@ from atlas_sim.executive.runtime_control import RuntimeControl
 from atlas_sim.executive.trace_check import OutcomeTracker, Trace, TraceStep
 from respec.errors import ErrorCode
 from respec.naming import activated, is_activation, outcome_proposition
-from respec.robot import RobotSystem
-from sm_generation.config import INPUT_STATE_CLASS, flexbe_config, generation_system
+from respec.robot import RobotSystem, robot_system
+from sm_generation.config import INPUT_STATE_CLASS, flexbe_config, generation_system_errors
 from sm_generation.instantiation import DECISION_CLASS, HELPER_STATE_CLASSES, StateInstantiation
 from sm_generation.state_machine import State
 
@@ -421,7 +421,9 @@ def execute_state_machine(states, robot: Robot, system: RobotSystem | str = 'atl
     ``control`` (a :class:`RuntimeControl`: the operator in the loop).
     Raises :class:`ExecutionError` subclasses (with ``item`` and the partial ``trace``).
     """
-    return Executive(states, robot, StateMapping(generation_system(system)), **options).run()
+    with generation_system_errors():
+        system = robot_system(system)
+    return Executive(states, robot, StateMapping(system), **options).run()
 
 
 __all__ = ['execute_state_machine', 'Executive', 'ExecutionResult', 'StateMapping', 'UnmappedStateError',

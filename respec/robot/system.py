@@ -31,8 +31,8 @@ from respec.robot.abstraction import RobotAbstraction, abstraction_from_document
 from respec.robot.cnu import CapabilitySystem, is_capability_document, load_capability_system
 from respec.robot.description import RobotDescription
 from respec.robot.files import (ConfigDirs, ConfigFileInvalidError, SystemConfigError, SystemNotFoundError,
-                                available_systems, config_search_path, parse_config_text, read_config_file,
-                                system_config_path)
+                                available_systems, check_system_name, config_search_path, parse_config_text,
+                                read_config_file, system_file)
 
 ABSTRACTION_KIND = 'abstraction'
 Entry = TypeVar('Entry')
@@ -221,7 +221,9 @@ def robot_system(system: RobotSystem | str, config_dir: ConfigDirs = None) -> Ro
     """
     if isinstance(system, RobotSystem):
         return system
-    return robot_system_from_file(system_config_path(system, config_dir), system, config_search_path(config_dir))
+    check_system_name(system)   # before the search path: an invalid name is named first
+    search_path = config_search_path(config_dir)
+    return robot_system_from_file(system_file(system, search_path), system, search_path)
 
 
 @dataclass(frozen=True)

@@ -33,8 +33,8 @@ from atlas_sim.executive.engine_trace import EngineTraceRecorder
 from atlas_sim.executive.executor import ExecutionLimitError
 from atlas_sim.simulator.node_names import CAPABILITY_ACTION_PREFIX
 from atlas_sim.simulator.operator_data import answers_by_request_type, flexbe_input_data
-from respec.robot import RobotSystem
-from sm_generation.config import flexbe_config, generation_system, input_request_capabilities
+from respec.robot import RobotSystem, robot_system
+from sm_generation.config import flexbe_config, generation_system_errors, input_request_capabilities
 from sm_generation.flexbe_behavior import behavior_package
 from sm_generation.instantiation import StateInstantiation
 
@@ -175,7 +175,8 @@ def run_on_flexbe(states, simulator, simulator_lock, domain_id: int, system: Rob
     from synthesis_manager.ros.harness import RosHarness
 
     states = [s if isinstance(s, StateInstantiation) else StateInstantiation.from_dict(s) for s in states]
-    system = generation_system(system)
+    with generation_system_errors():
+        system = robot_system(system)
     config = flexbe_config(system)
     package = behavior_package(states, config, behavior_name, date=time.strftime('%a %b %d %Y'))
     recorder = EngineTraceRecorder(states, simulator, system, simulator_lock)

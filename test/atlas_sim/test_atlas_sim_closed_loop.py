@@ -17,16 +17,17 @@ from ltl_specification import compile_task
 from ltl_synthesizer import synthesize
 from respec.automaton import automaton_from_strategy
 from sm_generation import generate_state_machine, validate_state_machine
+from respec.robot import robot_system
 
 STAND_HEIGHT_RANGE = (0.6, 1.1)  # pelvis height (m): crouched stand_prep is ~0.67, standing ~0.85
 
 
 def synthesize_machine(initial_conditions, goals, sm_outcomes=('finished', 'failed')):
-    spec = compile_task('atlas', initial_conditions, goals, sm_outcomes=sm_outcomes)
+    spec = compile_task(robot_system('atlas'), initial_conditions, goals, sm_outcomes=sm_outcomes)
     result = synthesize(spec)
     assert result.realizable, result.explanation
     automaton = automaton_from_strategy(result.strategy, spec)
-    states = generate_state_machine(automaton, 'atlas', initial_conditions=initial_conditions)
+    states = generate_state_machine(automaton, robot_system('atlas'), initial_conditions=initial_conditions)
     assert validate_state_machine(states) == []
     return spec, states
 

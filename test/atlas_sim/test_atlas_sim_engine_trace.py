@@ -20,9 +20,9 @@ INITIAL, GOALS = ['stand_prep'], ['walk']
 
 
 def machine():
-    spec = compile_task('atlas', INITIAL, GOALS)
+    spec = compile_task(robot_system('atlas'), INITIAL, GOALS)
     automaton = automaton_from_strategy(synthesize(spec).strategy, spec)
-    return spec, generate_state_machine(automaton, 'atlas', initial_conditions=INITIAL)
+    return spec, generate_state_machine(automaton, robot_system('atlas'), initial_conditions=INITIAL)
 
 
 def drive(states, simulator, recorder):

@@ -84,7 +84,7 @@ class ScriptedRobot:
 
 @pytest.fixture(scope='module')
 def pickup_spec():
-    return compile_task('atlas', ['stand_prep'], ['look_down', 'pickup_object'])
+    return compile_task(robot_system('atlas'), ['stand_prep'], ['look_down', 'pickup_object'])
 
 
 # --- FlexBE semantics on the simulator ---------------------------------------------------------------

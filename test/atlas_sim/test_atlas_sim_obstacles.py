@@ -37,9 +37,9 @@ def with_scene(simulator, **scene):
 
 @pytest.fixture(scope='module')
 def twelve_goal_task():
-    spec = compile_task('atlas', ['stand_prep'], TWELVE_GOALS)
+    spec = compile_task(robot_system('atlas'), ['stand_prep'], TWELVE_GOALS)
     automaton = automaton_from_strategy(synthesize(spec).strategy, spec)
-    return spec, generate_state_machine(automaton, 'atlas', initial_conditions=['stand_prep'])
+    return spec, generate_state_machine(automaton, robot_system('atlas'), initial_conditions=['stand_prep'])
 
 
 def run_twelve_goals(task, simulator):
@@ -105,7 +105,7 @@ def test_walking_blind_into_the_table_is_an_incident_naming_the_part_and_the_tab
 
 @pytest.fixture(scope='module')
 def walk_spec():
-    return compile_task('atlas', ['stand_prep'], ['walk'], sm_outcomes=['finished', 'failed'])
+    return compile_task(robot_system('atlas'), ['stand_prep'], ['walk'], sm_outcomes=['finished', 'failed'])
 
 
 def walk_trace(incidents=()):

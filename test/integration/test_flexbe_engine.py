@@ -28,9 +28,9 @@ FOOTSTEPS = (['manipulate'], ['footstep_execution'])
 
 
 def synthesized(initial_conditions, goals, sm_outcomes=('finished', 'failed')):
-    spec = compile_task('atlas', initial_conditions, goals, sm_outcomes=sm_outcomes)
+    spec = compile_task(robot_system('atlas'), initial_conditions, goals, sm_outcomes=sm_outcomes)
     automaton = automaton_from_strategy(synthesize(spec).strategy, spec)
-    return spec, generate_state_machine(automaton, 'atlas', initial_conditions=initial_conditions)
+    return spec, generate_state_machine(automaton, robot_system('atlas'), initial_conditions=initial_conditions)
 
 
 def test_exported_behavior_loads_in_flexbe_core_and_create_builds_the_machine(ros, tmp_path):
@@ -151,9 +151,9 @@ def test_mobile_manipulator_tasks_on_the_flexbe_engine(ros, goals):
     """The other configured system: its states, the Dock At Charger behavior, userdata through the root."""
     from synthesis_manager.ros.flexbe_engine import run_on_flexbe
 
-    spec = compile_task('mobile_manipulator', ['parked'], goals)
+    spec = compile_task(robot_system('mobile_manipulator'), ['parked'], goals)
     automaton = automaton_from_strategy(synthesize(spec).strategy, spec)
-    states = generate_state_machine(automaton, 'mobile_manipulator', initial_conditions=['parked'])
+    states = generate_state_machine(automaton, robot_system('mobile_manipulator'), initial_conditions=['parked'])
     simulator = make_simulator('mobile_manipulator', initial_conditions=['parked'])
     node = ros.add_node(AtlasSimNode, simulator=simulator, parameter_overrides=[
         Parameter('speed', value=20.0), Parameter('state_rate', value=50.0)])

@@ -63,7 +63,7 @@ def reading_of(parsed):
 
 @pytest.mark.parametrize('automaton', ['concurrent.yaml', 'two_behaviors.yaml'])
 def test_the_editor_parser_reads_an_exported_behavior_as_generated(parser, automaton):
-    states = generate_state_machine(load_automaton(AUTOMATA / automaton), 'atlas')
+    states = generate_state_machine(load_automaton(AUTOMATA / automaton), robot_system('atlas'))
     package = behavior_package(states, flexbe_config(robot_system('atlas')), 'Parsed Behavior')
     answer = parser(package.files[f'{package.package}/{package.module}.py'])
     assert answer['warnings'] == []
@@ -106,9 +106,9 @@ def test_the_editor_parser_reads_an_exported_behavior_as_generated(parser, autom
 
 
 def test_the_editor_parser_reads_the_paper_task_and_atlas_sim_behaviors(parser):
-    spec = compile_task('atlas', ['stand_prep'], ['look_down', 'pickup_object'])
+    spec = compile_task(robot_system('atlas'), ['stand_prep'], ['look_down', 'pickup_object'])
     automaton = automaton_from_strategy(synthesize(spec).strategy, spec)
-    states = generate_state_machine(automaton, 'atlas', initial_conditions=['stand_prep'])
+    states = generate_state_machine(automaton, robot_system('atlas'), initial_conditions=['stand_prep'])
     package = behavior_package(states, flexbe_config(robot_system('atlas')), 'Look Down Pickup Object')
     answer = parser(package.files[f'{package.package}/{package.module}.py'])
     assert answer['warnings'] == []

@@ -1,6 +1,7 @@
 """The robot interface (respec.robot.description): both formats answer what the surfaces ask,
 each layer keeps what it does per format in a registry, and the format is told apart in one place."""
 
+import ast
 import re
 from pathlib import Path
 
@@ -86,3 +87,25 @@ def kind_checks_outside_the_implementations() -> list[str]:
 def test_the_surfaces_ask_the_interface_not_the_kind():
     found = kind_checks_outside_the_implementations()
     assert len(found) <= 2, '\n'.join(found)
+
+
+# --- names resolved at the edges ---------------------------------------------------------------------
+
+def functions_taking_a_system_and_a_config_dir() -> list[str]:
+    """Every function whose parameters name a system (or its name) and a config_dir."""
+    found = []
+    for package in PACKAGES:
+        for path in sorted((ROOT / package).rglob('*.py')):
+            for node in ast.walk(ast.parse(path.read_text(encoding='utf-8'))):
+                if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
+                    arguments = node.args
+                    names = [a.arg for a in [*arguments.posonlyargs, *arguments.args, *arguments.kwonlyargs]]
+                    if any(n in ('config_dir', 'config_dirs') for n in names) and any(n in ('system', 'name')
+                                                                                      for n in names):
+                        found.append(f'{path.relative_to(ROOT).as_posix()}:{node.lineno} {node.name}')
+    return found
+
+
+def test_a_name_becomes_a_robot_system_at_the_edge_alone():
+    found = functions_taking_a_system_and_a_config_dir()   # today: respec.robot.system.robot_system alone
+    assert 'robot_system' in [entry.split(' ')[1] for entry in found] and len(found) <= 3, found

@@ -39,8 +39,9 @@ an ``AtlasSimulator`` directly; ``synthesis_manager.nodes.atlas_sim_robot.RosRob
 simulator node. The machine is the tree of :mod:`sm_generation.state_machine`, loaded by
 :mod:`atlas_sim.executive.machine`.
 
-    sim = make_simulator('atlas', initial_conditions=['stand_prep'])
-    run = execute_state_machine(states, SimulatedRobot(sim), system='atlas')
+    atlas = robot_system('atlas')
+    sim = make_simulator(atlas, initial_conditions=['stand_prep'])
+    run = execute_state_machine(states, SimulatedRobot(sim), atlas)
     run.outcome, run.trace                  # 'finished', Trace (see atlas_sim.executive.trace_check)
 """
 
@@ -58,8 +59,8 @@ from atlas_sim.executive.runtime_control import RuntimeControl
 from atlas_sim.executive.trace_check import OutcomeTracker, Trace, TraceStep
 from respec.errors import ErrorCode
 from respec.naming import activated, is_activation, outcome_proposition
-from respec.robot import RobotSystem, robot_system
-from sm_generation.config import INPUT_STATE_CLASS, flexbe_config, generation_system_errors
+from respec.robot import RobotSystem
+from sm_generation.config import INPUT_STATE_CLASS, flexbe_config
 from sm_generation.instantiation import DECISION_CLASS, HELPER_STATE_CLASSES, StateInstantiation
 from sm_generation.state_machine import State
 
@@ -409,11 +410,10 @@ def input_prompt(node: State) -> str:
     return node.name
 
 
-def execute_state_machine(states, robot: Robot, system: RobotSystem | str = 'atlas', **options) -> ExecutionResult:
+def execute_state_machine(states, robot: Robot, system: RobotSystem, **options) -> ExecutionResult:
     """Run ``states`` on ``robot`` until an SM outcome; returns the outcome and the trace.
 
-    ``system`` is a RobotSystem, or the name of one in config/ (another folder's system:
-    ``respec.robot.robot_system(name, config_dir)``).
+    ``system`` is the RobotSystem ``states`` were generated for (its FlexBE mapping).
 
     ``options``: ``max_robot_time`` (s, default 600), ``max_states`` (default 500),
     ``max_wall_time`` (s, default none),
@@ -421,8 +421,6 @@ def execute_state_machine(states, robot: Robot, system: RobotSystem | str = 'atl
     ``control`` (a :class:`RuntimeControl`: the operator in the loop).
     Raises :class:`ExecutionError` subclasses (with ``item`` and the partial ``trace``).
     """
-    with generation_system_errors():
-        system = robot_system(system)
     return Executive(states, robot, StateMapping(system), **options).run()
 
 

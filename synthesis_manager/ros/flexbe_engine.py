@@ -33,8 +33,8 @@ from atlas_sim.executive.engine_trace import EngineTraceRecorder
 from atlas_sim.executive.executor import ExecutionLimitError
 from atlas_sim.simulator.node_names import CAPABILITY_ACTION_PREFIX
 from atlas_sim.simulator.operator_data import answers_by_request_type, flexbe_input_data
-from respec.robot import RobotSystem, robot_system
-from sm_generation.config import flexbe_config, generation_system_errors, input_request_capabilities
+from respec.robot import RobotSystem
+from sm_generation.config import flexbe_config, input_request_capabilities
 from sm_generation.flexbe_behavior import behavior_package
 from sm_generation.instantiation import StateInstantiation
 
@@ -158,12 +158,12 @@ def _wait_for_proxy_tasks(executor, timeout: float = 2.0) -> None:
         time.sleep(0.01)
 
 
-def run_on_flexbe(states, simulator, simulator_lock, domain_id: int, system: RobotSystem | str = 'atlas',
+def run_on_flexbe(states, simulator, simulator_lock, domain_id: int, system: RobotSystem,
                   behavior_name: str = 'Synthesized Behavior', autonomy: int = FULL_AUTONOMY,
                   max_wall_time: float = 600.0, verbose: bool = False):
     """Run ``states`` (StateInstantiation objects or dicts) on FlexBE; returns an ExecutionResult.
 
-    ``system`` is a RobotSystem, or the name of one in config/. The simulator node must be
+    ``system`` is the RobotSystem ``states`` were generated for. The simulator node must be
     running on ``domain_id`` around ``simulator``. Raises
     ExecutionLimitError (with the partial trace) if no outcome came within ``max_wall_time``.
     flexbe_core's INFO log lines and progress notes (about a hundred per run) are shown on
@@ -175,8 +175,6 @@ def run_on_flexbe(states, simulator, simulator_lock, domain_id: int, system: Rob
     from synthesis_manager.ros.harness import RosHarness
 
     states = [s if isinstance(s, StateInstantiation) else StateInstantiation.from_dict(s) for s in states]
-    with generation_system_errors():
-        system = robot_system(system)
     config = flexbe_config(system)
     package = behavior_package(states, config, behavior_name, date=time.strftime('%a %b %d %Y'))
     recorder = EngineTraceRecorder(states, simulator, system, simulator_lock)

@@ -35,9 +35,9 @@ def synthesize_machine(initial_conditions, goals, sm_outcomes=('finished', 'fail
 def run_task(initial_conditions, goals, sm_outcomes=('finished', 'failed'), **fault_lists):
     """Synthesize, execute on a fresh simulator, check the trace and the robot's health."""
     spec, states = synthesize_machine(initial_conditions, goals, sm_outcomes)
-    simulator = make_simulator('atlas', initial_conditions=initial_conditions,
+    simulator = make_simulator(robot_system('atlas'), initial_conditions=initial_conditions,
                                faults=parse_faults(**fault_lists))
-    run = execute_state_machine(states, SimulatedRobot(simulator))
+    run = execute_state_machine(states, SimulatedRobot(simulator), robot_system('atlas'))
     report = check_trace(run.trace, spec, goals=goals)
     assert report.ok, report.summary()
     assert not run.fallen and not simulator.has_fallen()

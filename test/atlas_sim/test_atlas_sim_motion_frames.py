@@ -25,7 +25,7 @@ def filmed_pickup(tmp_path_factory):
     spec = compile_task(robot_system('atlas'), ['stand_prep'], goals)
     automaton = automaton_from_strategy(synthesize(spec).strategy, spec)
     states = generate_state_machine(automaton, robot_system('atlas'), initial_conditions=['stand_prep'])
-    simulator = make_simulator('atlas', initial_conditions=['stand_prep'])
+    simulator = make_simulator(robot_system('atlas'), initial_conditions=['stand_prep'])
     progress = []
     run = run_and_check(states, SimulatedRobot(simulator), simulator, robot_system('atlas'), spec, goals,
                         record_dir=tmp_path_factory.mktemp('run'),

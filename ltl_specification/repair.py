@@ -223,10 +223,9 @@ def propose_repairs(system: RobotSystem, request: TaskRequest, custom_ltl: Mappi
                     state_library: Mapping | None = None) -> Repairs:
     """Verified proposals that make ``request`` (with ``custom_ltl``) possible on ``system``.
 
-    Candidates are verified cheapest first
-    until ``max_proposals`` are found or four fifths of ``time_budget`` are spent (the problem's
-    diagnosis gets the rest: the budget bounds the whole); ``on_proposal`` is
-    called with each one as it is verified (to show progress). ``state_library`` is the
+    Candidates are verified cheapest first until ``max_proposals`` are found or four fifths of
+    ``time_budget`` are spent (the problem's diagnosis gets the rest: the budget bounds the
+    whole); ``on_proposal`` is called with each one as it is verified (to show progress). ``state_library`` is the
     capability compiler's (default: the workspace's FlexBE states).
     """
     start = time.monotonic()

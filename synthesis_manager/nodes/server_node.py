@@ -29,8 +29,8 @@ from rclpy.time import Time
 from ltl_specification.errors import InvalidInitialConditionsError
 from ltl_synthesizer.interrupt import released_memory
 from ltl_specification.repair import REPAIRABLE
-from ltl_specification.initial_conditions import (detected_status, initial_conditions_from_robot_state,
-                                                  reads_robot_state)
+from ltl_specification.initial_conditions import (asks_for_robot_state, detected_status,
+                                                  initial_conditions_from_robot_state, reads_robot_state)
 from respec.errors import INTERNAL_ERROR, CodedError, ErrorCode
 from respec.robot import RobotSystem, robot_system
 from sm_generation.instantiation import count_states
@@ -495,7 +495,8 @@ class BehaviorSynthesisServer(Node):
     async def with_initial_conditions(self, goal_handle, task: SynthesisTask, outcome: PipelineOutcome,
                                       feedback, deadline: GoalDeadline) -> SynthesisTask:
         """``task``, with the robot's initial conditions when it names none or ``current``."""
-        if not reads_robot_state(task.initial_conditions, self.readable_system(task.system)):
+        asks = asks_for_robot_state(task.initial_conditions)   # read the system file only then
+        if not reads_robot_state(task.initial_conditions, self.readable_system(task.system) if asks else None):
             return task
         topic = self.robot_state.topic
         timeout = deadline.stage_limit(self.parameter('robot_state_timeout'), 'reading the robot state')

@@ -39,6 +39,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path[:0] = [str(ROOT), str(ROOT / 'bench')]
 
 import capability_robots  # noqa: E402
+from respec.robot import robot_system
 
 RESULTS = ROOT / 'bench' / 'results' / 'capability_scale.md'
 SIZES = [10, 20, 40, 80, 160]
@@ -82,8 +83,8 @@ def pipeline_child(config_dir: str, shape: str, size: int, slugsin: str) -> None
     robot = capability_robots.SHAPES[shape](size)
     stages = {}
     start = time.perf_counter()
-    spec = compile_task(robot.name, robot.initial_conditions, robot.goals,
-                        sm_outcomes=capability_robots.REQUEST_OUTCOMES, config_dir=config_dir,
+    spec = compile_task(robot_system(robot.name, config_dir), robot.initial_conditions, robot.goals,
+                        sm_outcomes=capability_robots.REQUEST_OUTCOMES,
                         state_library=capability_robots.STATE_LIBRARY)
     text = spec.to_slugsin()
     stages['compile'] = time.perf_counter() - start
@@ -99,7 +100,7 @@ def pipeline_child(config_dir: str, shape: str, size: int, slugsin: str) -> None
         stages['well_separation'] = time.perf_counter() - mark
         mark = time.perf_counter()
         automaton = automaton_from_strategy(result.strategy, spec)
-        states = generate_state_machine(automaton, robot.name, config_dir,
+        states = generate_state_machine(automaton, robot_system(robot.name, config_dir),
                                         state_library=capability_robots.STATE_LIBRARY)
         stages['generate'] = time.perf_counter() - mark
         report['machine_states'] = len(states.to_instantiations())
@@ -165,10 +166,11 @@ import sys
 sys.path[:0] = ['.', 'bench']
 import capability_robots
 from ltl_specification import compile_task
+from respec.robot import robot_system
 directory, shape, size, out = sys.argv[1], sys.argv[2], int(sys.argv[3]), sys.argv[4]
 robot = capability_robots.SHAPES[shape](size)
-spec = compile_task(robot.name, robot.initial_conditions, robot.goals, sm_outcomes=capability_robots.REQUEST_OUTCOMES,
-                    config_dir=directory, state_library=capability_robots.STATE_LIBRARY)
+spec = compile_task(robot_system(robot.name, directory), robot.initial_conditions, robot.goals,
+                    sm_outcomes=capability_robots.REQUEST_OUTCOMES, state_library=capability_robots.STATE_LIBRARY)
 open(out, 'w').write(spec.to_slugsin())
 '''
 

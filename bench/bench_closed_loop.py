@@ -10,6 +10,9 @@ Runs the closed-loop tasks directly on the simulator and through the simulator n
 from __future__ import annotations
 
 import time
+from respec.robot import robot_system
+
+ATLAS = robot_system('atlas')
 
 # name, initial conditions, goals, SM outcomes, faults
 TASKS = [
@@ -31,9 +34,9 @@ def synthesized_machine(initial_conditions, goals, sm_outcomes):
     from respec.automaton import automaton_from_strategy
     from sm_generation import generate_state_machine
 
-    spec = compile_task('atlas', initial_conditions, goals, sm_outcomes=sm_outcomes)
+    spec = compile_task(ATLAS, initial_conditions, goals, sm_outcomes=sm_outcomes)
     automaton = automaton_from_strategy(synthesize(spec).strategy, spec)
-    return spec, generate_state_machine(automaton, 'atlas', initial_conditions=initial_conditions)
+    return spec, generate_state_machine(automaton, ATLAS, initial_conditions=initial_conditions)
 
 
 def run_direct(states, initial_conditions, faults):
@@ -41,9 +44,9 @@ def run_direct(states, initial_conditions, faults):
     from atlas_sim.simulated_robot import SimulatedRobot
     from atlas_sim.simulator.factory import make_simulator, parse_faults
 
-    simulator = make_simulator('atlas', initial_conditions=initial_conditions, faults=parse_faults(**faults))
+    simulator = make_simulator(ATLAS, initial_conditions=initial_conditions, faults=parse_faults(**faults))
     started = time.perf_counter()
-    run = execute_state_machine(states, SimulatedRobot(simulator))
+    run = execute_state_machine(states, SimulatedRobot(simulator), ATLAS)
     return run, run.robot_time, time.perf_counter() - started
 
 
@@ -58,14 +61,14 @@ def run_over_ros(states, initial_conditions, faults, speed):
     from synthesis_manager.ros.harness import RosHarness
 
     with RosHarness() as ros:
-        simulator = make_simulator('atlas', initial_conditions=initial_conditions,
+        simulator = make_simulator(ATLAS, initial_conditions=initial_conditions,
                                    faults=parse_faults(**faults))
         ros.add_node(AtlasSimNode, simulator=simulator, parameter_overrides=[
             Parameter('speed', value=speed), Parameter('state_rate', value=50.0)])
         robot = RosRobot(ros.add_node(Node, 'bench_robot'))
         robot.wait_until_ready()
         started = time.perf_counter()
-        run = execute_state_machine(states, robot, max_wall_time=120)
+        run = execute_state_machine(states, robot, ATLAS, max_wall_time=120)
         return run, run.duration, time.perf_counter() - started
 
 
@@ -79,12 +82,12 @@ def run_on_flexbe_engine(states, initial_conditions, faults, speed):
     from synthesis_manager.ros.harness import RosHarness
 
     with RosHarness() as ros:
-        simulator = make_simulator('atlas', initial_conditions=initial_conditions,
+        simulator = make_simulator(ATLAS, initial_conditions=initial_conditions,
                                    faults=parse_faults(**faults))
         node = ros.add_node(AtlasSimNode, simulator=simulator, parameter_overrides=[
             Parameter('speed', value=speed), Parameter('state_rate', value=50.0)])
         started = time.perf_counter()
-        run = run_on_flexbe(states, simulator, node.lock, ros.domain_id, max_wall_time=300)
+        run = run_on_flexbe(states, simulator, node.lock, ros.domain_id, ATLAS, max_wall_time=300)
         return run, run.duration, time.perf_counter() - started
 
 

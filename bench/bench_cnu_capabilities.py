@@ -28,6 +28,7 @@ from ltl_synthesizer import synthesize  # noqa: E402
 from respec.automaton import automaton_from_strategy  # noqa: E402
 from respec.robot.state_library import workspace_state_library  # noqa: E402
 from sm_generation import generate_state_machine  # noqa: E402
+from respec.robot import robot_system
 
 # name: (capabilities, spec, mappings, initial conditions, goals, CNU's expected post-reduction count)
 CNU_EXAMPLES = {
@@ -57,17 +58,17 @@ def top_level(machine) -> int:
     return len(machine.states)
 
 
-def measure(system, initial_conditions, goals, config_dir=None, library=None, repeat=3):
-    spec = compile_task(system, initial_conditions, goals, config_dir=config_dir, state_library=library)
+def measure(system, initial_conditions, goals, library=None, repeat=3):
+    spec = compile_task(system, initial_conditions, goals, state_library=library)
     best, result = float('inf'), None
     for _ in range(repeat):
         start = time.perf_counter()
         result = synthesize(spec)
         best = min(best, time.perf_counter() - start)
     automaton = automaton_from_strategy(result.strategy, spec)
-    plain = generate_state_machine(automaton, system, config_dir, initial_conditions=initial_conditions,
+    plain = generate_state_machine(automaton, system, initial_conditions=initial_conditions,
                                    state_library=library)
-    reduced = generate_state_machine(automaton, system, config_dir, initial_conditions=initial_conditions,
+    reduced = generate_state_machine(automaton, system, initial_conditions=initial_conditions,
                                      reduce=True, state_library=library)
     return (len(spec.env_props), len(spec.sys_props), best, len(result.strategy['nodes']), top_level(plain),
             top_level(reduced))
@@ -107,11 +108,12 @@ def main() -> None:
     with tempfile.TemporaryDirectory() as directory:
         write_cnu_systems(Path(directory), sources / 'flexbe_synthesis')
         for name, (*_files, initial_conditions, goals, cnu_count) in CNU_EXAMPLES.items():
-            env, sys_, seconds, nodes, plain, reduced = measure(name, initial_conditions, goals, directory, library)
+            env, sys_, seconds, nodes, plain, reduced = measure(robot_system(name, directory), initial_conditions,
+                                                                goals, library)
             rows.append(f'| CNU {name}: {",".join(initial_conditions) or "-"} -> {",".join(goals)} | {env} / {sys_} | '
                         f'{seconds * 1000:.1f} | {nodes} | {plain} | {reduced} | {cnu_count} |')
     for initial_conditions, goals in ATLAS_TASKS:
-        env, sys_, seconds, nodes, plain, reduced = measure('atlas', initial_conditions, goals)
+        env, sys_, seconds, nodes, plain, reduced = measure(robot_system('atlas'), initial_conditions, goals)
         rows.append(f'| atlas: {",".join(initial_conditions)} -> {",".join(goals)} | {env} / {sys_} | '
                     f'{seconds * 1000:.1f} | {nodes} | {plain} | {reduced} | - |')
     table = '\n'.join([header, *rows])

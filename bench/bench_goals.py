@@ -28,6 +28,7 @@ import sys
 import tempfile
 import time
 from pathlib import Path
+from respec.robot import robot_system
 
 ROOT = Path(__file__).resolve().parents[1]
 RESULTS = ROOT / 'bench' / 'results'
@@ -48,8 +49,7 @@ OPTIMISATIONS = {
 
 def task_spec(goals: int, ordered: bool):
     from ltl_specification import compile_task
-    return compile_task('atlas', ['stand_prep'], GOALS[:goals], strict_order=ordered,
-                        config_dir=ROOT / 'config')
+    return compile_task(robot_system('atlas', ROOT / 'config'), ['stand_prep'], GOALS[:goals], strict_order=ordered)
 
 
 def run_one(goals: int, ordered: bool, options: dict) -> dict:

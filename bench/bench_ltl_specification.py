@@ -16,6 +16,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
 from ltl_specification import compile_task  # noqa: E402
 from respec.spec import FORMULA_SECTIONS  # noqa: E402
+from respec.robot import robot_system
 
 TASKS = [
     ('demo 1 (strict)', 'atlas', ['stand_prep'], ['look_down', 'pickup_object'], ('finished', 'failed'), True),
@@ -41,7 +42,7 @@ def main() -> None:
     for name, system, initial, goals, sm_outcomes, strict in TASKS:
         start = time.perf_counter()
         for _ in range(args.repeat):
-            spec = compile_task(system, initial, goals, sm_outcomes=sm_outcomes, strict_order=strict)
+            spec = compile_task(robot_system(system), initial, goals, sm_outcomes=sm_outcomes, strict_order=strict)
         compile_ms = (time.perf_counter() - start) / args.repeat * 1000
         formulas = sum(len(getattr(spec, s)) for s in FORMULA_SECTIONS)
         line = f'{name:22} {len(spec.env_props):4} {len(spec.sys_props):4} {formulas:8} {compile_ms:10.2f}'

@@ -96,7 +96,7 @@ def cnu_variants() -> list[tuple[str, TaskRequest, dict | None]]:
 def run(tasks, config_dir: Path, library, budget: float) -> list[dict]:
     rows = []
     for label, request, custom in tasks:
-        repairs = propose_repairs(request.system, request, custom, config_dir, time_budget=budget,
+        repairs = propose_repairs(robot_system(request.system, config_dir), request, custom, time_budget=budget,
                                   state_library=library)
         if repairs.realizable:
             raise SystemExit(f'{label}: the task is realizable, not a repair case')

@@ -40,7 +40,7 @@ def filmed_run(initial_conditions, goals, record_dir: Path) -> dict:
     from atlas_sim.simulator.rendering import MOTION_FPS
     from respec.robot import robot_system
 
-    simulator = make_simulator('atlas', initial_conditions=initial_conditions)
+    simulator = make_simulator(robot_system('atlas'), initial_conditions=initial_conditions)
     first_frame = []
 
     def on_progress(steps, frames):

@@ -19,6 +19,7 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 from sm_generation import Automaton, AutomatonState, generate_state_machine, load_automaton  # noqa: E402
+from respec.robot import robot_system
 
 ACTIONS = ['look_down', 'pregrasp', 'pregrasp_plan', 'approach_object', 'footstep_plan', 'footstep_goal']
 
@@ -64,6 +65,7 @@ def main() -> None:
     print(f'{"case":42s} {"aut. states":>11s} {"SM states":>9s} {"plain ms":>9s} {"reduced":>8s} {"reduce ms":>9s}')
 
     def row(label, automaton, system='atlas'):
+        system = robot_system(system)
         plain_time, plain = timed(lambda: generate_state_machine(automaton, system))
         reduced_time, reduced = timed(lambda: generate_state_machine(automaton, system, reduce=True))
         top = lambda machine: len(machine.states)  # noqa: E731
@@ -83,7 +85,7 @@ def main() -> None:
                                        ('atlas', 'stand_prep', 'pickup_object, grasp_object'),
                                        ('atlas', 'stand_prep', 'footstep_execution'),
                                        ('mobile_manipulator', 'parked', 'grasp, dock')]:
-            spec = compile_task(system, initial, goals)
+            spec = compile_task(robot_system(system), initial, goals)
             automaton = automaton_from_strategy(synthesize(spec).strategy, spec)
             row(f'{system}: {goals}', automaton, system)
     for size in args.sizes:

@@ -27,6 +27,7 @@ import threading
 import time
 from argparse import Namespace
 from pathlib import Path
+from respec.robot import robot_system
 
 TASKS = {
     'stand_prep -> [look_down]': (['stand_prep'], ['look_down']),
@@ -68,7 +69,7 @@ def requests() -> dict:
 
     made = {}
     for label, (initial, goals) in TASKS.items():
-        spec = compile_task('atlas', initial, goals)
+        spec = compile_task(robot_system('atlas'), initial, goals)
         made[label] = SynthesizeAutomaton.Request(ltl_specification=spec_to_msg(spec), spec_name='bench',
                                                   provenance=provenance_to_json(spec.provenance))
     made[f'{COPIED_INPUTS} free inputs copied to outputs'] = SynthesizeAutomaton.Request(

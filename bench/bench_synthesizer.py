@@ -26,6 +26,7 @@ import sys
 import tempfile
 import time
 from pathlib import Path
+from respec.robot import robot_system
 
 ROOT = Path(__file__).resolve().parents[1]
 RESULTS = ROOT / 'bench' / 'results'
@@ -65,12 +66,12 @@ def chain_spec(n: int):
     from ltl_specification import compile_task
     with tempfile.TemporaryDirectory() as directory:
         system = chain_config(n, Path(directory))
-        return compile_task(system, ['stand_prep'], [f'act{n - 1}'], config_dir=directory)
+        return compile_task(robot_system(system, directory), ['stand_prep'], [f'act{n - 1}'])
 
 
 def paper_spec(initial, goals):
     from ltl_specification import compile_task
-    return compile_task('atlas', initial, goals, config_dir=ROOT / 'config')
+    return compile_task(robot_system('atlas', ROOT / 'config'), initial, goals)
 
 
 def run_one(kind: str, argument: str, options: dict) -> dict:

@@ -1,6 +1,7 @@
 """Compile robot tasks (initial conditions, goals) into GR(1) LTL specifications (ROS-free).
 
-    >>> spec = compile_task('atlas', ['stand_prep'], ['look_down', 'pickup_object'])
+    >>> from respec.robot import robot_system
+    >>> spec = compile_task(robot_system('atlas'), ['stand_prep'], ['look_down', 'pickup_object'])
     >>> print(spec.to_structuredslugs())     # or to_slugsin(), to_text_sections()
 
 ``ltl_specification.diagnosis`` says in plain words why a task cannot be done, from the

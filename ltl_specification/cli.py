@@ -17,8 +17,10 @@ from pathlib import Path
 
 from ltl_specification.compiler import compile_task, explain
 from ltl_specification.errors import InvalidFormulaError
+from ltl_specification.systems import task_system_errors
 from respec.errors import CodedError, ExitStatus, exit_status_help
 from respec.naming import parse_names
+from respec.robot import robot_system
 from respec.robot.files import add_config_dir_argument
 from respec.untrusted import BoundedYamlError, load_bounded_yaml, read_bounded_file
 
@@ -58,9 +60,11 @@ def run(args: argparse.Namespace) -> int:
     """Compile and write the specification; returns the process exit status."""
     try:
         custom_ltl = read_custom_ltl(args.custom_ltl)
-        spec = compile_task(args.system, args.initial_conditions, args.goals,
+        with task_system_errors():
+            system = robot_system(args.system, args.config_dir)
+        spec = compile_task(system, args.initial_conditions, args.goals,
                             sm_outcomes=parse_names(args.sm_outcomes), strict_order=not args.unordered,
-                            custom_ltl=custom_ltl, config_dir=args.config_dir)
+                            custom_ltl=custom_ltl)
     except CodedError as error:  # the task's and the robot files' own errors (a state class the workspace lacks)
         # One line naming the code and the item; a refusal's diagnosis (core, play) follows it.
         sentence, _, diagnosis = str(error).partition('\n')

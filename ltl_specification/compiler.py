@@ -41,11 +41,11 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass, field, fields
-from pathlib import Path
 from typing import Mapping, Sequence
 
-from respec.robot import RobotSystem
+from respec.robot import RobotSystem, for_description
 from respec.robot.abstraction import RobotAbstraction
+from respec.robot.cnu import CapabilitySystem
 from respec.components import (
     SOURCE_CUSTOM, FormulaGroup, action_groups, action_specification, control_mode_groups,
     control_mode_specification, goal_groups, goal_specification, initial_conditions_groups,
@@ -71,7 +71,7 @@ from ltl_specification.errors import (
 )
 from ltl_specification.pertinence import Pertinence, infer_pertinence, mode_distances
 from ltl_specification.provenance import Provenance, task_provenance
-from ltl_specification.systems import load_task_abstraction, load_task_system
+from ltl_specification.systems import load_task_abstraction
 
 SUPPORTED_SM_OUTCOMES = (DEFAULT_SM_OUTCOMES, (FINISHED,))
 
@@ -86,19 +86,19 @@ class CompiledSpecification(GR1Specification):
         return explain(self)
 
 
-def compile_task(system: RobotSystem | str, initial_conditions: Sequence[str] | str, goals: Sequence[str] | str,
+def compile_task(system: RobotSystem, initial_conditions: Sequence[str] | str, goals: Sequence[str] | str,
                  sm_outcomes: Sequence[str] = DEFAULT_SM_OUTCOMES, strict_order: bool = True,
                  custom_ltl: Mapping[str, Sequence[str]] | None = None,
-                 config_dir: str | Path | None = None,
                  state_library: Mapping[str, StateClass] | None = None,
                  explain_refusal: bool = True) -> CompiledSpecification:
     """Compile the GR(1) specification of reaching ``goals`` from ``initial_conditions``.
 
-    ``system`` is a RobotSystem, or the name of one in ``config_dir`` (default ``config/``).
-    A system described by CNU capability files (``respec.robot.cnu``) is compiled by
-    ``ltl_specification.capabilities``; its state classes are checked against
-    ``state_library`` (default: the FlexBE state packages on ``AMENT_PREFIX_PATH``); its mappings
-    name the ``sm_outcomes`` (CNU's request semantics), and ``strict_order`` does not apply;
+    ``system`` is a RobotSystem (a name becomes one at the edge: ``respec.robot.robot_system``
+    inside ``ltl_specification.systems.task_system_errors``). A system described by CNU
+    capability files (``respec.robot.cnu``) is compiled by ``ltl_specification.capabilities``;
+    its state classes are checked against ``state_library`` (default: the FlexBE state packages
+    on ``AMENT_PREFIX_PATH``); its mappings name the ``sm_outcomes`` (CNU's request semantics),
+    and ``strict_order`` does not apply;
     ``ltl_specification.capability_precheck`` refuses, before synthesis, an initial condition
     that names nothing of it, a goal no capability can make true and a precondition nothing
     establishes.
@@ -115,16 +115,28 @@ def compile_task(system: RobotSystem | str, initial_conditions: Sequence[str] | 
     up to its REFUSAL_DIAGNOSIS_SECONDS); ``explain_refusal=False`` refuses with the sentence
     alone, at once (for callers that only need the verdict).
     """
-    system = load_task_system(system, config_dir)
-    if system.is_capability_system:
-        library = workspace_state_library() if state_library is None else state_library
-        initial_conditions = _names(initial_conditions, 'initial conditions', InvalidInitialConditionsError)
-        goals = _names(goals, 'goals', InvalidGoalsError)
-        check_capability_names(system, initial_conditions)   # first: the sentence names the entry to change
-        spec = compile_capability_task(system.capabilities, library, initial_conditions, goals, custom_ltl,
-                                       _names(sm_outcomes, 'state-machine outcomes', InvalidSmOutcomesError))
-        check_capability_task(system, initial_conditions, goals)   # once the files' own errors are ruled out
-        return CompiledSpecification(**_spec_fields(spec))
+    # a file without an abstraction: section: the mode compiler names what is missing
+    compile_for = for_description(_COMPILERS, system, missing=_compiled_for_modes)
+    return compile_for(system, initial_conditions, goals, sm_outcomes, strict_order, custom_ltl, state_library,
+                       explain_refusal)
+
+
+def _compiled_for_capabilities(system: RobotSystem, initial_conditions, goals, sm_outcomes, strict_order,
+                               custom_ltl, state_library, explain_refusal) -> CompiledSpecification:
+    del strict_order, explain_refusal  # CNU's goals hold together; its refusals come from the pre-check
+    library = workspace_state_library() if state_library is None else state_library
+    initial_conditions = _names(initial_conditions, 'initial conditions', InvalidInitialConditionsError)
+    goals = _names(goals, 'goals', InvalidGoalsError)
+    check_capability_names(system, initial_conditions)   # first: the sentence names the entry to change
+    spec = compile_capability_task(system.capabilities, library, initial_conditions, goals, custom_ltl,
+                                   _names(sm_outcomes, 'state-machine outcomes', InvalidSmOutcomesError))
+    check_capability_task(system, initial_conditions, goals)   # once the files' own errors are ruled out
+    return CompiledSpecification(**_spec_fields(spec))
+
+
+def _compiled_for_modes(system: RobotSystem, initial_conditions, goals, sm_outcomes, strict_order,
+                        custom_ltl, state_library, explain_refusal) -> CompiledSpecification:
+    del state_library  # the abstraction's flexbe: section names its states
     abstraction = load_task_abstraction(system)
     sm_outcomes = _check_sm_outcomes(sm_outcomes)
     goals = _check_goals(abstraction, goals)
@@ -153,6 +165,9 @@ def compile_task(system: RobotSystem | str, initial_conditions: Sequence[str] | 
     if unreachable:
         raise _impossible_goals(compiled, *unreachable[0], explain=explain_refusal)
     return compiled
+
+
+_COMPILERS = {RobotAbstraction: _compiled_for_modes, CapabilitySystem: _compiled_for_capabilities}
 
 
 def _flexbe_states(system: RobotSystem) -> dict:

@@ -38,6 +38,9 @@ from dataclasses import asdict, dataclass, field
 from respec.components import SOURCE_CUSTOM, FormulaGroup
 from respec.ltl import Formula, evaluate, mentions_next, to_infix, variables
 from respec.naming import activation
+from respec.robot import RobotSystem, for_description
+from respec.robot.abstraction import RobotAbstraction
+from respec.robot.cnu import CapabilitySystem
 from respec.spec import FORMULA_SECTIONS, GR1Specification
 from ltl_synthesizer.errors import SynthesisCancelledError
 from ltl_synthesizer.explanation import without_play
@@ -46,7 +49,7 @@ from ltl_synthesizer.unrealizable_core import environment_play, unrealizable_cor
 from ltl_synthesizer.well_separation import check_well_separation
 
 from ltl_specification.capability_precheck import capability_file, unreachable_goals
-from ltl_specification.systems import load_task_abstraction, load_task_system
+from ltl_specification.systems import load_task_abstraction
 from ltl_specification.provenance import Provenance
 from ltl_specification.reachability import Finding, unreachable_goal_modes
 
@@ -126,17 +129,24 @@ def precheck(spec: GR1Specification, provenance: Provenance | None = None) -> li
     return findings
 
 
-def goal_findings(system, initial_conditions, goals, strict_order: bool = True,
-                  config_dir=None) -> list[Finding]:
+def goal_findings(system: RobotSystem, initial_conditions, goals, strict_order: bool = True) -> list[Finding]:
     """The goal part of the pre-check, without compiling (cheap enough to run as a form changes).
 
-    ``system`` is a RobotSystem or its name. Names that are not actions or modes of it are
-    skipped (compilation reports them).
+    Names that are not actions or modes of ``system`` are skipped (compilation reports them).
     """
-    system = load_task_system(system, config_dir)
-    if system.is_capability_system:  # a goal no capability can make true, as the compiler refuses it
-        return [Finding(str(error), 'frame axiom', f'postconditions in {capability_file(system)}', error.item)
-                for error in unreachable_goals(system, initial_conditions, goals)]
+    findings_for = for_description(_GOAL_FINDINGS, system, missing=_mode_goal_findings)
+    return findings_for(system, initial_conditions, goals, strict_order)
+
+
+def _capability_goal_findings(system: RobotSystem, initial_conditions, goals, strict_order: bool) -> list[Finding]:
+    """A goal no capability can make true, as the compiler refuses it."""
+    del strict_order  # CNU's goals hold together at the end
+    return [Finding(str(error), 'frame axiom', f'postconditions in {capability_file(system)}', error.item)
+            for error in unreachable_goals(system, initial_conditions, goals)]
+
+
+def _mode_goal_findings(system: RobotSystem, initial_conditions, goals, strict_order: bool) -> list[Finding]:
+    """A goal mode no route from the initial mode reaches (as the compiler refuses it)."""
     abstraction = load_task_abstraction(system)
     modes = [i for i in initial_conditions if abstraction.kind_of(i) == 'control_mode']
     initial_mode = modes[0] if modes else abstraction.initial_mode
@@ -146,12 +156,14 @@ def goal_findings(system, initial_conditions, goals, strict_order: bool = True,
     return unreachable_goal_modes(abstraction, known, initial_mode, strict_order, system.config_file)
 
 
-def impossible_next_goals(system, initial_conditions, goals, strict_order: bool = True,
-                          config_dir=None, candidates=None) -> dict[str, str]:
+_GOAL_FINDINGS = {RobotAbstraction: _mode_goal_findings, CapabilitySystem: _capability_goal_findings}
+
+
+def impossible_next_goals(system: RobotSystem, initial_conditions, goals, strict_order: bool = True,
+                          candidates=None) -> dict[str, str]:
     """For every one of ``candidates`` that is not a goal yet (default: the abstraction's actions
     and modes; a capability robot's view gives what its capabilities make true): why it cannot
     be the next goal (if so)."""
-    system = load_task_system(system, config_dir)
     impossible = {}
     if candidates is None:
         candidates = load_task_abstraction(system).items()

@@ -16,8 +16,12 @@ from __future__ import annotations
 
 import re
 from collections.abc import Iterable, Sequence
+from typing import TYPE_CHECKING
 
 from ltl_specification.errors import InvalidInitialConditionsError
+
+if TYPE_CHECKING:
+    from respec.robot import RobotSystem
 
 #: The initial condition that stands for "wherever the robot is now".
 CURRENT = 'current'
@@ -42,24 +46,18 @@ def asks_for_robot_state(initial_conditions: Sequence[str]) -> bool:
     return True
 
 
-def reads_robot_state(initial_conditions: Sequence[str], system, config_dir=None) -> bool:
+def reads_robot_state(initial_conditions: Sequence[str], system: RobotSystem | None) -> bool:
     """Whether the server must read the robot's state for this request (``asks_for_robot_state``).
 
-    ``system`` is a RobotSystem or its name. A robot described by CNU's capability files keeps
-    CNU's meaning of no initial conditions: its specification already gives them (``current``
-    still asks the robot).
+    ``system`` is None when it cannot be read (compiling the task reports why). A robot
+    described by CNU's capability files keeps CNU's meaning of no initial conditions: its
+    specification already gives them (``current`` still asks the robot).
     """
-    from respec.errors import CodedError
-    from respec.robot import robot_system
-
     if not asks_for_robot_state(initial_conditions):
         return False
     if CURRENT in initial_conditions:
         return True
-    try:
-        return not robot_system(system, config_dir).is_capability_system
-    except CodedError:  # an unknown or broken system: compiling the task reports it
-        return True
+    return system is None or system.reads_robot_state_by_default
 
 
 def initial_conditions_from_robot_state(mode: str, completed_actions: Iterable[str],

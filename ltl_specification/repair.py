@@ -32,14 +32,15 @@ import itertools
 import re
 import time
 from dataclasses import dataclass, field, replace
-from typing import Callable, Iterator, Mapping, Sequence
+from typing import Callable, Iterator, Mapping, NamedTuple, Sequence
 
 import yaml
 
 from respec.errors import CodedError, ErrorCode
 from respec.naming import DEFAULT_SM_OUTCOMES, FAILED, activation, memory, parse_names
-from respec.robot import RobotSystem, robot_system
-from respec.robot.files import ConfigDirs
+from respec.robot import RobotSystem, for_description
+from respec.robot.abstraction import RobotAbstraction
+from respec.robot.cnu import CapabilitySystem
 from respec.robot.system import robot_system_from_files
 from ltl_synthesizer.errors import SynthesisCancelledError
 from ltl_synthesizer.interrupt import Limits
@@ -215,24 +216,21 @@ def attempt(system: RobotSystem, request: TaskRequest, custom_ltl: Mapping | Non
 
 # --- the search --------------------------------------------------------------------------------
 
-def propose_repairs(system: RobotSystem | str, request: TaskRequest, custom_ltl: Mapping | None = None,
-                    config_dir: ConfigDirs = None, time_budget: float = DEFAULT_TIME_BUDGET,
+def propose_repairs(system: RobotSystem, request: TaskRequest, custom_ltl: Mapping | None = None,
+                    time_budget: float = DEFAULT_TIME_BUDGET,
                     max_proposals: int = DEFAULT_MAX_PROPOSALS,
                     on_proposal: Callable[[Proposal], None] | None = None,
                     state_library: Mapping | None = None) -> Repairs:
     """Verified proposals that make ``request`` (with ``custom_ltl``) possible on ``system``.
 
-    ``system`` is a RobotSystem or its name (read once). Candidates are verified cheapest first
-    until ``max_proposals`` are found or four fifths of ``time_budget`` are spent (the problem's
-    diagnosis gets the rest: the budget bounds the whole); ``on_proposal`` is
-    called with each one as it is verified (to show progress). ``state_library`` is the
-    capability compiler's (default: the workspace's FlexBE states). Raises the system's own
-    SystemConfigError when its file cannot be read.
+    Candidates are verified cheapest first until ``max_proposals`` are found or four fifths of
+    ``time_budget`` are spent (the problem's diagnosis gets the rest: the budget bounds the
+    whole); ``on_proposal`` is called with each one as it is verified (to show progress). ``state_library`` is the
+    capability compiler's (default: the workspace's FlexBE states).
     """
     start = time.monotonic()
     # The search leaves the diagnosis of the problem its share: the budget bounds the whole.
     deadline = start + time_budget * (1 - DIAGNOSIS_SHARE)
-    system = robot_system(system, config_dir)
     request = replace(request, system=system.name)
     original = attempt(system, request, custom_ltl, deadline, state_library=state_library)
     repairs = Repairs(request, original.realizable, original.problem)
@@ -283,11 +281,13 @@ def _names_a_goal_memory(system: RobotSystem, refusal: Attempt) -> bool:
 
 
 def _memory_owner(system: RobotSystem, name: str) -> str | None:
-    abstraction = system.abstraction
-    if abstraction is None or not name.endswith('_m'):
-        return None
+    """The item ``name`` is the goal memory of (eq. (20)): a mode robot's modes and actions have one."""
+    return _robot_repairs(system).memory_owner(system, name) if name.endswith('_m') else None
+
+
+def _mode_memory_owner(system: RobotSystem, name: str) -> str | None:
     item = name[:-2]
-    return item if abstraction.kind_of(item) is not None else None
+    return item if system.abstraction.kind_of(item) is not None else None
 
 
 def _diagnosed_sentence(system: RobotSystem, request: TaskRequest, custom_ltl, state_library,
@@ -349,19 +349,20 @@ def _shown_file(system: RobotSystem, relative: str) -> str:
 # --- candidates --------------------------------------------------------------------------------
 
 def _candidates(system: RobotSystem, request: TaskRequest, custom_ltl) -> Iterator[Proposal]:
+    robot = _robot_repairs(system)
     yield from _goal_order_candidates(system, request)
-    yield from _prerequisite_candidates(system, request, custom_ltl)
-    yield from _initial_condition_candidates(system, request)
+    yield from robot.prerequisites(system, request, custom_ltl)
+    yield from robot.starts(system, request)
     yield from _outcome_candidates(request)
     yield from _drop_goal_candidates(request)
     yield from _custom_ltl_candidates(system, request, custom_ltl)
-    yield from _robot_candidates(system, request)
+    yield from robot.changes(system, request)
 
 
 def _goal_order_candidates(system: RobotSystem, request: TaskRequest) -> Iterator[Proposal]:
     """Goals in another order (fewest swapped pairs first), or in any order (eq. (17) for (20))."""
     goals = request.goals
-    if system.is_capability_system or len(goals) < 2 or request.unordered:
+    if not system.orders_goals or len(goals) < 2 or request.unordered:
         return
     yield Proposal(UNORDERED, 'Let the goals be achieved in any order (--unordered).', 1, True,
                    replace(request, unordered=True))
@@ -385,8 +386,6 @@ def _prerequisite_candidates(system: RobotSystem, request: TaskRequest, custom_l
     """An item added as a goal before a goal: one whose goal memory (``<item>_m``, eq. (20))
     the custom LTL uses first, then a control mode or a precondition of a goal, which with goals
     in order takes the robot where the next goal can be reached from."""
-    if system.is_capability_system or system.abstraction is None:
-        return
     abstraction = system.abstraction
     used = _custom_names(custom_ltl)
     remembered = [i for i in abstraction.items() if f'{i}_m' in used and i not in request.goals]
@@ -409,23 +408,22 @@ def _custom_names(custom_ltl) -> set[str]:
             for text in entries or () for word in re.findall(r'[A-Za-z_][A-Za-z0-9_]*', str(text))}
 
 
-def _initial_condition_candidates(system: RobotSystem, request: TaskRequest) -> Iterator[Proposal]:
-    """Start elsewhere: another initial control mode (ATLAS-style) or one initial condition more
-    or less (a capability robot's memories)."""
-    if system.is_capability_system:
-        capabilities = system.capabilities
-        for condition in request.initial_conditions:
-            rest = tuple(c for c in request.initial_conditions if c != condition)
-            yield Proposal(INITIAL, f'Drop the initial condition {condition}.', 2, True,
-                           replace(request, initial_conditions=rest))
-        for name in capabilities.memory:
-            if name not in request.initial_conditions and memory(name) not in request.initial_conditions:
-                yield Proposal(INITIAL, f'Start with {name} already true (initial condition {name}).', 2, True,
-                               replace(request, initial_conditions=request.initial_conditions + (name,)))
-        return
+def _capability_start_candidates(system: RobotSystem, request: TaskRequest) -> Iterator[Proposal]:
+    """Start elsewhere: one initial condition more or less (a capability robot's memories)."""
+    capabilities = system.capabilities
+    for condition in request.initial_conditions:
+        rest = tuple(c for c in request.initial_conditions if c != condition)
+        yield Proposal(INITIAL, f'Drop the initial condition {condition}.', 2, True,
+                       replace(request, initial_conditions=rest))
+    for name in capabilities.memory:
+        if name not in request.initial_conditions and memory(name) not in request.initial_conditions:
+            yield Proposal(INITIAL, f'Start with {name} already true (initial condition {name}).', 2, True,
+                           replace(request, initial_conditions=request.initial_conditions + (name,)))
+
+
+def _mode_start_candidates(system: RobotSystem, request: TaskRequest) -> Iterator[Proposal]:
+    """Start elsewhere: another initial control mode."""
     abstraction = system.abstraction
-    if abstraction is None:
-        return
     modes = [c for c in request.initial_conditions if abstraction.is_mode(c)]
     others = tuple(c for c in request.initial_conditions if not abstraction.is_mode(c))
     current = modes[0] if modes else abstraction.initial_mode
@@ -497,7 +495,8 @@ def mined_assumptions(system: RobotSystem, request: TaskRequest, custom_ltl: Map
     environment wins with, so assuming it changes infinitely often (fairness) or, once it has
     the good value, keeps it (stability) is tried first. Returns (section, formula, why)."""
     inputs = [str(name) for name in custom_ltl.get('env_props') or ()]
-    inputs += [s for s in (system.abstraction.sensors if system.abstraction else ()) if s not in inputs]
+    # a capability robot's sensors are bound by its capabilities instead (_sensor_candidates)
+    inputs += [s for s in _robot_repairs(system).assumed_sensors(system) if s not in inputs]
     if not inputs:
         return []
     held = _held_inputs(system, request, custom_ltl, inputs)
@@ -538,12 +537,9 @@ def _held_inputs(system: RobotSystem, request: TaskRequest, custom_ltl, inputs: 
 
 # --- the robot ---------------------------------------------------------------------------------------
 
-def _robot_candidates(system: RobotSystem, request: TaskRequest) -> Iterator[Proposal]:
-    if system.is_capability_system:
-        yield from _sensor_candidates(system)
-        yield from _capability_candidates(system, request)
-    elif system.abstraction is not None:
-        yield from _abstraction_candidates(system, request)
+def _capability_robot_candidates(system: RobotSystem, request: TaskRequest) -> Iterator[Proposal]:
+    yield from _sensor_candidates(system)
+    yield from _capability_candidates(system, request)
 
 
 def _abstraction_candidates(system: RobotSystem, request: TaskRequest) -> Iterator[Proposal]:
@@ -679,3 +675,35 @@ def _capability_file(system: RobotSystem) -> str | None:
     relative = system.sections.get(CAPABILITIES_KEY)
     return relative if isinstance(relative, str) and relative in system.files else None
 
+
+# --- what each robot format offers to repair ---------------------------------------------------------
+
+class _RobotRepairs(NamedTuple):
+    """The candidates a robot format adds, in their place among the others (``_candidates``)."""
+
+    prerequisites: Callable[..., Iterator[Proposal]]   # (system, request, custom_ltl): goals added before goals
+    starts: Callable[..., Iterator[Proposal]]          # (system, request): other initial conditions
+    changes: Callable[..., Iterator[Proposal]]         # (system, request): changes to the robot's files
+    assumed_sensors: Callable[[RobotSystem], Sequence[str]]   # inputs mined_assumptions may assume of
+    memory_owner: Callable[[RobotSystem, str], str | None]    # the goal whose memory a name (``x_m``) is
+
+
+def _nothing(*arguments) -> Iterator[Proposal]:
+    del arguments
+    yield from ()
+
+
+_ROBOT_REPAIRS = {
+    RobotAbstraction: _RobotRepairs(_prerequisite_candidates, _mode_start_candidates, _abstraction_candidates,
+                                    lambda system: system.abstraction.sensors, _mode_memory_owner),
+    # a capability robot's sensors are bound by its capabilities instead (_sensor_candidates)
+    # (and its memories are its own propositions, no goal's)
+    CapabilitySystem: _RobotRepairs(_nothing, _capability_start_candidates, _capability_robot_candidates,
+                                    lambda system: (), lambda system, name: None),
+}
+# a file without a description: nothing of the robot to change
+_NO_ROBOT_REPAIRS = _RobotRepairs(_nothing, _nothing, _nothing, lambda system: (), lambda system, name: None)
+
+
+def _robot_repairs(system: RobotSystem) -> _RobotRepairs:
+    return for_description(_ROBOT_REPAIRS, system, missing=_NO_ROBOT_REPAIRS)

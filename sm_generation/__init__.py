@@ -1,7 +1,8 @@
 """sm_generation: synthesized automata -> FlexBE state machines (ROS-free).
 
     >>> from sm_generation import generate_state_machine, load_automaton, validate_state_machine
-    >>> machine = generate_state_machine(load_automaton('test/automata/look_down.yaml'), 'atlas')
+    >>> from respec.robot import robot_system
+    >>> machine = generate_state_machine(load_automaton('test/automata/look_down.yaml'), robot_system('atlas'))
     >>> validate_state_machine(machine.to_instantiations())
     []
 

@@ -30,7 +30,6 @@ from respec.robot.state_library import StateClass, capability_outcomes
 from sm_generation.config import FlexBEConfig, StateConfig
 from sm_generation.errors import StateConfigInvalidError
 from sm_generation.generator import generate_from_config
-from sm_generation.instantiation import StateInstantiation
 from sm_generation.state_machine import StateMachine
 
 DEFAULT_AUTONOMY = 1

@@ -15,8 +15,10 @@ from pathlib import Path
 
 from respec.errors import ExitStatus, exit_status_help
 from respec.naming import parse_names
+from respec.robot import robot_system
 from respec.robot.files import add_config_dir_argument
 from sm_generation.automaton_io import load_automaton
+from sm_generation.config import generation_system_errors
 from sm_generation.errors import SMGenerationError
 from sm_generation.export import RENDER_FORMATS, RenderError, render, to_dot, to_json, to_yaml
 from sm_generation.for_system import generate_state_machine
@@ -49,7 +51,9 @@ def run(args: argparse.Namespace) -> int:
         initial_conditions = parse_names(args.initial_conditions)
     try:
         automaton = load_automaton(args.automaton, args.spec)
-        machine = generate_state_machine(automaton, args.system, args.config_dir, initial_conditions, args.reduce)
+        with generation_system_errors():
+            system = robot_system(args.system, args.config_dir)
+        machine = generate_state_machine(automaton, system, initial_conditions, args.reduce)
     except SMGenerationError as error:
         print(f'error: {error.code}: {error} (item: {error.item})', file=sys.stderr)
         return ExitStatus.FAILED

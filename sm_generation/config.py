@@ -34,12 +34,14 @@ is the dotted key of the offending entry (e.g. ``flexbe.states.look_down_a.auton
 
 from __future__ import annotations
 
+from contextlib import contextmanager
 from dataclasses import dataclass, field
+from typing import Iterator
 
 from respec.naming import activated
 from sm_generation.instantiation import StateInstantiation
-from respec.robot import RobotSystem, robot_system
-from respec.robot.files import ConfigDirectoryNotFoundError, ConfigDirs, ConfigFileInvalidError, SystemNotFoundError
+from respec.robot import RobotSystem
+from respec.robot.files import ConfigDirectoryNotFoundError, ConfigFileInvalidError, SystemNotFoundError
 from sm_generation.errors import (AutonomyConfigInvalidError, FlexBEConfigInvalidError, NoSystemConfigError,
                                   SMGenerationError, StateConfigInvalidError, SystemConfigNotFoundError,
                                   UserdataConfigInvalidError)
@@ -122,16 +124,16 @@ def input_request_capabilities(config: FlexBEConfig) -> dict[int, str]:
     return capabilities
 
 
-def generation_system(system: RobotSystem | str, config_dir: ConfigDirs = None) -> RobotSystem:
-    """``system``, or the system of that name, with sm_generation's codes when it cannot be found."""
-    if isinstance(system, RobotSystem):
-        return system
+@contextmanager
+def generation_system_errors() -> Iterator[None]:
+    """sm_generation's codes for a robot system read in this block that cannot be found or read,
+    e.g. ``with generation_system_errors(): system = robot_system(name, config_dir)``."""
     try:
-        return robot_system(system, config_dir)
+        yield
     except ConfigDirectoryNotFoundError as error:
         raise SystemConfigNotFoundError(str(error), error.item) from error
     except SystemNotFoundError as error:
-        raise NoSystemConfigError(str(error), error.item or system) from error
+        raise NoSystemConfigError(str(error), error.item) from error
     except ConfigFileInvalidError as error:
         raise FlexBEConfigInvalidError(str(error), error.item) from error
 

@@ -9,34 +9,48 @@ with the FlexBE side of that mapping (``behavior_flexbe_config``).
 
 from __future__ import annotations
 
-from pathlib import Path
 
-from respec.robot import RobotSystem
+from respec.robot import RobotSystem, for_description
+from respec.robot.abstraction import RobotAbstraction
+from respec.robot.cnu import CapabilitySystem
 from respec.robot.state_library import capability_outcomes, workspace_state_library
 from sm_generation.capabilities import capability_flexbe_config, generate_capability_machine
-from sm_generation.config import FlexBEConfig, flexbe_config, generation_system
+from sm_generation.config import FlexBEConfig, flexbe_config
 from sm_generation.generator import generate_from_config
 from sm_generation.state_machine import StateMachine
 
 
-def generate_state_machine(automaton, system: RobotSystem | str, config_dir: str | Path | None = None,
-                           initial_conditions: list[str] | None = None,
+def generate_state_machine(automaton, system: RobotSystem, initial_conditions: list[str] | None = None,
                            reduce: bool = False, state_library=None) -> StateMachine:
     """The FlexBE state machine implementing ``automaton`` on ``system``, as its tree (its
     StateInstantiation list, FlexBE's wire format, is ``to_instantiations()``).
 
-    ``system`` is a RobotSystem, or the name of one in ``config_dir`` (default ``config/``).
-    A system described by CNU capability files takes its state classes from ``state_library``
-    (default: the FlexBE state packages on ``AMENT_PREFIX_PATH``) and is reduced unless its
-    system file says ``reduce: false``. How the initial state is chosen and what ``reduce``
-    does: ``sm_generation.generator.generate_from_config``. Raises ``SMGenerationError``.
+    A name becomes ``system`` at the edge (``respec.robot.robot_system`` inside
+    ``sm_generation.config.generation_system_errors``). A system described by CNU capability
+    files takes its state classes from ``state_library`` (default: the FlexBE state packages on
+    ``AMENT_PREFIX_PATH``) and is reduced unless its system file says ``reduce: false``. How the
+    initial state is chosen and what ``reduce`` does:
+    ``sm_generation.generator.generate_from_config``. Raises ``SMGenerationError``.
     """
-    system = generation_system(system, config_dir)
-    if system.is_capability_system:
-        library = workspace_state_library() if state_library is None else state_library
-        capabilities = system.capabilities
-        return generate_capability_machine(automaton, capabilities, library, reduce or capabilities.reduce)
+    generate = for_description(_GENERATORS, system, missing=_generated_from_flexbe_section)
+    return generate(automaton, system, initial_conditions, reduce, state_library)
+
+
+def _generated_from_capabilities(automaton, system: RobotSystem, initial_conditions, reduce: bool,
+                                 state_library) -> StateMachine:
+    del initial_conditions  # the automaton's initial state is the spec's
+    library = workspace_state_library() if state_library is None else state_library
+    capabilities = system.capabilities
+    return generate_capability_machine(automaton, capabilities, library, reduce or capabilities.reduce)
+
+
+def _generated_from_flexbe_section(automaton, system: RobotSystem, initial_conditions, reduce: bool,
+                                   state_library) -> StateMachine:
+    del state_library  # the flexbe: section names each state's class and package
     return generate_from_config(automaton, flexbe_config(system), initial_conditions, reduce)
+
+
+_GENERATORS = {RobotAbstraction: _generated_from_flexbe_section, CapabilitySystem: _generated_from_capabilities}
 
 
 def behavior_flexbe_config(system: RobotSystem, state_library=None) -> FlexBEConfig:
@@ -49,8 +63,19 @@ def behavior_flexbe_config(system: RobotSystem, state_library=None) -> FlexBECon
     generation checks them, so a missing workspace is reported with what to set
     (``respec.robot.state_library.StateClassError``). Raises a CodedError.
     """
-    if system.is_capability_system:
-        library = workspace_state_library() if state_library is None else state_library
-        capability_outcomes(system.capabilities, library)
-        return capability_flexbe_config(system.capabilities, library)
+    behavior_config = for_description(_BEHAVIOR_CONFIGS, system, missing=_flexbe_section_config)
+    return behavior_config(system, state_library)
+
+
+def _capability_behavior_config(system: RobotSystem, state_library) -> FlexBEConfig:
+    library = workspace_state_library() if state_library is None else state_library
+    capability_outcomes(system.capabilities, library)
+    return capability_flexbe_config(system.capabilities, library)
+
+
+def _flexbe_section_config(system: RobotSystem, state_library) -> FlexBEConfig:
+    del state_library
     return flexbe_config(system)
+
+
+_BEHAVIOR_CONFIGS = {RobotAbstraction: _flexbe_section_config, CapabilitySystem: _capability_behavior_config}

@@ -95,11 +95,9 @@ def add_arguments(parser):
 
 
 def run(args) -> int:
-    from atlas_sim.simulator.factory import FaultSpecError, InitialConditionError, make_simulator, parse_faults
-    from ltl_specification.errors import InvalidInitialConditionsError
-    from ltl_specification.initial_conditions import asks_for_robot_state
-    from respec.naming import parse_names
-    from respec.robot import robot_system
+    from respec.robot import for_description, robot_system
+    from respec.robot.abstraction import RobotAbstraction
+    from respec.robot.cnu import CapabilitySystem
     from respec.robot.files import SystemConfigError
 
     if args.engine == 'flexbe':
@@ -112,15 +110,25 @@ def run(args) -> int:
             return ExitStatus.UNAVAILABLE
     if args.record:
         os.environ.setdefault('MUJOCO_GL', 'egl')  # before anything imports mujoco
-    initial_conditions = parse_names(args.initial_conditions)
-    batches = [parse_names(args.goals), *(parse_names(goals) for goals in args.then)]
     try:
         system = robot_system(args.system, args.config_dir or None)
     except SystemConfigError as error:
         print(f'execute: {error.code}: {error}', file=sys.stderr)
         return ExitStatus.FAILED
-    if system.capabilities is not None:
-        return execute_capability_robot(args, system)
+    runners = {RobotAbstraction: execute_mode_robot, CapabilitySystem: execute_capability_robot}
+    return for_description(runners, system, missing=execute_mode_robot)(args, system)
+
+
+def execute_mode_robot(args, system) -> int:
+    """``execute`` for a robot of our own format: its machine on atlas_sim's simulated robot."""
+    from atlas_sim.simulator.factory import FaultSpecError, InitialConditionError, make_simulator, parse_faults
+    from ltl_specification.errors import InvalidInitialConditionsError
+    from ltl_specification.initial_conditions import asks_for_robot_state
+    from respec.naming import parse_names
+    from respec.robot.files import SystemConfigError
+
+    initial_conditions = parse_names(args.initial_conditions)
+    batches = [parse_names(args.goals), *(parse_names(goals) for goals in args.then)]
     try:  # the simulator first: a bad fault or start is a usage error, found before synthesis
         if args.sensor:
             raise FaultSpecError(f'--sensor is for capability robots; {system.name} reads its sensors in the simulator')

@@ -43,8 +43,9 @@ def add_arguments(parser):
 def run(args) -> int:
     from respec.errors import CodedError
     from respec.naming import parse_names
+    from respec.robot import robot_system
     from sm_generation import SMGenerationError
-    from sm_generation.config import generation_system
+    from sm_generation.config import generation_system_errors
     from sm_generation.for_system import behavior_flexbe_config
     from sm_generation.flexbe_behavior import (behavior_package, check_behavior_name, check_package_name,
                                                default_behavior_name)
@@ -58,7 +59,9 @@ def run(args) -> int:
         print(f'export-behavior: {error.code}: {error}', file=sys.stderr)
         return ExitStatus.USAGE
     try:  # a robot file refused: an error code of the pipeline, as from every command
-        config = behavior_flexbe_config(generation_system(args.system, args.config_dir or None))
+        with generation_system_errors():
+            system = robot_system(args.system, args.config_dir or None)
+        config = behavior_flexbe_config(system)
     except CodedError as error:
         print(f'export-behavior: {error.code}: {error}', file=sys.stderr)
         return ExitStatus.FAILED

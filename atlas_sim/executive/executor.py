@@ -39,8 +39,9 @@ an ``AtlasSimulator`` directly; ``synthesis_manager.nodes.atlas_sim_robot.RosRob
 simulator node. The machine is the tree of :mod:`sm_generation.state_machine`, as generated (or
 as a message's list became it where it arrived).
 
-    sim = make_simulator('atlas', initial_conditions=['stand_prep'])
-    run = execute_state_machine(machine, SimulatedRobot(sim), system='atlas')
+    atlas = robot_system('atlas')
+    sim = make_simulator(atlas, initial_conditions=['stand_prep'])
+    run = execute_state_machine(machine, SimulatedRobot(sim), atlas)
     run.outcome, run.trace                  # 'finished', Trace (see atlas_sim.executive.trace_check)
 """
 
@@ -59,7 +60,7 @@ from atlas_sim.executive.trace_check import OutcomeTracker, Trace, TraceStep
 from respec.errors import ErrorCode
 from respec.naming import activated, is_activation, outcome_proposition
 from respec.robot import RobotSystem
-from sm_generation.config import INPUT_STATE_CLASS, flexbe_config, generation_system
+from sm_generation.config import INPUT_STATE_CLASS, flexbe_config
 from sm_generation.instantiation import DECISION_CLASS, HELPER_STATE_CLASSES, StateInstantiation
 from sm_generation.state_machine import State, StateMachine
 
@@ -409,12 +410,10 @@ def input_prompt(node: State) -> str:
     return node.name
 
 
-def execute_state_machine(machine: StateMachine, robot: Robot, system: RobotSystem | str = 'atlas',
-                          **options) -> ExecutionResult:
+def execute_state_machine(machine: StateMachine, robot: Robot, system: RobotSystem, **options) -> ExecutionResult:
     """Run ``machine`` on ``robot`` until an SM outcome; returns the outcome and the trace.
 
-    ``system`` is a RobotSystem, or the name of one in config/ (another folder's system:
-    ``respec.robot.robot_system(name, config_dir)``).
+    ``system`` is the RobotSystem ``machine`` was generated for (its FlexBE mapping).
 
     ``options``: ``max_robot_time`` (s, default 600), ``max_states`` (default 500),
     ``max_wall_time`` (s, default none),
@@ -422,7 +421,7 @@ def execute_state_machine(machine: StateMachine, robot: Robot, system: RobotSyst
     ``control`` (a :class:`RuntimeControl`: the operator in the loop).
     Raises :class:`ExecutionError` subclasses (with ``item`` and the partial ``trace``).
     """
-    return Executive(machine, robot, StateMapping(generation_system(system)), **options).run()
+    return Executive(machine, robot, StateMapping(system), **options).run()
 
 
 __all__ = ['execute_state_machine', 'Executive', 'ExecutionResult', 'StateMapping', 'UnmappedStateError',

@@ -20,7 +20,7 @@ alone, whatever the operator's reaction time (the simulated world is frozen mean
 robot would hold its posture). A wait ends at the executive's wall-time limit like any run.
 
     control = RuntimeControl(receive=queue_reader, report=print, autonomy_level=HIGH)
-    execute_state_machine(machine, robot, control=control)
+    execute_state_machine(machine, robot, system, control=control)
 """
 
 from __future__ import annotations

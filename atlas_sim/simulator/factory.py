@@ -9,7 +9,7 @@ import dataclasses
 from atlas_sim.simulator.config import SystemConfig
 from respec.errors import CodedError, ErrorCode
 from respec.naming import COMPLETED
-from respec.robot import RobotSystem, robot_system
+from respec.robot import RobotSystem
 
 
 class InitialConditionError(CodedError, ValueError):
@@ -44,19 +44,17 @@ def parse_faults(fail=(), fail_first=(), probability=()) -> dict:
     return faults
 
 
-def make_simulator(system: RobotSystem | str = 'atlas', initial_conditions=(), faults: dict | None = None,
+def make_simulator(system: RobotSystem, initial_conditions=(), faults: dict | None = None,
                    seed: int | None = None, **simulation_changes):
     """An ``AtlasSimulator`` for ``system``, started in the given initial conditions.
 
-    ``system`` is a RobotSystem, or the name of one in config/ (another folder's system:
-    ``respec.robot.robot_system(name, config_dir)``).
     ``initial_conditions`` name at most one control mode (the initial mode; default: the
     config's) and actions that have already completed. ``faults`` (capability -> entry of
     ``simulation.faults``) are added to the config's, ``seed`` replaces its seed.
     """
     from atlas_sim.simulator.atlas_simulator import AtlasSimulator  # here: parse_faults needs no MuJoCo
 
-    config = SystemConfig.of(robot_system(system))
+    config = SystemConfig.of(system)
     modes = [c for c in initial_conditions if c in config.abstraction.control_modes]
     actions = [c for c in initial_conditions if c in config.abstraction.actions]
     unknown = [c for c in initial_conditions if c not in modes and c not in actions]

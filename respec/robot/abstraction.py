@@ -52,6 +52,15 @@ class RobotAbstraction:
     sensors: tuple[str, ...] = ()
     initial_mode: str | None = None
 
+    # The robot interface (respec.robot.description.RobotDescription).
+    reads_robot_state_by_default = True   # the robot reports its control mode and completed actions
+    orders_goals = True
+
+    @property
+    def default_initial_conditions(self) -> list[str]:
+        """The ``initial_mode``, when the section names one."""
+        return [self.initial_mode] if self.initial_mode else []
+
     @property
     def success_outcome(self) -> str:
         """The outcome that means completion (the first one listed)."""

@@ -155,6 +155,20 @@ class CapabilitySystem:
     reduce: bool = True
     source: str = ''
 
+    # The robot interface (respec.robot.description.RobotDescription).
+    reads_robot_state_by_default = False   # its spec file gives the initial conditions
+    orders_goals = False                   # CNU's goals hold together at the end
+
+    @property
+    def default_initial_conditions(self) -> list[str]:
+        """Nothing to name: the spec file's ENV_INIT and SYS_INIT entries and the memories' values apply."""
+        return []
+
+    @property
+    def sensors(self) -> tuple[str, ...]:
+        """The Boolean inputs its spec file adds (capabilities' outcomes report some of them)."""
+        return self.spec_inputs
+
     def outcome_proposition(self, capability: str, transition_outcome: str) -> str:
         """CNU's name: the capability and the outcome's first letter (``br_c``, ``pay_f``)."""
         return f'{capability}_{transition_outcome[0]}'

@@ -84,20 +84,28 @@ def _directories(config_dirs: ConfigDirs) -> list[Path]:
 
 def available_systems(config_dirs: ConfigDirs = None) -> list[str]:
     """Names of all systems on the search path (``config_search_path``), sorted."""
-    return sorted({p.stem for directory in config_search_path(config_dirs) for p in directory.glob('*.yaml')
-                   if _SYSTEM_NAME.match(p.stem)})
+    return _systems_on(config_search_path(config_dirs))
 
 
-def system_config_path(system: str, config_dirs: ConfigDirs = None) -> Path:
-    """The file of ``system``: the first on the search path; raises SystemNotFoundError if none has it."""
+def _systems_on(search_path: Sequence[Path]) -> list[str]:
+    return sorted({p.stem for directory in search_path for p in directory.glob('*.yaml') if _SYSTEM_NAME.match(p.stem)})
+
+
+def check_system_name(system) -> None:
+    """Raises SystemNotFoundError unless ``system`` can name a system file."""
     if not isinstance(system, str) or not _SYSTEM_NAME.match(system):
         raise SystemNotFoundError(f'invalid system name {quoted(system)}', item=str(system))
-    search_path = config_search_path(config_dirs)
+
+
+def system_file(system: str, search_path: Sequence[Path]) -> Path:
+    """The file of ``system``: the first on ``search_path`` (``config_search_path``); raises
+    SystemNotFoundError if none has it."""
+    check_system_name(system)
     for directory in search_path:
         path = directory / f'{system}.yaml'
         if path.is_file():
             return path
-    known = ', '.join(available_systems(config_dirs)) or 'none'
+    known = ', '.join(_systems_on(search_path)) or 'none'
     raise SystemNotFoundError(
         f'unknown system {quoted(system)}: no {system}.yaml in {", ".join(map(str, search_path))} '
         f'(known systems: {known})', item=system)

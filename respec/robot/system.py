@@ -25,17 +25,19 @@ from collections import OrderedDict
 from dataclasses import dataclass, field
 from pathlib import Path
 from types import MappingProxyType
-from typing import Callable, Mapping, Sequence
+from typing import Callable, Mapping, Sequence, TypeVar
 
 import yaml
 
 from respec.robot.abstraction import RobotAbstraction, abstraction_from_document
 from respec.robot.cnu import SYSTEM_FILE_KEYS, CapabilitySystem, is_capability_document, load_capability_system
+from respec.robot.description import RobotDescription
 from respec.robot.files import (ConfigDirs, ConfigFileInvalidError, SystemConfigError, SystemNotFoundError,
-                                available_systems, config_search_path, load_config_yaml, parse_config_text,
-                                read_config_file, system_config_path)
+                                available_systems, check_system_name, config_search_path, load_config_yaml,
+                                parse_config_text, read_config_file, system_file)
 
 ABSTRACTION_KIND = 'abstraction'
+Entry = TypeVar('Entry')
 CAPABILITIES_KIND = 'capabilities'
 
 
@@ -62,8 +64,10 @@ class RobotSystem:
         return CAPABILITIES_KIND if self.capabilities is not None else ABSTRACTION_KIND
 
     @property
-    def is_capability_system(self) -> bool:
-        return self.capabilities is not None
+    def description(self) -> RobotDescription | None:
+        """The robot as its format describes it (the robot interface, ``respec.robot.description``):
+        the capability system, or the abstraction (None for a file without an ``abstraction:`` section)."""
+        return self.capabilities if self.capabilities is not None else self.abstraction
 
     @property
     def config_file(self) -> str:
@@ -79,11 +83,19 @@ class RobotSystem:
 
     @property
     def default_initial_conditions(self) -> list[str]:
-        """What a task on this robot starts from when it names nothing: an abstraction's
-        ``initial_mode``; a capability robot's specification gives its own (nothing to name)."""
-        if self.abstraction is not None and self.abstraction.initial_mode:
-            return [self.abstraction.initial_mode]
-        return []
+        """What a task on this robot starts from when it names nothing (``RobotDescription``)."""
+        return self.description.default_initial_conditions if self.description is not None else []
+
+    @property
+    def reads_robot_state_by_default(self) -> bool:
+        """Whether naming no initial conditions means the robot's reported state (``RobotDescription``);
+        a file without a description is of our own format, whose robots report their state."""
+        return self.description is None or self.description.reads_robot_state_by_default
+
+    @property
+    def orders_goals(self) -> bool:
+        """Whether goals may be asked in a strict order (``RobotDescription``)."""
+        return self.description is None or self.description.orders_goals
 
     def has_section(self, name: str) -> bool:
         return isinstance(self.sections.get(name), Mapping)
@@ -92,6 +104,20 @@ class RobotSystem:
         """The abstraction, for a stage that cannot work without one: raises AbstractionConfigError
         naming what is missing (a capability system, a file without an ``abstraction:`` section)."""
         return self.abstraction or abstraction_from_document(self.sections, self.name)
+
+
+def for_description(registry: Mapping[type, Entry], system: RobotSystem, missing: Entry) -> Entry:
+    """A layer's entry for ``system``'s description, by its class (``respec.robot.description``);
+    ``missing`` for a system file without a description (an abstraction-kind file with only a
+    ``flexbe:`` section)."""
+    description = system.description
+    if description is None:
+        return missing
+    try:
+        return registry[type(description)]
+    except KeyError:
+        raise TypeError(f'no entry for a robot described by {type(description).__name__} '
+                        f'(known: {", ".join(c.__name__ for c in registry)})') from None
 
 
 def robot_system_from_file(path: str | Path, name: str | None = None,
@@ -197,7 +223,9 @@ def robot_system(system: RobotSystem | str, config_dir: ConfigDirs = None) -> Ro
     """
     if isinstance(system, RobotSystem):
         return system
-    return robot_system_from_file(system_config_path(system, config_dir), system, config_search_path(config_dir))
+    check_system_name(system)   # before the search path: an invalid name is named first
+    search_path = config_search_path(config_dir)
+    return robot_system_from_file(system_file(system, search_path), system, search_path)
 
 
 @dataclass(frozen=True)

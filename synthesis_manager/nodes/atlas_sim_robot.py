@@ -10,7 +10,7 @@ so snapshots report none.
         ros.add_node(AtlasSimNode)
         robot = RosRobot(ros.add_node(Node, 'executive'))
         robot.wait_until_ready()
-        run = execute_state_machine(states, robot)
+        run = execute_state_machine(states, robot, robot_system('atlas'))
 """
 
 from __future__ import annotations

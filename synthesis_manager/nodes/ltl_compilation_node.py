@@ -27,6 +27,7 @@ from ltl_specification import compile_task
 from ltl_specification.provenance import provenance_to_json
 from ltl_specification.repair import TaskRequest
 from ltl_specification.repair_process import RepairSearch, RepairSearchError, repair_settings
+from ltl_specification.systems import task_system_errors
 from ltl_synthesizer import SynthesisCancelledError
 from respec.errors import ErrorCode
 from respec.robot import SystemCatalog, catalog_to_json
@@ -53,11 +54,13 @@ MAX_REPAIR_TIME_BUDGET = 60.0
 
 
 def compiled_sections(system: str, initial_conditions: list, goals: list, sm_outcomes: tuple, strict_order: bool,
-                      custom_ltl: dict | None, config_dir: str | None) -> tuple[dict, str]:
+                      custom_ltl: dict | None, catalog: SystemCatalog) -> tuple[dict, str]:
     """The compiled specification's text sections and its provenance (JSON): plain data, so
-    that a child process can send them back."""
-    spec = compile_task(system, initial_conditions, goals, sm_outcomes=sm_outcomes, strict_order=strict_order,
-                        custom_ltl=custom_ltl, config_dir=config_dir)
+    that a child process can send them back. The node's edge: ``system`` is a name of ``catalog``."""
+    with task_system_errors():
+        robot = catalog.load(system)
+    spec = compile_task(robot, initial_conditions, goals, sm_outcomes=sm_outcomes, strict_order=strict_order,
+                        custom_ltl=custom_ltl)
     # CNU capability systems record none: their unrealizable specifications are diagnosed by formula.
     provenance = provenance_to_json(spec.provenance) if spec.provenance is not None else ''
     return spec.to_text_sections(), provenance
@@ -149,8 +152,7 @@ class LTLCompilationNode(Node):
             requested = check_timeout(request.timeout, 'request.timeout')  # 0: the node's own limit
             arguments = (request.system, list(request.initial_conditions), list(request.goals),
                          tuple(request.sm_outcomes) or DEFAULT_SM_OUTCOMES, not request.unordered_goals,
-                         msg_to_sections(request.custom_ltl) or None,
-                         self.get_parameter('config_dir').value or None)
+                         msg_to_sections(request.custom_ltl) or None, self.catalog())
             custom_bytes = sum(utf8_length(formula) for section in (arguments[5] or {}).values()
                                for formula in section)
             if custom_bytes <= SMALL_CUSTOM_BYTES:

@@ -29,9 +29,10 @@ from rclpy.time import Time
 from ltl_specification.errors import InvalidInitialConditionsError
 from ltl_synthesizer.interrupt import released_memory
 from ltl_specification.repair import REPAIRABLE
-from ltl_specification.initial_conditions import (detected_status, initial_conditions_from_robot_state,
-                                                  reads_robot_state)
+from ltl_specification.initial_conditions import (asks_for_robot_state, detected_status,
+                                                  initial_conditions_from_robot_state, reads_robot_state)
 from respec.errors import INTERNAL_ERROR, CodedError, ErrorCode
+from respec.robot import RobotSystem, robot_system
 from sm_generation.instantiation import count_states
 from synthesis_manager.client_shares import ClientShares, goal_origin
 from synthesis_manager.limits import (DEFAULT_MAX_GOAL_TIMEOUT, MAX_STRING_BYTES, BusyError, GoalDeadline,
@@ -484,10 +485,18 @@ class BehaviorSynthesisServer(Node):
         outcome.states = list(generated.state_definition)
         feedback(f'Generated a state machine with {count_states(outcome.states)} states', 1.0)
 
+    def readable_system(self, name: str) -> RobotSystem | None:
+        """The robot system of that name, or None when it cannot be read (compiling the task reports why)."""
+        try:
+            return robot_system(name, self.parameter('config_dir') or None)
+        except CodedError:
+            return None
+
     async def with_initial_conditions(self, goal_handle, task: SynthesisTask, outcome: PipelineOutcome,
                                       feedback, deadline: GoalDeadline) -> SynthesisTask:
         """``task``, with the robot's initial conditions when it names none or ``current``."""
-        if not reads_robot_state(task.initial_conditions, task.system, self.parameter('config_dir') or None):
+        asks = asks_for_robot_state(task.initial_conditions)   # read the system file only then
+        if not reads_robot_state(task.initial_conditions, self.readable_system(task.system) if asks else None):
             return task
         topic = self.robot_state.topic
         timeout = deadline.stage_limit(self.parameter('robot_state_timeout'), 'reading the robot state')

@@ -15,7 +15,9 @@ from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.node import Node
 
 from respec.errors import ErrorCode
+from respec.robot import SystemCatalog
 from sm_generation import generate_state_machine
+from sm_generation.config import generation_system_errors
 from synthesis_manager.limits import check_message, check_timeout
 from synthesis_manager.ros.child_stage import ChildStage, StageStopped
 from synthesis_manager.ros.conversions import error_code, msg_to_automaton, state_to_msg
@@ -29,6 +31,15 @@ from synthesis_msgs.srv import CancelSynthesis, GenerateFlexBESM
 #: took 76 ms in-process; starting the work in a child costs a few milliseconds more).
 SMALL_AUTOMATON_STATES = 2000
 #: How often requests waiting for a generation child look at their deadline.
+
+
+def generated_states(automaton, system: str, catalog: SystemCatalog, initial_conditions: list[str] | None,
+                     reduce: bool) -> list:
+    """The machine of ``automaton`` on ``catalog``'s system of that name (the node's edge: in a
+    child process too, so it takes the name)."""
+    with generation_system_errors():
+        robot = catalog.load(system)
+    return generate_state_machine(automaton, robot, initial_conditions=initial_conditions, reduce=reduce)
 
 
 class SMGenerationNode(Node):
@@ -81,14 +92,14 @@ class SMGenerationNode(Node):
             check_message(request, max_list=None, max_total=None)
             requested = check_timeout(request.timeout, 'request.timeout')  # 0: the node's own limit
             arguments = (msg_to_automaton(request.automaton), request.system)
-            options = {'config_dir': self.get_parameter('config_dir').value or None,
+            options = {'catalog': SystemCatalog(self.get_parameter('config_dir').value or None),
                        'initial_conditions': list(request.initial_conditions) or None,
                        'reduce': self.get_parameter('reduce').value}
             if len(request.automaton.automaton) <= SMALL_AUTOMATON_STATES:
-                states = generate_state_machine(*arguments, **options)
+                states = generated_states(*arguments, **options)
             else:
                 try:
-                    states = await self.children.run(generate_state_machine, arguments, options,
+                    states = await self.children.run(generated_states, arguments, options,
                                                      size=f'{len(request.automaton.automaton):,} automaton states',
                                                      arrival=arrival, requested=requested,
                                                      request_id=request.request_id)

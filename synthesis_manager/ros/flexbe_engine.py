@@ -34,7 +34,7 @@ from atlas_sim.executive.executor import ExecutionLimitError
 from atlas_sim.simulator.node_names import CAPABILITY_ACTION_PREFIX
 from atlas_sim.simulator.operator_data import answers_by_request_type, flexbe_input_data
 from respec.robot import RobotSystem
-from sm_generation.config import flexbe_config, generation_system, input_request_capabilities
+from sm_generation.config import flexbe_config, input_request_capabilities
 from sm_generation.flexbe_behavior import behavior_package
 from sm_generation.state_machine import StateMachine
 
@@ -161,12 +161,12 @@ def _wait_for_proxy_tasks(executor, timeout: float = 2.0) -> None:
         time.sleep(0.01)
 
 
-def run_on_flexbe(machine: StateMachine, simulator, simulator_lock, domain_id: int, system: RobotSystem | str = 'atlas',
+def run_on_flexbe(machine: StateMachine, simulator, simulator_lock, domain_id: int, system: RobotSystem,
                   behavior_name: str = 'Synthesized Behavior', autonomy: int = FULL_AUTONOMY,
                   max_wall_time: float = 600.0, verbose: bool = False):
     """Run ``machine`` on FlexBE; returns an ExecutionResult.
 
-    ``system`` is a RobotSystem, or the name of one in config/. The simulator node must be
+    ``system`` is the RobotSystem ``machine`` was generated for. The simulator node must be
     running on ``domain_id`` around ``simulator``. Raises
     ExecutionLimitError (with the partial trace) if no outcome came within ``max_wall_time``.
     flexbe_core's INFO log lines and progress notes (about a hundred per run) are shown on
@@ -177,7 +177,6 @@ def run_on_flexbe(machine: StateMachine, simulator, simulator_lock, domain_id: i
 
     from synthesis_manager.ros.harness import RosHarness
 
-    system = generation_system(system)
     config = flexbe_config(system)
     package = behavior_package(machine, config, behavior_name, date=time.strftime('%a %b %d %Y'))
     recorder = EngineTraceRecorder(machine, simulator, system, simulator_lock)

@@ -1,4 +1,4 @@
-"""What each GUI surface asks of a robot, answered by its kind: ``robot_view(robot)``.
+"""What each GUI surface asks of a robot, answered by its format: ``robot_view(robot)``.
 
 A robot of our own format (a mode abstraction: control modes and actions) and a robot of CNU's
 capability format (capabilities, memories, a spec file's sensors) offer different things to the
@@ -23,7 +23,9 @@ from ltl_specification.capability_precheck import clause_text
 from ltl_specification.diagnosis import impossible_next_goals
 from ltl_specification.systems import load_task_abstraction
 from respec.naming import DEFAULT_SM_OUTCOMES, FINISHED
-from respec.robot import RobotSystem
+from respec.robot import RobotSystem, for_description
+from respec.robot.abstraction import RobotAbstraction
+from respec.robot.cnu import CapabilitySystem
 from respec.robot.files import SystemConfigError
 from synthesis_manager.web.jobs import JOB_OPTIONS
 
@@ -179,9 +181,13 @@ class CapabilityRobotView:
                 'faults': 'this capability answers the outcome it fails with, every time (fault injection)'}
 
 
+_VIEWS = {RobotAbstraction: ModeRobotView, CapabilitySystem: CapabilityRobotView}
+
+
 def robot_view(robot: RobotSystem) -> ModeRobotView | CapabilityRobotView:
-    """The view of ``robot`` for the GUI's surfaces (the one place its kind is asked)."""
-    return CapabilityRobotView(robot) if robot.is_capability_system else ModeRobotView(robot)
+    """The view of ``robot`` for the GUI's surfaces, by the format that describes it (a file
+    without a description gets the mode view, which names what is missing)."""
+    return for_description(_VIEWS, robot, missing=ModeRobotView)(robot)
 
 
 def common_choices(robot: RobotSystem, view) -> dict:

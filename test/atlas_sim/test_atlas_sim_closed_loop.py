@@ -17,16 +17,17 @@ from ltl_specification import compile_task
 from ltl_synthesizer import synthesize
 from respec.automaton import automaton_from_strategy
 from sm_generation import generate_state_machine, validate_state_machine
+from respec.robot import robot_system
 
 STAND_HEIGHT_RANGE = (0.6, 1.1)  # pelvis height (m): crouched stand_prep is ~0.67, standing ~0.85
 
 
 def synthesize_machine(initial_conditions, goals, sm_outcomes=('finished', 'failed')):
-    spec = compile_task('atlas', initial_conditions, goals, sm_outcomes=sm_outcomes)
+    spec = compile_task(robot_system('atlas'), initial_conditions, goals, sm_outcomes=sm_outcomes)
     result = synthesize(spec)
     assert result.realizable, result.explanation
     automaton = automaton_from_strategy(result.strategy, spec)
-    machine = generate_state_machine(automaton, 'atlas', initial_conditions=initial_conditions)
+    machine = generate_state_machine(automaton, robot_system('atlas'), initial_conditions=initial_conditions)
     assert validate_state_machine(machine.to_instantiations()) == []
     return spec, machine
 
@@ -34,9 +35,9 @@ def synthesize_machine(initial_conditions, goals, sm_outcomes=('finished', 'fail
 def run_task(initial_conditions, goals, sm_outcomes=('finished', 'failed'), **fault_lists):
     """Synthesize, execute on a fresh simulator, check the trace and the robot's health."""
     spec, states = synthesize_machine(initial_conditions, goals, sm_outcomes)
-    simulator = make_simulator('atlas', initial_conditions=initial_conditions,
+    simulator = make_simulator(robot_system('atlas'), initial_conditions=initial_conditions,
                                faults=parse_faults(**fault_lists))
-    run = execute_state_machine(states, SimulatedRobot(simulator))
+    run = execute_state_machine(states, SimulatedRobot(simulator), robot_system('atlas'))
     report = check_trace(run.trace, spec, goals=goals)
     assert report.ok, report.summary()
     assert not run.fallen and not simulator.has_fallen()

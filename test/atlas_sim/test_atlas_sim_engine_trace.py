@@ -16,13 +16,15 @@ from respec.automaton import automaton_from_strategy
 from respec.robot import robot_system
 from sm_generation import generate_state_machine
 
+ATLAS = robot_system('atlas')
+
 INITIAL, GOALS = ['stand_prep'], ['walk']
 
 
 def machine():
-    spec = compile_task('atlas', INITIAL, GOALS)
+    spec = compile_task(ATLAS, INITIAL, GOALS)
     automaton = automaton_from_strategy(synthesize(spec).strategy, spec)
-    return spec, generate_state_machine(automaton, 'atlas', initial_conditions=INITIAL)
+    return spec, generate_state_machine(automaton, ATLAS, initial_conditions=INITIAL)
 
 
 def drive(machine, simulator, recorder):
@@ -44,14 +46,14 @@ def drive(machine, simulator, recorder):
 
 def test_recorded_trace_checks_clean_and_matches_our_executive():
     spec, states = machine()
-    simulator = make_simulator('atlas', initial_conditions=INITIAL)
-    recorder = EngineTraceRecorder(states, simulator, robot_system('atlas'))
+    simulator = make_simulator(ATLAS, initial_conditions=INITIAL)
+    recorder = EngineTraceRecorder(states, simulator, ATLAS)
     end = drive(states, simulator, recorder)
     recorder.close()
     run = recorder.result()
     assert end == 'finished' and run.outcome == 'finished' and not run.fallen
     assert check_trace(run.trace, spec, goals=GOALS).ok
-    ours = execute_state_machine(states, SimulatedRobot(make_simulator('atlas', initial_conditions=INITIAL)))
+    ours = execute_state_machine(states, SimulatedRobot(make_simulator(ATLAS, initial_conditions=INITIAL)), ATLAS)
     assert [(s.state, s.activated, s.state_outcome, s.transition) for s in run.trace.steps] == \
         [(s.state, s.activated, s.state_outcome, s.transition) for s in ours.trace.steps]
     assert [s.outcomes_at_exit for s in run.trace.steps] == [s.outcomes_at_exit for s in ours.trace.steps]

@@ -13,7 +13,9 @@ from sm_generation import SMGenerationError, StateInstantiation, StateMachine
 from respec.robot import robot_system
 from sm_generation.config import flexbe_config
 
-FLEXBE = flexbe_config(robot_system('atlas'))
+ATLAS = robot_system('atlas')
+
+FLEXBE = flexbe_config(ATLAS)
 MODES = ['stand_prep', 'stand', 'manipulate', 'step', 'walk']
 
 
@@ -84,7 +86,7 @@ class ScriptedRobot:
 
 @pytest.fixture(scope='module')
 def pickup_spec():
-    return compile_task('atlas', ['stand_prep'], ['look_down', 'pickup_object'])
+    return compile_task(ATLAS, ['stand_prep'], ['look_down', 'pickup_object'])
 
 
 # --- FlexBE semantics on the simulator ---------------------------------------------------------------
@@ -103,8 +105,8 @@ def test_a_container_returns_on_its_first_holding_condition_and_running_states_c
                                   ('failed_inside', {'stand': 'failed'})],
                                  both_done='look_down', template_done='stand', failed_inside='failed'),
                state('/stand', 'stand_a', changed='look_down', failed='failed'), *PICKUP_TAIL]
-    simulator = make_simulator('atlas', initial_conditions=['stand_prep'])
-    run = execute_state_machine(StateMachine.from_instantiations(machine), SimulatedRobot(simulator))
+    simulator = make_simulator(ATLAS, initial_conditions=['stand_prep'])
+    run = execute_state_machine(StateMachine.from_instantiations(machine), SimulatedRobot(simulator), ATLAS)
     assert run.outcome == 'finished'
     first, second = run.trace.steps[:2]
     assert first.activated == ['object_template_a', 'stand_a'] and first.state_outcome == 'template_done'
@@ -126,7 +128,7 @@ def test_a_container_waits_until_a_condition_holds(pickup_spec):
                *PICKUP_TAIL]
     machine[1]['outcomes'], machine[1]['transitions'] = ['both_done', 'failed_inside'], ['look_down', 'failed']
     machine[2]['outcomes'], machine[2]['transitions'] = ['received'], ['both_done']
-    run = execute_state_machine(StateMachine.from_instantiations(machine), SimulatedRobot(make_simulator('atlas')))
+    run = execute_state_machine(StateMachine.from_instantiations(machine), SimulatedRobot(make_simulator(ATLAS)), ATLAS)
     first = run.trace.steps[0]
     assert first.state_outcome == 'both_done' and first.ended_at >= 1.5  # stand takes 1.5 s
     assert sorted(first.outcomes_at_exit) == ['obj_detected', 'object_template_c', 'stand_c']
@@ -136,9 +138,9 @@ def test_a_container_waits_until_a_condition_holds(pickup_spec):
 def test_dataclasses_and_dicts_run_the_same():
     machine = [root('stand'), state('/stand', 'stand_a', changed='walk', failed='failed'),
                state('/walk', 'walk_a', changed='finished', failed='failed')]
-    from_dicts = execute_state_machine(StateMachine.from_instantiations(machine), SimulatedRobot(make_simulator('atlas')))
+    from_dicts = execute_state_machine(StateMachine.from_instantiations(machine), SimulatedRobot(make_simulator(ATLAS)), ATLAS)
     objects = [StateInstantiation.from_dict(entry) for entry in machine]
-    from_objects = execute_state_machine(StateMachine.from_instantiations(objects), SimulatedRobot(make_simulator('atlas')))
+    from_objects = execute_state_machine(StateMachine.from_instantiations(objects), SimulatedRobot(make_simulator(ATLAS)), ATLAS)
     assert from_dicts.trace.to_dict() == from_objects.trace.to_dict()
     assert from_dicts.outcome == 'finished' and from_dicts.trace.steps[-1].mode_at_exit == 'walk'
 
@@ -146,8 +148,8 @@ def test_dataclasses_and_dicts_run_the_same():
 def test_a_failing_capability_takes_the_failure_transition():
     machine = [root('stand'), state('/stand', 'stand_a', changed='walk', failed='failed'),
                state('/walk', 'walk_a', changed='finished', failed='failed')]
-    simulator = make_simulator('atlas', faults=parse_faults(fail=['walk']))
-    run = execute_state_machine(StateMachine.from_instantiations(machine), SimulatedRobot(simulator))
+    simulator = make_simulator(ATLAS, faults=parse_faults(fail=['walk']))
+    run = execute_state_machine(StateMachine.from_instantiations(machine), SimulatedRobot(simulator), ATLAS)
     assert run.outcome == 'failed'
     assert run.trace.steps[-1].results[0]['reason'].startswith('injected fault')
     assert 'walk_f' in run.trace.steps[-1].outcomes_at_exit
@@ -162,7 +164,7 @@ def test_an_abandoned_request_is_recorded_and_the_check_blames_the_robot(pickup_
                state('/object_template', 'object_template_a', received='failed', aborted='failed')]
     machine[2]['outcomes'], machine[2]['transitions'] = ['received'], ['template_done']
     robot = ScriptedRobot({'object_template': [(1, 'completed'), (5, 'completed')], 'stand': (3, 'completed')})
-    run = execute_state_machine(StateMachine.from_instantiations(machine), robot)
+    run = execute_state_machine(StateMachine.from_instantiations(machine), robot, ATLAS)
     second = run.trace.steps[1]
     assert second.results[0] == {'capability': 'stand', 'outcome': 'completed', 'reason': 'scripted',
                                  'time': 0.3, 'abandoned': True}
@@ -182,7 +184,7 @@ def test_sensor_states_return_when_the_sensor_turns_true():
                state('/look_down_and_obj_detected/look_down', 'look_down_a', done='looked'),
                state('/look_down_and_obj_detected/obj_detected', 'obj_detected', found='seen')]
     robot = ScriptedRobot({'look_down': (10, 'completed')}, mode='stand', sensors_at={'obj_detected': 4})
-    run = execute_state_machine(StateMachine.from_instantiations(machine), robot)
+    run = execute_state_machine(StateMachine.from_instantiations(machine), robot, ATLAS)
     assert run.outcome == 'finished' and robot.tick == 4
     assert run.trace.steps[0].activated == ['look_down_a']  # sensors are not activated
     assert 'obj_detected' in run.trace.steps[0].outcomes_at_exit
@@ -196,11 +198,11 @@ def test_helper_states_take_no_robot_time_and_decisions_use_the_hook():
                 'transitions': ['finished']},
                state('/stand', 'stand_a', changed='finished', failed='failed')]
     robot = ScriptedRobot({'stand': (2, 'completed')})
-    run = execute_state_machine(StateMachine.from_instantiations(machine), robot)  # default: the first outcome
+    run = execute_state_machine(StateMachine.from_instantiations(machine), robot, ATLAS)  # default: the first outcome
     assert run.outcome == 'finished' and robot.started == [(0, 'stand')]
     robot = ScriptedRobot({})
     asked = []
-    run = execute_state_machine(StateMachine.from_instantiations(machine), robot, decide=lambda path, outcomes: asked.append(path) or outcomes[1])
+    run = execute_state_machine(StateMachine.from_instantiations(machine), robot, ATLAS, decide=lambda path, outcomes: asked.append(path) or outcomes[1])
     assert run.outcome == 'finished' and robot.tick == 0 and asked == ['/choose_initial_state']
     assert [s.state for s in run.trace.steps] == ['/choose_initial_state', '/nothing_to_do']
 
@@ -210,7 +212,7 @@ def test_helper_states_take_no_robot_time_and_decisions_use_the_hook():
 def test_a_run_without_outcome_hits_the_robot_time_limit():
     machine = [root('stand'), state('/stand', 'stand_a', changed='finished', failed='failed')]
     with pytest.raises(ExecutionLimitError) as error:
-        execute_state_machine(StateMachine.from_instantiations(machine), ScriptedRobot({}), max_robot_time=2.0)
+        execute_state_machine(StateMachine.from_instantiations(machine), ScriptedRobot({}), ATLAS, max_robot_time=2.0)
     assert error.value.item == '/stand' and error.value.code == 'TIMEOUT'
     assert len(error.value.trace.steps) == 1 and 'robot time' in str(error.value)
 
@@ -218,7 +220,7 @@ def test_a_run_without_outcome_hits_the_robot_time_limit():
 def test_an_undeclared_outcome_names_the_state():
     machine = [root('stand'), state('/stand', 'stand_a', changed='finished')]  # no 'failed' outcome
     with pytest.raises(UndeclaredOutcomeError) as error:
-        execute_state_machine(StateMachine.from_instantiations(machine), ScriptedRobot({'stand': (1, 'failed')}))
+        execute_state_machine(StateMachine.from_instantiations(machine), ScriptedRobot({'stand': (1, 'failed')}), ATLAS)
     assert error.value.item == '/stand' and "'failed'" in str(error.value)
 
 
@@ -226,12 +228,12 @@ def test_an_unmapped_state_names_the_state():
     machine = [root('dance'), {'state_path': '/dance', 'state_class': 'DanceState', 'outcomes': ['done'],
                                'transitions': ['finished']}]
     with pytest.raises(UnmappedStateError) as error:
-        execute_state_machine(StateMachine.from_instantiations(machine), ScriptedRobot({}))
+        execute_state_machine(StateMachine.from_instantiations(machine), ScriptedRobot({}), ATLAS)
     assert error.value.item == '/dance' and 'DanceState' in str(error.value)
     wrong_parameter = state('/stand', 'stand_a', changed='finished', failed='failed')
     wrong_parameter['parameter_values'] = ['ChangeControlModeActionState.FLY']
     with pytest.raises(UnmappedStateError) as error:
-        execute_state_machine(StateMachine.from_instantiations([root('stand'), wrong_parameter]), ScriptedRobot({}))
+        execute_state_machine(StateMachine.from_instantiations([root('stand'), wrong_parameter]), ScriptedRobot({}), ATLAS)
     assert error.value.item == '/stand'
 
 
@@ -255,7 +257,7 @@ def test_invalid_machines_name_the_offending_entry(machine, item):
 # --- simulator set-up -------------------------------------------------------------------------------
 
 def test_make_simulator_starts_in_the_initial_conditions():
-    simulator = make_simulator('atlas', initial_conditions=['manipulate', 'object_template'])
+    simulator = make_simulator(ATLAS, initial_conditions=['manipulate', 'object_template'])
     assert simulator.mode == 'manipulate' and simulator.completed_actions() == ['object_template']
     assert simulator.execute('pickup_object').completed  # its preconditions hold from the start
     assert not simulator.has_fallen()
@@ -264,7 +266,7 @@ def test_make_simulator_starts_in_the_initial_conditions():
 @pytest.mark.parametrize('conditions, item', [(['fly'], 'fly'), (['stand', 'walk'], 'walk')])
 def test_make_simulator_rejects_bad_initial_conditions(conditions, item):
     with pytest.raises(InitialConditionError) as error:
-        make_simulator('atlas', initial_conditions=conditions)
+        make_simulator(ATLAS, initial_conditions=conditions)
     assert error.value.item == item
 
 
@@ -275,5 +277,5 @@ def test_parse_faults():
         parse_faults(fail_first=['pickup_object'])
     assert error.value.item == 'pickup_object'
     with pytest.raises(FaultSpecError) as error:
-        make_simulator('atlas', faults=parse_faults(fail=['fly']))
+        make_simulator(ATLAS, faults=parse_faults(fail=['fly']))
     assert error.value.item == 'fly'

@@ -22,10 +22,10 @@ FRAME_NAME = re.compile(r'^(\d{4})_(\d{4}\.\d{3})s_([A-Za-z0-9_.-]+)\.png$')
 @pytest.fixture(scope='module')
 def filmed_pickup(tmp_path_factory):
     goals = ['look_down', 'pickup_object']
-    spec = compile_task('atlas', ['stand_prep'], goals)
+    spec = compile_task(robot_system('atlas'), ['stand_prep'], goals)
     automaton = automaton_from_strategy(synthesize(spec).strategy, spec)
-    states = generate_state_machine(automaton, 'atlas', initial_conditions=['stand_prep'])
-    simulator = make_simulator('atlas', initial_conditions=['stand_prep'])
+    states = generate_state_machine(automaton, robot_system('atlas'), initial_conditions=['stand_prep'])
+    simulator = make_simulator(robot_system('atlas'), initial_conditions=['stand_prep'])
     progress = []
     run = run_and_check(states, SimulatedRobot(simulator), simulator, robot_system('atlas'), spec, goals,
                         record_dir=tmp_path_factory.mktemp('run'),

@@ -21,6 +21,8 @@ from respec.automaton import automaton_from_strategy
 from respec.robot import robot_system
 from sm_generation import generate_state_machine
 
+ATLAS = robot_system('atlas')
+
 TWELVE_GOALS = ['look_down', 'approach_object', 'pregrasp', 'grasp_object', 'pickup_object',
                 'footstep_execution', 'object_template', 'pregrasp_pose', 'footstep_plan', 'target_pose',
                 'pregrasp_plan', 'footstep_goal']
@@ -37,15 +39,15 @@ def with_scene(simulator, **scene):
 
 @pytest.fixture(scope='module')
 def twelve_goal_task():
-    spec = compile_task('atlas', ['stand_prep'], TWELVE_GOALS)
+    spec = compile_task(ATLAS, ['stand_prep'], TWELVE_GOALS)
     automaton = automaton_from_strategy(synthesize(spec).strategy, spec)
-    return spec, generate_state_machine(automaton, 'atlas', initial_conditions=['stand_prep'])
+    return spec, generate_state_machine(automaton, ATLAS, initial_conditions=['stand_prep'])
 
 
 def run_twelve_goals(task, simulator):
     spec, states = task
     path = []
-    run = run_and_check(states, SimulatedRobot(simulator), simulator, robot_system('atlas'), spec, TWELVE_GOALS,
+    run = run_and_check(states, SimulatedRobot(simulator), simulator, ATLAS, spec, TWELVE_GOALS,
                         on_progress=lambda steps, frames: path.append(simulator.physics.pelvis_position()[:2]))
     return run, path
 
@@ -53,7 +55,7 @@ def run_twelve_goals(task, simulator):
 # --- the 12-goal run ---------------------------------------------------------------------------
 
 def test_the_twelve_goal_run_walks_around_the_table_and_the_check_passes_it(twelve_goal_task):
-    run, path = run_twelve_goals(twelve_goal_task, make_simulator('atlas', initial_conditions=['stand_prep']))
+    run, path = run_twelve_goals(twelve_goal_task, make_simulator(ATLAS, initial_conditions=['stand_prep']))
     assert run.result.outcome == 'finished'
     assert run.check.ok, run.check.summary()
     assert run.result.trace.incidents == [] and not run.result.fallen
@@ -63,7 +65,7 @@ def test_the_twelve_goal_run_walks_around_the_table_and_the_check_passes_it(twel
 
 
 def test_the_twelve_goal_run_of_a_blind_robot_hits_the_table_and_the_check_fails_it(twelve_goal_task):
-    blind = with_scene(make_simulator('atlas', initial_conditions=['stand_prep']), look_ahead=False)
+    blind = with_scene(make_simulator(ATLAS, initial_conditions=['stand_prep']), look_ahead=False)
     run, _ = run_twelve_goals(twelve_goal_task, blind)
     contacts = [v for v in run.check.violations if v.kind == 'contact']
     assert not run.check.ok and contacts, run.check.summary()
@@ -76,7 +78,7 @@ def test_the_twelve_goal_run_of_a_blind_robot_hits_the_table_and_the_check_fails
 # --- walks and the table -----------------------------------------------------------------------
 
 def test_a_walk_whose_way_is_blocked_on_both_sides_fails_naming_the_table():
-    simulator = with_scene(make_simulator('atlas', initial_conditions=['stand']), clearance=1.5)
+    simulator = with_scene(make_simulator(ATLAS, initial_conditions=['stand']), clearance=1.5)
     x_before = simulator.snapshot()['base_xy'][0]
     result = simulator.execute('walk')
     assert result.outcome == 'failed'
@@ -85,7 +87,7 @@ def test_a_walk_whose_way_is_blocked_on_both_sides_fails_naming_the_table():
 
 
 def test_a_short_walk_with_room_ahead_goes_straight():
-    simulator = make_simulator('atlas', initial_conditions=['stand'])
+    simulator = make_simulator(ATLAS, initial_conditions=['stand'])
     simulator.execute('object_template')
     assert simulator.execute('approach_object').completed
     x, y = simulator.snapshot()['base_xy']
@@ -93,7 +95,7 @@ def test_a_short_walk_with_room_ahead_goes_straight():
 
 
 def test_walking_blind_into_the_table_is_an_incident_naming_the_part_and_the_table():
-    simulator = with_scene(make_simulator('atlas', initial_conditions=['stand']), look_ahead=False)
+    simulator = with_scene(make_simulator(ATLAS, initial_conditions=['stand']), look_ahead=False)
     simulator.execute('walk')
     contacts = [i for i in simulator.incidents if i.kind == 'contact']
     assert contacts and {i.obstacle for i in contacts} == {'table'}
@@ -105,7 +107,7 @@ def test_walking_blind_into_the_table_is_an_incident_naming_the_part_and_the_tab
 
 @pytest.fixture(scope='module')
 def walk_spec():
-    return compile_task('atlas', ['stand_prep'], ['walk'], sm_outcomes=['finished', 'failed'])
+    return compile_task(ATLAS, ['stand_prep'], ['walk'], sm_outcomes=['finished', 'failed'])
 
 
 def walk_trace(incidents=()):

@@ -13,6 +13,9 @@ from atlas_sim.simulated_robot import SimulatedRobot
 from atlas_sim.simulator.factory import make_simulator
 from sm_generation import StateMachine
 from test_atlas_sim_executor import ScriptedRobot, root, state
+from respec.robot import robot_system
+
+ATLAS = robot_system('atlas')
 
 STAND_THEN_LOOK = [root('stand'),
                    {**state('/stand', 'stand_a', changed='look_down', failed='failed'), 'autonomy': [2, 0]},
@@ -53,10 +56,10 @@ def test_flexbe_rule_a_transition_waits_unless_its_autonomy_is_below_the_level()
 
 def test_at_full_autonomy_nothing_waits_and_the_run_is_the_unattended_one():
     unattended = execute_state_machine(StateMachine.from_instantiations(STAND_THEN_LOOK), ScriptedRobot({'stand': (3, 'completed'),
-                                                                       'look_down': (2, 'completed')}))
+                                                                       'look_down': (2, 'completed')}), ATLAS)
     robot = ScriptedRobot({'stand': (3, 'completed'), 'look_down': (2, 'completed')})
     operator = Operator(robot)
-    run = execute_state_machine(StateMachine.from_instantiations(STAND_THEN_LOOK), robot, control=operator.make(FULL))
+    run = execute_state_machine(StateMachine.from_instantiations(STAND_THEN_LOOK), robot, ATLAS, control=operator.make(FULL))
     assert run.outcome == unattended.outcome == 'finished'
     assert run.trace.to_dict() == unattended.trace.to_dict()
     assert all(status['waiting'] is None for status in operator.statuses)
@@ -65,7 +68,7 @@ def test_at_full_autonomy_nothing_waits_and_the_run_is_the_unattended_one():
 def test_a_high_transition_at_high_autonomy_waits_for_confirmation_and_robot_time_stands_still():
     robot = ScriptedRobot({'stand': (3, 'completed'), 'look_down': (2, 'completed')})
     operator = Operator(robot, script={'confirm': [{'command': 'confirm', 'state': '/stand'}]})
-    run = execute_state_machine(StateMachine.from_instantiations(STAND_THEN_LOOK), robot, control=operator.make(HIGH))
+    run = execute_state_machine(StateMachine.from_instantiations(STAND_THEN_LOOK), robot, ATLAS, control=operator.make(HIGH))
     waits = [s['waiting'] for s in operator.statuses if s['waiting']]
     assert waits == [{'kind': 'confirm', 'state': '/stand', 'outcome': 'changed', 'required': 2,
                       'outcomes': ['changed', 'failed']}]  # look_down's done (Low) did not wait
@@ -77,14 +80,14 @@ def test_a_high_transition_at_high_autonomy_waits_for_confirmation_and_robot_tim
 def test_raising_the_level_lets_the_waiting_transition_go():
     robot = ScriptedRobot({'stand': (3, 'completed'), 'look_down': (2, 'completed')})
     operator = Operator(robot, script={'confirm': [{'command': 'autonomy', 'level': FULL}]})
-    run = execute_state_machine(StateMachine.from_instantiations(STAND_THEN_LOOK), robot, control=operator.make(OFF))
+    run = execute_state_machine(StateMachine.from_instantiations(STAND_THEN_LOOK), robot, ATLAS, control=operator.make(OFF))
     assert run.outcome == 'finished' and operator.control.autonomy_level == FULL
 
 
 def test_forcing_another_outcome_at_a_waiting_transition_takes_it():
     robot = ScriptedRobot({'stand': (3, 'completed')})
     operator = Operator(robot, script={'confirm': [{'command': 'force', 'state': '/stand', 'outcome': 'failed'}]})
-    run = execute_state_machine(StateMachine.from_instantiations(STAND_THEN_LOOK), robot, control=operator.make(HIGH))
+    run = execute_state_machine(StateMachine.from_instantiations(STAND_THEN_LOOK), robot, ATLAS, control=operator.make(HIGH))
     assert run.outcome == 'failed' and run.trace.steps[0].state_outcome == 'failed'
     # The trace says who chose it, and what the choice stands for (the trace check reads it so).
     assert (run.trace.steps[0].forced, run.trace.steps[0].forced_propositions) == ('failed', ['stand_f'])
@@ -93,7 +96,7 @@ def test_forcing_another_outcome_at_a_waiting_transition_takes_it():
 def test_an_outcome_forced_while_the_state_runs_ends_it_at_once():
     robot = ScriptedRobot({'stand': (30, 'completed')})
     operator = Operator(robot, at_tick={4: [{'command': 'force', 'state': '/stand', 'outcome': 'failed'}]})
-    run = execute_state_machine(StateMachine.from_instantiations(STAND_THEN_LOOK), robot, control=operator.make(FULL))
+    run = execute_state_machine(StateMachine.from_instantiations(STAND_THEN_LOOK), robot, ATLAS, control=operator.make(FULL))
     assert run.outcome == 'failed' and robot.tick == 4
     assert run.trace.steps[0].ended_at == pytest.approx(0.4)
     assert (run.trace.steps[0].forced, run.trace.steps[0].forced_propositions) == ('failed', ['stand_f'])
@@ -102,7 +105,7 @@ def test_an_outcome_forced_while_the_state_runs_ends_it_at_once():
 def test_an_outcome_the_state_does_not_have_is_refused_and_the_run_goes_on():
     robot = ScriptedRobot({'stand': (3, 'completed'), 'look_down': (2, 'completed')})
     operator = Operator(robot, at_tick={1: [{'command': 'force', 'state': '/stand', 'outcome': 'nonsense'}]})
-    run = execute_state_machine(StateMachine.from_instantiations(STAND_THEN_LOOK), robot, control=operator.make(FULL))
+    run = execute_state_machine(StateMachine.from_instantiations(STAND_THEN_LOOK), robot, ATLAS, control=operator.make(FULL))
     assert run.outcome == 'finished'
     assert run.operator_events[-1]['command'] == 'refused' and 'nonsense' in run.operator_events[-1]['reason']
 
@@ -110,14 +113,14 @@ def test_an_outcome_the_state_does_not_have_is_refused_and_the_run_goes_on():
 def test_pause_holds_the_robot_until_resume_and_stop_ends_the_run_with_its_trace():
     robot = ScriptedRobot({'stand': (3, 'completed'), 'look_down': (2, 'completed')})
     operator = Operator(robot, at_tick={2: [{'command': 'pause'}]}, script={'resume': [{'command': 'resume'}]})
-    run = execute_state_machine(StateMachine.from_instantiations(STAND_THEN_LOOK), robot, control=operator.make(FULL))
+    run = execute_state_machine(StateMachine.from_instantiations(STAND_THEN_LOOK), robot, ATLAS, control=operator.make(FULL))
     assert run.outcome == 'finished' and robot.tick == 5
     assert {'kind': 'resume', 'state': '/stand'} in [s['waiting'] for s in operator.statuses]
 
     robot = ScriptedRobot({'stand': (3, 'completed'), 'look_down': (20, 'completed')})
     operator = Operator(robot, at_tick={2: [{'command': 'pause'}]}, script={'resume': [{'command': 'stop'}]})
     with pytest.raises(OperatorStopError) as stopped:
-        execute_state_machine(StateMachine.from_instantiations(STAND_THEN_LOOK), robot, control=operator.make(FULL))
+        execute_state_machine(StateMachine.from_instantiations(STAND_THEN_LOOK), robot, ATLAS, control=operator.make(FULL))
     assert stopped.value.item == '/stand' and [s.state for s in stopped.value.trace.steps] == ['/stand']
     assert robot.tick == 2
 
@@ -126,7 +129,7 @@ def test_a_wait_ends_at_the_wall_time_limit():
     robot = ScriptedRobot({'stand': (3, 'completed')})
     control = RuntimeControl(lambda timeout: [], autonomy_level=OFF)
     with pytest.raises(OperatorWaitLimitError) as limit:
-        execute_state_machine(StateMachine.from_instantiations(STAND_THEN_LOOK), robot, control=control, max_wall_time=0.2)
+        execute_state_machine(StateMachine.from_instantiations(STAND_THEN_LOOK), robot, ATLAS, control=control, max_wall_time=0.2)
     assert limit.value.item == '/stand' and 'waited for the operator: confirm' in str(limit.value)
 
 
@@ -161,7 +164,7 @@ PICK = [root('object_template'),
 
 
 def test_input_state_asks_the_operator_with_the_simulators_answer_offered():
-    simulator = make_simulator('atlas', initial_conditions=['stand_prep'])
+    simulator = make_simulator(ATLAS, initial_conditions=['stand_prep'])
     asked = []
 
     def receive(timeout):
@@ -172,7 +175,7 @@ def test_input_state_asks_the_operator_with_the_simulators_answer_offered():
         return []
 
     control = RuntimeControl(receive, autonomy_level=HIGH)
-    run = execute_state_machine(StateMachine.from_instantiations(PICK), SimulatedRobot(simulator), control=control)
+    run = execute_state_machine(StateMachine.from_instantiations(PICK), SimulatedRobot(simulator), ATLAS, control=control)
     assert asked == [{'kind': 'input', 'state': '/object_template', 'prompt': 'Specify desired object template',
                       'default': 1}]
     assert run.outcome == 'finished' and simulator.answers == {'template_id': 1}
@@ -180,17 +183,17 @@ def test_input_state_asks_the_operator_with_the_simulators_answer_offered():
 
 @pytest.mark.parametrize('answer', [None, 7, 'box'])
 def test_an_aborted_or_invalid_input_fails_the_input_state(answer):
-    simulator = make_simulator('atlas', initial_conditions=['stand_prep'])
+    simulator = make_simulator(ATLAS, initial_conditions=['stand_prep'])
     control = RuntimeControl(lambda timeout: [{'command': 'input', 'state': '/object_template', 'value': answer}]
                              if control.waiting else [], autonomy_level=LOW)
-    run = execute_state_machine(StateMachine.from_instantiations(PICK), SimulatedRobot(simulator), control=control)
+    run = execute_state_machine(StateMachine.from_instantiations(PICK), SimulatedRobot(simulator), ATLAS, control=control)
     assert run.outcome == 'failed'
     assert run.trace.steps[0].results[0]['reason'] == 'operator did not provide object_template'
 
 
 def test_at_full_autonomy_the_input_takes_the_robots_default_without_asking():
-    simulator = make_simulator('atlas', initial_conditions=['stand_prep'])
-    run = execute_state_machine(StateMachine.from_instantiations(PICK), SimulatedRobot(simulator), control=RuntimeControl(lambda timeout: []))
+    simulator = make_simulator(ATLAS, initial_conditions=['stand_prep'])
+    run = execute_state_machine(StateMachine.from_instantiations(PICK), SimulatedRobot(simulator), ATLAS, control=RuntimeControl(lambda timeout: []))
     assert run.outcome == 'finished' and simulator.answers == {'template_id': 1} and run.operator_events == []
 
 
@@ -207,11 +210,11 @@ def test_an_operator_decision_waits_with_its_suggestion_even_at_full_autonomy():
                state('/stand', 'stand_a', changed='finished', failed='failed')]
     robot = ScriptedRobot({'stand': (2, 'completed')})
     operator = Operator(robot, script={'confirm': [{'command': 'confirm', 'state': '/choose_initial_state'}]})
-    run = execute_state_machine(StateMachine.from_instantiations(machine), robot, control=operator.make(FULL))
+    run = execute_state_machine(StateMachine.from_instantiations(machine), robot, ATLAS, control=operator.make(FULL))
     assert [s['waiting']['outcome'] for s in operator.statuses if s['waiting']] == ['stand']  # the suggestion
     assert [s.state for s in run.trace.steps] == ['/choose_initial_state', '/stand']
     robot = ScriptedRobot({'stand': (2, 'completed')})
     operator = Operator(robot, script={'confirm': [{'command': 'force', 'state': '/choose_initial_state',
                                                     'outcome': 'nothing_to_do'}]})
-    run = execute_state_machine(StateMachine.from_instantiations(machine), robot, control=operator.make(FULL))
+    run = execute_state_machine(StateMachine.from_instantiations(machine), robot, ATLAS, control=operator.make(FULL))
     assert [s.state for s in run.trace.steps] == ['/choose_initial_state', '/nothing_to_do'] and robot.tick == 0

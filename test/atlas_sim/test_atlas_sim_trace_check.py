@@ -9,6 +9,7 @@ from atlas_sim.executive.trace_check import (OutcomeTracker, Trace, TraceError, 
 from ltl_specification import compile_task
 from respec.ltl import to_infix, var
 from respec.parsing import parse_formula
+from respec.robot import robot_system
 
 MODES = ['stand_prep', 'stand', 'manipulate', 'step', 'walk']
 
@@ -41,17 +42,17 @@ def make_trace(steps, outcome, initial_mode='stand_prep', completed=()):
 
 @pytest.fixture(scope='module')
 def walk_spec():
-    return compile_task('atlas', ['stand_prep'], ['walk'], sm_outcomes=['finished', 'failed'])
+    return compile_task(robot_system('atlas'), ['stand_prep'], ['walk'], sm_outcomes=['finished', 'failed'])
 
 
 @pytest.fixture(scope='module')
 def pickup_spec():
-    return compile_task('atlas', ['stand_prep'], ['look_down', 'pickup_object'])
+    return compile_task(robot_system('atlas'), ['stand_prep'], ['look_down', 'pickup_object'])
 
 
 @pytest.fixture(scope='module')
 def unordered_pickup_spec():
-    return compile_task('atlas', ['stand_prep'], ['look_down', 'pickup_object'], strict_order=False)
+    return compile_task(robot_system('atlas'), ['stand_prep'], ['look_down', 'pickup_object'], strict_order=False)
 
 
 GOOD_WALK = [('/stand', ['stand'], [('stand', 'completed')]),
@@ -191,7 +192,7 @@ def test_goals_out_of_order_count_when_unordered(unordered_pickup_spec):
 
 
 def test_sys_init_violation_is_reported(walk_spec):
-    spec = compile_task('atlas', ['stand_prep'], ['walk'])
+    spec = compile_task(robot_system('atlas'), ['stand_prep'], ['walk'])
     spec.sys_init.append(var('walk_a'))  # the start activates nothing
     report = check_trace(make_trace(GOOD_WALK, 'finished'), spec)
     violation = next(v for v in report.violations if v.kind == 'sys_init')
@@ -302,7 +303,8 @@ def test_a_machine_answering_a_forced_failure_is_not_blamed_and_a_broken_guarant
 
 
 def test_a_forced_outcome_that_breaks_an_assumption_is_the_operators_by_name(pickup_spec):
-    retrying = compile_task('atlas', ['stand_prep'], ['look_down', 'pickup_object'], sm_outcomes=['finished'])
+    retrying = compile_task(robot_system('atlas'),
+                            ['stand_prep'], ['look_down', 'pickup_object'], sm_outcomes=['finished'])
     following = [('/object_template_1', ['object_template'], [('object_template', 'completed')]),
                  ('/look_down_1', ['look_down'], [('look_down', 'completed')])]
     report = check_trace(forced_failure_of_look_down(following, None), retrying)

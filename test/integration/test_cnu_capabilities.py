@@ -84,12 +84,12 @@ def top_level_states(states):
 
 def synthesized(config_dir, name, library):
     example = EXAMPLES[name]
-    spec = compile_task(name, example['initial_conditions'], example['goals'], example['outcomes'],
-                        config_dir=config_dir, state_library=library)
+    spec = compile_task(robot_system(name, config_dir),
+                        example['initial_conditions'], example['goals'], example['outcomes'], state_library=library)
     result = synthesize(spec)
     assert result.realizable
     automaton = automaton_from_strategy(result.strategy, spec)
-    states = generate_state_machine(automaton, name, config_dir, state_library=library).to_instantiations()
+    states = generate_state_machine(automaton, robot_system(name, config_dir), state_library=library).to_instantiations()
     return spec, result.strategy, states
 
 
@@ -158,13 +158,14 @@ def test_all_of_cnus_example_pairs_succeed_with_at_most_cnus_state_count(cnu, li
         config_dir = tmp_path / pair.launch
         write_system_file(config_dir, pair)
         request = pair.request
-        spec = compile_task(request['system_name'], request['initial_conditions'], request['goals'],
-                            request['outcomes'], config_dir=config_dir, state_library=library)
+        spec = compile_task(robot_system(request['system_name'], config_dir),
+                            request['initial_conditions'], request['goals'],
+                            request['outcomes'], state_library=library)
         result = synthesize(spec)
         assert result.realizable, pair.launch
         assert strategy_violations(spec, result.strategy) == [], pair.launch
         automaton = automaton_from_strategy(result.strategy, spec)
-        states = generate_state_machine(automaton, request['system_name'], config_dir, state_library=library).to_instantiations()
+        states = generate_state_machine(automaton, robot_system(request['system_name'], config_dir), state_library=library).to_instantiations()
         never_exits = ['/: a container needs outcomes'] if not states[0].outcomes else []
         assert validate_state_machine(states) == never_exits, pair.launch
         assert states[0].outcomes == request['outcomes'], pair.launch
@@ -180,9 +181,9 @@ def test_a_given_machine_is_generated_as_given(cnu, library, tmp_path):
     """CNU's sm/ file: classes, parameters (Python source), transitions and autonomy unchanged."""
     (pair,) = [p for p in example_pairs(cnu) if 'cnu_state_machine' in p.files]
     write_system_file(tmp_path, pair)
-    spec = compile_task('hello_world', [], [], config_dir=tmp_path, state_library=library)
+    spec = compile_task(robot_system('hello_world', tmp_path), [], [], state_library=library)
     automaton = automaton_from_strategy(synthesize(spec).strategy, spec)
-    states = generate_state_machine(automaton, 'hello_world', tmp_path, state_library=library).to_instantiations()
+    states = generate_state_machine(automaton, robot_system('hello_world', tmp_path), state_library=library).to_instantiations()
     given = yaml.safe_load(pair.files['cnu_state_machine'].read_text())
     assert states[0].initial_state_name == given['sm']['initial_state']
     assert [(s.name, s.state_class, dict(zip(s.parameter_names, s.parameter_values)), s.outcomes, s.transitions,
@@ -194,27 +195,27 @@ def test_a_given_machine_is_generated_as_given(cnu, library, tmp_path):
 def test_full_spec_request_replaces_the_files_initial_literal_and_reads_goals_as_memories(cnu, library, tmp_path):
     (pair,) = [p for p in example_pairs(cnu) if p.launch == 'vending_full_spec_example.launch.py']
     write_system_file(tmp_path, pair)
-    spec = compile_task('vending_demo', ['prep_pay_a'], ['soda'], config_dir=tmp_path, state_library=library)
+    spec = compile_task(robot_system('vending_demo', tmp_path), ['prep_pay_a'], ['soda'], state_library=library)
     sys_init = [to_infix(f) for f in spec.sys_init]
     assert 'prep_pay_a' in sys_init and '!prep_pay_a' not in sys_init   # the file says ! prep_pay_a
     assert any("soda_m" in to_infix(f) and "finished" in to_infix(f) for f in spec.sys_trans)
     with pytest.raises(UnknownPropositionError) as unknown:
-        compile_task('vending_demo', [], ['lemonade'], config_dir=tmp_path, state_library=library)
+        compile_task(robot_system('vending_demo', tmp_path), [], ['lemonade'], state_library=library)
     assert unknown.value.item == 'lemonade'
 
 
 def test_full_spec_goals_recur_without_a_success_outcome(cnu, library, tmp_path):
     (pair,) = [p for p in example_pairs(cnu) if p.launch == 'coffee_full_spec_example.launch.py']
     write_system_file(tmp_path, pair)
-    spec = compile_task('coffee_maker', ['bd_a'], ['br_c'], config_dir=tmp_path, state_library=library)
+    spec = compile_task(robot_system('coffee_maker', tmp_path), ['bd_a'], ['br_c'], state_library=library)
     assert [to_infix(f) for f in spec.sys_liveness] == ['br_c'] and spec.env_liveness   # the file's `bu`
     assert 'bu' in spec.env_props
 
 
 def test_empty_goals_add_no_success_formula(cnu, library, tmp_path):
     example_system(tmp_path, cnu, 'vending_demo')
-    with_goal = compile_task('vending_demo', ['prep_pay_a'], ['soda'], config_dir=tmp_path, state_library=library)
-    without = compile_task('vending_demo', ['prep_pay_a'], [], config_dir=tmp_path, state_library=library)
+    with_goal = compile_task(robot_system('vending_demo', tmp_path), ['prep_pay_a'], ['soda'], state_library=library)
+    without = compile_task(robot_system('vending_demo', tmp_path), ['prep_pay_a'], [], state_library=library)
     assert [to_infix(f) for f in with_goal.sys_liveness] == ['finished'] and without.sys_liveness == []
     assert len(with_goal.sys_trans) == len(without.sys_trans) + 1
 
@@ -226,14 +227,15 @@ def test_a_given_state_with_two_targets_for_one_transition_outcome_is_named(libr
     (tmp_path / 'sm.yaml').write_text(yaml.safe_dump(machine))
     write_system(tmp_path, 'robot', None, cnu_state_machine='sm.yaml')
     with pytest.raises(CapabilityConfigError) as error:
-        compile_task('robot', [], [], config_dir=tmp_path, state_library=library)
+        compile_task(robot_system('robot', tmp_path), [], [], state_library=library)
     assert error.value.item == 'states.Ask' and "'completed'" in str(error.value)
 
 
 def test_spec_file_formulas_join_the_capabilities_in_cnus_capability_pipeline(cnu, library, tmp_path):
     """A spec file's SYS_TRANS (CNU's own remedy for a capability that must not restart) is added."""
     example_system(tmp_path / 'plain', cnu, 'vending_demo')
-    plain = compile_task('vending_demo', ['prep_pay_a'], ['soda'], config_dir=tmp_path / 'plain', state_library=library)
+    plain = compile_task(robot_system('vending_demo', tmp_path / 'plain'),
+                         ['prep_pay_a'], ['soda'], state_library=library)
     (tmp_path / 'more').mkdir()
     spec_file = tmp_path / 'more' / 'spec.yaml'  # inside the config folder, as every referenced file
     spec_file.write_text(yaml.safe_dump({'specs': {'OUTPUT': ['prep_pay_a', 'item:0...3'],
@@ -243,12 +245,13 @@ def test_spec_file_formulas_join_the_capabilities_in_cnus_capability_pipeline(cn
     write_system(tmp_path / 'more', 'vending_demo', cnu,
                  cnu_capabilities=examples / EXAMPLES['vending_demo']['capabilities'], cnu_spec=spec_file,
                  cnu_mappings=cnu / 'flexbe_synthesis_generic' / 'mappings' / 'global_mappings.yaml')
-    more = compile_task('vending_demo', ['prep_pay_a'], ['soda'], config_dir=tmp_path / 'more', state_library=library)
+    more = compile_task(robot_system('vending_demo', tmp_path / 'more'),
+                        ['prep_pay_a'], ['soda'], state_library=library)
     added = [to_infix(f) for f in more.sys_trans if f not in plain.sys_trans]
     assert added == ['next(pay_c) -> !next(prep_pay_a)'] and synthesize(more).realizable
     spec_file.write_text(yaml.safe_dump({'specs': {'SYS_TRANS': ['ghost -> pay_a']}}))
     with pytest.raises(CapabilityConfigError) as unknown:
-        compile_task('vending_demo', ['prep_pay_a'], ['soda'], config_dir=tmp_path / 'more', state_library=library)
+        compile_task(robot_system('vending_demo', tmp_path / 'more'), ['prep_pay_a'], ['soda'], state_library=library)
     assert unknown.value.item == 'specs.SYS_TRANS' and 'ghost' in str(unknown.value)
 
 
@@ -296,9 +299,9 @@ def test_at_var_parameters_take_the_value_the_strategy_chose(library, tmp_path):
     (tmp_path / 'shop_capabilities.yaml').write_text(yaml.safe_dump(capabilities))
     write_system(tmp_path, 'shop', None, cnu_capabilities='shop_capabilities.yaml')
     for goal, value in (('item=2', "'cake'"), ('item=1', "'tea'")):
-        spec = compile_task('shop', [], ['give', goal], config_dir=tmp_path, state_library=library)
+        spec = compile_task(robot_system('shop', tmp_path), [], ['give', goal], state_library=library)
         automaton = automaton_from_strategy(synthesize(spec).strategy, spec)
-        states = generate_state_machine(automaton, 'shop', tmp_path, state_library=library).to_instantiations()
+        states = generate_state_machine(automaton, robot_system('shop', tmp_path), state_library=library).to_instantiations()
         give = next(s for s in top_level_states(states) if s.state_class == 'LogState' and s.name.startswith('give'))
         assert give.name == f'give_{value.strip(chr(39))}'
         assert dict(zip(give.parameter_names, give.parameter_values)) == {'text': value}
@@ -308,16 +311,16 @@ def test_missing_state_class_and_unknown_parameter_are_named(cnu, tmp_path):
     example_system(tmp_path, cnu, 'vending_demo')
     log_only = {'LogState': StateClass('LogState', 'flexbe_states', ('text', 'severity'), ('text',),
                                        outcomes=('done',))}
-    spec = compile_task('vending_demo', ['prep_pay_a'], ['soda'], config_dir=tmp_path, state_library=log_only)
+    spec = compile_task(robot_system('vending_demo', tmp_path), ['prep_pay_a'], ['soda'], state_library=log_only)
     assert 'soda_a' in spec.sys_props
     extended = example_system(tmp_path, cnu, 'vending_demo_extended')
     with pytest.raises(StateClassError) as missing:
-        compile_task('vending_demo_extended', extended['initial_conditions'], extended['goals'],
-                     config_dir=tmp_path, state_library=log_only)
+        compile_task(robot_system('vending_demo_extended', tmp_path),
+                     extended['initial_conditions'], extended['goals'], state_library=log_only)
     assert missing.value.item == 'pay.interface' and 'OperatorDecisionState' in str(missing.value)
     no_text = {'LogState': StateClass('LogState', 'flexbe_states', ('message',), (), outcomes=('done',))}
     with pytest.raises(StateClassError) as parameter:
-        compile_task('vending_demo', ['prep_pay_a'], ['soda'], config_dir=tmp_path, state_library=no_text)
+        compile_task(robot_system('vending_demo', tmp_path), ['prep_pay_a'], ['soda'], state_library=no_text)
     assert parameter.value.item == 'prep_pay.parameters.text'  # the first capability of the file
 
 
@@ -325,7 +328,7 @@ def test_a_missing_flexbe_workspace_says_what_to_set(cnu, tmp_path):
     example_system(tmp_path, cnu, 'vending_demo')
     for library in ({}, workspace_state_library(str(tmp_path))):  # nothing, or no FlexBE package, on the path
         with pytest.raises(StateClassError) as missing:
-            compile_task('vending_demo', ['prep_pay_a'], ['soda'], config_dir=tmp_path, state_library=library)
+            compile_task(robot_system('vending_demo', tmp_path), ['prep_pay_a'], ['soda'], state_library=library)
         message = str(missing.value)
         assert 'no FlexBE state package is on AMENT_PREFIX_PATH at all' in message
         assert 'source <workspace>/install/setup.bash' in message and '`make flexbe`' in message
@@ -369,7 +372,7 @@ def test_bad_capability_files_name_the_capability_and_key(capabilities, item, li
     (tmp_path / 'bad.yaml').write_text(yaml.safe_dump({'name': 'bad', **capabilities}))
     write_system(tmp_path, 'robot', None, cnu_capabilities='bad.yaml')
     with pytest.raises(CapabilityConfigError) as error:
-        compile_task('robot', [], ['a'], config_dir=tmp_path, state_library=library)
+        compile_task(robot_system('robot', tmp_path), [], ['a'], state_library=library)
     assert error.value.item == item, str(error.value)
     assert error.value.code in ('ABSTRACTION_CONFIG_INVALID', 'CONFIG_VARIABLE_CONFIG_INVALID')
 
@@ -377,12 +380,12 @@ def test_bad_capability_files_name_the_capability_and_key(capabilities, item, li
 def test_bad_system_files_are_reported_not_raised_as_tracebacks(tmp_path, library):
     write_system(tmp_path, 'robot', None, cnu_capabilities='missing.yaml')
     with pytest.raises(CapabilityConfigError) as missing:
-        compile_task('robot', [], ['a'], config_dir=tmp_path, state_library=library)
+        compile_task(robot_system('robot', tmp_path), [], ['a'], state_library=library)
     assert missing.value.item == 'cnu_capabilities'
     (tmp_path / 'broken.yaml').write_text('capabilities: [unclosed\n')
     write_system(tmp_path, 'robot', None, cnu_capabilities='broken.yaml')
     with pytest.raises(CapabilityConfigError, match='not valid YAML'):
-        compile_task('robot', [], ['a'], config_dir=tmp_path, state_library=library)
+        compile_task(robot_system('robot', tmp_path), [], ['a'], state_library=library)
 
 
 def test_cnu_behaviors_run_on_the_real_flexbe_engine(cnu, library, tmp_path):
@@ -467,10 +470,10 @@ def test_no_initial_conditions_keep_cnus_meaning_for_capability_systems(cnu, tmp
     from ltl_specification.initial_conditions import reads_robot_state
 
     example_system(tmp_path, cnu, 'hello_world')
-    assert not reads_robot_state([], 'hello_world', tmp_path)
-    assert reads_robot_state(['current'], 'hello_world', tmp_path)
-    assert reads_robot_state([], 'atlas') and not reads_robot_state(['stand'], 'atlas')
-    assert reads_robot_state([], 'no_such_system', tmp_path)  # compiling reports the unknown system
+    assert not reads_robot_state([], robot_system('hello_world', tmp_path))
+    assert reads_robot_state(['current'], robot_system('hello_world', tmp_path))
+    assert reads_robot_state([], robot_system('atlas')) and not reads_robot_state(['stand'], robot_system('atlas'))
+    assert reads_robot_state([], None)  # a system that cannot be read: compiling reports why
 
 
 def copied_rover(config_dir: Path) -> Path:
@@ -487,13 +490,13 @@ def copied_rover(config_dir: Path) -> Path:
 
 def rover_machine(library, sm_outcomes, config_dir=None):
     """config/delivery_rover (or its variant in ``config_dir``): deliver, from a battery check."""
-    spec = compile_task('delivery_rover', ['check_battery_a'], ['hand_over'], sm_outcomes, config_dir=config_dir,
+    spec = compile_task(robot_system('delivery_rover', config_dir), ['check_battery_a'], ['hand_over'], sm_outcomes,
                         state_library=library)
     result = synthesize(spec)
     assert result.realizable
     assert strategy_violations(spec, result.strategy) == []
     automaton = automaton_from_strategy(result.strategy, spec)
-    states = generate_state_machine(automaton, 'delivery_rover', config_dir, state_library=library).to_instantiations()
+    states = generate_state_machine(automaton, robot_system('delivery_rover', config_dir), state_library=library).to_instantiations()
     assert validate_state_machine(states) == []
     return spec, {s.state_path: s for s in states}
 
@@ -523,7 +526,7 @@ def test_a_requested_outcome_the_mappings_do_not_name_is_refused(library):
     from ltl_specification.errors import InvalidSmOutcomesError
 
     with pytest.raises(InvalidSmOutcomesError, match="'delivered' is not one of its mappings' sm_outcome_mappings"):
-        compile_task('delivery_rover', [], ['hand_over'], ['delivered', 'failed'], state_library=library)
+        compile_task(robot_system('delivery_rover'), [], ['hand_over'], ['delivered', 'failed'], state_library=library)
 
 
 def test_a_strategy_that_reacts_to_an_input_no_state_observes_is_refused(library, tmp_path):
@@ -548,14 +551,14 @@ def test_a_strategy_that_reacts_to_an_input_no_state_observes_is_refused(library
 
 def test_a_sensor_starts_as_env_init_says_or_free(library, tmp_path):
     """slugs' meaning: ENV_INIT constrains a spec INPUT's initial value; without it, it is free."""
-    free = compile_task('delivery_rover', [], ['hand_over'], ['finished'], state_library=library)
+    free = compile_task(robot_system('delivery_rover'), [], ['hand_over'], ['finished'], state_library=library)
     assert not any('battery_low' in to_infix(f) for f in free.env_init)
     copied_rover(tmp_path)
     spec_file = tmp_path / 'delivery_rover' / 'spec.yaml'
     spec = yaml.safe_load(spec_file.read_text())
     spec['specs']['ENV_INIT'] = ['battery_low']
     spec_file.write_text(yaml.safe_dump(spec))
-    low = compile_task('delivery_rover', [], ['hand_over'], ['finished'], config_dir=tmp_path, state_library=library)
+    low = compile_task(robot_system('delivery_rover', tmp_path), [], ['hand_over'], ['finished'], state_library=library)
     assert 'battery_low' in [to_infix(f) for f in low.env_init]
     _, states = rover_machine(library, ['finished'], tmp_path)
     assert dict(zip(states['/check_battery'].outcomes, states['/check_battery'].transitions))['low'] == 'charge'

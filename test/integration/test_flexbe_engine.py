@@ -28,9 +28,9 @@ FOOTSTEPS = (['manipulate'], ['footstep_execution'])
 
 
 def synthesized(initial_conditions, goals, sm_outcomes=('finished', 'failed')):
-    spec = compile_task('atlas', initial_conditions, goals, sm_outcomes=sm_outcomes)
+    spec = compile_task(robot_system('atlas'), initial_conditions, goals, sm_outcomes=sm_outcomes)
     automaton = automaton_from_strategy(synthesize(spec).strategy, spec)
-    return spec, generate_state_machine(automaton, 'atlas', initial_conditions=initial_conditions)
+    return spec, generate_state_machine(automaton, robot_system('atlas'), initial_conditions=initial_conditions)
 
 
 def test_exported_behavior_loads_in_flexbe_core_and_create_builds_the_machine(ros, tmp_path):
@@ -69,10 +69,10 @@ def run_task(ros, initial_conditions, goals, sm_outcomes=('finished', 'failed'),
     from synthesis_manager.ros.flexbe_engine import run_on_flexbe
 
     spec, states = synthesized(initial_conditions, goals, sm_outcomes)
-    simulator = make_simulator('atlas', initial_conditions=initial_conditions, faults=faults)
+    simulator = make_simulator(robot_system('atlas'), initial_conditions=initial_conditions, faults=faults)
     node = ros.add_node(AtlasSimNode, simulator=simulator, parameter_overrides=[
         Parameter('speed', value=20.0), Parameter('state_rate', value=50.0)])
-    run = run_on_flexbe(states, simulator, node.lock, ros.domain_id, max_wall_time=120.0)
+    run = run_on_flexbe(states, simulator, node.lock, ros.domain_id, robot_system('atlas'), max_wall_time=120.0)
     report = check_trace(run.trace, spec, goals=goals)
     assert report.ok, report.summary()
     assert not run.fallen
@@ -187,13 +187,13 @@ def test_mobile_manipulator_tasks_on_the_flexbe_engine(ros, goals):
     """The other configured system: its states, the Dock At Charger behavior, userdata through the root."""
     from synthesis_manager.ros.flexbe_engine import run_on_flexbe
 
-    spec = compile_task('mobile_manipulator', ['parked'], goals)
+    spec = compile_task(robot_system('mobile_manipulator'), ['parked'], goals)
     automaton = automaton_from_strategy(synthesize(spec).strategy, spec)
-    states = generate_state_machine(automaton, 'mobile_manipulator', initial_conditions=['parked'])
-    simulator = make_simulator('mobile_manipulator', initial_conditions=['parked'])
+    states = generate_state_machine(automaton, robot_system('mobile_manipulator'), initial_conditions=['parked'])
+    simulator = make_simulator(robot_system('mobile_manipulator'), initial_conditions=['parked'])
     node = ros.add_node(AtlasSimNode, simulator=simulator, parameter_overrides=[
         Parameter('speed', value=20.0), Parameter('state_rate', value=50.0)])
-    run = run_on_flexbe(states, simulator, node.lock, ros.domain_id, system='mobile_manipulator',
+    run = run_on_flexbe(states, simulator, node.lock, ros.domain_id, system=robot_system('mobile_manipulator'),
                         max_wall_time=120.0)
     assert run.outcome == 'finished' and run.trace.steps[-1].state == f'/{goals[-1]}'
     assert check_trace(run.trace, spec, goals=goals).ok

@@ -136,8 +136,8 @@ def exported_behavior(tmp_path_factory):
     from sm_generation.flexbe_behavior import behavior_package
 
     initial, goals = ['stand_prep'], ['look_down', 'pickup_object']
-    spec = compile_task('atlas', initial, goals)
-    states = generate_state_machine(automaton_from_strategy(synthesize(spec).strategy, spec), 'atlas',
+    spec = compile_task(robot_system('atlas'), initial, goals)
+    states = generate_state_machine(automaton_from_strategy(synthesize(spec).strategy, spec), robot_system('atlas'),
                                     initial_conditions=initial)
     package = behavior_package(states, flexbe_config(robot_system('atlas')), 'Look Down Pickup Object')
     states = states.to_instantiations()

@@ -63,7 +63,7 @@ def reading_of(parsed):
 
 @pytest.mark.parametrize('automaton', ['concurrent.yaml', 'two_behaviors.yaml'])
 def test_the_editor_parser_reads_an_exported_behavior_as_generated(parser, automaton):
-    machine = generate_state_machine(load_automaton(AUTOMATA / automaton), 'atlas')
+    machine = generate_state_machine(load_automaton(AUTOMATA / automaton), robot_system('atlas'))
     package = behavior_package(machine, flexbe_config(robot_system('atlas')), 'Parsed Behavior')
     states = machine.to_instantiations()
     answer = parser(package.files[f'{package.package}/{package.module}.py'])
@@ -107,9 +107,9 @@ def test_the_editor_parser_reads_an_exported_behavior_as_generated(parser, autom
 
 
 def test_the_editor_parser_reads_the_paper_task_and_atlas_sim_behaviors(parser):
-    spec = compile_task('atlas', ['stand_prep'], ['look_down', 'pickup_object'])
+    spec = compile_task(robot_system('atlas'), ['stand_prep'], ['look_down', 'pickup_object'])
     automaton = automaton_from_strategy(synthesize(spec).strategy, spec)
-    machine = generate_state_machine(automaton, 'atlas', initial_conditions=['stand_prep'])
+    machine = generate_state_machine(automaton, robot_system('atlas'), initial_conditions=['stand_prep'])
     package = behavior_package(machine, flexbe_config(robot_system('atlas')), 'Look Down Pickup Object')
     states = machine.to_instantiations()
     answer = parser(package.files[f'{package.package}/{package.module}.py'])

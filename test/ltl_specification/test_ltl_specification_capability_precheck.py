@@ -15,6 +15,7 @@ from ltl_specification import InvalidGoalsError, UnknownPropositionError, compil
 from ltl_synthesizer import synthesize
 from respec.robot.cnu import CapabilityConfigError
 from respec.robot.state_library import StateClass
+from respec.robot import robot_system
 
 ROOT = Path(__file__).resolve().parents[2]
 LIBRARY = {'LogState': StateClass('LogState', 'flexbe_states', ('text',), ('text',), outcomes=('done',))}
@@ -46,7 +47,7 @@ def courier(config_dir: Path, spec: dict | None = None, **capabilities) -> Path:
 
 
 def compiled(config_dir, initial_conditions, goals):
-    return compile_task('courier', initial_conditions, goals, config_dir=config_dir, state_library=LIBRARY)
+    return compile_task(robot_system('courier', config_dir), initial_conditions, goals, state_library=LIBRARY)
 
 
 def test_a_possible_task_passes_and_synthesizes(tmp_path):

@@ -11,6 +11,7 @@ import pytest
 
 from ltl_specification import compile_task
 from ltl_specification.cli import add_arguments, run
+from respec.robot import robot_system
 
 ROOT = Path(__file__).resolve().parents[2]
 DEMO = ['--system', 'atlas', '--initial-conditions', 'stand_prep', '--goals', 'look_down,pickup_object']
@@ -25,7 +26,8 @@ def cli(*args, hash_seed='0'):
 def test_structuredslugs_by_default():
     result = cli(*DEMO)
     assert result.returncode == 0, result.stderr
-    assert result.stdout == compile_task('atlas', ['stand_prep'], ['look_down', 'pickup_object']).to_structuredslugs()
+    assert result.stdout == compile_task(robot_system('atlas'),
+                                         ['stand_prep'], ['look_down', 'pickup_object']).to_structuredslugs()
 
 
 def test_output_is_byte_identical_across_processes_and_hash_seeds():
@@ -79,7 +81,7 @@ def test_add_arguments_and_run_in_process(tmp_path, capsys):
     target = tmp_path / 'walk.slugsin'
     assert run(parser.parse_args(['--system', 'atlas', '--goals', 'walk', '--format', 'slugsin',
                                   '-o', str(target)])) == 0
-    assert target.read_text() == compile_task('atlas', [], ['walk']).to_slugsin()
+    assert target.read_text() == compile_task(robot_system('atlas'), [], ['walk']).to_slugsin()
     assert run(parser.parse_args(['--system', 'atlas', '--goals', ''])) == 1  # ExitStatus.FAILED
     assert 'INVALID_GOALS' in capsys.readouterr().err
 

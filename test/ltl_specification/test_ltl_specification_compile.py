@@ -13,6 +13,8 @@ from ltl_specification import (
 )
 from ltl_specification.pertinence import infer_pertinence
 from respec.robot.abstraction import abstraction_from_dict
+from respec.robot import robot_system
+from ltl_specification.systems import task_system_errors
 
 
 def text(spec):
@@ -22,7 +24,7 @@ def text(spec):
 # --- the paper's demo tasks ---------------------------------------------------------------------
 
 def test_paper_demo_look_down_then_pickup():
-    spec = compile_task('atlas', ['stand_prep'], ['look_down', 'pickup_object'])
+    spec = compile_task(robot_system('atlas'), ['stand_prep'], ['look_down', 'pickup_object'])
     p = spec.provenance.pertinence
     assert p.modes == ('stand_prep', 'stand', 'manipulate')
     assert p.actions == ('look_down', 'pickup_object', 'object_template')
@@ -54,7 +56,7 @@ def test_paper_demo_look_down_then_pickup():
 
 
 def test_paper_demo_footstep_execution_from_manipulate():
-    spec = compile_task('atlas', ['manipulate'], ['footstep_execution'])
+    spec = compile_task(robot_system('atlas'), ['manipulate'], ['footstep_execution'])
     p = spec.provenance.pertinence
     assert p.modes == ('stand', 'manipulate')
     assert p.actions == ('footstep_execution', 'footstep_plan', 'footstep_goal', 'target_pose')
@@ -71,26 +73,26 @@ def test_paper_demo_footstep_execution_from_manipulate():
     ('step', ('stand_prep', 'stand', 'step')),
 ])
 def test_locomotion_mode_goals_bring_in_their_path(goal, modes):
-    spec = compile_task('atlas', ['stand_prep'], [goal])
+    spec = compile_task(robot_system('atlas'), ['stand_prep'], [goal])
     assert spec.provenance.pertinence.modes == modes
     assert spec.provenance.pertinence.reasons['stand'] == f'on the way from stand_prep to {goal}'
     assert f'{goal}_a & next({goal}_c) | {goal}_m <-> next({goal}_m)' in text(spec)['sys_trans']
 
 
 def test_mode_topology_is_restricted_to_pertinent_modes_with_self_loops():
-    spec = compile_task('atlas', ['stand_prep'], ['walk'])
+    spec = compile_task(robot_system('atlas'), ['stand_prep'], ['walk'])
     assert ('next(stand_c) -> next(stand_a & !stand_prep_a & !walk_a) | next(walk_a & !stand_prep_a & !stand_a)'
             ' | next(!stand_prep_a & !stand_a & !walk_a)') in text(spec)['sys_trans']
 
 
 def test_walking_between_two_manipulation_goals_keeps_every_needed_mode():
-    spec = compile_task('atlas', ['stand_prep'], ['pickup_object', 'walk', 'grasp_object'])
+    spec = compile_task(robot_system('atlas'), ['stand_prep'], ['pickup_object', 'walk', 'grasp_object'])
     assert spec.provenance.pertinence.modes == ('stand_prep', 'stand', 'manipulate', 'walk')
 
 
 def test_unreachable_mode_goal_is_rejected():
     with pytest.raises(InvalidGoalsError) as caught:
-        compile_task('atlas', ['stand'], ['stand_prep'])
+        compile_task(robot_system('atlas'), ['stand'], ['stand_prep'])
     assert caught.value.item == 'stand_prep' and caught.value.code == 'INVALID_GOALS'
     assert 'stand -> stand_prep is not a transition in config/atlas.yaml' in str(caught.value)
     assert 'can only change to manipulate, step, walk' in str(caught.value)
@@ -109,7 +111,7 @@ def test_shortest_paths_leave_detours_out():
 # --- variants -----------------------------------------------------------------------------------
 
 def test_unordered_goals_use_eq17():
-    spec = compile_task('atlas', ['stand_prep'], ['look_down', 'pickup_object'], strict_order=False)
+    spec = compile_task(robot_system('atlas'), ['stand_prep'], ['look_down', 'pickup_object'], strict_order=False)
     sys_trans = text(spec)['sys_trans']
     assert 'next(look_down_c) | look_down_m <-> next(look_down_m)' in sys_trans
     assert 'next(pickup_object_c) | pickup_object_m <-> next(pickup_object_m)' in sys_trans
@@ -117,14 +119,14 @@ def test_unordered_goals_use_eq17():
 
 
 def test_unordered_goal_order_does_not_change_propositions():
-    one = compile_task('atlas', ['stand_prep'], ['look_down', 'pickup_object'], strict_order=False)
-    other = compile_task('atlas', ['stand_prep'], ['pickup_object', 'look_down'], strict_order=False)
+    one = compile_task(robot_system('atlas'), ['stand_prep'], ['look_down', 'pickup_object'], strict_order=False)
+    other = compile_task(robot_system('atlas'), ['stand_prep'], ['pickup_object', 'look_down'], strict_order=False)
     assert one.env_props == other.env_props
     assert one.env_trans == other.env_trans
 
 
 def test_retry_after_failure_encoding():
-    spec = compile_task('atlas', ['stand_prep'], ['look_down'], sm_outcomes=['finished'])
+    spec = compile_task(robot_system('atlas'), ['stand_prep'], ['look_down'], sm_outcomes=['finished'])
     sections = text(spec)
     assert 'failed' not in spec.sys_props and spec.sys_props[-1] == 'finished'
     assert sections['sys_liveness'] == ['finished']
@@ -138,38 +140,39 @@ def test_retry_after_failure_encoding():
 
 
 def test_sm_outcomes_order_is_normalized():
-    assert compile_task('atlas', 'stand_prep', 'walk', sm_outcomes=['failed', 'finished']).sys_props[-2:] == \
+    assert compile_task(robot_system('atlas'),
+                        'stand_prep', 'walk', sm_outcomes=['failed', 'finished']).sys_props[-2:] == \
         ['finished', 'failed']
 
 
 def test_default_initial_mode_and_action_initial_condition():
-    spec = compile_task('atlas', ['object_template'], ['pickup_object'])
+    spec = compile_task(robot_system('atlas'), ['object_template'], ['pickup_object'])
     assert spec.provenance.pertinence.initial_mode == 'stand_prep'
     env_init = text(spec)['env_init']
     assert 'stand_prep_c' in env_init and 'object_template_c' in env_init and '!object_template_f' in env_init
 
 
 def test_initial_condition_not_needed_is_left_out_and_explained():
-    spec = compile_task('atlas', 'stand_prep,target_pose', 'walk')
+    spec = compile_task(robot_system('atlas'), 'stand_prep,target_pose', 'walk')
     assert 'target_pose_c' not in spec.env_props
     assert spec.provenance.pertinence.left_out == {'target_pose': 'initial condition not needed by any goal'}
     assert 'Left out: target_pose' in explain(spec)
 
 
 def test_comma_separated_strings_are_accepted():
-    assert compile_task('atlas', 'stand_prep', 'look_down, pickup_object') == \
-        compile_task('atlas', ['stand_prep'], ['look_down', 'pickup_object'])
+    assert compile_task(robot_system('atlas'), 'stand_prep', 'look_down, pickup_object') == \
+        compile_task(robot_system('atlas'), ['stand_prep'], ['look_down', 'pickup_object'])
 
 
 def test_explain_lists_items_and_reasons():
-    summary = compile_task('atlas', ['manipulate'], ['footstep_execution']).explain()
+    summary = compile_task(robot_system('atlas'), ['manipulate'], ['footstep_execution']).explain()
     assert 'Control modes: stand (precondition of footstep_execution), manipulate (initial mode).' in summary
     assert 'target_pose (precondition of footstep_goal)' in summary
     assert 'Size: ' in summary
 
 
 def test_mobile_manipulator_compiles_a_task():
-    spec = compile_task('mobile_manipulator', [], ['grasp', 'place'])
+    spec = compile_task(robot_system('mobile_manipulator'), [], ['grasp', 'place'])
     p = spec.provenance.pertinence
     assert p.initial_mode == 'parked'
     assert text(spec)['env_init'][:2] == ['parked_c', '!parked_f']
@@ -183,7 +186,7 @@ def test_configurable_outcomes(tmp_path):
     (tmp_path / 'beeper.yaml').write_text(yaml.safe_dump({'abstraction': {
         'outcomes': ['completed', 'failed', 'preempted'],
         'control_modes': {'on': []}, 'initial_mode': 'on', 'actions': {'beep': ['on']}}}))
-    spec = compile_task('beeper', [], ['beep'], config_dir=tmp_path)
+    spec = compile_task(robot_system('beeper', tmp_path), [], ['beep'])
     assert spec.env_props == ['on_c', 'on_f', 'on_p', 'beep_c', 'beep_f', 'beep_p']
     assert 'failed <-> on_f | on_p | beep_f | beep_p' in text(spec)['sys_trans']
     assert 'next(beep_p) -> next(!beep_c) & next(!beep_f)' in text(spec)['env_trans']
@@ -191,7 +194,7 @@ def test_configurable_outcomes(tmp_path):
 
 def test_system_without_control_modes(tmp_path):
     (tmp_path / 'speaker.yaml').write_text('abstraction:\n  actions: {say_hello: []}\n')
-    spec = compile_task('speaker', [], ['say_hello'], config_dir=tmp_path)
+    spec = compile_task(robot_system('speaker', tmp_path), [], ['say_hello'])
     assert spec.env_props == ['say_hello_c', 'say_hello_f']
     assert spec.provenance.pertinence.modes == ()
 
@@ -200,7 +203,7 @@ def test_a_chain_of_thousands_of_preconditions_compiles(tmp_path):
     actions = {f'act{i}': ['on'] if i == 0 else [f'act{i - 1}'] for i in range(3000)}
     (tmp_path / 'chain.yaml').write_text(yaml.safe_dump({'abstraction': {
         'control_modes': {'on': []}, 'initial_mode': 'on', 'actions': actions}}, sort_keys=False))
-    spec = compile_task('chain', [], ['act2999'], config_dir=tmp_path)
+    spec = compile_task(robot_system('chain', tmp_path), [], ['act2999'])
     assert spec.provenance.pertinence.actions == tuple(actions)
     assert spec.provenance.pertinence.reasons['act0'] == 'precondition of act1'
 
@@ -208,7 +211,8 @@ def test_a_chain_of_thousands_of_preconditions_compiles(tmp_path):
 # --- determinism --------------------------------------------------------------------------------
 
 def test_same_request_gives_byte_identical_output():
-    request = dict(system='atlas', initial_conditions=['stand_prep'], goals=['look_down', 'pickup_object'])
+    request = dict(system=robot_system('atlas'), initial_conditions=['stand_prep'],
+                   goals=['look_down', 'pickup_object'])
     first, second = compile_task(**request), compile_task(**request)
     assert first.to_structuredslugs() == second.to_structuredslugs()
     assert first.to_slugsin() == second.to_slugsin()
@@ -216,7 +220,7 @@ def test_same_request_gives_byte_identical_output():
 
 
 def test_shared_preconditions_are_not_duplicated():
-    spec = compile_task('atlas', ['stand_prep'], ['pickup_object', 'grasp_object'])
+    spec = compile_task(robot_system('atlas'), ['stand_prep'], ['pickup_object', 'grasp_object'])
     for section in ('env_trans', 'sys_trans', 'env_liveness', 'env_init', 'sys_init'):
         formulas = text(spec)[section]
         assert len(formulas) == len(set(formulas)), section
@@ -226,7 +230,7 @@ def test_shared_preconditions_are_not_duplicated():
 # --- custom LTL ---------------------------------------------------------------------------------
 
 def test_custom_ltl_is_merged_and_pulls_in_what_it_mentions():
-    spec = compile_task('atlas', ['stand_prep'], ['look_down'], custom_ltl={
+    spec = compile_task(robot_system('atlas'), ['stand_prep'], ['look_down'], custom_ltl={
         'sys_props': ['beacon'],
         'sys_trans': ['next(beacon) <-> next(look_down_a)', '!approach_object_a'],
         'env_trans': ['obj_detected -> next(obj_detected)'],
@@ -242,7 +246,7 @@ def test_custom_ltl_is_merged_and_pulls_in_what_it_mentions():
 
 
 def test_custom_ltl_may_use_goal_memories_and_sm_outcomes():
-    spec = compile_task('atlas', ['stand_prep'], ['look_down'],
+    spec = compile_task(robot_system('atlas'), ['stand_prep'], ['look_down'],
                         custom_ltl={'sys_trans': ['look_down_m -> !failed']})
     assert text(spec)['sys_trans'][-1] == 'look_down_m -> !failed'
 
@@ -250,10 +254,14 @@ def test_custom_ltl_may_use_goal_memories_and_sm_outcomes():
 # --- bad input ----------------------------------------------------------------------------------
 
 def raised(error_type, **overrides) -> SpecificationError:
+    """The error compiling a request gives, its system read by name as the edges read it."""
     request = dict(system='atlas', initial_conditions=['stand_prep'], goals=['look_down'])
     request.update(overrides)
+    name, config_dir = request.pop('system'), request.pop('config_dir', None)
     with pytest.raises(error_type) as caught:
-        compile_task(**request)
+        with task_system_errors():
+            system = robot_system(name, config_dir)
+        compile_task(system, **request)
     assert isinstance(caught.value, SpecificationError)
     return caught.value
 
@@ -363,7 +371,7 @@ ATLAS_GOALS = ['stand', 'manipulate', 'step', 'walk', 'look_down', 'pickup_objec
        strict=st.booleans(), retry=st.booleans())
 def test_every_task_is_well_formed_and_deterministic(goals, strict, retry):
     sm_outcomes = ['finished'] if retry else ['finished', 'failed']
-    spec = compile_task('atlas', ['stand_prep'], goals, sm_outcomes=sm_outcomes, strict_order=strict)
+    spec = compile_task(robot_system('atlas'), ['stand_prep'], goals, sm_outcomes=sm_outcomes, strict_order=strict)
     assert spec.undeclared_variables() == []
     assert len(set(spec.propositions())) == len(spec.propositions())
     for section, formulas in text(spec).items():
@@ -371,18 +379,18 @@ def test_every_task_is_well_formed_and_deterministic(goals, strict, retry):
     assert [f'{g}_m' for g in goals] == [p for p in spec.sys_props if p.endswith('_m')]
     p = spec.provenance.pertinence
     assert 'stand_prep' in p.modes and set(goals) <= set(p.modes) | set(p.actions)
-    again = compile_task('atlas', ['stand_prep'], goals, sm_outcomes=sm_outcomes, strict_order=strict)
+    again = compile_task(robot_system('atlas'), ['stand_prep'], goals, sm_outcomes=sm_outcomes, strict_order=strict)
     assert again.to_slugsin() == spec.to_slugsin()
 
 
 def test_misspelled_goal_and_initial_condition_suggest_the_close_name():
     with pytest.raises(UnknownPropositionError) as caught:
-        compile_task('atlas', ['stand'], ['look_dwon'])
+        compile_task(robot_system('atlas'), ['stand'], ['look_dwon'])
     assert caught.value.code == 'UNKNOWN_PROPOSITION' and caught.value.item == 'look_dwon'
     assert 'did you mean look_down?' in str(caught.value)
     with pytest.raises(UnknownPropositionError) as caught:
-        compile_task('atlas', ['stnad'], ['look_down'])
+        compile_task(robot_system('atlas'), ['stnad'], ['look_down'])
     assert 'did you mean stand?' in str(caught.value)
     with pytest.raises(UnknownPropositionError) as caught:
-        compile_task('atlas', ['stand'], ['xyzzy'])
+        compile_task(robot_system('atlas'), ['stand'], ['xyzzy'])
     assert 'did you mean' not in str(caught.value)

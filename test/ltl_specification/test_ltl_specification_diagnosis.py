@@ -14,12 +14,13 @@ from ltl_synthesizer.unrealizable_core import (ddmin, droppable_sections, enviro
                                                restrict_guarantees, unrealizable_core)
 from respec.parsing import spec_from_text_sections
 from respec.spec import FORMULA_SECTIONS
+from respec.robot import robot_system
 
-IMPOSSIBLE = dict(system='atlas', initial_conditions=[], goals=['look_down', 'stand_prep'])
+IMPOSSIBLE = dict(system=robot_system('atlas'), initial_conditions=[], goals=['look_down', 'stand_prep'])
 
 
 def test_formula_groups_cover_every_formula_and_name_an_equation():
-    spec = compile_task('atlas', ['stand_prep'], ['look_down', 'pickup_object'],
+    spec = compile_task(robot_system('atlas'), ['stand_prep'], ['look_down', 'pickup_object'],
                         custom_ltl={'sys_trans': ['!walk_a']})
     groups = spec.provenance.groups
     covered = {(g.section, f) for g in groups for f in g.formulas}
@@ -41,19 +42,20 @@ def test_precheck_names_the_missing_transition():
 
 
 def test_precheck_accepts_possible_orders_and_unordered_goals():
-    assert precheck(compile_task('atlas', [], ['stand_prep', 'look_down'])) == []
-    assert precheck(compile_task('atlas', [], ['look_down', 'stand_prep'], strict_order=False)) == []
-    assert precheck(compile_task('atlas', [], ['walk', 'look_down', 'pickup_object'])) == []
+    assert precheck(compile_task(robot_system('atlas'), [], ['stand_prep', 'look_down'])) == []
+    assert precheck(compile_task(robot_system('atlas'), [], ['look_down', 'stand_prep'], strict_order=False)) == []
+    assert precheck(compile_task(robot_system('atlas'), [], ['walk', 'look_down', 'pickup_object'])) == []
 
 
 def test_precheck_names_forbidden_preconditions_and_contradictory_custom_ltl():
-    forbidden = precheck(compile_task('atlas', [], ['look_down'], custom_ltl={'sys_trans': ['!stand_a']}))
+    forbidden = precheck(compile_task(robot_system('atlas'), [], ['look_down'], custom_ltl={'sys_trans': ['!stand_a']}))
     assert [f.item for f in forbidden] == ['stand']
     assert "custom LTL sys_trans[0] '!stand_a' forbids ever activating it" in forbidden[0].sentence
-    contradictory = precheck(compile_task('atlas', [], ['look_down'],
+    contradictory = precheck(compile_task(robot_system('atlas'), [], ['look_down'],
                                           custom_ltl={'sys_trans': ['look_down_a', '!look_down_a']}))
     assert any('contradict each other' in f.sentence for f in contradictory)
-    against_init = precheck(compile_task('atlas', [], ['look_down'], custom_ltl={'sys_init': ['stand_a']}))
+    against_init = precheck(compile_task(robot_system('atlas'),
+                                         [], ['look_down'], custom_ltl={'sys_init': ['stand_a']}))
     assert any('generated initial conditions' in f.sentence for f in against_init)
 
 
@@ -72,7 +74,7 @@ def test_core_is_unrealizable_and_one_minimal():
 
 
 def test_realizable_spec_has_no_core():
-    spec = compile_task('atlas', ['stand_prep'], ['look_down', 'pickup_object'])
+    spec = compile_task(robot_system('atlas'), ['stand_prep'], ['look_down', 'pickup_object'])
     assert unrealizable_core(spec, spec.provenance.groups) is None
     assert diagnose(spec) is None
 
@@ -110,7 +112,7 @@ def test_diagnosis_message_leads_with_the_plain_sentence():
 
 def test_core_sentence_when_the_precheck_finds_nothing():
     # Contradiction only visible over time: look_down must never be activated after stand completes.
-    spec = compile_task('atlas', [], ['look_down'], custom_ltl={'sys_trans': ['stand_c -> !look_down_a']})
+    spec = compile_task(robot_system('atlas'), [], ['look_down'], custom_ltl={'sys_trans': ['stand_c -> !look_down_a']})
     assert precheck(spec) == []
     diagnosis = diagnose(spec)
     assert diagnosis.sentence.startswith('The task cannot be done as requested')
@@ -125,11 +127,12 @@ def test_explain_unsynthesizable_keeps_the_details_and_never_raises():
     given_whole = spec_from_text_sections(impossible.to_text_sections())
     by_formulas = explain_unsynthesizable('DETAILS', given_whole, None)
     assert by_formulas.startswith('The task cannot be done as requested') and by_formulas.endswith('DETAILS')
-    realizable = compile_task('atlas', [], ['look_down'])
+    realizable = compile_task(robot_system('atlas'), [], ['look_down'])
     assert explain_unsynthesizable('DETAILS', realizable, realizable.provenance) == 'DETAILS'
 
 
-@pytest.mark.parametrize('task', [IMPOSSIBLE, dict(system='atlas', initial_conditions=[], goals=['look_down'],
+@pytest.mark.parametrize('task', [IMPOSSIBLE, dict(system=robot_system('atlas'), initial_conditions=[],
+                                                   goals=['look_down'],
                                                    custom_ltl={'sys_trans': ['stand_c -> !look_down_a']})])
 def test_a_specification_sent_with_its_provenance_as_json_is_diagnosed_the_same(task):
     """What the synthesis node receives: the specification as message sections and the
@@ -154,12 +157,12 @@ def test_deadline_keeps_the_precheck_sentence():
 
 
 def test_goal_findings_and_impossible_next_goals_without_compiling():
-    assert [f.item for f in goal_findings('atlas', [], ['look_down', 'stand_prep'])] == ['stand_prep']
-    assert goal_findings('atlas', [], ['look_down', 'stand_prep'], strict_order=False) == []
-    assert goal_findings('atlas', ['walk'], ['stand_prep'], strict_order=False)[0].sentence.startswith(
+    assert [f.item for f in goal_findings(robot_system('atlas'), [], ['look_down', 'stand_prep'])] == ['stand_prep']
+    assert goal_findings(robot_system('atlas'), [], ['look_down', 'stand_prep'], strict_order=False) == []
+    assert goal_findings(robot_system('atlas'), ['walk'], ['stand_prep'], strict_order=False)[0].sentence.startswith(
         'Goal 1 (stand_prep) can never be achieved: the robot starts in walk, and walk -> stand_prep')
-    assert goal_findings('atlas', [], ['no_such_goal']) == []
-    impossible = impossible_next_goals('atlas', [], ['look_down'])
+    assert goal_findings(robot_system('atlas'), [], ['no_such_goal']) == []
+    impossible = impossible_next_goals(robot_system('atlas'), [], ['look_down'])
     assert list(impossible) == ['stand_prep']
     assert 'stand -> stand_prep is not a transition' in impossible['stand_prep']
-    assert impossible_next_goals('atlas', [], []) == {}
+    assert impossible_next_goals(robot_system('atlas'), [], []) == {}

@@ -10,6 +10,7 @@ from ltl_specification.initial_conditions import (CURRENT, asks_for_robot_state,
 from ltl_synthesizer import synthesize
 from respec.automaton import automaton_from_strategy
 from sm_generation import generate_state_machine
+from respec.robot import robot_system
 
 # Where the paper's first task (stand_prep -> look_down, pickup_object) leaves ATLAS.
 AFTER_PICKUP = dict(mode='manipulate', completed_actions=['look_down', 'object_template', 'pickup_object'])
@@ -51,12 +52,12 @@ def test_status_line_round_trip():
 def test_paper_second_demo_from_the_state_after_the_first_task():
     """Fig. 7b: from 𝓘 = {manipulate} (plus what the first task completed) to footstep_execution."""
     initial_conditions = initial_conditions_from_robot_state(**AFTER_PICKUP)
-    spec = compile_task('atlas', initial_conditions, ['footstep_execution'])
+    spec = compile_task(robot_system('atlas'), initial_conditions, ['footstep_execution'])
     env_init = spec.to_text_sections()['env_init']
     assert 'manipulate_c' in env_init and '!stand_c' in env_init
     result = synthesize(spec)
     assert result.realizable
-    machine = generate_state_machine(automaton_from_strategy(result.strategy, spec), 'atlas',
+    machine = generate_state_machine(automaton_from_strategy(result.strategy, spec), robot_system('atlas'),
                                      initial_conditions=initial_conditions)
     top = {s.name: s for s in machine.states}
     path, current = [], machine.initial_state_name

@@ -11,17 +11,18 @@ from ltl_specification.errors import ImpossibleGoalsError, InvalidGoalsError
 from ltl_synthesizer.explanation import without_play
 from ltl_synthesizer.synthesizer import synthesize
 from respec.parsing import spec_from_text_sections
+from respec.robot import robot_system
 
 
 def test_the_refusal_carries_the_diagnosis_that_synthesis_gives_from_the_other_start():
     with pytest.raises(ImpossibleGoalsError) as refused:
-        compile_task('atlas', ['stand'], ['look_down', 'stand_prep'])
+        compile_task(robot_system('atlas'), ['stand'], ['look_down', 'stand_prep'])
     refusal = refused.value.diagnosis
     assert refused.value.code == 'INVALID_GOALS' and refused.value.item == 'stand_prep'
     assert str(refused.value) == refusal.message()
     # the same sentence as the form's check, and as the synthesis stage's diagnosis from stand_prep
-    unrealizable = diagnose(compile_task('atlas', ['stand_prep'], ['look_down', 'stand_prep']))
-    assert refusal.sentence == goal_findings('atlas', ['stand'], ['look_down', 'stand_prep'])[0].sentence
+    unrealizable = diagnose(compile_task(robot_system('atlas'), ['stand_prep'], ['look_down', 'stand_prep']))
+    assert refusal.sentence == goal_findings(robot_system('atlas'), ['stand'], ['look_down', 'stand_prep'])[0].sentence
     assert refusal.sentence == unrealizable.sentence
     assert {entry.name() for entry in refusal.core} >= {'eq. (9) control-mode topology for stand',
                                                         'eq. (20) goals in the given order for stand_prep'}
@@ -32,21 +33,21 @@ def test_the_refusal_carries_the_diagnosis_that_synthesis_gives_from_the_other_s
 
 def test_in_any_order_the_refusal_leads_with_the_any_order_sentence():
     with pytest.raises(ImpossibleGoalsError) as refused:
-        compile_task('atlas', ['stand'], ['look_down', 'stand_prep'], strict_order=False)
+        compile_task(robot_system('atlas'), ['stand'], ['look_down', 'stand_prep'], strict_order=False)
     assert str(refused.value).startswith('Goal 2 (stand_prep) can never be achieved: the robot starts in stand,')
     assert 'How the environment wins' in str(refused.value)
 
 
 def test_a_refusal_without_explanation_is_the_sentence_alone_and_immediate():
     with pytest.raises(ImpossibleGoalsError) as refused:
-        compile_task('atlas', ['step'], ['stand_prep', 'pregrasp'], explain_refusal=False)
-    assert str(refused.value) == goal_findings('atlas', ['step'], ['stand_prep', 'pregrasp'])[0].sentence
+        compile_task(robot_system('atlas'), ['step'], ['stand_prep', 'pregrasp'], explain_refusal=False)
+    assert str(refused.value) == goal_findings(robot_system('atlas'), ['step'], ['stand_prep', 'pregrasp'])[0].sentence
     assert refused.value.diagnosis.core == [] and refused.value.diagnosis.play == []
 
 
 def test_a_mode_only_custom_ltl_needs_is_refused_with_its_own_sentence_and_the_diagnosis():
     with pytest.raises(InvalidGoalsError) as refused:
-        compile_task('atlas', ['stand'], ['look_down'], custom_ltl={'sys_trans': ['!stand_prep_a']})
+        compile_task(robot_system('atlas'), ['stand'], ['look_down'], custom_ltl={'sys_trans': ['!stand_prep_a']})
     first_line = str(refused.value).splitlines()[0]
     assert first_line == ("Control mode 'stand_prep' (mentioned in custom LTL) cannot be reached from the "
                           "initial mode 'stand' on atlas.")
@@ -54,7 +55,7 @@ def test_a_mode_only_custom_ltl_needs_is_refused_with_its_own_sentence_and_the_d
 
 
 def test_the_synthesizers_play_is_left_out_once_the_diagnosis_tells_one():
-    spec = compile_task('atlas', ['stand_prep'], ['look_down', 'stand_prep'])
+    spec = compile_task(robot_system('atlas'), ['stand_prep'], ['look_down', 'stand_prep'])
     details = synthesize(spec).explanation
     assert 'Environment play (counter-strategy' in details
     kept = without_play(details)

@@ -6,11 +6,12 @@ from ltl_specification import compile_task
 from ltl_specification.play import MAX_PLAY_STEPS, PlayError, RobotPlay
 from ltl_synthesizer.synthesizer import solve
 from respec.ltl import evaluate
+from respec.robot import robot_system
 
 
 @pytest.fixture(scope='module')
 def wrong_order():
-    spec = compile_task('atlas', ['stand_prep'], ['look_down', 'stand_prep'])
+    spec = compile_task(robot_system('atlas'), ['stand_prep'], ['look_down', 'stand_prep'])
     return spec, RobotPlay(spec, spec.provenance.meanings)
 
 
@@ -71,13 +72,13 @@ def test_moves_that_do_not_exist_and_overlong_plays_are_refused(wrong_order):
 
 
 def test_a_realizable_task_has_no_environment_play():
-    spec = compile_task('atlas', ['stand_prep'], ['look_down'])
+    spec = compile_task(robot_system('atlas'), ['stand_prep'], ['look_down'])
     assert solve(spec).realizable
     with pytest.raises(PlayError, match='realizable'):
         RobotPlay(spec)
 
 
 def test_the_same_play_gives_the_same_turns():
-    spec = compile_task('atlas', ['stand_prep'], ['look_down', 'stand_prep'])
+    spec = compile_task(robot_system('atlas'), ['stand_prep'], ['look_down', 'stand_prep'])
     first, second = RobotPlay(spec, spec.provenance.meanings), RobotPlay(spec, spec.provenance.meanings)
     assert first.turn([0, 0, 0]).to_dict() == second.turn([0, 0, 0]).to_dict()

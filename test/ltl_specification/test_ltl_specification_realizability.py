@@ -15,6 +15,7 @@ from ltl_specification import compile_task
 from ltl_synthesizer import is_realizable, synthesize
 from respec import activation_outcomes as ao
 from respec.ltl import FALSE
+from respec.robot import robot_system
 
 TASKS = {
     'paper demo 1: look_down, pickup_object': ('atlas', ['stand_prep'], ['look_down', 'pickup_object']),
@@ -36,24 +37,24 @@ def assert_realizable(spec):
 @pytest.mark.parametrize('name', list(TASKS))
 def test_strict_order_tasks_are_realizable(name):
     system, initial, goals = TASKS[name]
-    assert_realizable(compile_task(system, initial, goals))
+    assert_realizable(compile_task(robot_system(system), initial, goals))
 
 
 @pytest.mark.parametrize('name', ['paper demo 1: look_down, pickup_object', 'pickup then walk'])
 def test_unordered_goals_are_realizable(name):
     system, initial, goals = TASKS[name]
-    assert_realizable(compile_task(system, initial, goals, strict_order=False))
+    assert_realizable(compile_task(robot_system(system), initial, goals, strict_order=False))
 
 
 @pytest.mark.parametrize('name', ['paper demo 1: look_down, pickup_object', 'paper demo 2: footstep_execution',
                                   'walk'])
 def test_retry_after_failure_is_realizable(name):
     system, initial, goals = TASKS[name]
-    assert_realizable(compile_task(system, initial, goals, sm_outcomes=['finished']))
+    assert_realizable(compile_task(robot_system(system), initial, goals, sm_outcomes=['finished']))
 
 
 def test_mobile_manipulator_retry_is_realizable():
-    assert_realizable(compile_task('mobile_manipulator', [], ['navigate', 'detect_object'],
+    assert_realizable(compile_task(robot_system('mobile_manipulator'), [], ['navigate', 'detect_object'],
                                    sm_outcomes=['finished']))
 
 
@@ -66,7 +67,7 @@ def without_success(spec):
 def test_environment_assumptions_cannot_be_forced_false(sm_outcomes):
     # If the system could make the environment violate an assumption, it would win even a
     # goal that never holds. It must not.
-    spec = compile_task('atlas', ['stand_prep'], ['look_down', 'pickup_object'], sm_outcomes=sm_outcomes)
+    spec = compile_task(robot_system('atlas'), ['stand_prep'], ['look_down', 'pickup_object'], sm_outcomes=sm_outcomes)
     assert not is_realizable(without_success(spec))
 
 
@@ -82,7 +83,7 @@ def original_retry_encoding(spec):
 
 
 def test_the_original_retry_encoding_is_unrealizable_and_ours_is_not():
-    spec = compile_task('atlas', ['manipulate'], ['footstep_execution'], sm_outcomes=['finished'])
+    spec = compile_task(robot_system('atlas'), ['manipulate'], ['footstep_execution'], sm_outcomes=['finished'])
     assert synthesize(spec).realizable
     assert not is_realizable(original_retry_encoding(spec))
 
@@ -104,19 +105,19 @@ def beeper(tmp_path):
     (['finished', 'failed'], ['blink']),
 ])
 def test_oracle_agrees_small_system(beeper, sm_outcomes, goals):
-    spec = compile_task('beeper', [], goals, sm_outcomes=sm_outcomes, config_dir=beeper)
+    spec = compile_task(robot_system('beeper', beeper), [], goals, sm_outcomes=sm_outcomes)
     assert len(spec.propositions()) <= 10
     assert gr1_oracle.solve(spec, robotics_semantics=True)
     assert not gr1_oracle.solve(without_success(spec), robotics_semantics=True)
 
 
 def test_oracle_agrees_original_retry_is_unrealizable(beeper):
-    spec = compile_task('beeper', [], ['beep'], sm_outcomes=['finished'], config_dir=beeper)
+    spec = compile_task(robot_system('beeper', beeper), [], ['beep'], sm_outcomes=['finished'])
     assert gr1_oracle.solve(spec)
     assert not gr1_oracle.solve(original_retry_encoding(spec))
 
 
 def test_oracle_agrees_walk_with_retry():
-    spec = compile_task('atlas', ['stand_prep'], ['walk'], sm_outcomes=['finished'])
+    spec = compile_task(robot_system('atlas'), ['stand_prep'], ['walk'], sm_outcomes=['finished'])
     assert len(spec.propositions()) == 11
     assert gr1_oracle.solve(spec, robotics_semantics=True)

@@ -18,6 +18,7 @@ import yaml
 from ltl_specification.repair import (ADD_ASSUMPTION, ADD_GOAL, ADD_POSTCONDITION, ADD_TRANSITION, DROP_GOAL,
                                       REORDER, UNORDERED, WEAKEN_GUARANTEE, ConfigPatch, TaskRequest,
                                       patched_text, propose_repairs)
+from respec.robot import robot_system
 
 ROOT = Path(__file__).resolve().parents[2]
 FLEXBE_PREFIX = Path(sys.prefix) / 'flexbe'
@@ -108,7 +109,7 @@ def test_a_goal_the_robot_cannot_reach_gets_the_missing_transition_verified_in_t
 def test_custom_ltl_that_needs_another_goal_first_gets_that_prerequisite_goal(tmp_path):
     # stand_m is the memory of a goal stand (eq. (20)); without that goal the name is unknown.
     custom = {'sys_trans': ['look_down_a -> stand_m']}
-    repairs = propose_repairs('atlas', TaskRequest('atlas', ('stand_prep',), ('look_down',)), custom)
+    repairs = propose_repairs(robot_system('atlas'), TaskRequest('atlas', ('stand_prep',), ('look_down',)), custom)
     assert repairs.problem.startswith("UNKNOWN_PROPOSITION: custom LTL names unknown proposition 'stand_m'")
     first = repairs.proposals[0]
     assert first.kind == ADD_GOAL and first.request.goals == ('stand', 'look_down')
@@ -140,7 +141,7 @@ def test_an_assumption_that_lets_the_controller_win_by_cheating_is_never_propose
     # The environment may never open the door (env_trans): assuming it opens infinitely often
     # would make the assumptions unsatisfiable and the task realizable only vacuously.
     custom = {'env_props': ['door_open'], 'env_trans': ['!door_open'], 'sys_liveness': ['door_open']}
-    repairs = propose_repairs('atlas', TaskRequest('atlas', ('stand_prep',), ('look_down',)), custom)
+    repairs = propose_repairs(robot_system('atlas'), TaskRequest('atlas', ('stand_prep',), ('look_down',)), custom)
     assert repairs.proposals and ADD_ASSUMPTION not in [p.kind for p in repairs.proposals]
     assert repairs.proposals[0].kind == WEAKEN_GUARANTEE
 
@@ -182,12 +183,13 @@ def test_proposals_are_deterministic():
         return data
 
     request = TaskRequest('atlas', ('stand_prep',), ('look_down', 'stand_prep'))
-    assert without_times(propose_repairs('atlas', request)) == without_times(propose_repairs('atlas', request))
+    assert without_times(propose_repairs(robot_system('atlas'),
+                                         request)) == without_times(propose_repairs(robot_system('atlas'), request))
 
 
 def test_guarantees_that_contradict_each_other_get_both_dropped_when_one_is_not_enough():
     custom = {'sys_trans': ['look_down_a', '!look_down_a']}
-    repairs = propose_repairs('atlas', TaskRequest('atlas', ('stand_prep',), ('look_down',)), custom)
+    repairs = propose_repairs(robot_system('atlas'), TaskRequest('atlas', ('stand_prep',), ('look_down',)), custom)
     assert [p.custom_ltl for p in repairs.proposals if p.kind == WEAKEN_GUARANTEE] == [{}]
     assert repairs.proposals[0].summary == ("Drop the custom guarantees sys_trans[0] 'look_down_a' and "
                                             "sys_trans[1] '!look_down_a'.")

@@ -17,6 +17,7 @@ from ltl_synthesizer.strategy import strategy_to_json
 from respec.ltl import (TRUE, conj, disj, evaluate, iff,
                         implies, neg, next_, var)
 from respec.spec import GR1Specification
+from respec.robot import robot_system
 
 x, y, r, g = var('x'), var('y'), var('r'), var('g')
 
@@ -285,7 +286,7 @@ def atlas_chain(tmp_path_factory):
              'manipulate': ['stand'], 'step': ['stand'], 'walk': ['stand']}
     (directory / 'chain.yaml').write_text(yaml.safe_dump({'system': 'chain', 'abstraction': {
         'outcomes': ['completed', 'failed'], 'control_modes': modes, 'actions': actions}}))
-    return compile_task('chain', ['stand_prep'], ['act19'], config_dir=directory)
+    return compile_task(robot_system('chain', directory), ['stand_prep'], ['act19'])
 
 
 def test_deadline_stops_a_long_synthesis(atlas_chain):

@@ -17,6 +17,7 @@ from ltl_synthesizer.errors import SynthesisMemoryError, UndeclaredPropositionEr
 from ltl_synthesizer.isolated import SynthesisProcessDiedError, SynthesisProcesses
 from respec.ltl import var
 from respec.spec import GR1Specification
+from respec.robot import robot_system
 
 # Strategy extraction over 2**100 initial states: runs until stopped.
 RUNAWAY = GR1Specification(env_props=[f'x{i}' for i in range(100)],
@@ -52,7 +53,7 @@ def children_of_this_process() -> set[int]:
 
 
 def test_results_equal_the_in_process_synthesizer_and_children_are_reused(processes):
-    spec = compile_task('atlas', ['stand_prep'], ['pregrasp', 'grasp_object'])
+    spec = compile_task(robot_system('atlas'), ['stand_prep'], ['pregrasp', 'grasp_object'])
     first = processes.synthesize(spec)
     children = children_of_this_process()
     second = processes.synthesize(spec)
@@ -61,7 +62,7 @@ def test_results_equal_the_in_process_synthesizer_and_children_are_reused(proces
 
 
 def test_unrealizable_specs_come_back_with_their_explanation(processes):
-    spec = compile_task('atlas', ['stand_prep'], ['look_down', 'stand_prep'])
+    spec = compile_task(robot_system('atlas'), ['stand_prep'], ['look_down', 'stand_prep'])
     result = processes.synthesize(spec)
     assert not result.realizable and result.explanation == synthesize(spec).explanation
 
@@ -89,7 +90,7 @@ def test_a_cancel_kills_the_child_at_once_and_the_next_synthesis_works(processes
     assert error.value.code == 'PREEMPTED'
     assert len(working) == 1 and not Path(f'/proc/{working.pop()}').exists()  # killed and reaped
     assert len(children_of_this_process()) <= 1  # at most the replacement, started idle
-    assert processes.synthesize(compile_task('atlas', ['stand_prep'], ['look_down'])).realizable
+    assert processes.synthesize(compile_task(robot_system('atlas'), ['stand_prep'], ['look_down'])).realizable
     assert time.monotonic() - stopped < 30
 
 
@@ -119,7 +120,7 @@ def test_a_child_killed_from_outside_is_reported_and_replaced(processes):
     worker.join(timeout=10)
     assert isinstance(outcome.get('error'), SynthesisProcessDiedError)
     assert outcome['error'].code == 'SYNTHESIS_FAILED'
-    assert processes.synthesize(compile_task('atlas', ['stand_prep'], ['look_down'])).realizable
+    assert processes.synthesize(compile_task(robot_system('atlas'), ['stand_prep'], ['look_down'])).realizable
 
 
 def test_close_kills_busy_and_idle_children():
@@ -152,7 +153,7 @@ def test_idle_children_are_released_and_fresh_prepared_ones_replace_them():
         processes.prepare(1)
         time.sleep(1.0)  # let the fresh child import the synthesizer
         baseline = sum(rss_kib(pid) for pid in children_of_this_process())
-        spec = compile_task('atlas', ['stand_prep'], ['look_down', 'pickup_object'])
+        spec = compile_task(robot_system('atlas'), ['stand_prep'], ['look_down', 'pickup_object'])
         with ThreadPoolExecutor(3) as pool:  # three at once: three children
             assert all(result.realizable for result in pool.map(lambda _: processes.synthesize(spec), range(6)))
             list(pool.map(lambda _: processes.call(time.sleep, (0.5,)), range(3)))

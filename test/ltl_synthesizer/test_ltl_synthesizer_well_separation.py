@@ -14,6 +14,7 @@ from ltl_synthesizer.synthesizer import is_realizable
 from ltl_synthesizer.well_separation import check_well_separation
 from respec.errors import CodedError
 from respec.parsing import spec_from_text_sections
+from respec.robot import robot_system
 
 
 def spec(**sections):
@@ -112,13 +113,13 @@ def test_compile_diagnose_warns_of_a_custom_assumption_the_robot_can_force_broke
 def atlas_tasks():
     """Every single goal and the first 60 pairs of goals, from every control mode, with both
     outcome sets: the tasks the compiler accepts."""
-    abstraction = load_task_abstraction('atlas')
+    abstraction = load_task_abstraction(robot_system('atlas'))
     items = abstraction.items()
     goal_lists = [[item] for item in items] + [list(pair) for pair in itertools.combinations(items, 2)][:60]
     for start, goals, outcomes in itertools.product(abstraction.control_modes, goal_lists,
                                                     (('finished', 'failed'), ('finished',))):
         try:
-            yield compile_task('atlas', [start], goals, sm_outcomes=outcomes, explain_refusal=False)
+            yield compile_task(robot_system('atlas'), [start], goals, sm_outcomes=outcomes, explain_refusal=False)
         except CodedError:   # refused (a goal mode no route reaches): no specification to check
             continue
 

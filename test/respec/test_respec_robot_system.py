@@ -20,7 +20,7 @@ CONFIG = Path(__file__).resolve().parents[2] / 'config'
 
 def test_atlas_is_an_abstraction_kind_system_with_its_sections():
     atlas = robot_system('atlas')
-    assert atlas.kind == ABSTRACTION_KIND and not atlas.is_capability_system
+    assert atlas.kind == ABSTRACTION_KIND and atlas.capabilities is None
     assert atlas.name == 'atlas' and atlas.config_file == 'config/atlas.yaml'
     assert 'look_down' in atlas.abstraction.actions
     assert set(atlas.section('flexbe')) >= {'states'} and atlas.has_section('simulation')

@@ -7,14 +7,19 @@ import yaml
 
 from sm_generation import SMGenerationError, generate_state_machine, load_automaton
 from sm_generation import errors
+from respec.robot import robot_system
+from sm_generation.config import generation_system_errors
 
 AUTOMATA = Path(__file__).resolve().parents[1] / 'automata'
 ATLAS = Path(__file__).resolve().parents[2] / 'config' / 'atlas.yaml'
 
 
 def fails(automaton_file, code, item, system='atlas', config_dir=None, **kwargs):
+    """The error generating gives, its system read by name as the edges read it."""
     with pytest.raises(SMGenerationError) as caught:
-        generate_state_machine(load_automaton(AUTOMATA / automaton_file), system, config_dir, **kwargs).to_instantiations()
+        with generation_system_errors():
+            robot = robot_system(system, config_dir)
+        generate_state_machine(load_automaton(AUTOMATA / automaton_file), robot, **kwargs).to_instantiations()
     assert caught.value.code == code, str(caught.value)
     assert caught.value.item == item
     return caught.value
@@ -147,5 +152,5 @@ def test_constant_unobserved_input_is_harmless():
     data = yaml.safe_load((AUTOMATA / 'invalid' / 'unobserved_input.yaml').read_text())
     data['automaton'][2]['input_valuation'][3] = 0  # door_open never changes now
     from sm_generation.automaton_io import automaton_from_dict
-    states = generate_state_machine(automaton_from_dict(data), 'atlas').to_instantiations()
+    states = generate_state_machine(automaton_from_dict(data), robot_system('atlas')).to_instantiations()
     assert [s.name for s in states if s.parent_path == '/'] == ['stand', 'finished', 'failed']

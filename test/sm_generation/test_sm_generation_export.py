@@ -10,13 +10,14 @@ from sm_generation import export
 from sm_generation.state_machine import StateMachine
 from sm_generation.cli import main
 from sm_generation.export import RenderError, from_text, render, to_dot, to_json, to_yaml
+from respec.robot import robot_system
 
 AUTOMATA = Path(__file__).resolve().parents[1] / 'automata'
 
 
 @pytest.fixture(scope='module')
 def concurrent():
-    return generate_state_machine(load_automaton(AUTOMATA / 'concurrent.yaml'), 'atlas')
+    return generate_state_machine(load_automaton(AUTOMATA / 'concurrent.yaml'), robot_system('atlas'))
 
 
 def test_yaml_and_json_round_trip(concurrent):
@@ -64,9 +65,9 @@ def twelve_goals():
     from ltl_synthesizer import synthesize
     from respec.automaton import automaton_from_strategy
 
-    spec = compile_task('atlas', ['stand_prep'], TWELVE_GOALS)
+    spec = compile_task(robot_system('atlas'), ['stand_prep'], TWELVE_GOALS)
     automaton = automaton_from_strategy(synthesize(spec).strategy, spec)
-    return generate_state_machine(automaton, 'atlas', initial_conditions=['stand_prep'])
+    return generate_state_machine(automaton, robot_system('atlas'), initial_conditions=['stand_prep'])
 
 
 def test_a_long_machine_wraps_its_main_path_into_columns_with_a_failure_rail(twelve_goals, tmp_path):
@@ -94,7 +95,7 @@ def test_a_long_machine_wraps_its_main_path_into_columns_with_a_failure_rail(twe
 
 
 def test_dot_labels_behaviours_and_escapes_quotes():
-    states = generate_state_machine(load_automaton(AUTOMATA / 'two_behaviors.yaml'), 'atlas').to_instantiations()
+    states = generate_state_machine(load_automaton(AUTOMATA / 'two_behaviors.yaml'), robot_system('atlas')).to_instantiations()
     states[2].state_path = '/say "hi"'
     states[1].transitions = ['say "hi"', 'failed']
     dot = to_dot(StateMachine.from_instantiations(states))
@@ -123,7 +124,7 @@ def test_render_rejects_other_formats(concurrent, tmp_path):
 def test_cli_writes_yaml_to_stdout(capsys):
     assert main(['--system', 'atlas', '--automaton', str(AUTOMATA / 'look_down.yaml')]) == 0
     out = capsys.readouterr().out
-    assert from_text(out) == generate_state_machine(load_automaton(AUTOMATA / 'look_down.yaml'), 'atlas').to_instantiations()
+    assert from_text(out) == generate_state_machine(load_automaton(AUTOMATA / 'look_down.yaml'), robot_system('atlas')).to_instantiations()
 
 
 def test_cli_formats_from_suffix_and_flag(tmp_path):

@@ -22,7 +22,7 @@ DATE = 'Sun Nov 22 2026'
 
 
 def export(automaton='concurrent.yaml', name='Look Down And Pickup', **kwargs):
-    machine = generate_state_machine(load_automaton(AUTOMATA / automaton), 'atlas')
+    machine = generate_state_machine(load_automaton(AUTOMATA / automaton), robot_system('atlas'))
     return machine.to_instantiations(), behavior_package(machine, flexbe_config(robot_system('atlas')), name, date=DATE, **kwargs)
 
 
@@ -165,7 +165,7 @@ def test_bad_names_are_rejected_with_the_item(kwargs, item):
 
 
 def test_a_class_without_a_package_names_the_state():
-    machine = generate_state_machine(load_automaton(AUTOMATA / 'concurrent.yaml'), 'atlas')
+    machine = generate_state_machine(load_automaton(AUTOMATA / 'concurrent.yaml'), robot_system('atlas'))
     config = flexbe_config(robot_system('atlas'))
     bare = parse_flexbe_config({'sm_outcomes': config.sm_outcomes, 'states': {
         proposition: {'class_decl': {'name': s.state_class, 'behavior_class': s.behavior_class,

@@ -14,6 +14,7 @@ from sm_generation import (Automaton, AutomatonState, StateInstantiation, StateM
                            load_automaton, validate_state_machine)
 from sm_generation.automaton_io import automaton_from_dict, automaton_to_dict, dump_automaton
 from sm_generation.export import to_yaml
+from respec.robot import robot_system
 
 AUTOMATA = Path(__file__).resolve().parents[1] / 'automata'
 VALID = sorted(AUTOMATA.glob('*.yaml'))
@@ -21,7 +22,7 @@ REPO_CONFIG = Path(__file__).resolve().parents[2] / 'config'
 
 
 def generate(name, system='atlas', **kwargs):
-    machine = generate_state_machine(load_automaton(AUTOMATA / name), system, **kwargs)
+    machine = generate_state_machine(load_automaton(AUTOMATA / name), robot_system(system), **kwargs)
     assert validate_state_machine(machine.to_instantiations()) == []
     return machine
 
@@ -37,7 +38,7 @@ def edges(state):
 @pytest.mark.parametrize('path', VALID, ids=lambda p: p.stem)
 @pytest.mark.parametrize('reduce', [False, True])
 def test_every_fixture_gives_a_consistent_machine(path, reduce):
-    states = generate_state_machine(load_automaton(path), 'atlas', reduce=reduce).to_instantiations()
+    states = generate_state_machine(load_automaton(path), robot_system('atlas'), reduce=reduce).to_instantiations()
     assert validate_state_machine(states) == []
     root = states[0]
     assert root.state_path == '/' and root.state_class == ':STATEMACHINE'
@@ -54,19 +55,19 @@ def test_every_fixture_gives_a_consistent_machine(path, reduce):
 
 @pytest.mark.parametrize('path', VALID, ids=lambda p: p.stem)
 def test_same_automaton_same_bytes(path):
-    first = to_yaml(generate_state_machine(load_automaton(path), 'atlas'))
-    second = to_yaml(generate_state_machine(load_automaton(path), 'atlas'))
+    first = to_yaml(generate_state_machine(load_automaton(path), robot_system('atlas')))
+    second = to_yaml(generate_state_machine(load_automaton(path), robot_system('atlas')))
     assert first == second
 
 
 @pytest.mark.parametrize('name', ['concurrent.yaml', 'sensors.yaml', 'initial_decision.yaml'])
 def test_order_of_states_in_the_file_does_not_matter(name):
     data = yaml.safe_load((AUTOMATA / name).read_text())
-    expected = to_yaml(generate_state_machine(automaton_from_dict(data), 'atlas'))
+    expected = to_yaml(generate_state_machine(automaton_from_dict(data), robot_system('atlas')))
     shuffler = random.Random(7)
     for _ in range(5):
         shuffled = dict(data, automaton=shuffler.sample(data['automaton'], len(data['automaton'])))
-        assert to_yaml(generate_state_machine(automaton_from_dict(shuffled), 'atlas')) == expected
+        assert to_yaml(generate_state_machine(automaton_from_dict(shuffled), robot_system('atlas'))) == expected
 
 
 def test_sequence_of_single_states():
@@ -165,17 +166,17 @@ def test_initial_state_deduced_from_initial_conditions():
     automaton = load_automaton(AUTOMATA / 'no_initial_states.yaml')
     assert automaton.initial_states == []
     # no hint: the state that activates nothing and that nothing enters
-    assert generate_state_machine(automaton, 'atlas').initial_state_name == 'stand'
-    assert generate_state_machine(automaton, 'atlas', initial_conditions=['stand_prep']).initial_state_name == 'stand'
+    assert generate_state_machine(automaton, robot_system('atlas')).initial_state_name == 'stand'
+    assert generate_state_machine(automaton, robot_system('atlas'), initial_conditions=['stand_prep']).initial_state_name == 'stand'
     # starting from stand: state '6' (stand_c true) is passed through to look_down
-    from_stand = generate_state_machine(automaton, 'atlas', initial_conditions=['stand'])
+    from_stand = generate_state_machine(automaton, robot_system('atlas'), initial_conditions=['stand'])
     assert from_stand.initial_state_name == 'look_down'
     assert [s.name for s in from_stand.walk() if s.parent_path == '/'] == ['look_down', 'finished', 'failed']
     # manipulate is configured but not in this automaton (irrelevant to the task): no constraint
-    assert generate_state_machine(automaton, 'atlas', initial_conditions=['stand_prep', 'manipulate']) \
+    assert generate_state_machine(automaton, robot_system('atlas'), initial_conditions=['stand_prep', 'manipulate']) \
         .initial_state_name == 'stand'
     # a proposition name works as well
-    assert generate_state_machine(automaton, 'atlas', initial_conditions=['stand_c']).initial_state_name == 'look_down'
+    assert generate_state_machine(automaton, robot_system('atlas'), initial_conditions=['stand_c']).initial_state_name == 'look_down'
 
 
 def test_pass_through_state_in_the_middle():
@@ -216,7 +217,8 @@ def test_autonomy_levels_come_from_the_configuration(tmp_path):
     config['flexbe']['states']['stand_a']['autonomy'] = [2, 1]
     config['flexbe']['states']['object_template_a']['autonomy'] = 3
     (tmp_path / 'atlas.yaml').write_text(yaml.safe_dump(config))
-    states = by_path(generate_state_machine(load_automaton(AUTOMATA / 'concurrent.yaml'), 'atlas', tmp_path))
+    states = by_path(generate_state_machine(load_automaton(AUTOMATA / 'concurrent.yaml'),
+                                            robot_system('atlas', tmp_path)))
     assert states['/object_template_and_stand/stand'].autonomy == [2, 1]
     container = states['/object_template_and_stand']
     autonomy = dict(zip(container.outcomes, container.autonomy))
@@ -241,7 +243,7 @@ def test_another_system_with_other_names(tmp_path):
                 AutomatonState('bad', [0, 0, 1], [0, 1, 0], ['bad'], 0),
                 AutomatonState('bumped', [0, 0, 1], [0, 0, 1], ['bumped'], 0)],
         initial_states=['s'])
-    states = by_path(generate_state_machine(automaton, 'rover', tmp_path))
+    states = by_path(generate_state_machine(automaton, robot_system('rover', tmp_path)))
     assert validate_state_machine(list(states.values())) == []
     assert states['/'].outcomes == ['success', 'failure']
     assert states['/'].initial_state_name == 'drive_and_bump'
@@ -264,7 +266,7 @@ def test_mobile_manipulator_configuration_is_usable():
                 AutomatonState('4', [0, 0, 0, 1], [1, 0, 1, 0, 0], ['4'], 0),
                 AutomatonState('5', [0, 0, 0, 1], [1, 1, 0, 0, 1], ['5'], 0)],
         initial_states=['0'])
-    states = by_path(generate_state_machine(automaton, 'mobile_manipulator'))
+    states = by_path(generate_state_machine(automaton, robot_system('mobile_manipulator')))
     assert validate_state_machine(list(states.values())) == []
     assert edges(states['/navigate']) == {'arrived': 'finished', 'failed': 'failed', 'blocked': 'failed'}
     assert states['/localize'].userdata_remapping == ['robot_pose']
@@ -274,7 +276,7 @@ def test_dataclass_automaton_with_int_names_and_bool_valuations():
     automaton = automaton_from_dict(yaml.safe_load((AUTOMATA / 'look_down.yaml').read_text()))
     for state in automaton.states:
         state.output_valuation = [bool(v) for v in state.output_valuation]
-    assert to_yaml(generate_state_machine(automaton, 'atlas')) == to_yaml(generate('look_down.yaml'))
+    assert to_yaml(generate_state_machine(automaton, robot_system('atlas'))) == to_yaml(generate('look_down.yaml'))
 
 
 def test_automaton_file_round_trip(tmp_path):
@@ -299,7 +301,7 @@ def test_silent_change_of_activations_is_left_out_and_reported(caplog):
     data['automaton'].append({'name': '2x', 'output_valuation': [0, 1, 0, 0],
                               'input_valuation': [1, 0, 0, 0, 0, 0], 'transitions': ['2x', '3', '4']})
     with caplog.at_level('WARNING', logger='sm_generation.generator'):
-        machine = generate_state_machine(automaton_from_dict(data), 'atlas')
+        machine = generate_state_machine(automaton_from_dict(data), robot_system('atlas'))
     assert validate_state_machine(machine.to_instantiations()) == []
     assert to_yaml(machine) == to_yaml(generate('look_down.yaml'))
     assert any('1 -> 2x' in record.getMessage() for record in caplog.records)
@@ -312,7 +314,7 @@ def test_stay_in_an_equal_state_keeps_running():
     data['automaton'][1]['transitions'] = ['1y', '2']
     data['automaton'].append({'name': '1y', 'output_valuation': [1, 0, 0, 0],
                               'input_valuation': [1, 0, 0, 0, 0, 0], 'transitions': ['1y', '2', '5']})
-    states = by_path(generate_state_machine(automaton_from_dict(data), 'atlas'))
+    states = by_path(generate_state_machine(automaton_from_dict(data), robot_system('atlas')))
     assert edges(states['/stand']) == {'changed': 'look_down', 'failed': 'failed'}
 
 

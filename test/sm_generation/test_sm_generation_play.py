@@ -6,6 +6,7 @@ import pytest
 
 from sm_generation import StateMachine, generate_state_machine, load_automaton
 from sm_generation.play import MachinePlayError, play_machine
+from respec.robot import robot_system
 
 AUTOMATA = Path(__file__).resolve().parents[1] / 'automata'
 
@@ -13,7 +14,7 @@ AUTOMATA = Path(__file__).resolve().parents[1] / 'automata'
 @pytest.fixture(scope='module')
 def concurrent():
     return StateMachine.from_instantiations(
-        generate_state_machine(load_automaton(AUTOMATA / 'concurrent.yaml'), 'atlas').to_instantiations())
+        generate_state_machine(load_automaton(AUTOMATA / 'concurrent.yaml'), robot_system('atlas')).to_instantiations())
 
 
 def test_the_play_starts_at_the_initial_state_with_its_outcomes(concurrent):

@@ -20,7 +20,7 @@ DEPTH = 6
 
 
 def test_runs_of_a_small_machine():
-    machine = generate_state_machine(load_automaton(AUTOMATA / 'look_down.yaml'), 'atlas')
+    machine = generate_state_machine(load_automaton(AUTOMATA / 'look_down.yaml'), robot_system('atlas'))
     stand = ('ChangeControlModeActionState', '', ('"stand"',))
     look = ('TiltHeadState', '', ('-45.0',))
     assert runs(machine, DEPTH) == {
@@ -37,8 +37,8 @@ def test_runs_of_a_small_machine():
 @pytest.mark.parametrize('path', sorted(AUTOMATA.glob('*.yaml')), ids=lambda p: p.stem)
 def test_reduced_machine_has_the_same_runs(path):
     automaton = load_automaton(path)
-    plain = generate_state_machine(automaton, 'atlas')
-    reduced = generate_state_machine(automaton, 'atlas', reduce=True)
+    plain = generate_state_machine(automaton, robot_system('atlas'))
+    reduced = generate_state_machine(automaton, robot_system('atlas'), reduce=True)
     assert validate_state_machine(reduced.to_instantiations()) == []
     assert len(reduced.to_instantiations()) <= len(plain.to_instantiations())
     assert runs(reduced, DEPTH) == runs(plain, DEPTH)
@@ -61,8 +61,8 @@ def _loop_automaton():
 
 def test_bisimilar_loop_copies_are_merged():
     automaton = _loop_automaton()
-    plain = generate_state_machine(automaton, 'atlas')
-    reduced = generate_state_machine(automaton, 'atlas', reduce=True)
+    plain = generate_state_machine(automaton, robot_system('atlas'))
+    reduced = generate_state_machine(automaton, robot_system('atlas'), reduce=True)
     assert [s.name for s in plain.walk() if s.parent_path == '/'] == ['stand', 'look_down_1', 'look_down_2',
                                                                'finished', 'failed']
     assert [s.name for s in reduced.walk() if s.parent_path == '/'] == ['stand', 'look_down', 'finished', 'failed']

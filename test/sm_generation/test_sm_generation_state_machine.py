@@ -13,6 +13,7 @@ from respec.robot.state_library import workspace_state_library
 from sm_generation import (OutcomeCondition, SMGenerationError, StateInstantiation, StateMachine,
                            generate_state_machine, load_automaton, validate_state_machine)
 from sm_generation.state_machine import State
+from respec.robot import robot_system
 
 AUTOMATA = Path(__file__).resolve().parents[1] / 'automata'
 GENERATED = [(path.name, reduce) for path in sorted(AUTOMATA.glob('*.yaml')) for reduce in (False, True)]
@@ -21,7 +22,7 @@ PLAIN, CONTAINER = 4, 1  # /pregrasp_pose and /object_template_and_stand of conc
 
 
 def generated(name: str, reduce: bool = False) -> list[StateInstantiation]:
-    return generate_state_machine(load_automaton(AUTOMATA / name), 'atlas', reduce=reduce).to_instantiations()
+    return generate_state_machine(load_automaton(AUTOMATA / name), robot_system('atlas'), reduce=reduce).to_instantiations()
 
 
 @pytest.mark.parametrize('name, reduce', GENERATED)
@@ -33,7 +34,7 @@ def test_every_generated_machine_round_trips_exactly(name, reduce):
     from_dicts = StateMachine.from_instantiations([s.to_dict() for s in states])
     assert from_dicts.to_instantiations() == states
     # the generator builds the tree itself: the same tree as its list read back
-    assert generate_state_machine(load_automaton(AUTOMATA / name), 'atlas', reduce=reduce).to_dict() == machine.to_dict()
+    assert generate_state_machine(load_automaton(AUTOMATA / name), robot_system('atlas'), reduce=reduce).to_dict() == machine.to_dict()
 
 
 def test_a_cnu_machine_round_trips_exactly(flexbe, flexbe_sources, tmp_path):
@@ -45,9 +46,9 @@ def test_a_cnu_machine_round_trips_exactly(flexbe, flexbe_sources, tmp_path):
         f'cnu_spec: {examples / "specs" / "vending_demo_capabilities_spec.yaml"}\n'
         f'cnu_mappings: {cnu / "flexbe_synthesis_generic" / "mappings" / "global_mappings.yaml"}\n')
     library = workspace_state_library(str(flexbe))
-    spec = compile_task('vending_demo', ['prep_pay_a'], ['soda'], config_dir=tmp_path, state_library=library)
+    spec = compile_task(robot_system('vending_demo', tmp_path), ['prep_pay_a'], ['soda'], state_library=library)
     automaton = automaton_from_strategy(synthesize(spec).strategy, spec)
-    states = generate_state_machine(automaton, 'vending_demo', tmp_path, state_library=library).to_instantiations()
+    states = generate_state_machine(automaton, robot_system('vending_demo', tmp_path), state_library=library).to_instantiations()
     assert StateMachine.from_instantiations(states).to_instantiations() == states
 
 

@@ -7,13 +7,14 @@ import pytest
 
 from sm_generation import OutcomeCondition, StateInstantiation, generate_state_machine, load_automaton
 from sm_generation import validate_state_machine
+from respec.robot import robot_system
 
 AUTOMATA = Path(__file__).resolve().parents[1] / 'automata'
 
 
 @pytest.fixture(scope='module')
 def concurrent():
-    return generate_state_machine(load_automaton(AUTOMATA / 'concurrent.yaml'), 'atlas').to_instantiations()
+    return generate_state_machine(load_automaton(AUTOMATA / 'concurrent.yaml'), robot_system('atlas')).to_instantiations()
 
 
 def broken(states, path, **changes):

@@ -18,6 +18,7 @@ from synthesis_manager.client import SynthesisClient, make_goal
 from synthesis_manager.nodes.atlas_sim_node import AtlasSimNode
 from synthesis_manager.nodes.atlas_sim_robot import RosRobot
 from synthesis_manager.suite import suite_node_factories
+from respec.robot import robot_system
 
 
 def synthesize_over_ros(ros, initial_conditions, goals, sm_outcomes=('finished', 'failed')):
@@ -40,7 +41,7 @@ def test_pickup_task_over_ros(ros, fail, expected):
         Parameter('initial_conditions', value='stand_prep'), Parameter('fail', value=fail)])
     robot = RosRobot(ros.add_node(Node, 'executive'))
     robot.wait_until_ready()
-    run = execute_state_machine(outcome.machine, robot, max_wall_time=60.0)
+    run = execute_state_machine(outcome.machine, robot, robot_system('atlas'), max_wall_time=60.0)
     assert run.outcome == expected
     report = check_trace(run.trace, spec, goals=goals)
     assert report.ok, report.summary()

@@ -18,6 +18,7 @@ from synthesis_manager.ros.cnu_interface import (FALLBACK_TYPE, cnu_error_name, 
 from synthesis_manager.ros.conversions import constants, msg_to_state_dict, state_to_msg
 from synthesis_manager.suite import suite_node_factories
 from synthesis_msgs.msg import SynthesisErrorCodes
+from respec.robot import robot_system
 
 PAPER_TASK = dict(system='atlas', initial_conditions=['stand_prep'], goals=['look_down', 'pickup_object'])
 CNU_STAGES = ('BEHAVIOR_SYNTHESIS_FAILED', 'SPEC_COMPILATION_FAILED', 'SYNTHESIS_FAILED',
@@ -414,7 +415,7 @@ def test_the_capability_precheck_sentence_reaches_both_actions(cnu_package, flex
                if p.launch == 'coffee_capabilities_example.launch.py']
     write_system_file(tmp_path, pair)
     with pytest.raises(InvalidGoalsError) as refused:
-        compile_task('coffee_maker', ['bd_a'], ['br'], config_dir=tmp_path,
+        compile_task(robot_system('coffee_maker', tmp_path), ['bd_a'], ['br'],
                      state_library=workspace_state_library(str(flexbe)))
     sentence = str(refused.value)
     assert sentence.startswith("Goal 'br' can never be reached: no capability sets br_m true")

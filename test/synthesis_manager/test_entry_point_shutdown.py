@@ -37,6 +37,7 @@ from synthesis_manager.ros.env import prepare_ros_environment
 from synthesis_manager.ros.harness import RosHarness, reserve_domain_id
 from test_atlas_sim_node import Client as SimClient
 from test_synthesis_manager_reliability import RUNAWAY_SPEC, runaway_goal
+from respec.robot import robot_system
 
 BIN = Path(sys.executable).parent
 STOP_WITHIN = 3.0  # seconds from the signal to the process's exit
@@ -411,8 +412,8 @@ def test_gr1synth_time_limit_ends_a_synthesis_in_the_middle_of_long_bdd_operatio
     still ends gr1synth on time, with its exit code 3 and no process left behind."""
     from ltl_specification import compile_task
     spec = tmp_path / 'many_parts.slugsin'
-    spec.write_text(compile_task('many_parts', ['idle'], ['assemble'],
-                                 config_dir=many_parts_config(tmp_path / 'config')).to_slugsin())
+    robot = robot_system('many_parts', many_parts_config(tmp_path / 'config'))
+    spec.write_text(compile_task(robot, ['idle'], ['assemble']).to_slugsin())
     began = time.monotonic()
     with subprocess.Popen([BIN / 'gr1synth', '--timeout', '2', spec], stdout=subprocess.PIPE,
                           stderr=subprocess.PIPE, text=True) as process:

@@ -19,6 +19,7 @@ from synthesis_manager.web.backend import SynthesisBackend
 from synthesis_manager.web.outcome import JobOutcome
 from synthesis_manager.web.routes import create_app
 from test_gui_browser import browser_context, choose_task, gui_server, open_page, result_code  # noqa: F401
+from respec.robot import robot_system
 
 SIX_GOALS = ['look_down', 'pickup_object', 'grasp_object', 'pregrasp', 'approach_object', 'footstep_execution']
 SHOTS_ENV = 'BEHAVIOR_SYNTHESIS_GUI_SHOTS'
@@ -278,7 +279,7 @@ def concurrent_machine(request, feedback, cancel):
     from sm_generation import generate_state_machine, load_automaton
 
     automaton = load_automaton(Path(__file__).resolve().parents[1] / 'automata' / 'concurrent.yaml')
-    return JobOutcome(1, 'SUCCESS', '', machine=generate_state_machine(automaton, 'atlas'))
+    return JobOutcome(1, 'SUCCESS', '', machine=generate_state_machine(automaton, robot_system('atlas')))
 
 
 def test_a_concurrency_container_names_its_states_when_clicked(browser_context):  # noqa: F811

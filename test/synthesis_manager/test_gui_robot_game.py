@@ -8,11 +8,12 @@ import pytest
 from ltl_specification import compile_task
 from ltl_specification.play import RobotPlay
 from synthesis_manager.web.robot_game import MAX_GAME_MOVES, game_turn
+from respec.robot import robot_system
 
 
 @pytest.fixture(scope='module')
 def wrong_order():
-    spec = compile_task('atlas', ['stand_prep'], ['look_down', 'stand_prep'])
+    spec = compile_task(robot_system('atlas'), ['stand_prep'], ['look_down', 'stand_prep'])
     return RobotPlay(spec, spec.provenance.meanings), spec
 
 

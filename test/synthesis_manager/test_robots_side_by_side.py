@@ -20,6 +20,7 @@ from synthesis_manager.nodes.atlas_sim_node import AtlasSimNode
 from synthesis_manager.nodes.atlas_sim_robot import RosRobot
 from synthesis_manager.ros.namespaces import synthesis_service_remapping
 from synthesis_manager.suite import suite_node_factories
+from respec.robot import robot_system
 
 ROBOTS = {  # namespace -> (where its simulated ATLAS starts, what it is asked to do)
     '/robot1': ('stand_prep', ['look_down', 'pickup_object']),
@@ -58,7 +59,7 @@ def test_two_robots_synthesize_and_run_at_once_with_one_synthesis_service(ros, t
         outcome = clients[namespace].run(make_goal('atlas', 'current', goals), timeout=120.0,
                                          feedback=lambda status, _: statuses.append(status))
         detected = next(filter(None, map(initial_conditions_in_status, statuses)), None)
-        run = execute_state_machine(outcome.machine, robots[namespace], max_wall_time=120.0) \
+        run = execute_state_machine(outcome.machine, robots[namespace], robot_system('atlas'), max_wall_time=120.0) \
             if outcome.succeeded else None
         results[namespace] = outcome, detected, run
 

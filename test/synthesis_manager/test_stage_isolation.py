@@ -12,6 +12,7 @@ from respec.nesting import run_with_deep_stack
 from synthesis_manager.client import make_goal
 from synthesis_manager.nodes.ltl_compilation_node import SMALL_CUSTOM_BYTES, LTLCompilationNode, compiled_sections
 from test_synthesis_manager_reliability import PAPER_TASK, runaway_goal, start_suite
+from respec.robot import SystemCatalog, robot_system
 
 FORMULA_BYTES = 56_000  # as in the attack: just under the 64 KB string cap
 
@@ -36,7 +37,8 @@ def test_large_custom_formulas_compile_in_a_child_to_the_same_specification(ros,
                                    ltl_specification={'sys_trans': formulas}), timeout=60)
     assert outcome.error_name == 'SUCCESS', outcome.message
     sections, _ = run_with_deep_stack(compiled_sections, PAPER_TASK['system'], PAPER_TASK['initial_conditions'],
-                                      PAPER_TASK['goals'], ('finished', 'failed'), True, {'sys_trans': formulas}, None)
+                                      PAPER_TASK['goals'], ('finished', 'failed'), True, {'sys_trans': formulas},
+                                      SystemCatalog())
     assert outcome.ltl_specification == {name: lines for name, lines in sections.items() if lines}
 
 
@@ -196,7 +198,7 @@ def test_a_large_automaton_is_generated_in_a_child_to_the_same_state_machine(ros
     assert len(message.automaton) > SMALL_AUTOMATON_STATES
     answer = generation_service(ros)(message)
     assert answer.error_code.value == 1, answer.error_code.message
-    assert list(answer.state_definition) == [state_to_msg(state) for state in generate_state_machine(automaton, 'atlas').to_instantiations()]
+    assert list(answer.state_definition) == [state_to_msg(state) for state in generate_state_machine(automaton, robot_system('atlas')).to_instantiations()]
 
 
 def test_a_large_generation_stops_at_its_time_and_memory_limits(ros):

@@ -14,6 +14,7 @@ from rclpy.parameter import Parameter
 
 from ltl_specification.compiler import compile_task
 from ltl_specification.provenance import provenance_to_json
+from respec.robot import robot_system
 from suite_settings import suite_args
 from synthesis_manager.client import SynthesisClient, make_goal
 from synthesis_manager.nodes.ltl_synthesis_node import LTLSynthesisNode
@@ -37,7 +38,7 @@ def answer_of(response) -> str:
 
 
 def request_for(task, spec_name='task', config_dir=None, **fields):
-    spec = compile_task('atlas', *task, config_dir=config_dir)
+    spec = compile_task(robot_system('atlas', config_dir), *task)
     return SynthesizeAutomaton.Request(ltl_specification=spec_to_msg(spec), spec_name=spec_name,
                                        provenance=provenance_to_json(spec.provenance), **fields)
 

@@ -22,6 +22,7 @@ from synthesis_manager.client import SynthesisClient, make_flexbe_goal, make_goa
 from synthesis_manager.nodes.atlas_sim_node import AtlasSimNode
 from synthesis_manager.nodes.atlas_sim_robot import RosRobot
 from synthesis_manager.suite import suite_node_factories
+from respec.robot import robot_system
 
 TASK_1 = ['look_down', 'pickup_object']
 AFTER_TASK_1 = ['manipulate', 'look_down', 'object_template', 'pickup_object']  # in any action order
@@ -55,7 +56,7 @@ def synthesize(client, initial_conditions, goals):
 
 
 def execute(outcome, robot, goals):
-    run = execute_state_machine(outcome.machine, robot, max_wall_time=120.0)
+    run = execute_state_machine(outcome.machine, robot, robot_system('atlas'), max_wall_time=120.0)
     report = check_trace(run.trace, spec_from_text_sections(outcome.ltl_specification), goals=goals)
     assert report.ok, report.summary()
     return run

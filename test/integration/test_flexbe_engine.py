@@ -115,14 +115,14 @@ def test_an_outcome_the_operator_forces_on_the_engine_is_the_operators_in_the_tr
 
     spec, machine = synthesized(*PICKUP)
     first = next(s for s in machine.states if s.name == machine.initial_state_name)
-    simulator = make_simulator('atlas', initial_conditions=PICKUP[0])
+    simulator = make_simulator(robot_system('atlas'), initial_conditions=PICKUP[0])
     node = ros.add_node(AtlasSimNode, simulator=simulator, parameter_overrides=[
         Parameter('speed', value=20.0), Parameter('state_rate', value=50.0)])
     operator = ros.add_node(Node, 'forcing_operator')
     commands = operator.create_publisher(OutcomeRequest, 'flexbe/command/transition', 10)
     done = {}
     runner = threading.Thread(target=lambda: done.update(run=run_on_flexbe(
-        machine, simulator, node.lock, ros.domain_id, autonomy=0, max_wall_time=60.0)))
+        machine, simulator, node.lock, ros.domain_id, robot_system('atlas'), autonomy=0, max_wall_time=60.0)))
     runner.start()
     while runner.is_alive():  # the command is read while the state waits (buffered until then)
         commands.publish(OutcomeRequest(outcome=first.outcomes.index('failed'), target=first.name))

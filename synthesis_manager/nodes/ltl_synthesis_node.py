@@ -1,8 +1,9 @@
-"""The ``ltl_synthesis`` service node (SynthesizeAutomaton): a thin adapter around the synthesizer.
+"""The ``ltl_synthesis`` service node (SynthesizeAutomaton): a thin adapter around the
+synthesis service (ltl_synthesizer.service).
 
 Like the original it writes the byproducts ``<spec_name>.structuredslugs``, ``.slugsin`` and
 ``.json`` to a directory (see synthesis_manager.byproducts for names and retention). An
-unrealizable specification that comes with its provenance is diagnosed here, with this node's
+unrealizable specification that comes with its provenance is diagnosed, with this node's
 settings, and the diagnosis leads the answer's message (ltl_specification.diagnosis).
 """
 
@@ -17,57 +18,35 @@ from rclpy.node import Node
 
 from ltl_specification.diagnosis import CORE_NOT_COMPUTED, explain_unsynthesizable, explain_well_separation
 from ltl_specification.provenance import provenance_from_json
-from ltl_synthesizer.cache import DEFAULT_MAX_BYTES
 from ltl_synthesizer.isolated import SERVER_CHILD_NICENESS, WORKING_CHILDREN_MEMORY, SynthesisProcesses
-from ltl_synthesizer.service import (DEFAULT_MAX_STRATEGY_EDGES, Explainers, SynthesisJob, SynthesisService,
-                                     SynthesisSettings, answer_cache)
+from ltl_synthesizer.service import Explainers, SynthesisJob, SynthesisService, SynthesisSettings, answer_cache
 from respec.errors import CodedError
 from respec.nesting import run_with_deep_stack
 from respec.parsing import ParseError
-from synthesis_manager.byproducts import DEFAULT_KEEP_LAST, ByproductStore, default_directory
-from synthesis_manager.limits import DEFAULT_MAX_GOAL_TIMEOUT, capped_timeout, check_message, check_timeout
+from synthesis_manager.byproducts import ByproductStore
+from synthesis_manager.limits import capped_timeout, check_message, check_timeout
 from synthesis_manager.ros.conversions import automaton_to_msg, error_code, msg_to_sections
 from synthesis_manager.ros.errors import reported_error
 from synthesis_manager.ros.logs import QuickLogger
 from synthesis_manager.ros.node_main import node_main
 from synthesis_manager.ros.qos import service_qos
+from synthesis_manager.ros.settings import declare_settings
 from synthesis_manager.ros.stage_calls import LookTimer
 from synthesis_manager.ros.worker_pool import Abandoned, WorkerPool, executor_waker
+from synthesis_manager.settings import LTL_SYNTHESIS
 from synthesis_msgs.srv import CancelSynthesis, SynthesizeAutomaton
 
 #: How the node's answers are explained (run in a synthesis child process).
 EXPLAINERS = Explainers(diagnose=explain_unsynthesizable, check_well_separation=explain_well_separation,
                         read_provenance=provenance_from_json, incomplete_mark=CORE_NOT_COMPUTED)
-#: The default bound of all working children's memory together (MiB; memory_sum_limit_mb): two
-#: syntheses at their own limit (memory_limit_mb 2048).
-DEFAULT_MEMORY_SUM_LIMIT_MB = 4096
-#: The strategy cache's default bound (MiB; strategy_cache_mb).
-DEFAULT_STRATEGY_CACHE_MB = DEFAULT_MAX_BYTES / 2**20
 
 
 class LTLSynthesisNode(Node):
     """Synthesizes automata from GR(1) specifications.
 
-    Parameters: ``byproducts_dir``; ``keep_byproducts`` (how many spec names' byproduct
-    files to keep, newest first; 0 keeps none) and ``byproducts_max_age`` (seconds, 0: no
-    limit); ``backend`` ('builtin' or 'slugs': an external slugs-compatible executable,
-    ``slugs_executable``, called the original way); ``timeout`` (seconds, used when a
-    request gives none; time spent waiting for a worker counts); ``robotics_semantics``;
-    ``memory_limit_mb`` (per synthesis; beyond it the synthesis ends with SYNTHESIS_FAILED
-    naming the limit, not an OOM kill); ``memory_sum_limit_mb`` (this process and all its children
-    together; beyond it the working child holding the most ends, SYNTHESIS_FAILED naming the
-    sum limit; 0: none); ``diagnosis_timeout`` (seconds to find why an
-    unrealizable specification cannot be met, used when a request gives none; never past the
-    request's time limit); ``check_well_separation`` (a realizable specification's answer
-    carries, as its SUCCESS message, a warning when the controller can win by forcing the
-    environment to break its assumptions: ltl_synthesizer.well_separation; checked within the
-    diagnosis time); ``max_strategy_edges`` (largest builtin strategy sent back, in
-    transitions; larger ones are SYNTHESIS_FAILED naming their size; 0: no limit); ``max_timeout`` (seconds: the longest time limit a request gets,
-    600; 0: no cap); ``parallel_syntheses`` (run at once) and ``queued_syntheses`` (waiting beyond those;
-    further requests are answered BUSY); ``strategy_cache_mb`` (MiB of answers kept for identical
-    requests, least recently used dropped first; 0: no cache) and ``strategy_cache_dir`` (a
-    private directory where they are kept too, so that a restarted node finds them; '': memory
-    only): see ``SynthesisService.cache_key`` for what an identical request is and which answers are kept.
+    Its settings (ROS parameters) are ``synthesis_manager.settings.LTL_SYNTHESIS``; what it
+    answers is ``ltl_synthesizer.service``'s (see ``SynthesisService.cache_key`` for what an
+    identical request is and which answers are kept); the node adapts messages to it.
 
     Syntheses run in the node's own worker threads, awaited by an async service callback,
     so the executor stays free for cancel requests and the other nodes of the process. Each
@@ -78,39 +57,22 @@ class LTLSynthesisNode(Node):
     def __init__(self, **kwargs):
         super().__init__('ltl_synthesis', **kwargs)
         self.log = QuickLogger(self.get_logger())  # a line per failed request
-        self.declare_parameter('byproducts_dir', str(default_directory()))
-        self.declare_parameter('keep_byproducts', DEFAULT_KEEP_LAST)
-        self.declare_parameter('byproducts_max_age', 0.0)
-        self.declare_parameter('backend', 'builtin')
-        self.declare_parameter('slugs_executable', 'slugs')
-        self.declare_parameter('timeout', 60.0)
-        self.declare_parameter('max_timeout', DEFAULT_MAX_GOAL_TIMEOUT)
-        self.declare_parameter('max_strategy_edges', DEFAULT_MAX_STRATEGY_EDGES)
-        self.declare_parameter('robotics_semantics', True)
-        self.declare_parameter('memory_limit_mb', 2048)
-        self.declare_parameter('memory_sum_limit_mb', DEFAULT_MEMORY_SUM_LIMIT_MB)
-        self.declare_parameter('diagnosis_timeout', 20.0)
-        self.declare_parameter('check_well_separation', True)
-        self.declare_parameter('parallel_syntheses', 8)
-        self.declare_parameter('queued_syntheses', 200)
-        self.declare_parameter('strategy_cache_mb', DEFAULT_STRATEGY_CACHE_MB)
-        self.declare_parameter('strategy_cache_dir', '')
-        self.declare_parameter('strategy_cache_key_file', '')
+        self.settings = declare_settings(self, LTL_SYNTHESIS)
         self._running: dict[str, threading.Event] = {}
         self._lock = threading.Lock()
-        self.workers = WorkerPool(self.parameter('parallel_syntheses'), self.parameter('queued_syntheses'),
+        self.workers = WorkerPool(self.settings.parallel_syntheses, self.settings.queued_syntheses,
                                   name='synthesis')
         # The bound of this process's whole tree (compilations, repairs and a GUI's simulations
         # too, when they run in the same process).
-        WORKING_CHILDREN_MEMORY.limit = self.parameter('memory_sum_limit_mb') * 2**20 or None
+        WORKING_CHILDREN_MEMORY.limit = self.settings.memory_sum_limit_mb * 2**20 or None
         warn = lambda text: self.get_logger().warning(text)  # noqa: E731
         self.service = SynthesisService(
             self.synthesis_settings, self.byproduct_store, answer_cache(
-                int(self.parameter('strategy_cache_mb') * 2**20), self.parameter('strategy_cache_dir'),
-                self.parameter('strategy_cache_key_file'), warn),
+                int(self.settings.strategy_cache_mb * 2**20), self.settings.strategy_cache_dir,
+                self.settings.strategy_cache_key_file, warn),
             SynthesisProcesses(niceness=SERVER_CHILD_NICENESS), EXPLAINERS, warn)
         self._prune_leftovers()
-        if self.parameter('backend') == 'builtin':
+        if self.settings.backend == 'builtin':
             self.service.processes.prepare()
         group = ReentrantCallbackGroup()
         # Wakes the executor while requests wait for a worker, so they see their deadline or cancel pass.
@@ -146,12 +108,9 @@ class LTLSynthesisNode(Node):
         with self._lock:
             return sorted(self._running)
 
-    def parameter(self, name):
-        return self.get_parameter(name).value
-
     def byproduct_store(self) -> ByproductStore:
-        return ByproductStore(self.parameter('byproducts_dir'), keep_last=self.parameter('keep_byproducts'),
-                              max_age=self.parameter('byproducts_max_age'))
+        return ByproductStore(self.settings.byproducts_dir, keep_last=self.settings.keep_byproducts,
+                              max_age=self.settings.byproducts_max_age)
 
     def on_cancel_request(self, request, response):
         with self._lock:
@@ -166,7 +125,7 @@ class LTLSynthesisNode(Node):
         return self.service.cache
 
     def synthesis_settings(self) -> SynthesisSettings:
-        return SynthesisSettings(**{name: self.parameter(name) for name in SynthesisSettings.__dataclass_fields__})
+        return SynthesisSettings(**{name: getattr(self.settings, name) for name in SynthesisSettings.__dataclass_fields__})
 
     async def on_request(self, request, response):
         cancel = threading.Event()
@@ -177,8 +136,8 @@ class LTLSynthesisNode(Node):
         try:
             check_message(request)
             # A request asking more than max_timeout gets the cap (as a goal gets max_goal_timeout).
-            timeout = capped_timeout(check_timeout(request.timeout, 'request.timeout') or self.parameter('timeout'),
-                                     self.parameter('max_timeout'))
+            timeout = capped_timeout(check_timeout(request.timeout, 'request.timeout') or self.settings.timeout,
+                                     self.settings.max_timeout)
             check_timeout(request.diagnosis_timeout, 'request.diagnosis_timeout')
             # The time limit starts now: waiting for a worker counts.
             job = SynthesisJob(msg_to_sections(request.ltl_specification), request.spec_name, timeout,

@@ -34,11 +34,10 @@ from ltl_specification.initial_conditions import (detected_status, initial_condi
 from respec.errors import INTERNAL_ERROR, CodedError, ErrorCode
 from sm_generation.instantiation import count_states
 from synthesis_manager.client_shares import ClientShares, goal_origin
-from synthesis_manager.limits import (DEFAULT_MAX_GOAL_TIMEOUT, MAX_STRING_BYTES, BusyError, GoalDeadline,
+from synthesis_manager.limits import (MAX_STRING_BYTES, BusyError, GoalDeadline,
                                       GoalTimeoutError, capped_timeout, check_message, check_timeout, utf8_length)
-from synthesis_manager.nodes.atlas_sim_node import STATE_TOPIC
-from synthesis_manager.requests import (DEFAULT_SYSTEM, InvalidRequestError, SynthesisTask,
-                                        task_from_behavior_synthesis, task_from_flexbe_synthesis)
+from synthesis_manager.requests import (InvalidRequestError, SynthesisTask, task_from_behavior_synthesis,
+                                        task_from_flexbe_synthesis)
 from synthesis_manager.ros.action_server import BurstActionServer
 from synthesis_manager.ros.cnu_interface import load_flexbe_synthesis_interface
 from synthesis_manager.ros.conversions import error_code, error_name, is_empty_spec
@@ -47,8 +46,10 @@ from synthesis_manager.ros.logs import QuickLogger
 from synthesis_manager.ros.node_main import node_main
 from synthesis_manager.ros.qos import action_server_qos, service_qos
 from synthesis_manager.ros.robot_state import RobotStateListener
+from synthesis_manager.ros.settings import declare_settings
 from synthesis_manager.ros.stage_calls import (WATCH_PERIOD, Preempted, ServerStoppingError, StageCaller,
                                               StageFailedError, StageTimeoutError, next_executor_turn)
+from synthesis_manager.settings import BEHAVIOR_SYNTHESIS_SERVER
 from synthesis_msgs.action import BehaviorSynthesis
 from synthesis_msgs.msg import FSAutomaton, LTLSpecification
 from synthesis_msgs.srv import (CancelSynthesis, GenerateFlexBESM, GenerateLTLSpecification, ProposeRepairs,
@@ -180,49 +181,22 @@ class BehaviorSynthesisServer(Node):
     ``flexbe_synthesis`` (CNU's flexbe_synthesis_msgs/action/FlexBESynthesis when importable, else
     our look-alike synthesis_msgs/action/FlexBESynthesis; the log says why, once).
 
-    Parameters: ``default_system`` (for requests naming none or ``system_wide``),
-    ``flexbe_log_topic`` (FlexBE's operator log; '' disables it), ``service_timeout`` (seconds
-    to wait for a service to appear), ``compilation_timeout``, ``synthesis_timeout`` and
-    ``generation_timeout`` (seconds per stage), ``diagnosis_timeout`` (seconds the synthesis node
-    may take, within the synthesis's limit, to find why an unrealizable task cannot be done: it
-    diagnoses the specification it holds, from the provenance the compilation gave), ``robot_state_topic`` (synthesis_msgs/RobotState, default
-    the simulator's ``atlas_sim/state``), ``robot_state_timeout`` (seconds to wait for a state
-    when a request names no initial conditions, or ``current``: synthesis on the fly),
-    ``max_active_goals`` (goals in progress at once, both actions together; more are answered
-    BUSY), ``max_goal_timeout`` (seconds: the longest time limit a goal may have; a goal asking
-    for more gets this, and its feedback and a TIMEOUT result say so; 0: no cap) and
-    ``result_retention`` (seconds a finished goal's result stays available to its client).
+    Settings (ROS parameters): ``synthesis_manager.settings.BEHAVIOR_SYNTHESIS_SERVER``.
     """
 
     def __init__(self, **kwargs):
         super().__init__('behavior_synthesis_server', **kwargs)
-        self.declare_parameter('default_system', DEFAULT_SYSTEM)
-        self.declare_parameter('config_dir', '')  # the compilation node's: which systems are CNU's
-        self.declare_parameter('service_timeout', 5.0)
-        self.declare_parameter('compilation_timeout', 30.0)
-        self.declare_parameter('synthesis_timeout', 120.0)
-        self.declare_parameter('generation_timeout', 30.0)
-        self.declare_parameter('diagnosis_timeout', 20.0)
-        self.declare_parameter('robot_state_topic', STATE_TOPIC)
-        self.declare_parameter('robot_state_timeout', 2.0)
-        self.declare_parameter('flexbe_log_topic', 'flexbe/log')
-        self.declare_parameter('max_active_goals', 100)
-        self.declare_parameter('max_goal_timeout', DEFAULT_MAX_GOAL_TIMEOUT)
-        self.declare_parameter('result_retention', 60.0)
-        self.declare_parameter('repair_time_budget', 3.0)
-        self.declare_parameter('max_client_goals', 6)
-        self.declare_parameter('max_client_goal_seconds', 1200.0)
-        self.declare_parameter('max_client_waiting', 50)
+        self.settings = declare_settings(self, BEHAVIOR_SYNTHESIS_SERVER)
         self._stopping = threading.Event()
         self._active_goals = 0
         self._accepted_goals = 0  # accepted and not finished: running, or waiting for the executor
         self.heap_trim = HeapTrim(self)
-        self.shares = ClientShares(self.parameter('max_client_goals'), self.parameter('max_client_goal_seconds'),
-                                   self.parameter('max_client_waiting'))
+        self.shares = ClientShares(self.settings.max_client_goals, self.settings.max_client_goal_seconds,
+                                   self.settings.max_client_waiting)
         self._lock = threading.Lock()
         self.stages = StageCaller(self)
         self.log = QuickLogger(self.get_logger())  # a line per failed goal
-        self.log_to_flexbe = flexbe_log_publisher(self, self.parameter('flexbe_log_topic'))
+        self.log_to_flexbe = flexbe_log_publisher(self, self.settings.flexbe_log_topic)
         group = ReentrantCallbackGroup()
 
         def client(service_type, name):
@@ -234,7 +208,7 @@ class BehaviorSynthesisServer(Node):
         self.generator_cancel = client(CancelSynthesis, 'sm_generate/cancel')
         self.generator = client(GenerateFlexBESM, 'sm_generate')
         self.repairer = client(ProposeRepairs, 'propose_repairs')
-        self.robot_state = RobotStateListener(self, self.parameter('robot_state_topic'), callback_group=group)
+        self.robot_state = RobotStateListener(self, self.settings.robot_state_topic, callback_group=group)
         flexbe_synthesis = load_flexbe_synthesis_interface()
         # Before `make flexbe` CNU's package is missing in every ordinary run: said at debug
         # here, and once plainly when a client uses /flexbe_synthesis (where it matters).
@@ -247,7 +221,7 @@ class BehaviorSynthesisServer(Node):
                          self._executor_for(interface),
                          goal_callback=self.admit_goal,
                          cancel_callback=lambda _: CancelResponse.ACCEPT, callback_group=group,
-                         result_timeout=max(1, round(self.parameter('result_retention'))),
+                         result_timeout=max(1, round(self.settings.result_retention)),
                          **action_server_qos())
             for interface in action_interfaces(flexbe_synthesis)]
 
@@ -272,9 +246,6 @@ class BehaviorSynthesisServer(Node):
             action_server.destroy()
         super().destroy_node()
 
-    def parameter(self, name):
-        return self.get_parameter(name).value
-
     # --- goal execution -----------------------------------------------------------------
 
     async def execute(self, goal_handle, interface: ActionInterface):
@@ -286,9 +257,9 @@ class BehaviorSynthesisServer(Node):
         task = deadline = None
         try:
             check_message(goal_handle.request, 'goal')
-            task = interface.read_goal(goal_handle.request, self.parameter('default_system'))
+            task = interface.read_goal(goal_handle.request, self.settings.default_system)
             requested = check_timeout(task.timeout)
-            task = replace(task, timeout=capped_timeout(requested, self.parameter('max_goal_timeout')))
+            task = replace(task, timeout=capped_timeout(requested, self.settings.max_goal_timeout))
             deadline = GoalDeadline(task.timeout, started=self.accepted_at(goal_handle), requested=requested)
             if deadline.capped():
                 feedback(deadline.capped())
@@ -325,7 +296,7 @@ class BehaviorSynthesisServer(Node):
         BehaviorSynthesis' ``error_code.message``, one per line after the failure in CNU's
         FlexBESynthesis ``messages[]``.
         Without an answer in time the refusal stands as it is."""
-        budget = self.parameter('repair_time_budget')
+        budget = self.settings.repair_time_budget
         if budget <= 0 or str(outcome.code) not in REPAIRABLE or task.option == 'ltl_synthesis_only' \
                 or goal_handle.is_cancel_requested or (deadline is not None and deadline.passed()):
             return
@@ -348,7 +319,7 @@ class BehaviorSynthesisServer(Node):
         the next ones are answered BUSY (a result), beyond twice that they are rejected at
         once (one response, no result for a client to lose; send-goal reports it as BUSY)."""
         with self._lock:
-            if self._accepted_goals >= 2 * self.parameter('max_active_goals'):
+            if self._accepted_goals >= 2 * self.settings.max_active_goals:
                 return GoalResponse.REJECT
             self._accepted_goals += 1
         return GoalResponse.ACCEPT
@@ -362,7 +333,7 @@ class BehaviorSynthesisServer(Node):
         """Run a goal within its client's share (ClientShares): until it fits, it waits, told
         its place; its time limit (or, without one, its stages' limits) counts against the
         client's max_client_goal_seconds."""
-        seconds = deadline.limit or sum(self.parameter(f'{stage}_timeout')
+        seconds = deadline.limit or sum(getattr(self.settings, f'{stage}_timeout')
                                         for stage in ('compilation', 'synthesis', 'generation'))
         ticket = self.shares.join(goal_origin(goal_handle.goal_id.uuid), seconds)
         try:
@@ -387,7 +358,7 @@ class BehaviorSynthesisServer(Node):
     @contextlib.contextmanager
     def admitted(self):
         """Count a goal in while it runs; raise BusyError when max_active_goals are running."""
-        limit = self.parameter('max_active_goals')
+        limit = self.settings.max_active_goals
         with self._lock:
             if self._active_goals >= limit:
                 raise BusyError(f'the server is busy: {self._active_goals} goals in progress '
@@ -426,7 +397,7 @@ class BehaviorSynthesisServer(Node):
             feedback('Compiling the LTL specification', 0.05)
             # The node gets what is left of the goal's time, so that it stops a large compilation
             # when the goal ends (its own limit otherwise; 30 s).
-            limit = deadline.stage_limit(self.parameter('compilation_timeout'), 'LTL compilation')
+            limit = deadline.stage_limit(self.settings.compilation_timeout, 'LTL compilation')
             compiled = await self.call(goal_handle, self.compiler, GenerateLTLSpecification.Request(
                 system=task.system, goals=task.goals, initial_conditions=task.initial_conditions,
                 sm_outcomes=task.sm_outcomes, custom_ltl=task.custom_ltl or LTLSpecification(),
@@ -450,11 +421,11 @@ class BehaviorSynthesisServer(Node):
             # The synthesizer gets what is left of the goal's time and answers SYNTHESIS_TIMEOUT
             # then; but its clock starts on receipt, later: the goal's limit ends the wait itself.
             timeout = deadline.stage_limit(task.timeout, 'LTL synthesis') if task.timeout else \
-                self.parameter('synthesis_timeout')
+                self.settings.synthesis_timeout
             synthesized = await self.call(goal_handle, self.synthesizer, SynthesizeAutomaton.Request(
                 ltl_specification=outcome.ltl_specification, spec_name=spec_name,
                 timeout=float(timeout), request_id=goal_id, provenance=provenance,
-                diagnosis_timeout=float(self.parameter('diagnosis_timeout'))),
+                diagnosis_timeout=float(self.settings.diagnosis_timeout)),
                 'LTL synthesis', timeout + SYNTHESIS_ANSWER_GRACE,
                 on_cancel=lambda: self.cancel_request(self.synthesis_cancel, goal_id),
                 deadline=deadline)
@@ -473,7 +444,7 @@ class BehaviorSynthesisServer(Node):
             return
 
         feedback('Generating the state machine', 0.7)
-        limit = deadline.stage_limit(self.parameter('generation_timeout'), 'state machine generation')
+        limit = deadline.stage_limit(self.settings.generation_timeout, 'state machine generation')
         generated = await self.call(goal_handle, self.generator, GenerateFlexBESM.Request(
             automaton=outcome.automaton, system=task.system,
             initial_conditions=task.initial_conditions, timeout=float(limit), request_id=goal_id),
@@ -487,10 +458,10 @@ class BehaviorSynthesisServer(Node):
     async def with_initial_conditions(self, goal_handle, task: SynthesisTask, outcome: PipelineOutcome,
                                       feedback, deadline: GoalDeadline) -> SynthesisTask:
         """``task``, with the robot's initial conditions when it names none or ``current``."""
-        if not reads_robot_state(task.initial_conditions, task.system, self.parameter('config_dir') or None):
+        if not reads_robot_state(task.initial_conditions, task.system, self.settings.config_dir or None):
             return task
         topic = self.robot_state.topic
-        timeout = deadline.stage_limit(self.parameter('robot_state_timeout'), 'reading the robot state')
+        timeout = deadline.stage_limit(self.settings.robot_state_timeout, 'reading the robot state')
         feedback(f'Reading the initial conditions from {topic}', 0.02)
         with self.stages.looks.waiting():
             state = await self.robot_state.next_state_async(
@@ -519,7 +490,7 @@ class BehaviorSynthesisServer(Node):
         limit, shutdown and the node."""
         limit = deadline.stage_limit(timeout, stage) if deadline is not None else timeout
         try:
-            return await self.stages.call(client, request, stage, limit, self.parameter('service_timeout'),
+            return await self.stages.call(client, request, stage, limit, self.settings.service_timeout,
                                           cancelled=lambda: goal_handle.is_cancel_requested, on_cancel=on_cancel)
         except StageTimeoutError:
             if deadline is not None and deadline.passed():

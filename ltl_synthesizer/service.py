@@ -40,6 +40,7 @@ from respec.automaton import Automaton, AutomatonState, automaton_from_strategy,
 from respec.errors import CodedError, ErrorCode
 from respec.parsing import spec_from_text_sections
 from respec.spec import GR1Specification
+from respec.untrusted import utf8_length
 
 BACKENDS = ('builtin', 'slugs')
 DIAGNOSIS_GRACE = 1.0  # seconds past its own time limit before the diagnosis process is killed
@@ -110,8 +111,7 @@ class SynthesisJob:
 
     def is_large(self) -> bool:
         """Whether the specification's text is over LARGE_SPEC_BYTES."""
-        return sum(len(line.encode('utf-8', errors='surrogatepass'))
-                   for lines in self.sections.values() for line in lines) > LARGE_SPEC_BYTES
+        return sum(utf8_length(line) for lines in self.sections.values() for line in lines) > LARGE_SPEC_BYTES
 
 
 @dataclass

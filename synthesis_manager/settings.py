@@ -17,7 +17,7 @@ from typing import Callable
 
 from atlas_sim.simulator.node_names import STATE_TOPIC
 from ltl_synthesizer.cache import DEFAULT_MAX_BYTES
-from ltl_synthesizer.service import BACKENDS, DEFAULT_MAX_STRATEGY_EDGES
+from ltl_synthesizer.service import BACKENDS, SynthesisSettings
 from respec.robot.files import add_config_dir_argument
 from synthesis_manager.byproducts import DEFAULT_KEEP_LAST, default_directory
 from synthesis_manager.limits import DEFAULT_MAX_GOAL_TIMEOUT
@@ -70,6 +70,9 @@ LTL_COMPILATION = (
     Setting('parallel_repairs', int, 1, 'repair searches at once, each in a child process', '8 more wait, then `BUSY`'),
 )
 
+#: The synthesis service's own defaults (ltl_synthesizer.service), the synthesis node's too.
+SERVICE = SynthesisSettings()
+
 LTL_SYNTHESIS = (
     Setting('byproducts_dir', str, lambda: str(default_directory()),
             'where the synthesizer writes its byproducts (`<spec_name>.structuredslugs`, `.slugsin`, `.json`)',
@@ -78,24 +81,24 @@ LTL_SYNTHESIS = (
     Setting('keep_byproducts', int, DEFAULT_KEEP_LAST, "spec names whose byproduct files are kept, newest first",
             '0: keep none'),
     Setting('byproducts_max_age', float, 0.0, 'seconds byproduct files are kept', '0: no age limit'),
-    Setting('backend', str, 'builtin', 'the synthesizer: our own, or `slugs_executable` called the original way',
+    Setting('backend', str, SERVICE.backend, 'the synthesizer: our own, or `slugs_executable` called the original way',
             choices=BACKENDS),
-    Setting('slugs_executable', str, 'slugs', 'the executable of the `slugs` backend'),
+    Setting('slugs_executable', str, SERVICE.slugs_executable, 'the executable of the `slugs` backend'),
     Setting('timeout', float, 60.0, 'seconds per synthesis when a request gives none; waiting for a worker counts'),
     Setting('max_timeout', float, DEFAULT_MAX_GOAL_TIMEOUT, 'the longest time limit a request gets; more is capped',
             '0: no cap'),
-    Setting('max_strategy_edges', int, DEFAULT_MAX_STRATEGY_EDGES,
+    Setting('max_strategy_edges', int, SERVICE.max_strategy_edges,
             'the largest builtin strategy sent back, in transitions', 'beyond: `SYNTHESIS_FAILED` naming its size; '
             '0: no limit'),
-    Setting('robotics_semantics', bool, True, "slugs' robotics semantics: every initial state allowed by ENV_INIT "
+    Setting('robotics_semantics', bool, SERVICE.robotics_semantics, "slugs' robotics semantics: every initial state allowed by ENV_INIT "
             'and SYS_INIT must be winning'),
-    Setting('memory_limit_mb', int, 2048, 'MiB per synthesis', 'beyond: `SYNTHESIS_FAILED` naming the limit'),
+    Setting('memory_limit_mb', int, SERVICE.memory_limit_mb, 'MiB per synthesis', 'beyond: `SYNTHESIS_FAILED` naming the limit'),
     Setting('memory_sum_limit_mb', int, 4096, "MiB of the suite's process and all its child processes together "
             "(syntheses, compilations, repair searches, a GUI's simulations)", 'beyond: the working child holding '
             'the most is ended, `SYNTHESIS_FAILED` naming `memory_sum_limit`; 0: none'),
-    Setting('diagnosis_timeout', float, 20.0, 'seconds to find why an unrealizable specification cannot be met, '
+    Setting('diagnosis_timeout', float, SERVICE.diagnosis_timeout, 'seconds to find why an unrealizable specification cannot be met, '
             'when a request gives none', "never past the request's time limit"),
-    Setting('check_well_separation', bool, True, 'a realizable specification whose controller can win by forcing '
+    Setting('check_well_separation', bool, SERVICE.check_well_separation, 'a realizable specification whose controller can win by forcing '
             'the environment to break its assumptions gets a warning naming them, as its `SUCCESS` message',
             'checked within `diagnosis_timeout` and the time limit'),
     Setting('parallel_syntheses', int, 8, 'syntheses at once'),

@@ -76,3 +76,13 @@ def test_each_node_declares_exactly_its_settings(tmp_path):
                 expected['speed'] = 0.0
             assert declared == expected, node.get_name()
             assert all(type(declared[name]) is type(value) for name, value in expected.items())
+
+
+def test_no_node_declares_or_reads_a_parameter_by_hand():
+    """Parameters are declared from the settings in one place and read as ``settings.<name>``."""
+    shell = DOCS.parents[1] / 'synthesis_manager'
+    found = [f'{path.relative_to(shell)}:{number}' for path in sorted(shell.rglob('*.py'))
+             if path != shell / 'ros' / 'settings.py'
+             for number, line in enumerate(path.read_text().splitlines(), 1)
+             if 'declare_parameter(' in line or 'get_parameter(' in line]
+    assert not found

@@ -22,7 +22,6 @@ gives a store whose ``open_set(spec_name)`` yields a set with ``write(kind, text
 
 from __future__ import annotations
 
-import dataclasses
 import importlib.metadata
 import json
 import threading
@@ -141,8 +140,7 @@ class KeptAnswer:
         entry = {kind: text.encode() for kind, text in self.byproducts.items()}
         entry.update(synthesizable=b'1' if self.synthesizable else b'0', code=self.code.encode())
         if self.synthesizable:
-            automaton = json.dumps(dataclasses.asdict(self.automaton), separators=(',', ':'))
-            entry.update(message=self.message.encode(), automaton=automaton.encode())
+            entry.update(message=self.message.encode(), automaton=_automaton_json(self.automaton).encode())
         else:
             entry.update(message_before=self.message[0].encode(), message_after=self.message[1].encode())
         return entry
@@ -154,8 +152,7 @@ class KeptAnswer:
         if entry['synthesizable'] != b'1':
             return cls(byproducts, False, entry['code'].decode(),
                        (entry['message_before'].decode(), entry['message_after'].decode()))
-        fields = json.loads(entry['automaton'])
-        automaton = Automaton(**{**fields, 'states': [AutomatonState(**state) for state in fields['states']]})
+        automaton = _automaton_from_json(entry['automaton'])
         return cls(byproducts, True, entry['code'].decode(), entry['message'].decode(), automaton)
 
     def answer(self, spec_name: str) -> SynthesisAnswer:
@@ -391,6 +388,23 @@ class SynthesisService:
         except ValueError as error:
             self.warn(f'request.provenance ignored (no diagnosis): {error!r}'[:300])
             return None
+
+
+def _automaton_json(automaton: Automaton) -> str:
+    """An automaton as compact JSON: each state one array, its valuations as 0 and 1."""
+    return json.dumps([automaton.output_variables, automaton.input_variables, automaton.initial_states,
+                       [[state.name, [int(value) for value in state.output_valuation],
+                         [int(value) for value in state.input_valuation], state.transitions, state.rank]
+                        for state in automaton.states]], separators=(',', ':'))
+
+
+def _automaton_from_json(text: bytes) -> Automaton:
+    """The automaton of :func:`_automaton_json` (ValueError, TypeError: not one)."""
+    outputs, inputs, initial, states = json.loads(text)
+    return Automaton(outputs, inputs, [
+        AutomatonState(name, [bool(value) for value in output_valuation], [bool(value) for value in input_valuation],
+                       transitions, rank) for name, output_valuation, input_valuation, transitions, rank in states],
+        initial)
 
 
 def unrealizable_head(spec_name: str) -> str:

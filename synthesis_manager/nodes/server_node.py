@@ -4,7 +4,7 @@ synthesis -> state machine generation.
 Both actions (the original BehaviorSynthesis and CNU's FlexBESynthesis, which FlexBE WebUI
 revisions send) are read into one SynthesisTask and run the same pipeline with the same cancel;
 synthesis_manager.ros.cnu_interface chooses FlexBESynthesis' type (CNU's own when importable).
-Each stage is an asynchronous call to its service node, awaited by the goal's coroutine
+Each stage is an asynchronous call to its service node (synthesis_manager.ros.pipeline), awaited by the goal's coroutine
 (synthesis_manager.ros.stage_calls): a waiting goal holds no executor thread, so any number
 of goals run side by side and the executor keeps serving. Cancel requests, the stage's time
 limit, shutdown and the stage's node going away end the wait; a cancel is forwarded to the

@@ -106,27 +106,36 @@ class Service:
         return elapsed, response
 
 
+def job_of(request):
+    """The synthesis service's job of a SynthesizeAutomaton request, as the node makes it."""
+    from ltl_synthesizer.service import SynthesisJob
+    from synthesis_manager.ros.conversions import msg_to_sections
+
+    return SynthesisJob(msg_to_sections(request.ltl_specification), request.spec_name, 60.0,
+                        time.monotonic() + 60.0, request.provenance, request.diagnosis_timeout)
+
+
 def at_the_node(node, request, calls: int) -> list[float]:
     """A hit's work in the node, as on_request does it (no ROS transport)."""
-    from synthesis_msgs.srv import SynthesizeAutomaton
+    from synthesis_manager.ros.conversions import automaton_to_msg
 
     latencies = []
     for _ in range(calls):
         started = time.perf_counter()
-        entry = node.strategy_cache.get(node._cache_key(request))
-        node._answer_from_cache(entry, request, SynthesizeAutomaton.Response())
+        answer, _ = node.service.cached_answer(job_of(request))
+        automaton_to_msg(answer.automaton)
         latencies.append(time.perf_counter() - started)
     return latencies
 
 
 def hit_parts(node, request, calls: int) -> str:
     """Medians (ms) of a hit's three parts: the key, the automaton message, the byproduct files."""
-    from rclpy.serialization import deserialize_message
-
+    from ltl_synthesizer.service import KeptAnswer
     from synthesis_manager.byproducts import EXTENSIONS
-    from synthesis_msgs.msg import FSAutomaton
+    from synthesis_manager.ros.conversions import automaton_to_msg
 
-    entry = node.strategy_cache.get(node._cache_key(request))
+    job = job_of(request)
+    entry = node.strategy_cache.get(node.service.cache_key(job))
 
     def write_files():
         with node.byproduct_store().open_set(request.spec_name) as files:
@@ -134,7 +143,7 @@ def hit_parts(node, request, calls: int) -> str:
                 if extension in entry:
                     files.write(extension, entry[extension].decode())
 
-    parts = (lambda: node._cache_key(request), lambda: deserialize_message(entry['automaton'], FSAutomaton),
+    parts = (lambda: node.service.cache_key(job), lambda: automaton_to_msg(KeptAnswer.from_entry(entry).automaton),
              write_files)
     medians = []
     for part in parts:

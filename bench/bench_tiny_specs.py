@@ -112,7 +112,7 @@ def server_child_wall(spec, repeats: int, cpu_batch: int) -> tuple[float, float]
     the mean CPU seconds per synthesis of the child and this caller over ``cpu_batch`` of them."""
     from ltl_synthesizer.interrupt import Limits
     from ltl_synthesizer.isolated import SERVER_CHILD_NICENESS, SynthesisProcesses
-    from synthesis_manager.nodes.ltl_synthesis_node import DEFAULT_MAX_STRATEGY_EDGES
+    from ltl_synthesizer.service import DEFAULT_MAX_STRATEGY_EDGES
     processes = SynthesisProcesses(niceness=SERVER_CHILD_NICENESS)
     processes.prepare(1)
 

@@ -27,6 +27,11 @@ _OPENING = (yaml.MappingStartEvent, yaml.SequenceStartEvent)
 _CLOSING = (yaml.MappingEndEvent, yaml.SequenceEndEvent)
 
 
+def utf8_length(text: str) -> int:
+    """Bytes of ``text`` in UTF-8 (a lone surrogate, which a message may carry, counts as its 3 bytes)."""
+    return len(text.encode('utf-8', errors='surrogatepass'))
+
+
 class BoundedYamlError(ValueError):
     """Text that is not YAML within the bounds; ``problem`` says what, ``line``/``column``
     (1-based, or None) where."""

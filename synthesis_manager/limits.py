@@ -13,6 +13,7 @@ import re
 import time
 
 from respec.errors import CodedError, ErrorCode, quoted
+from respec.untrusted import utf8_length
 from synthesis_manager.requests import InvalidRequestError
 
 #: Longest string accepted in any request field, in UTF-8 bytes.
@@ -44,10 +45,6 @@ def check_timeout(value, item: str = 'timeout') -> float:
         raise InvalidRequestError(f'{item} must be a finite number of seconds >= 0 (0: the default), '
                              f'got {quoted(value)}')
     return seconds
-
-
-def utf8_length(text: str) -> int:
-    return len(text.encode('utf-8', errors='surrogatepass'))
 
 
 def oversized_strings(message, path: str = 'request', limit: int = MAX_STRING_BYTES):

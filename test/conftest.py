@@ -146,14 +146,14 @@ def runaway_synthesis(monkeypatch):
     """
     from respec.ltl import var
     from respec.spec import GR1Specification
-    from synthesis_manager.nodes import ltl_synthesis_node
+    from ltl_synthesizer import service
 
     runaway = GR1Specification(env_props=[f'x{i}' for i in range(100)],
                                sys_props=[f'y{i}' for i in range(100)], sys_liveness=[var('y0')])
 
     # The node's specification (from the request) is replaced; the rest runs as always,
     # the synthesis in the node's synthesis process.
-    monkeypatch.setattr(ltl_synthesis_node, 'spec_from_text_sections', lambda sections: runaway)
+    monkeypatch.setattr(service, 'spec_from_text_sections', lambda sections: runaway)
     # The strategy cache keys the request's text, which the substitution leaves as it was: an
     # earlier answer to the same request must not stand in for the runaway.
-    monkeypatch.setattr(ltl_synthesis_node.LTLSynthesisNode, '_cache_key', lambda self, request: None)
+    monkeypatch.setattr(service.SynthesisService, 'cache_key', lambda self, job, settings=None: None)

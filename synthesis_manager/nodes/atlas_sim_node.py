@@ -19,10 +19,9 @@
   (0: as fast as possible; the default 10 is faster than real time), also between
   requests, as a real robot keeps balancing.
 
-Parameters: ``system`` (atlas), ``config_dir`` (searched before config/), ``initial_conditions``,
-``fail`` (capabilities that always fail), ``fail_first`` ('capability:k'), ``seed``
-(-1: the config's), ``speed``, ``state_rate``, ``batch_window``. List parameters take a
-string array or a comma-separated string. Run it with ``atlas-sim-node`` (DDS stays on
+Settings (ROS parameters): ``synthesis_manager.settings.ATLAS_SIM`` (the robot system, its
+initial conditions and faults, the seed, the speed and the state topic's rate). List parameters
+take a string array or a comma-separated string. Run it with ``atlas-sim-node`` (DDS stays on
 loopback) or in-process: ``AtlasSimNode(context=...)`` like the suite's nodes.
 """
 
@@ -32,7 +31,6 @@ import functools
 import threading
 import time
 
-from rcl_interfaces.msg import ParameterDescriptor
 from rclpy.action import ActionServer, CancelResponse, GoalResponse
 from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.node import Node
@@ -45,6 +43,8 @@ from respec.naming import parse_names
 from respec.robot import robot_system
 from synthesis_manager.ros.errors import log_internal_error
 from synthesis_manager.ros.node_main import node_main
+from synthesis_manager.ros.settings import declare_settings
+from synthesis_manager.settings import ATLAS_SIM
 from synthesis_msgs.action import ExecuteCapability
 from synthesis_msgs.msg import RobotState
 
@@ -80,26 +80,16 @@ class AtlasSimNode(Node):
 
     def __init__(self, simulator=None, **kwargs):
         super().__init__(NODE_NAME, **kwargs)
-        flexible = ParameterDescriptor(dynamic_typing=True)
-        self.declare_parameter('system', 'atlas')
-        self.declare_parameter('config_dir', '')
-        self.declare_parameter('initial_conditions', '', flexible)
-        self.declare_parameter('fail', '', flexible)
-        self.declare_parameter('fail_first', '', flexible)
-        self.declare_parameter('seed', -1)
-        self.declare_parameter('speed', 10.0)
-        self.declare_parameter('state_rate', 10.0)
-        self.declare_parameter('batch_window', 0.02)
-        value = lambda name: self.get_parameter(name).value  # noqa: E731
+        self.settings = settings = declare_settings(self, ATLAS_SIM)
         if simulator is None:
-            seed = int(value('seed'))
+            seed = int(settings.seed)
             simulator = make_simulator(
-                robot_system(value('system'), value('config_dir') or None), parse_names(value('initial_conditions')),
-                faults=parse_faults(parse_names(value('fail')), parse_names(value('fail_first'))),
+                robot_system(settings.system, settings.config_dir or None), parse_names(settings.initial_conditions),
+                faults=parse_faults(parse_names(settings.fail), parse_names(settings.fail_first)),
                 seed=None if seed < 0 else seed)
         self.simulator = simulator
-        self.speed = float(value('speed'))
-        self.batch_window = float(value('batch_window'))
+        self.speed = float(settings.speed)
+        self.batch_window = float(settings.batch_window)
         self.lock = threading.Lock()  # guards the simulator and the job lists (render under it too)
         self._pending: list[_Job] = []
         self._last_arrival = 0.0
@@ -107,7 +97,7 @@ class AtlasSimNode(Node):
         self._stop = threading.Event()
         group = ReentrantCallbackGroup()
         self.state_publisher = self.create_publisher(RobotState, STATE_TOPIC, 10)
-        self.state_timer = self.create_timer(1.0 / float(value('state_rate')), self.publish_state,
+        self.state_timer = self.create_timer(1.0 / float(settings.state_rate), self.publish_state,
                                              callback_group=group)
         self.action_server = ActionServer(
             self, ExecuteCapability, ACTION_NAME, self.execute,

@@ -42,7 +42,9 @@ from synthesis_manager.ros.logs import QuickLogger
 from synthesis_manager.ros.node_main import node_main
 from synthesis_manager.ros.qos import service_qos
 from synthesis_manager.ros.robot_systems import create_systems_publisher
+from synthesis_manager.ros.settings import declare_settings
 from synthesis_manager.ros.worker_pool import Abandoned, WorkerPool, executor_waker
+from synthesis_manager.settings import LTL_COMPILATION
 from synthesis_msgs.srv import CancelSynthesis, GenerateLTLSpecification, ProposeRepairs
 
 #: Custom formulas (bytes, all sections) up to which a request is compiled in the node's process.
@@ -74,15 +76,9 @@ def _compiled_in_child(*args) -> tuple[dict, str]:
 class LTLCompilationNode(Node):
     """Compiles partial tasks into complete GR(1) specifications.
 
-    Parameters: ``config_dir`` (directories of robot system files searched before the packaged
-    config/, joined with os.pathsep; empty = config/ alone). Publishes those systems on ``robot_systems`` (latched; checked for edits
-    every ``SYSTEMS_PERIOD`` seconds), so clients elsewhere see the systems it compiles for.
-    ``timeout`` (seconds a request with large custom formulas may take from its arrival, waiting
-    included; then TIMEOUT), ``memory_limit_mb`` (growth of the child compiling such a request;
-    then LTL_SPEC_COMPILATION_FAILED naming it), ``parallel_compilations`` and ``queued_compilations`` (such requests
-    compiled at once in child processes, and waiting beyond those; further ones are BUSY).
-    ``repair_time_budget`` (seconds a ProposeRepairs search takes when the request names none,
-    3) and ``parallel_repairs`` (searches at once, each in a child process; 8 more may wait).
+    Settings (ROS parameters): ``synthesis_manager.settings.LTL_COMPILATION``. Publishes the
+    systems of ``config_dir`` on ``robot_systems`` (latched; checked for edits every
+    ``SYSTEMS_PERIOD`` seconds), so clients elsewhere see the systems it compiles for.
     """
 
     SYSTEMS_PERIOD = 2.0
@@ -90,18 +86,12 @@ class LTLCompilationNode(Node):
     def __init__(self, **kwargs):
         super().__init__('ltl_compilation', **kwargs)
         self.log = QuickLogger(self.get_logger())  # a line per failed request
-        self.declare_parameter('config_dir', '')
-        self.declare_parameter('timeout', 30.0)
-        self.declare_parameter('memory_limit_mb', 2048)
-        self.declare_parameter('parallel_compilations', 2)
-        self.declare_parameter('queued_compilations', 200)
-        self.declare_parameter('repair_time_budget', 3.0)
-        self.declare_parameter('parallel_repairs', 1)
+        self.settings = declare_settings(self, LTL_COMPILATION)
         self._stopping = threading.Event()
-        self.repairs = WorkerPool(self.get_parameter('parallel_repairs').value, 8, name='repair')
+        self.repairs = WorkerPool(self.settings.parallel_repairs, 8, name='repair')
         self._repair_searches: set[RepairSearch] = set()
-        self.children = ChildStage(self, 'ltl_specification', self.get_parameter('parallel_compilations').value,
-                                   self.get_parameter('queued_compilations').value, name='compilation',
+        self.children = ChildStage(self, 'ltl_specification', self.settings.parallel_compilations,
+                                   self.settings.queued_compilations, name='compilation',
                                    what='LTL compilation', failed=ErrorCode.LTL_SPEC_COMPILATION_FAILED)
         group = ReentrantCallbackGroup()
         self.create_service(GenerateLTLSpecification, 'ltl_compilation', self.on_request,
@@ -127,7 +117,7 @@ class LTLCompilationNode(Node):
         return super().destroy_node()
 
     def catalog(self) -> SystemCatalog:
-        return SystemCatalog(self.get_parameter('config_dir').value or None)
+        return SystemCatalog(self.settings.config_dir or None)
 
     def publish_systems(self) -> None:
         """Publish the systems when they changed (a system file edited, added or removed)."""
@@ -182,7 +172,7 @@ class LTLCompilationNode(Node):
         try:
             check_message(request)
             system = self.catalog().load(request.system)
-            budget = min(request.time_budget or self.get_parameter('repair_time_budget').value,
+            budget = min(request.time_budget or self.settings.repair_time_budget,
                          MAX_REPAIR_TIME_BUDGET)
             task = TaskRequest(system.name, tuple(request.initial_conditions), tuple(request.goals),
                                tuple(request.sm_outcomes) or DEFAULT_SM_OUTCOMES, request.unordered_goals)

@@ -25,6 +25,8 @@ from synthesis_manager.ros.errors import reported_error
 from synthesis_manager.ros.logs import QuickLogger
 from synthesis_manager.ros.node_main import node_main
 from synthesis_manager.ros.qos import service_qos
+from synthesis_manager.ros.settings import declare_settings
+from synthesis_manager.settings import SM_GENERATION
 from synthesis_msgs.srv import CancelSynthesis, GenerateFlexBESM
 
 #: Automata with more states than this are generated in a child process (2,000 chain states
@@ -45,25 +47,17 @@ def generated_states(automaton, system: str, catalog: SystemCatalog, initial_con
 class SMGenerationNode(Node):
     """Turns synthesized automata into FlexBE state instantiations.
 
-    Parameters: ``config_dir`` (directories of robot system files searched before the packaged config/),
-    ``reduce`` (merge equivalent automaton states); for automata over SMALL_AUTOMATON_STATES
-    states: ``timeout`` (seconds from the request's arrival, waiting included; then TIMEOUT),
-    ``memory_limit_mb`` (growth of the generating child; then SM_GENERATION_FAILED naming it),
-    ``parallel_generations`` and ``queued_generations`` (at once in child processes, and
-    waiting beyond those; further ones are BUSY).
+    Settings (ROS parameters): ``synthesis_manager.settings.SM_GENERATION``; ``timeout``,
+    ``memory_limit_mb`` and the parallel and queued generations bound automata over
+    SMALL_AUTOMATON_STATES states, generated in child processes.
     """
 
     def __init__(self, **kwargs):
         super().__init__('sm_generation', **kwargs)
         self.log = QuickLogger(self.get_logger())  # a line per failed request
-        self.declare_parameter('config_dir', '')
-        self.declare_parameter('reduce', False)
-        self.declare_parameter('timeout', 30.0)
-        self.declare_parameter('memory_limit_mb', 2048)
-        self.declare_parameter('parallel_generations', 1)
-        self.declare_parameter('queued_generations', 50)
-        self.children = ChildStage(self, 'sm_generation', self.get_parameter('parallel_generations').value,
-                                   self.get_parameter('queued_generations').value, name='generation',
+        self.settings = declare_settings(self, SM_GENERATION)
+        self.children = ChildStage(self, 'sm_generation', self.settings.parallel_generations,
+                                   self.settings.queued_generations, name='generation',
                                    what='state machine generation', failed=ErrorCode.SM_GENERATION_FAILED)
         group = ReentrantCallbackGroup()
         self.create_service(GenerateFlexBESM, 'sm_generate', self.on_request,
@@ -92,9 +86,9 @@ class SMGenerationNode(Node):
             check_message(request, max_list=None, max_total=None)
             requested = check_timeout(request.timeout, 'request.timeout')  # 0: the node's own limit
             arguments = (msg_to_automaton(request.automaton), request.system)
-            options = {'catalog': SystemCatalog(self.get_parameter('config_dir').value or None),
+            options = {'catalog': SystemCatalog(self.settings.config_dir or None),
                        'initial_conditions': list(request.initial_conditions) or None,
-                       'reduce': self.get_parameter('reduce').value}
+                       'reduce': self.settings.reduce}
             if len(request.automaton.automaton) <= SMALL_AUTOMATON_STATES:
                 states = generated_states(*arguments, **options)
             else:

@@ -55,7 +55,7 @@ class _StopFlag:
 
 class ChildStage:
     """Large requests of ``node`` in child processes (module docstring). The node declares the
-    parameters ``timeout`` (s) and ``memory_limit_mb``; ``what`` starts the messages and
+    settings ``timeout`` (s) and ``memory_limit_mb``; ``what`` starts the messages and
     ``failed`` is the code of work beyond its memory limit."""
 
     def __init__(self, node, preload: str, workers: int, waiting: int, name: str, what: str, failed: ErrorCode):
@@ -89,7 +89,7 @@ class ChildStage:
         (``size`` says how large the request was, in the message; the time limit, the node's or
         the shorter ``requested`` one when it is over 0, counts from ``arrival``, a
         time.monotonic() instant, or from now)."""
-        timeout = self.node.get_parameter('timeout').value
+        timeout = self.node.settings.timeout
         if requested > 0:
             timeout = min(timeout, requested)
         deadline = (time.monotonic() if arrival is None else arrival) + timeout
@@ -118,7 +118,7 @@ class ChildStage:
         if stop.is_set() or time.monotonic() > deadline:
             raise SynthesisCancelledError('stopped while waiting')
         return self.processes.call(function, args, kwargs, cancel=stop, deadline=deadline,
-                                   memory_limit=self.node.get_parameter('memory_limit_mb').value * 2**20)
+                                   memory_limit=self.node.settings.memory_limit_mb * 2**20)
 
     def stop(self) -> None:
         """Kill every child, busy or idle, and refuse further work (at shutdown)."""

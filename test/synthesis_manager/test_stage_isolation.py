@@ -129,7 +129,7 @@ def test_a_large_specification_is_read_in_the_synthesis_child_to_the_same_automa
     from respec.automaton import automaton_from_strategy
     from respec.parsing import spec_from_text_sections
     from synthesis_manager.client import automaton_to_dict
-    from synthesis_manager.nodes.ltl_synthesis_node import LARGE_SPEC_BYTES
+    from ltl_synthesizer.service import LARGE_SPEC_BYTES
     from synthesis_manager.ros.conversions import automaton_to_msg
 
     client = start(ros, tmp_path)

@@ -15,10 +15,11 @@ from rclpy.parameter import Parameter
 from ltl_specification.compiler import compile_task
 from ltl_specification.provenance import provenance_to_json
 from respec.robot import robot_system
+from ltl_synthesizer.service import SynthesisJob
 from suite_settings import suite_args
 from synthesis_manager.client import SynthesisClient, make_goal
 from synthesis_manager.nodes.ltl_synthesis_node import LTLSynthesisNode
-from synthesis_manager.ros.conversions import spec_to_msg
+from synthesis_manager.ros.conversions import msg_to_sections, spec_to_msg
 from synthesis_manager.ros.harness import RosHarness, wait_for
 from synthesis_manager.suite import suite_node_factories
 from synthesis_msgs.msg import LTLSpecification, SynthesisErrorCodes
@@ -241,7 +242,7 @@ def test_an_option_that_changes_the_answer_is_another_key(fresh_and_cached):
 
 
 def test_a_large_specification_is_kept_too(fresh_and_cached):
-    from synthesis_manager.nodes.ltl_synthesis_node import LARGE_SPEC_BYTES
+    from ltl_synthesizer.service import LARGE_SPEC_BYTES
 
     fresh, cached = fresh_and_cached
     tautology = ' & '.join(['(p0 | !p0)'] * 100)
@@ -266,7 +267,8 @@ def test_an_entry_signed_with_a_stolen_key_but_not_a_winning_strategy_is_not_ser
     with RosHarness() as ros:
         service = SynthesisService(ros, tmp_path, 'first', strategy_cache_dir=str(cache_dir))
         honest = answer_of(service.call(request))
-        key = service.node._cache_key(request)
+        key = service.node.service.cache_key(SynthesisJob(msg_to_sections(request.ltl_specification),
+                                                          request.spec_name, 60.0, 0.0, request.provenance))
     thief = StrategyCache(directory=cache_dir)  # the key file beside the directory: the thief has it
     entry = dict(thief.get(key))
     strategy = json.loads(entry['json'])

@@ -4,6 +4,7 @@ import os
 import threading
 import time
 from argparse import Namespace
+from dataclasses import replace
 from pathlib import Path
 
 import pytest
@@ -160,16 +161,17 @@ IMPOSSIBLE_TASK = dict(system='atlas', initial_conditions=['stand_prep'], goals=
 def endless_diagnosis(suite, monkeypatch, tmp_path):
     """The suite's synthesis node diagnoses with test/endless_diagnosis.py; yields its pid file."""
     from ltl_synthesizer.isolated import SERVER_CHILD_NICENESS, SynthesisProcesses
-    from synthesis_manager.nodes import ltl_synthesis_node
 
     test_dir = str(Path(__file__).resolve().parents[1])
     monkeypatch.setenv('PYTHONPATH', os.pathsep.join(filter(None, [test_dir, os.environ.get('PYTHONPATH')])))
     pid_file = tmp_path / 'diagnosis.pid'
     monkeypatch.setenv('ENDLESS_DIAGNOSIS_PID_FILE', str(pid_file))
-    monkeypatch.setattr(ltl_synthesis_node, 'DIAGNOSIS', endless_diagnosis_module.endless_diagnosis)
+    service = synthesis_node_of(suite).service
+    monkeypatch.setattr(service, 'explainers', replace(service.explainers,
+                                                       diagnose=endless_diagnosis_module.endless_diagnosis))
     # Children that import the stand-in: started from now on, with the test folder on their path.
     processes = SynthesisProcesses(niceness=SERVER_CHILD_NICENESS)
-    monkeypatch.setattr(synthesis_node_of(suite), 'synthesis_processes', processes)
+    monkeypatch.setattr(service, 'processes', processes)
     yield pid_file
     processes.close()
 
@@ -219,7 +221,7 @@ def test_a_cancel_ends_the_diagnosis_at_once(suite, endless_diagnosis):
 
 def test_the_diagnosis_time_limit_keeps_the_synthesizers_verdict(suite, endless_diagnosis):
     from rclpy.parameter import Parameter
-    from synthesis_manager.nodes.ltl_synthesis_node import DIAGNOSIS_GRACE
+    from ltl_synthesizer.service import DIAGNOSIS_GRACE
 
     server_of(suite).set_parameters([Parameter('diagnosis_timeout', value=1.0)])
     started = []

@@ -241,8 +241,7 @@ SUITE_FLAGS = (
               'use; give a fleet the same file)', metavar='FILE'),
     SuiteFlag('--memory-sum-limit-mb', (('ltl_synthesis', 'memory_sum_limit_mb'),),
               'MiB that the suite and all its synthesis, compilation and repair processes may hold together; '
-              'beyond it the working one holding the most is ended (default {default}; 0: none)', metavar='MB',
-              type=float),
+              'beyond it the working one holding the most is ended (default {default}; 0: none)', metavar='MB'),
     SuiteFlag('--service-timeout', (('behavior_synthesis_server', 'service_timeout'),),
               'seconds to wait for a pipeline service to appear', always=True),
     SuiteFlag('--default-system', (('behavior_synthesis_server', 'default_system'),),

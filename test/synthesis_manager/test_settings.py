@@ -58,6 +58,24 @@ def test_flags_become_the_settings_of_each_node_they_set():
     assert node_overrides(None, 'ltl_synthesis') == {}
 
 
+def test_every_flag_gives_each_setting_a_value_of_its_type():
+    """A ROS parameter refuses a value of another type at start-up (``serve --memory-sum-limit-mb
+    1024`` ended in InvalidParameterTypeException when the flag parsed floats for an int setting)."""
+    parser = argparse.ArgumentParser()
+    add_suite_flags(parser)
+    typical = {int: '3', float: '2.5', str: 'x'}
+    for flag in SUITE_FLAGS:
+        if flag.add is not None:
+            continue
+        first = setting(*flag.sets[0])
+        if first.choices:
+            continue
+        args = parser.parse_args([flag.option, typical[first.type]])
+        for node, name in flag.sets:
+            value = node_overrides(args, node)[name]
+            assert type(value) is setting(node, name).type, (flag.option, node, name, value)
+
+
 @pytest.mark.ros
 def test_each_node_declares_exactly_its_settings(tmp_path):
     from rclpy.parameter import Parameter

@@ -59,6 +59,8 @@ from respec.robot.files import MAX_CONFIG_DEPTH, ConfigFileInvalidError, SystemC
 CAPABILITIES_KEY, SPEC_KEY, MAPPINGS_KEY = 'cnu_capabilities', 'cnu_spec', 'cnu_mappings'
 PIPELINE_KEY, STATE_MACHINE_KEY = 'cnu_pipeline', 'cnu_state_machine'
 SYSTEM_FILE_KEYS = ('system', CAPABILITIES_KEY, SPEC_KEY, MAPPINGS_KEY, PIPELINE_KEY, STATE_MACHINE_KEY, 'reduce')
+#: The system file's keys that name another file.
+CNU_FILE_KEYS = (CAPABILITIES_KEY, SPEC_KEY, MAPPINGS_KEY, STATE_MACHINE_KEY)
 CAPABILITIES_PIPELINE, FULL_SPEC_PIPELINE = 'capabilities', 'full_spec'   # CNU's two processes pipelines
 FAILURE = 'failure'  # CNU's transition outcome of a failure; success is COMPLETED
 

@@ -17,6 +17,7 @@ once, when the file is read.
 
 from __future__ import annotations
 
+import contextlib
 import errno
 import json
 import os
@@ -30,7 +31,8 @@ from typing import Callable, Mapping, Sequence, TypeVar
 import yaml
 
 from respec.robot.abstraction import RobotAbstraction, abstraction_from_document
-from respec.robot.cnu import SYSTEM_FILE_KEYS, CapabilitySystem, is_capability_document, load_capability_system
+from respec.robot.cnu import (CNU_FILE_KEYS, SYSTEM_FILE_KEYS, CapabilitySystem, is_capability_document,
+                              load_capability_system)
 from respec.robot.description import RobotDescription
 from respec.robot.files import (ConfigDirs, ConfigFileInvalidError, SystemConfigError, SystemNotFoundError,
                                 available_systems, check_system_name, config_search_path, load_config_yaml,
@@ -244,6 +246,32 @@ class SystemCatalog:
 
     def load(self, name: RobotSystem | str) -> RobotSystem:
         return robot_system(name, self.config_dir)
+
+    def files_bytes(self, name: str) -> int:
+        """How many bytes of robot files loading ``name`` reads: its system file and the CNU files
+        it names (sizes only; a system file over SMALL_SYSTEM_FILE_BYTES is not parsed for them),
+        so that a caller can load a large robot where large work belongs. 0 when the system file
+        cannot be found (loading says why)."""
+        try:
+            path = system_file(name, config_search_path(self.config_dir))
+            size = path.stat().st_size
+        except (SystemConfigError, OSError):
+            return 0
+        if size > SMALL_SYSTEM_FILE_BYTES:
+            return size
+        try:
+            document = parse_config_text(path.read_text(encoding='utf-8'), path)
+        except (SystemConfigError, OSError, UnicodeDecodeError):
+            return size
+        for key in CNU_FILE_KEYS:
+            if isinstance(document.get(key), str):
+                with contextlib.suppress(OSError):
+                    size += (path.parent / document[key]).stat().st_size
+        return size
+
+
+#: A system file up to this size is read to find the CNU files it names (CNU's are a few lines).
+SMALL_SYSTEM_FILE_BYTES = 64 * 1024
 
 
 # --- a catalog as text: how a suite serves its systems to a GUI running elsewhere ---------------

@@ -49,6 +49,9 @@ from synthesis_msgs.srv import CancelSynthesis, GenerateLTLSpecification, Propos
 
 #: Custom formulas (bytes, all sections) up to which a request is compiled in the node's process.
 SMALL_CUSTOM_BYTES = 64 * 1024
+#: Robot files (bytes) up to which a request is compiled in the node's process: a 4 MiB system
+#: file (the most accepted) takes about 4 s and 250 MiB to read and check.
+SMALL_ROBOT_BYTES = 256 * 1024
 #: Proposals a ProposeRepairs request gets when it names no number.
 DEFAULT_REPAIR_PROPOSALS = 3
 #: The longest search a request may ask for (seconds).
@@ -145,13 +148,16 @@ class LTLCompilationNode(Node):
                          msg_to_sections(request.custom_ltl) or None, self.catalog())
             custom_bytes = sum(utf8_length(formula) for section in (arguments[5] or {}).values()
                                for formula in section)
-            if custom_bytes <= SMALL_CUSTOM_BYTES:
+            robot_bytes = self.catalog().files_bytes(request.system) if isinstance(request.system, str) else 0
+            if custom_bytes <= SMALL_CUSTOM_BYTES and robot_bytes <= SMALL_ROBOT_BYTES:
                 # Formulas may nest MAX_FORMULA_NESTING deep: compiled on a deep stack.
                 sections, provenance = run_with_deep_stack(compiled_sections, *arguments)
             else:
+                size = (f'{custom_bytes:,} bytes of custom formulas' if custom_bytes > SMALL_CUSTOM_BYTES else
+                        f'{robot_bytes:,} bytes of robot files')
                 try:
                     sections, provenance = await self.children.run(
-                        _compiled_in_child, arguments, size=f'{custom_bytes:,} bytes of custom formulas', arrival=arrival,
+                        _compiled_in_child, arguments, size=size, arrival=arrival,
                         requested=requested, request_id=request.request_id)
                 except StageStopped as stopped:
                     response.error_code = stopped.error_code

@@ -34,3 +34,16 @@ def test_notes_and_other_keys_of_a_system_file_stay_on_the_server(tmp_path):
     assert list(entry['files']) == ['atlas_noted.yaml']
     served = ServedCatalog.from_json(text).load('atlas_noted')
     assert served == robot_system('atlas_noted', str(tmp_path)) and 'notes' not in served.sections
+
+
+def test_a_catalog_tells_how_many_bytes_of_files_a_system_reads():
+    from pathlib import Path
+
+    from respec.robot import SystemCatalog
+
+    config = Path(__file__).resolve().parents[2] / 'config'
+    catalog = SystemCatalog()
+    assert catalog.files_bytes('atlas') == (config / 'atlas.yaml').stat().st_size
+    rover = sum(path.stat().st_size for path in [config / 'delivery_rover.yaml', *(config / 'delivery_rover').glob('*.yaml')])
+    assert catalog.files_bytes('delivery_rover') == rover   # the system file and the three CNU files it names
+    assert catalog.files_bytes('nowhere') == 0

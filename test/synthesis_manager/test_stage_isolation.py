@@ -52,6 +52,32 @@ def test_a_large_compilation_beyond_its_memory_limit_names_the_limit(ros, tmp_pa
     assert client.run(make_goal(**PAPER_TASK), timeout=60).error_name == 'SUCCESS'
 
 
+def big_robot(folder, extra_actions: int = 60_000) -> str:
+    """ATLAS with ``extra_actions`` more actions (about 2 MB of system file) in ``folder``; its name."""
+    from pathlib import Path
+
+    text = (Path(__file__).resolve().parents[2] / 'config' / 'atlas.yaml').read_text()
+    extra = ''.join(f'    extra_action_{k:06d}: [stand]\n' for k in range(extra_actions))
+    (folder / 'atlas_big.yaml').write_text(text.replace('    target_pose: []\n', '    target_pose: []\n' + extra, 1))
+    return 'atlas_big'
+
+
+def test_a_large_robot_file_is_read_and_compiled_in_a_child(ros, tmp_path):
+    """Issue 48, item 3: a robot file of megabytes is read and checked (seconds, hundreds of MB)
+    where the work can be stopped and bounded, not in the node: here the child's 1 MB memory
+    limit ends it, naming the limit; the node goes on compiling other tasks."""
+    config = tmp_path / 'config'
+    config.mkdir()
+    name = big_robot(config)
+    ros.add_node(LTLCompilationNode, parameter_overrides=[Parameter('memory_limit_mb', value=1),
+                                                          Parameter('config_dir', value=str(config))])
+    client = start_suite(ros, tmp_path, names=('ltl_synthesis', 'sm_generation'))
+    outcome = client.run(make_goal(name, ['stand_prep'], ['look_down'], option='ltl_compilation_only'), timeout=120)
+    assert outcome.error_name == 'LTL_SPEC_COMPILATION_FAILED', outcome.message
+    assert 'memory limit of 1 MB' in outcome.message and 'bytes of robot files' in outcome.message
+    assert client.run(make_goal(**PAPER_TASK), timeout=60).error_name == 'SUCCESS'
+
+
 def normal_goal_beside(client, huge):
     """Send ``huge``, and a second later the paper task: (its result, its seconds, and the huge
     goal's result and seconds as ``answers['huge']``, ``answers['huge seconds']``)."""

@@ -57,7 +57,7 @@ def run_over_ros(states, initial_conditions, faults, speed):
     from atlas_sim.executive.executor import execute_state_machine
     from atlas_sim.simulator.factory import make_simulator, parse_faults
     from synthesis_manager.nodes.atlas_sim_node import AtlasSimNode
-    from synthesis_manager.nodes.atlas_sim_robot import RosRobot
+    from synthesis_manager.ros.atlas_sim_robot import RosRobot
     from synthesis_manager.ros.harness import RosHarness
 
     with RosHarness() as ros:

@@ -356,7 +356,7 @@ def _ros_robot(ros, args, simulator):
     from rclpy.parameter import Parameter
 
     from synthesis_manager.nodes.atlas_sim_node import AtlasSimNode
-    from synthesis_manager.nodes.atlas_sim_robot import RosRobot
+    from synthesis_manager.ros.atlas_sim_robot import RosRobot
 
     node = ros.add_node(AtlasSimNode, simulator=simulator,
                         parameter_overrides=[Parameter('speed', value=float(args.speed)),

@@ -35,7 +35,7 @@ that the next state does not activate is abandoned (the robot cannot cancel it) 
 whatever it still reports is recorded, so the trace check sees it.
 
 The robot is anything with the :class:`atlas_sim.executive.robot.Robot` protocol: ``SimulatedRobot`` drives
-an ``AtlasSimulator`` directly; ``synthesis_manager.nodes.atlas_sim_robot.RosRobot`` drives the
+an ``AtlasSimulator`` directly; ``synthesis_manager.ros.atlas_sim_robot.RosRobot`` drives the
 simulator node. The machine is the tree of :mod:`sm_generation.state_machine`, as generated (or
 as a message's list became it where it arrived).
 

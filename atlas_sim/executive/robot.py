@@ -1,7 +1,7 @@
 """The robot the executive drives (ROS-free): the :class:`Robot` protocol and what a capability returns.
 
 ``atlas_sim.simulated_robot.SimulatedRobot`` is this protocol on the in-process simulator,
-``synthesis_manager.nodes.atlas_sim_robot.RosRobot`` the same protocol over ROS 2.
+``synthesis_manager.ros.atlas_sim_robot.RosRobot`` the same protocol over ROS 2.
 """
 
 from __future__ import annotations

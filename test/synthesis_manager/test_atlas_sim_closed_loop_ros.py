@@ -16,7 +16,7 @@ from respec.parsing import spec_from_text_sections
 from synthesis_manager.cli import main as cli_main
 from synthesis_manager.client import SynthesisClient, make_goal
 from synthesis_manager.nodes.atlas_sim_node import AtlasSimNode
-from synthesis_manager.nodes.atlas_sim_robot import RosRobot
+from synthesis_manager.ros.atlas_sim_robot import RosRobot
 from synthesis_manager.suite import suite_node_factories
 from respec.robot import robot_system
 

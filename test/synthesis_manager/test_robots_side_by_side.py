@@ -17,7 +17,7 @@ from ltl_specification.initial_conditions import initial_conditions_in_status
 from respec.parsing import spec_from_text_sections
 from synthesis_manager.client import SynthesisClient, make_goal
 from synthesis_manager.nodes.atlas_sim_node import AtlasSimNode
-from synthesis_manager.nodes.atlas_sim_robot import RosRobot
+from synthesis_manager.ros.atlas_sim_robot import RosRobot
 from synthesis_manager.ros.namespaces import synthesis_service_remapping
 from synthesis_manager.suite import suite_node_factories
 from respec.robot import robot_system

@@ -18,7 +18,7 @@ from pathlib import Path
 os.environ.setdefault("MUJOCO_GL", "egl")
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
-from atlas_sim.simulator import AtlasSimulator, FrameRenderer  # noqa: E402
+from atlas_sim.simulator import AtlasSimulator, FrameRenderer
 
 
 def measure(label: str, sim: AtlasSimulator, names) -> None:

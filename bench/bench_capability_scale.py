@@ -38,7 +38,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path[:0] = [str(ROOT), str(ROOT / 'bench')]
 
-import capability_robots  # noqa: E402
+import capability_robots
 from respec.robot import robot_system
 
 RESULTS = ROOT / 'bench' / 'results' / 'capability_scale.md'

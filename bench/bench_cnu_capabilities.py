@@ -23,11 +23,11 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
-from ltl_specification import compile_task  # noqa: E402
-from ltl_synthesizer import synthesize  # noqa: E402
-from respec.automaton import automaton_from_strategy  # noqa: E402
-from respec.robot.state_library import workspace_state_library  # noqa: E402
-from sm_generation import generate_state_machine  # noqa: E402
+from ltl_specification import compile_task
+from ltl_synthesizer import synthesize
+from respec.automaton import automaton_from_strategy
+from respec.robot.state_library import workspace_state_library
+from sm_generation import generate_state_machine
 from respec.robot import robot_system
 
 # name: (capabilities, spec, mappings, initial conditions, goals, CNU's expected post-reduction count)

@@ -21,8 +21,8 @@ ROOT = Path(__file__).resolve().parents[1]
 RESULTS = ROOT / 'bench' / 'results'
 sys.path[:0] = [str(ROOT), str(ROOT / 'bench')]
 
-import gr1_families  # noqa: E402
-from bench_gr1_families import GR1SYNTH, add_comparison_arguments, run_timed  # noqa: E402
+import gr1_families
+from bench_gr1_families import GR1SYNTH, add_comparison_arguments, run_timed
 
 INSTANCES = [
     ('free inputs, width 4', gr1_families.free_inputs, (4,)),

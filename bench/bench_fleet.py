@@ -23,7 +23,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from fleet_network import (Fleet, PrivateNetwork, killed_host, network_namespaces_available,  # noqa: E402
+from fleet_network import (Fleet, PrivateNetwork, killed_host, network_namespaces_available,
                            pulled_cable, restarted_host, run_round)
 
 RESULTS = Path(__file__).resolve().parent / 'results' / 'fleet.md'

@@ -30,7 +30,7 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / 'bench'))
 
-from flexbe_onboard_system import Operator, OnboardSystem, exported_and_installed  # noqa: E402
+from flexbe_onboard_system import Operator, OnboardSystem, exported_and_installed
 
 BEHAVIOR = 'Bench Five Goals'
 FIVE_GOALS = ['--system', 'atlas', '--initial-conditions', 'stand_prep',

@@ -36,7 +36,7 @@ ROOT = Path(__file__).resolve().parents[1]
 RESULTS = ROOT / 'bench' / 'results'
 sys.path[:0] = [str(ROOT), str(ROOT / 'bench')]
 
-import gr1_families  # noqa: E402
+import gr1_families
 
 GR1SYNTH = [sys.executable, '-m', 'ltl_synthesizer']
 # Instances ours solves within this many CPU seconds are also timed in the resident mode.

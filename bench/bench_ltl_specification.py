@@ -14,8 +14,8 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
-from ltl_specification import compile_task  # noqa: E402
-from respec.spec import FORMULA_SECTIONS  # noqa: E402
+from ltl_specification import compile_task
+from respec.spec import FORMULA_SECTIONS
 from respec.robot import robot_system
 
 TASKS = [

@@ -32,10 +32,10 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / 'bench'))
 
-from bench_cnu_capabilities import CNU_EXAMPLES, write_cnu_systems  # noqa: E402
-from ltl_specification.repair import TaskRequest, attempt, propose_repairs  # noqa: E402
-from respec.robot import robot_system  # noqa: E402
-from respec.robot.state_library import workspace_state_library  # noqa: E402
+from bench_cnu_capabilities import write_cnu_systems
+from ltl_specification.repair import TaskRequest, attempt, propose_repairs
+from respec.robot import robot_system
+from respec.robot.state_library import workspace_state_library
 
 ATLAS_STRIDE = 3
 ATLAS_COUNT = 16

@@ -18,7 +18,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
-from sm_generation import Automaton, AutomatonState, generate_state_machine, load_automaton  # noqa: E402
+from sm_generation import Automaton, AutomatonState, generate_state_machine, load_automaton
 from respec.robot import robot_system
 
 ACTIONS = ['look_down', 'pregrasp', 'pregrasp_plan', 'approach_object', 'footstep_plan', 'footstep_goal']

@@ -19,8 +19,8 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path[:0] = [str(ROOT), str(ROOT / 'bench')]
 
-import gr1_families  # noqa: E402
-from bench_gr1_families import GR1SYNTH, RESULTS, run_timed  # noqa: E402
+import gr1_families
+from bench_gr1_families import GR1SYNTH, RESULTS, run_timed
 
 INSTANCES = [('amba 2 masters', gr1_families.amba, (2,)),
              ('factory 5x3 s1 e0', gr1_families.factory, (5, 3, 1, 0)),

@@ -30,8 +30,8 @@ ROOT = Path(__file__).resolve().parents[1]
 RESULTS = ROOT / 'bench' / 'results'
 sys.path[:0] = [str(ROOT), str(ROOT / 'bench')]
 
-import gr1_families  # noqa: E402
-from bench_gr1_families import GR1SYNTH, run_timed  # noqa: E402
+import gr1_families
+from bench_gr1_families import GR1SYNTH, run_timed
 
 SPECS = {
     'one input, one output (realizable)':

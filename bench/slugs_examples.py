@@ -23,8 +23,8 @@ from pathlib import Path
 REPOSITORY = Path(__file__).resolve().parent.parent
 sys.path[:0] = [str(REPOSITORY), str(REPOSITORY / 'test')]
 
-from ltl_synthesizer import is_realizable  # noqa: E402
-from respec.parsing import ParseError, parse_slugsin, parse_structuredslugs  # noqa: E402
+from ltl_synthesizer import is_realizable
+from respec.parsing import ParseError, parse_slugsin, parse_structuredslugs
 
 # Realizability per slugs: (default semantics, --sysInitRoboticsSemantics).
 EXPECTED = {

@@ -160,7 +160,6 @@ def check_counterstrategy(spec, strategy: dict, robotics_semantics: bool = False
     if sorted(names) != sorted(formulas.variables):
         return [f'counter-strategy variables {names} are not the specification\'s']
     inputs, outputs = list(spec.env_props), list(spec.sys_props)
-    next_inputs, next_outputs = [v + "'" for v in inputs], [v + "'" for v in outputs]
     # The safety sections stay lists of formulas, cofactored by each node's state before they
     # are conjoined: as one BDD in the declared order, GenBuf's SYS_TRANS alone is huge.
     env_init, sys_init = formulas.conjunction(spec.env_init), formulas.conjunction(spec.sys_init)

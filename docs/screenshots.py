@@ -18,8 +18,8 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path[:0] = [str(ROOT / 'test'), str(ROOT / 'test' / 'synthesis_manager')]
 
-import headless_chromium  # noqa: E402
-from test_gui_browser import STATUS_DONE as DONE, choose_task, gui_server, result_code  # noqa: E402
+import headless_chromium
+from test_gui_browser import STATUS_DONE as DONE, choose_task, gui_server, result_code
 
 PAPER_GOALS = ['look_down', 'pickup_object']
 WIDE, SMALL = {'width': 1400, 'height': 900}, {'width': 1280, 'height': 720}

@@ -385,7 +385,7 @@ def explain_unsynthesizable(details: str, spec: GR1Specification, provenance: Pr
     raises: if it cannot be diagnosed, ``details`` are returned unchanged."""
     try:
         diagnosis = diagnose(spec, robotics_semantics, limits, provenance)
-    except Exception:  # the diagnosis is a help; the synthesizer's verdict stands without it
+    except Exception:  # noqa: BLE001 - the diagnosis is a help; the synthesizer's verdict stands without it
         return details
     if diagnosis is None:
         return details

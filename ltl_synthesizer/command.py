@@ -118,7 +118,7 @@ def _read_text(path: str, deadline: float | None, max_chars: int | None = None) 
     def read():  # opening a FIFO blocks until a writer comes: in a thread the process may leave
         try:
             outcome['text'] = _read_at_most(path, max_chars)
-        except BaseException as error:  # re-raised in the caller's thread
+        except BaseException as error:  # noqa: BLE001 - re-raised in the caller's thread
             outcome['error'] = error
 
     reader = threading.Thread(target=read, name='gr1synth-input', daemon=True)

@@ -27,7 +27,7 @@ def _import_cudd():
         del sys.modules['networkx']
     utils = sys.modules.get('dd._utils')
     if getattr(utils, '_nx', None) is placeholder:
-        utils._nx = _lazy_module('networkx')
+        utils._nx = _lazy_module('networkx')  # noqa: SLF001 - dd keeps its networkx import there
     return cudd
 
 

@@ -266,7 +266,7 @@ def _codes(game: SymbolicGame, u, names: list[str], either: set[str]) -> list[in
     bits = [(name, 1 << (len(names) - 1 - index)) for index, name in enumerate(names)]
     free = [bit for name, bit in bits if name in either and name not in support]
     codes = []
-    for cube in game.bdd._pick_iter(u):
+    for cube in game.bdd._pick_iter(u):  # noqa: SLF001 - dd.cudd's cube iterator without the public copy of each cube
         found = [sum([bit for name, bit in bits if cube.get(name)])]
         for bit in free:  # each free name doubles the valuations
             found += [code | bit for code in found]

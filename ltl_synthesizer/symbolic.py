@@ -127,7 +127,7 @@ class SymbolicGame:
         ``prime(prime(u)) == u``. Swapping each pair is exact for any ``u`` and much cheaper
         than dd's general renaming, which composes a substitution vector.
         """
-        return self.bdd._swap(u, self.to_next)
+        return self.bdd._swap(u, self.to_next)  # noqa: SLF001 - exact and cheaper than rename (above)
 
     def env_trans(self):
         """The monolithic environment safety relation (for explicit extraction and explanations)."""

@@ -197,7 +197,7 @@ class SynthesisClient:
         requests = []
 
         def request_result():
-            future = self.action_client._get_result_async(handle)
+            future = self.action_client._get_result_async(handle)  # noqa: SLF001 - rclpy has no public way to ask for a result twice
             future.add_done_callback(lambda _: done.set())
             requests.append((future, time.monotonic()))
 

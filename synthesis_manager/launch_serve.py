@@ -59,21 +59,22 @@ def serve_parser() -> argparse.ArgumentParser:
     """``behavior-synthesis serve``'s parser, as the command line builds it."""
     from synthesis_manager.cli import build_parser
 
-    subparsers = next(action for action in build_parser(only='serve')._actions
-                      if isinstance(action, argparse._SubParsersAction))
+    # argparse lists a parser's options and their kinds only in private attributes and classes.
+    subparsers = next(action for action in build_parser(only='serve')._actions  # noqa: SLF001
+                      if isinstance(action, argparse._SubParsersAction))  # noqa: SLF001
     return subparsers.choices['serve']
 
 
 def serve_launch_arguments() -> list[LaunchArgument]:
     """Every option of ``serve`` (but ``--help``) as a launch argument, in ``serve --help``'s order."""
     arguments = []
-    for action in serve_parser()._actions:
+    for action in serve_parser()._actions:  # noqa: SLF001
         long_options = [option for option in action.option_strings if option.startswith('--')]
-        if not long_options or isinstance(action, argparse._HelpAction):
+        if not long_options or isinstance(action, argparse._HelpAction):  # noqa: SLF001
             continue
-        if isinstance(action, (argparse._StoreTrueAction, argparse._StoreFalseAction)):
+        if isinstance(action, (argparse._StoreTrueAction, argparse._StoreFalseAction)):  # noqa: SLF001
             kind = 'flag'
-        elif isinstance(action, argparse._AppendAction):
+        elif isinstance(action, argparse._AppendAction):  # noqa: SLF001
             kind = 'list'
         else:
             kind = 'value'

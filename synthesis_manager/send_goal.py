@@ -191,7 +191,7 @@ def run(args) -> int:
             try:
                 outcome_box['outcome'] = client.run(goal, feedback=progress, cancel=cancel,
                                                     timeout=args.timeout + 30)
-            except Exception as error:
+            except Exception as error:  # noqa: BLE001 - handed to the waiting thread, which reports it
                 outcome_box['error'] = error
             finally:
                 finished.set()

@@ -109,7 +109,7 @@ def selection_for(node, name: str):
         library = BehaviorLibrary(node)
         key, entry = library.find_behavior(name)
     if entry is None:
-        known = sorted(entry['name'] for entry in library._behavior_lib.values())
+        known = sorted(entry['name'] for entry in library._behavior_lib.values())  # noqa: SLF001 - listed nowhere else
         raise LookupError(f'no installed behavior is called {name!r} (found: {", ".join(known) or "none"}; '
                           'is its workspace sourced, or its prefix on AMENT_PREFIX_PATH and PYTHONPATH?)')
     source = Path(library.get_sourcecode_filepath(key)).read_text(encoding='utf-8')

@@ -174,7 +174,7 @@ class AtlasSimNode(Node):
     def _physics_loop(self):
         try:
             self._run_physics()
-        except Exception as error:  # a dead physics thread must not leave goals waiting forever
+        except Exception as error:  # noqa: BLE001 - a dead physics thread must not leave goals waiting forever
             log_internal_error(self.get_logger(), 'physics stopped', error)
             self._stop.set()
             with self.lock:

@@ -163,7 +163,7 @@ class LTLCompilationNode(Node):
                     response.error_code = stopped.error_code
                     self.log.warning(response.error_code.message)
                     return response
-        except Exception as error:  # every failure becomes an error code; the node keeps serving
+        except Exception as error:  # noqa: BLE001 - every failure becomes an error code; the node keeps serving
             response.error_code = reported_error(error, self.get_logger(), 'LTL compilation failed')
             self.log.warning(response.error_code.message)
             return response
@@ -190,7 +190,7 @@ class LTLCompilationNode(Node):
         except (RepairSearchError, Abandoned, SynthesisCancelledError) as error:
             response.error_code = error_code(ErrorCode.TIMEOUT, f'repair search stopped: {error or "shutdown"}')
             return response
-        except Exception as error:  # every failure becomes an error code; the node keeps serving
+        except Exception as error:  # noqa: BLE001 - every failure becomes an error code; the node keeps serving
             response.error_code = reported_error(error, self.get_logger(), 'repair search failed')
             self.log.warning(response.error_code.message)
             return response

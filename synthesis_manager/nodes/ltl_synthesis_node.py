@@ -158,7 +158,7 @@ class LTLSynthesisNode(Node):
         except ParseError as error:  # the parsers' own code, as in every other stage
             response.synthesizable = False
             response.error_code = error_code(error.code, f'malformed specification: {error}')
-        except Exception as error:  # every failure becomes an error code; the node keeps serving
+        except Exception as error:  # noqa: BLE001 - every failure becomes an error code; the node keeps serving
             response.synthesizable = False
             response.error_code = reported_error(error, self.get_logger(), 'synthesis failed')
         finally:

@@ -123,7 +123,7 @@ class BehaviorSynthesisServer(Node):
             return interface.make_result(outcome)
         except CodedError as error:
             outcome.fail(error.code, str(error))
-        except Exception as error:  # a bug: logged with its traceback; the server keeps serving
+        except Exception as error:  # noqa: BLE001 - a bug: logged with its traceback; the server keeps serving
             log_internal_error(self.get_logger(), 'behavior synthesis failed', error)
             outcome.fail(INTERNAL_ERROR, f'internal error: {error!r}')
         if not outcome.succeeded and task is not None:

@@ -101,7 +101,7 @@ class SMGenerationNode(Node):
                     response.error_code = stopped.error_code
                     self.log.warning(response.error_code.message)
                     return response
-        except Exception as error:  # every failure becomes an error code; the node keeps serving
+        except Exception as error:  # noqa: BLE001 - every failure becomes an error code; the node keeps serving
             response.error_code = reported_error(error, self.get_logger(), 'state machine generation failed')
             self.log.warning(response.error_code.message)
             return response

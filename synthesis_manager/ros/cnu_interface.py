@@ -120,7 +120,7 @@ def load_flexbe_synthesis_interface() -> FlexBESynthesisInterface:
                                       CnuState.get_fields_and_field_types())
         if mismatches:
             raise TypeError(f'flexbe_msgs/StateInstantiation differs from ours: {"; ".join(mismatches)}')
-    except Exception as error:  # whatever makes it unusable: say it once, serve our type
+    except Exception as error:  # noqa: BLE001 - whatever makes it unusable: say it once, serve our type
         from synthesis_msgs.action import FlexBESynthesis
         from synthesis_msgs.msg import FlexBESynthesisRequest, SynthesisErrorCode
 

@@ -34,7 +34,7 @@ class SuiteExecutor(MultiThreadedExecutor):
         except (ExternalShutdownException, ShutdownException, TimeoutException, ConditionReachedException):
             return
         if _suspended(handler):
-            turn = awaited_turn(handler._handler)
+            turn = awaited_turn(handler._handler)  # noqa: SLF001 - rclpy keeps the coroutine in the handler
             if turn is not None and not turn.due():
                 return  # nothing for it to look at yet; the executor offers it again next pass
             handler()  # resumes, checks its conditions, and yields again or ends

@@ -48,6 +48,6 @@ class QuickLogger:
     def _log(self, severity: LoggingSeverity, message: str) -> None:
         if not self.logger.is_enabled_for(severity):
             return
-        caller = sys._getframe(2)  # the frame that called info/warning/error
+        caller = sys._getframe(2)  # noqa: SLF001 - the frame that called info/warning/error, as logging finds it
         _rclpy.rclpy_logging_rcutils_log(severity, self.logger.name, bounded_line(str(message)), caller.f_code.co_name,
                                          caller.f_code.co_filename, caller.f_lineno)

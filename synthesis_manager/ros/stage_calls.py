@@ -252,7 +252,7 @@ class StageCaller:
         for name, namespace in self.node.get_node_names_and_namespaces():
             try:
                 services = self.node.get_service_names_and_types_by_node(name, namespace)
-            except Exception:  # the node left the graph meanwhile
+            except Exception:  # noqa: BLE001 - the node left the graph meanwhile
                 continue
             if any(service == resolved for service, _ in services):
                 full_name = f'{namespace.rstrip("/")}/{name}'

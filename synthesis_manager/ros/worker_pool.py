@@ -91,7 +91,7 @@ class WorkerPool:
             try:
                 if future.set_running_or_notify_cancel():
                     future.set_result(function(*args))
-            except BaseException as error:  # handed to the awaiting callback
+            except BaseException as error:  # noqa: BLE001 - handed to the awaiting callback
                 future.set_exception(error)
             finally:
                 with self._lock:

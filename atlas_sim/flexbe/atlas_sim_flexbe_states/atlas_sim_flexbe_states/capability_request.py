@@ -71,7 +71,7 @@ class CapabilityRequest:
             ProxyActionClient.send_goal(self._topic, capability_goal(self.capability, userdata),
                                         wait_duration=SERVER_WAIT)
             self._sent_at = time.monotonic()
-        except Exception as error:  # pylint: disable=broad-except  (no server, wrong type)
+        except Exception as error:  # noqa: BLE001 - no server, a wrong type: the state says so
             self._failure = f'{self.state_name}: could not request {self.capability}: {error}'
             Logger.logwarn(self._failure)
 
@@ -102,7 +102,7 @@ class CapabilityRequest:
         """Ask for the result again when the goal's status has said "finished" for RESULT_RETRY
         seconds (and again every RESULT_RETRY seconds). flexbe_core 2.3.3's proxy has no public
         accessor for the goal's handle: its ``_current_goal`` future is read."""
-        goal = ProxyActionClient._current_goal.get(self._topic)  # pylint: disable=protected-access
+        goal = ProxyActionClient._current_goal.get(self._topic)  # noqa: SLF001 - flexbe_core keeps running goals in a class attribute only
         handle = goal.result() if goal is not None and goal.done() else None
         if handle is None or handle.status not in _FINISHED:
             return

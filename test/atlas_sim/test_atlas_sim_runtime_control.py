@@ -11,7 +11,7 @@ from atlas_sim.executive.runtime_control import (FULL, HIGH, LOW, OFF, CommandEr
                                                  needs_confirmation)
 from atlas_sim.simulated_robot import SimulatedRobot
 from atlas_sim.simulator.factory import make_simulator
-from test_atlas_sim_executor import ScriptedRobot, root, state
+from hand_made_machines import ScriptedRobot, root, state
 
 STAND_THEN_LOOK = [root('stand'),
                    {**state('/stand', 'stand_a', changed='look_down', failed='failed'), 'autonomy': [2, 0]},

@@ -16,7 +16,7 @@ from synthesis_manager.web import backend as backend_module
 from synthesis_manager.web.backend import SynthesisBackend
 from synthesis_manager.web.routes import create_app
 
-from test_gui_api import gui_args, run_job
+from gui_jobs import gui_args, run_job
 
 WRONG_ORDER = {'system': 'atlas', 'initial_conditions': ['stand_prep'], 'goals': ['look_down', 'stand_prep']}
 PAPER_TASK = {'system': 'atlas', 'initial_conditions': ['stand_prep'], 'goals': ['look_down', 'pickup_object']}

@@ -113,7 +113,7 @@ def test_the_documented_commands_serve_two_robots_and_the_clients_pick_one(tmp_p
 
     import httpx
 
-    from test_entry_point_shutdown import BIN, GUI_URL, loopback_domain, started
+    from suite_processes import BIN, GUI_URL, loopback_domain, started
 
     serve = [BIN / 'behavior-synthesis', 'serve', '--byproducts-dir', tmp_path]
     with loopback_domain() as (_, environment):

@@ -11,7 +11,8 @@ from rclpy.parameter import Parameter
 from respec.nesting import run_with_deep_stack
 from synthesis_manager.client import make_goal
 from synthesis_manager.nodes.ltl_compilation_node import SMALL_CUSTOM_BYTES, LTLCompilationNode, compiled_sections
-from test_synthesis_manager_reliability import PAPER_TASK, runaway_goal, start_suite
+from runaway_requests import runaway_goal
+from suite_in_process import PAPER_TASK, start_suite
 
 FORMULA_BYTES = 56_000  # as in the attack: just under the 64 KB string cap
 

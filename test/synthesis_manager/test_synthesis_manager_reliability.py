@@ -21,45 +21,14 @@ import pytest
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 
-from suite_settings import suite_args
+from runaway_requests import runaway_goal
+from suite_in_process import PAPER_TASK, start_suite
 from synthesis_manager.client import SynthesisClient, make_goal
 from synthesis_manager.limits import MAX_LIST_LENGTH, MAX_STRING_BYTES
-from synthesis_manager.nodes.server_node import BehaviorSynthesisServer
 from synthesis_manager.requests import byproduct_file_stem
 from synthesis_manager.ros.env import prepare_ros_environment
 from synthesis_manager.ros.harness import RosHarness, reserve_domain_id
-from synthesis_manager.suite import suite_node_factories
 from synthesis_msgs.srv import SynthesizeAutomaton
-
-PAPER_TASK = dict(system='atlas', initial_conditions=['stand_prep'], goals=['look_down', 'pickup_object'])
-# 200 unconstrained outputs: strategy extraction alone would run for hours.
-RUNAWAY_SPEC = {'sys_props': [f'p{i}' for i in range(200)], 'env_props': ['e'], 'sys_liveness': ['p0']}
-
-
-def runaway_goal(timeout=0.0):
-    return make_goal('atlas', [], [], option='ltl_synthesis_only', ltl_specification=RUNAWAY_SPEC,
-                     timeout=timeout)
-
-
-def reliability_suite_args(byproducts_dir, **overrides):
-    return suite_args(byproducts_dir, **{'service_timeout': 5.0, **overrides})
-
-
-def start_suite(ros, tmp_path, names=('ltl_compilation', 'ltl_synthesis', 'sm_generation'),
-                server_parameters=(), synthesis_parameters=()):
-    """The suite in ``ros`` (the synthesis node with extra parameters); returns a client."""
-    from synthesis_manager.nodes.ltl_synthesis_node import LTLSynthesisNode
-
-    for factory in suite_node_factories(reliability_suite_args(tmp_path), [n for n in names if n != 'ltl_synthesis']):
-        ros.add_node(factory)
-    if 'ltl_synthesis' in names:
-        ros.add_node(LTLSynthesisNode, parameter_overrides=[
-            Parameter('byproducts_dir', value=str(tmp_path)), *synthesis_parameters])
-    ros.add_node(BehaviorSynthesisServer, parameter_overrides=list(server_parameters))
-    client = SynthesisClient(ros.add_node(Node, 'reliability_client'))
-    assert client.wait_for_server(timeout=10.0)
-    return client
-
 
 def run_all(client, goals, timeout=120.0):
     """Send every goal at once (one thread each); returns outcomes (or exceptions) in order."""

@@ -18,6 +18,8 @@ from ltl_synthesizer import synthesize
 from respec.automaton import automaton_from_strategy
 from sm_generation import generate_state_machine, validate_state_machine
 
+pytestmark = pytest.mark.mujoco
+
 STAND_HEIGHT_RANGE = (0.6, 1.1)  # pelvis height (m): crouched stand_prep is ~0.67, standing ~0.85
 
 

@@ -12,6 +12,8 @@ from sm_generation import StateInstantiation
 
 from hand_made_machines import ScriptedRobot, root, state
 
+pytestmark = pytest.mark.mujoco
+
 
 def container(path, conditions, **transitions):
     """conditions: (container outcome, {child: outcome}) in FlexBE's order."""

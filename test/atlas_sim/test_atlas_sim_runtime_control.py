@@ -159,6 +159,7 @@ PICK = [root('object_template'),
         state('/object_template', 'object_template_a', received='finished', aborted='failed')]
 
 
+@pytest.mark.mujoco
 def test_input_state_asks_the_operator_with_the_simulators_answer_offered():
     simulator = make_simulator('atlas', initial_conditions=['stand_prep'])
     asked = []
@@ -177,6 +178,7 @@ def test_input_state_asks_the_operator_with_the_simulators_answer_offered():
     assert run.outcome == 'finished' and simulator.answers == {'template_id': 1}
 
 
+@pytest.mark.mujoco
 @pytest.mark.parametrize('answer', [None, 7, 'box'])
 def test_an_aborted_or_invalid_input_fails_the_input_state(answer):
     simulator = make_simulator('atlas', initial_conditions=['stand_prep'])
@@ -187,6 +189,7 @@ def test_an_aborted_or_invalid_input_fails_the_input_state(answer):
     assert run.trace.steps[0].results[0]['reason'] == 'operator did not provide object_template'
 
 
+@pytest.mark.mujoco
 def test_at_full_autonomy_the_input_takes_the_robots_default_without_asking():
     simulator = make_simulator('atlas', initial_conditions=['stand_prep'])
     run = execute_state_machine(PICK, SimulatedRobot(simulator), control=RuntimeControl(lambda timeout: []))

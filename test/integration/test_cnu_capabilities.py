@@ -24,6 +24,8 @@ from sm_generation import generate_state_machine, validate_state_machine
 from cnu_example_pairs import example_pairs, write_system_file
 from cnu_systems import EXAMPLES, copied_rover, example_system, write_system
 
+pytestmark = [pytest.mark.ros, pytest.mark.flexbe]
+
 @pytest.fixture
 def cnu(flexbe_sources) -> Path:
     return flexbe_sources / 'flexbe_synthesis'

@@ -18,7 +18,7 @@ import pytest
 
 from flexbe_workspace import WORKSPACE_PACKAGES
 
-pytestmark = pytest.mark.usefixtures('flexbe')
+pytestmark = [pytest.mark.usefixtures('flexbe'), pytest.mark.ros, pytest.mark.flexbe, pytest.mark.slow]
 
 REPOSITORY = Path(__file__).resolve().parents[2]
 DOCS = REPOSITORY / 'docs' / 'flexbe.md'

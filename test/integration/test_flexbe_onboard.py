@@ -25,7 +25,7 @@ from flexbe_onboard_system import Operator, OnboardSystem, exported_and_installe
 
 from cnu_systems import copied_rover, example_system
 
-pytestmark = pytest.mark.usefixtures('flexbe')
+pytestmark = [pytest.mark.usefixtures('flexbe'), pytest.mark.ros, pytest.mark.flexbe]
 
 PAPER_TASK = ['--initial-conditions', 'stand_prep', '--goals', 'look_down,pickup_object']
 BEHAVIOR = 'Onboard Pickup'

@@ -29,7 +29,7 @@ import headless_chromium
 from flexbe_onboard_system import OnboardSystem, Operator, finished_with
 from flexbe_webui_port import WEBUI_PORT, port_for_this_run
 
-pytestmark = pytest.mark.usefixtures('flexbe')
+pytestmark = [pytest.mark.usefixtures('flexbe'), pytest.mark.ros, pytest.mark.browser, pytest.mark.flexbe]
 
 REPOSITORY = Path(__file__).resolve().parents[2]
 # fastapi/starlette as the WebUI needs them (starlette<0.47), put first on its path only.

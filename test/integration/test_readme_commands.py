@@ -27,6 +27,8 @@ from synthesis_manager.ros.env import prepare_ros_environment
 
 from readme_sections import flexbe_section, readme_commands
 
+pytestmark = [pytest.mark.ros, pytest.mark.slow]
+
 REPOSITORY = Path(__file__).resolve().parents[2]
 README = REPOSITORY / 'README.md'
 BIN = Path(sys.executable).parent

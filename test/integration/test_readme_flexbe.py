@@ -31,6 +31,8 @@ from flexbe_webui_port import WEBUI_PORT, port_for_this_run
 from flexbe_workspace import WORKSPACE_PACKAGES
 from readme_sections import flexbe_section, readme_commands
 
+pytestmark = [pytest.mark.ros, pytest.mark.mujoco, pytest.mark.slow]
+
 REPOSITORY = Path(__file__).resolve().parents[2]
 README = REPOSITORY / 'README.md'
 # Commands a user leaves running (a terminal of their own, or until Ctrl-C): run in the background.
@@ -80,6 +82,7 @@ def webui_answers() -> bool:
     return False
 
 
+@pytest.mark.flexbe
 def test_the_section_runs_in_order_to_a_finished_behavior(ros, flexbe, flexbe_sources, tmp_path):
     from flexbe_msgs.msg import BEStatus
 

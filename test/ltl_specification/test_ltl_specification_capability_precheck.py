@@ -68,6 +68,7 @@ def test_a_precondition_nothing_establishes_names_its_capability(tmp_path):
     assert compiled(courier(tmp_path, sign=unsigned), ['signature'], ['deliver'])
 
 
+@pytest.mark.flexbe
 def test_the_command_line_says_the_compilers_sentence(tmp_path, flexbe):
     """`behavior-synthesis compile` exits 1 with the same sentence, code and item on one line."""
     courier(tmp_path)

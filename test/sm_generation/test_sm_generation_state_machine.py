@@ -34,6 +34,7 @@ def test_every_generated_machine_round_trips_exactly(name, reduce):
     assert from_dicts.to_instantiations() == states
 
 
+@pytest.mark.flexbe
 def test_a_cnu_machine_round_trips_exactly(flexbe, flexbe_sources, tmp_path):
     cnu = flexbe_sources / 'flexbe_synthesis'
     examples = cnu / 'flexbe_synthesis_examples' / 'example' / 'vending_demo'

@@ -19,6 +19,8 @@ from synthesis_manager.nodes.atlas_sim_node import AtlasSimNode
 from synthesis_manager.nodes.atlas_sim_robot import RosRobot
 from synthesis_manager.suite import suite_node_factories
 
+pytestmark = [pytest.mark.ros, pytest.mark.mujoco]
+
 
 def synthesize_over_ros(ros, initial_conditions, goals, sm_outcomes=('finished', 'failed')):
     for factory in suite_node_factories():

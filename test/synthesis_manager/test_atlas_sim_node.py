@@ -20,6 +20,8 @@ from synthesis_msgs.action import ExecuteCapability
 
 from atlas_sim_client import Client
 
+pytestmark = [pytest.mark.ros, pytest.mark.mujoco]
+
 
 def sim_node(ros, **parameters):
     values = {'speed': 20.0, 'state_rate': 50.0, **parameters}

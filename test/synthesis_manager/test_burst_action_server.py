@@ -15,6 +15,8 @@ from synthesis_manager.ros.harness import reserve_domain_id
 from synthesis_manager.ros.qos import action_client_qos, action_server_qos
 from synthesis_msgs.action import BehaviorSynthesis
 
+pytestmark = pytest.mark.ros
+
 GOALS = 30
 
 

@@ -9,10 +9,13 @@ import signal
 import time
 
 import httpx
+import pytest
 
 from synthesis_manager.client import SERVER_LOST_SECONDS
 from runaway_requests import RUNAWAY_SPEC, many_parts_config, runaway_gui_job
 from suite_processes import BIN, GUI_URL, assert_busy_synthesizing, loopback_domain, serve_with_clients, started
+
+pytestmark = pytest.mark.ros
 
 NOTICED_WITHIN = SERVER_LOST_SECONDS + 3.5  # the DDS lease (1 s), its discovery, a loaded machine
 UNAVAILABLE_STATUS = 5  # README's exit status table: a server the command needs is missing

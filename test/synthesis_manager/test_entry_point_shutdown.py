@@ -35,6 +35,8 @@ from atlas_sim_client import Client as SimClient
 from runaway_requests import RUNAWAY_SPEC, many_parts_config, runaway_gui_job, runaway_goal
 from suite_processes import BIN, GUI_URL, assert_busy_synthesizing, cpu_seconds, descendants, loopback_domain, started, synthesis_processes
 
+pytestmark = pytest.mark.ros
+
 STOP_WITHIN = 3.0  # seconds from the signal to the process's exit
 STOP_SIGNALS = pytest.mark.parametrize('stop_signal', [signal.SIGINT, signal.SIGTERM], ids=['SIGINT', 'SIGTERM'])
 NODE_SCRIPTS = ('ltl-compilation-node', 'ltl-synthesis-node', 'sm-generation-node', 'behavior-synthesis-server')

@@ -5,12 +5,15 @@ import sys
 import threading
 import time
 
+import pytest
 from rcl_interfaces.msg import Log
 from rclpy.logging import LoggingSeverity
 from rclpy.node import Node
 
 from synthesis_manager.ros.logs import QuickLogger
 from synthesis_manager.ros.stage_calls import ExecutorTurn, LookTimer, awaited_turn, next_executor_turn
+
+pytestmark = pytest.mark.ros
 
 
 def test_the_turn_a_coroutine_waits_on_is_found_through_nested_awaits():

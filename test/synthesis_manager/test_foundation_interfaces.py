@@ -12,6 +12,8 @@ from synthesis_msgs.msg import (AutomatonState, BehaviorSynthesisRequest, FSAuto
 from synthesis_msgs.srv import GenerateFlexBESM, GenerateLTLSpecification, SynthesizeAutomaton
 from synthesis_manager.ros.harness import wait_for
 
+pytestmark = pytest.mark.ros
+
 FLEXBE_STATE_INSTANTIATION = {
     'state_path': 'string', 'state_class': 'string', 'initial_state_name': 'string',
     'input_keys': 'sequence<string>', 'output_keys': 'sequence<string>',

@@ -10,6 +10,8 @@ from gui_jobs import PAPER_TASK, follow, follow_simulation, gui_args, run_job
 from synthesis_manager.gui import ros_backend
 from synthesis_manager.web.routes import create_app
 
+pytestmark = pytest.mark.ros
+
 STATE_FIELDS = {'state_path', 'state_class', 'initial_state_name', 'input_keys', 'output_keys',
                 'cond_outcome', 'cond_transition', 'behavior_class', 'parameter_names',
                 'parameter_values', 'position', 'outcomes', 'transitions', 'autonomy',
@@ -86,6 +88,7 @@ def test_paper_task_succeeds_with_progress_states_and_downloads(client):
     assert b"self.use_behavior(PickupObjectSM, 'pickup_object')" in code
 
 
+@pytest.mark.flexbe
 def test_a_capability_system_exports_its_behavior_package_for_download(tmp_path, flexbe, flexbe_sources, monkeypatch):
     """CNU's vending_demo from a config folder of the user's (added to the shipped systems):
     its job offers the FlexBE behavior package export-behavior writes, with CNU's state classes."""

@@ -8,9 +8,12 @@ import os
 import shutil
 from pathlib import Path
 
+import pytest
 import yaml
 
 from gui_in_browser import choose_task, result_code
+
+pytestmark = [pytest.mark.ros, pytest.mark.browser]
 
 SCREENSHOT_ENV = 'BEHAVIOR_SYNTHESIS_GUI_SCREENSHOT'
 

@@ -15,7 +15,7 @@ import pytest
 
 from gui_in_browser import STATUS_DONE, docs_shot, flexbe_gui_server, open_page, result_code
 
-pytestmark = pytest.mark.browser
+pytestmark = [pytest.mark.ros, pytest.mark.browser, pytest.mark.flexbe]
 
 SIZE = {'width': 1280, 'height': 720}
 

@@ -10,7 +10,7 @@ import pytest
 
 from gui_in_browser import STATUS_DONE, TWELVE_GOALS, choose_task, open_page, stop_a_running_simulation, synthesize
 
-pytestmark = pytest.mark.browser
+pytestmark = [pytest.mark.ros, pytest.mark.browser]
 
 SIZES = [{'width': 1280, 'height': 720}, {'width': 1920, 'height': 1080}]
 BY_SIZE = {'ids': lambda s: f"{s['width']}x{s['height']}"}

@@ -5,6 +5,8 @@ import pytest
 
 from gui_in_browser import choose_task, open_page, result_code
 
+pytestmark = [pytest.mark.ros, pytest.mark.browser]
+
 PLAY_AND_SAMPLE = """() => new Promise((resolve) => {
   const samples = [];
   const start = performance.now();

@@ -10,6 +10,8 @@ import pytest
 
 from gui_in_browser import TWELVE_GOALS, choose_task, docs_shot, gui_server, open_page, result_code
 
+pytestmark = [pytest.mark.ros, pytest.mark.browser]
+
 WINDOW = {'width': 1400, 'height': 900}  # the usability tests' tab
 
 

@@ -15,7 +15,7 @@ import pytest
 from synthesis_manager.web import picture
 from gui_in_browser import TWELVE_GOALS, choose_task, gui_server, open_page, result_code
 
-pytestmark = pytest.mark.browser
+pytestmark = [pytest.mark.ros, pytest.mark.browser]
 
 SIZES = [{'width': 1280, 'height': 720}, {'width': 1920, 'height': 1080}]
 

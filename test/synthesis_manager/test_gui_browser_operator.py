@@ -7,7 +7,7 @@ import pytest
 
 from gui_in_browser import STATUS_DONE, choose_task, open_page, result_code
 
-pytestmark = pytest.mark.browser
+pytestmark = [pytest.mark.ros, pytest.mark.browser]
 
 SIZES = [{'width': 1280, 'height': 720}, {'width': 1920, 'height': 1080}]
 

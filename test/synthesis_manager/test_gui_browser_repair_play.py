@@ -9,6 +9,8 @@ import pytest
 
 from gui_in_browser import choose_task, docs_shot, flexbe_gui_server, open_page, result_code, synthesize
 
+pytestmark = [pytest.mark.ros, pytest.mark.browser, pytest.mark.flexbe]
+
 
 @pytest.fixture(scope='module')
 def gui(tmp_path_factory, flexbe):

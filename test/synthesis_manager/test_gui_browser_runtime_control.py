@@ -5,6 +5,8 @@ import pytest
 
 from gui_in_browser import STATUS_DONE, choose_task, open_page, result_code, stop_a_running_simulation
 
+pytestmark = [pytest.mark.ros, pytest.mark.browser]
+
 
 
 @pytest.fixture

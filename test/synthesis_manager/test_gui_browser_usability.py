@@ -20,6 +20,8 @@ from synthesis_manager.web.outcome import JobOutcome
 from synthesis_manager.web.routes import create_app
 from gui_in_browser import choose_task, gui_server, open_page, result_code
 
+pytestmark = [pytest.mark.ros, pytest.mark.browser]
+
 SIX_GOALS = ['look_down', 'pickup_object', 'grasp_object', 'pregrasp', 'approach_object', 'footstep_execution']
 SHOTS_ENV = 'BEHAVIOR_SYNTHESIS_GUI_SHOTS'
 

@@ -11,6 +11,8 @@ from gui_jobs import follow_simulation, gui_args, operate, run_job
 from synthesis_manager.gui import ros_backend
 from synthesis_manager.web.routes import create_app
 
+pytestmark = [pytest.mark.ros, pytest.mark.flexbe]
+
 ROVER_TASK = {'system': 'delivery_rover', 'goals': ['hand_over']}
 
 

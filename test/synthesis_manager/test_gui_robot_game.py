@@ -9,6 +9,8 @@ from ltl_specification import compile_task
 from ltl_specification.play import RobotPlay
 from synthesis_manager.web.robot_game import MAX_GAME_MOVES, game_turn
 
+pytestmark = pytest.mark.ros
+
 
 @pytest.fixture(scope='module')
 def wrong_order():

@@ -1,7 +1,11 @@
 """The operator in the loop over the GUI's API: autonomy, confirmations, forced outcomes,
 InputState answers and stop reach the simulation's child while it runs."""
 
+import pytest
+
 from gui_jobs import PAPER_TASK, follow_simulation, operate, run_job
+
+pytestmark = pytest.mark.ros
 
 
 def test_high_autonomy_waits_for_confirmations_and_robot_time_does_not_count_the_wait(client):

@@ -8,6 +8,7 @@ own robot's state topic, and each behavior is run on its own robot and checked.
 from argparse import Namespace
 import threading
 
+import pytest
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 
@@ -20,6 +21,8 @@ from synthesis_manager.nodes.atlas_sim_node import AtlasSimNode
 from synthesis_manager.nodes.atlas_sim_robot import RosRobot
 from synthesis_manager.ros.namespaces import synthesis_service_remapping
 from synthesis_manager.suite import suite_node_factories
+
+pytestmark = pytest.mark.ros
 
 ROBOTS = {  # namespace -> (where its simulated ATLAS starts, what it is asked to do)
     '/robot1': ('stand_prep', ['look_down', 'pickup_object']),

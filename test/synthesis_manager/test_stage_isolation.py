@@ -6,6 +6,7 @@ waited 228 s), and a SynthesizeAutomaton request could ask for any time limit.""
 import threading
 import time
 
+import pytest
 from rclpy.parameter import Parameter
 
 from respec.nesting import run_with_deep_stack
@@ -13,6 +14,8 @@ from synthesis_manager.client import make_goal
 from synthesis_manager.nodes.ltl_compilation_node import SMALL_CUSTOM_BYTES, LTLCompilationNode, compiled_sections
 from runaway_requests import runaway_goal
 from suite_in_process import PAPER_TASK, start_suite
+
+pytestmark = pytest.mark.ros
 
 FORMULA_BYTES = 56_000  # as in the attack: just under the 64 KB string cap
 

@@ -13,6 +13,8 @@ from synthesis_msgs.srv import GenerateFlexBESM, GenerateLTLSpecification
 
 from suite_in_process import make_slow_service, start_with_stand_ins as start
 
+pytestmark = pytest.mark.ros
+
 PAPER_TASK = dict(system='atlas', initial_conditions=['stand_prep'], goals=['look_down', 'pickup_object'])
 
 

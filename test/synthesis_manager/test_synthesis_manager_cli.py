@@ -15,6 +15,8 @@ from respec.naming import parse_names
 from synthesis_manager.requests import InvalidRequestError, selected_option
 from synthesis_manager.ros.env import prepare_ros_environment
 
+pytestmark = pytest.mark.ros
+
 CLI = [str(Path(sys.executable).parent / 'behavior-synthesis')]
 
 

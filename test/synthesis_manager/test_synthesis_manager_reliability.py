@@ -30,6 +30,8 @@ from synthesis_manager.ros.env import prepare_ros_environment
 from synthesis_manager.ros.harness import RosHarness, reserve_domain_id
 from synthesis_msgs.srv import SynthesizeAutomaton
 
+pytestmark = pytest.mark.ros
+
 def run_all(client, goals, timeout=120.0):
     """Send every goal at once (one thread each); returns outcomes (or exceptions) in order."""
     outcomes = [None] * len(goals)

@@ -4,12 +4,15 @@ import shutil
 import time
 from pathlib import Path
 
+import pytest
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 
 from respec.robot import SystemCatalog, robot_system
 from synthesis_manager.nodes.ltl_compilation_node import LTLCompilationNode
 from synthesis_manager.ros.robot_systems import SuiteSystems
+
+pytestmark = pytest.mark.ros
 
 CONFIG = Path(__file__).resolve().parents[2] / 'config'
 

@@ -23,6 +23,8 @@ from synthesis_manager.nodes.atlas_sim_node import AtlasSimNode
 from synthesis_manager.nodes.atlas_sim_robot import RosRobot
 from synthesis_manager.suite import suite_node_factories
 
+pytestmark = pytest.mark.ros
+
 TASK_1 = ['look_down', 'pickup_object']
 AFTER_TASK_1 = ['manipulate', 'look_down', 'object_template', 'pickup_object']  # in any action order
 

@@ -101,7 +101,7 @@ def assert_busy_synthesizing(pid: int, within: float = 1.0):
         assert time.monotonic() < deadline, f'process {pid} started no synthesis process'
         time.sleep(0.05)
     before = {child: cpu_seconds(child) for child in synthesizers}
-    time.sleep(within)
+    time.sleep(within)  # the measurement window
     used = max(cpu_seconds(child) - seconds for child, seconds in before.items())
     # A fifth of a core: synthesis processes run niced (+5), and this machine is shared.
     assert used > within / 5, f'no synthesis process of {pid} is computing ({used:.2f} s CPU in {within} s)'

@@ -108,7 +108,7 @@ def test_per_capability_servers_join_running_requests_and_wait_for_sensors(ros):
     with node.lock:
         node.simulator.set_sensor('obj_detected', False)
     reading = wait_for(clients['obj_detected'].send_goal_async(goal)).get_result_async()
-    time.sleep(0.3)
+    time.sleep(0.3)  # the behaviour under test: the reading stays open while the sensor reads false
     assert not reading.done()
     with node.lock:
         node.simulator.set_sensor('obj_detected', True)

@@ -152,7 +152,7 @@ def test_a_cancel_reply_arriving_after_the_result_does_not_roll_the_timeline_bac
     route, stale_reply = held[0]
     assert stale_reply.json()['state'] != 'finished'  # the reply really is older than the page
     route.fulfill(response=stale_reply)
-    page.wait_for_timeout(300)
+    page.wait_for_timeout(300)  # the behaviour under test: the stale reply, handled, changes nothing
     assert 'Cancelled' in page.inner_text('#timeline')
     assert result_code(page) == 'CANCELLED'
     page.unroute('**/api/jobs/*/cancel')

@@ -55,18 +55,19 @@ def test_a_large_compilation_beyond_its_memory_limit_names_the_limit(ros, tmp_pa
 
 
 def normal_goal_beside(client, huge):
-    """Send ``huge``, and a second later the paper task: (its result, its seconds, and the huge
-    goal's result and seconds as ``answers['huge']``, ``answers['huge seconds']``)."""
-    answers = {}
+    """Send ``huge``, and once it is in its stage the paper task: (its result, its seconds, and the
+    huge goal's result and seconds as ``answers['huge']``, ``answers['huge seconds']``)."""
+    answers, in_stage = {}, threading.Event()
 
     def send_huge():
         started = time.monotonic()
-        answers['huge'] = client.run(huge, timeout=120)
+        answers['huge'] = client.run(huge, timeout=120, feedback=lambda status, _progress: in_stage.set())
         answers['huge seconds'] = time.monotonic() - started
 
     sender = threading.Thread(target=send_huge)
     sender.start()
-    time.sleep(1.0)  # the huge one is being compiled or parsed
+    # its first stage (compiling, or for a given specification synthesizing, which parses it)
+    assert in_stage.wait(60), 'the huge goal never reached its first stage (no feedback)'
     started = time.monotonic()
     normal = client.run(make_goal(**PAPER_TASK), timeout=60)
     normal_seconds = time.monotonic() - started

@@ -23,6 +23,7 @@ from rclpy.parameter import Parameter
 
 from runaway_requests import runaway_goal
 from suite_in_process import PAPER_TASK, start_suite
+from waiting import wait_until
 from synthesis_manager.client import SynthesisClient, make_goal
 from synthesis_manager.limits import MAX_LIST_LENGTH, MAX_STRING_BYTES
 from synthesis_manager.requests import byproduct_file_stem
@@ -53,13 +54,16 @@ def run_all(client, goals, timeout=120.0):
 @contextlib.contextmanager
 def slow_goals_running(client, count):
     """``count`` runaway syntheses in progress (cancelled on leaving); yields their threads."""
-    cancel = threading.Event()
-    threads = [threading.Thread(target=client.run, args=(runaway_goal(30.0),), kwargs={'cancel': cancel})
-               for _ in range(count)]
+    cancel, synthesizing = threading.Event(), set()
+
+    def feedback(index):
+        return lambda status, _progress: status.startswith('Synthesizing') and synthesizing.add(index)
+    threads = [threading.Thread(target=client.run, args=(runaway_goal(30.0),),
+                                kwargs={'cancel': cancel, 'feedback': feedback(index)}) for index in range(count)]
     for thread in threads:
         thread.start()
-    time.sleep(2.0)  # they are synthesizing now
     try:
+        wait_until(lambda: len(synthesizing) == count, 60, f'{count} runaway goals synthesizing (their feedback)')
         yield threads
     finally:
         cancel.set()
@@ -373,8 +377,11 @@ def test_a_result_asked_for_after_its_retention_is_a_timeout_not_a_success(ros, 
     client = default_qos_client(ros)
     handle = wait_for(client.send_goal_async(make_goal(**PAPER_TASK, option='ltl_compilation_only')), 30)
     assert outcome_from_response(wait_for(handle.get_result_async(), 30), 0.0).error_name == 'SUCCESS'
-    time.sleep(3.0)  # the result is forgotten 1 s after the goal finished
-    late = outcome_from_response(wait_for(handle.get_result_async(), 30), 0.0)
+
+    def forgotten():  # 1 s after the goal finished
+        late = outcome_from_response(wait_for(handle.get_result_async(), 30), 0.0)
+        return late if late.goal_status == 'UNKNOWN' else None
+    late = wait_until(forgotten, 3.0, 'the result forgotten (result_retention 1 s)')
     assert (late.error_name, late.goal_status) == ('TIMEOUT', 'UNKNOWN')
     assert 'result_retention' in late.message
 

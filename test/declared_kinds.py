@@ -16,8 +16,9 @@ start each kind fail it when its marker is missing, naming the marker:
               from a test that has none of the markers above (nor slow): the pure-core selection
               runs Python only
 
-Starts in a thread of the test, and ROS programs (judged by how they ended), fail it at its teardown. What a child process starts in turn is
-not followed (a ros test's GUI simulates with MuJoCo in a child process of its own).
+Starts in a thread of the test, and ROS programs (judged by how they ended), fail it at its
+teardown. What a child process starts in turn is not followed (a ros test's GUI simulates with
+MuJoCo in a child process of its own).
 """
 
 from __future__ import annotations
@@ -125,7 +126,7 @@ def _check_command(args) -> str | None:
     words = argv[1:]
     if (program == 'behavior-synthesis' and words and words[0] in ROS_COMMANDS or program in ROS_PROGRAMS) \
             and not {'--help', '-h'} & set(words):
-        ros = f'runs `{program} {" ".join(words[:1])}`'.rstrip() + ' (ROS)'
+        ros = f'runs `{program} {words[0]}` (ROS)' if program == 'behavior-synthesis' else f'runs `{program}` (ROS)'
     else:
         ros = None
     markers = current_markers()

@@ -35,6 +35,7 @@ def fleet_args(tmp_path, **settings):
                      synthesis_timeout=60.0, service_timeout=3.0, **settings)
 
 
+@pytest.mark.mujoco  # each robot is an atlas_sim node: a simulator in this process
 def test_two_robots_synthesize_and_run_at_once_with_one_synthesis_service(ros, tmp_path):
     factories = suite_node_factories(fleet_args(tmp_path, namespaces=list(ROBOTS)))
     nodes = [ros.add_node(factory) for factory in factories]

@@ -59,9 +59,9 @@ def assert_idle(pid: int, within: float = 1.0):
     """``pid`` has gone back to idle: under a tenth of a core over ``within`` seconds."""
     def quiet():  # the last moments of a stopped synthesis are over
         before = cpu_seconds(pid)
-        time.sleep(0.1)
-        return cpu_seconds(pid) - before < 0.1 / 10
-    wait_until(quiet, 10, f'process {pid} quiet for 0.1 s')
+        time.sleep(0.2)
+        return cpu_seconds(pid) - before <= 0.2 / 10
+    wait_until(quiet, 10, f'process {pid} quiet for 0.2 s')
     before = cpu_seconds(pid)
     time.sleep(within)  # the measurement window
     used = cpu_seconds(pid) - before

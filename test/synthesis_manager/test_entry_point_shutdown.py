@@ -56,16 +56,18 @@ def assert_busy(pid: int, within: float = 1.0):
 
 
 def assert_idle(pid: int, within: float = 1.0):
-    """``pid`` has gone back to idle: under a tenth of a core over ``within`` seconds."""
+    """``pid`` has gone back to idle: under a fifth of a core over ``within`` seconds (a synthesis
+    uses a whole one; an idle server beside a CPU-bound job on this 2-core machine used 0.11-0.13 s
+    in 1 s, over the tenth this asked before)."""
     def quiet():  # the last moments of a stopped synthesis are over
         before = cpu_seconds(pid)
         time.sleep(0.2)
-        return cpu_seconds(pid) - before <= 0.2 / 10
+        return cpu_seconds(pid) - before <= 0.2 / 5
     wait_until(quiet, 10, f'process {pid} quiet for 0.2 s')
     before = cpu_seconds(pid)
     time.sleep(within)  # the measurement window
     used = cpu_seconds(pid) - before
-    assert used < within / 10, f'process {pid} still used {used:.2f} s CPU in {within} s'
+    assert used < within / 5, f'process {pid} still used {used:.2f} s CPU in {within} s'
 
 
 def assert_no_synthesis_running(pid: int, within: float = 1.0):

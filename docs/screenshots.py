@@ -5,7 +5,7 @@ server and pipeline, an in-process suite), so that the pictures show the page as
 
 Writes gui-result.png (1400x900, README's first picture), gui-layout-1280x720.png,
 gui-abstraction.png, gui-runtime-control.png (a High transition waiting for the operator) and
-gui-simulation.png (a finished run). Uses the browser tests' helpers (test/).
+gui-simulation.png (a finished run). Uses the browser tests' helpers (test/synthesis_manager/gui_in_browser.py).
 """
 
 from __future__ import annotations
@@ -19,7 +19,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path[:0] = [str(ROOT / 'test'), str(ROOT / 'test' / 'synthesis_manager')]
 
 import headless_chromium
-from test_gui_browser import STATUS_DONE as DONE, choose_task, gui_server, result_code
+from gui_in_browser import STATUS_DONE as DONE, choose_task, gui_server, result_code
 
 PAPER_GOALS = ['look_down', 'pickup_object']
 WIDE, SMALL = {'width': 1400, 'height': 900}, {'width': 1280, 'height': 720}

@@ -4,18 +4,23 @@
 test/sm_generation, test/atlas_sim, test/synthesis_manager), with test/integration for tests that
 span packages or run the real FlexBE, and test/bench for the benchmarks' own tests.
 
-Markers (given here, from the folder, the fixtures a test uses and the lists below):
+Markers, declared by each module (``pytestmark = [pytest.mark.ros, ...]``) or test:
 
-    ros      starts ROS 2 (the ``ros`` fixture, the shell's nodes or its processes)
-    browser  drives headless Chromium
-    mujoco   runs the MuJoCo simulator
-    flexbe   runs the real FlexBE (``flexbe_sources``, ``flexbe``)
-    slow     takes more than a few seconds on a 2-core machine
-    netns    builds private network namespaces (needs root and ``ip``; fails without them)
+    ros       starts ROS 2 (the ``ros`` fixture, the shell's nodes or its processes)
+    browser   drives headless Chromium
+    mujoco    runs the MuJoCo simulator
+    flexbe    runs the real FlexBE (``flexbe_sources``, ``flexbe``)
+    external  runs a program that is not Python (Graphviz' dot, slugs, Node.js)
+    slow      takes more than a few seconds on a 2-core machine
+    netns     builds private network namespaces (needs root and ``ip``; fails without them)
 
-The pure-core tests alone, in under a minute::
+A test that starts ROS, a browser, MuJoCo, the real FlexBE or (without any of those markers) a
+program that is not Python, and lacks the marker, fails with a message naming it
+(test/declared_kinds.py).
 
-    .venv/bin/python -m pytest -m "not (ros or browser or mujoco or flexbe or slow)"
+The pure-core tests alone (Python only)::
+
+    .venv/bin/python -m pytest -m "not (ros or browser or mujoco or flexbe or external or slow)"
 
 Tests against the real FlexBE find its pinned sources through FLEXBE_SOURCES, by default
 ../shared/third_party beside the repository when present; `make flexbe` (run by `make test`)
@@ -28,6 +33,8 @@ import sys
 from pathlib import Path
 
 import pytest
+
+import declared_kinds
 
 os.environ.setdefault('MUJOCO_GL', 'egl')
 
@@ -47,47 +54,41 @@ MARKERS = {
     'browser': 'drives headless Chromium',
     'mujoco': 'runs the MuJoCo simulator',
     'flexbe': 'runs the real FlexBE',
+    'external': 'runs a program that is not Python (dot, slugs, node)',
     'slow': 'takes more than a few seconds on a 2-core machine',
     'netns': 'builds private network namespaces (root and ip)',
 }
-# Everything the shell does goes through ROS (its nodes, its processes, its in-process suite).
-FOLDER_MARKERS = {'synthesis_manager': ('ros',)}
-MODULE_MARKERS = {
-    'browser': ('test_gui_browser', 'test_gui_browser_newcomer', 'test_gui_browser_usability',
-                'test_gui_browser_repair_play',
-                'test_flexbe_webui', 'test_flexbe_webui_parser'),
-    'mujoco': ('test_atlas_sim_closed_loop', 'test_atlas_sim_engine_trace', 'test_atlas_sim_executor',
-               'test_atlas_sim_operator_data', 'test_atlas_sim_rendering', 'test_atlas_sim_simulator',
-               'test_atlas_sim_closed_loop_ros', 'test_atlas_sim_node', 'test_flexbe_engine', 'test_readme_flexbe',
-               'test_atlas_sim_obstacles', 'test_atlas_sim_motion_frames'),
-    'ros': ('test_colcon_route', 'test_flexbe_engine', 'test_flexbe_onboard', 'test_flexbe_states', 'test_flexbe_webui',
-            'test_cnu_capabilities', 'test_readme_commands', 'test_readme_flexbe', 'test_ros2_launch',
-            'test_start_behavior'),
-    'slow': ('test_bench_gr1_families', 'test_colcon_route', 'test_readme_commands', 'test_readme_flexbe',
-             'test_fleet_hosts', 'test_start_behavior'),
-    'netns': ('test_fleet_hosts',),
-}
-FIXTURE_MARKERS = {'ros': 'ros', 'flexbe': 'flexbe', 'flexbe_sources': 'flexbe'}
 
 
 def pytest_configure(config):
     for name, meaning in MARKERS.items():
         config.addinivalue_line('markers', f'{name}: {meaning}')
+    declared_kinds.install()
 
 
 def pytest_collection_modifyitems(config, items):
-    for item in items:
-        names = set(FOLDER_MARKERS.get(item.path.parent.name, ()))
-        names |= {marker for marker, modules in MODULE_MARKERS.items() if item.path.stem in modules}
-        names |= {marker for fixture, marker in FIXTURE_MARKERS.items() if fixture in item.fixturenames}
-        for name in sorted(names):
-            item.add_marker(name)
     if any(item.get_closest_marker('ros') for item in items):
         # Before any test runs: DDS stays on loopback in this process and every process it
         # starts, whether or not a test starts ROS itself.
         from synthesis_manager.ros.env import prepare_ros_environment
 
         prepare_ros_environment()
+
+
+@pytest.hookimpl(wrapper=True)
+def pytest_runtest_protocol(item, nextitem):
+    with declared_kinds.running(item):
+        return (yield)
+
+
+@pytest.fixture(autouse=True)
+def declares_what_it_starts(request):
+    """Fails a test that starts a kind of thing its markers do not declare (test/declared_kinds.py)."""
+    declared_kinds.check_fixtures(request)
+    yield
+    complaints = declared_kinds.late_complaints()
+    if complaints:
+        pytest.fail('\n'.join(complaints), pytrace=False)
 
 
 @pytest.fixture
@@ -120,7 +121,7 @@ def flexbe(flexbe_sources) -> Path:
     Returns the ament prefix under which our FlexBE packages are registered.
     """
     try:
-        import flexbe_core  # noqa: F401
+        import flexbe_core
         import flexbe_msgs.msg  # noqa: F401
         import flexbe_states  # noqa: F401
     except ImportError as error:

@@ -113,6 +113,7 @@ def test_a_bad_script_entry_is_named(cart, fail, sensor, said):
                      [sensor] if sensor else [])
 
 
+@pytest.mark.ros
 @pytest.mark.flexbe
 def test_execute_runs_the_delivery_rover_and_names_a_scripted_failure(flexbe):
     environment = dict(os.environ, AMENT_PREFIX_PATH=str(flexbe), ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST')
@@ -131,6 +132,7 @@ def test_execute_runs_the_delivery_rover_and_names_a_scripted_failure(flexbe):
     assert status == 7 and "The script answered 'low' on check_battery" in report['trace_check']['violations'][0]
 
 
+@pytest.mark.ros
 @pytest.mark.flexbe
 def test_execute_runs_the_shelf_picker_the_second_shipped_capability_robot(flexbe):
     """config/shelf_picker (issue 45, item 6): its look reports a sensor and its grasp can fail."""

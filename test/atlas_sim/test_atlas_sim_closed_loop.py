@@ -19,6 +19,8 @@ from respec.automaton import automaton_from_strategy
 from sm_generation import generate_state_machine, validate_state_machine
 from respec.robot import robot_system
 
+pytestmark = pytest.mark.mujoco
+
 STAND_HEIGHT_RANGE = (0.6, 1.1)  # pelvis height (m): crouched stand_prep is ~0.67, standing ~0.85
 
 

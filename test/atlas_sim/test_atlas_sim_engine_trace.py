@@ -5,6 +5,8 @@ starts their capabilities on the simulator as FlexBE's states would and reports 
 outcomes; the recorded trace must check clean and match what our executive records.
 """
 
+import pytest
+
 from atlas_sim.executive.engine_trace import EngineTraceRecorder
 from atlas_sim.executive.executor import execute_state_machine
 from atlas_sim.executive.trace_check import check_trace
@@ -15,6 +17,8 @@ from ltl_synthesizer import synthesize
 from respec.automaton import automaton_from_strategy
 from respec.robot import robot_system
 from sm_generation import generate_state_machine
+
+pytestmark = pytest.mark.mujoco
 
 ATLAS = robot_system('atlas')
 

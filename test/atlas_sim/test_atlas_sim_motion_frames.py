@@ -16,6 +16,8 @@ from respec.automaton import automaton_from_strategy
 from respec.robot import robot_system
 from sm_generation import generate_state_machine
 
+pytestmark = pytest.mark.mujoco
+
 FRAME_NAME = re.compile(r'^(\d{4})_(\d{4}\.\d{3})s_([A-Za-z0-9_.-]+)\.png$')
 
 

@@ -21,6 +21,8 @@ from respec.automaton import automaton_from_strategy
 from respec.robot import robot_system
 from sm_generation import generate_state_machine
 
+pytestmark = pytest.mark.mujoco
+
 ATLAS = robot_system('atlas')
 
 TWELVE_GOALS = ['look_down', 'approach_object', 'pregrasp', 'grasp_object', 'pickup_object',

@@ -12,6 +12,8 @@ import yaml
 from atlas_sim.simulator.atlas_simulator import AtlasSimulator
 from atlas_sim.simulator.config import DEFAULT_CONFIG, SimulationConfigError, SystemConfig
 
+pytestmark = pytest.mark.mujoco
+
 
 def atlas_document():
     with open(DEFAULT_CONFIG, encoding='utf-8') as stream:

@@ -17,6 +17,8 @@ import pytest
 
 from atlas_sim.simulator.rendering import encode_png
 
+pytestmark = pytest.mark.mujoco
+
 REPO = Path(__file__).resolve().parents[2]
 WIDTH, HEIGHT = 320, 240
 

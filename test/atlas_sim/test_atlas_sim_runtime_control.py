@@ -12,8 +12,9 @@ from atlas_sim.executive.runtime_control import (FULL, HIGH, LOW, OFF, CommandEr
 from atlas_sim.simulated_robot import SimulatedRobot
 from atlas_sim.simulator.factory import make_simulator
 from sm_generation import StateMachine
-from test_atlas_sim_executor import ScriptedRobot, root, state
 from respec.robot import robot_system
+
+from hand_made_machines import ScriptedRobot, root, state
 
 ATLAS = robot_system('atlas')
 
@@ -163,6 +164,7 @@ PICK = [root('object_template'),
         state('/object_template', 'object_template_a', received='finished', aborted='failed')]
 
 
+@pytest.mark.mujoco
 def test_input_state_asks_the_operator_with_the_simulators_answer_offered():
     simulator = make_simulator(ATLAS, initial_conditions=['stand_prep'])
     asked = []
@@ -181,6 +183,7 @@ def test_input_state_asks_the_operator_with_the_simulators_answer_offered():
     assert run.outcome == 'finished' and simulator.answers == {'template_id': 1}
 
 
+@pytest.mark.mujoco
 @pytest.mark.parametrize('answer', [None, 7, 'box'])
 def test_an_aborted_or_invalid_input_fails_the_input_state(answer):
     simulator = make_simulator(ATLAS, initial_conditions=['stand_prep'])
@@ -191,6 +194,7 @@ def test_an_aborted_or_invalid_input_fails_the_input_state(answer):
     assert run.trace.steps[0].results[0]['reason'] == 'operator did not provide object_template'
 
 
+@pytest.mark.mujoco
 def test_at_full_autonomy_the_input_takes_the_robots_default_without_asking():
     simulator = make_simulator(ATLAS, initial_conditions=['stand_prep'])
     run = execute_state_machine(StateMachine.from_instantiations(PICK), SimulatedRobot(simulator), ATLAS, control=RuntimeControl(lambda timeout: []))

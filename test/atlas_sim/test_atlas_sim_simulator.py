@@ -13,6 +13,8 @@ from atlas_sim.simulator.config import CONFIG_DIR, load_system_config
 from respec.robot import robot_system_from_file
 from atlas_sim.simulator.faults import FaultSpec
 
+pytestmark = pytest.mark.mujoco
+
 CONFIG = load_system_config()
 MODES = CONFIG.abstraction.control_modes
 ACTIONS = CONFIG.abstraction.actions

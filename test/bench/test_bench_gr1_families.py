@@ -8,10 +8,14 @@ import shutil
 import sys
 from pathlib import Path
 
+import pytest
+
 REPOSITORY = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(REPOSITORY / 'bench'))
 
 import bench_gr1_families  # noqa: E402
+
+pytestmark = pytest.mark.slow
 
 
 def test_the_families_bench_times_ours_cold_and_resident(tmp_path, monkeypatch):

@@ -13,7 +13,7 @@ import sys
 os.environ.setdefault('QT_QPA_PLATFORM', 'offscreen')
 os.environ.setdefault('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
 
-from flexbe_input import input_action_server  # noqa: E402  (after the environment is set)
+from flexbe_input import input_action_server
 
 ANSWERS = sys.argv[1:] or ['1']
 

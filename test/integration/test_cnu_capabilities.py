@@ -22,51 +22,9 @@ from respec.robot.state_library import StateClass, StateClassError, workspace_st
 from sm_generation import StateMachine, generate_state_machine, validate_state_machine
 
 from cnu_example_pairs import example_pairs, write_system_file
+from cnu_systems import EXAMPLES, copied_rover, example_system, write_system
 
-# CNU's example files with CNU's request defaults (flexbe_synthesis_examples/request_*.py), for
-# the tests below that look into one machine; all of CNU's pairs run in
-# test_all_of_cnus_example_pairs_succeed_with_at_most_cnus_state_count. ``top_level`` bounds the
-# machine's own states (the capability states, without the root and the outcomes).
-EXAMPLES = {
-    'coffee_maker': dict(capabilities='coffee_maker/capabilities/coffee_capabilities.yaml',
-                         spec='coffee_maker/specs/coffee_demo_capabilities_spec.yaml', mappings='infinite_mappings.yaml',
-                         initial_conditions=['bd_a'], goals=['br_c'], outcomes=[], top_level=3),
-    'coffee_maker_extended': dict(capabilities='coffee_maker/capabilities/coffee_capabilities_extended.yaml',
-                                  spec='coffee_maker/specs/coffee_demo_capabilities_spec.yaml',
-                                  mappings='infinite_mappings.yaml', initial_conditions=['bd_a'], goals=['br_c'],
-                                  outcomes=[], top_level=3),
-    'vending_demo': dict(capabilities='vending_demo/capabilities/vending_capabilities.yaml',
-                         spec='vending_demo/specs/vending_demo_capabilities_spec.yaml', mappings='global_mappings.yaml',
-                         initial_conditions=['prep_pay_a'], goals=['soda'], outcomes=['finished'], top_level=4),
-    'vending_demo_extended': dict(capabilities='vending_demo/capabilities/vending_capabilities_extended.yaml',
-                                  spec='vending_demo/specs/vending_demo_capabilities_spec.yaml',
-                                  mappings='global_mappings.yaml', initial_conditions=['prep_pay_a'], goals=['soda'],
-                                  outcomes=['finished'], top_level=4),
-    # CNU's hello_world pair runs a given machine; here its capabilities are synthesized, for a goal.
-    'hello_world': dict(capabilities='hello_world/capabilities/hello_world_capabilities.yaml', spec=None,
-                        mappings='global_mappings.yaml', initial_conditions=[], goals=['say_world'],
-                        outcomes=['finished'], top_level=2),
-}
-
-
-def write_system(config_dir: Path, name: str, cnu: Path, **entries) -> Path:
-    """A system file pointing at CNU's files (paths relative to it, as users write them)."""
-    config_dir.mkdir(parents=True, exist_ok=True)
-    lines = [f'system: {name}'] + [f'{key}: {value}' for key, value in entries.items() if value is not None]
-    path = config_dir / f'{name}.yaml'
-    path.write_text('\n'.join(lines) + '\n')
-    return path
-
-
-def example_system(config_dir: Path, cnu: Path, name: str) -> dict:
-    example = EXAMPLES[name]
-    examples = cnu / 'flexbe_synthesis_examples' / 'example'
-    write_system(config_dir, name, cnu,
-                 cnu_capabilities=examples / example['capabilities'],
-                 cnu_spec=examples / example['spec'] if example['spec'] else None,
-                 cnu_mappings=cnu / 'flexbe_synthesis_generic' / 'mappings' / example['mappings'])
-    return example
-
+pytestmark = [pytest.mark.ros, pytest.mark.flexbe]
 
 @pytest.fixture
 def cnu(flexbe_sources) -> Path:
@@ -422,7 +380,7 @@ def run_behavior(ros, behavior_class, checksum, name):
         behavior = behavior_class(node)
         behavior.set_up(beh_id=checksum, autonomy_level=FULL_AUTONOMY, debug=False)
         behavior.prepare_for_execution({})
-        for state in behavior._state_machine._states:  # noqa: SLF001 - flexbe_core keeps no public list
+        for state in behavior._state_machine._states:
             original = state.execute
 
             def observed(*args, _state=state, _original=original, **kwargs):
@@ -474,18 +432,6 @@ def test_no_initial_conditions_keep_cnus_meaning_for_capability_systems(cnu, tmp
     assert reads_robot_state(['current'], robot_system('hello_world', tmp_path))
     assert reads_robot_state([], robot_system('atlas')) and not reads_robot_state(['stand'], robot_system('atlas'))
     assert reads_robot_state([], None)  # a system that cannot be read: compiling reports why
-
-
-def copied_rover(config_dir: Path) -> Path:
-    """The shipped config/delivery_rover copied into ``config_dir`` (a user's folder, which shadows
-    config/'s), for a variant of it; returns ``config_dir``."""
-    import shutil
-
-    shipped = Path(__file__).resolve().parents[2] / 'config'
-    config_dir.mkdir(parents=True, exist_ok=True)
-    shutil.copy(shipped / 'delivery_rover.yaml', config_dir / 'delivery_rover.yaml')
-    shutil.copytree(shipped / 'delivery_rover', config_dir / 'delivery_rover')
-    return config_dir
 
 
 def rover_machine(library, sm_outcomes, config_dir=None):

@@ -16,14 +16,13 @@ from pathlib import Path
 
 import pytest
 
-pytestmark = pytest.mark.usefixtures('flexbe')
+from flexbe_workspace import WORKSPACE_PACKAGES
+
+pytestmark = [pytest.mark.usefixtures('flexbe'), pytest.mark.ros, pytest.mark.flexbe, pytest.mark.slow]
 
 REPOSITORY = Path(__file__).resolve().parents[2]
 DOCS = REPOSITORY / 'docs' / 'flexbe.md'
 BEHAVIOR = 'Colcon Pickup'
-# Our ROS packages in a user's workspace (README, "Use it from FlexBE", step 1).
-WORKSPACE_PACKAGES = ('synthesis_msgs', 'atlas_sim/flexbe/atlas_sim_flexbe_states',
-                      'atlas_sim/flexbe/atlas_sim_flexbe_behaviors', 'behavior_synthesis_bringup')
 FIND_BEHAVIOR = f'''
 import rclpy
 from rclpy.node import Node

@@ -21,7 +21,7 @@ from sm_generation.config import flexbe_config
 from sm_generation.flexbe_behavior import behavior_package
 from synthesis_manager.nodes.atlas_sim_node import AtlasSimNode
 
-pytestmark = pytest.mark.usefixtures('flexbe')
+pytestmark = [pytest.mark.usefixtures('flexbe'), pytest.mark.ros, pytest.mark.mujoco, pytest.mark.flexbe]
 
 PICKUP = (['stand_prep'], ['look_down', 'pickup_object'])
 FOOTSTEPS = (['manipulate'], ['footstep_execution'])

@@ -21,10 +21,11 @@ from pathlib import Path
 import pytest
 
 # The processes and the operator, shared with bench/bench_flexbe_onboard.py (which runs them 100 times).
-sys.path.insert(0, str(Path(__file__).resolve().parents[2] / 'bench'))
-from flexbe_onboard_system import Operator, OnboardSystem, exported_and_installed, finished_with  # noqa: E402,F401
+from flexbe_onboard_system import Operator, OnboardSystem, exported_and_installed, finished_with
 
-pytestmark = pytest.mark.usefixtures('flexbe')
+from cnu_systems import copied_rover, example_system
+
+pytestmark = [pytest.mark.usefixtures('flexbe'), pytest.mark.ros, pytest.mark.flexbe]
 
 PAPER_TASK = ['--initial-conditions', 'stand_prep', '--goals', 'look_down,pickup_object']
 BEHAVIOR = 'Onboard Pickup'
@@ -131,7 +132,6 @@ def test_a_cnu_capability_system_exports_and_finishes_onboard(ros, onboard, flex
     shipped ATLAS), exported by export-behavior and run by FlexBE's onboard to ``finished``:
     its LogState capabilities log, in order, the path the synthesized machine takes."""
     from respec.robot import robot_system
-    from test_cnu_capabilities import example_system
 
     config = tmp_path / 'config'
     example = example_system(config, flexbe_sources / 'flexbe_synthesis', 'vending_demo')
@@ -160,7 +160,6 @@ def rover_variant(config: Path, suggestions: dict[str, str]) -> Path:
     its OperatorDecisionStates suggesting ``suggestions`` (capability -> outcome): a sensor
     reading or a failure injected the way an operator would choose it."""
     import yaml
-    from test_cnu_capabilities import copied_rover
 
     path = copied_rover(config) / 'delivery_rover' / 'capabilities.yaml'
     capabilities = yaml.safe_load(path.read_text(encoding='utf-8'))

@@ -17,7 +17,7 @@ from respec.robot import robot_system
 from sm_generation.config import flexbe_config
 from sm_generation.flexbe_behavior import behavior_class_name, behavior_module_name, state_module_name
 
-pytestmark = pytest.mark.usefixtures('flexbe')
+pytestmark = [pytest.mark.usefixtures('flexbe'), pytest.mark.ros, pytest.mark.flexbe]
 
 SYSTEMS = ('atlas', 'mobile_manipulator')
 CONFIGS = {system: flexbe_config(robot_system(system)) for system in SYSTEMS}

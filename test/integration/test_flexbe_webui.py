@@ -11,13 +11,10 @@ it with README's two manual imports runs on FlexBE's onboard executive.
 """
 
 import contextlib
-import fcntl
 import os
 import signal
-import socket
 import subprocess
 import sys
-import tempfile
 import time
 import urllib.request
 from pathlib import Path
@@ -29,15 +26,14 @@ from synthesis_manager.ros.harness import RosHarness, reserve_domain_id
 from synthesis_manager.ros.env import prepare_ros_environment
 
 import headless_chromium
+from flexbe_onboard_system import OnboardSystem, Operator, finished_with
+from flexbe_webui_port import WEBUI_PORT, port_for_this_run
 
-pytestmark = pytest.mark.usefixtures('flexbe')
+pytestmark = [pytest.mark.usefixtures('flexbe'), pytest.mark.ros, pytest.mark.browser, pytest.mark.flexbe]
 
 REPOSITORY = Path(__file__).resolve().parents[2]
 # fastapi/starlette as the WebUI needs them (starlette<0.47), put first on its path only.
 WEBUI_SITE = REPOSITORY / 'build' / 'flexbe_webui_site'
-# The WebUI 4.0.3 page opens its topic subscriptions at ws://localhost:8000 whatever port it is
-# served from, so it only fully works on 8000; runs on one machine take turns (a lock file).
-WEBUI_PORT = 8000
 # README's workaround for the upstream mismatch, typed under the Dashboard's Manual Imports:
 # WebUI 4.0.3 calls these two names of engine 2.3.3 without importing them.
 MANUAL_IMPORTS = ('from flexbe_core import StateLogger', 'from flexbe_core.proxy import initialize_proxies')
@@ -57,28 +53,6 @@ READ_CONTAINER = """path => {
         initial: container.getInitialState() ? container.getInitialState().getStateName() : null,
         outcomes: container.getOutcomes()};
 }"""
-
-
-@contextlib.contextmanager
-def port_for_this_run(port: int, timeout: float = 600):
-    """Wait until no other run on this machine uses ``port``, then hold it for this run."""
-    with open(Path(tempfile.gettempdir()) / f'flexbe_webui_port_{port}.lock', 'w') as lock:
-        deadline = time.monotonic() + timeout
-        while True:
-            try:
-                fcntl.flock(lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
-                break
-            except BlockingIOError:
-                if time.monotonic() > deadline:
-                    pytest.fail(f'port {port} stayed taken by another FlexBE WebUI run for {timeout:g} s')
-                time.sleep(1.0)
-        with socket.socket() as probe:
-            probe.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)  # as uvicorn binds it
-            try:
-                probe.bind(('127.0.0.1', port))
-            except OSError:
-                pytest.fail(f'port {port} is in use; the FlexBE WebUI 4.0.3 page needs it')
-        yield port
 
 
 @contextlib.contextmanager
@@ -318,7 +292,6 @@ def test_a_five_goal_synthesis_saves_in_the_webui_and_runs_onboard(editor, expor
     import builtins
     import importlib
 
-    from test_flexbe_onboard import Operator, OnboardSystem, finished_with
 
     synthesize_in_new_container(editor, *FIVE_GOALS)
     editor.wait_for_function(f'() => ({READ_CONTAINER})("/Container")?.states.length > 0', timeout=120_000)
@@ -367,7 +340,6 @@ def test_runtime_control_cannot_start_a_behavior_on_engine_2_3_3(editor, exporte
     engine 2.3.3's flexbe_msgs), so README starts behaviors with be_launcher instead."""
     from types import SimpleNamespace
 
-    from test_flexbe_onboard import OnboardSystem
 
     name = exported_behavior[0]
     assert editor.evaluate(LOAD_BEHAVIOR, name)['error'] is None

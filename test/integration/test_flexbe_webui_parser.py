@@ -25,7 +25,7 @@ import headless_chromium
 ROOT = Path(__file__).resolve().parents[2]
 AUTOMATA = ROOT / 'test' / 'automata'
 
-pytestmark = pytest.mark.usefixtures('flexbe')
+pytestmark = [pytest.mark.usefixtures('flexbe'), pytest.mark.browser, pytest.mark.flexbe]
 
 PARSER_SCRIPTS = ('prototype.js', 'io/io.js', 'io/io_codeparser.js')
 # The page's terminal, as the parser uses it; warnings are collected.

@@ -25,6 +25,10 @@ import pytest
 from synthesis_manager.cli import SUBCOMMANDS, build_parser
 from synthesis_manager.ros.env import prepare_ros_environment
 
+from readme_sections import flexbe_section, readme_commands
+
+pytestmark = [pytest.mark.ros, pytest.mark.slow]
+
 REPOSITORY = Path(__file__).resolve().parents[2]
 README = REPOSITORY / 'README.md'
 BIN = Path(sys.executable).parent
@@ -41,24 +45,6 @@ ELSEWHERE = {
 }
 SERVERS = {'serve': 'suite up', 'gui': 'behavior synthesis GUI: http://'}
 QUICK = {'compile', 'repair', 'generate-sm', 'export-behavior', 'execute', 'demo'}
-
-
-def readme_commands(text: str) -> list[str]:
-    """The commands of the README's ``sh`` blocks: continuation lines joined, comments dropped."""
-    commands = []
-    for block in re.findall(r'^```(?:sh|bash)\n(.*?)^```', text, flags=re.M | re.S):
-        pending = ''
-        for line in block.replace('\\\n', ' ').splitlines():
-            pending = f'{pending}\n{line}' if pending else line
-            try:
-                words = shlex.split(pending, comments=True)
-            except ValueError:  # a quoted argument goes on over the next line
-                continue
-            if words:
-                commands.append(pending.strip())
-            pending = ''
-        assert not pending, f'unterminated quote in README: {pending}'
-    return commands
 
 
 def program(argv: list[str]) -> str:
@@ -146,16 +132,6 @@ def start_and_stop(argv, environment, cwd, ready: str):
     finally:
         if process.poll() is None:
             process.kill()
-
-
-FLEXBE_SECTION = '## Use it from FlexBE'
-
-
-def flexbe_section(text: str) -> str:
-    """The README's "Use it from FlexBE" section, up to the next ``##`` heading."""
-    start = text.index(f'\n{FLEXBE_SECTION}\n')
-    end = text.find('\n## ', start + 1)
-    return text[start:end if end >= 0 else len(text)]
 
 
 def outside_the_flexbe_section(text: str) -> str:

@@ -26,9 +26,12 @@ from pathlib import Path
 
 import pytest
 
-from test_flexbe_onboard import Operator
-from test_flexbe_webui import WEBUI_PORT, port_for_this_run
-from test_readme_commands import flexbe_section, readme_commands
+from flexbe_onboard_system import Operator
+from flexbe_webui_port import WEBUI_PORT, port_for_this_run
+from flexbe_workspace import WORKSPACE_PACKAGES
+from readme_sections import flexbe_section, readme_commands
+
+pytestmark = [pytest.mark.ros, pytest.mark.mujoco, pytest.mark.slow]
 
 REPOSITORY = Path(__file__).resolve().parents[2]
 README = REPOSITORY / 'README.md'
@@ -68,8 +71,6 @@ def test_the_section_names_every_step_in_order():
     assert positions == sorted(positions), dict(zip(order, positions))
     assert not any('python3.' in command or 'third_party' in command for command in commands), commands
     # the workspace holds what the colcon route builds
-    from test_colcon_route import WORKSPACE_PACKAGES
-
     (copy,) = [command for command in commands if command.startswith('cp -r ')]
     assert copy.split()[2:-1] == list(WORKSPACE_PACKAGES), copy
 
@@ -81,6 +82,7 @@ def webui_answers() -> bool:
     return False
 
 
+@pytest.mark.flexbe
 def test_the_section_runs_in_order_to_a_finished_behavior(ros, flexbe, flexbe_sources, tmp_path):
     from flexbe_msgs.msg import BEStatus
 

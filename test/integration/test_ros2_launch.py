@@ -28,7 +28,7 @@ LAUNCH = ['launch', 'behavior_synthesis_bringup', 'suite.launch.py']
 GOAL = ("{request: {name: launched, system: atlas, goal: 'look_down, pickup_object', "
         "initial_condition: stand_prep, sm_outcomes: [finished, failed]}}")
 
-pytestmark = pytest.mark.usefixtures('flexbe')
+pytestmark = [pytest.mark.usefixtures('flexbe'), pytest.mark.ros, pytest.mark.flexbe]
 
 
 @pytest.fixture(scope='module')

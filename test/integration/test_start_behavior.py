@@ -18,9 +18,9 @@ from pathlib import Path
 import pytest
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / 'bench'))
-from flexbe_onboard_system import BIN, OnboardSystem, exported_and_installed  # noqa: E402
+from flexbe_onboard_system import BIN, OnboardSystem, exported_and_installed
 
-pytestmark = pytest.mark.usefixtures('flexbe')
+pytestmark = [pytest.mark.usefixtures('flexbe'), pytest.mark.ros, pytest.mark.flexbe, pytest.mark.slow]
 
 PAPER_TASK = ['--system', 'atlas', '--initial-conditions', 'stand_prep', '--goals', 'look_down,pickup_object']
 MANUAL_IMPORTS = ('from flexbe_core import StateLogger', 'from flexbe_core.proxy import initialize_proxies')

@@ -9,41 +9,15 @@ import sys
 from pathlib import Path
 
 import pytest
-import yaml
 
 from ltl_specification import InvalidGoalsError, UnknownPropositionError, compile_task
 from ltl_synthesizer import synthesize
 from respec.robot.cnu import CapabilityConfigError
-from respec.robot.state_library import StateClass
 from respec.robot import robot_system
 
+from courier_robot import LIBRARY, courier
+
 ROOT = Path(__file__).resolve().parents[2]
-LIBRARY = {'LogState': StateClass('LogState', 'flexbe_states', ('text',), ('text',), outcomes=('done',))}
-
-# A courier of our own: it picks a parcel into a bin, then delivers it.
-COURIER = {
-    'name': 'courier',
-    'variable_mappings': {'sys_props': {'bin': {0: 'none', 1: 'left', 2: 'right'}}},
-    'memory': {'sys_props': {'parcel_m': False, 'signature_m': False}},
-    'capabilities': {
-        'pick': {'interface': 'LogState', 'parameters': {'text': 'picking'}, 'preconditions': ['!parcel'],
-                 'postconditions': ['parcel', 'bin=1']},
-        'deliver': {'interface': 'LogState', 'parameters': {'text': 'delivering'}, 'preconditions': ['parcel'],
-                    'postconditions': ['deliver', '!parcel']},
-    },
-}
-
-
-def courier(config_dir: Path, spec: dict | None = None, **capabilities) -> Path:
-    """The courier's files in ``config_dir``, with ``capabilities`` added to its own."""
-    files = {**COURIER, 'capabilities': {**COURIER['capabilities'], **capabilities}}
-    (config_dir / 'courier_capabilities.yaml').write_text(yaml.safe_dump(files))
-    system = ['system: courier', 'cnu_capabilities: courier_capabilities.yaml']
-    if spec is not None:
-        (config_dir / 'courier_spec.yaml').write_text(yaml.safe_dump({'specs': spec}))
-        system.append('cnu_spec: courier_spec.yaml')
-    (config_dir / 'courier.yaml').write_text('\n'.join(system) + '\n')
-    return config_dir
 
 
 def compiled(config_dir, initial_conditions, goals):
@@ -95,6 +69,7 @@ def test_a_precondition_nothing_establishes_names_its_capability(tmp_path):
     assert compiled(courier(tmp_path, sign=unsigned), ['signature'], ['deliver'])
 
 
+@pytest.mark.flexbe
 def test_the_command_line_says_the_compilers_sentence(tmp_path, flexbe):
     """`behavior-synthesis compile` exits 1 with the same sentence, code and item on one line."""
     courier(tmp_path)

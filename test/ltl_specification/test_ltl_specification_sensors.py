@@ -13,7 +13,8 @@ from ltl_synthesizer import synthesize
 from ltl_synthesizer.synthesizer import solve
 from ltl_synthesizer.well_separation import is_well_separated
 from respec.robot import robot_system, robot_system_from_files
-from test_ltl_specification_capability_precheck import LIBRARY, courier
+
+from courier_robot import LIBRARY, courier
 
 # The courier's door: deliver needs it open, and nothing reports it.
 DOOR = {'INPUT': ['door_open']}

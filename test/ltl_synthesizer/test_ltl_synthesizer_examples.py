@@ -184,6 +184,7 @@ def write_slugsin(tmp_path, name):
     return path
 
 
+@pytest.mark.external
 @pytest.mark.parametrize('robotics_semantics', [False, True], ids=['standard', 'robotics'])
 def test_external_run_reads_result_and_strategy(tmp_path, gr1synth_executable, robotics_semantics):
     name = 'lamp_robotics_semantics.structuredslugs'
@@ -198,6 +199,7 @@ def test_external_run_reads_result_and_strategy(tmp_path, gr1synth_executable, r
         assert strategy is None and not (tmp_path / 'out.json').exists()
 
 
+@pytest.mark.external
 def test_external_run_of_a_safety_game(tmp_path, gr1synth_executable):
     name = 'copy_safety.structuredslugs'
     realizable, strategy, _ = run_external_synthesizer(
@@ -215,6 +217,7 @@ def test_missing_executable(tmp_path):
     assert 'cannot run synthesizer' in str(caught.value)
 
 
+@pytest.mark.external
 @pytest.mark.parametrize('body, message', [
     ('echo "Segmentation fault" >&2; kill -SEGV $$', 'without a RESULT line'),
     ('echo "RESULT: Specification is realizable." >&2; exit 3', 'exited with status 3'),
@@ -232,6 +235,7 @@ def test_broken_executables_are_reported(tmp_path, body, message):
     assert message in str(caught.value)
 
 
+@pytest.mark.external
 def test_arguments_follow_slugs_conventions(tmp_path):
     recorder = script(tmp_path, 'recorder', 'printf "%s\\n" "$@" > "$(dirname "$0")/args"; '
                       'echo "RESULT: Specification is unrealizable." >&2')
@@ -255,6 +259,7 @@ def assert_killed(tmp_path):
         os.kill(pid, 0)
 
 
+@pytest.mark.external
 def test_timeout_kills_the_process(tmp_path):
     started = time.monotonic()
     with pytest.raises(SynthesisCancelledError) as caught:
@@ -265,6 +270,7 @@ def test_timeout_kills_the_process(tmp_path):
     assert_killed(tmp_path)
 
 
+@pytest.mark.external
 def test_cancel_kills_the_process(tmp_path):
     cancel = threading.Event()
     threading.Timer(0.5, cancel.set).start()

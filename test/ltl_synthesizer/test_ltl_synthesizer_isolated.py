@@ -31,6 +31,36 @@ def processes():
     pool.close()
 
 
+def wait_until(*args):
+    # Imported here: the synthesis children import this module (its functions are their work)
+    # without test/ on their path.
+    from waiting import wait_until
+
+    return wait_until(*args)
+
+
+def process_state(pid: int) -> tuple[str, int]:
+    """``pid``'s scheduler state (R running, S sleeping, ...) and its CPU time so far (ticks)."""
+    try:
+        fields = Path(f'/proc/{pid}/stat').read_text().rsplit(')', 1)[1].split()
+        return fields[0], int(fields[11]) + int(fields[12])
+    except (OSError, IndexError):  # ended meanwhile
+        return 'gone', 0
+
+
+def a_child_computing() -> bool:
+    return any(process_state(pid)[0] == 'R' for pid in children_of_this_process())
+
+
+def children_settled() -> set[int]:
+    """The children, once every one sleeps using no CPU for 0.1 s (its imports done, waiting for work)."""
+    children = children_of_this_process()
+    before = {pid: process_state(pid) for pid in children}
+    time.sleep(0.1)
+    settled = all(state == 'S' and process_state(pid) == (state, ticks) for pid, (state, ticks) in before.items())
+    return children if children and settled else set()
+
+
 def children_of_this_process() -> set[int]:
     """The synthesis processes (multiprocessing's resource tracker aside)."""
     pids = set()
@@ -114,7 +144,7 @@ def test_a_child_killed_from_outside_is_reported_and_replaced(processes):
 
     worker = threading.Thread(target=run)
     worker.start()
-    time.sleep(1.0)
+    wait_until(a_child_computing, 30, 'the runaway synthesis computing in a child')
     for pid in children_of_this_process():
         os.kill(pid, signal.SIGKILL)
     worker.join(timeout=10)
@@ -128,8 +158,8 @@ def test_close_kills_busy_and_idle_children():
     processes.prepare(2)
     worker = threading.Thread(target=lambda: pytest.raises(SynthesisCancelledError, processes.synthesize, RUNAWAY))
     worker.start()
-    time.sleep(1.0)
-    assert len(children_of_this_process()) >= 2
+    wait_until(lambda: len(children_of_this_process()) >= 2 and a_child_computing(), 30,
+               'a busy child (the runaway) beside an idle one')
     processes.close()
     worker.join(timeout=5)
     assert not worker.is_alive()
@@ -151,7 +181,7 @@ def test_idle_children_are_released_and_fresh_prepared_ones_replace_them():
     processes = SynthesisProcesses(idle_seconds=3.0)  # margin for a loaded machine before the first check
     try:
         processes.prepare(1)
-        time.sleep(1.0)  # let the fresh child import the synthesizer
+        wait_until(children_settled, 30, 'the fresh child importing the synthesizer')
         baseline = sum(rss_kib(pid) for pid in children_of_this_process())
         spec = compile_task(robot_system('atlas'), ['stand_prep'], ['look_down', 'pickup_object'])
         with ThreadPoolExecutor(3) as pool:  # three at once: three children
@@ -164,8 +194,8 @@ def test_idle_children_are_released_and_fresh_prepared_ones_replace_them():
             time.sleep(0.1)
         assert not children_of_this_process() & used  # every used child has ended
         assert processes.idle_count == 1 and len(children_of_this_process()) == 1
-        time.sleep(0.5)
-        assert sum(rss_kib(pid) for pid in children_of_this_process()) < 1.5 * baseline
+        fresh = wait_until(children_settled, 30, 'the fresh child importing the synthesizer')
+        assert sum(rss_kib(pid) for pid in fresh) < 1.5 * baseline
         assert processes.synthesize(spec).realizable  # and the next synthesis is served at once
     finally:
         processes.close()
@@ -179,7 +209,7 @@ def test_a_child_outlives_the_thread_that_started_it():
         starter = threading.Thread(target=lambda: processes.call(time.sleep, (0.0,)))
         starter.start()
         starter.join()
-        time.sleep(1.0)
+        time.sleep(1.0)  # the behaviour under test: the child is still there a second after its thread ended
         (child,) = children_of_this_process()
         assert processes.call(os.getpid) == child  # the same child serves the next call
     finally:

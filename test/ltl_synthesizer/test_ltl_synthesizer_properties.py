@@ -20,6 +20,8 @@ from ltl_synthesizer.symbolic import SymbolicGame
 from respec.ltl import implies, neg, next_, var
 from respec.spec import GR1Specification
 
+pytestmark = pytest.mark.slow
+
 
 def literals(names):
     return st.tuples(st.sampled_from(names), st.booleans()).map(

@@ -11,6 +11,7 @@ import pytest
 
 from ltl_synthesizer.cache import (ENTRY_OVERHEAD_BYTES, CacheDirectoryError, StrategyCache, cache_key,
                                    default_key_file, entry_size, load_cache_key, source_digest)
+from waiting import wait_until
 
 
 def entry(text: str, size: int = 0) -> dict:
@@ -70,18 +71,19 @@ def test_zero_bytes_disables_the_cache():
 
 def test_concurrent_identical_requests_are_one_computation():
     cache = StrategyCache()
-    calls, started = [], threading.Event()
+    calls, started, waiting = [], threading.Event(), set()
 
     def compute():
         calls.append(threading.current_thread().name)
         started.set()
-        time.sleep(0.3)  # the others arrive meanwhile
+        # the others arrive meanwhile: each waits for this computation (asking whether to give up)
+        wait_until(lambda: len(waiting) == 7, 10, 'seven identical requests waiting for the first')
         return entry('answer')
 
     answers = [None] * 8
 
     def ask(index):
-        answers[index] = cache.answer(key('same'), compute)
+        answers[index] = cache.answer(key('same'), compute, give_up=lambda: waiting.add(index))
 
     threads = [threading.Thread(target=ask, args=(index,), name=f'asker-{index}') for index in range(8)]
     threads[0].start()

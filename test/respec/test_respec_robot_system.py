@@ -71,6 +71,7 @@ def test_a_system_rebuilt_from_its_files_is_the_same_system():
     assert first.to_structuredslugs() == second.to_structuredslugs()
 
 
+@pytest.mark.flexbe
 def test_a_capability_system_keeps_every_file_it_read(tmp_path, flexbe_sources):
     cnu = flexbe_sources / 'flexbe_synthesis'
     examples = cnu / 'flexbe_synthesis_examples' / 'example' / 'vending_demo'
@@ -87,6 +88,7 @@ def test_a_capability_system_keeps_every_file_it_read(tmp_path, flexbe_sources):
         robot_system_from_files('vending', {'vending.yaml': vending.files['vending.yaml']})
 
 
+@pytest.mark.flexbe
 def test_unchanged_files_are_not_parsed_again_and_any_edit_is_seen(tmp_path, flexbe_sources):
     """Loading reads every file of the system each time; it parses them only when a text changed."""
     (tmp_path / 'tiny.yaml').write_text('abstraction:\n  actions: {wave: []}\n')

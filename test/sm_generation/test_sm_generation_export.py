@@ -70,6 +70,7 @@ def twelve_goals():
     return generate_state_machine(automaton, robot_system('atlas'), initial_conditions=['stand_prep'])
 
 
+@pytest.mark.external
 def test_a_long_machine_wraps_its_main_path_into_columns_with_a_failure_rail(twelve_goals, tmp_path):
     import re
     import xml.etree.ElementTree as ET
@@ -103,6 +104,7 @@ def test_dot_labels_behaviours_and_escapes_quotes():
     assert '"state:say \\"hi\\""' in dot and '<B>say &quot;hi&quot;</B>' in dot
 
 
+@pytest.mark.external
 @pytest.mark.parametrize('fmt, magic', [('svg', b'<svg'), ('png', b'\x89PNG')])
 def test_render(concurrent, tmp_path, fmt, magic):
     path = render(to_dot(concurrent), tmp_path / f'machine.{fmt}')
@@ -127,6 +129,7 @@ def test_cli_writes_yaml_to_stdout(capsys):
     assert from_text(out) == generate_state_machine(load_automaton(AUTOMATA / 'look_down.yaml'), robot_system('atlas')).to_instantiations()
 
 
+@pytest.mark.external
 def test_cli_formats_from_suffix_and_flag(tmp_path):
     automaton = str(AUTOMATA / 'sensors.yaml')
     assert main(['--automaton', automaton, '-o', str(tmp_path / 'm.json'), '--reduce']) == 0

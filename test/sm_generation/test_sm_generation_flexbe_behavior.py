@@ -73,7 +73,7 @@ def test_concurrent_activation_becomes_a_concurrency_container_with_its_conditio
     for outcome, condition in zip(container.cond_outcome, container.cond_transition):
         pairs = ', '.join(f"('{n}', '{o}')" for n, o in zip(condition.state_name, condition.state_outcome))
         assert f"('{outcome}', [{pairs}])" in code
-    assert f"input_keys=['template_id']" in code and f"output_keys=['template_id']" in code
+    assert "input_keys=['template_id']" in code and "output_keys=['template_id']" in code
 
 
 def test_userdata_lives_in_the_root_and_reaches_the_pickup_behavior():

@@ -37,6 +37,7 @@ def test_every_generated_machine_round_trips_exactly(name, reduce):
     assert generate_state_machine(load_automaton(AUTOMATA / name), robot_system('atlas'), reduce=reduce).to_dict() == machine.to_dict()
 
 
+@pytest.mark.flexbe
 def test_a_cnu_machine_round_trips_exactly(flexbe, flexbe_sources, tmp_path):
     cnu = flexbe_sources / 'flexbe_synthesis'
     examples = cnu / 'flexbe_synthesis_examples' / 'example' / 'vending_demo'

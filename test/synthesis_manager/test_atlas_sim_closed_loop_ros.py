@@ -20,6 +20,8 @@ from synthesis_manager.ros.atlas_sim_robot import RosRobot
 from synthesis_manager.suite import suite_node_factories
 from respec.robot import robot_system
 
+pytestmark = [pytest.mark.ros, pytest.mark.mujoco]
+
 
 def synthesize_over_ros(ros, initial_conditions, goals, sm_outcomes=('finished', 'failed')):
     for factory in suite_node_factories():

@@ -8,6 +8,8 @@ import pytest
 from synthesis_manager.client_shares import ClientShares, goal_origin, new_origin, tagged_goal_id
 from synthesis_manager.limits import BusyError
 
+pytestmark = pytest.mark.ros
+
 
 def test_our_goal_ids_name_their_client_and_others_are_clients_of_their_own():
     origin = new_origin()

@@ -20,6 +20,8 @@ from synthesis_manager.suite import suite_node_factories
 from synthesis_msgs.msg import SynthesisErrorCodes
 from respec.robot import robot_system
 
+pytestmark = pytest.mark.ros
+
 PAPER_TASK = dict(system='atlas', initial_conditions=['stand_prep'], goals=['look_down', 'pickup_object'])
 CNU_STAGES = ('BEHAVIOR_SYNTHESIS_FAILED', 'SPEC_COMPILATION_FAILED', 'SYNTHESIS_FAILED',
               'SM_GENERATION_FAILED')
@@ -74,6 +76,7 @@ def cnu_package(flexbe):
         pytest.fail(f'flexbe_synthesis_msgs is not importable ({error}); run `make flexbe`')
 
 
+@pytest.mark.flexbe
 def test_cnu_type_is_offered_and_states_copy_field_by_field(cnu_package):
     from flexbe_msgs.msg import OutcomeCondition, StateInstantiation
     from flexbe_synthesis_msgs.action import FlexBESynthesis
@@ -174,6 +177,7 @@ def plain_cnu_client(cnu_package, suite):
     client.close()
 
 
+@pytest.mark.flexbe
 def test_unmodified_cnu_client_gets_success_and_the_states_of_behavior_synthesis(plain_cnu_client, suite):
     from action_msgs.msg import GoalStatus
     from flexbe_msgs.msg import StateInstantiation
@@ -202,6 +206,7 @@ def test_unmodified_cnu_client_gets_success_and_the_states_of_behavior_synthesis
         time.sleep(0.05)
 
 
+@pytest.mark.flexbe
 def test_bad_goals_get_cnus_error_codes_and_a_message(plain_cnu_client):
     from action_msgs.msg import GoalStatus
     from flexbe_synthesis_msgs.msg import SynthesisErrorCode
@@ -240,6 +245,7 @@ def documented_cnu_codes() -> dict[str, str]:
     return table
 
 
+@pytest.mark.flexbe
 def test_docs_table_gives_every_code_of_ours_its_cnu_code(cnu_package):
     from flexbe_synthesis_msgs.msg import SynthesisErrorCode
 
@@ -296,11 +302,13 @@ def refused(client, goal, cnu_name: str, our_name: str, *words: str):
     assert documented_cnu_codes()[our_name] == cnu_name
 
 
+@pytest.mark.flexbe
 def test_row_unknown_system_is_no_system_config(broken_robots_client):
     refused(broken_robots_client, broken_robots_client.goal(['stand_prep'], ['look_down'], system_name='r2d2'),
             'NO_SYSTEM_CONFIG', 'UNKNOWN_SYSTEM', "'r2d2'")
 
 
+@pytest.mark.flexbe
 def test_row_malformed_system_file_is_config_file_invalid(broken_robots_client):
     # A file that is not YAML is our CONFIG_FILE_INVALID too (every command and both actions say so).
     refused(broken_robots_client, broken_robots_client.goal(['stand_prep'], ['look_down'], system_name='broken'),
@@ -309,22 +317,26 @@ def test_row_malformed_system_file_is_config_file_invalid(broken_robots_client):
             'CONFIG_FILE_INVALID', 'ABSTRACTION_CONFIG_INVALID', 'capabilities/bad.yaml', 'not valid YAML')
 
 
+@pytest.mark.flexbe
 def test_row_same_names_keep_their_code(broken_robots_client):
     refused(broken_robots_client, broken_robots_client.goal(['stand_prep'], ['look_down'],
                                                            specification_file_name='mine.yaml'),
             'INVALID_REQUEST', 'INVALID_REQUEST', 'mine.yaml')
 
 
+@pytest.mark.flexbe
 def test_row_compilation_refusals_are_spec_compilation_failed(broken_robots_client):
     refused(broken_robots_client, broken_robots_client.goal(['stand_prep'], ['fly_away']),
             'SPEC_COMPILATION_FAILED', 'UNKNOWN_PROPOSITION', "'fly_away'")
 
 
+@pytest.mark.flexbe
 def test_row_synthesis_timeout_is_synthesis_failed(broken_robots_client, runaway_synthesis):
     refused(broken_robots_client, broken_robots_client.goal(['stand_prep'], ['look_down'], synthesis_timeout_s=1.0),
             'SYNTHESIS_FAILED', 'SYNTHESIS_TIMEOUT')
 
 
+@pytest.mark.flexbe
 def test_row_a_missing_pipeline_node_is_behavior_synthesis_failed(cnu_package, tmp_path):
     """Only the server runs: the compilation service never appears."""
     from synthesis_manager.ros.harness import RosHarness
@@ -342,6 +354,7 @@ def test_row_a_missing_pipeline_node_is_behavior_synthesis_failed(cnu_package, t
             client.close()
 
 
+@pytest.mark.flexbe
 def test_cancel_from_an_unmodified_cnu_client(plain_cnu_client, runaway_synthesis):
     from action_msgs.msg import GoalStatus
     from flexbe_synthesis_msgs.msg import SynthesisErrorCode
@@ -360,6 +373,7 @@ def test_cancel_from_an_unmodified_cnu_client(plain_cnu_client, runaway_synthesi
     assert response.result.messages[-1].startswith('PREEMPTED:')
 
 
+@pytest.mark.flexbe
 def test_all_of_cnus_example_pairs_through_an_unmodified_cnu_client(cnu_package, flexbe, flexbe_sources, tmp_path,
                                                                     monkeypatch):
     """CNU's 11 pairs, each served as CNU's launch serves it (its own config folder, the system
@@ -397,6 +411,7 @@ def test_all_of_cnus_example_pairs_through_an_unmodified_cnu_client(cnu_package,
     assert all(0 < ours <= cnu for ours, cnu in counts.values()), counts
 
 
+@pytest.mark.flexbe
 def test_the_capability_precheck_sentence_reaches_both_actions(cnu_package, flexbe, flexbe_sources, tmp_path,
                                                                 monkeypatch):
     """A goal no capability can make true (CNU's coffee maker sets no memory: `br`, not its outcome

@@ -1,6 +1,10 @@
 """DDS beyond this host only when the deployer says so (docs/deployment.md)."""
 
+import pytest
+
 from synthesis_manager.ros.env import prepare_ros_environment
+
+pytestmark = pytest.mark.ros
 
 
 def test_the_network_scope_keeps_the_deployers_discovery_settings():

@@ -3,42 +3,22 @@
 connected to it stayed "running" 150 s. Now the goal ends SERVICE_UNAVAILABLE (exit 5) once
 the action server has left the ROS graph for SERVER_LOST_SECONDS."""
 
-import contextlib
 import json
 import os
 import signal
 import time
 
 import httpx
+import pytest
 
 from synthesis_manager.client import SERVER_LOST_SECONDS
-from test_entry_point_shutdown import (BIN, GUI_URL, assert_busy_synthesizing, loopback_domain, many_parts_config,
-                                       runaway_gui_job, started)
-from test_synthesis_manager_reliability import RUNAWAY_SPEC
+from runaway_requests import RUNAWAY_SPEC, many_parts_config, runaway_gui_job
+from suite_processes import BIN, GUI_URL, assert_busy_synthesizing, loopback_domain, serve_with_clients, started
+
+pytestmark = pytest.mark.ros
 
 NOTICED_WITHIN = SERVER_LOST_SECONDS + 3.5  # the DDS lease (1 s), its discovery, a loaded machine
 UNAVAILABLE_STATUS = 5  # README's exit status table: a server the command needs is missing
-
-
-@contextlib.contextmanager
-def serve_with_clients(tmp_path, *actions: str):
-    """``serve`` in a process of its own, and a SynthesisClient here for each action name
-    (``behavior_synthesis``, ``flexbe_synthesis``), each of its own client, its server up."""
-    from rclpy.node import Node
-
-    from synthesis_manager.client import SynthesisClient
-    from synthesis_manager.ros.harness import RosHarness
-
-    with loopback_domain() as (domain, environment):
-        with started([BIN / 'behavior-synthesis', 'serve', '--byproducts-dir', tmp_path / 'byproducts'],
-                     environment) as (server, output):
-            output.wait_for('suite up')
-            with RosHarness(domain_id=domain) as ros:
-                clients = [SynthesisClient(ros.add_node(Node, f'client_{index}'), action)
-                           for index, action in enumerate(actions or ('behavior_synthesis',))]
-                for client in clients:
-                    assert client.wait_for_server(30)
-                yield server, clients
 
 
 def kill_server(server) -> float:

@@ -23,6 +23,8 @@ from synthesis_manager.suite import suite_node_factories
 from synthesis_manager.web.backend import SynthesisBackend
 from synthesis_manager.web.routes import create_app
 
+pytestmark = pytest.mark.ros
+
 GOALS = ['look_down', 'stand_prep']
 SENTENCE = ('Goal 2 (stand_prep) can never be achieved: goal 1 (look_down) needs the robot in stand, and '
             'stand -> stand_prep is not a transition in config/atlas.yaml (from stand the robot can only change '
@@ -114,6 +116,7 @@ def test_the_same_diagnosis_in_every_channel_whichever_stage_finds_it(channels, 
         assert 'initial state(s)' in details   # what the synthesizer adds stays
 
 
+@pytest.mark.flexbe
 def test_a_goal_no_capability_makes_true_is_named_up_front_in_every_channel(channels, flexbe, monkeypatch):
     monkeypatch.setenv('AMENT_PREFIX_PATH', str(flexbe))
     sentence = ("Goal 'charge' can never be reached: no capability sets charge_m true and it starts false; "

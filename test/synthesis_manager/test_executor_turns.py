@@ -5,12 +5,16 @@ import sys
 import threading
 import time
 
+import pytest
 from rcl_interfaces.msg import Log
 from rclpy.logging import LoggingSeverity
 from rclpy.node import Node
 
 from synthesis_manager.ros.logs import QuickLogger
 from synthesis_manager.ros.stage_calls import ExecutorTurn, LookTimer, awaited_turn, next_executor_turn
+from waiting import wait_until
+
+pytestmark = pytest.mark.ros
 
 
 def test_the_turn_a_coroutine_waits_on_is_found_through_nested_awaits():
@@ -53,7 +57,7 @@ def test_the_suite_executor_resumes_a_waiting_coroutine_only_when_its_turn_is_du
         return 'done'
 
     task = ros.executor.create_task(waiting)
-    time.sleep(1.2)
+    time.sleep(1.2)  # the behaviour under test: how often it is resumed over 1.2 s of executor wake-ups
     # Started once, then looked again every 0.5 s: 3, not the ~100 wake-ups of the executor.
     assert 2 <= len(resumptions) <= 4, resumptions
     ready.set()
@@ -76,8 +80,7 @@ def test_a_look_timer_wakes_the_executor_only_while_a_coroutine_waits(ros):
                 await next_executor_turn(look_every=0.05)
 
     task = ros.executor.create_task(waiting)
-    time.sleep(1.0)
-    assert looks.active and len(taken) >= 8, taken
+    wait_until(lambda: looks.active and len(taken) >= 8, 1.0, 'eight looks of the timer (every 0.05 s)')
     release.set()
     deadline = time.monotonic() + 2.0
     while not task.done() and time.monotonic() < deadline:
@@ -97,7 +100,7 @@ def test_quick_log_lines_reach_rosout_as_rclpy_would_write_them(ros):
     listener.create_subscription(Log, '/rosout', on_log, 100)
     node = ros.add_node(Node, 'quick_logging')
     log = QuickLogger(node.get_logger())
-    time.sleep(0.5)  # discovery of /rosout
+    wait_until(lambda: node.count_subscribers('/rosout') > 0, 10, "the listener's /rosout subscription discovered")
     node.get_logger().set_level(LoggingSeverity.WARN)
     log.info('not written: below the level')
     expected_line = sys._getframe().f_lineno + 1

@@ -18,6 +18,8 @@ from respec.errors import ExitStatus
 from synthesis_manager.ros.env import prepare_ros_environment
 from synthesis_manager.ros.harness import reserve_domain_id
 
+pytestmark = pytest.mark.ros
+
 CLI = [str(Path(sys.executable).parent / 'behavior-synthesis')]
 STOP_WITHIN = 3.0
 READY = {'serve': 'suite up', 'gui': 'behavior synthesis GUI: http://'}

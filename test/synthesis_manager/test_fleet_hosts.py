@@ -15,10 +15,14 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / 'bench'))
 
-from fleet_network import (SUBNET, Fleet, PrivateNetwork, killed_host, network_namespaces_available,  # noqa: E402
+from fleet_network import (SUBNET, Fleet, PrivateNetwork, killed_host, network_namespaces_available,
                            pulled_cable, restarted_host, run_round)
+
+pytestmark = [pytest.mark.ros, pytest.mark.slow, pytest.mark.netns]
 
 CLIENTS, GOALS, INTERVAL = 8, 2, 2.5  # 2 clients on each host
 #: Seconds a round may take (about 10 s each here): three rounds stay within the test's time limit,

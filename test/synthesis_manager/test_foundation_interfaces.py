@@ -1,6 +1,5 @@
 """synthesis_msgs: every interface field for field, and a live service/action round trip."""
 
-import threading
 import time
 
 import pytest
@@ -11,6 +10,8 @@ from synthesis_msgs.msg import (AutomatonState, BehaviorSynthesisRequest, FSAuto
                                 SynthesisErrorCodes, SynthesisOptions)
 from synthesis_msgs.srv import GenerateFlexBESM, GenerateLTLSpecification, SynthesizeAutomaton
 from synthesis_manager.ros.harness import wait_for
+
+pytestmark = pytest.mark.ros
 
 FLEXBE_STATE_INSTANTIATION = {
     'state_path': 'string', 'state_class': 'string', 'initial_state_name': 'string',

@@ -4,7 +4,11 @@ import os
 import subprocess
 import sys
 
+import pytest
+
 from synthesis_manager.ros.env import prepare_ros_environment
+
+pytestmark = pytest.mark.ros
 
 
 def test_prepare_sets_loopback_and_drops_conflicting_settings():

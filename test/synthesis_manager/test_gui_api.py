@@ -6,59 +6,16 @@ import pytest
 import yaml
 from fastapi.testclient import TestClient
 
-from synthesis_manager.cli import build_parser
+from gui_jobs import PAPER_TASK, follow, follow_simulation, gui_args, run_job
 from synthesis_manager.gui import ros_backend
 from synthesis_manager.web.routes import create_app
 
-PAPER_TASK = {'system': 'atlas', 'initial_conditions': ['stand_prep'], 'goals': ['look_down', 'pickup_object']}
+pytestmark = pytest.mark.ros
+
 STATE_FIELDS = {'state_path', 'state_class', 'initial_state_name', 'input_keys', 'output_keys',
                 'cond_outcome', 'cond_transition', 'behavior_class', 'parameter_names',
                 'parameter_values', 'position', 'outcomes', 'transitions', 'autonomy',
                 'userdata_keys', 'userdata_remapping'}
-
-
-def gui_args(byproducts_dir, *more):
-    """The settings ``behavior-synthesis gui`` would get, parsed by the real command line."""
-    return build_parser(only='gui').parse_args(
-        ['gui', '--byproducts-dir', str(byproducts_dir), '--synthesis-timeout', '60',
-         '--goal-timeout', '120', *more])
-
-
-@pytest.fixture(scope='module')
-def backend(tmp_path_factory):
-    with ros_backend(gui_args(tmp_path_factory.mktemp('gui-api'))) as backend:
-        yield backend
-
-
-@pytest.fixture(scope='module')
-def client(backend):
-    with TestClient(create_app(backend)) as client:
-        yield client
-
-
-def follow(client, job_id):
-    """Read the job's event stream to its end; returns (progress events, final job)."""
-    progress, final = [], None
-    with client.stream('GET', f'/api/jobs/{job_id}/events', timeout=180) as response:
-        assert response.status_code == 200
-        assert response.headers['content-type'].startswith('text/event-stream')
-        kind = None
-        for line in response.iter_lines():
-            if line.startswith('event: '):
-                kind = line[len('event: '):]
-            elif line.startswith('data: '):
-                job = json.loads(line[len('data: '):])
-                if kind == 'finished':
-                    final = job
-                else:
-                    progress.append(job)
-    return progress, final
-
-
-def run_job(client, request):
-    response = client.post('/api/jobs', json=request)
-    assert response.status_code == 202, response.text
-    return follow(client, response.json()['id'])
 
 
 def test_systems_and_their_choices(client):
@@ -131,6 +88,7 @@ def test_paper_task_succeeds_with_progress_states_and_downloads(client):
     assert b"self.use_behavior(PickupObjectSM, 'pickup_object')" in code
 
 
+@pytest.mark.flexbe
 def test_a_capability_system_exports_its_behavior_package_for_download(tmp_path, flexbe, flexbe_sources, monkeypatch):
     """CNU's vending_demo from a config folder of the user's (added to the shipped systems):
     its job offers the FlexBE behavior package export-behavior writes, with CNU's state classes."""
@@ -245,15 +203,6 @@ def test_cancel_a_running_synthesis(client, runaway_synthesis):
     _, final = follow(client, job['id'])
     assert final['outcome']['error_name'] == 'PREEMPTED'
     assert final['outcome']['seconds'] < 30
-
-
-def follow_simulation(client, simulation_id):
-    with client.stream('GET', f'/api/simulations/{simulation_id}/events', timeout=300) as response:
-        last = None
-        for line in response.iter_lines():
-            if line.startswith('data: '):
-                last = json.loads(line[len('data: '):])
-    return last
 
 
 def test_simulate_the_synthesized_machine_with_and_without_a_fault(client, backend):

@@ -3,11 +3,13 @@ precondition graph of the chosen system, the task's path highlighted, following 
 
 import pytest
 
-from test_gui_browser import browser_context, choose_task, gui, open_page, result_code  # noqa: F401
+from gui_in_browser import choose_task, open_page, result_code
+
+pytestmark = [pytest.mark.ros, pytest.mark.browser]
 
 
 @pytest.fixture
-def page(gui, browser_context):  # noqa: F811
+def page(gui, browser_context):
     with open_page(browser_context, gui[0]) as page:
         yield page
 

@@ -13,10 +13,9 @@ from pathlib import Path
 
 import pytest
 
-from test_gui_browser import STATUS_DONE, browser_context, flexbe_gui_server, open_page, result_code  # noqa: F401
-from test_gui_browser_newcomer import docs_shot
+from gui_in_browser import STATUS_DONE, docs_shot, flexbe_gui_server, open_page, result_code
 
-pytestmark = pytest.mark.browser
+pytestmark = [pytest.mark.ros, pytest.mark.browser, pytest.mark.flexbe]
 
 SIZE = {'width': 1280, 'height': 720}
 
@@ -28,7 +27,7 @@ def gui(tmp_path_factory, flexbe):
 
 
 @pytest.fixture
-def page(gui, browser_context):  # noqa: F811
+def page(gui, browser_context):
     with open_page(browser_context, gui[0], viewport=SIZE) as page:
         page.select_option('#system', 'delivery_rover')
         page.wait_for_selector('#goal-choice option[value="hand_over"]', state='attached')

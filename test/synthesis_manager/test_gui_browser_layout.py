@@ -8,11 +8,9 @@ import re
 
 import pytest
 
-from test_gui_browser import (STATUS_DONE, browser_context, choose_task, gui, open_page,  # noqa: F401
-                              stop_a_running_simulation, synthesize)
-from test_gui_browser_newcomer import TWELVE_GOALS
+from gui_in_browser import STATUS_DONE, TWELVE_GOALS, choose_task, open_page, stop_a_running_simulation, synthesize
 
-pytestmark = pytest.mark.browser
+pytestmark = [pytest.mark.ros, pytest.mark.browser]
 
 SIZES = [{'width': 1280, 'height': 720}, {'width': 1920, 'height': 1080}]
 BY_SIZE = {'ids': lambda s: f"{s['width']}x{s['height']}"}
@@ -60,7 +58,7 @@ def assert_drawn_whole_and_readable(page, size, minimum_states=5):
 
 @pytest.mark.parametrize('size', SIZES, **BY_SIZE)
 def test_the_machine_in_view_fitted_and_readable_after_synthesize_during_and_after_a_run(
-        gui, browser_context, size):  # noqa: F811
+        gui, browser_context, size):
     with open_page(browser_context, gui[0], viewport=size) as page:
         synthesize(page, ['look_down', 'pickup_object'])
         page.wait_for_selector('.graph-viewport svg g[id="state:stand"]')
@@ -92,7 +90,7 @@ def test_the_machine_in_view_fitted_and_readable_after_synthesize_during_and_aft
 
 
 @pytest.mark.parametrize('size', SIZES, **BY_SIZE)
-def test_the_form_has_no_scroll_of_its_own_and_the_panel_covers_no_field(gui, browser_context, size):  # noqa: F811
+def test_the_form_has_no_scroll_of_its_own_and_the_panel_covers_no_field(gui, browser_context, size):
     with open_page(browser_context, gui[0], viewport=size) as page:
         choose_task(page, ['look_down', 'pickup_object'])
         scrolled = page.evaluate("""() => [...document.querySelectorAll('#request-form, #request-form *')]
@@ -118,7 +116,7 @@ def test_the_form_has_no_scroll_of_its_own_and_the_panel_covers_no_field(gui, br
 
 
 @pytest.mark.parametrize('size', SIZES, **BY_SIZE)
-def test_a_goal_flagged_red_after_an_error_stays_in_view_above_the_panel(gui, browser_context, size):  # noqa: F811
+def test_a_goal_flagged_red_after_an_error_stays_in_view_above_the_panel(gui, browser_context, size):
     with open_page(browser_context, gui[0], viewport=size) as page:
         synthesize(page, ['look_down', 'stand_prep'], 'SPEC_UNSYNTHESIZABLE')
         page.wait_for_selector('#goals li.impossible')
@@ -134,7 +132,7 @@ def test_a_goal_flagged_red_after_an_error_stays_in_view_above_the_panel(gui, br
 
 @pytest.mark.parametrize('size', SIZES, **BY_SIZE)
 def test_abstraction_labels_inside_their_boxes_the_task_path_once_per_visit_and_no_duplicate_goal(
-        gui, browser_context, size):  # noqa: F811
+        gui, browser_context, size):
     with open_page(browser_context, gui[0], viewport=size) as page:
         choose_task(page, TWELVE_GOALS)
         labels = page.evaluate("""() => [...document.querySelectorAll('#abstraction-graphs svg g.node')].map((g) => {
@@ -158,7 +156,7 @@ def test_abstraction_labels_inside_their_boxes_the_task_path_once_per_visit_and_
 
 
 @pytest.mark.parametrize('size', SIZES, **BY_SIZE)
-def test_a_stopped_run_shows_when_each_step_ran(gui, browser_context, size):  # noqa: F811
+def test_a_stopped_run_shows_when_each_step_ran(gui, browser_context, size):
     with open_page(browser_context, gui[0], viewport=size) as page:
         # The paper's task runs for several robot seconds: long enough to be stopped in its first states.
         synthesize(page, ['look_down', 'pickup_object'])
@@ -174,7 +172,7 @@ def test_a_stopped_run_shows_when_each_step_ran(gui, browser_context, size):  # 
 
 
 @pytest.mark.parametrize('size', SIZES, **BY_SIZE)
-def test_the_twelve_goal_machine_opens_whole_and_readable(gui, browser_context, size):  # noqa: F811
+def test_the_twelve_goal_machine_opens_whole_and_readable(gui, browser_context, size):
     """The README's largest task: its 27 states and outcome boxes all in view right after
     Synthesize, no text under 11 px (the grid layout is drawn tight enough for 1280x720)."""
     with open_page(browser_context, gui[0], viewport=size) as page:

@@ -3,7 +3,9 @@ image, playback at robot speed with the active state in step with the frame show
 
 import pytest
 
-from test_gui_browser import browser_context, choose_task, gui, open_page, result_code  # noqa: F401
+from gui_in_browser import choose_task, open_page, result_code
+
+pytestmark = [pytest.mark.ros, pytest.mark.browser]
 
 PLAY_AND_SAMPLE = """() => new Promise((resolve) => {
   const samples = [];
@@ -20,7 +22,7 @@ PLAY_AND_SAMPLE = """() => new Promise((resolve) => {
 
 
 @pytest.fixture
-def page(gui, browser_context):  # noqa: F811
+def page(gui, browser_context):
     with open_page(browser_context, gui[0]) as page:
         yield page
 

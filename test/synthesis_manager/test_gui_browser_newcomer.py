@@ -6,25 +6,26 @@ $BEHAVIOR_SYNTHESIS_DOCS_SHOTS set to a directory, the 12-goal machine and the s
 are also written there (docs/gui-12-goals.png, docs/gui-simulation.png).
 """
 
-import os
-from pathlib import Path
-
 import pytest
 
-from test_gui_browser import browser_context, choose_task, result_code  # noqa: F401
-from test_gui_browser_usability import gui, page  # noqa: F401 - the GUI and a 1400x900 tab
+from gui_in_browser import TWELVE_GOALS, choose_task, docs_shot, gui_server, open_page, result_code
 
-TWELVE_GOALS = ['look_down', 'approach_object', 'pregrasp', 'grasp_object', 'pickup_object',
-                'footstep_execution', 'object_template', 'pregrasp_pose', 'footstep_plan', 'target_pose',
-                'pregrasp_plan', 'footstep_goal']
-DOCS_SHOTS_ENV = 'BEHAVIOR_SYNTHESIS_DOCS_SHOTS'
+pytestmark = [pytest.mark.ros, pytest.mark.browser]
+
 WINDOW = {'width': 1400, 'height': 900}  # the usability tests' tab
 
 
-def docs_shot(page, name):
-    if os.environ.get(DOCS_SHOTS_ENV):
-        Path(os.environ[DOCS_SHOTS_ENV]).mkdir(parents=True, exist_ok=True)
-        page.screenshot(path=str(Path(os.environ[DOCS_SHOTS_ENV]) / name))
+@pytest.fixture(scope='module')
+def gui(tmp_path_factory):
+    """The usability tests' GUI, with a long synthesis limit: the 12-goal machine, on a shared machine."""
+    with gui_server(tmp_path_factory.mktemp('gui-usability'), synthesis_timeout=300, goal_timeout=400) as served:
+        yield served
+
+
+@pytest.fixture
+def page(gui, browser_context):
+    with open_page(browser_context, gui[0], viewport=WINDOW) as page:
+        yield page
 
 
 def in_window(page, selector):

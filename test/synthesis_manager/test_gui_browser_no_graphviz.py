@@ -13,9 +13,9 @@ from pathlib import Path
 import pytest
 
 from synthesis_manager.web import picture
-from test_gui_browser import browser_context, choose_task, gui_server, open_page, result_code  # noqa: F401
+from gui_in_browser import TWELVE_GOALS, choose_task, gui_server, open_page, result_code
 
-pytestmark = pytest.mark.browser
+pytestmark = [pytest.mark.ros, pytest.mark.browser]
 
 SIZES = [{'width': 1280, 'height': 720}, {'width': 1920, 'height': 1080}]
 
@@ -37,7 +37,7 @@ def gui_without_dot(tmp_path_factory):
 
 @pytest.mark.parametrize('size', SIZES, ids=lambda s: f"{s['width']}x{s['height']}")
 def test_without_dot_the_machine_is_drawn_and_the_pictures_download(gui_without_dot, browser_context, size,
-                                                                      tmp_path):  # noqa: F811
+                                                                      tmp_path):
     url = gui_without_dot[0]
     with open_page(browser_context, url, viewport=size) as page:
         choose_task(page, ['look_down', 'pickup_object'])
@@ -91,8 +91,7 @@ def test_without_dot_the_job_says_the_page_makes_the_png_and_the_server_says_why
     assert "Graphviz' 'dot' is not installed: the page makes the PNG from its drawing" in message
 
 
-def test_without_dot_the_twelve_goal_machine_is_drawn_whole_at_1920x1080(gui_without_dot, browser_context):  # noqa: F811
-    from test_gui_browser_newcomer import TWELVE_GOALS
+def test_without_dot_the_twelve_goal_machine_is_drawn_whole_at_1920x1080(gui_without_dot, browser_context):
 
     size = {'width': 1920, 'height': 1080}
     with open_page(browser_context, gui_without_dot[0], viewport=size) as page:

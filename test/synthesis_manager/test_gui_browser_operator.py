@@ -5,9 +5,9 @@ trace check tells the operator's choice from the machine's."""
 
 import pytest
 
-from test_gui_browser import STATUS_DONE, browser_context, choose_task, gui, open_page, result_code  # noqa: F401
+from gui_in_browser import STATUS_DONE, choose_task, open_page, result_code
 
-pytestmark = pytest.mark.browser
+pytestmark = [pytest.mark.ros, pytest.mark.browser]
 
 SIZES = [{'width': 1280, 'height': 720}, {'width': 1920, 'height': 1080}]
 
@@ -41,7 +41,7 @@ def overlap(a, b):
 
 @pytest.mark.parametrize('size', SIZES, ids=lambda s: f"{s['width']}x{s['height']}")
 def test_a_click_anywhere_in_the_cell_forces_and_the_details_keep_clear_of_the_active_state(
-        gui, browser_context, size):  # noqa: F811
+        gui, browser_context, size):
     with open_page(browser_context, gui[0], viewport=size) as page:
         synthesized(page)
         paused_in(page, 'look_down')
@@ -74,7 +74,7 @@ def test_a_click_anywhere_in_the_cell_forces_and_the_details_keep_clear_of_the_a
 
 @pytest.mark.parametrize('size', SIZES, ids=lambda s: f"{s['width']}x{s['height']}")
 def test_keys_force_the_active_states_outcomes_and_the_check_names_the_operators_choice(
-        gui, browser_context, size):  # noqa: F811
+        gui, browser_context, size):
     with open_page(browser_context, gui[0], viewport=size) as page:
         synthesized(page)
         paused_in(page, 'look_down')

@@ -7,9 +7,9 @@ import re
 
 import pytest
 
-from test_gui_browser import (browser_context, choose_task, flexbe_gui_server, open_page,  # noqa: F401
-                              result_code, synthesize)
-from test_gui_browser_newcomer import docs_shot
+from gui_in_browser import choose_task, docs_shot, flexbe_gui_server, open_page, result_code, synthesize
+
+pytestmark = [pytest.mark.ros, pytest.mark.browser, pytest.mark.flexbe]
 
 
 @pytest.fixture(scope='module')
@@ -19,7 +19,7 @@ def gui(tmp_path_factory, flexbe):
 
 
 @pytest.fixture
-def page(gui, browser_context):  # noqa: F811
+def page(gui, browser_context):
     with open_page(browser_context, gui[0]) as page:
         yield page
 
@@ -218,7 +218,7 @@ def test_a_capability_robot_asked_to_drive_and_not_to_drive_is_played_and_fixed(
 
 @pytest.mark.parametrize('size', [{'width': 1280, 'height': 720}, {'width': 1920, 'height': 1080}],
                          ids=lambda s: f"{s['width']}x{s['height']}")
-def test_playing_the_robot_progress_first_ends_with_a_verdict_in_view_and_readable(gui, browser_context, size):  # noqa: F811
+def test_playing_the_robot_progress_first_ends_with_a_verdict_in_view_and_readable(gui, browser_context, size):
     with open_page(browser_context, gui[0], viewport=size) as page:
         synthesize(page, ['look_down', 'stand_prep'], 'SPEC_UNSYNTHESIZABLE')
         page.click('#play-robot')

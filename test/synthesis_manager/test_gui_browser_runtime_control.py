@@ -3,13 +3,14 @@ answer InputState with the system's default offered, force an outcome while paus
 
 import pytest
 
-from test_gui_browser import (STATUS_DONE, browser_context, choose_task, gui, open_page,  # noqa: F401
-                              result_code, stop_a_running_simulation)
+from gui_in_browser import STATUS_DONE, choose_task, open_page, result_code, stop_a_running_simulation
+
+pytestmark = [pytest.mark.ros, pytest.mark.browser]
 
 
 
 @pytest.fixture
-def page(gui, browser_context):  # noqa: F811
+def page(gui, browser_context):
     with open_page(browser_context, gui[0]) as page:
         choose_task(page, ['look_down', 'pickup_object'])
         page.click('#synthesize')

@@ -18,8 +18,10 @@ from synthesis_manager.gui import listening_socket, make_server
 from synthesis_manager.web.backend import SynthesisBackend
 from synthesis_manager.web.outcome import JobOutcome
 from synthesis_manager.web.routes import create_app
-from test_gui_browser import browser_context, choose_task, gui_server, open_page, result_code  # noqa: F401
 from respec.robot import robot_system
+from gui_in_browser import choose_task, gui_server, open_page, result_code
+
+pytestmark = [pytest.mark.ros, pytest.mark.browser]
 
 SIX_GOALS = ['look_down', 'pickup_object', 'grasp_object', 'pregrasp', 'approach_object', 'footstep_execution']
 SHOTS_ENV = 'BEHAVIOR_SYNTHESIS_GUI_SHOTS'
@@ -33,7 +35,7 @@ def gui(tmp_path_factory):
 
 
 @pytest.fixture
-def page(gui, browser_context):  # noqa: F811
+def page(gui, browser_context):
     with open_page(browser_context, gui[0], viewport={'width': 1400, 'height': 900}) as page:
         yield page
 
@@ -248,7 +250,7 @@ def never_finishing(request, feedback, cancel):
     return JobOutcome(-9, 'PREEMPTED', 'cancelled')
 
 
-def test_server_restart_mid_job_is_said_plainly_and_the_page_reconnects(browser_context):  # noqa: F811
+def test_server_restart_mid_job_is_said_plainly_and_the_page_reconnects(browser_context):
     port = free_port()
     first = Server(SynthesisBackend(never_finishing), port)
     page = browser_context.new_page()
@@ -282,7 +284,7 @@ def concurrent_machine(request, feedback, cancel):
     return JobOutcome(1, 'SUCCESS', '', machine=generate_state_machine(automaton, robot_system('atlas')))
 
 
-def test_a_concurrency_container_names_its_states_when_clicked(browser_context):  # noqa: F811
+def test_a_concurrency_container_names_its_states_when_clicked(browser_context):
     server = Server(SynthesisBackend(concurrent_machine), free_port())
     try:
         with open_page(browser_context, f'http://127.0.0.1:{server.sock.getsockname()[1]}/') as page:

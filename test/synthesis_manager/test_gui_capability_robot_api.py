@@ -6,11 +6,12 @@ sensors, each step's outcome and who chose it, the trace check."""
 import pytest
 from starlette.testclient import TestClient
 
-from test_gui_api import follow_simulation, gui_args, run_job
-from test_gui_runtime_control_api import operate
+from gui_jobs import follow_simulation, gui_args, operate, run_job
 
 from synthesis_manager.gui import ros_backend
 from synthesis_manager.web.routes import create_app
+
+pytestmark = [pytest.mark.ros, pytest.mark.flexbe]
 
 ROVER_TASK = {'system': 'delivery_rover', 'goals': ['hand_over']}
 

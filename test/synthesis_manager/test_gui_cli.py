@@ -14,6 +14,8 @@ import pytest
 
 from synthesis_manager.ros.env import prepare_ros_environment
 
+pytestmark = pytest.mark.ros
+
 REPOSITORY = Path(__file__).resolve().parents[2]
 URL_LINE = re.compile(r'behavior synthesis GUI: (http://\S+/)')
 

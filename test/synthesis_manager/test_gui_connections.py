@@ -11,7 +11,7 @@ import time
 import httpx
 import pytest
 
-from test_entry_point_shutdown import BIN, GUI_URL, loopback_domain, started
+from suite_processes import BIN, GUI_URL, loopback_domain, started
 
 pytestmark = pytest.mark.ros
 

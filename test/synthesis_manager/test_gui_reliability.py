@@ -20,6 +20,8 @@ from synthesis_manager.web.guards import json_nesting_exceeds
 from synthesis_manager.web.routes import create_app
 from synthesis_manager.web.simulation_process import CHILD_ENVIRONMENT, SimulationProcess
 
+pytestmark = pytest.mark.ros
+
 PAPER_TASK = {'system': 'atlas', 'initial_conditions': ['stand_prep'], 'goals': ['look_down', 'pickup_object']}
 
 

@@ -17,7 +17,9 @@ from synthesis_manager.web import repairs as repairs_module
 from synthesis_manager.web.backend import SynthesisBackend
 from synthesis_manager.web.routes import create_app
 
-from test_gui_api import gui_args, run_job
+from gui_jobs import gui_args, run_job
+
+pytestmark = pytest.mark.ros
 
 WRONG_ORDER = {'system': 'atlas', 'initial_conditions': ['stand_prep'], 'goals': ['look_down', 'stand_prep']}
 PAPER_TASK = {'system': 'atlas', 'initial_conditions': ['stand_prep'], 'goals': ['look_down', 'pickup_object']}
@@ -44,6 +46,7 @@ def play(client, job_id, moves):
     return client.post(f'/api/jobs/{job_id}/play', json={'moves': moves})
 
 
+@pytest.mark.flexbe
 def test_suggest_fixes_offers_verified_changes_and_an_applied_one_succeeds(client):
     _, refused = run_job(client, WRONG_ORDER)
     assert refused['outcome']['error_name'] == 'SPEC_UNSYNTHESIZABLE'
@@ -62,6 +65,7 @@ def test_suggest_fixes_offers_verified_changes_and_an_applied_one_succeeds(clien
         assert fixed['outcome']['error_name'] == 'SUCCESS', proposal['summary']
 
 
+@pytest.mark.flexbe
 def test_fixes_stream_as_json_lines_as_they_are_found(client):
     import json
 
@@ -76,6 +80,7 @@ def test_fixes_stream_as_json_lines_as_they_are_found(client):
         assert refused.status_code == 404     # refusals come before the stream, as plain answers
 
 
+@pytest.mark.flexbe
 def test_a_refusal_before_synthesis_gets_fixes_too(client):
     from_stand = {**WRONG_ORDER, 'initial_conditions': ['stand']}
     _, refused = run_job(client, from_stand)
@@ -86,6 +91,7 @@ def test_a_refusal_before_synthesis_gets_fixes_too(client):
     assert run_job(client, applied['request'])[1]['outcome']['error_name'] == 'SUCCESS'
 
 
+@pytest.mark.flexbe
 def test_the_page_learns_which_refusals_can_be_repaired_and_the_search_budget(client):
     from ltl_specification.repair import REPAIRABLE
 
@@ -94,6 +100,7 @@ def test_the_page_learns_which_refusals_can_be_repaired_and_the_search_budget(cl
     assert client.get('/api/info').json()['repair_time_budget'] == 10.0
 
 
+@pytest.mark.flexbe
 def test_a_task_that_can_be_done_needs_no_fix_and_bad_requests_are_refused(client):
     repairs = client.post('/api/repair', json=PAPER_TASK).json()
     assert repairs['realizable'] is True and repairs['proposals'] == []
@@ -103,6 +110,7 @@ def test_a_task_that_can_be_done_needs_no_fix_and_bad_requests_are_refused(clien
     assert no_goals.status_code == 422 and no_goals.json()['item'] == 'goals'
 
 
+@pytest.mark.flexbe
 def test_custom_ltl_is_part_of_the_request_and_a_weakened_guarantee_is_proposed(client):
     forbidden = {**PAPER_TASK, 'goals': ['look_down'], 'custom_ltl': {'sys_trans': ['!look_down_a']}}
     _, refused = run_job(client, forbidden)
@@ -116,6 +124,7 @@ def test_custom_ltl_is_part_of_the_request_and_a_weakened_guarantee_is_proposed(
     assert bad.status_code == 422 and bad.json()['item'] == 'sys_nonsense'
 
 
+@pytest.mark.flexbe
 def test_playing_the_robot_of_an_unrealizable_job_until_it_loses(client):
     _, job = run_job(client, WRONG_ORDER)
     start = play(client, job['id'], [])
@@ -159,6 +168,7 @@ def test_playing_the_robot_of_an_unrealizable_job_until_it_loses(client):
     assert play(client, job['id'], ['look_down']).status_code == 422   # a robot's moves are indices
 
 
+@pytest.mark.flexbe
 def test_playing_the_environment_of_a_machine_until_it_ends(client):
     _, job = run_job(client, PAPER_TASK)
     turn = play(client, job['id'], []).json()
@@ -180,6 +190,7 @@ def test_playing_the_environment_of_a_machine_until_it_ends(client):
     assert client.post(f"/api/jobs/{job['id']}/play", json={'moves': [], 'extra': 1}).status_code == 422
 
 
+@pytest.mark.flexbe
 def test_nothing_to_play_and_unknown_jobs(client):
     _, compiled = run_job(client, {**PAPER_TASK, 'option': 'ltl_compilation_only'})
     nothing = play(client, compiled['id'], [])
@@ -187,6 +198,7 @@ def test_nothing_to_play_and_unknown_jobs(client):
     assert play(client, 'no-such-job', []).status_code == 404
 
 
+@pytest.mark.flexbe
 def test_a_capability_robot_offers_its_capabilities_as_actions_and_negated_goals(client):
     choices = client.get('/api/systems/delivery_rover').json()
     assert choices['control_modes'] == []
@@ -198,6 +210,7 @@ def test_a_capability_robot_offers_its_capabilities_as_actions_and_negated_goals
     assert not any(g['name'].startswith('!') for group in atlas['goal_groups'] for g in group['items'])
 
 
+@pytest.mark.flexbe
 def test_a_capability_robot_plays_both_ways_and_is_repaired(client):
     _, refused = run_job(client, ROVER_CONTRADICTION)
     assert refused['outcome']['error_name'] == 'SPEC_UNSYNTHESIZABLE', refused['outcome']['message']
@@ -275,6 +288,7 @@ def test_repairs_beyond_the_limit_are_busy(monkeypatch):
         assert client.post('/api/repair', json=WRONG_ORDER).status_code == 200   # the slot is free again
 
 
+@pytest.mark.flexbe
 def test_plays_beyond_the_limit_are_busy(gui, monkeypatch):
     backend, client = gui
     _, job = run_job(client, WRONG_ORDER)
@@ -323,6 +337,7 @@ def test_stopping_the_gui_ends_a_running_search_at_once():
     assert time.monotonic() - started < 2.0 and search.child.process.poll() is not None
 
 
+@pytest.mark.flexbe
 def test_a_client_that_goes_away_stops_its_search(gui):
     """Issue 48, item 7: a client disconnecting did not stop its search (a BDD bomb's ran to its
     hard kill). The stream's end stops it: its child is killed at once."""

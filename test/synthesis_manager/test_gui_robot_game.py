@@ -10,6 +10,8 @@ from ltl_specification.play import RobotPlay
 from synthesis_manager.web.robot_game import MAX_GAME_MOVES, game_turn
 from respec.robot import robot_system
 
+pytestmark = pytest.mark.ros
+
 
 @pytest.fixture(scope='module')
 def wrong_order():

@@ -1,26 +1,11 @@
 """The operator in the loop over the GUI's API: autonomy, confirmations, forced outcomes,
 InputState answers and stop reach the simulation's child while it runs."""
 
-import json
+import pytest
 
-from test_gui_api import PAPER_TASK, backend, client, follow_simulation, run_job  # noqa: F401
+from gui_jobs import PAPER_TASK, follow_simulation, operate, run_job
 
-
-def operate(client, simulation_id, answer):
-    """Follow the run; ``answer(waiting) -> command`` for each thing it waits for. The final run."""
-    answered, last = set(), None
-    with client.stream('GET', f'/api/simulations/{simulation_id}/events', timeout=300) as response:
-        for line in response.iter_lines():
-            if not line.startswith('data: '):
-                continue
-            last = json.loads(line[len('data: '):])
-            waiting = (last.get('operator') or {}).get('waiting')
-            key = json.dumps([len(last['steps']), waiting], sort_keys=True)
-            if waiting and key not in answered:
-                answered.add(key)
-                sent = client.post(f'/api/simulations/{simulation_id}/control', json=answer(waiting))
-                assert sent.status_code == 202, sent.text
-    return last
+pytestmark = pytest.mark.ros
 
 
 def test_high_autonomy_waits_for_confirmations_and_robot_time_does_not_count_the_wait(client):

@@ -14,6 +14,8 @@ from respec.nesting import MAX_FORMULA_NESTING
 from respec.parsing import ParseError, UnknownVariableError, parse_formula, parse_structuredslugs
 from synthesis_manager.requests import MAX_YAML_DEPTH, InvalidRequestError, load_request_yaml, parse_synthesis_options
 
+pytestmark = pytest.mark.ros
+
 
 def alias_bomb(levels: int) -> str:
     """A few hundred bytes that yaml.safe_load expands to 9**levels strings."""

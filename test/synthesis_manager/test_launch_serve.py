@@ -8,6 +8,8 @@ import pytest
 from synthesis_manager.launch_serve import ROS_ARGS, launch_values, main, serve_argv, serve_launch_arguments
 from synthesis_manager.cli import build_parser
 
+pytestmark = pytest.mark.ros
+
 
 def test_values_become_serves_options_and_empty_ones_keep_its_defaults():
     values = launch_values(['config_dir:=/a:/b', 'byproducts_dir:=', 'namespace:=/robot1, /robot2',

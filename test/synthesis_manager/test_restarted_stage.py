@@ -6,12 +6,15 @@ SERVICE_UNAVAILABLE within about a second, and the next goal succeeds on the new
 
 import time
 
+import pytest
 from rclpy.parameter import Parameter
 
 from synthesis_manager.client import make_goal
 from synthesis_manager.nodes.sm_generation_node import SMGenerationNode
 from synthesis_msgs.srv import GenerateFlexBESM
-from test_synthesis_manager_cancel import PAPER_TASK, make_slow_service, start
+from suite_in_process import PAPER_TASK, make_slow_service, start_with_stand_ins as start
+
+pytestmark = pytest.mark.ros
 
 
 def test_a_request_to_a_node_that_was_replaced_ends_service_unavailable_at_once(ros, tmp_path):

@@ -8,6 +8,7 @@ own robot's state topic, and each behavior is run on its own robot and checked.
 from argparse import Namespace
 import threading
 
+import pytest
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 
@@ -22,6 +23,8 @@ from synthesis_manager.ros.namespaces import synthesis_service_remapping
 from synthesis_manager.suite import suite_node_factories
 from respec.robot import robot_system
 
+pytestmark = pytest.mark.ros
+
 ROBOTS = {  # namespace -> (where its simulated ATLAS starts, what it is asked to do)
     '/robot1': ('stand_prep', ['look_down', 'pickup_object']),
     '/robot2': ('stand', ['footstep_execution']),
@@ -33,6 +36,7 @@ def fleet_args(tmp_path, **settings):
                      synthesis_timeout=60.0, service_timeout=3.0, **settings)
 
 
+@pytest.mark.mujoco  # each robot is an atlas_sim node: a simulator in this process
 def test_two_robots_synthesize_and_run_at_once_with_one_synthesis_service(ros, tmp_path):
     factories = suite_node_factories(fleet_args(tmp_path, namespaces=list(ROBOTS)))
     nodes = [ros.add_node(factory) for factory in factories]
@@ -114,7 +118,7 @@ def test_the_documented_commands_serve_two_robots_and_the_clients_pick_one(tmp_p
 
     import httpx
 
-    from test_entry_point_shutdown import BIN, GUI_URL, loopback_domain, started
+    from suite_processes import BIN, GUI_URL, loopback_domain, started
 
     serve = [BIN / 'behavior-synthesis', 'serve', '--byproducts-dir', tmp_path]
     with loopback_domain() as (_, environment):

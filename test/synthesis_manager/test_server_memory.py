@@ -6,7 +6,7 @@ import time
 
 import pytest
 from synthesis_manager.client import make_flexbe_goal, make_goal
-from test_dead_server import serve_with_clients
+from suite_processes import serve_with_clients
 
 pytestmark = pytest.mark.ros
 KEPT_AT_MOST_MIB = 100

@@ -6,13 +6,17 @@ waited 228 s), and a SynthesizeAutomaton request could ask for any time limit.""
 import threading
 import time
 
+import pytest
 from rclpy.parameter import Parameter
 
 from respec.nesting import run_with_deep_stack
 from synthesis_manager.client import make_goal
 from synthesis_manager.nodes.ltl_compilation_node import SMALL_CUSTOM_BYTES, LTLCompilationNode, compiled_sections
-from test_synthesis_manager_reliability import PAPER_TASK, runaway_goal, start_suite
 from respec.robot import SystemCatalog, robot_system
+from runaway_requests import runaway_goal
+from suite_in_process import PAPER_TASK, start_suite
+
+pytestmark = pytest.mark.ros
 
 FORMULA_BYTES = 56_000  # as in the attack: just under the 64 KB string cap
 
@@ -79,18 +83,19 @@ def test_a_large_robot_file_is_read_and_compiled_in_a_child(ros, tmp_path):
 
 
 def normal_goal_beside(client, huge):
-    """Send ``huge``, and a second later the paper task: (its result, its seconds, and the huge
-    goal's result and seconds as ``answers['huge']``, ``answers['huge seconds']``)."""
-    answers = {}
+    """Send ``huge``, and once it is in its stage the paper task: (its result, its seconds, and the
+    huge goal's result and seconds as ``answers['huge']``, ``answers['huge seconds']``)."""
+    answers, in_stage = {}, threading.Event()
 
     def send_huge():
         started = time.monotonic()
-        answers['huge'] = client.run(huge, timeout=120)
+        answers['huge'] = client.run(huge, timeout=120, feedback=lambda status, _progress: in_stage.set())
         answers['huge seconds'] = time.monotonic() - started
 
     sender = threading.Thread(target=send_huge)
     sender.start()
-    time.sleep(1.0)  # the huge one is being compiled or parsed
+    # its first stage (compiling, or for a given specification synthesizing, which parses it)
+    assert in_stage.wait(60), 'the huge goal never reached its first stage (no feedback)'
     started = time.monotonic()
     normal = client.run(make_goal(**PAPER_TASK), timeout=60)
     normal_seconds = time.monotonic() - started

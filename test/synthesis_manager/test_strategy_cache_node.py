@@ -25,6 +25,8 @@ from synthesis_manager.suite import suite_node_factories
 from synthesis_msgs.msg import LTLSpecification, SynthesisErrorCodes
 from synthesis_msgs.srv import SynthesizeAutomaton
 
+pytestmark = pytest.mark.ros
+
 SHIPPED_CONFIG = Path(__file__).resolve().parents[2] / 'config'
 REALIZABLE = (['stand_prep'], ['look_down'])
 # Compiled, then found unrealizable by synthesis (test_diagnosis_channels.py).

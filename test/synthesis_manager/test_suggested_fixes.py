@@ -5,9 +5,13 @@ them (``ltl_specification.repair`` in a child process)."""
 
 import json
 
+import pytest
+
 from suite_settings import suite_args
 from synthesis_manager.client import SynthesisClient, make_flexbe_goal, make_goal
 from synthesis_manager.suite import suite_node_factories
+
+pytestmark = pytest.mark.ros
 
 WRONG_ORDER = ('atlas', ['stand_prep'], ['look_down', 'stand_prep'])
 FIRST_FIX = 'Suggested fix 1: Let the goals be achieved in any order (--unordered).'

@@ -10,6 +10,8 @@ import pytest
 from synthesis_manager.byproducts import (ByproductsDirectoryError, ByproductStore, InvalidSpecNameError,
                                           default_directory)
 
+pytestmark = pytest.mark.ros
+
 
 def write_set(store, name):
     with store.open_set(name) as files:

@@ -9,49 +9,13 @@ from rclpy.node import Node
 from rclpy.parameter import Parameter
 
 from synthesis_manager.client import SynthesisClient, make_goal
-from synthesis_manager.nodes.server_node import BehaviorSynthesisServer
-from synthesis_manager.suite import suite_node_factories
 from synthesis_msgs.srv import GenerateFlexBESM, GenerateLTLSpecification
 
+from suite_in_process import make_slow_service, start_with_stand_ins as start
+
+pytestmark = pytest.mark.ros
+
 PAPER_TASK = dict(system='atlas', initial_conditions=['stand_prep'], goals=['look_down', 'pickup_object'])
-
-
-def make_slow_service(service_type, name, seconds):
-    """A stand-in pipeline service that takes ``seconds`` to answer (or forever)."""
-    def factory(context, **kwargs):
-        from rclpy.callback_groups import ReentrantCallbackGroup
-
-        node = Node(f'slow_{name}', context=context)
-        release = threading.Event()
-        node.release = release
-        node.stop_work = release.set  # the harness ends running callbacks before teardown
-
-        def handle(request, response):
-            release.wait(seconds)
-            response.error_code.value = response.error_code.FAILURE
-            response.error_code.message = 'slow stand-in answered'
-            return response
-
-        node.create_service(service_type, name, handle, callback_group=ReentrantCallbackGroup())
-        return node
-    return factory
-
-
-def start(ros, tmp_path, replace=None, server_parameters=()):
-    """The suite with some services replaced by stand-ins; returns a client."""
-    names = ['ltl_compilation', 'ltl_synthesis', 'sm_generation']
-    args = Namespace(config_dir='', byproducts_dir=str(tmp_path), backend='builtin',
-                     slugs_executable='slugs', synthesis_timeout=60.0, service_timeout=1.0)
-    replace = replace or {}
-    real = [n for n in names if n not in replace and n is not None]
-    for factory in suite_node_factories(args, real):
-        ros.add_node(factory)
-    stand_ins = [ros.add_node(factory) for factory in replace.values() if factory is not None]
-    ros.add_node(BehaviorSynthesisServer, parameter_overrides=[
-        Parameter('service_timeout', value=1.0), *server_parameters])
-    client = SynthesisClient(ros.add_node(Node, 'cancel_client'))
-    assert client.wait_for_server(timeout=10.0)
-    return client, stand_ins
 
 
 def cancel_when(client, goal, status_prefix):

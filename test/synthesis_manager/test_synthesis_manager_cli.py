@@ -10,10 +10,16 @@ from pathlib import Path
 from types import SimpleNamespace
 
 import pytest
+from rclpy.node import Node
 
 from respec.naming import parse_names
 from synthesis_manager.requests import InvalidRequestError, selected_option
 from synthesis_manager.ros.env import prepare_ros_environment
+from synthesis_manager.ros.harness import RosHarness
+from synthesis_msgs.action import BehaviorSynthesis
+from waiting import wait_until
+
+pytestmark = pytest.mark.ros
 
 CLI = [str(Path(sys.executable).parent / 'behavior-synthesis')]
 
@@ -101,9 +107,15 @@ def test_ctrl_c_cancels_the_goal(served, tmp_path):
     runaway = tmp_path / 'runaway.json'
     runaway.write_text(json.dumps({'env_props': [f'x{i}' for i in range(40)],
                                    'sys_props': [f'y{i}' for i in range(40)], 'sys_liveness': ['y0']}))
-    process = subprocess.Popen(CLI + ['send-goal', '--synthesis-only', str(runaway), '--json'],
-                               env=served, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    time.sleep(8.0)  # connected and synthesizing (the synthesis never ends by itself)
+    with RosHarness(domain_id=int(served['ROS_DOMAIN_ID'])) as ros:  # the goal's feedback, as a client sees it
+        statuses = []
+        ros.add_node(Node, 'feedback_watcher').create_subscription(
+            BehaviorSynthesis.Impl.FeedbackMessage, '/behavior_synthesis/_action/feedback',
+            lambda message: statuses.append(message.feedback.status), 10)
+        process = subprocess.Popen(CLI + ['send-goal', '--synthesis-only', str(runaway), '--json'],
+                                   env=served, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        wait_until(lambda: any(status.startswith('Synthesizing') for status in statuses), 60,
+                   'the runaway goal synthesizing (its feedback)')
     process.send_signal(signal.SIGINT)
     stdout, stderr = process.communicate(timeout=30)
     assert process.returncode == 130, stderr

@@ -15,6 +15,8 @@ from synthesis_manager.ros.cnu_interface import load_flexbe_synthesis_interface
 from synthesis_manager.suite import suite_node_factories
 from synthesis_msgs.action import BehaviorSynthesis
 
+pytestmark = pytest.mark.ros
+
 FLEXBE_SYNTHESIS = load_flexbe_synthesis_interface()
 SynthesisErrorCode = FLEXBE_SYNTHESIS.error_code_type
 

@@ -9,6 +9,8 @@ from synthesis_manager.limits import (MAX_LIST_LENGTH, MAX_MESSAGE_BYTES, MAX_ST
                                       capped_timeout, check_message, check_timeout, oversized_strings)
 from synthesis_manager.requests import InvalidRequestError
 
+pytestmark = pytest.mark.ros
+
 
 @pytest.mark.parametrize('value', [-1, -0.001, math.nan, math.inf, -math.inf, 'soon'])
 def test_bad_time_limits_are_invalid_requests(value):

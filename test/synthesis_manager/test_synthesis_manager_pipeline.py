@@ -14,6 +14,8 @@ from suite_settings import suite_args
 from synthesis_manager.client import SynthesisClient, make_goal
 from synthesis_manager.suite import suite_node_factories
 
+pytestmark = pytest.mark.ros
+
 PAPER_TASK = dict(system='atlas', initial_conditions=['stand_prep'], goals=['look_down', 'pickup_object'])
 
 

@@ -6,9 +6,13 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 from synthesis_manager.client import SynthesisClient, make_goal
 from synthesis_manager.ros.harness import RosHarness
 from synthesis_manager.ros.env import prepare_ros_environment
+
+pytestmark = pytest.mark.ros
 
 NODE_SCRIPTS = ('ltl-compilation-node', 'ltl-synthesis-node', 'sm-generation-node',
                 'behavior-synthesis-server')

@@ -21,45 +21,17 @@ import pytest
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 
-from suite_settings import suite_args
+from runaway_requests import runaway_goal
+from suite_in_process import PAPER_TASK, start_suite
+from waiting import wait_until
 from synthesis_manager.client import SynthesisClient, make_goal
 from synthesis_manager.limits import MAX_LIST_LENGTH, MAX_STRING_BYTES
-from synthesis_manager.nodes.server_node import BehaviorSynthesisServer
 from synthesis_manager.requests import byproduct_file_stem
 from synthesis_manager.ros.env import prepare_ros_environment
 from synthesis_manager.ros.harness import RosHarness, reserve_domain_id
-from synthesis_manager.suite import suite_node_factories
 from synthesis_msgs.srv import SynthesizeAutomaton
 
-PAPER_TASK = dict(system='atlas', initial_conditions=['stand_prep'], goals=['look_down', 'pickup_object'])
-# 200 unconstrained outputs: strategy extraction alone would run for hours.
-RUNAWAY_SPEC = {'sys_props': [f'p{i}' for i in range(200)], 'env_props': ['e'], 'sys_liveness': ['p0']}
-
-
-def runaway_goal(timeout=0.0):
-    return make_goal('atlas', [], [], option='ltl_synthesis_only', ltl_specification=RUNAWAY_SPEC,
-                     timeout=timeout)
-
-
-def reliability_suite_args(byproducts_dir, **overrides):
-    return suite_args(byproducts_dir, **{'service_timeout': 5.0, **overrides})
-
-
-def start_suite(ros, tmp_path, names=('ltl_compilation', 'ltl_synthesis', 'sm_generation'),
-                server_parameters=(), synthesis_parameters=()):
-    """The suite in ``ros`` (the synthesis node with extra parameters); returns a client."""
-    from synthesis_manager.nodes.ltl_synthesis_node import LTLSynthesisNode
-
-    for factory in suite_node_factories(reliability_suite_args(tmp_path), [n for n in names if n != 'ltl_synthesis']):
-        ros.add_node(factory)
-    if 'ltl_synthesis' in names:
-        ros.add_node(LTLSynthesisNode, parameter_overrides=[
-            Parameter('byproducts_dir', value=str(tmp_path)), *synthesis_parameters])
-    ros.add_node(BehaviorSynthesisServer, parameter_overrides=list(server_parameters))
-    client = SynthesisClient(ros.add_node(Node, 'reliability_client'))
-    assert client.wait_for_server(timeout=10.0)
-    return client
-
+pytestmark = pytest.mark.ros
 
 def run_all(client, goals, timeout=120.0):
     """Send every goal at once (one thread each); returns outcomes (or exceptions) in order."""
@@ -68,7 +40,7 @@ def run_all(client, goals, timeout=120.0):
     def run(index):
         try:
             outcomes[index] = client.run(goals[index], timeout=timeout)
-        except Exception as error:  # a hang shows up as TimeoutError here
+        except Exception as error:  # noqa: BLE001 - a hang shows up as TimeoutError here
             outcomes[index] = error
 
     threads = [threading.Thread(target=run, args=(index,)) for index in range(len(goals))]
@@ -82,13 +54,16 @@ def run_all(client, goals, timeout=120.0):
 @contextlib.contextmanager
 def slow_goals_running(client, count):
     """``count`` runaway syntheses in progress (cancelled on leaving); yields their threads."""
-    cancel = threading.Event()
-    threads = [threading.Thread(target=client.run, args=(runaway_goal(30.0),), kwargs={'cancel': cancel})
-               for _ in range(count)]
+    cancel, synthesizing = threading.Event(), set()
+
+    def feedback(index):
+        return lambda status, _progress: status.startswith('Synthesizing') and synthesizing.add(index)
+    threads = [threading.Thread(target=client.run, args=(runaway_goal(30.0),),
+                                kwargs={'cancel': cancel, 'feedback': feedback(index)}) for index in range(count)]
     for thread in threads:
         thread.start()
-    time.sleep(2.0)  # they are synthesizing now
     try:
+        wait_until(lambda: len(synthesizing) == count, 60, f'{count} runaway goals synthesizing (their feedback)')
         yield threads
     finally:
         cancel.set()
@@ -402,8 +377,11 @@ def test_a_result_asked_for_after_its_retention_is_a_timeout_not_a_success(ros, 
     client = default_qos_client(ros)
     handle = wait_for(client.send_goal_async(make_goal(**PAPER_TASK, option='ltl_compilation_only')), 30)
     assert outcome_from_response(wait_for(handle.get_result_async(), 30), 0.0).error_name == 'SUCCESS'
-    time.sleep(3.0)  # the result is forgotten 1 s after the goal finished
-    late = outcome_from_response(wait_for(handle.get_result_async(), 30), 0.0)
+
+    def forgotten():  # 1 s after the goal finished
+        late = outcome_from_response(wait_for(handle.get_result_async(), 30), 0.0)
+        return late if late.goal_status == 'UNKNOWN' else None
+    late = wait_until(forgotten, 3.0, 'the result forgotten (result_retention 1 s)')
     assert (late.error_name, late.goal_status) == ('TIMEOUT', 'UNKNOWN')
     assert 'result_retention' in late.message
 

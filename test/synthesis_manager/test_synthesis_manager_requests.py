@@ -10,6 +10,8 @@ from synthesis_manager.requests import (InvalidRequestError, behavior_name, bypr
                                         parse_synthesis_options, resolve_system,
                                         task_from_behavior_synthesis, task_from_flexbe_synthesis)
 
+pytestmark = pytest.mark.ros
+
 
 def test_container_paths_name_the_behavior():
     assert behavior_name('/Container') == 'Container'

@@ -4,12 +4,15 @@ import shutil
 import time
 from pathlib import Path
 
+import pytest
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 
 from respec.robot import SystemCatalog, robot_system
 from synthesis_manager.nodes.ltl_compilation_node import LTLCompilationNode
 from synthesis_manager.ros.robot_systems import SuiteSystems
+
+pytestmark = pytest.mark.ros
 
 CONFIG = Path(__file__).resolve().parents[2] / 'config'
 
@@ -33,7 +36,7 @@ def test_a_client_sees_the_suite_systems_and_their_edits(ros, tmp_path):
     assert systems.load('atlas') == robot_system('atlas', tmp_path)
     try:
         systems.load('broken')
-    except Exception as error:  # the suite's own error, as it would answer a request
+    except Exception as error:  # noqa: BLE001 - the suite's own error, as it would answer a request
         assert 'abstraction' in str(error) and error.item
     else:
         raise AssertionError('a broken system must not load')

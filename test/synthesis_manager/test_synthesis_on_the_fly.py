@@ -24,6 +24,8 @@ from synthesis_manager.ros.atlas_sim_robot import RosRobot
 from synthesis_manager.suite import suite_node_factories
 from respec.robot import robot_system
 
+pytestmark = pytest.mark.ros
+
 TASK_1 = ['look_down', 'pickup_object']
 AFTER_TASK_1 = ['manipulate', 'look_down', 'object_template', 'pickup_object']  # in any action order
 

@@ -19,6 +19,8 @@ from synthesis_manager.suite import suite_node_factories
 from synthesis_manager.web.backend import SynthesisBackend
 from synthesis_manager.web.routes import create_app
 
+pytestmark = pytest.mark.ros
+
 CONFIG = Path(__file__).resolve().parents[2] / 'config'
 # The battery check never answers: the rover starts every delivery with it (SYS_INIT), so the
 # environment cannot keep the check's answer assumptions (ENV_TRANS) from the first step.
@@ -42,6 +44,7 @@ def cheating_rover(tmp_path, flexbe, monkeypatch) -> Path:
     return config
 
 
+@pytest.mark.flexbe
 def test_the_warning_reaches_every_channel_and_the_machine_is_still_made(ros, tmp_path, cheating_rover):
     from rclpy.node import Node
 

@@ -37,7 +37,7 @@ from typing import Callable, Iterator, Mapping, NamedTuple, Sequence
 import yaml
 
 from respec.errors import CodedError, ErrorCode
-from respec.naming import DEFAULT_SM_OUTCOMES, FAILED, activation, memory, parse_names
+from respec.naming import DEFAULT_SM_OUTCOMES, FAILED, activation, memory, parse_names, remembered
 from respec.robot import RobotSystem, for_description
 from respec.robot.abstraction import RobotAbstraction
 from respec.robot.cnu import CapabilitySystem
@@ -282,11 +282,11 @@ def _names_a_goal_memory(system: RobotSystem, refusal: Attempt) -> bool:
 
 def _memory_owner(system: RobotSystem, name: str) -> str | None:
     """The item ``name`` is the goal memory of (eq. (20)): a mode robot's modes and actions have one."""
-    return _robot_repairs(system).memory_owner(system, name) if name.endswith('_m') else None
+    return _robot_repairs(system).memory_owner(system, name) if remembered(name) is not None else None
 
 
 def _mode_memory_owner(system: RobotSystem, name: str) -> str | None:
-    item = name[:-2]
+    item = remembered(name)
     return item if system.abstraction.kind_of(item) is not None else None
 
 
@@ -388,17 +388,17 @@ def _prerequisite_candidates(system: RobotSystem, request: TaskRequest, custom_l
     in order takes the robot where the next goal can be reached from."""
     abstraction = system.abstraction
     used = _custom_names(custom_ltl)
-    remembered = [i for i in abstraction.items() if f'{i}_m' in used and i not in request.goals]
+    remembered_items = [i for i in abstraction.items() if memory(i) in used and i not in request.goals]
     preconditions = {p for g in request.goals for p in abstraction.actions.get(g, ())}
-    extra = remembered + [i for i in abstraction.items() if i not in request.goals and i not in remembered
-                          and (abstraction.is_mode(i) or i in preconditions)]
+    extra = remembered_items + [i for i in abstraction.items() if i not in request.goals
+                                and i not in remembered_items and (abstraction.is_mode(i) or i in preconditions)]
     for item in extra:
-        for position in range(len(request.goals) + (item in remembered)):
+        for position in range(len(request.goals) + (item in remembered_items)):
             goals = request.goals[:position] + (item,) + request.goals[position:]
             where = (f'before goal {position + 1} ({request.goals[position]})' if position < len(request.goals)
                      else 'after the last goal')
-            why = f' (the custom LTL uses {item}_m, its goal memory)' if item in remembered else ''
-            yield Proposal(ADD_GOAL, f'Add the goal {item} {where}{why}.', 1 if item in remembered else 2, True,
+            why = f' (the custom LTL uses {memory(item)}, its goal memory)' if item in remembered_items else ''
+            yield Proposal(ADD_GOAL, f'Add the goal {item} {where}{why}.', 1 if item in remembered_items else 2, True,
                            replace(request, goals=goals))
 
 

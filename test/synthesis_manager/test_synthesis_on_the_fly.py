@@ -64,6 +64,7 @@ def execute(outcome, robot, goals):
     return run
 
 
+@pytest.mark.mujoco  # the robot is simulated in this process
 def test_paper_second_demo_on_the_fly(ros, tmp_path):
     """Task 1, then footstep_execution with no initial conditions: it starts from manipulate."""
     client = start_suite(ros, tmp_path)
@@ -133,6 +134,7 @@ def run_mission(capsys, *arguments):
     return code, json.loads(capsys.readouterr().out)
 
 
+@pytest.mark.mujoco  # the robot is simulated in this process
 def test_mission_runs_the_second_demo_on_the_fly(capsys):
     code, report = run_mission(capsys, '--goals', ','.join(TASK_1), '--then', 'footstep_execution')
     assert code == 0, report
@@ -147,6 +149,7 @@ def test_mission_runs_the_second_demo_on_the_fly(capsys):
     assert second['trace']['steps'][0]['mode_at_entry'] == 'manipulate'
 
 
+@pytest.mark.mujoco  # the robot is simulated in this process
 def test_mission_recovers_after_a_failed_batch(capsys):
     code, report = run_mission(capsys, '--goals', ','.join(TASK_1), '--fail-first', 'pickup_object:1',
                                '--then', 'pickup_object')
@@ -162,6 +165,7 @@ def test_mission_recovers_after_a_failed_batch(capsys):
     assert steps == ['/pickup_object']  # nothing already done is redone
 
 
+@pytest.mark.mujoco  # the robot is simulated in this process
 def test_mission_without_ros_sim_reads_the_in_process_simulator(capsys):
     code = cli_main(['execute', '--json', '--goals', 'walk', '--then', 'look_down'])
     report = json.loads(capsys.readouterr().out)

@@ -226,6 +226,7 @@ def test_simulate_the_synthesized_machine_with_and_without_a_fault(client, backe
                for step in run['steps'] for r in step['results'])
 
 
+@pytest.mark.mujoco  # the simulation runs in this process
 def test_a_simulation_runs_the_system_the_gui_was_served_not_a_local_file(tmp_path):
     """A GUI attached to a suite elsewhere simulates the suite's system: the child rebuilds it
     from the files the GUI holds (here a variant of ATLAS whose walk always fails, under a

@@ -77,6 +77,7 @@ def test_every_flag_gives_each_setting_a_value_of_its_type():
 
 
 @pytest.mark.ros
+@pytest.mark.mujoco  # the atlas_sim node builds its simulator
 def test_each_node_declares_exactly_its_settings(tmp_path):
     from rclpy.parameter import Parameter
 

@@ -7,6 +7,10 @@
 ``ltl_specification.diagnosis`` says in plain words why a task cannot be done, from the
 specification and its ``provenance`` alone (``ltl_specification.provenance``, which also
 carries it as JSON).
+
+The ATLAS paper's encoding lives here: ``activation_outcomes`` (one function per formula
+family, equations (3)-(20)) and ``components`` (the sub-specifications made of them, in
+FormulaGroups: the provenance of every formula).
 """
 
 from ltl_specification.compiler import CompiledSpecification, compile_task, explain

@@ -3,7 +3,7 @@
 The specification is the merge, in this fixed order, of: the control-mode formulas, the
 action formulas, the initial conditions, the goal formulas, the sensors that custom LTL
 uses and the user's custom LTL
-(see ``respec.components`` and ``respec.spec.merge_specifications``). Pertinent actions and
+(see ``ltl_specification.components`` and ``respec.spec.merge_specifications``). Pertinent actions and
 modes are inferred from the task (``ltl_specification.pertinence``) and listed in
 configuration order, so the same request always gives a byte-identical specification.
 
@@ -46,7 +46,7 @@ from typing import Mapping, Sequence
 from respec.robot import RobotSystem, for_description
 from respec.robot.abstraction import RobotAbstraction
 from respec.robot.cnu import CapabilitySystem
-from respec.components import (
+from ltl_specification.components import (
     SOURCE_CUSTOM, FormulaGroup, action_groups, action_specification, control_mode_groups,
     control_mode_specification, goal_groups, goal_specification, initial_conditions_groups,
     initial_conditions_specification,

@@ -35,7 +35,7 @@ import itertools
 import time
 from dataclasses import asdict, dataclass, field
 
-from respec.components import SOURCE_CUSTOM, FormulaGroup
+from ltl_specification.components import SOURCE_CUSTOM, FormulaGroup
 from respec.ltl import Formula, evaluate, mentions_next, to_infix, variables
 from respec.naming import activation
 from respec.robot import RobotSystem, for_description

@@ -21,7 +21,7 @@ from dataclasses import asdict, dataclass, field
 from typing import Mapping
 
 from respec.robot.abstraction import RobotAbstraction
-from respec.components import (SOURCE_ACTIONS, SOURCE_CONTROL_MODES, SOURCE_GOALS, SOURCE_INITIAL_CONDITIONS,
+from ltl_specification.components import (SOURCE_ACTIONS, SOURCE_CONTROL_MODES, SOURCE_GOALS, SOURCE_INITIAL_CONDITIONS,
                                SOURCE_SM_OUTCOMES, FormulaGroup)
 from respec.ltl import to_infix
 from respec.naming import BEHAVIOR_CLASS, activation, memory, outcome_proposition

@@ -1,6 +1,6 @@
 """Unrealizable cores: the fewest guarantees that are still unrealizable, by delta debugging.
 
-A specification is divided into groups of formulas (``respec.components.FormulaGroup``: the
+A specification is divided into groups of formulas (``ltl_specification.components.FormulaGroup``: the
 formulas one paper equation adds for one item, or one custom formula). The environment's
 assumptions stay as they are; among the system's guarantees, Zeller and Hildebrandt's
 ``ddmin`` finds a subset of groups that is still unrealizable and from which no single group
@@ -104,7 +104,7 @@ def unrealizable_core(spec: GR1Specification, groups: Sequence, robotics_semanti
     """A 1-minimal set of guarantee ``groups`` that, with all assumptions, is unrealizable.
 
     ``groups`` are objects with ``section`` and ``formulas`` covering the specification
-    (e.g. ``respec.components.FormulaGroup``); only those of ``droppable_sections`` are candidates.
+    (e.g. ``ltl_specification.components.FormulaGroup``); only those of ``droppable_sections`` are candidates.
     Returns None when ``spec`` is realizable. Raises ``SynthesisCancelledError`` when ``limits``
     stop it (each realizability check keeps to them).
     """

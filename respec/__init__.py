@@ -6,9 +6,10 @@ The LTL library:
     spec                 GR1Specification: sections, printers, merging with stable order
     parsing              parsers for structuredslugs, slugsin and LTLSpecification sections
     nesting              how deeply formulas may nest (one limit for every parser and process)
-    activation_outcomes  the paper's formula families, one function per equation (3)-(20)
-    components           sub-specifications (control modes, actions, initial conditions, goals),
-                         made of FormulaGroups (the provenance of every formula)
+
+(The ATLAS paper's encoding, its formula families and the sub-specifications made of them, is
+``ltl_specification.activation_outcomes`` and ``ltl_specification.components``: only the
+compiler uses it.)
 
 Shared model types:
     robot                robot systems: RobotSystem, the abstraction, CNU capability robots,

@@ -1,5 +1,5 @@
 import sys
 
-from synthesis_manager.cli import main
+from synthesis_manager.programs.cli import main
 
 sys.exit(main())

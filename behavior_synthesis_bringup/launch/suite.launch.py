@@ -19,12 +19,12 @@ from behavior_synthesis_bringup import suite_python
 
 def generate_launch_description():
     python = suite_python()
-    described = subprocess.run([python, '-m', 'synthesis_manager.launch_serve', '--arguments'],
+    described = subprocess.run([python, '-m', 'synthesis_manager.programs.launch_serve', '--arguments'],
                                capture_output=True, text=True, check=True, timeout=60)
     arguments = json.loads(described.stdout)
     return LaunchDescription([
         *[DeclareLaunchArgument(a['name'], default_value='', description=a['description']) for a in arguments],
-        ExecuteProcess(cmd=[python, '-m', 'synthesis_manager.launch_serve',
+        ExecuteProcess(cmd=[python, '-m', 'synthesis_manager.programs.launch_serve',
                             *[[f"{a['name']}:=", LaunchConfiguration(a['name'])] for a in arguments]],
                        name='behavior_synthesis', output='screen', emulate_tty=True),
     ])

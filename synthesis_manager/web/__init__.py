@@ -1,4 +1,4 @@
-"""The synthesis web GUI (ROS-free; ``synthesis_manager.gui`` wires it to ROS).
+"""The synthesis web GUI (ROS-free; ``synthesis_manager.programs.gui`` wires it to ROS).
 
     routes        the FastAPI app: page, JSON API, server-sent event streams, downloads
     backend       SynthesisBackend: the robot systems, and one object per concern behind the routes

@@ -293,7 +293,7 @@ def test_a_missing_flexbe_workspace_says_what_to_set(cnu, tmp_path):
 
 
 def test_export_without_a_flexbe_workspace_says_what_to_set_before_synthesis(cnu, tmp_path, capsys, monkeypatch):
-    from synthesis_manager.cli import main
+    from synthesis_manager.programs.cli import main
 
     example_system(tmp_path, cnu, 'vending_demo')
     monkeypatch.setenv('AMENT_PREFIX_PATH', str(tmp_path))  # no FlexBE state package there

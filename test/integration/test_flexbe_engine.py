@@ -140,7 +140,7 @@ def test_an_outcome_the_operator_forces_on_the_engine_is_the_operators_in_the_tr
 
 
 def run_cli(capsys, *arguments):
-    from synthesis_manager.cli import main
+    from synthesis_manager.programs.cli import main
 
     code = main(list(arguments))
     return code, capsys.readouterr()

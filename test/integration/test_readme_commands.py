@@ -22,7 +22,7 @@ from pathlib import Path
 
 import pytest
 
-from synthesis_manager.cli import SUBCOMMANDS, build_parser
+from synthesis_manager.programs.cli import SUBCOMMANDS, build_parser
 from synthesis_manager.ros.env import prepare_ros_environment
 
 from readme_sections import flexbe_section, readme_commands

@@ -21,7 +21,7 @@ from pathlib import Path
 
 import pytest
 
-from synthesis_manager.launch_serve import serve_parser
+from synthesis_manager.programs.launch_serve import serve_parser
 
 ROS2 = Path(sys.prefix) / 'ros2cli' / 'ros2'
 LAUNCH = ['launch', 'behavior_synthesis_bringup', 'suite.launch.py']

@@ -13,7 +13,7 @@ import yaml
 import gr1_oracle
 from ltl_specification import compile_task
 from ltl_synthesizer import is_realizable, synthesize
-from respec import activation_outcomes as ao
+from ltl_specification import activation_outcomes as ao
 from respec.ltl import FALSE
 from respec.robot import robot_system
 

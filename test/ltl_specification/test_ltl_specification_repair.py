@@ -25,7 +25,7 @@ FLEXBE_PREFIX = Path(sys.prefix) / 'flexbe'
 
 
 def command(program, *args, env=None):
-    module = {'behavior-synthesis': 'synthesis_manager.cli', 'gr1synth': 'ltl_synthesizer'}[program]
+    module = {'behavior-synthesis': 'synthesis_manager.programs.cli', 'gr1synth': 'ltl_synthesizer'}[program]
     environment = dict(os.environ, PYTHONPATH=str(ROOT), **(env or {}))
     return subprocess.run([sys.executable, '-m', module, *map(str, args)], cwd=ROOT, env=environment,
                           capture_output=True, text=True, timeout=120)

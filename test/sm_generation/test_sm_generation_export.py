@@ -154,7 +154,7 @@ def test_cli_reports_errors(capsys):
 
 
 def test_cli_subcommand_of_behavior_synthesis(tmp_path):
-    from synthesis_manager.cli import main as suite_main
+    from synthesis_manager.programs.cli import main as suite_main
     out = tmp_path / 'm.yaml'
     assert suite_main(['generate-sm', '--system', 'atlas', '--automaton', str(AUTOMATA / 'look_down.yaml'),
                        '-o', str(out)]) == 0

@@ -7,7 +7,7 @@ from fastapi.testclient import TestClient
 
 from gui_in_browser import gui_server, open_page
 from gui_jobs import gui_args
-from synthesis_manager.gui import ros_backend
+from synthesis_manager.programs.gui import ros_backend
 from synthesis_manager.web.routes import create_app
 
 import headless_chromium

@@ -6,8 +6,8 @@ from pathlib import Path
 
 import pytest
 
-from synthesis_manager.cli import build_parser
-from synthesis_manager.gui import background_server, ros_backend
+from synthesis_manager.programs.cli import build_parser
+from synthesis_manager.programs.gui import background_server, ros_backend
 from synthesis_manager.web.routes import create_app
 
 

@@ -2,7 +2,7 @@
 
 import json
 
-from synthesis_manager.cli import build_parser
+from synthesis_manager.programs.cli import build_parser
 
 PAPER_TASK = {'system': 'atlas', 'initial_conditions': ['stand_prep'], 'goals': ['look_down', 'pickup_object']}
 

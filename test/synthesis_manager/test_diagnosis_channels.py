@@ -18,7 +18,7 @@ from fastapi.testclient import TestClient
 
 from suite_settings import suite_args
 from synthesis_manager.client import SynthesisClient, make_flexbe_goal, make_goal
-from synthesis_manager.gui import RosGoalRunner
+from synthesis_manager.programs.gui import RosGoalRunner
 from synthesis_manager.suite import suite_node_factories
 from synthesis_manager.web.backend import SynthesisBackend
 from synthesis_manager.web.routes import create_app

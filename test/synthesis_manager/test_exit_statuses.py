@@ -83,7 +83,7 @@ def test_demo_help_lists_status_2_which_a_bad_demo_command_line_exits_with():
 
 
 HIDE_FLEXBE = ("import sys; sys.modules['flexbe_core'] = None; "  # as if FlexBE were not installed
-               "from synthesis_manager.cli import main; sys.exit(main(sys.argv[1:]))")
+               "from synthesis_manager.programs.cli import main; sys.exit(main(sys.argv[1:]))")
 
 
 def test_execute_on_a_missing_flexbe_engine_exits_5_saying_what_to_install():
@@ -154,7 +154,7 @@ def test_a_task_naming_no_initial_conditions_starts_where_its_system_says():
     from argparse import Namespace
 
     from respec.robot import robot_system
-    from synthesis_manager.send_goal import fill_default_initial_conditions
+    from synthesis_manager.programs.send_goal import fill_default_initial_conditions
 
     assert robot_system('atlas').default_initial_conditions == ['stand_prep']
     assert robot_system('mobile_manipulator').default_initial_conditions == ['parked']

@@ -7,7 +7,7 @@ import yaml
 from fastapi.testclient import TestClient
 
 from gui_jobs import PAPER_TASK, follow, follow_simulation, gui_args, run_job
-from synthesis_manager.gui import ros_backend
+from synthesis_manager.programs.gui import ros_backend
 from synthesis_manager.web.routes import create_app
 
 pytestmark = pytest.mark.ros

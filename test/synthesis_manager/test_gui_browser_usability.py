@@ -14,7 +14,7 @@ from pathlib import Path
 import pytest
 from PIL import Image
 
-from synthesis_manager.gui import listening_socket, make_server
+from synthesis_manager.programs.gui import listening_socket, make_server
 from synthesis_manager.web.backend import SynthesisBackend
 from synthesis_manager.web.outcome import JobOutcome
 from synthesis_manager.web.routes import create_app

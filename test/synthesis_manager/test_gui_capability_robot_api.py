@@ -8,7 +8,7 @@ from starlette.testclient import TestClient
 
 from gui_jobs import follow_simulation, gui_args, operate, run_job
 
-from synthesis_manager.gui import ros_backend
+from synthesis_manager.programs.gui import ros_backend
 from synthesis_manager.web.routes import create_app
 
 pytestmark = [pytest.mark.ros, pytest.mark.flexbe]

@@ -12,8 +12,8 @@ from concurrent.futures import ThreadPoolExecutor
 
 import pytest
 
-from synthesis_manager.cli import build_parser
-from synthesis_manager.gui import background_server, ros_backend
+from synthesis_manager.programs.cli import build_parser
+from synthesis_manager.programs.gui import background_server, ros_backend
 from synthesis_manager.limits import MAX_BODY_BYTES
 from synthesis_manager.web import request_form as request_form_module
 from synthesis_manager.web.guards import json_nesting_exceeds

@@ -11,7 +11,7 @@ from fastapi.testclient import TestClient
 
 from respec.robot import SystemCatalog
 from respec.robot.system import ServedCatalog, catalog_to_json
-from synthesis_manager.gui import ros_backend
+from synthesis_manager.programs.gui import ros_backend
 from synthesis_manager.web import plays as plays_module
 from synthesis_manager.web import repairs as repairs_module
 from synthesis_manager.web.backend import SynthesisBackend

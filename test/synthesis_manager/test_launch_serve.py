@@ -5,8 +5,8 @@ import json
 
 import pytest
 
-from synthesis_manager.launch_serve import ROS_ARGS, launch_values, main, serve_argv, serve_launch_arguments
-from synthesis_manager.cli import build_parser
+from synthesis_manager.programs.launch_serve import ROS_ARGS, launch_values, main, serve_argv, serve_launch_arguments
+from synthesis_manager.programs.cli import build_parser
 
 pytestmark = pytest.mark.ros
 

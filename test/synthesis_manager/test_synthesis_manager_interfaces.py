@@ -161,7 +161,7 @@ def test_container_paths_become_distinct_safe_file_names(suite):
 def test_serve_default_system_answers_system_wide_requests(ros, tmp_path):
     from rclpy.node import Node
 
-    from synthesis_manager.cli import build_parser
+    from synthesis_manager.programs.cli import build_parser
 
     args = build_parser(only='serve').parse_args(
         ['serve', '--default-system', 'mobile_manipulator', '--byproducts-dir', str(tmp_path)])

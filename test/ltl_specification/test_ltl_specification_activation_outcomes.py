@@ -1,6 +1,6 @@
 """Each formula family of the activation-outcomes paradigm against hand-derived formulas."""
 
-from respec import activation_outcomes as ao
+from ltl_specification import activation_outcomes as ao
 from respec.ltl import to_infix, to_prefix
 
 CF = ['completed', 'failed']

@@ -21,7 +21,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Mapping, Sequence
 
-from respec import activation_outcomes as ao
+from ltl_specification import activation_outcomes as ao
 from respec.naming import FAILED, FINISHED
 from respec.ltl import Formula
 from respec.spec import FORMULA_SECTIONS, GR1Specification

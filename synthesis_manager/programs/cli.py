@@ -19,17 +19,17 @@ import sys
 
 # name -> (module providing add_arguments/run, one-line help)
 SUBCOMMANDS = {
-    'demo': ('synthesis_manager.demo', "run the paper's task end to end and write the artifacts"),
-    'serve': ('synthesis_manager.serve', 'run the synthesis suite until SIGINT/SIGTERM'),
-    'send-goal': ('synthesis_manager.send_goal', 'send a goal to /behavior_synthesis and show the result'),
+    'demo': ('synthesis_manager.programs.demo', "run the paper's task end to end and write the artifacts"),
+    'serve': ('synthesis_manager.programs.serve', 'run the synthesis suite until SIGINT/SIGTERM'),
+    'send-goal': ('synthesis_manager.programs.send_goal', 'send a goal to /behavior_synthesis and show the result'),
     'compile': ('ltl_specification.cli', 'compile a task into a GR(1) specification (no ROS)'),
     'repair': ('ltl_specification.repair_cli', 'propose verified changes that make a refused task possible (no ROS)'),
     'generate-sm': ('sm_generation.cli', 'turn an automaton into a FlexBE state machine (no ROS)'),
-    'execute': ('synthesis_manager.execute', 'synthesize a behavior and run it on the simulated robot (ATLAS, or a capability robot)'),
-    'export-behavior': ('synthesis_manager.export_behavior', 'synthesize a behavior and write it as a FlexBE '
+    'execute': ('synthesis_manager.programs.execute', 'synthesize a behavior and run it on the simulated robot (ATLAS, or a capability robot)'),
+    'export-behavior': ('synthesis_manager.programs.export_behavior', 'synthesize a behavior and write it as a FlexBE '
                         'behavior package'),
-    'gui': ('synthesis_manager.gui', 'serve the synthesis web GUI on 127.0.0.1'),
-    'start-behavior': ('synthesis_manager.start_behavior', 'start an installed FlexBE behavior on the onboard '
+    'gui': ('synthesis_manager.programs.gui', 'serve the synthesis web GUI on 127.0.0.1'),
+    'start-behavior': ('synthesis_manager.programs.start_behavior', 'start an installed FlexBE behavior on the onboard '
                        'engine and say how it ended'),
 }
 
@@ -78,11 +78,11 @@ def main(argv: list[str] | None = None) -> int:
         parser.print_help()
         return 0 if not argv or '-h' in argv or '--help' in argv else 2
     if hasattr(args, 'initial_conditions') and hasattr(args, 'sm_outcomes') and args.initial_conditions is None:
-        from synthesis_manager.send_goal import fill_default_initial_conditions
+        from synthesis_manager.programs.send_goal import fill_default_initial_conditions
 
         fill_default_initial_conditions(args)  # a command of the suite's task (send-goal, demo, execute, ...)
     if getattr(args, 'goals', '') is None:
-        from synthesis_manager.send_goal import use_demo_goals_unless_given
+        from synthesis_manager.programs.send_goal import use_demo_goals_unless_given
 
         use_demo_goals_unless_given(args, args.command)
     with stop_signals_interrupt() as received:

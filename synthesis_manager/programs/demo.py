@@ -13,7 +13,7 @@ from pathlib import Path
 from respec.errors import ExitStatus, exit_status_help
 from sm_generation.export import render, to_dot, to_json, to_yaml
 from synthesis_manager.web.picture import render_svg
-from synthesis_manager.send_goal import ProgressBar, add_goal_arguments, goal_from_args, print_summary
+from synthesis_manager.programs.send_goal import ProgressBar, add_goal_arguments, goal_from_args, print_summary
 from synthesis_manager.suite import SuiteUnavailableError, add_suite_arguments, in_process_suite
 
 

@@ -49,7 +49,7 @@ from atlas_sim.executive.errors import ExecutionError
 from respec.errors import ExitStatus, exit_status_help
 from respec.nesting import run_with_deep_stack
 from respec.parsing import spec_from_text_sections
-from synthesis_manager.send_goal import ProgressBar, add_goal_arguments, goal_from_args, print_summary
+from synthesis_manager.programs.send_goal import ProgressBar, add_goal_arguments, goal_from_args, print_summary
 from synthesis_manager.suite import SuiteUnavailableError, add_suite_arguments, in_process_suite
 
 EXIT_STATUS_HELP = exit_status_help(ExitStatus.OK, ExitStatus.FAILED, ExitStatus.USAGE, ExitStatus.TIMED_OUT,

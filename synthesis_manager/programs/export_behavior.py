@@ -23,7 +23,7 @@ import time
 from pathlib import Path
 
 from respec.errors import ExitStatus, exit_status_help
-from synthesis_manager.send_goal import ProgressBar, add_goal_arguments, goal_from_args
+from synthesis_manager.programs.send_goal import ProgressBar, add_goal_arguments, goal_from_args
 from synthesis_manager.suite import SuiteUnavailableError, add_suite_arguments, in_process_suite
 
 EXIT_STATUSES = (ExitStatus.OK, ExitStatus.FAILED, ExitStatus.USAGE, ExitStatus.TIMED_OUT, ExitStatus.UNAVAILABLE)

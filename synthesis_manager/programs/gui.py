@@ -25,7 +25,7 @@ from synthesis_manager.http_connections import BoundedH11Protocol, install_repea
 from synthesis_manager.ros.harness import RosHarness, environment_domain_id
 from synthesis_manager.ros.namespaces import namespace_placement
 from synthesis_manager.ros.robot_systems import SuiteSystems
-from synthesis_manager.send_goal import add_robot_namespace_argument
+from synthesis_manager.programs.send_goal import add_robot_namespace_argument
 from synthesis_manager.suite import add_suite_arguments, suite_node_factories
 from synthesis_manager.web.backend import SynthesisBackend
 from synthesis_manager.web.outcome import JobOutcome

@@ -8,7 +8,7 @@ repeatable option (``--namespace``) takes a comma-separated list, a flag ``true`
 ``ros_args`` passes standard ROS arguments (``ros_args:='-r __ns:=/robot1'``).
 
 The launch file runs in the Python of the user's ``ros2`` (their ROS installation), which need
-not have the suite: it runs ``python -m synthesis_manager.launch_serve`` with the interpreter of
+not have the suite: it runs ``python -m synthesis_manager.programs.launch_serve`` with the interpreter of
 the ``behavior-synthesis`` it finds, first with ``--arguments`` (the launch arguments as JSON),
 then with the values given (``name:=value`` items). That process is ``serve`` itself, except that
 a stop asked by the launcher (SIGINT, SIGTERM) ends it with status 0: ``ros2 launch`` reports any
@@ -57,7 +57,7 @@ class LaunchArgument:
 
 def serve_parser() -> argparse.ArgumentParser:
     """``behavior-synthesis serve``'s parser, as the command line builds it."""
-    from synthesis_manager.cli import build_parser
+    from synthesis_manager.programs.cli import build_parser
 
     # argparse lists a parser's options and their kinds only in private attributes and classes.
     subparsers = next(action for action in build_parser(only='serve')._actions  # noqa: SLF001
@@ -110,7 +110,7 @@ def launch_values(items: list[str]) -> dict[str, str]:
 def main(argv: list[str] | None = None) -> int:
     """``--arguments``: the launch arguments as JSON (the launch file declares them); otherwise
     ``name:=value`` items: ``serve`` with them until the launcher stops it."""
-    from synthesis_manager.cli import main as cli_main
+    from synthesis_manager.programs.cli import main as cli_main
 
     argv = sys.argv[1:] if argv is None else argv
     if argv == ['--arguments']:

@@ -103,7 +103,8 @@ class BehaviorSynthesisServer(Node):
         if self._fallback_note and interface.action_name == 'flexbe_synthesis':
             self.get_logger().info(self._fallback_note)
             self._fallback_note = ''
-        feedback = FeedbackChannel(goal_handle, interface.action_type.Feedback)
+        feedback = FeedbackChannel(goal_handle, interface.action_type.Feedback, listeners=lambda: self.count_subscribers(
+            f'{interface.action_name}/_action/feedback'))
         outcome = PipelineOutcome()
         task = deadline = None
         try:

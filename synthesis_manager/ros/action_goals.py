@@ -46,15 +46,30 @@ def action_interfaces(flexbe_synthesis) -> tuple[ActionInterface, ...]:
                             flexbe_synthesis_result))
 
 
-class FeedbackChannel:
-    """Publishes a goal's feedback and remembers the progress reached."""
+#: How long a goal's first feedback waits for a feedback subscriber to be discovered (seconds).
+FEEDBACK_LISTENER_WAIT = 0.5
 
-    def __init__(self, goal_handle, feedback_type):
+
+class FeedbackChannel:
+    """Publishes a goal's feedback and remembers the progress reached.
+
+    ``listeners()`` counts the feedback topic's subscribers: a client that has just found the
+    server (``ros2 action send_goal --feedback``) may not yet be matched to its feedback, which
+    is not kept for late subscribers; a quick goal's first feedback waits FEEDBACK_LISTENER_WAIT
+    at most for one, or it would be lost."""
+
+    def __init__(self, goal_handle, feedback_type, listeners=None):
         self.goal_handle, self.feedback_type, self.progress = goal_handle, feedback_type, 0.0
+        self._listeners = listeners
 
     def __call__(self, status: str, progress: float | None = None):
         if progress is not None:
             self.progress = float(progress)
+        if self._listeners is not None:
+            waited_until = time.monotonic() + FEEDBACK_LISTENER_WAIT
+            while self._listeners() == 0 and time.monotonic() < waited_until:
+                time.sleep(0.02)
+            self._listeners = None  # once per goal
         self.goal_handle.publish_feedback(self.feedback_type(status=status, progress=self.progress))
 
 

@@ -14,7 +14,7 @@ in one place.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Iterable, Mapping
+from typing import Any, Callable, Iterable, Mapping
 
 
 @dataclass(frozen=True, slots=True)
@@ -73,7 +73,7 @@ FALSE = Const(False)
 # The constructors below make nodes without the dataclass __init__, which (frozen) sets each
 # field through object.__setattr__: allocating the node and calling its slots' setters costs
 # half as much, and large specifications build millions of nodes. The nodes are the same.
-FIELD_SETTERS = {kind: {name: getattr(kind, name).__set__ for name in kind.__dataclass_fields__}
+FIELD_SETTERS: dict[type[Formula], dict[str, Callable[[Formula, Any], None]]] = {kind: {name: getattr(kind, name).__set__ for name in kind.__dataclass_fields__}
                  for kind in (Const, Var, Not, And, Or, Implies, Iff, Next)}
 _new = object.__new__
 _set_name = FIELD_SETTERS[Var]['name']

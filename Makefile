@@ -63,7 +63,7 @@ test: setup system-packages $(if $(FLEXBE_SOURCES),flexbe) lint
 	$(if $(FLEXBE_SOURCES),FLEXBE_SOURCES=$(abspath $(FLEXBE_SOURCES))) $(BIN)/python -m pytest -q
 
 # Static checks (docs/testing.md): `make lint` runs them all; each also runs alone.
-lint: lint-py lint-js
+lint: lint-py lint-js lint-types
 
 # Python, with ruff (the test extra; rules in pyproject.toml's [tool.ruff]).
 lint-py: setup

@@ -19,7 +19,7 @@ VIZ_JS := @viz-js/viz@3.31.0
 NEEDS_NODE := make setup needs Node.js and npm: the GUI draws state machines with Graphviz compiled to \
   WebAssembly ($(VIZ_JS), from npm). Install them (sudo apt-get install nodejs npm) and run make again.
 
-.PHONY: setup run test bench serve clean system-packages flexbe webui lint lint-js lint-py
+.PHONY: setup run test bench serve clean system-packages flexbe webui lint lint-js lint-py lint-types
 
 # FlexBE: the folder holding flexbe_behavior_engine/ (and flexbe_webui/, rosidl_runtime_py/).
 FLEXBE_SOURCES ?= $(if $(wildcard ../shared/third_party/flexbe_behavior_engine),$(abspath ../shared/third_party))
@@ -63,11 +63,15 @@ test: setup system-packages $(if $(FLEXBE_SOURCES),flexbe) lint
 	$(if $(FLEXBE_SOURCES),FLEXBE_SOURCES=$(abspath $(FLEXBE_SOURCES))) $(BIN)/python -m pytest -q
 
 # Static checks (docs/testing.md): `make lint` runs them all; each also runs alone.
-lint: lint-py lint-js
+lint: lint-py lint-js lint-types
 
 # Python, with ruff (the test extra; rules in pyproject.toml's [tool.ruff]).
 lint-py: setup
 	$(BIN)/ruff check --no-cache .
+
+# Python types, with mypy (the test extra; settings in pyproject.toml's [tool.mypy]).
+lint-types: setup
+	$(BIN)/mypy
 
 # The GUI's ES modules, with ESLint from npm (package.json, package-lock.json; eslint.config.mjs).
 lint-js: node_modules/.installed

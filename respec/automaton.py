@@ -9,6 +9,7 @@ strings, valuations split into inputs and outputs, goal-memory propositions (nam
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Any
 
 from respec.errors import CodedError, ErrorCode
 from respec.ltl import conj, evaluate
@@ -37,7 +38,7 @@ class Automaton:
     initial_states: list[str] = field(default_factory=list)
 
 
-def automaton_from_strategy(strategy: dict, spec: GR1Specification,
+def automaton_from_strategy(strategy: dict[str, Any], spec: GR1Specification,
                             drop_memory: bool = True) -> Automaton:
     """The automaton of a slugs JSON strategy; ``initial_states`` are the nodes whose valuation
     satisfies ENV_INIT and SYS_INIT (the extraction numbers them first)."""
@@ -71,7 +72,7 @@ def automaton_from_strategy(strategy: dict, spec: GR1Specification,
                      states=states, initial_states=initial)
 
 
-def _initial_nodes(strategy: dict, spec: GR1Specification) -> list[str]:
+def _initial_nodes(strategy: dict[str, Any], spec: GR1Specification) -> list[str]:
     condition = conj(list(spec.env_init) + list(spec.sys_init))
     names = list(strategy['variables'])
     try:
@@ -82,7 +83,7 @@ def _initial_nodes(strategy: dict, spec: GR1Specification) -> list[str]:
                              'variable of the strategy', item=unknown.args[0]) from None
 
 
-def strategy_move_problems(strategy: dict, spec: GR1Specification, seconds: float = 0.5) -> list[str]:
+def strategy_move_problems(strategy: dict[str, Any], spec: GR1Specification, seconds: float = 0.5) -> list[str]:
     """What in a slugs JSON ``strategy`` its ``spec`` forbids: no initial node, or a move that
     breaks a transition formula (ENV_TRANS or SYS_TRANS, on both steps' whole valuations).
     Moves are checked for up to ``seconds`` (a strategy of thousands of moves is checked in

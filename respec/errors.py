@@ -12,6 +12,7 @@ import enum
 import reprlib
 import sys
 import textwrap
+from typing import Callable
 
 #: How much of a user's value any message quotes: a refused value may be megabytes long.
 QUOTED_CHARACTERS = 40
@@ -25,13 +26,15 @@ class ErrorCode(enum.StrEnum):
     read "INVALID_FORMULA"), with the integer ``number`` of synthesis_msgs/SynthesisErrorCodes
     (the original's codes plus the ones marked "added" there)."""
 
-    def __new__(cls, name: str, number: int):
+    number: int
+
+    def __new__(cls, name: str, number: int) -> ErrorCode:
         member = str.__new__(cls, name)
         member._value_, member.number = name, number
         return member
 
     @staticmethod
-    def _generate_next_value_(name, start, count, last_values):
+    def _generate_next_value_(name: str, start: int, count: int, last_values: list[str]) -> str:
         return name
 
     SUCCESS = enum.auto(), 1
@@ -102,11 +105,11 @@ class CodedError(Exception):
 
     code = ErrorCode.FAILURE
 
-    def __init__(self, message: str, item=''):
+    def __init__(self, message: str, item: object = ''):
         super().__init__(message)
         self.item = item if not isinstance(item, str) or len(item) <= ITEM_CHARACTERS else item[:ITEM_CHARACTERS] + '...'
 
-    def __reduce__(self):
+    def __reduce__(self) -> tuple[Callable[..., CodedError], tuple[type[CodedError], tuple[object, ...], dict[str, object]]]:
         # Pickled whole (item and the subclass's own attributes), e.g. when a synthesis process
         # reports it: Exception's default pickling would call __init__ with the message only.
         return _rebuild_coded_error, (type(self), self.args, self.__dict__)
@@ -118,7 +121,7 @@ class ControlFlowSignal(Exception):
     reported as a failure or logged as a bug. Subclasses say what stopped."""
 
 
-def _rebuild_coded_error(cls, args, state):
+def _rebuild_coded_error(cls: type[CodedError], args: tuple[object, ...], state: dict[str, object]) -> CodedError:
     error = Exception.__new__(cls)
     error.args = args
     error.__dict__.update(state)
@@ -130,7 +133,7 @@ _SHORT_REPR.maxlevel, _SHORT_REPR.maxstring, _SHORT_REPR.maxother = 3, QUOTED_CH
 _SHORT_REPR.maxlist = _SHORT_REPR.maxtuple = _SHORT_REPR.maxdict = _SHORT_REPR.maxset = 4
 
 
-def quoted(value, length: int = QUOTED_CHARACTERS) -> str:
+def quoted(value: object, length: int = QUOTED_CHARACTERS) -> str:
     """``value`` as every message quotes a user's input: ``'its start'...`` after ``length``
     characters. Strings are cut before they are quoted and other values are shown by a
     bounded repr, so quoting costs little whatever the size of the value."""
@@ -144,7 +147,9 @@ class ExitStatus(enum.IntEnum):
     """The exit status of every command of the suite, one meaning per number (README, "Exit
     status"); a command stopped by SIGINT or SIGTERM exits with 128 + the signal's number."""
 
-    def __new__(cls, number: int, meaning: str):
+    meaning: str
+
+    def __new__(cls, number: int, meaning: str) -> ExitStatus:
         member = int.__new__(cls, number)
         member._value_, member.meaning = number, meaning
         return member
@@ -167,7 +172,8 @@ class ExitStatus(enum.IntEnum):
         """The exit status of a command whose request ended with ``code`` (an ErrorCode or the
         name a server answered; one this suite does not know is a failure)."""
         try:
-            code = ErrorCode(code)
+            # A lookup by value; mypy reads the call as the members' __new__(name, number).
+            code = ErrorCode(code)  # type: ignore[call-arg]
         except ValueError:
             return cls.FAILED
         if code == ErrorCode.SUCCESS:
@@ -186,7 +192,7 @@ def exit_status_help(*statuses: ExitStatus) -> str:
     return '\n'.join(['Exit status:', *lines, '  130, 143  stopped by SIGINT (Ctrl-C) or SIGTERM'])
 
 
-def unbuildable_value(error: ValueError) -> str:
+def unbuildable_value(error: ValueError | OverflowError) -> str:
     """Why YAML (or JSON) text parsed but a value of it could not be built, in a few words:
     PyYAML lets the constructors' ValueError through (an integer of more digits than Python
     converts, an impossible date), which would otherwise be an internal error."""

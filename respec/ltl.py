@@ -14,7 +14,7 @@ in one place.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Iterable
+from typing import Any, Callable, Iterable, Mapping
 
 
 @dataclass(frozen=True, slots=True)
@@ -73,7 +73,7 @@ FALSE = Const(False)
 # The constructors below make nodes without the dataclass __init__, which (frozen) sets each
 # field through object.__setattr__: allocating the node and calling its slots' setters costs
 # half as much, and large specifications build millions of nodes. The nodes are the same.
-FIELD_SETTERS = {kind: {name: getattr(kind, name).__set__ for name in kind.__dataclass_fields__}
+FIELD_SETTERS: dict[type[Formula], dict[str, Callable[[Formula, Any], None]]] = {kind: {name: getattr(kind, name).__set__ for name in kind.__dataclass_fields__}
                  for kind in (Const, Var, Not, And, Or, Implies, Iff, Next)}
 _new = object.__new__
 _set_name = FIELD_SETTERS[Var]['name']
@@ -123,16 +123,16 @@ def next_(arg: Formula) -> Formula:
     return node
 
 
-def _binary(kind, left: Formula, right: Formula) -> Formula:
-    node = _new(kind)
+def _binary(kind: type[Implies] | type[Iff], left: Formula, right: Formula) -> Formula:
+    node: Formula = _new(kind)
     set_left, set_right = _set_sides[kind]
     set_left(node, left)
     set_right(node, right)
     return node
 
 
-def _associative(kind, args, unit, zero):
-    flat = []
+def _associative(kind: type[And] | type[Or], args: Iterable[Formula], unit: Const, zero: Const) -> Formula:
+    flat: list[Formula] = []
     for arg in args:
         if isinstance(arg, Const):  # the unit or the zero
             if arg.value == zero.value:
@@ -146,7 +146,7 @@ def _associative(kind, args, unit, zero):
         return unit
     if len(flat) == 1:
         return flat[0]
-    node = _new(kind)
+    node: Formula = _new(kind)
     _set_args[kind](node, tuple(flat))
     return node
 
@@ -267,7 +267,7 @@ def evaluate(formula: Formula, current: dict[str, bool], next_step: dict[str, bo
     raise TypeError(f'not a formula: {formula!r}')
 
 
-def partial_evaluate(formula: Formula, current: dict, next_step: dict):
+def partial_evaluate(formula: Formula, current: Mapping[str, bool], next_step: Mapping[str, bool]) -> bool | None:
     """Kleene truth value of ``formula`` on a step: True, False, or None if it depends on
     variables missing from the valuations (strong Kleene logic, so partial assignments can
     already refute a formula)."""

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import difflib
 import re
+from typing import Iterable
 
 ACTIVATION_SUFFIX = '_a'
 MEMORY_SUFFIX = '_m'
@@ -67,14 +68,14 @@ def _strip(proposition: str, suffix: str) -> str | None:
     return None
 
 
-def parse_names(text) -> list[str]:
+def parse_names(text: str | list[str] | tuple[str, ...] | None) -> list[str]:
     """``'look_down, pickup_object'`` (or a list of such texts) -> ``['look_down', 'pickup_object']``."""
     if isinstance(text, (list, tuple)):
         text = ','.join(text)
     return [name for name in _SEPARATORS.split(_DECORATION.sub(' ', text or '')) if name]
 
 
-def did_you_mean(name: str, known) -> str:
+def did_you_mean(name: str, known: Iterable[str]) -> str:
     """``'; did you mean look_down?'`` for a misspelled ``name`` close to one of ``known``, else ''."""
     close = difflib.get_close_matches(name, list(known), n=2, cutoff=0.7)
     return f'; did you mean {" or ".join(close)}?' if close else ''

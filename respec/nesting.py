@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import sys
 import threading
+from typing import Callable, ParamSpec, TypeVar
 
 #: Deepest nesting of parentheses and unary operators (``!``, ``next``) in one formula.
 MAX_FORMULA_NESTING = 10_000
@@ -27,9 +28,11 @@ DEEP_STACK_BYTES = 256 << 20
 DEEP_RECURSION_LIMIT = 200_000
 
 _DEEP_THREAD_NAME = 'deep-formulas'
+_P = ParamSpec('_P')
+_T = TypeVar('_T')
 _limit_lock = threading.Lock()
 _deep_callers = 0  # deep work running now, in any thread
-_limit_before = None  # the recursion limit to restore when the last of them ends
+_limit_before = sys.getrecursionlimit()  # the limit to restore when the last of them ends (read at its start)
 
 
 def _raise_limit() -> None:
@@ -51,24 +54,27 @@ def _restore_limit() -> None:
 
 def in_deep_thread() -> bool:
     """True in a thread started by :func:`start_deep_thread` (its stack is sized for formulas)."""
-    return getattr(threading.current_thread(), 'deep_stack', False)
+    return isinstance(threading.current_thread(), _DeepThread)
 
 
-def start_deep_thread(target, name: str = _DEEP_THREAD_NAME, daemon: bool = True) -> threading.Thread:
+class _DeepThread(threading.Thread):
+    """A thread started by :func:`start_deep_thread`."""
+
+
+def start_deep_thread(target: Callable[[], object], name: str = _DEEP_THREAD_NAME, daemon: bool = True) -> threading.Thread:
     """Start ``target()`` on a thread with a stack of DEEP_STACK_BYTES (the recursion limit is
     left as it is: run formula work in it through :func:`run_with_deep_stack`)."""
     with _limit_lock:  # threading.stack_size is process-wide: set only for this thread's start
         previous = threading.stack_size(DEEP_STACK_BYTES)
         try:
-            thread = threading.Thread(target=target, name=name, daemon=daemon)
-            thread.deep_stack = True
+            thread = _DeepThread(target=target, name=name, daemon=daemon)
             thread.start()
         finally:
             threading.stack_size(previous)
     return thread
 
 
-def run_with_deep_stack(function, *args, **kwargs):
+def run_with_deep_stack(function: Callable[_P, _T], *args: _P.args, **kwargs: _P.kwargs) -> _T:
     """``function(*args, **kwargs)`` with room for formulas nested MAX_FORMULA_NESTING deep: in
     this thread when it is a deep one, else in a new one (its exceptions are raised here). The
     recursion limit is raised while it runs and restored when no deep work is left."""
@@ -78,20 +84,21 @@ def run_with_deep_stack(function, *args, **kwargs):
             return function(*args, **kwargs)
         finally:
             _restore_limit()
-    outcome = {}
+    values: list[_T] = []
+    errors: list[BaseException] = []
 
-    def target():
+    def target() -> None:
         try:
-            outcome['value'] = run_with_deep_stack(function, *args, **kwargs)
+            values.append(run_with_deep_stack(function, *args, **kwargs))
         except BaseException as error:  # noqa: BLE001 -- re-raised in the caller's thread
-            outcome['error'] = error
+            errors.append(error)
 
     worker = start_deep_thread(target, name=getattr(function, '__name__', _DEEP_THREAD_NAME))
     while worker.is_alive():  # a timed join keeps Ctrl-C working in the main thread
         worker.join(0.1)
-    if 'error' in outcome:
-        raise outcome['error']
-    return outcome['value']
+    if errors:
+        raise errors[0]
+    return values[0]
 
 
 def too_deep(levels: int = MAX_FORMULA_NESTING) -> str:

@@ -7,7 +7,7 @@ slugs' file formats. Formulas are ``respec.ltl`` trees; text is made only by the
 from __future__ import annotations
 
 from dataclasses import dataclass, field, fields
-from typing import Iterable
+from typing import Any, Callable, Iterable
 
 from respec.errors import CodedError, ErrorCode
 from respec.ltl import Formula, to_infix, to_prefix, variables
@@ -80,7 +80,7 @@ class GR1Specification:
         """The specification as a ``.slugsin`` file (prefix formulas, primed next-step variables)."""
         return self._slugs_text(to_prefix)
 
-    def _slugs_text(self, printer) -> str:
+    def _slugs_text(self, printer: Callable[[Formula], str]) -> str:
         blocks = []
         for name in SECTIONS:
             lines = getattr(self, name)
@@ -101,7 +101,8 @@ def merge_specifications(specifications: Iterable[GR1Specification]) -> GR1Speci
 
     Raises PropositionConflictError if a proposition would be both input and output.
     """
-    merged = {name: {} for name in SECTIONS}  # dicts as insertion-ordered sets
+    # dicts as insertion-ordered sets (of names or of formulas: each section's own type)
+    merged: dict[str, dict[Any, None]] = {name: {} for name in SECTIONS}
     for specification in specifications:
         for section in fields(GR1Specification):
             for entry in getattr(specification, section.name):

@@ -16,6 +16,7 @@ from __future__ import annotations
 import os
 import stat
 from pathlib import Path
+from typing import Protocol
 
 import yaml
 
@@ -45,7 +46,7 @@ class BoundedYamlError(ValueError):
         return f' (line {self.line}, column {self.column})' if self.line is not None else ''
 
 
-def load_bounded_yaml(text: str, max_depth: int):
+def load_bounded_yaml(text: str, max_depth: int) -> object:
     """The value of the YAML ``text``; BoundedYamlError when it is not valid YAML, uses an
     alias or nests deeper than ``max_depth`` mappings and sequences."""
     try:
@@ -76,7 +77,14 @@ def _check_events(text: str, max_depth: int) -> None:
             depth -= 1
 
 
-def _located(problem: str, mark) -> BoundedYamlError:
+class _Mark(Protocol):
+    """Where PyYAML met a problem (its pure-Python and libyaml marks both have these)."""
+
+    line: int
+    column: int
+
+
+def _located(problem: str, mark: _Mark | None) -> BoundedYamlError:
     if mark is None:
         return BoundedYamlError(problem)
     return BoundedYamlError(problem, mark.line + 1, mark.column + 1)

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import itertools
 from bisect import bisect_right
+from typing import Iterator
 
 from respec.parsing.errors import ParseError
 from respec.parsing.scope import Source
@@ -21,7 +22,7 @@ class SectionText:
     """A section's non-blank lines (comments and surrounding blanks removed), and where each
     one is in the file (worked out only for the lines that need a position: errors)."""
 
-    def __init__(self):
+    def __init__(self) -> None:
         self.lines: list[str] = []
         self._parts: list[tuple[int, int, list[str], list[int] | None]] = []
 
@@ -84,7 +85,7 @@ def sections_of(text: str, filename: str) -> dict[str, SectionText]:
     return sections
 
 
-def _header_lines(text: str):
+def _header_lines(text: str) -> Iterator[tuple[int, int]]:
     """(start, end) of each line whose first non-blank character is '[' (formulas have no '[')."""
     at = text.find('[')
     while at != -1:

@@ -13,7 +13,7 @@ from respec.errors import quoted
 from respec.ltl import FALSE, TRUE, Formula, Var, conj, disj, neg, next_
 from respec.nesting import MAX_FORMULA_NESTING, too_deep
 from respec.parsing.errors import ParseError
-from respec.parsing.integers import COMPARATORS, compare
+from respec.parsing.integers import COMPARATORS, Term, compare
 from respec.parsing.operators import BINDING, Binding, combine, shared_var
 from respec.parsing.scope import KEYWORDS, Scope, Source, error_kind, scope_problem
 
@@ -44,7 +44,8 @@ _INFIX_TOKEN = re.compile(
 
 
 def _infix_tokens(text: str, source: Source) -> list[_Token]:
-    tokens, line, line_start = [], 1, 0
+    tokens: list[_Token] = []
+    line, line_start = 1, 0
     append = tokens.append
     for match in _INFIX_TOKEN.finditer(text):
         kind = match.lastgroup
@@ -97,7 +98,7 @@ class InfixParser:
         self.position += 1
         return token
 
-    def error(self, problem: str, token: _Token, kind=ParseError) -> ParseError:
+    def error(self, problem: str, token: _Token, kind: type[ParseError] = ParseError) -> ParseError:
         text = token.text + ("'" if token.kind == 'primed' else '') if token.kind != 'end' else '<end>'
         return self.source.error(problem, text, token.line, token.column, kind)
 
@@ -193,14 +194,14 @@ class InfixParser:
         except ValueError as error:
             raise self.error(str(error), operator) from None
 
-    def sum(self, in_next: bool) -> list:
+    def sum(self, in_next: bool) -> list[Term]:
         terms = self.summand(in_next)
         while self.peek().kind == 'op' and self.peek().text == '+':
             self.take()
             terms = terms + self.summand(in_next)
         return terms
 
-    def summand(self, in_next: bool) -> list:
+    def summand(self, in_next: bool) -> list[Term]:
         token = self.take()
         if token.kind == 'number':
             return [int(token.text)]

@@ -10,10 +10,11 @@ from __future__ import annotations
 
 import itertools
 from dataclasses import dataclass
+from typing import Callable
 
 from respec.ltl import TRUE, Formula, conj, disj, neg, next_, var
 
-COMPARATORS = {
+COMPARATORS: dict[str, Callable[[int, int], bool]] = {
     '=': lambda a, b: a == b, '!=': lambda a, b: a != b, '<': lambda a, b: a < b,
     '<=': lambda a, b: a <= b, '>': lambda a, b: a > b, '>=': lambda a, b: a >= b,
 }
@@ -49,23 +50,27 @@ class IntegerVariable:
         return compare([(self, next_step)], '<=', [self.high])
 
 
-def compare(left: list, operator: str, right: list) -> Formula:
+#: A term of an integer comparison: a constant, or an integer variable now (False) or next (True).
+Term = int | tuple[IntegerVariable, bool]
+
+
+def compare(left: list[Term], operator: str, right: list[Term]) -> Formula:
     """Expand ``sum(left) <operator> sum(right)`` to a disjunction over the valuations of the
     integer variables involved (terms: ints, or (IntegerVariable, next_step) pairs)."""
-    unknowns = sorted({term for term in left + right if not isinstance(term, int)},
-                      key=lambda term: (term[0].name, term[1]))
+    unknowns: list[tuple[IntegerVariable, bool]] = sorted(
+        {term for term in left + right if not isinstance(term, int)}, key=lambda term: (term[0].name, term[1]))
     ranges = [range(variable.low, variable.high + 1) for variable, _ in unknowns]
     size = 1
-    for values in ranges:
-        size *= len(values)
+    for variable_values in ranges:
+        size *= len(variable_values)
     if size > _MAX_EXPANSION:
         raise ValueError(f'integer comparison over {size} valuations is too large to expand')
     holds = COMPARATORS[operator]
-    cases = []
+    cases: list[Formula] = []
     for values in itertools.product(*ranges):
         value_of = dict(zip(unknowns, values))
 
-        def total(terms):
+        def total(terms: list[Term]) -> int:
             return sum(term if isinstance(term, int) else value_of[term] for term in terms)
 
         if holds(total(left), total(right)):

@@ -15,6 +15,7 @@ from respec.parsing.scope import KEYWORDS, NAME, Scope, Source, error_kind, scop
 
 
 _PREFIX_TOKEN = re.compile(r'\S+')
+_Token = tuple[str, int, int]  # text, line, column
 
 
 class PrefixParser:
@@ -24,7 +25,7 @@ class PrefixParser:
     def __init__(self, text: str, scope: Scope, source: Source):
         self.source = source
         self.scope = scope
-        self.tokens = []
+        self.tokens: list[_Token] = []
         for line_number, line in enumerate(text.split('\n'), start=1):
             line = line.split('#', 1)[0]
             self.tokens += [(m.group(), line_number, m.start() + 1) for m in _PREFIX_TOKEN.finditer(line)]
@@ -40,17 +41,17 @@ class PrefixParser:
             raise self.error('stray token after the formula', self.tokens[self.position])
         return formula
 
-    def error(self, problem, token, kind=ParseError) -> ParseError:
+    def error(self, problem: str, token: _Token, kind: type[ParseError] = ParseError) -> ParseError:
         return self.source.error(problem, token[0], token[1], token[2], kind)
 
-    def take(self):
+    def take(self) -> _Token:
         if self.position == len(self.tokens):
             raise self.source.error('formula ends too early', '<end>', *self.end)
         token = self.tokens[self.position]
         self.position += 1
         return token
 
-    def number(self, after) -> int:
+    def number(self, after: _Token) -> int:
         token = self.take()
         if not token[0].isdigit():
             raise self.error(f"expected a number after {after[0]!r}", token)
@@ -66,7 +67,7 @@ class PrefixParser:
         finally:
             self.depth -= 1
 
-    def operation(self, token, memory: list[Formula] | None) -> Formula:
+    def operation(self, token: _Token, memory: list[Formula] | None) -> Formula:
         """The formula that starts with ``token``."""
         text = token[0]
         if text == '!':

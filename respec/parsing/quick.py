@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import re
 import string
+from typing import Any
 
 from respec.ltl import FALSE, TRUE, Formula, Var, conj, disj, neg, next_, var
 from respec.nesting import MAX_FORMULA_NESTING
@@ -40,7 +41,7 @@ _KIND = {
     **{mark: BINDING[operator] for operator, mark in _MARK_OF_OPERATOR.items()},
     '(': _OPEN, '!': _NOT, '~': _NOT, 'next': _NEXT, ')': _CLOSE, 'TRUE': _TRUE, 'FALSE': _FALSE,
 }
-_OPERATOR_OF_BINDING = {binding: operator for operator, binding in BINDING.items()}
+_OPERATOR_OF_BINDING: dict[int, str] = {binding: operator for operator, binding in BINDING.items()}
 # Runs of the operators binding this tightly or more (| and &) make one node, as in the grammar.
 _FOLDED = Binding.OR
 
@@ -63,7 +64,10 @@ def quick_infix(line: str, scope: Scope, variables: dict[str, Var] | None = None
         if operator in line:
             line = line.replace(operator, f' {operator} ')
     known, now, following = scope.names, scope.current, scope.next_step
-    operands, operators, counts = [], [], []
+    operands: list[Formula] = []
+    operators: list[int] = []  # Bindings and the marks below them
+    counts: list[int] = []  # the operands of each binary operator on the stack
+    operand: Formula
     push, push_operator = operands.append, operators.append
     kinds = _KIND
     in_next = False
@@ -136,7 +140,7 @@ def quick_infix(line: str, scope: Scope, variables: dict[str, Var] | None = None
     return operands[0]
 
 
-def _reduce(operands: list, operators: list, counts: list) -> None:
+def _reduce(operands: list[Formula], operators: list[int], counts: list[int]) -> None:
     """Replace the operands of the operator on top of the stack by its formula."""
     operator, count = _OPERATOR_OF_BINDING[operators.pop()], counts.pop()
     arguments = operands[-count:]
@@ -151,6 +155,8 @@ def _reduce(operands: list, operators: list, counts: list) -> None:
 
 # --- slugsin: right to left -------------------------------------------------------------
 
+# A run of & or | read right to left: [operator, operands last first].
+_Run = list[Any]
 _PREFIX_KIND = {token: token for token in ('!', '&', '|', '^', '1', '0')}
 
 
@@ -168,7 +174,9 @@ def quick_prefix(line: str, scope: Scope, variables: dict[str, Var]) -> Formula 
         # Memory buffers, or a line long enough to be nested too deeply: read left to right,
         # which resolves recalls and counts the nesting levels as the grammar does.
         return _quick_prefix_left_to_right(line, now, following, variables)
-    operands = []
+    # Formulas and runs; told apart by their class, which is faster than isinstance (and
+    # which mypy does not narrow by).
+    operands: list[Any] = []
     push, pop = operands.append, operands.pop
     for token in reversed(line.split()):
         kind = _PREFIX_KIND.get(token)
@@ -205,10 +213,10 @@ def quick_prefix(line: str, scope: Scope, variables: dict[str, Var]) -> Formula 
     return _finished(operands[0]) if len(operands) == 1 else None
 
 
-def _finished(operand):
+def _finished(operand: Formula | _Run) -> Formula:
     """A formula, from a formula or a run: [operator, operands last first] (quick_prefix)."""
     if operand.__class__ is not list:
-        return operand
+        return operand  # type: ignore[return-value]  # a formula: mypy narrows by isinstance, not __class__
     return conj(operand[:0:-1]) if operand[0] == '&' else disj(operand[:0:-1])
 
 
@@ -217,14 +225,14 @@ _BUFFER, _RECALL, _ONE, _ZERO = 0, -1, -2, -3
 _LEFT_TO_RIGHT_KIND = {'!': 1, '&': 2, '|': 2, '^': 2, '$': _BUFFER, '?': _RECALL, '1': _ONE, '0': _ZERO}
 
 
-def _quick_prefix_left_to_right(line: str, now, following, variables: dict[str, Var]) -> Formula | None:
+def _quick_prefix_left_to_right(line: str, now: frozenset[str], following: frozenset[str], variables: dict[str, Var]) -> Formula | None:
     """A slugsin line, with memory buffers ``$ n f0 ... fn-1`` and recalls ``? i``, read left
     to right with a stack of open operators, each ``[operator, operands wanted, operands]``.
     A recall reads the innermost open buffer, as the grammar's ``memory``; the operators
     open at once are the grammar's nesting levels; a run ``& a & b c`` is one node, as the
     grammar gathers it. Anything unexpected is left to the grammar (None)."""
     tokens = iter(line.split())
-    open_operators = []
+    open_operators: list[list[Any]] = []  # each [operator, operands wanted, operands]
     push, pop = open_operators.append, open_operators.pop
     kinds = _LEFT_TO_RIGHT_KIND
     for token in tokens:
@@ -280,7 +288,7 @@ def _count(token: str) -> int | None:
     return int(token) if token.isascii() and token.isdigit() else None
 
 
-def _applied(operator: str, operands: list) -> Formula:
+def _applied(operator: str, operands: list[Formula]) -> Formula:
     if operator == '$':
         return operands[-1]  # a buffer's value is its last element
     if operator == '!':

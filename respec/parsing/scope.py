@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 
 from respec.errors import quoted
 from respec.parsing.errors import ParseError, UnknownVariableError
+from respec.parsing.integers import IntegerVariable
 from respec.spec import SLUGS_HEADERS
 
 NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_.@]*")
@@ -27,7 +28,8 @@ class Source:
     line: int = 1
     column: int = 1
 
-    def error(self, problem: str, token: str, line: int, column: int, kind=ParseError):
+    def error(self, problem: str, token: str, line: int, column: int,
+              kind: type[ParseError] = ParseError) -> ParseError:
         # Positions inside the text are relative to its first character.
         absolute_column = column + self.column - 1 if line == 1 else column
         return kind(problem, token, self.filename, self.line + line - 1, absolute_column)
@@ -38,13 +40,13 @@ class Scope:
     """Which propositions a formula may use, and which of them in the next step."""
 
     names: frozenset[str] | None        # None: any name (parse_formula without declarations)
-    current: frozenset[str] | None
-    next_step: frozenset[str] | None
+    current: frozenset[str]             # read only when names is set
+    next_step: frozenset[str]
     section: str = ''
-    integers: dict = field(default_factory=dict)   # name -> IntegerVariable (structured slugs)
+    integers: dict[str, IntegerVariable] = field(default_factory=dict)   # structured slugs' integers by name
 
 
-ANY = Scope(None, None, None)
+ANY = Scope(None, frozenset(), frozenset())
 
 
 def scope_problem(scope: Scope, name: str, next_step: bool) -> str:
@@ -66,12 +68,13 @@ def error_kind(problem: str) -> type[ParseError]:
     return UnknownVariableError if problem.startswith('unknown') else ParseError
 
 
-def section_scopes(env_props: list[str], sys_props: list[str], integers=None) -> dict[str, Scope]:
+def section_scopes(env_props: list[str], sys_props: list[str],
+                   integers: dict[str, IntegerVariable] | None = None) -> dict[str, Scope]:
     """slugs' rules for which variables each formula section may read (synthesisContextBasics.cpp)."""
     inputs, outputs = frozenset(env_props), frozenset(env_props) | frozenset(sys_props)
-    nothing = frozenset()
+    nothing: frozenset[str] = frozenset()
 
-    def scope(section, current, next_step):
+    def scope(section: str, current: frozenset[str], next_step: frozenset[str]) -> Scope:
         return Scope(outputs, current, next_step, f'[{SLUGS_HEADERS[section]}]', integers or {})
 
     return {

@@ -16,6 +16,7 @@ import re
 import string
 from collections import deque
 from operator import add
+from typing import Any, Callable, Literal, cast
 
 from respec.ltl import FALSE, FIELD_SETTERS, TRUE, And, Const, Formula, Iff, Implies, Next, Not, Or, Var, variables
 from respec.parsing.errors import ParseError
@@ -43,14 +44,20 @@ _OUTLINE_WORD = re.compile(f'[{_PLACEHOLDER}{_DIGIT_MARK}{_DOT_MARK}]+')
 _OUTLINE_NON_NAME = re.compile(f'(?<![{_PLACEHOLDER}{_DIGIT_MARK}{_DOT_MARK}])[{_DIGIT_MARK}{_DOT_MARK}]')
 _MAX_SHAPE_PLACEHOLDERS = 64
 _MAX_SHAPE_NESTING = 32
-_SHAPES: dict[str, dict[str, object]] = {}  # syntax -> shape -> compiled (or False)
+# build(columns, n, leaves): the formulas of n lines of a shape (see _compile_shape).
+_Build = Callable[[list[list[str]], int, 'LeafNodes'], list[Formula]]
+# (build, read_now, read_next), or False for a shape the grammar handles.
+_CompiledShape = tuple[_Build, tuple[int, ...], tuple[int, ...]] | Literal[False]
+# (names, starts, lines_of_shape): see _shapes_by_translation.
+_Shapes = tuple[list[str], list[int], dict[str, list[int]]]
+_SHAPES: dict[str, dict[str, _CompiledShape]] = {}  # syntax -> shape -> compiled (or False)
 _MAX_SHAPES = 1 << 14
 _LINES_WORTH_COMPILING = 8     # lines sharing a shape before it is compiled
 _LINES_WORTH_GROUPING = 1000   # sections this large may be left whole to the line readers
 
 
 def parse_section_by_shapes(lines: list[str], syntax: str, scope: Scope, leaves: LeafNodes,
-                            check=None) -> list:
+                            check: Callable[[], object] | None = None) -> list[Formula | None]:
     """The formula of each line, or None where the grammar must handle the line.
 
     The shapes and propositions of all lines are found at once (a few passes of str.translate
@@ -70,7 +77,7 @@ def parse_section_by_shapes(lines: list[str], syntax: str, scope: Scope, leaves:
     check_now = scope.names is not None and not scope.current.issuperset(names)
     check_next = scope.names is not None and not scope.next_step.issuperset(names)
     compiled_shapes = _SHAPES.setdefault(syntax, {})
-    formulas = [None] * len(lines)
+    formulas: list[Formula | None] = [None] * len(lines)
     for shape, indices in lines_of_shape.items():
         compiled = compiled_shapes.get(shape)
         if compiled is None:
@@ -98,7 +105,7 @@ def parse_section_by_shapes(lines: list[str], syntax: str, scope: Scope, leaves:
     return formulas
 
 
-def _shapes_by_translation(marked: str):
+def _shapes_by_translation(marked: str) -> _Shapes | None:
     """(names, starts, lines_of_shape): every proposition in order, where each line's
     propositions start in it, and the lines of each shape. Found with str.translate (faster
     than a regular expression); None when the text needs the expression
@@ -114,7 +121,8 @@ def _shapes_by_translation(marked: str):
     lines_of_outline = _positions(outline_of_line)
     if _mostly_unlike(lines_of_outline, len(outline_of_line)):
         return [], [], {}
-    word_counts, lines_of_shape = {}, {}
+    word_counts: dict[str, int] = {}
+    lines_of_shape: dict[str, list[int]] = {}
     for outline, indices in lines_of_outline.items():
         if _OUTLINE_NON_NAME.search(outline):
             return None
@@ -124,7 +132,7 @@ def _shapes_by_translation(marked: str):
     return names, list(itertools.accumulate(map(word_counts.__getitem__, outline_of_line), initial=0)), lines_of_shape
 
 
-def _shapes_by_expression(marked: str):
+def _shapes_by_expression(marked: str) -> _Shapes:
     """What _shapes_by_translation finds, for any text."""
     parts = _WORD.split(marked)
     names = parts[1::2]
@@ -141,7 +149,7 @@ def _shapes_by_expression(marked: str):
     return names, starts, lines_of_shape
 
 
-def _mostly_unlike(groups: dict, lines: int) -> bool:
+def _mostly_unlike(groups: dict[str, list[int]], lines: int) -> bool:
     """Whether a large section's lines fall into more groups than half their number."""
     return lines >= _LINES_WORTH_GROUPING and 2 * len(groups) > lines
 
@@ -163,14 +171,14 @@ def _columns(names: list[str], line_starts: list[int], count: int) -> list[list[
     return [list(map(names.__getitem__, map(add, line_starts, itertools.repeat(offset)))) for offset in range(count)]
 
 
-def _within(scope: Scope, columns: list[list[str]], read_now: tuple, read_next: tuple) -> bool:
+def _within(scope: Scope, columns: list[list[str]], read_now: tuple[int, ...], read_next: tuple[int, ...]) -> bool:
     """Whether lines read only what the section allows (``read_now``, ``read_next``: the
     columns read in the current and in the next step)."""
     return (scope.current.issuperset(itertools.chain.from_iterable(columns[i] for i in read_now))
             and scope.next_step.issuperset(itertools.chain.from_iterable(columns[i] for i in read_next)))
 
 
-def _compiled_shape(compiled_shapes: dict, shape: str, syntax: str, count: int):
+def _compiled_shape(compiled_shapes: dict[str, _CompiledShape], shape: str, syntax: str, count: int) -> _CompiledShape:
     """A shape's compiled form (see _compile_shape), kept; False for unusual lines (very long
     or deeply nested), which the grammar handles."""
     if count > _MAX_SHAPE_PLACEHOLDERS or shape.count('(') > _MAX_SHAPE_NESTING:
@@ -181,7 +189,7 @@ def _compiled_shape(compiled_shapes: dict, shape: str, syntax: str, count: int):
     return compiled
 
 
-def _compile_shape(shape: str, syntax: str, count: int):
+def _compile_shape(shape: str, syntax: str, count: int) -> _CompiledShape:
     """(build, read_now, read_next), or False when the shape is not a formula (the grammar then
     reports the line's error). ``build(columns, n)`` makes the formulas of n lines of the shape,
     where ``columns[i]`` holds each line's i-th proposition; ``read_now`` / ``read_next`` are the
@@ -197,22 +205,24 @@ def _compile_shape(shape: str, syntax: str, count: int):
     if variables(template) != {f'_{index}' for index in range(count)}:
         return False  # folded away (e.g. '& 0 a'): the grammar still checks the proposition
     in_next = [False] * count
-    namespace = dict(_BUILDER_NAMES)
+    namespace: dict[str, Any] = dict(_BUILDER_NAMES)
     exec(_builder_source(template, in_next), namespace)  # noqa: S102 -- our own generated code
     return (namespace['build'], tuple(i for i in range(count) if not in_next[i]),
             tuple(i for i in range(count) if in_next[i]))
 
 
-_consume = deque(maxlen=0).extend  # runs an iterator to its end
+_EMPTY: deque[object] = deque(maxlen=0)
+_consume = _EMPTY.extend  # runs an iterator to its end
 
 
 class LeafNodes:
     """The leaf nodes of one file's compiled lines: one node per proposition for each of a,
     !a, next(a), next(!a) and !next(a), made a column at a time."""
 
-    def __init__(self):
+    def __init__(self) -> None:
         self._made: dict[str, dict[str, Formula]] = {factory: {} for factory in _LEAF_PARTS}
-        self.variables: dict[str, Var] = self._made['Var']  # name -> its Var node
+        # name -> its Var node (the 'Var' factory makes Vars)
+        self.variables: dict[str, Var] = cast('dict[str, Var]', self._made['Var'])
 
     def __call__(self, factory: str, names: list[str]) -> list[Formula]:
         """The ``factory`` leaf ('Var', 'NotVar', ...) of each of ``names``."""
@@ -223,7 +233,7 @@ class LeafNodes:
             pass
         missing = list(set(names).difference(made))
         kind, inner = _LEAF_PARTS[factory]
-        nodes = list(map(object.__new__, itertools.repeat(kind, len(missing))))
+        nodes: list[Formula] = list(map(object.__new__, itertools.repeat(kind, len(missing))))
         if inner is None:
             _consume(map(FIELD_SETTERS[Var]['name'], nodes, missing))
         else:
@@ -233,7 +243,7 @@ class LeafNodes:
 
 
 # Each leaf factory: the node's class, and the leaf factory of its argument.
-_LEAF_PARTS = {'Var': (Var, None), 'NotVar': (Not, 'Var'), 'NextVar': (Next, 'Var'),
+_LEAF_PARTS: dict[str, tuple[type[Var] | type[Not] | type[Next], str | None]] = {'Var': (Var, None), 'NotVar': (Not, 'Var'), 'NextVar': (Next, 'Var'),
                'NextNotVar': (Next, 'NotVar'), 'NotNextVar': (Not, 'NextVar')}
 
 
@@ -265,12 +275,12 @@ def _leaf(formula: Formula) -> tuple[str, Var] | None:
     return None
 
 
-def _builder_source(template: Formula, in_next: list) -> str:
+def _builder_source(template: Formula, in_next: list[bool]) -> str:
     """Python source of ``build(columns, n, leaves)``: ``template`` for n lines, its placeholder
     ``_i`` replaced by the propositions of ``columns[i]`` (their leaf nodes from ``leaves``, a
     LeafNodes), one node column (a list over the lines) at a time (``in_next[i]`` is set if
     ``_i`` is read in the next step)."""
-    statements = []
+    statements: list[str] = []
 
     def column(formula: Formula, under_next: bool) -> str:
         """The name of a list holding ``formula``'s node for each line, after the statements making it."""
@@ -288,6 +298,7 @@ def _builder_source(template: Formula, in_next: list) -> str:
         elif isinstance(formula, (And, Or)):
             fields = {'args': 'zip(' + ', '.join(column(arg, under_next) for arg in formula.args) + ')'}
         else:
+            assert isinstance(formula, (Implies, Iff))  # the other kinds are handled above
             fields = {'left': column(formula.left, under_next), 'right': column(formula.right, under_next)}
         nodes = new_column(f'list(map(new, repeat({kind}, n)))')
         statements.extend(f'consume(map({kind}_{field}, {nodes}, {values}))' for field, values in fields.items())

@@ -10,10 +10,11 @@ from __future__ import annotations
 import gc
 import re
 from contextlib import contextmanager
+from typing import Callable, Iterator, cast
 
 from respec.ltl import TRUE, Formula, variables
 from respec.parsing.errors import ParseError, UnknownVariableError
-from respec.parsing.files import sections_of
+from respec.parsing.files import SectionText, sections_of
 from respec.parsing.grammar import parse_in_scope
 from respec.parsing.integers import IntegerVariable
 from respec.parsing.quick import quick_infix, quick_prefix
@@ -24,7 +25,8 @@ from respec.spec import FORMULA_SECTIONS, PROPOSITION_SECTIONS, GR1Specification
 _INTEGER_DECLARATION = re.compile(r"^([A-Za-z_][A-Za-z0-9_]*)\s*:\s*(-?[0-9]+)\s*\.\.\.\s*(-?[0-9]+)$")
 
 
-def parse_structuredslugs(text: str, filename: str = '<string>', check=None) -> GR1Specification:
+def parse_structuredslugs(text: str, filename: str = '<string>',
+                          check: Callable[[], object] | None = None) -> GR1Specification:
     """Parse a ``.structuredslugs`` file: one infix conjunct per non-empty line.
 
     Like slugs' structured compiler, a line that is not infix but is a valid slugsin prefix
@@ -34,7 +36,8 @@ def parse_structuredslugs(text: str, filename: str = '<string>', check=None) -> 
     return _parse_slugs_file(text, filename, 'infix', check)
 
 
-def parse_slugsin(text: str, filename: str = '<string>', check=None) -> GR1Specification:
+def parse_slugsin(text: str, filename: str = '<string>',
+                  check: Callable[[], object] | None = None) -> GR1Specification:
     """Parse a ``.slugsin`` file: one prefix conjunct per non-empty line (``check``: as above)."""
     return _parse_slugs_file(text, filename, 'prefix', check)
 
@@ -59,7 +62,7 @@ def spec_from_text_sections(sections: dict[str, list[str]]) -> GR1Specification:
                 raise ParseError('expected a string', repr(entry), f'{key}[{index}]')
 
     seen: set[str] = set()
-    declared = {}
+    declared: dict[str, list[str]] = {}
     for section in PROPOSITION_SECTIONS:
         declared[section] = []
         for index, name in enumerate(sections.get(section, [])):
@@ -72,10 +75,11 @@ def spec_from_text_sections(sections: dict[str, list[str]]) -> GR1Specification:
         section: [parse_in_scope(text, 'infix', scopes[section], Source(f'{section}[{index}]'))
                   for index, text in enumerate(sections.get(section, []))]
         for section in FORMULA_SECTIONS}
-    return GR1Specification(**declared, **formulas)
+    return GR1Specification(env_props=declared['env_props'], sys_props=declared['sys_props'], **formulas)
 
 
-def _parse_slugs_file(text: str, filename: str, syntax: str, check=None) -> GR1Specification:
+def _parse_slugs_file(text: str, filename: str, syntax: str,
+                      check: Callable[[], object] | None = None) -> GR1Specification:
     sections = sections_of(text, filename)
     declared: dict[str, list[str]] = {}
     integers: dict[str, IntegerVariable] = {}
@@ -101,13 +105,13 @@ def _parse_slugs_file(text: str, filename: str, syntax: str, check=None) -> GR1S
             seen.update(names)
 
     scopes = section_scopes(declared['env_props'], declared['sys_props'], integers)
-    formulas = {}
+    formulas: dict[str, list[Formula]] = {}
     leaves = LeafNodes()
     quick = quick_infix if syntax == 'infix' else quick_prefix
     with _collector_paused():
         for section in FORMULA_SECTIONS:
             scope, lines = scopes[section], sections[section].lines
-            parsed = parse_section_by_shapes(lines, syntax, scope, leaves, check) \
+            parsed: list[Formula | None] = parse_section_by_shapes(lines, syntax, scope, leaves, check) \
                 if not scope.integers else [None] * len(lines)
             for index, formula in enumerate(parsed):
                 if check is not None and index % LINES_BETWEEN_CHECKS == 0:
@@ -116,7 +120,7 @@ def _parse_slugs_file(text: str, filename: str, syntax: str, check=None) -> GR1S
                     formula = parsed[index] = quick(lines[index], scope, leaves.variables)
                 if formula is None:
                     parsed[index] = _parse_line(lines[index], syntax, scope, sections[section].source(index, filename))
-            formulas[section] = parsed
+            formulas[section] = cast('list[Formula]', parsed)  # each None was replaced by a formula
     _check_declared_before_use(sections, formulas, integers, filename)
     # Like slugs' compiler, keep integers in range: initially and after every step.
     for variable in integers.values():
@@ -125,13 +129,14 @@ def _parse_slugs_file(text: str, filename: str, syntax: str, check=None) -> GR1S
             limit = variable.in_range(next_step)
             if limit != TRUE:
                 formulas[section].append(limit)
-    return GR1Specification(**declared, **formulas)
+    return GR1Specification(env_props=declared['env_props'], sys_props=declared['sys_props'], **formulas)
 
 
-def _check_declared_before_use(sections, formulas, integers, filename: str) -> None:
+def _check_declared_before_use(sections: dict[str, SectionText], formulas: dict[str, list[Formula]],
+                               integers: dict[str, IntegerVariable], filename: str) -> None:
     """slugs reads a file top to bottom: a formula may use only variables declared above it.
     Only files with a formula section above a declaration section need the (slower) look."""
-    def lines_of(section):  # the file line of each of the section's lines
+    def lines_of(section: str) -> list[int]:  # the file line of each of the section's lines
         return [sections[section].source(index, filename).line
                 for index in range(len(sections[section].lines))]
     last_declaration = max((first for section in PROPOSITION_SECTIONS
@@ -139,7 +144,7 @@ def _check_declared_before_use(sections, formulas, integers, filename: str) -> N
     if not any(first < last_declaration for section in FORMULA_SECTIONS
                for first in sections[section].first_lines()):
         return
-    declared_at = {}
+    declared_at: dict[str, int] = {}
     bit_owner = {bit: variable.name for variable in integers.values() for bit in variable.bits}
     for section in PROPOSITION_SECTIONS:
         for name, line in zip(sections[section].lines, lines_of(section)):
@@ -156,7 +161,7 @@ def _check_declared_before_use(sections, formulas, integers, filename: str) -> N
                         f'(line {declared_at[name]})', name, 1, 1)
 
 
-def _integer_variable(declaration: re.Match, seen: set[str], source: Source) -> IntegerVariable:
+def _integer_variable(declaration: re.Match[str], seen: set[str], source: Source) -> IntegerVariable:
     name, low, high = declaration.group(1), int(declaration.group(2)), int(declaration.group(3))
     if low > high:
         raise source.error(f'empty integer range {low}...{high}', name, 1, 1)
@@ -168,7 +173,7 @@ def _integer_variable(declaration: re.Match, seen: set[str], source: Source) -> 
 
 
 @contextmanager
-def _collector_paused():
+def _collector_paused() -> Iterator[None]:
     """Python's cyclic garbage collector off while a file's formula trees are built: trees
     have no cycles, and its passes over millions of new nodes are slow (docs/parsing.md)."""
     was_enabled = gc.isenabled()

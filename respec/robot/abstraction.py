@@ -21,6 +21,7 @@ order in which propositions appear in compiled specifications.
 from __future__ import annotations
 
 import re
+from typing import Mapping
 from dataclasses import dataclass, field
 
 from respec.errors import ErrorCode
@@ -115,7 +116,7 @@ class RobotAbstraction:
         return found
 
 
-def abstraction_from_document(document: dict, system: str) -> RobotAbstraction:
+def abstraction_from_document(document: Mapping[str, object], system: str) -> RobotAbstraction:
     """The validated ``abstraction:`` section of a whole (parsed) system file."""
     if 'abstraction' not in document:
         raise AbstractionConfigError(f'{system}.yaml has no abstraction: section', item='abstraction')
@@ -246,7 +247,9 @@ def _reject_proposition_clashes(abstraction: RobotAbstraction, where: str) -> No
     for outcome in DEFAULT_SM_OUTCOMES:
         claim(outcome, 'the state-machine outcomes')
     for item in abstraction.items():
-        owner = f'{abstraction.kind_of(item).replace("_", " ")} {item!r}'
+        kind = abstraction.kind_of(item)
+        assert kind is not None  # one of its own items
+        owner = f'{kind.replace("_", " ")} {item!r}'
         claim(activation(item), owner)
         claim(memory(item), owner)
         for outcome in abstraction.outcomes:

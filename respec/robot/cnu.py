@@ -49,7 +49,7 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass, field, replace
-from typing import Callable
+from typing import Any, Callable, Mapping
 
 from respec.untrusted import BoundedYamlError, load_bounded_yaml
 from respec.errors import ErrorCode
@@ -86,7 +86,7 @@ _SPEC_SECTIONS = ('INPUT', 'OUTPUT', *_FORMULA_SECTIONS)
 # CNU's files may spell a memory proposition with their suffix; ours is added by respec.naming.
 CNU_MEMORY_SUFFIX = '_m'
 # YAML reads `true`/`false` keys as booleans; CNU's mappings quote them, but be lenient.
-_YAML_WORDS = {True: 'true', False: 'false'}
+_YAML_WORDS: dict[object, str] = {True: 'true', False: 'false'}
 
 
 class CapabilityConfigError(SystemConfigError):
@@ -116,7 +116,7 @@ Clause = tuple[Literal, ...]   # a disjunction
 class Capability:
     name: str
     interface: str
-    parameters: dict
+    parameters: dict[str, object]
     preconditions: tuple[Clause, ...]
     postconditions: dict[str, tuple[Literal, ...]]          # transition outcome -> literals
     transition_relation: dict[str, tuple[Clause, ...]]      # transition outcome -> clauses of targets
@@ -198,12 +198,12 @@ class CapabilitySystem:
         return self.state_outcomes[key]
 
 
-def is_capability_document(document: dict) -> bool:
+def is_capability_document(document: object) -> bool:
     """Whether a parsed system file points at CNU capability files (or a given machine)."""
     return isinstance(document, dict) and (CAPABILITIES_KEY in document or STATE_MACHINE_KEY in document)
 
 
-def load_capability_system(document: dict, system: str, read: Callable[[str], str]) -> CapabilitySystem:
+def load_capability_system(document: Mapping[str, object], system: str, read: Callable[[str], str]) -> CapabilitySystem:
     """The capability system a system file (``document``) points at; ``read`` gives the text of a
     file named relative to the system file (raising OSError when it cannot)."""
     for key in document:
@@ -221,7 +221,7 @@ def load_capability_system(document: dict, system: str, read: Callable[[str], st
     capabilities = _read_yaml(document, CAPABILITIES_KEY, read, system, required=machine is None)
     spec = _read_yaml(document, SPEC_KEY, read, system) or {}
     mappings = _read_yaml(document, MAPPINGS_KEY, read, system)
-    initial = ()
+    initial: tuple[str, ...] = ()
     if machine is not None:
         if capabilities is not None and not isinstance(capabilities, dict):
             raise CapabilityConfigError(f'{system}: the capabilities file must hold a mapping', item=CAPABILITIES_KEY)
@@ -236,7 +236,7 @@ def load_capability_system(document: dict, system: str, read: Callable[[str], st
     return result
 
 
-def capabilities_of_state_machine(machine: object, system: str) -> tuple[dict, tuple[str, ...]]:
+def capabilities_of_state_machine(machine: object, system: str) -> tuple[dict[str, dict[str, object]], tuple[str, ...]]:
     """A machine in CNU's ``sm/`` format as capability entries, and the initial condition that
     starts its initial state. Parameters are Python source text already: ``*`` keeps them verbatim
     (``sm_generation.capabilities.parameter_source``)."""
@@ -245,7 +245,7 @@ def capabilities_of_state_machine(machine: object, system: str) -> tuple[dict, t
             or not isinstance(machine.get('states'), list) or not machine['states']:
         raise CapabilityConfigError(f'{where} must hold sm (outcomes, initial_state) and a list of states',
                                     item=STATE_MACHINE_KEY)
-    capabilities = {}
+    capabilities: dict[str, dict[str, object]] = {}
     for index, state in enumerate(machine['states']):
         name = state.get('name') if isinstance(state, dict) else None
         item = f'states.{name if isinstance(name, str) else index}'
@@ -325,7 +325,8 @@ def capability_system_from_dicts(capabilities: object, spec: object = None, mapp
 
 # --- files ----------------------------------------------------------------------------------
 
-def _read_yaml(document: dict, key: str, read: Callable[[str], str], system: str, required: bool = False):
+def _read_yaml(document: Mapping[str, object], key: str, read: Callable[[str], str], system: str,
+               required: bool = False) -> object:
     value = document.get(key)
     if value is None:
         if required:
@@ -346,7 +347,7 @@ def _read_yaml(document: dict, key: str, read: Callable[[str], str], system: str
         raise CapabilityConfigError(f'{system}.yaml: {key} {value!r}: {error}', item=key) from None
 
 
-def _mappings(mappings, system: str):
+def _mappings(mappings: object, system: str) -> tuple[dict[str, str], dict[str, str], tuple[str, ...]]:
     if mappings is None:
         return dict(DEFAULT_STATE_OUTCOMES), dict(CNU_SM_OUTCOMES), DEFAULT_TRANSITION_OUTCOMES
     if not isinstance(mappings, dict):
@@ -360,7 +361,7 @@ def _mappings(mappings, system: str):
     if len(set(letters)) != len(letters) or 'a' in letters or 'm' in letters:
         raise CapabilityConfigError(f'{system}: transition_outcomes need distinct first letters other than '
                                     f'a and m (the activation and memory suffixes)', item='transition_outcomes')
-    result = []
+    result: list[dict[str, str]] = []
     for key in ('state_outcome_mappings', 'sm_outcome_mappings'):
         value = mappings.get(key) or {}
         if not isinstance(value, dict) or not all(isinstance(v, str) and v for v in value.values()):
@@ -369,11 +370,11 @@ def _mappings(mappings, system: str):
     return result[0], result[1], tuple(transition_outcomes)
 
 
-def _word(key) -> str:
+def _word(key: object) -> str:
     return _YAML_WORDS.get(key, str(key)) if isinstance(key, bool) else str(key)
 
 
-def _mapping(raw, system: str, key: str) -> dict:
+def _mapping(raw: object, system: str, key: str) -> dict[Any, Any]:
     """The mapping under ``key`` (empty when absent); anything else names the key."""
     if raw is None:
         return {}
@@ -382,9 +383,9 @@ def _mapping(raw, system: str, key: str) -> dict:
     return raw
 
 
-def _integers(raw, system: str) -> dict[str, IntegerRange]:
+def _integers(raw: object, system: str) -> dict[str, IntegerRange]:
     raw = _mapping(raw, system, 'variable_mappings')
-    integers = {}
+    integers: dict[str, IntegerRange] = {}
     for side, environment in (('env_props', True), ('sys_props', False)):
         variables = _mapping(raw.get(side), system, f'variable_mappings.{side}')
         for name, values in variables.items():
@@ -403,7 +404,8 @@ def _integers(raw, system: str) -> dict[str, IntegerRange]:
     return integers
 
 
-def _spec(spec, system: str, integers: dict[str, IntegerRange]):
+def _spec(spec: object, system: str, integers: dict[str, IntegerRange]
+          ) -> tuple[tuple[str, ...], tuple[str, ...], tuple[str, ...], tuple[tuple[str, str], ...]]:
     """The spec file's propositions, its initial values (text) and its formulas (section, text)."""
     if not spec:
         return (), (), (), ()
@@ -412,7 +414,10 @@ def _spec(spec, system: str, integers: dict[str, IntegerRange]):
     sections = spec.get('specs') or {}
     if not isinstance(sections, dict):
         raise CapabilityConfigError(f'{system}: specs must map slugs sections to lists', item='specs')
-    inputs, outputs, initial, formulas = [], [], [], []
+    inputs: list[str] = []
+    outputs: list[str] = []
+    initial: list[str] = []
+    formulas: list[tuple[str, str]] = []  # (section, text)
     for section, entries in sections.items():
         where = f'specs.{section}'
         if section not in _SPEC_SECTIONS:
@@ -446,9 +451,9 @@ def _spec(spec, system: str, integers: dict[str, IntegerRange]):
     return tuple(inputs), tuple(outputs), tuple(initial), tuple(formulas)
 
 
-def _memory(raw, system: str) -> dict[str, bool]:
+def _memory(raw: object, system: str) -> dict[str, bool]:
     raw = _mapping(raw, system, 'memory')
-    memory = {}
+    memory: dict[str, bool] = {}
     for side, names in raw.items():
         if side != 'sys_props' or not isinstance(names, dict):
             raise CapabilityConfigError(f'{system}: memory may only hold sys_props: name -> initial value',
@@ -464,7 +469,8 @@ def _memory(raw, system: str) -> dict[str, bool]:
 
 # --- capabilities ---------------------------------------------------------------------------
 
-def _capability(name: str, entry, system: str, transition_outcomes, state_outcomes, integers, names):
+def _capability(name: str, entry: object, system: str, transition_outcomes: tuple[str, ...],
+                state_outcomes: dict[str, str], integers: dict[str, IntegerRange], names: set[str]) -> Capability:
     where = f'{system}: capability {name!r}'
     if not isinstance(entry, dict):
         raise CapabilityConfigError(f'{where} must be a mapping', item=name)
@@ -488,7 +494,7 @@ def _capability(name: str, entry, system: str, transition_outcomes, state_outcom
     if declared and (not isinstance(declared, list) or not all(isinstance(o, str) for o in declared)):
         raise CapabilityConfigError(f'{where}: outcomes must list FlexBE outcome names', item=f'{name}.outcomes')
 
-    def outcome_key(key, what: str) -> str:
+    def outcome_key(key: object, what: str) -> str:
         key = _word(key)
         if key in transition_outcomes:
             return key
@@ -498,7 +504,7 @@ def _capability(name: str, entry, system: str, transition_outcomes, state_outcom
                                     f'({", ".join(transition_outcomes)}) nor a mapped FlexBE outcome',
                                     item=f'{name}.{what}.{key}')
 
-    def literal(text, key: str, allow_choice: bool) -> Literal:
+    def literal(text: str, key: str, allow_choice: bool) -> Literal:
         return parse_literal(text, f'{name}.{key}', where, integers, allow_choice)
 
     preconditions = tuple(tuple(literal(term, 'preconditions', False) for term in _terms(clause, name, 'preconditions'))
@@ -506,7 +512,7 @@ def _capability(name: str, entry, system: str, transition_outcomes, state_outcom
     postconditions: dict[str, tuple[Literal, ...]] = {}
     for key, items in _by_outcome(entry.get('postconditions'), name, 'postconditions').items():
         outcome = outcome_key(key, 'postconditions')
-        literals = []
+        literals: list[Literal] = []
         for item in _list(items, name, f'postconditions.{key}'):
             if '|' in str(item):
                 raise CapabilityConfigError(f'{where}: postcondition {item!r} is a disjunction; postconditions '
@@ -521,7 +527,7 @@ def _capability(name: str, entry, system: str, transition_outcomes, state_outcom
                         for item in _list(items, name, f'transition_relation.{key}')
                         for term in _terms(item, name, 'transition_relation'))
         relation[outcome] = relation.get(outcome, ()) + (targets,)
-    autonomy = {}
+    autonomy: dict[str, int] = {}
     raw_autonomy = entry.get('autonomy') or {}
     if not isinstance(raw_autonomy, dict):
         raise CapabilityConfigError(f'{where}: autonomy must map FlexBE outcomes to levels 0..3', item=f'{name}.autonomy')
@@ -534,7 +540,7 @@ def _capability(name: str, entry, system: str, transition_outcomes, state_outcom
                       tuple(declared))
 
 
-def _list(value, name: str, key: str) -> list:
+def _list(value: object, name: str, key: str) -> list[str]:
     if value is None:
         return []
     if isinstance(value, str):
@@ -544,7 +550,7 @@ def _list(value, name: str, key: str) -> list:
     return [_word(v) for v in value]
 
 
-def _by_outcome(value, name: str, key: str) -> dict:
+def _by_outcome(value: object, name: str, key: str) -> dict[Any, Any]:
     """A per-outcome mapping; a plain list means the completion outcome (as CNU reads it)."""
     if value is None:
         return {}
@@ -564,7 +570,8 @@ def _terms(clause: str, name: str, key: str) -> list[str]:
     return terms
 
 
-def parse_literal(text: str, item: str, where: str, integers, allow_choice: bool) -> Literal:
+def parse_literal(text: str, item: str, where: str, integers: Mapping[str, IntegerRange],
+                  allow_choice: bool) -> Literal:
     """One condition term: ``[!]name``, ``name=value``, ``name!=value`` or (``allow_choice``) ``@name``."""
     text = str(text).strip()
     if text.startswith('@'):

@@ -27,7 +27,9 @@ from typing import Protocol
 class RobotDescription(Protocol):
     """A robot as one file format describes it (implemented by RobotAbstraction and CapabilitySystem)."""
 
-    system: str   # the robot system's name
+    @property
+    def system(self) -> str:
+        """The robot system's name (read-only: the implementations are frozen)."""
 
     @property
     def default_initial_conditions(self) -> list[str]:

@@ -17,7 +17,7 @@ import argparse
 import os
 import re
 from pathlib import Path
-from typing import Sequence, Union
+from typing import Any, Sequence, Union
 
 from respec.untrusted import BoundedFileError, BoundedYamlError, load_bounded_yaml, read_bounded_file
 from respec.errors import CodedError, ErrorCode, quoted
@@ -91,7 +91,7 @@ def _systems_on(search_path: Sequence[Path]) -> list[str]:
     return sorted({p.stem for directory in search_path for p in directory.glob('*.yaml') if _SYSTEM_NAME.match(p.stem)})
 
 
-def check_system_name(system) -> None:
+def check_system_name(system: object) -> None:
     """Raises SystemNotFoundError unless ``system`` can name a system file."""
     if not isinstance(system, str) or not _SYSTEM_NAME.match(system):
         raise SystemNotFoundError(f'invalid system name {quoted(system)}', item=str(system))
@@ -114,18 +114,20 @@ def system_file(system: str, search_path: Sequence[Path]) -> Path:
 class _AddConfigDir(argparse.Action):
     """Each ``--config-dir`` adds a directory; kept as one os.pathsep-joined string (a ROS parameter's type)."""
 
-    def __call__(self, parser, namespace, value, option_string=None):
+    def __call__(self, parser: argparse.ArgumentParser, namespace: argparse.Namespace,
+                 value: str | Sequence[Any] | None, option_string: str | None = None) -> None:
+        assert isinstance(value, str)  # one DIR per option (no nargs)
         setattr(namespace, self.dest, os.pathsep.join(filter(None, [getattr(namespace, self.dest, ''), value])))
 
 
-def add_config_dir_argument(parser) -> None:
+def add_config_dir_argument(parser: argparse.ArgumentParser) -> None:
     """The ``--config-dir DIR`` option every command shares (repeatable; see ``config_search_path``)."""
     parser.add_argument('--config-dir', action=_AddConfigDir, default='', metavar='DIR',
                         help='a directory of robot system files (<system>.yaml), searched before the shipped '
                              'config/; repeat it, or join directories with ' + repr(os.pathsep) + ', to add several')
 
 
-def parse_config_text(text: str, path: str | Path) -> dict:
+def parse_config_text(text: str, path: str | Path) -> dict[str, Any]:
     """The text of the system configuration file ``path`` as a dict (errors name the file, the
     line and the column, and refuse aliases and nesting deeper than MAX_CONFIG_DEPTH)."""
     document = load_config_yaml(text, path)
@@ -134,7 +136,7 @@ def parse_config_text(text: str, path: str | Path) -> dict:
     return document
 
 
-def load_config_yaml(text: str, path: str | Path):
+def load_config_yaml(text: str, path: str | Path) -> object:
     """The value of a robot file's YAML text, within the bounds (``respec.untrusted``);
     ConfigFileInvalidError naming the file, the line and the column."""
     try:

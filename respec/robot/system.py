@@ -26,7 +26,7 @@ from collections import OrderedDict
 from dataclasses import dataclass, field
 from pathlib import Path
 from types import MappingProxyType
-from typing import Callable, Mapping, Sequence, TypeVar
+from typing import Any, Callable, Mapping, Sequence, TypeVar
 
 import yaml
 
@@ -76,7 +76,7 @@ class RobotSystem:
         """The file as users know it, e.g. 'config/atlas.yaml'."""
         return f'{self.path.parent.name}/{self.path.name}'
 
-    def section(self, name: str) -> dict:
+    def section(self, name: str) -> dict[str, Any]:
         """One top-level section of the system file; raises ConfigFileInvalidError if missing."""
         content = self.sections.get(name)
         if not isinstance(content, Mapping):
@@ -142,6 +142,9 @@ def robot_system_from_files(name: str, files: Mapping[str, str], config_file: st
 
     return _robot_system(name, Path(config_file or f'config/{name}.yaml'), read)
 
+# A parsed system's key: its name, its file's path and text.
+_SystemKey = tuple[str, str, str]
+
 
 class _ParsedSystems:
     """Robot systems already parsed, by the texts of their files (least recently used dropped).
@@ -152,11 +155,11 @@ class _ParsedSystems:
 
     KEPT = 16
 
-    def __init__(self):
-        self._systems: OrderedDict[tuple, RobotSystem] = OrderedDict()
+    def __init__(self) -> None:
+        self._systems: OrderedDict[_SystemKey, RobotSystem] = OrderedDict()
         self._lock = threading.Lock()
 
-    def get(self, key: tuple, read: Callable[[str], str]) -> RobotSystem | None:
+    def get(self, key: _SystemKey, read: Callable[[str], str]) -> RobotSystem | None:
         with self._lock:
             system = self._systems.get(key)
             if system is not None:
@@ -165,7 +168,7 @@ class _ParsedSystems:
             return None
         return system
 
-    def put(self, key: tuple, system: RobotSystem) -> None:
+    def put(self, key: _SystemKey, system: RobotSystem) -> None:
         with self._lock:
             self._systems[key] = system
             while len(self._systems) > self.KEPT:
@@ -314,7 +317,7 @@ def served_files(system: RobotSystem) -> dict[str, str]:
 class ServedCatalog:
     """The systems a suite serves (``catalog_to_json``), with SystemCatalog's ``names``/``load``."""
 
-    entries: Mapping[str, Mapping]
+    entries: Mapping[str, Mapping[str, Any]]
 
     @classmethod
     def from_json(cls, text: str) -> ServedCatalog:

@@ -14,8 +14,8 @@ offending token, e.g. ``spec.structuredslugs:7:12: unknown variable 'foo' near '
 Modules, each importing only those above it:
 
     errors          ParseError, UnknownVariableError
-    scope           proposition names, each section's scope, error positions
     integers        structured slugs' integer variables, bit-blasted
+    scope           proposition names, each section's scope (integer variables too), error positions
     operators       the binary operators: how tightly each binds, the nodes each makes
     infix           the reference reader of infix formulas
     prefix          the reference reader of prefix (slugsin) formulas

@@ -1,6 +1,7 @@
 """Fixtures of the shell's tests: the GUI served with its suite in-process, a headless Chromium
 and a tab on the GUI, the GUI's JSON API. Module-scoped: each module gets its own; a module
-defining a fixture of the same name (a GUI with other settings, a tab of another size) uses its own."""
+defining a fixture of the same name (a GUI with other settings, a tab of another size) uses its own.
+A module may instead say ``GUI_LIMITS`` (gui_server's time limits) and ``WINDOW`` (the tab's size)."""
 
 import pytest
 from fastapi.testclient import TestClient
@@ -14,8 +15,9 @@ import headless_chromium
 
 
 @pytest.fixture(scope='module')
-def gui(tmp_path_factory):
-    with gui_server(tmp_path_factory.mktemp('gui-browser')) as served:
+def gui(request, tmp_path_factory):
+    limits = getattr(request.module, 'GUI_LIMITS', {})
+    with gui_server(tmp_path_factory.mktemp('gui-browser'), **limits) as served:
         yield served
 
 
@@ -26,8 +28,8 @@ def browser_context():
 
 
 @pytest.fixture
-def page(gui, browser_context):
-    with open_page(browser_context, gui[0]) as page:
+def page(request, gui, browser_context):
+    with open_page(browser_context, gui[0], viewport=getattr(request.module, 'WINDOW', None)) as page:
         yield page
 
 

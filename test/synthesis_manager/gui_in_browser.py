@@ -11,6 +11,12 @@ from synthesis_manager.programs.gui import background_server, ros_backend
 from synthesis_manager.web.routes import create_app
 
 
+#: Time limits for a GUI that synthesizes large machines (6 and 12 goals) on a shared machine.
+LONG_LIMITS = {'synthesis_timeout': 300, 'goal_timeout': 400}
+#: The tab the usability tests look at.
+USABILITY_WINDOW = {'width': 1400, 'height': 900}
+
+
 @contextmanager
 def gui_server(byproducts_dir, synthesis_timeout=60, goal_timeout=120):
     """The GUI served over HTTP on 127.0.0.1, the suite in-process; yields (url, backend)."""

@@ -8,24 +8,12 @@ are also written there (docs/gui-12-goals.png, docs/gui-simulation.png).
 
 import pytest
 
-from gui_in_browser import TWELVE_GOALS, choose_task, docs_shot, gui_server, open_page, result_code
+from gui_in_browser import LONG_LIMITS, TWELVE_GOALS, USABILITY_WINDOW, choose_task, docs_shot, result_code
 
 pytestmark = [pytest.mark.ros, pytest.mark.browser]
 
-WINDOW = {'width': 1400, 'height': 900}  # the usability tests' tab
-
-
-@pytest.fixture(scope='module')
-def gui(tmp_path_factory):
-    """The usability tests' GUI, with a long synthesis limit: the 12-goal machine, on a shared machine."""
-    with gui_server(tmp_path_factory.mktemp('gui-usability'), synthesis_timeout=300, goal_timeout=400) as served:
-        yield served
-
-
-@pytest.fixture
-def page(gui, browser_context):
-    with open_page(browser_context, gui[0], viewport=WINDOW) as page:
-        yield page
+# The conftest's GUI and tab, as the usability tests have them: the 12-goal machine, on a shared machine.
+GUI_LIMITS, WINDOW = LONG_LIMITS, USABILITY_WINDOW
 
 
 def in_window(page, selector):

@@ -19,7 +19,7 @@ from synthesis_manager.web.backend import SynthesisBackend
 from synthesis_manager.web.outcome import JobOutcome
 from synthesis_manager.web.routes import create_app
 from respec.robot import robot_system
-from gui_in_browser import choose_task, gui_server, open_page, result_code
+from gui_in_browser import LONG_LIMITS, USABILITY_WINDOW, choose_task, open_page, result_code
 
 pytestmark = [pytest.mark.ros, pytest.mark.browser]
 
@@ -27,17 +27,8 @@ SIX_GOALS = ['look_down', 'pickup_object', 'grasp_object', 'pregrasp', 'approach
 SHOTS_ENV = 'BEHAVIOR_SYNTHESIS_GUI_SHOTS'
 
 
-@pytest.fixture(scope='module')
-def gui(tmp_path_factory):
-    """The GUI with a long synthesis limit: the 6-goal machine, on a shared machine."""
-    with gui_server(tmp_path_factory.mktemp('gui-usability'), synthesis_timeout=300, goal_timeout=400) as served:
-        yield served
-
-
-@pytest.fixture
-def page(gui, browser_context):
-    with open_page(browser_context, gui[0], viewport={'width': 1400, 'height': 900}) as page:
-        yield page
+# The conftest's GUI and tab: long time limits for the 6-goal machine on a shared machine, 1400x900.
+GUI_LIMITS, WINDOW = LONG_LIMITS, USABILITY_WINDOW
 
 
 def shot(page, name):

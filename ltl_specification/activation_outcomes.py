@@ -15,7 +15,7 @@ from __future__ import annotations
 from typing import Iterable, Mapping, Sequence
 
 from respec.ltl import FALSE, TRUE, Formula, conj, disj, iff, implies, neg, next_, var
-from respec.naming import COMPLETED, FAILED, FINISHED, activation, memory, outcome_proposition
+from respec.vocabulary.naming import COMPLETED, FAILED, FINISHED, activation, memory, outcome_proposition
 
 
 

@@ -54,7 +54,7 @@ from typing import Mapping, Sequence
 
 from respec.robot.cnu import FAILURE, CapabilityConfigError, CapabilitySystem, Literal, parse_literal
 from respec.ltl import TRUE, Formula, Not, Var, conj, disj, iff, implies, neg, next_, var, variables
-from respec.naming import COMPLETED, FAILED, FINISHED, activation, did_you_mean, memory, remembered
+from respec.vocabulary.naming import COMPLETED, FAILED, FINISHED, activation, did_you_mean, memory, remembered
 from respec.parsing import IntegerVariable
 from respec.parsing.errors import ParseError
 from respec.parsing.grammar import parse_in_scope

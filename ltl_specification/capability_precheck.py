@@ -27,7 +27,7 @@ from __future__ import annotations
 
 from typing import Sequence
 
-from respec.naming import activation, did_you_mean, memory
+from respec.vocabulary.naming import activation, did_you_mean, memory
 from respec.robot import RobotSystem
 from respec.robot.cnu import (CAPABILITIES_KEY, SPEC_KEY, CapabilityConfigError, CapabilitySystem, Literal,
                               parse_literal)

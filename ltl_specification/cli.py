@@ -18,8 +18,8 @@ from pathlib import Path
 from ltl_specification.compiler import compile_task, explain
 from ltl_specification.errors import InvalidFormulaError
 from ltl_specification.systems import task_system_errors
-from respec.errors import CodedError, ExitStatus, exit_status_help
-from respec.naming import parse_names
+from respec.vocabulary.errors import CodedError, ExitStatus, exit_status_help
+from respec.vocabulary.naming import parse_names
 from respec.robot import robot_system
 from respec.robot.files import add_config_dir_argument
 from respec.untrusted import BoundedYamlError, load_bounded_yaml, read_bounded_file

@@ -51,10 +51,10 @@ from ltl_specification.components import (
     control_mode_specification, goal_groups, goal_specification, initial_conditions_groups,
     initial_conditions_specification,
 )
-from respec.errors import quoted
+from respec.vocabulary.errors import quoted
 from respec.ltl import variables
-from respec.naming import (DEFAULT_SM_OUTCOMES, FAILED, FINISHED, activation, did_you_mean, outcome_proposition,
-                           parse_names)
+from respec.vocabulary.naming import (DEFAULT_SM_OUTCOMES, FAILED, FINISHED, activation, did_you_mean,
+                                      outcome_proposition, parse_names)
 from respec.parsing import ParseError, UnknownVariableError, parse_formula, spec_from_text_sections
 from respec.spec import (
     FORMULA_SECTIONS, PROPOSITION_SECTIONS, SECTIONS, GR1Specification, PropositionConflictError,

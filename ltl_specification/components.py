@@ -22,7 +22,7 @@ from dataclasses import dataclass
 from typing import Mapping, Sequence
 
 from ltl_specification import activation_outcomes as ao
-from respec.naming import FAILED, FINISHED
+from respec.vocabulary.naming import FAILED, FINISHED
 from respec.ltl import Formula
 from respec.spec import FORMULA_SECTIONS, GR1Specification
 

@@ -37,7 +37,7 @@ from dataclasses import asdict, dataclass, field
 
 from ltl_specification.components import SOURCE_CUSTOM, FormulaGroup
 from respec.ltl import Formula, evaluate, mentions_next, to_infix, variables
-from respec.naming import activation
+from respec.vocabulary.naming import activation
 from respec.robot import RobotSystem, for_description
 from respec.robot.abstraction import RobotAbstraction
 from respec.robot.cnu import CapabilitySystem

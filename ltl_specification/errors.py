@@ -7,7 +7,7 @@ constant that reports it.
 
 from __future__ import annotations
 
-from respec.errors import CodedError, ErrorCode
+from respec.vocabulary.errors import CodedError, ErrorCode
 
 
 class SpecificationError(CodedError):

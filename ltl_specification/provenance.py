@@ -24,7 +24,7 @@ from respec.robot.abstraction import RobotAbstraction
 from ltl_specification.components import (SOURCE_ACTIONS, SOURCE_CONTROL_MODES, SOURCE_GOALS, SOURCE_INITIAL_CONDITIONS,
                                SOURCE_SM_OUTCOMES, FormulaGroup)
 from respec.ltl import to_infix
-from respec.naming import BEHAVIOR_CLASS, activation, memory, outcome_proposition
+from respec.vocabulary.naming import BEHAVIOR_CLASS, activation, memory, outcome_proposition
 from respec.parsing import ParseError, parse_formula
 
 from ltl_specification.pertinence import Pertinence

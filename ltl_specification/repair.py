@@ -36,8 +36,8 @@ from typing import Callable, Iterator, Mapping, NamedTuple, Sequence
 
 import yaml
 
-from respec.errors import CodedError, ErrorCode
-from respec.naming import DEFAULT_SM_OUTCOMES, FAILED, activation, memory, parse_names, remembered
+from respec.vocabulary.errors import CodedError, ErrorCode
+from respec.vocabulary.naming import DEFAULT_SM_OUTCOMES, FAILED, activation, memory, parse_names, remembered
 from respec.robot import RobotSystem, for_description
 from respec.robot.abstraction import RobotAbstraction
 from respec.robot.cnu import CapabilitySystem

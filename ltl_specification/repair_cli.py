@@ -17,8 +17,8 @@ import argparse
 import json
 import sys
 
-from respec.errors import CodedError, ExitStatus, exit_status_help
-from respec.naming import parse_names
+from respec.vocabulary.errors import CodedError, ExitStatus, exit_status_help
+from respec.vocabulary.naming import parse_names
 from respec.robot import robot_system
 
 from ltl_specification.cli import add_task_arguments, read_custom_ltl

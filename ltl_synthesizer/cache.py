@@ -39,7 +39,7 @@ from importlib.util import find_spec
 from pathlib import Path
 from typing import Callable, Mapping
 
-from respec.private_files import private_directory_problem
+from respec.vocabulary.private_files import private_directory_problem
 
 #: The default bound of a cache (memory, and the directory if any): 64 MiB holds about 70 000
 #: automaton transitions of answers, or thousands of answers of ATLAS-sized tasks (~30 kB each).

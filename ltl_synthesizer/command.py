@@ -15,7 +15,7 @@ import os
 import sys
 import time
 
-from respec.errors import ExitStatus, exit_status_help
+from respec.vocabulary.errors import ExitStatus, exit_status_help
 
 REALIZABLE_LINE = 'RESULT: Specification is realizable.'
 UNREALIZABLE_LINE = 'RESULT: Specification is unrealizable.'

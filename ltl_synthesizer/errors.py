@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from respec.errors import CodedError, ErrorCode
+from respec.vocabulary.errors import CodedError, ErrorCode
 
 
 class SynthesisError(CodedError):

@@ -18,7 +18,7 @@ import time
 from pathlib import Path
 
 from ltl_synthesizer.errors import SynthesisCancelledError, SynthesisError, SynthesisTimeoutError
-from respec.errors import ErrorCode
+from respec.vocabulary.errors import ErrorCode
 
 REALIZABLE_LINE = 'RESULT: Specification is realizable.'
 UNREALIZABLE_LINE = 'RESULT: Specification is unrealizable.'

@@ -13,7 +13,7 @@ import contextlib
 import io
 import json
 
-from respec.errors import ExitStatus
+from respec.vocabulary.errors import ExitStatus
 
 from ltl_synthesizer.command import parse_arguments, run
 from respec.nesting import run_with_deep_stack

@@ -36,7 +36,7 @@ from ltl_synthesizer.interrupt import Limits
 from ltl_synthesizer.isolated import SpecificationText, SynthesisProcesses, byproduct_texts
 from ltl_synthesizer.strategy import strategy_to_json
 from respec.automaton import Automaton, AutomatonState, automaton_from_strategy, strategy_move_problems
-from respec.errors import CodedError, ErrorCode
+from respec.vocabulary.errors import CodedError, ErrorCode
 from respec.parsing import spec_from_text_sections
 from respec.spec import GR1Specification
 from respec.untrusted import utf8_length

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from ltl_synthesizer.cudd_import import cudd
 
-from respec.errors import quoted
+from respec.vocabulary.errors import quoted
 from respec.ltl import And, Const, Formula, Iff, Implies, Next, Not, Or, Var, children, to_infix
 from respec.spec import GR1Specification
 

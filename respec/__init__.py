@@ -15,6 +15,8 @@ Shared model types:
     robot                robot systems: RobotSystem, the abstraction, CNU capability robots,
                          the FlexBE state classes of a workspace (see ``respec.robot``)
     automaton            the synthesized Automaton (the FSAutomaton message shape)
-    naming               the naming rules of propositions (``_a``, ``_c``, ``_m``), outcomes, lists
-    errors               CodedError and the error vocabulary (SynthesisErrorCodes)
+
+The suite's vocabulary (``respec.vocabulary``): the naming rules of propositions, outcomes and
+lists (``naming``), the result codes and CodedError (``errors``), private directories
+(``private_files``).
 """

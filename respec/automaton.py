@@ -11,9 +11,9 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any
 
-from respec.errors import CodedError, ErrorCode
+from respec.vocabulary.errors import CodedError, ErrorCode
 from respec.ltl import conj, evaluate
-from respec.naming import is_memory
+from respec.vocabulary.naming import is_memory
 from respec.spec import GR1Specification
 
 

@@ -9,7 +9,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field, fields
 from typing import Any, Callable, Iterable
 
-from respec.errors import CodedError, ErrorCode
+from respec.vocabulary.errors import CodedError, ErrorCode
 from respec.ltl import Formula, to_infix, to_prefix, variables
 
 PROPOSITION_SECTIONS = ('env_props', 'sys_props')

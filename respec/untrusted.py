@@ -20,7 +20,7 @@ from typing import Protocol
 
 import yaml
 
-from respec.errors import quoted, unbuildable_value
+from respec.vocabulary.errors import quoted, unbuildable_value
 
 # libyaml's parser and safe loader when PyYAML was built with it (5x faster), else pure Python.
 _SAFE_LOADER = getattr(yaml, 'CSafeLoader', yaml.SafeLoader)

@@ -31,8 +31,8 @@ from __future__ import annotations
 from collections import deque
 from dataclasses import dataclass, field
 
-from respec.errors import quoted
-from respec.naming import activation, is_memory
+from respec.vocabulary.errors import quoted
+from respec.vocabulary.naming import activation, is_memory
 from sm_generation.config import FlexBEConfig, StateConfig
 from sm_generation.errors import (AutomatonInvalidError, InitialConditionsInvalidError, InputValuationInvalidError,
                                   NextStateInvalidError, NoInitialStateError, OutputValuationInvalidError,

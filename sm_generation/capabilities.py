@@ -24,7 +24,7 @@ from typing import Mapping
 
 from respec.automaton import Automaton, AutomatonState
 from respec.robot.cnu import CapabilitySystem
-from respec.naming import activation
+from respec.vocabulary.naming import activation
 from respec.parsing import IntegerVariable
 from respec.robot.state_library import StateClass, capability_outcomes
 from sm_generation.config import FlexBEConfig, StateConfig

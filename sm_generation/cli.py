@@ -13,8 +13,8 @@ import argparse
 import sys
 from pathlib import Path
 
-from respec.errors import ExitStatus, exit_status_help
-from respec.naming import parse_names
+from respec.vocabulary.errors import ExitStatus, exit_status_help
+from respec.vocabulary.naming import parse_names
 from respec.robot import robot_system
 from respec.robot.files import add_config_dir_argument
 from sm_generation.automaton_io import load_automaton

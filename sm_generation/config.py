@@ -38,7 +38,7 @@ from contextlib import contextmanager
 from dataclasses import dataclass, field
 from typing import Iterator
 
-from respec.naming import activated
+from respec.vocabulary.naming import activated
 from sm_generation.instantiation import StateInstantiation
 from respec.robot import RobotSystem
 from respec.robot.files import ConfigDirectoryNotFoundError, ConfigFileInvalidError, SystemNotFoundError

@@ -5,7 +5,7 @@ Each names the offending state, proposition, file or configuration key in ``item
 
 from __future__ import annotations
 
-from respec.errors import CodedError, ErrorCode
+from respec.vocabulary.errors import CodedError, ErrorCode
 
 
 class SMGenerationError(CodedError):

@@ -18,8 +18,8 @@ from pathlib import Path
 
 import yaml
 
-from respec.errors import CodedError, ErrorCode
-from respec.naming import FINISHED
+from respec.vocabulary.errors import CodedError, ErrorCode
+from respec.vocabulary.naming import FINISHED
 from sm_generation.instantiation import StateInstantiation
 from sm_generation.state_machine import State, StateMachine
 

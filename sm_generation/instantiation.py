@@ -9,7 +9,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field, fields
 
-from respec.naming import BEHAVIOR_CLASS, CONCURRENCY_CLASS, OUTCOME_CLASS, PRIORITY_CLASS, STATEMACHINE_CLASS
+from respec.vocabulary.naming import (BEHAVIOR_CLASS, CONCURRENCY_CLASS, OUTCOME_CLASS, PRIORITY_CLASS,
+                                      STATEMACHINE_CLASS)
 
 
 @dataclass

@@ -27,8 +27,8 @@ import tempfile
 import time
 from pathlib import Path
 
-from respec.errors import CodedError, ErrorCode, quoted
-from respec.private_files import private_directory_problem
+from respec.vocabulary.errors import CodedError, ErrorCode, quoted
+from respec.vocabulary.private_files import private_directory_problem
 
 EXTENSIONS = ('structuredslugs', 'slugsin', 'json')
 DEFAULT_SPEC_NAME = 'synthesized_spec'
@@ -62,7 +62,7 @@ def default_directory() -> Path:
 
 def private_directory(directory: Path) -> Path:
     """``directory``, created 0700 if missing; refused unless it is a real directory of this
-    user that no one else can write to (respec.private_files)."""
+    user that no one else can write to (respec.vocabulary.private_files)."""
     try:
         problem = private_directory_problem(directory)
     except OSError as error:

@@ -10,8 +10,8 @@ from dataclasses import dataclass, field
 import yaml
 from unique_identifier_msgs.msg import UUID
 
-from respec.errors import ErrorCode
-from respec.naming import DEFAULT_SM_OUTCOMES
+from respec.vocabulary.errors import ErrorCode
+from respec.vocabulary.naming import DEFAULT_SM_OUTCOMES
 from sm_generation.state_machine import StateMachine
 from synthesis_manager.client_shares import new_origin, tagged_goal_id
 from synthesis_manager.limits import check_texts

@@ -11,7 +11,7 @@ from dataclasses import dataclass, field
 from typing import Callable
 
 from ltl_specification.repair import REPAIRABLE
-from respec.errors import ErrorCode
+from respec.vocabulary.errors import ErrorCode
 from synthesis_manager.client_shares import ClientShares, Ticket
 from synthesis_manager.limits import BusyError
 from synthesis_manager.requests import SynthesisTask

@@ -12,7 +12,7 @@ import math
 import re
 import time
 
-from respec.errors import CodedError, ErrorCode, quoted
+from respec.vocabulary.errors import CodedError, ErrorCode, quoted
 from respec.untrusted import utf8_length
 from synthesis_manager.requests import InvalidRequestError
 

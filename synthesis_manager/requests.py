@@ -11,8 +11,8 @@ from typing import Any
 
 
 from respec.untrusted import BoundedYamlError, load_bounded_yaml
-from respec.errors import CodedError, ErrorCode, quoted
-from respec.naming import DEFAULT_SM_OUTCOMES, parse_names
+from respec.vocabulary.errors import CodedError, ErrorCode, quoted
+from respec.vocabulary.naming import DEFAULT_SM_OUTCOMES, parse_names
 
 OPTION_NAMES = ('ltl_compilation_only', 'ltl_synthesis_only', 'ltl_steps_only')
 

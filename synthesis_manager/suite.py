@@ -8,7 +8,7 @@ import functools
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 
-from respec.errors import CodedError, ErrorCode
+from respec.vocabulary.errors import CodedError, ErrorCode
 from synthesis_manager.client import SynthesisClient
 from synthesis_manager.nodes.ltl_compilation_node import LTLCompilationNode
 from synthesis_manager.nodes.ltl_synthesis_node import LTLSynthesisNode

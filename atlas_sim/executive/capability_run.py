@@ -19,7 +19,7 @@ import re
 from dataclasses import asdict, dataclass, field
 
 from respec.ltl import evaluate, to_infix
-from respec.naming import FAILED, activation
+from respec.vocabulary.naming import FAILED, activation
 from sm_generation.state_machine import State, StateMachine
 
 #: States a run may enter before it is said not to finish (a failure retried forever).

@@ -7,7 +7,7 @@ over; a StateInstantiation list becomes that tree where it arrives (a message, a
 from __future__ import annotations
 
 from atlas_sim.executive.trace_check import Trace
-from respec.errors import CodedError, ErrorCode
+from respec.vocabulary.errors import CodedError, ErrorCode
 from sm_generation.state_machine import State
 
 

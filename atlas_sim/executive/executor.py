@@ -57,8 +57,8 @@ from atlas_sim.executive.errors import ExecutionError, UndeclaredOutcomeError, n
 from atlas_sim.executive.robot import CapabilityResult, Robot
 from atlas_sim.executive.runtime_control import RuntimeControl
 from atlas_sim.executive.trace_check import OutcomeTracker, Trace, TraceStep
-from respec.errors import ErrorCode
-from respec.naming import activated, is_activation, outcome_proposition
+from respec.vocabulary.errors import ErrorCode
+from respec.vocabulary.naming import activated, is_activation, outcome_proposition
 from respec.robot import RobotSystem
 from sm_generation.config import INPUT_STATE_CLASS, flexbe_config
 from sm_generation.instantiation import DECISION_CLASS, HELPER_STATE_CLASSES, StateInstantiation

@@ -29,7 +29,7 @@ import time
 from typing import Any, Callable
 
 from atlas_sim.executive.errors import ExecutionError
-from respec.errors import ErrorCode
+from respec.vocabulary.errors import ErrorCode
 
 #: FlexBE's autonomy levels (flexbe_core.Autonomy), the operator's names for them.
 OFF, LOW, HIGH, FULL = 0, 1, 2, 3

@@ -11,7 +11,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from atlas_sim.executive.trace_check import Trace
-from respec.naming import COMPLETED, FAILED
+from respec.vocabulary.naming import COMPLETED, FAILED
 
 OUTCOME_COLOURS = {COMPLETED: '#3a9d5d', FAILED: '#d64541', None: '#9e9e9e'}
 

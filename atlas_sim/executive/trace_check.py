@@ -10,9 +10,10 @@ from __future__ import annotations
 
 from dataclasses import asdict, dataclass, field
 
-from respec.errors import CodedError, ErrorCode
+from respec.vocabulary.errors import CodedError, ErrorCode
 from respec.ltl import Formula, Next, mentions_next, partial_evaluate, to_infix
-from respec.naming import COMPLETED, DEFAULT_SM_OUTCOMES, FINISHED, is_activation, outcome_proposition, remembered
+from respec.vocabulary.naming import (COMPLETED, DEFAULT_SM_OUTCOMES, FINISHED, is_activation, outcome_proposition,
+                                      remembered)
 from respec.spec import GR1Specification
 
 # Each SM outcome is the system proposition of the same name.

@@ -50,7 +50,7 @@ from typing import Any, Dict, Mapping, Optional, Tuple
 
 from respec.robot import RobotSystem, robot_system_from_file
 from respec.robot.abstraction import RobotAbstraction, abstraction_from_document
-from respec.errors import CodedError, ErrorCode
+from respec.vocabulary.errors import CodedError, ErrorCode
 
 class SimulationConfigError(CodedError, ValueError):
     """The ``simulation:`` section is invalid; ``item`` names the offending key or capability."""

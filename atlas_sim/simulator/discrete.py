@@ -32,7 +32,7 @@ from typing import Dict, Iterable, List, Mapping, Optional, Set
 
 from .config import SimulationConfigError
 from respec.robot.abstraction import RobotAbstraction
-from respec.naming import COMPLETED, FAILED
+from respec.vocabulary.naming import COMPLETED, FAILED
 
 
 

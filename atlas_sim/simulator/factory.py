@@ -7,8 +7,8 @@ from __future__ import annotations
 import dataclasses
 
 from atlas_sim.simulator.config import SystemConfig
-from respec.errors import CodedError, ErrorCode
-from respec.naming import COMPLETED
+from respec.vocabulary.errors import CodedError, ErrorCode
+from respec.vocabulary.naming import COMPLETED
 from respec.robot import RobotSystem
 
 

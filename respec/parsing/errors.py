@@ -6,7 +6,7 @@ Each names the file (or message section), line, column and the offending token, 
 
 from __future__ import annotations
 
-from respec.errors import CodedError, ErrorCode, quoted
+from respec.vocabulary.errors import CodedError, ErrorCode, quoted
 
 
 class ParseError(CodedError):

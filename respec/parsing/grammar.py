@@ -12,7 +12,7 @@ expect.
 
 from __future__ import annotations
 
-from respec.errors import quoted
+from respec.vocabulary.errors import quoted
 from respec.ltl import Formula
 from respec.parsing.errors import ParseError
 from respec.parsing.infix import InfixParser

@@ -9,7 +9,7 @@ from __future__ import annotations
 import re
 from typing import NamedTuple
 
-from respec.errors import quoted
+from respec.vocabulary.errors import quoted
 from respec.ltl import FALSE, TRUE, Formula, Var, conj, disj, neg, next_
 from respec.nesting import MAX_FORMULA_NESTING, too_deep
 from respec.parsing.errors import ParseError

@@ -11,7 +11,7 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass, field
 
-from respec.errors import quoted
+from respec.vocabulary.errors import quoted
 from respec.parsing.errors import ParseError, UnknownVariableError
 from respec.parsing.integers import IntegerVariable
 from respec.spec import SLUGS_HEADERS

@@ -24,8 +24,8 @@ import re
 from typing import Mapping
 from dataclasses import dataclass, field
 
-from respec.errors import ErrorCode
-from respec.naming import COMPLETED, DEFAULT_SM_OUTCOMES, FAILED, activation, memory, outcome_proposition
+from respec.vocabulary.errors import ErrorCode
+from respec.vocabulary.naming import COMPLETED, DEFAULT_SM_OUTCOMES, FAILED, activation, memory, outcome_proposition
 from respec.robot.files import SystemConfigError
 
 _NAME = re.compile(r'^[A-Za-z][A-Za-z0-9_]*$')

@@ -52,8 +52,8 @@ from dataclasses import dataclass, field, replace
 from typing import Any, Callable, Mapping
 
 from respec.untrusted import BoundedYamlError, load_bounded_yaml
-from respec.errors import ErrorCode
-from respec.naming import COMPLETED, FAILED, FINISHED, activation
+from respec.vocabulary.errors import ErrorCode
+from respec.vocabulary.naming import COMPLETED, FAILED, FINISHED, activation
 from respec.robot.files import MAX_CONFIG_DEPTH, ConfigFileInvalidError, SystemConfigError
 
 CAPABILITIES_KEY, SPEC_KEY, MAPPINGS_KEY = 'cnu_capabilities', 'cnu_spec', 'cnu_mappings'
@@ -83,7 +83,7 @@ _FILE_KEYS = ('name', 'capabilities', 'variable_mappings', 'state_outcome_mappin
 _INITIAL_SECTIONS = ('ENV_INIT', 'SYS_INIT')
 _FORMULA_SECTIONS = (*_INITIAL_SECTIONS, 'ENV_TRANS', 'SYS_TRANS', 'ENV_LIVENESS', 'SYS_LIVENESS')
 _SPEC_SECTIONS = ('INPUT', 'OUTPUT', *_FORMULA_SECTIONS)
-# CNU's files may spell a memory proposition with their suffix; ours is added by respec.naming.
+# CNU's files may spell a memory proposition with their suffix; ours is added by respec.vocabulary.naming.
 CNU_MEMORY_SUFFIX = '_m'
 # YAML reads `true`/`false` keys as booleans; CNU's mappings quote them, but be lenient.
 _YAML_WORDS: dict[object, str] = {True: 'true', False: 'false'}

@@ -20,7 +20,7 @@ from pathlib import Path
 from typing import Any, Sequence, Union
 
 from respec.untrusted import BoundedFileError, BoundedYamlError, load_bounded_yaml, read_bounded_file
-from respec.errors import CodedError, ErrorCode, quoted
+from respec.vocabulary.errors import CodedError, ErrorCode, quoted
 
 CONFIG_DIR_ENV = 'BEHAVIOR_SYNTHESIS_CONFIG_DIR'
 #: The systems shipped with the repository; always last on the search path.

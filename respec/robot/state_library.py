@@ -21,7 +21,7 @@ from pathlib import Path
 from typing import Mapping
 
 from respec.robot.cnu import CapabilityConfigError, CapabilitySystem
-from respec.errors import ErrorCode
+from respec.vocabulary.errors import ErrorCode
 
 FLEXBE_STATES_EXPORT = '<flexbe_states'
 #: What to do when a capability's state class is not found: where the classes are looked for.

@@ -282,7 +282,7 @@ SMALL_SYSTEM_FILE_BYTES = 64 * 1024
 def catalog_to_json(catalog: SystemCatalog) -> str:
     """Every system of ``catalog`` as JSON (deterministic): name, config file and the text of
     each file it reads; a system that cannot be loaded is listed with its error instead."""
-    from respec.errors import CodedError
+    from respec.vocabulary.errors import CodedError
 
     entries = []
     for name in catalog.names():

@@ -38,8 +38,8 @@ from rclpy.node import Node
 from atlas_sim.simulator.factory import make_simulator, parse_faults
 from atlas_sim.simulator.node_names import ACTION_NAME, CAPABILITY_ACTION_PREFIX, NODE_NAME, STATE_TOPIC
 from atlas_sim.simulator.operator_data import decode_userdata
-from respec.errors import quoted
-from respec.naming import parse_names
+from respec.vocabulary.errors import quoted
+from respec.vocabulary.naming import parse_names
 from respec.robot import robot_system
 from synthesis_manager.ros.errors import log_internal_error
 from synthesis_manager.ros.node_main import node_main

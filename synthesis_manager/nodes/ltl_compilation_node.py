@@ -29,10 +29,10 @@ from ltl_specification.repair import TaskRequest
 from ltl_specification.repair_process import RepairSearch, RepairSearchError, repair_settings
 from ltl_specification.systems import task_system_errors
 from ltl_synthesizer import SynthesisCancelledError
-from respec.errors import ErrorCode
+from respec.vocabulary.errors import ErrorCode
 from respec.robot import SystemCatalog, catalog_to_json
 from respec.robot.files import SystemConfigError
-from respec.naming import DEFAULT_SM_OUTCOMES
+from respec.vocabulary.naming import DEFAULT_SM_OUTCOMES
 from respec.nesting import run_with_deep_stack
 from synthesis_manager.ros.child_stage import ChildStage, StageStopped
 from synthesis_manager.ros.conversions import error_code, msg_to_sections, sections_to_msg

@@ -23,7 +23,7 @@ from rclpy.action import CancelResponse, GoalResponse
 from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.node import Node
 
-from respec.errors import INTERNAL_ERROR, CodedError, ErrorCode
+from respec.vocabulary.errors import INTERNAL_ERROR, CodedError, ErrorCode
 from synthesis_manager.client_shares import ClientShares, goal_origin
 from synthesis_manager.goals import GoalAdmission, PipelineOutcome, share_waiting_message
 from synthesis_manager.limits import GoalDeadline, capped_timeout, check_message, check_timeout

@@ -14,7 +14,7 @@ import time
 from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.node import Node
 
-from respec.errors import ErrorCode
+from respec.vocabulary.errors import ErrorCode
 from respec.robot import SystemCatalog
 from sm_generation import generate_state_machine
 from sm_generation.config import generation_system_errors

@@ -10,7 +10,7 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-from respec.errors import ExitStatus, exit_status_help
+from respec.vocabulary.errors import ExitStatus, exit_status_help
 from sm_generation.export import render, to_dot, to_json, to_yaml
 from synthesis_manager.web.picture import render_svg
 from synthesis_manager.programs.send_goal import ProgressBar, add_goal_arguments, goal_from_args, print_summary

@@ -32,8 +32,8 @@ With ``--engine flexbe`` the machine is exported as a FlexBE behavior and run by
 FlexBE engine (``synthesis_manager.ros.flexbe_engine``), its states driving the simulator
 node over ROS; the report is the same.
 
-Exit status: see the table below (from respec.errors.ExitStatus). A mission stops at the first
-batch that ends with anything but 0 or 6 (another SM outcome) and exits with it; otherwise it
+Exit status: see the table below (from respec.vocabulary.errors.ExitStatus). A mission stops at the
+first batch that ends with anything but 0 or 6 (another SM outcome) and exits with it; otherwise it
 exits with the status of its last batch (earlier batches may end in any SM outcome).
 """
 
@@ -46,7 +46,7 @@ from pathlib import Path
 
 from atlas_sim.closed_loop import DeferredEvents, run_and_check
 from atlas_sim.executive.errors import ExecutionError
-from respec.errors import ExitStatus, exit_status_help
+from respec.vocabulary.errors import ExitStatus, exit_status_help
 from respec.nesting import run_with_deep_stack
 from respec.parsing import spec_from_text_sections
 from synthesis_manager.programs.send_goal import ProgressBar, add_goal_arguments, goal_from_args, print_summary
@@ -124,7 +124,7 @@ def execute_mode_robot(args, system) -> int:
     from atlas_sim.simulator.factory import FaultSpecError, InitialConditionError, make_simulator, parse_faults
     from ltl_specification.errors import InvalidInitialConditionsError
     from ltl_specification.initial_conditions import asks_for_robot_state
-    from respec.naming import parse_names
+    from respec.vocabulary.naming import parse_names
     from respec.robot.files import SystemConfigError
 
     initial_conditions = parse_names(args.initial_conditions)
@@ -153,8 +153,8 @@ def execute_capability_robot(args, system) -> int:
     from argparse import Namespace
 
     from atlas_sim.executive.capability_run import CapabilityRun, ScriptError, parse_script
-    from respec.errors import CodedError
-    from respec.naming import parse_names
+    from respec.vocabulary.errors import CodedError
+    from respec.vocabulary.naming import parse_names
     from respec.robot.state_library import capability_outcomes, workspace_state_library
 
     unsupported = [flag for flag, given in (('--engine flexbe', args.engine == 'flexbe'), ('--ros-sim', args.ros_sim),

@@ -22,7 +22,7 @@ import sys
 import time
 from pathlib import Path
 
-from respec.errors import ExitStatus, exit_status_help
+from respec.vocabulary.errors import ExitStatus, exit_status_help
 from synthesis_manager.programs.send_goal import ProgressBar, add_goal_arguments, goal_from_args
 from synthesis_manager.suite import SuiteUnavailableError, add_suite_arguments, in_process_suite
 
@@ -41,8 +41,8 @@ def add_arguments(parser):
 
 
 def run(args) -> int:
-    from respec.errors import CodedError
-    from respec.naming import parse_names
+    from respec.vocabulary.errors import CodedError
+    from respec.vocabulary.naming import parse_names
     from respec.robot import robot_system
     from sm_generation import SMGenerationError
     from sm_generation.config import generation_system_errors

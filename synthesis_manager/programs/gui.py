@@ -19,7 +19,7 @@ import time
 import uvicorn
 from rclpy.node import Node
 
-from respec.errors import ErrorCode, ExitStatus, exit_status_help
+from respec.vocabulary.errors import ErrorCode, ExitStatus, exit_status_help
 from synthesis_manager.client import SynthesisClient, SynthesisOutcome, make_goal
 from synthesis_manager.http_connections import BoundedH11Protocol, install_repeat_filter, raise_descriptor_limit
 from synthesis_manager.ros.harness import RosHarness, environment_domain_id

@@ -24,7 +24,7 @@ import signal
 import sys
 from dataclasses import dataclass
 
-from respec.errors import ExitStatus
+from respec.vocabulary.errors import ExitStatus
 
 #: The launch argument that carries standard ROS arguments (``--ros-args ...``).
 ROS_ARGS = 'ros_args'

@@ -9,8 +9,8 @@ from pathlib import Path
 
 from rclpy.node import Node
 
-from respec.errors import CodedError, ExitStatus, exit_status_help, quoted
-from respec.naming import parse_names
+from respec.vocabulary.errors import CodedError, ExitStatus, exit_status_help, quoted
+from respec.vocabulary.naming import parse_names
 from respec.nesting import run_with_deep_stack
 from respec.parsing import parse_structuredslugs
 from sm_generation.instantiation import count_states

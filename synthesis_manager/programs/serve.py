@@ -9,8 +9,8 @@ from __future__ import annotations
 
 import sys
 
-from respec.errors import ExitStatus, exit_status_help
-from respec.naming import parse_names
+from respec.vocabulary.errors import ExitStatus, exit_status_help
+from respec.vocabulary.naming import parse_names
 from synthesis_manager.ros.node_main import run_nodes
 from synthesis_manager.suite import (SUITE_NODE_NAMES, add_namespace_arguments, add_suite_arguments,
                                      robot_namespaces, suite_node_factories)

@@ -24,7 +24,7 @@ import time
 import zlib
 from pathlib import Path
 
-from respec.errors import ExitStatus, exit_status_help
+from respec.vocabulary.errors import ExitStatus, exit_status_help
 
 ENGINE_WAIT = 30.0   # seconds for an onboard engine to subscribe to flexbe/start_behavior
 PREPARATION_WAIT = 60.0  # seconds from the selection to the engine's first word on it

@@ -21,7 +21,7 @@ import time
 from rclpy.action import ActionClient
 
 from atlas_sim.executive.robot import CapabilityResult
-from respec.errors import CodedError, ErrorCode
+from respec.vocabulary.errors import CodedError, ErrorCode
 from synthesis_manager.nodes.atlas_sim_node import ACTION_NAME, STATE_TOPIC
 from synthesis_msgs.action import ExecuteCapability
 from synthesis_msgs.msg import RobotState

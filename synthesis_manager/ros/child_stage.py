@@ -26,7 +26,7 @@ import time
 from ltl_synthesizer import SynthesisCancelledError
 from ltl_synthesizer.errors import SynthesisMemoryError
 from ltl_synthesizer.isolated import SERVER_CHILD_NICENESS, SynthesisProcesses
-from respec.errors import ControlFlowSignal, ErrorCode
+from respec.vocabulary.errors import ControlFlowSignal, ErrorCode
 from synthesis_manager.ros.conversions import error_code
 from synthesis_manager.ros.stage_calls import LookTimer
 from synthesis_manager.ros.worker_pool import Abandoned, WorkerPool, executor_waker

@@ -13,7 +13,7 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass
 
-from respec.errors import ErrorCode
+from respec.vocabulary.errors import ErrorCode
 from synthesis_manager.ros.conversions import constants
 from synthesis_msgs.msg import OutcomeCondition, StateInstantiation
 

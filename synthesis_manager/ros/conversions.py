@@ -6,7 +6,7 @@ Nodes stay thin: they call a core function and use these helpers on the way in a
 from __future__ import annotations
 
 from respec.automaton import Automaton, AutomatonState as CoreState
-from respec.errors import ErrorCode
+from respec.vocabulary.errors import ErrorCode
 from synthesis_msgs.msg import (AutomatonState, FSAutomaton, LTLSpecification, OutcomeCondition,
                                 StateInstantiation, SynthesisErrorCodes)
 

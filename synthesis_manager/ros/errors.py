@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import traceback
 
-from respec.errors import INTERNAL_ERROR, CodedError
+from respec.vocabulary.errors import INTERNAL_ERROR, CodedError
 from synthesis_manager.ros.conversions import error_code
 from synthesis_manager.ros.logs import bounded_line
 from synthesis_msgs.msg import SynthesisErrorCodes

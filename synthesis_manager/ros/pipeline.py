@@ -14,7 +14,7 @@ from dataclasses import replace
 from ltl_specification.errors import InvalidInitialConditionsError
 from ltl_specification.initial_conditions import (asks_for_robot_state, detected_status,
                                                   initial_conditions_from_robot_state, reads_robot_state)
-from respec.errors import CodedError, ErrorCode
+from respec.vocabulary.errors import CodedError, ErrorCode
 from respec.robot import RobotSystem, robot_system
 from sm_generation.instantiation import count_states
 from synthesis_manager.goals import (MAX_SUGGESTED_FIXES, SYNTHESIS_ANSWER_GRACE, PipelineOutcome, byproduct_name,

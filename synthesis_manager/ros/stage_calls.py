@@ -31,7 +31,7 @@ from typing import Callable
 
 from rclpy.callback_groups import MutuallyExclusiveCallbackGroup
 
-from respec.errors import CodedError, ControlFlowSignal, ErrorCode
+from respec.vocabulary.errors import CodedError, ControlFlowSignal, ErrorCode
 
 WATCH_PERIOD = 0.1
 READER_CHECK_PERIOD = 0.5  # seconds between two looks at whether a pending request's node is there

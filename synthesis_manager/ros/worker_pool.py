@@ -16,7 +16,7 @@ import queue
 import threading
 from concurrent.futures import Future
 
-from respec.errors import ControlFlowSignal
+from respec.vocabulary.errors import ControlFlowSignal
 from synthesis_manager.limits import BusyError
 from synthesis_manager.ros.stage_calls import WATCH_PERIOD, next_executor_turn
 

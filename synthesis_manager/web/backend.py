@@ -15,7 +15,7 @@ from __future__ import annotations
 import threading
 from pathlib import Path
 
-from respec.errors import quoted
+from respec.vocabulary.errors import quoted
 from respec.robot import RobotSystem, SystemCatalog
 from synthesis_manager.web.downloads import Downloads
 from synthesis_manager.web.errors import NotFoundError

@@ -5,7 +5,7 @@ from __future__ import annotations
 import logging
 import threading
 
-from respec.errors import CodedError, quoted
+from respec.vocabulary.errors import CodedError, quoted
 from synthesis_manager.web.artifacts import ARTIFACTS, Artifact, download_filename
 from synthesis_manager.web.errors import ArtifactFailedError, NotAvailableError, NotFoundError
 from synthesis_manager.web.job_queue import JobQueue

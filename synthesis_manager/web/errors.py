@@ -8,7 +8,7 @@ progress) is 503, or 429 with Retry-After when it says when to come back.
 
 from __future__ import annotations
 
-from respec.errors import CodedError, ErrorCode, quoted
+from respec.vocabulary.errors import CodedError, ErrorCode, quoted
 from synthesis_manager.limits import BusyError
 
 

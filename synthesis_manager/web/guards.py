@@ -20,7 +20,7 @@ from __future__ import annotations
 import json
 import re
 
-from respec.errors import ErrorCode, quoted
+from respec.vocabulary.errors import ErrorCode, quoted
 from synthesis_manager.limits import MAX_BODY_BYTES
 
 LOOPBACK_ADDRESSES = ('127.0.0.1', '::1')

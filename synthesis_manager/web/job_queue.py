@@ -9,7 +9,7 @@ import uuid
 from collections import OrderedDict
 from typing import Callable
 
-from respec.errors import INTERNAL_ERROR, ErrorCode, quoted
+from respec.vocabulary.errors import INTERNAL_ERROR, ErrorCode, quoted
 from sm_generation.state_machine import StateMachine
 from synthesis_manager.limits import BusyError
 from synthesis_manager.web.errors import NotAvailableError, NotFoundError

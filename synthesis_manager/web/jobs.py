@@ -7,8 +7,8 @@ import threading
 import time
 from dataclasses import asdict, dataclass, field
 
-from respec.errors import ErrorCode, quoted
-from respec.naming import DEFAULT_SM_OUTCOMES, parse_names
+from respec.vocabulary.errors import ErrorCode, quoted
+from respec.vocabulary.naming import DEFAULT_SM_OUTCOMES, parse_names
 from respec.spec import SECTIONS
 from sm_generation.instantiation import StateInstantiation, count_states
 from synthesis_manager.limits import oversized_strings, too_long

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from respec.errors import ErrorCode
+from respec.vocabulary.errors import ErrorCode
 from sm_generation.state_machine import StateMachine
 
 

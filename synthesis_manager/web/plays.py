@@ -16,7 +16,7 @@ from collections import OrderedDict
 
 from ltl_specification import compile_task
 from ltl_specification.play import PlayError, RobotPlay
-from respec.errors import CodedError, ErrorCode, quoted
+from respec.vocabulary.errors import CodedError, ErrorCode, quoted
 from sm_generation.play import MachinePlayError, play_machine
 from synthesis_manager.limits import BusyError
 from synthesis_manager.web.errors import GuiRequestError, InvalidJobRequestError, NotAvailableError

@@ -9,7 +9,7 @@ import queue
 import threading
 
 from ltl_specification.repair_process import RepairSearch, RepairSearchError, repair_settings
-from respec.errors import CodedError
+from respec.vocabulary.errors import CodedError
 from synthesis_manager.limits import BusyError
 from synthesis_manager.web.errors import NotAvailableError
 from synthesis_manager.web.jobs import JobRequest

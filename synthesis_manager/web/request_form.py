@@ -6,7 +6,7 @@ import dataclasses
 import threading
 
 from ltl_specification.diagnosis import goal_findings
-from respec.errors import CodedError, quoted
+from respec.vocabulary.errors import CodedError, quoted
 from synthesis_manager.limits import BusyError
 from synthesis_manager.web.errors import NotAvailableError, NotFoundError
 from synthesis_manager.web.jobs import checked_body, names_field

@@ -15,7 +15,7 @@ import re
 
 from ltl_specification.play import PlayError
 from respec.ltl import Or, Var, partial_evaluate, to_infix
-from respec.naming import DEFAULT_SM_OUTCOMES, activated
+from respec.vocabulary.naming import DEFAULT_SM_OUTCOMES, activated
 
 MAX_GAME_MOVES = 12
 ACTIVATION_STARTS = ' starts'

@@ -22,7 +22,7 @@ import re
 from ltl_specification.capability_precheck import clause_text
 from ltl_specification.diagnosis import impossible_next_goals
 from ltl_specification.systems import load_task_abstraction
-from respec.naming import DEFAULT_SM_OUTCOMES, FINISHED
+from respec.vocabulary.naming import DEFAULT_SM_OUTCOMES, FINISHED
 from respec.robot import RobotSystem, for_description
 from respec.robot.abstraction import RobotAbstraction
 from respec.robot.cnu import CapabilitySystem

@@ -31,7 +31,7 @@ from typing import Callable
 from atlas_sim.executive.runtime_control import FULL, RuntimeControl
 from ltl_synthesizer.errors import SynthesisError
 from ltl_synthesizer.isolated import ChildProcess
-from respec.errors import INTERNAL_ERROR, CodedError
+from respec.vocabulary.errors import INTERNAL_ERROR, CodedError
 
 #: Seconds past its own wall-time limit a child is given before it is killed.
 KILL_GRACE = 30.0

@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from atlas_sim.executive.runtime_control import AUTONOMY_LEVELS, FULL, CommandError, checked_command
-from respec.errors import CodedError, quoted
+from respec.vocabulary.errors import CodedError, quoted
 from respec.robot import RobotSystem
 from synthesis_manager.limits import BusyError
 from synthesis_manager.web.artifacts import Artifact

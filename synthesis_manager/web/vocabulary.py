@@ -3,15 +3,15 @@ copies of them: state classes, autonomy levels, result codes, the machine's outc
 specification's sections.
 
 Each entry is built from the constant that defines it (sm_generation.instantiation,
-sm_generation.export, respec.errors, respec.naming, respec.spec, ltl_specification.repair); only the page's own words
-(section titles) are written here.
+sm_generation.export, respec.vocabulary.errors, respec.vocabulary.naming, respec.spec,
+ltl_specification.repair); only the page's own words (section titles) are written here.
 """
 
 from __future__ import annotations
 
 from ltl_specification.repair import REPAIRABLE
-from respec.errors import ErrorCode
-from respec.naming import FAILED, FINISHED
+from respec.vocabulary.errors import ErrorCode
+from respec.vocabulary.naming import FAILED, FINISHED
 from respec.spec import SECTIONS
 from sm_generation.export import AUTONOMY_NAMES
 from sm_generation.instantiation import StateInstantiation

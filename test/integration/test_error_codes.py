@@ -10,7 +10,7 @@ from pathlib import Path
 
 import pytest
 
-from respec.errors import CodedError, ErrorCode
+from respec.vocabulary.errors import CodedError, ErrorCode
 from synthesis_msgs.msg import SynthesisErrorCodes
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -118,7 +118,7 @@ def test_a_relayed_answer_keeps_its_code_and_an_unknown_number_is_named():
 
 
 def test_the_readme_lists_every_exit_status_with_its_meaning():
-    from respec.errors import ExitStatus
+    from respec.vocabulary.errors import ExitStatus
 
     readme = (ROOT / 'README.md').read_text()
     assert all(f'| {int(status)} | {status.meaning} |' in readme for status in ExitStatus)
@@ -128,7 +128,7 @@ def test_the_readme_lists_every_exit_status_with_its_meaning():
 
 
 def test_errors_end_in_error_and_every_other_exception_is_a_documented_control_flow_signal():
-    from respec.errors import ControlFlowSignal
+    from respec.vocabulary.errors import ControlFlowSignal
 
     exceptions = {cls for module in MODULES for cls in vars(module).values()
                   if isinstance(cls, type) and issubclass(cls, BaseException) and cls.__module__ == module.__name__}

@@ -17,7 +17,7 @@ from ltl_synthesizer.isolated import SynthesisProcesses
 from ltl_synthesizer.service import (Explainers, KeptAnswer, SynthesisJob, SynthesisService, SynthesisSettings,
                                      answer_cache, unrealizable_head)
 from respec.automaton import automaton_from_strategy
-from respec.errors import ErrorCode
+from respec.vocabulary.errors import ErrorCode
 from respec.ltl import Next, Not, iff, var
 from respec.spec import GR1Specification
 

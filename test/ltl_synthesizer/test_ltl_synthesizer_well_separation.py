@@ -12,7 +12,7 @@ from ltl_specification import compile_task
 from ltl_specification.systems import load_task_abstraction
 from ltl_synthesizer.synthesizer import is_realizable
 from ltl_synthesizer.well_separation import check_well_separation
-from respec.errors import CodedError
+from respec.vocabulary.errors import CodedError
 from respec.parsing import spec_from_text_sections
 from respec.robot import robot_system
 

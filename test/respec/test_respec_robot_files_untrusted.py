@@ -10,7 +10,7 @@ from pathlib import Path
 
 import pytest
 
-from respec.errors import ErrorCode
+from respec.vocabulary.errors import ErrorCode
 from respec.robot import robot_system
 from respec.robot.cnu import CapabilityConfigError
 from respec.robot.files import MAX_CONFIG_DEPTH, MAX_CONFIG_FILE_BYTES, ConfigFileInvalidError, SystemConfigError

@@ -11,7 +11,7 @@ from rclpy.parameter import Parameter
 
 from atlas_sim.executive.executor import execute_state_machine
 from atlas_sim.executive.trace_check import check_trace
-from respec.errors import ExitStatus
+from respec.vocabulary.errors import ExitStatus
 from respec.parsing import spec_from_text_sections
 from synthesis_manager.programs.cli import main as cli_main
 from synthesis_manager.client import SynthesisClient, make_goal

@@ -12,7 +12,7 @@ from rclpy.action import ActionClient
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 
-from respec.naming import parse_names
+from respec.vocabulary.naming import parse_names
 from synthesis_manager.nodes.atlas_sim_node import CAPABILITY_ACTION_PREFIX, AtlasSimNode
 from synthesis_manager.ros.harness import RosHarness, wait_for
 from synthesis_manager.ros.env import prepare_ros_environment

@@ -14,7 +14,7 @@ from pathlib import Path
 
 import pytest
 
-from respec.errors import ExitStatus
+from respec.vocabulary.errors import ExitStatus
 from synthesis_manager.ros.env import prepare_ros_environment
 from synthesis_manager.ros.harness import reserve_domain_id
 

@@ -5,7 +5,7 @@ import threading
 
 import pytest
 
-from respec.errors import ErrorCode
+from respec.vocabulary.errors import ErrorCode
 from synthesis_manager.goals import GoalAdmission, PipelineOutcome, byproduct_name, wants_fixes
 from synthesis_manager.limits import BusyError
 from synthesis_manager.requests import SynthesisTask

@@ -8,7 +8,7 @@ import time
 
 import pytest
 
-from respec.errors import QUOTED_CHARACTERS, quoted
+from respec.vocabulary.errors import QUOTED_CHARACTERS, quoted
 from respec.ltl import var
 from respec.nesting import MAX_FORMULA_NESTING
 from respec.parsing import ParseError, UnknownVariableError, parse_formula, parse_structuredslugs

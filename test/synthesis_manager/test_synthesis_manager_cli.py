@@ -12,7 +12,7 @@ from types import SimpleNamespace
 import pytest
 from rclpy.node import Node
 
-from respec.naming import parse_names
+from respec.vocabulary.naming import parse_names
 from synthesis_manager.requests import InvalidRequestError, selected_option
 from synthesis_manager.ros.env import prepare_ros_environment
 from synthesis_manager.ros.harness import RosHarness

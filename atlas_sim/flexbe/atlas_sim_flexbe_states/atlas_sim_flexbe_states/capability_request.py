@@ -21,7 +21,7 @@ from flexbe_core import Logger
 from flexbe_core.proxy import ProxyActionClient
 
 from atlas_sim.simulator.node_names import CAPABILITY_ACTION_PREFIX
-from respec.naming import COMPLETED  # the ExecuteCapability result outcome meaning success
+from respec.vocabulary.naming import COMPLETED  # the ExecuteCapability result outcome meaning success
 from synthesis_msgs.action import ExecuteCapability
 
 # How long on_enter waits for the simulator's action server the first time (discovery).

@@ -101,7 +101,7 @@ def synthesis_children() -> list[int]:
                 command = cmdline.read()
         except (FileNotFoundError, ProcessLookupError):
             continue
-        if parent == os.getpid() and b'ltl_synthesizer.isolated' in command:
+        if parent == os.getpid() and b'respec.child_processes.runner' in command:
             found.append(int(entry))
     return found
 
@@ -111,7 +111,8 @@ def server_child_wall(spec, repeats: int, cpu_batch: int) -> tuple[float, float]
     ``ltl_synthesis`` node asks it (its default strategy budget), the child already warm; and
     the mean CPU seconds per synthesis of the child and this caller over ``cpu_batch`` of them."""
     from ltl_synthesizer.interrupt import Limits
-    from ltl_synthesizer.isolated import SERVER_CHILD_NICENESS, SynthesisProcesses
+    from ltl_synthesizer.isolated import SynthesisProcesses
+    from respec.child_processes.runner import SERVER_CHILD_NICENESS
     from ltl_synthesizer.service import DEFAULT_MAX_STRATEGY_EDGES
     processes = SynthesisProcesses(niceness=SERVER_CHILD_NICENESS)
     processes.prepare(1)

@@ -4,7 +4,7 @@
 A repair search compiles and synthesizes dozens of candidate tasks for up to its time budget:
 in a server's own process it would hold Python's GIL (one CUDD operation can run for seconds),
 so every other request would wait. It therefore runs in a child process of its own
-(``ltl_synthesizer.isolated.ChildProcess``, which preloads this module), killed when the server
+(``respec.child_processes.runner.ChildProcess``, which preloads this module), killed when the server
 stops or the search overruns its deadline. The child gets the robot system's files as the
 server read them (perhaps from a suite on another machine), not a name to read again, and
 reports each verified proposal as it is found.
@@ -18,12 +18,14 @@ from __future__ import annotations
 import time
 from typing import Callable
 
-from ltl_synthesizer.errors import SynthesisError, SynthesisTimeoutError
+from ltl_synthesizer.errors import SynthesisError
 from ltl_synthesizer.interrupt import DEFAULT_MEMORY_LIMIT
-from ltl_synthesizer.isolated import SERVER_CHILD_NICENESS, ChildProcess
+from ltl_synthesizer.isolated import SYNTHESIS_PROCESS
+from respec.child_processes.errors import ChildWorkError, WorkTimeoutError
+from respec.child_processes.runner import SERVER_CHILD_NICENESS, ChildProcess
 
 #: Seconds a child may take beyond its search's time budget to answer (the kill comes
-#: isolated.DEADLINE_GRACE_SECONDS later still: 0.5 s in all). The budget counts from
+#: runner.DEADLINE_GRACE_SECONDS later still: 0.5 s in all). The budget counts from
 #: the search's creation in the parent, so the child's start (0.2-0.3 s measured) comes out of
 #: it, not on top of it (``search`` stops at ``ends_at``, a time.monotonic() value: one clock for
 #: every process of the machine). A candidate's compilation or synthesis that outlives the
@@ -55,7 +57,7 @@ class RepairSearch:
         ends_at = time.monotonic() + settings['time_budget']
         self.settings = {**settings, 'ends_at': ends_at}
         self.deadline = ends_at + ANSWER_GRACE
-        self.child = ChildProcess(niceness=SERVER_CHILD_NICENESS, preload=__name__)
+        self.child = ChildProcess(niceness=SERVER_CHILD_NICENESS, preload=__name__, name=SYNTHESIS_PROCESS)
 
     def run(self, on_proposal: Callable[[dict], None] | None = None) -> dict:
         """The search's ``Repairs.to_dict()``; ``on_proposal(proposal dict)`` as each is verified.
@@ -65,10 +67,10 @@ class RepairSearch:
         try:
             return self.child.call(search, (self.settings,), on_progress=on_proposal or (lambda _: None),
                                    deadline=self.deadline, memory_limit=self.settings.get('memory_limit'))
-        except SynthesisTimeoutError:
+        except WorkTimeoutError:  # the runner's, or the search's own synthesis timeout
             raise RepairSearchError(f'the repair search was ended at its time budget of '
                                     f'{self.settings["time_budget"]:g} s (a check was still running)') from None
-        except SynthesisError as error:  # died, stopped, its memory limit: SynthesisError's subclasses
+        except (ChildWorkError, SynthesisError) as error:  # died, stopped, its memory limit
             raise RepairSearchError(f'the repair search ended without an answer ({error})') from error
         finally:
             self.child.kill()

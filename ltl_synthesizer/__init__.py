@@ -27,8 +27,8 @@ Modules: interrupt (Limits and their check), symbolic (the game: formulas to BDD
 enforceable predecessors), policy (Options and the automatic plan), synthesizer (the entry
 points above), gr1 (the solver and its fixpoints), strategy (explicit strategies,
 counter-strategies, slugs JSON), explanation (why unrealizable), unrealizable_core (minimal
-unrealizable subsets of guarantees, by delta debugging), isolated (work in child processes
-that a cancel, a deadline or a shutdown ends at once), cache (answers of identical requests),
+unrealizable subsets of guarantees, by delta debugging), isolated (syntheses in child
+processes that a cancel, a deadline or a shutdown ends at once, on respec.child_processes), cache (answers of identical requests),
 service (one request's answer with the synthesis node's policy: backend, cache, diagnosis,
 well-separation), command (the ``gr1synth`` command:
 arguments, one run, outputs), cli (``gr1synth``) and serve (its resident mode), both on

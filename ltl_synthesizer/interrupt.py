@@ -4,13 +4,13 @@ a cancel flag, a deadline and a memory limit (``Limits``), checked by every long
 
 from __future__ import annotations
 
-import os
 import dataclasses
 import threading
 import time
 from dataclasses import dataclass
 
 from ltl_synthesizer.errors import SynthesisCancelledError, SynthesisMemoryError, SynthesisTimeoutError
+from respec.child_processes.memory import resident_memory
 
 # Default memory limit of one synthesis: BDD memory, in bytes.
 DEFAULT_MEMORY_LIMIT = 2 * 2**30
@@ -83,36 +83,6 @@ class Interrupt:
                 raise memory_exceeded(self.memory_limit, self.during())
 
     __call__ = check
-
-
-def resident_memory(pid: int | None = None) -> int:
-    """This process's resident memory in bytes (Linux; elsewhere its peak so far), or that of
-    process ``pid`` (0 once it is gone)."""
-    try:
-        with open(f'/proc/{pid or "self"}/statm') as statm:
-            return int(statm.read().split()[1]) * _PAGE_SIZE
-    except OSError:
-        if pid is not None:
-            return 0
-        import resource
-        return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
-
-
-_PAGE_SIZE = os.sysconf('SC_PAGE_SIZE') if hasattr(os, 'sysconf') else 4096
-
-
-def released_memory(collect: bool = True) -> int:
-    """This process's resident size after its garbage is collected (with ``collect``) and freed
-    heap pages go back to the system (glibc's malloc_trim; elsewhere only the collection)."""
-    if collect:
-        import gc
-        gc.collect()
-    try:
-        import ctypes
-        ctypes.CDLL('libc.so.6').malloc_trim(0)
-    except (OSError, AttributeError):
-        pass
-    return resident_memory()
 
 
 def memory_exceeded(limit: int, during: str = '') -> SynthesisMemoryError:

@@ -18,8 +18,9 @@ from rclpy.node import Node
 
 from ltl_specification.diagnosis import CORE_NOT_COMPUTED, explain_unsynthesizable, explain_well_separation
 from ltl_specification.provenance import provenance_from_json
-from ltl_synthesizer.isolated import SERVER_CHILD_NICENESS, WORKING_CHILDREN_MEMORY, SynthesisProcesses
+from ltl_synthesizer.isolated import SynthesisProcesses
 from ltl_synthesizer.service import Explainers, SynthesisJob, SynthesisService, SynthesisSettings, answer_cache
+from respec.child_processes.runner import SERVER_CHILD_NICENESS, WORKING_CHILDREN_MEMORY
 from respec.vocabulary.errors import CodedError
 from respec.nesting import run_with_deep_stack
 from respec.parsing import ParseError

@@ -11,7 +11,7 @@ from typing import Callable
 from rclpy.node import Node
 from rclpy.time import Time
 
-from ltl_synthesizer.interrupt import released_memory
+from respec.child_processes.memory import released_memory
 from synthesis_manager.goals import PipelineOutcome
 from synthesis_manager.requests import task_from_behavior_synthesis, task_from_flexbe_synthesis
 from synthesis_manager.ros.conversions import error_code

@@ -2,7 +2,7 @@
 
 The compilation and the state-machine generation nodes do small requests at once in their own
 process, and hand large ones (megabytes of custom formulas, automata of thousands of states)
-to this: a child process (``ltl_synthesizer.isolated``) per request, at most ``workers`` at once
+to this: a child process (``respec.child_processes``) per request, at most ``workers`` at once
 and ``waiting`` more in order (then BUSY), each killed at the node's ``timeout`` counted from
 the request's arrival (TIMEOUT), beyond its ``memory_limit_mb`` of growth (the stage's failure
 code naming the limit), at shutdown (PREEMPTED) or when its caller cancels it by its request id
@@ -23,9 +23,10 @@ from __future__ import annotations
 import threading
 import time
 
-from ltl_synthesizer import SynthesisCancelledError
-from ltl_synthesizer.errors import SynthesisMemoryError
-from ltl_synthesizer.isolated import SERVER_CHILD_NICENESS, SynthesisProcesses
+from ltl_synthesizer.errors import in_synthesis_words
+from ltl_synthesizer.isolated import SYNTHESIS_PROCESS
+from respec.child_processes.errors import ChildWorkError, WorkCancelledError, WorkMemoryError
+from respec.child_processes.runner import SERVER_CHILD_NICENESS, ChildProcesses
 from respec.vocabulary.errors import ControlFlowSignal, ErrorCode
 from synthesis_manager.ros.conversions import error_code
 from synthesis_manager.ros.stage_calls import LookTimer
@@ -64,7 +65,8 @@ class ChildStage:
         self.pool = WorkerPool(workers, waiting, name=name)
         # Queued requests see their deadline pass at most this late; stages rarely queue.
         self.looks = LookTimer(node, QUEUE_LOOK_SECONDS)
-        self.processes = SynthesisProcesses(niceness=SERVER_CHILD_NICENESS, preload=preload)
+        # Named, and a child that died answered (SYNTHESIS_FAILED), as the synthesizer's are.
+        self.processes = ChildProcesses(niceness=SERVER_CHILD_NICENESS, preload=preload, name=SYNTHESIS_PROCESS)
         self._cancels: dict[str, _StopFlag] = {}  # by request id, while the request runs
         self._lock = threading.Lock()
 
@@ -102,13 +104,15 @@ class ChildStage:
                 return await self.pool.run(self._in_child, function, args, kwargs, deadline, stop,
                                            wake=executor_waker(self.node),
                                            give_up=lambda: stop.is_set() or time.monotonic() > deadline)
-        except (Abandoned, SynthesisCancelledError):  # a timeout is a cancel by the deadline
+        except (Abandoned, WorkCancelledError):  # a timeout is a cancel by the deadline
             why = ('cancelled' if stop.cancelled.is_set() else 'shutdown' if self.stopping.is_set()
                    else 'time limit')
             raise StageStopped(error_code(ErrorCode.TIMEOUT if why == 'time limit' else ErrorCode.PREEMPTED,
                                           f'{self.what} stopped: {why} ({timeout:g} s for {size})')) from None
-        except SynthesisMemoryError as error:
+        except WorkMemoryError as error:
             raise StageStopped(error_code(self.failed, f'{self.what} failed: {error} (memory_limit_mb, {size})')) from None
+        except ChildWorkError as error:  # the child died (or could not send its answer)
+            raise in_synthesis_words(error) from None
         finally:
             with self._lock:
                 if self._cancels.get(request_id) is stop:
@@ -116,7 +120,7 @@ class ChildStage:
 
     def _in_child(self, function, args, kwargs, deadline: float, stop: _StopFlag):
         if stop.is_set() or time.monotonic() > deadline:
-            raise SynthesisCancelledError('stopped while waiting')
+            raise WorkCancelledError('stopped while waiting')
         return self.processes.call(function, args, kwargs, cancel=stop, deadline=deadline,
                                    memory_limit=self.node.settings.memory_limit_mb * 2**20)
 

@@ -2,7 +2,7 @@
 
 MuJoCo with its off-screen renderer grew the GUI process by ~280 MiB on its first run, and a
 crash in native code would have ended the GUI with it. Each run therefore has a child process
-of its own (``ltl_synthesizer.isolated.ChildProcess``, the project's one process runner, which
+of its own (``respec.child_processes.runner.ChildProcess``, the project's one process runner, which
 preloads this module): the run's settings go in, progress comes back as steps and key frames
 are added, then one final message (the state machine goes in as its tree, pickled with the rest).
 Frames and the timeline are files in the run's record
@@ -29,8 +29,8 @@ from pathlib import Path
 from typing import Callable
 
 from atlas_sim.executive.runtime_control import FULL, RuntimeControl
-from ltl_synthesizer.errors import SynthesisError
-from ltl_synthesizer.isolated import ChildProcess
+from respec.child_processes.errors import ChildWorkError
+from respec.child_processes.runner import ChildProcess
 from respec.vocabulary.errors import INTERNAL_ERROR, CodedError
 
 #: Seconds past its own wall-time limit a child is given before it is killed.
@@ -71,7 +71,7 @@ class SimulationProcess:
         try:
             return self.child.call(self.simulator, (self.settings,), on_progress=progress, wants_commands=True,
                                    deadline=time.monotonic() + self.settings['max_wall_time'] + KILL_GRACE)
-        except SynthesisError:  # the child died, was stopped or overran its time
+        except ChildWorkError:  # the child died, was stopped or overran its time
             pass
         finally:
             self.child.kill()

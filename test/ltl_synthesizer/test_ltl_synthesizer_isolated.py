@@ -1,4 +1,5 @@
-"""ltl_synthesizer.isolated: syntheses in child processes, stopped by killing the child."""
+"""ltl_synthesizer.isolated and the runner under it (respec.child_processes): syntheses and other
+work in child processes, stopped by killing the child."""
 
 import atexit
 import operator
@@ -13,8 +14,8 @@ import pytest
 
 from ltl_specification import compile_task
 from ltl_synthesizer import Limits, SynthesisCancelledError, synthesize
-from ltl_synthesizer.errors import SynthesisMemoryError, UndeclaredPropositionError
-from ltl_synthesizer.isolated import SynthesisProcessDiedError, SynthesisProcesses
+from ltl_synthesizer.errors import SynthesisMemoryError, SynthesisProcessDiedError, UndeclaredPropositionError
+from ltl_synthesizer.isolated import SynthesisProcesses
 from respec.ltl import var
 from respec.spec import GR1Specification
 from respec.robot import robot_system
@@ -75,7 +76,7 @@ def children_of_this_process() -> set[int]:
     for pid in pids:
         try:
             with open(f'/proc/{pid}/cmdline') as cmdline:
-                if b'ltl_synthesizer.isolated' in cmdline.read().encode():
+                if b'respec.child_processes.runner' in cmdline.read().encode():
                     found.add(pid)
         except FileNotFoundError:  # ended meanwhile
             pass
@@ -281,10 +282,10 @@ def echo_commands(count: int, progress, commands):
 
 
 def test_commands_reach_the_running_work_and_late_ones_are_dropped(monkeypatch):
-    from ltl_synthesizer.isolated import ChildProcess
+    from respec.child_processes.runner import ChildProcess
     # The child imports this module to find echo_commands.
     monkeypatch.setenv('PYTHONPATH', os.pathsep.join([str(Path(__file__).parent), os.environ.get('PYTHONPATH', '')]))
-    child = ChildProcess(preload='ltl_synthesizer.isolated')
+    child = ChildProcess()
     try:
         seen = []
 
@@ -305,12 +306,12 @@ def test_commands_reach_the_running_work_and_late_ones_are_dropped(monkeypatch):
 
 
 def test_specifications_reach_the_child_whole_with_their_shared_subformulas():
-    """Requests pickle formula nodes as class and fields (isolated._dumps): every kind of node
+    """Requests pickle formula nodes as class and fields (runner._dumps): every kind of node
     comes back equal, and a subformula shared by two formulas is still one object."""
     import pickle
 
     from respec.ltl import FALSE, conj, disj, iff, implies, neg, next_
-    from ltl_synthesizer.isolated import _dumps
+    from respec.child_processes.runner import _dumps
     shared = iff(var('x'), next_(var('y')))
     spec = GR1Specification(env_props=['x'], sys_props=['y'], env_trans=[implies(shared, disj([var('x'), FALSE]))],
                             sys_trans=[conj([shared, neg(var('y'))]), shared])
@@ -322,15 +323,15 @@ def test_specifications_reach_the_child_whole_with_their_shared_subformulas():
 def test_working_children_together_stay_under_the_sum_limit(monkeypatch):
     """Issue 48, item 9: three BDD bombs at once took the tree to 6.3 GB, each under its own
     limit. Past the sum limit the child holding the most is ended; the others finish."""
-    from ltl_synthesizer import isolated
+    from respec.child_processes import runner
 
     pool = SynthesisProcesses()
     try:
         pool.prepare(3)
         pool.call(os.getpid)  # the children have started: the tree as it is before the work
-        tree = isolated.resident_memory() + sum(isolated.resident_memory(pid) for pid in isolated._child_pids())
+        tree = runner.resident_memory() + sum(runner.resident_memory(pid) for pid in runner._child_pids())
         # The work may add 450 MB to the tree (the test process, whatever its size, and its children).
-        monkeypatch.setattr(isolated, 'WORKING_CHILDREN_MEMORY', isolated.WorkingChildrenMemory(limit=tree + 450 * 2**20))
+        monkeypatch.setattr(runner, 'WORKING_CHILDREN_MEMORY', runner.WorkingChildrenMemory(limit=tree + 450 * 2**20))
         sizes = {'big': (400, 3.0), 'small one': (100, 1.5), 'small two': (100, 1.5)}
         with ThreadPoolExecutor(3) as threads:
             answers = {name: threads.submit(pool.call, exec, (grow_and_wait(megabytes, seconds), {}))
@@ -349,17 +350,17 @@ def test_a_growing_tree_is_stopped_before_it_passes_the_sum_limit(monkeypatch):
     first reading after a pause does not count the pause's growth."""
     from types import SimpleNamespace
 
-    from ltl_synthesizer import isolated
+    from respec.child_processes import runner
 
     class Child:  # what the sum limit reads of a ChildProcess
         process = SimpleNamespace(pid=7)
 
     readings = {'child': 0}
-    monkeypatch.setattr(isolated, 'resident_memory', lambda pid=None: readings['child'] if pid == 7 else 0)
-    monkeypatch.setattr(isolated, '_child_pids', lambda: [7])
+    monkeypatch.setattr(runner, 'resident_memory', lambda pid=None: readings['child'] if pid == 7 else 0)
+    monkeypatch.setattr(runner, '_child_pids', lambda: [7])
     clock = {'now': 100.0}
-    monkeypatch.setattr(isolated.time, 'monotonic', lambda: clock['now'])
-    memory = isolated.WorkingChildrenMemory(limit=350, period=0.1)
+    monkeypatch.setattr(runner.time, 'monotonic', lambda: clock['now'])
+    memory = runner.WorkingChildrenMemory(limit=350, period=0.1)
     child = Child()
     memory.working(child, True)
     verdicts = []

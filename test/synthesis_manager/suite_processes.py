@@ -116,7 +116,7 @@ def _runs_a_synthesis(pid: int) -> bool:
         command = Path(f'/proc/{pid}/cmdline').read_bytes()
     except OSError:
         return False
-    return b'gr1synth' in command or b'ltl_synthesizer.isolated' in command
+    return b'gr1synth' in command or b'respec.child_processes.runner' in command
 
 
 @contextlib.contextmanager

@@ -12,7 +12,7 @@ strategy extraction would take hours (``RUNAWAY_SPEC``); through the GUI and the
 in-process commands, which take only a robot system and goals, a system whose goal needs
 300 parts assembled at once (``many_parts_config``), whose BDD operations run for seconds
 each. The builtin synthesizer runs each synthesis in a child process, which a stop kills
-(ltl_synthesizer.isolated); one test uses gr1synth as the external synthesizer instead.
+(respec.child_processes); one test uses gr1synth as the external synthesizer instead.
 """
 
 import contextlib

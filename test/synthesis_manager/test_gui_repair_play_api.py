@@ -312,10 +312,10 @@ def search_settings(time_budget=10.0):
 def test_a_search_past_its_deadline_is_killed(monkeypatch):
     from ltl_specification import repair_process
 
-    from ltl_synthesizer import isolated
+    from respec.child_processes import runner
 
     monkeypatch.setattr(repair_process, 'ANSWER_GRACE', 0.0)
-    monkeypatch.setattr(isolated, 'DEADLINE_GRACE_SECONDS', 0.0)  # no time to report its own timeout
+    monkeypatch.setattr(runner, 'DEADLINE_GRACE_SECONDS', 0.0)  # no time to report its own timeout
     search = repair_process.RepairSearch(search_settings(time_budget=0.01))
     with pytest.raises(repair_process.RepairSearchError, match='ended at its time budget'):
         search.run()

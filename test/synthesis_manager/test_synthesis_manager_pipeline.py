@@ -162,7 +162,8 @@ IMPOSSIBLE_TASK = dict(system='atlas', initial_conditions=['stand_prep'], goals=
 @pytest.fixture
 def endless_diagnosis(suite, monkeypatch, tmp_path):
     """The suite's synthesis node diagnoses with test/endless_diagnosis.py; yields its pid file."""
-    from ltl_synthesizer.isolated import SERVER_CHILD_NICENESS, SynthesisProcesses
+    from ltl_synthesizer.isolated import SynthesisProcesses
+    from respec.child_processes.runner import SERVER_CHILD_NICENESS
 
     test_dir = str(Path(__file__).resolve().parents[1])
     monkeypatch.setenv('PYTHONPATH', os.pathsep.join(filter(None, [test_dir, os.environ.get('PYTHONPATH')])))

@@ -427,7 +427,7 @@ def test_one_clients_runaways_leave_another_clients_goal_its_usual_latency(ros, 
 
 def children_at_lowest_priority() -> list[int]:
     """This process's child processes running at nice 19."""
-    from ltl_synthesizer.isolated import LOWEST_PRIORITY
+    from respec.child_processes.runner import LOWEST_PRIORITY
 
     found = []
     for entry in Path('/proc').iterdir():

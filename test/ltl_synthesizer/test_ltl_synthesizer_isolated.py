@@ -1,5 +1,5 @@
-"""ltl_synthesizer.isolated and the runner under it (respec.child_processes): syntheses and other
-work in child processes, stopped by killing the child."""
+"""ltl_synthesizer.isolated: syntheses in child processes, stopped by killing the child (the runner
+under it, respec.child_processes: test/respec/test_respec_child_processes.py)."""
 
 import atexit
 import operator
@@ -118,7 +118,7 @@ def test_a_cancel_kills_the_child_at_once_and_the_next_synthesis_works(processes
     with pytest.raises(SynthesisCancelledError) as error:
         processes.synthesize(RUNAWAY, limits=Limits(cancel=cancel))
     stopped = time.monotonic()
-    assert error.value.code == 'PREEMPTED'
+    assert error.value.code == 'PREEMPTED' and str(error.value) == 'synthesis cancelled'
     assert len(working) == 1 and not Path(f'/proc/{working.pop()}').exists()  # killed and reaped
     assert len(children_of_this_process()) <= 1  # at most the replacement, started idle
     assert processes.synthesize(compile_task(robot_system('atlas'), ['stand_prep'], ['look_down'])).realizable
@@ -150,7 +150,8 @@ def test_a_child_killed_from_outside_is_reported_and_replaced(processes):
         os.kill(pid, signal.SIGKILL)
     worker.join(timeout=10)
     assert isinstance(outcome.get('error'), SynthesisProcessDiedError)
-    assert outcome['error'].code == 'SYNTHESIS_FAILED'
+    assert outcome['error'].code == 'SYNTHESIS_FAILED' and outcome['error'].item == 'synthesis process'
+    assert str(outcome['error']) == 'the synthesis process ended (exit code -9) without an answer'
     assert processes.synthesize(compile_task(robot_system('atlas'), ['stand_prep'], ['look_down'])).realizable
 
 
@@ -270,56 +271,6 @@ def test_work_without_limits_of_its_own_is_killed_beyond_the_callers_memory_limi
     assert processes.call(exec, (grow_and_wait(16, 0.0), {}), memory_limit=64 * 2**20) is None  # a fresh child
 
 
-def echo_commands(count: int, progress, commands):
-    """In the child: report that it runs, then each command the caller sends, until ``count`` have come."""
-    received = []
-    progress({'n': -1})
-    while len(received) < count:
-        for value in commands(5.0):
-            received.append(value)
-            progress(value)
-    return received
-
-
-def test_commands_reach_the_running_work_and_late_ones_are_dropped(monkeypatch):
-    from respec.child_processes.runner import ChildProcess
-    # The child imports this module to find echo_commands.
-    monkeypatch.setenv('PYTHONPATH', os.pathsep.join([str(Path(__file__).parent), os.environ.get('PYTHONPATH', '')]))
-    child = ChildProcess()
-    try:
-        seen = []
-
-        def progress(value):  # answer each report with the next command, from another thread
-            seen.append(value)
-            threading.Thread(target=child.command, args=({'n': value['n'] + 1},)).start()
-
-        assert child.command({'n': -5})  # before the work: dropped
-        assert child.call(echo_commands, (3,), on_progress=progress, wants_commands=True,
-                          deadline=time.monotonic() + 30) == [{'n': 0}, {'n': 1}, {'n': 2}]
-        assert seen == [{'n': -1}, {'n': 0}, {'n': 1}, {'n': 2}]
-        time.sleep(0.2)  # the command sent after the third report arrives after the work ended
-        assert child.call(operator.add, (2, 3), deadline=time.monotonic() + 30) == 5
-        assert child.call(operator.add, (1, 1), deadline=time.monotonic() + 30) == 2
-    finally:
-        child.kill()
-    assert child.command({'n': 9}) is False  # the child is gone
-
-
-def test_specifications_reach_the_child_whole_with_their_shared_subformulas():
-    """Requests pickle formula nodes as class and fields (runner._dumps): every kind of node
-    comes back equal, and a subformula shared by two formulas is still one object."""
-    import pickle
-
-    from respec.ltl import FALSE, conj, disj, iff, implies, neg, next_
-    from respec.child_processes.runner import _dumps
-    shared = iff(var('x'), next_(var('y')))
-    spec = GR1Specification(env_props=['x'], sys_props=['y'], env_trans=[implies(shared, disj([var('x'), FALSE]))],
-                            sys_trans=[conj([shared, neg(var('y'))]), shared])
-    loaded = pickle.loads(_dumps(spec))
-    assert loaded == spec
-    assert loaded.sys_trans[1] is loaded.sys_trans[0].args[0] is loaded.env_trans[0].left
-
-
 def test_working_children_together_stay_under_the_sum_limit(monkeypatch):
     """Issue 48, item 9: three BDD bombs at once took the tree to 6.3 GB, each under its own
     limit. Past the sum limit the child holding the most is ended; the others finish."""
@@ -344,31 +295,24 @@ def test_working_children_together_stay_under_the_sum_limit(monkeypatch):
         pool.close()
 
 
-def test_a_growing_tree_is_stopped_before_it_passes_the_sum_limit(monkeypatch):
-    """The tree is read every ``period``: a child growing 100 MB per reading toward a 350 MB
-    limit is ended at the reading of 300 MB (the next would be 400), not after passing it; a
-    first reading after a pause does not count the pause's growth."""
-    from types import SimpleNamespace
+def test_the_runners_stops_reach_a_synthesis_in_the_synthesizers_words():
+    """The runner (respec.child_processes) stops work in its own words; a synthesis's callers get
+    the synthesizer's errors, which are the runner's kinds (so the compilation's and the repair
+    search's catches, written for the runner's, catch them too)."""
+    from ltl_synthesizer.errors import SynthesisTimeoutError, in_synthesis_words
+    from respec.child_processes.errors import (ChildDiedError, ChildWorkError, WorkCancelledError, WorkMemoryError,
+                                               WorkTimeoutError)
 
-    from respec.child_processes import runner
-
-    class Child:  # what the sum limit reads of a ChildProcess
-        process = SimpleNamespace(pid=7)
-
-    readings = {'child': 0}
-    monkeypatch.setattr(runner, 'resident_memory', lambda pid=None: readings['child'] if pid == 7 else 0)
-    monkeypatch.setattr(runner, '_child_pids', lambda: [7])
-    clock = {'now': 100.0}
-    monkeypatch.setattr(runner.time, 'monotonic', lambda: clock['now'])
-    memory = runner.WorkingChildrenMemory(limit=350, period=0.1)
-    child = Child()
-    memory.working(child, True)
-    verdicts = []
-    for size in (100, 200, 300):
-        clock['now'] += 0.125
-        readings['child'] = size
-        verdicts.append(memory.is_over(child))
-    assert verdicts == [False, False, True] and memory.growth == 100
-    clock['now'] += 60  # a minute later, 340 MB: under the limit, and no growth is known
-    readings['child'] = 340
-    assert not memory.is_over(child) and memory.growth == 0
+    died = 'the synthesis process ended (exit code -9) without an answer'
+    cases = [(WorkCancelledError(), SynthesisCancelledError, ('synthesis cancelled', 'PREEMPTED', 'cancelled')),
+             (WorkTimeoutError(), SynthesisTimeoutError, ('synthesis timeout', 'SYNTHESIS_TIMEOUT', 'timeout')),
+             (WorkMemoryError('the work needed more', item='memory_limit'), SynthesisMemoryError,
+              ('the work needed more', 'SYNTHESIS_FAILED', 'memory_limit')),
+             (ChildDiedError(died, item='synthesis process'), SynthesisProcessDiedError,
+              (died, 'SYNTHESIS_FAILED', 'synthesis process'))]
+    for stopped, kind, words in cases:
+        answer = in_synthesis_words(stopped)
+        assert type(answer) is kind and (str(answer), answer.code, answer.item) == words
+        assert isinstance(answer, type(stopped))
+    assert isinstance(SynthesisTimeoutError(during='solving the game'), WorkCancelledError)
+    assert not isinstance(UndeclaredPropositionError('x'), ChildWorkError)

@@ -1,5 +1,5 @@
-"""respec: a ROS-free library that builds LTL formulas and GR(1) specifications, and the model
-types every package shares.
+"""respec: a ROS-free library that builds LTL formulas and GR(1) specifications, and what every
+package shares: the model types, the suite's vocabulary and the process runner.
 
 The LTL library:
     ltl                  the LTL formula representation and its slugs printers
@@ -19,4 +19,8 @@ Shared model types:
 The suite's vocabulary (``respec.vocabulary``): the naming rules of propositions, outcomes and
 lists (``naming``), the result codes and CodedError (``errors``), private directories
 (``private_files``).
+
+The process runner (``respec.child_processes``): work in child processes that a cancel, a
+deadline, a memory limit or a shutdown ends at once, stopped with neutral errors (syntheses,
+large compilations and generations, repair searches, the GUI's simulations).
 """

@@ -28,7 +28,6 @@ from ltl_specification.provenance import provenance_to_json
 from ltl_specification.repair import TaskRequest
 from ltl_specification.repair_process import RepairSearch, RepairSearchError, repair_settings
 from ltl_specification.systems import task_system_errors
-from ltl_synthesizer import SynthesisCancelledError
 from respec.vocabulary.errors import ErrorCode
 from respec.robot import SystemCatalog, catalog_to_json
 from respec.robot.files import SystemConfigError
@@ -187,7 +186,7 @@ class LTLCompilationNode(Node):
             with self.children.looks.waiting():  # the search sees a shutdown
                 repairs = await self.repairs.run(self._search_repairs, settings, wake=executor_waker(self),
                                                  give_up=self._stopping.is_set)
-        except (RepairSearchError, Abandoned, SynthesisCancelledError) as error:
+        except (RepairSearchError, Abandoned) as error:
             response.error_code = error_code(ErrorCode.TIMEOUT, f'repair search stopped: {error or "shutdown"}')
             return response
         except Exception as error:  # noqa: BLE001 - every failure becomes an error code; the node keeps serving
@@ -205,7 +204,7 @@ class LTLCompilationNode(Node):
         self._repair_searches.add(search)
         try:
             if self._stopping.is_set():
-                raise SynthesisCancelledError('stopped while waiting')
+                raise RepairSearchError('shutdown before it started')
             return search.run()
         finally:
             self._repair_searches.discard(search)

@@ -23,8 +23,6 @@ from __future__ import annotations
 import threading
 import time
 
-from ltl_synthesizer.errors import in_synthesis_words
-from ltl_synthesizer.isolated import SYNTHESIS_PROCESS
 from respec.child_processes.errors import ChildWorkError, WorkCancelledError, WorkMemoryError
 from respec.child_processes.runner import SERVER_CHILD_NICENESS, ChildProcesses
 from respec.vocabulary.errors import ControlFlowSignal, ErrorCode
@@ -65,8 +63,7 @@ class ChildStage:
         self.pool = WorkerPool(workers, waiting, name=name)
         # Queued requests see their deadline pass at most this late; stages rarely queue.
         self.looks = LookTimer(node, QUEUE_LOOK_SECONDS)
-        # Named, and a child that died answered (SYNTHESIS_FAILED), as the synthesizer's are.
-        self.processes = ChildProcesses(niceness=SERVER_CHILD_NICENESS, preload=preload, name=SYNTHESIS_PROCESS)
+        self.processes = ChildProcesses(niceness=SERVER_CHILD_NICENESS, preload=preload, name=f'{name} process')
         self._cancels: dict[str, _StopFlag] = {}  # by request id, while the request runs
         self._lock = threading.Lock()
 
@@ -112,7 +109,7 @@ class ChildStage:
         except WorkMemoryError as error:
             raise StageStopped(error_code(self.failed, f'{self.what} failed: {error} (memory_limit_mb, {size})')) from None
         except ChildWorkError as error:  # the child died (or could not send its answer)
-            raise in_synthesis_words(error) from None
+            raise StageStopped(error_code(self.failed, f'{self.what} failed: {error} ({size})')) from None
         finally:
             with self._lock:
                 if self._cancels.get(request_id) is stop:

@@ -3,8 +3,12 @@ service caps its time limit (issue 34, item 2): 20 goals of 11 MB custom formula
 server (compiled synchronously in its process, holding the GIL; a normal goal after them
 waited 228 s), and a SynthesizeAutomaton request could ask for any time limit."""
 
+import contextlib
+import os
+import signal
 import threading
 import time
+from pathlib import Path
 
 import pytest
 from rclpy.parameter import Parameter
@@ -15,6 +19,7 @@ from synthesis_manager.nodes.ltl_compilation_node import SMALL_CUSTOM_BYTES, LTL
 from respec.robot import SystemCatalog, robot_system
 from runaway_requests import runaway_goal
 from suite_in_process import PAPER_TASK, start_suite
+from suite_processes import descendants
 
 pytestmark = pytest.mark.ros
 
@@ -250,6 +255,35 @@ def test_a_large_generation_beyond_its_memory_limit_names_the_limit(ros):
     answer = generation_service(ros, memory_limit_mb=1)(message)
     assert answer.error_code.value == answer.error_code.SM_GENERATION_FAILED, answer.error_code.message
     assert 'memory limit of 1 MB' in answer.error_code.message and 'memory_limit_mb' in answer.error_code.message
+
+
+def test_a_generation_child_that_dies_is_answered_in_the_stages_words(ros):
+    """A generation child killed from outside answers SM_GENERATION_FAILED naming the generation
+    process and the request's size (not a synthesis's words: nothing was synthesized), and the
+    node serves the next request in a fresh child."""
+    message, _ = chain_automaton_message(20_000)
+    generate = generation_service(ros)
+    answers = []
+    sender = threading.Thread(target=lambda: answers.append(generate(message)))
+    sender.start()
+
+    def generation_children() -> list[int]:
+        children = []
+        for pid in descendants(os.getpid()):
+            with contextlib.suppress(OSError):  # ended meanwhile
+                if b'sm_generation' in Path(f'/proc/{pid}/cmdline').read_bytes():
+                    children.append(pid)
+        return children
+
+    assert wait_until(generation_children, 30.0), 'no generation child started'
+    for pid in generation_children():
+        os.kill(pid, signal.SIGKILL)
+    sender.join(60)
+    answer = answers[0]
+    assert answer.error_code.value == answer.error_code.SM_GENERATION_FAILED, answer.error_code.message
+    assert answer.error_code.message == ('state machine generation failed: the generation process ended '
+                                         '(exit code -9) without an answer (40,002 automaton states)')
+    assert generate(chain_automaton_message(3)[0]).error_code.value == 1
 
 
 def test_a_compilation_stops_at_the_time_its_caller_has_left(ros, tmp_path):

@@ -13,6 +13,7 @@ from __future__ import annotations
 import warnings
 from dataclasses import dataclass, field
 from functools import cached_property
+from typing import Any, Iterable
 
 from ltl_synthesizer.cudd_import import cudd
 
@@ -31,6 +32,9 @@ from ltl_synthesizer.translation import Translator, check_declarations, declare_
 # allocation, 2-6 ms) and is as fast on the largest family instances.
 MEMORY_ESTIMATE = 256 * 2**20
 INITIAL_CACHE_SLOTS = 2**14
+
+#: A BDD of ``dd.cudd`` (a ``dd.cudd.Function``: dd has no type hints, so it is Any to mypy).
+Node = Any
 
 
 @dataclass
@@ -245,7 +249,7 @@ class SymbolicGame:
     def cube(self, valuation: dict[str, bool]):
         return self.bdd.cube(valuation)
 
-    def pick(self, u, names):
+    def pick(self, u: Node, names: Iterable[str]) -> tuple[dict[str, bool], Node]:
         """The smallest assignment to ``names`` (False before True, in the given order) within ``u``.
 
         Returns ``(assignment, u restricted to it)``; ``u`` must not be FALSE. Independent of

@@ -44,8 +44,7 @@ def _generated_from_capabilities(automaton: Automaton, system: RobotSystem, init
                                  reduce: bool, state_library: StateLibrary | None) -> StateMachine:
     del initial_conditions  # the automaton's initial state is the spec's
     library = workspace_state_library() if state_library is None else state_library
-    capabilities = system.capabilities
-    assert capabilities is not None  # for_description chose this generator by them
+    capabilities = system.required_capabilities()
     return generate_capability_machine(automaton, capabilities, library, reduce or capabilities.reduce)
 
 
@@ -74,8 +73,7 @@ def behavior_flexbe_config(system: RobotSystem, state_library: StateLibrary | No
 
 def _capability_behavior_config(system: RobotSystem, state_library: StateLibrary | None) -> FlexBEConfig:
     library = workspace_state_library() if state_library is None else state_library
-    capabilities = system.capabilities
-    assert capabilities is not None  # for_description chose this by them
+    capabilities = system.required_capabilities()
     capability_outcomes(capabilities, library)
     return capability_flexbe_config(capabilities, library)
 

@@ -22,14 +22,11 @@ from respec.ltl import to_infix
 from respec.spec import GR1Specification
 from ltl_synthesizer.gr1 import Solver, solve_environment_game
 from ltl_synthesizer.interrupt import Limits
-from ltl_synthesizer.strategy import EnvironmentStrategy, losing_initial_positions
+from ltl_synthesizer.strategy import EnvironmentStrategy, Position, losing_initial_positions
 from ltl_synthesizer.symbolic import SymbolicGame
 
 MAX_MOVES = 64          # responses listed at one step (the first ones, deterministic order)
 MAX_PLAY_STEPS = 500    # a play longer than this is refused (the API is stateless)
-# A node of the environment's counter-strategy: the propositions' values (None for the outputs of
-# a deadlock), and the rank (the assumption pursued, the goal blocked) (EnvironmentStrategy.successors).
-Position = tuple[tuple[bool | None, ...], tuple[int, int]]
 
 
 class PlayError(ValueError):

@@ -302,7 +302,8 @@ def _goals(spec: CapabilitySpecification, goals: Sequence[str], parts: dict[str,
     parts['sys_liveness'].append(disj([var(success), var(spec.failed)]) if spec.failed else var(success))
 
 
-def _initial_values(spec: CapabilitySpecification, initial_conditions: Sequence[str], parts: dict[str, list[Formula]]) -> None:
+def _initial_values(spec: CapabilitySpecification, initial_conditions: Sequence[str],
+                    parts: dict[str, list[Formula]]) -> None:
     given: dict[str, Formula] = {}    # variable -> its initial condition(s)
     for text in [*spec.system.spec_initial, *initial_conditions]:
         literal = _request_literal(spec, text, 'initial condition', InvalidInitialConditionsError)

@@ -139,7 +139,8 @@ def _can_hold(capabilities: CapabilitySystem, literal: Literal, initial: dict[st
     return (not literal.negated) in values
 
 
-def _possible_values(capabilities: CapabilitySystem, name: str, initial: dict[str, set[int | bool]]) -> set[int | bool] | None:
+def _possible_values(capabilities: CapabilitySystem, name: str,
+                     initial: dict[str, set[int | bool]]) -> set[int | bool] | None:
     """The values a memory or system integer can ever take (None for anything else)."""
     integer = capabilities.integers.get(name)
     if integer is not None and integer.environment:

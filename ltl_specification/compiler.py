@@ -122,7 +122,8 @@ def compile_task(system: RobotSystem, initial_conditions: Sequence[str] | str, g
 
 
 def _compiled_for_capabilities(system: RobotSystem, initial_conditions: Sequence[str] | str, goals: Sequence[str] | str,
-                               sm_outcomes: Sequence[str], strict_order: bool, custom_ltl: Mapping[str, Sequence[str]] | None,
+                               sm_outcomes: Sequence[str], strict_order: bool,
+                               custom_ltl: Mapping[str, Sequence[str]] | None,
                                state_library: Mapping[str, StateClass] | None,
                                explain_refusal: bool) -> CompiledSpecification:
     del strict_order, explain_refusal  # CNU's goals hold together; its refusals come from the pre-check
@@ -382,7 +383,8 @@ def _items_mentioned(abstraction: RobotAbstraction, custom_formulas: dict[str, l
     return items, sensors
 
 
-def _custom_specification(custom_ltl: Mapping[str, Sequence[str]] | None, custom_formulas: dict[str, list[Formula]]) -> GR1Specification:
+def _custom_specification(custom_ltl: Mapping[str, Sequence[str]] | None,
+                          custom_formulas: dict[str, list[Formula]]) -> GR1Specification:
     if not custom_ltl:
         return GR1Specification()
     return GR1Specification(env_props=list(custom_ltl.get('env_props', [])),

@@ -107,7 +107,8 @@ def control_mode_groups(adjacency: Mapping[str, Sequence[str]], outcomes: Sequen
 
 
 def control_mode_specification(adjacency: Mapping[str, Sequence[str]], outcomes: Sequence[str],
-                               retry_after_failure: bool = False, groups: Sequence[FormulaGroup] | None = None) -> GR1Specification:
+                               retry_after_failure: bool = False,
+                               groups: Sequence[FormulaGroup] | None = None) -> GR1Specification:
     """Formulas (3)-(5) and (9)-(13) for the control modes in ``adjacency``.
 
     ``adjacency`` maps every mode to the modes it may change to, its own self-loop included.
@@ -144,7 +145,8 @@ def action_groups(actions: Mapping[str, Sequence[str]], outcomes: Sequence[str],
 
 
 def action_specification(actions: Mapping[str, Sequence[str]], outcomes: Sequence[str],
-                         retry_after_failure: bool = False, groups: Sequence[FormulaGroup] | None = None) -> GR1Specification:
+                         retry_after_failure: bool = False,
+                         groups: Sequence[FormulaGroup] | None = None) -> GR1Specification:
     """Formulas (3)-(8) for each action in ``actions`` (action -> its preconditions);
     ``groups`` when already built (``action_groups``)."""
     return specification_from_groups(
@@ -181,7 +183,8 @@ def goal_groups(goals: Sequence[str], sm_outcomes: Sequence[str], strict_order: 
 
 def goal_specification(goals: Sequence[str], sm_outcomes: Sequence[str], strict_order: bool,
                        failure_propositions: Sequence[str], success: str = ao.COMPLETED,
-                       finished: str = FINISHED, failed: str = FAILED, groups: Sequence[FormulaGroup] | None = None) -> GR1Specification:
+                       finished: str = FINISHED, failed: str = FAILED,
+                       groups: Sequence[FormulaGroup] | None = None) -> GR1Specification:
     """Formulas (16)-(20): goal memories, state-machine outcomes and the single liveness.
 
     ``sm_outcomes`` contains ``finished`` and optionally ``failed``; ``failure_propositions``
@@ -209,7 +212,8 @@ def initial_conditions_groups(items: Sequence[str], initially_completed: Sequenc
 
 
 def initial_conditions_specification(items: Sequence[str], initially_completed: Sequence[str],
-                                     outcomes: Sequence[str], groups: Sequence[FormulaGroup] | None = None) -> GR1Specification:
+                                     outcomes: Sequence[str],
+                                     groups: Sequence[FormulaGroup] | None = None) -> GR1Specification:
     """Formulas (14) and (15) over all ``items`` (actions and modes) of the task; ``groups``
     when already built (``initial_conditions_groups``)."""
     return specification_from_groups(

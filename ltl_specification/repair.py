@@ -388,7 +388,8 @@ def _swapped_pairs(original: Sequence[str], order: Sequence[str]) -> int:
     return sum(1 for a, b in itertools.combinations(order, 2) if position[a] > position[b])
 
 
-def _prerequisite_candidates(system: RobotSystem, request: TaskRequest, custom_ltl: CustomLTL | None) -> Iterator[Proposal]:
+def _prerequisite_candidates(system: RobotSystem, request: TaskRequest,
+                             custom_ltl: CustomLTL | None) -> Iterator[Proposal]:
     """An item added as a goal before a goal: one whose goal memory (``<item>_m``, eq. (20))
     the custom LTL uses first, then a control mode or a precondition of a goal, which with goals
     in order takes the robot where the next goal can be reached from."""
@@ -462,7 +463,8 @@ def _drop_goal_candidates(request: TaskRequest) -> Iterator[Proposal]:
 
 # --- custom LTL ------------------------------------------------------------------------------------
 
-def _custom_ltl_candidates(system: RobotSystem, request: TaskRequest, custom_ltl: CustomLTL | None) -> Iterator[Proposal]:
+def _custom_ltl_candidates(system: RobotSystem, request: TaskRequest,
+                           custom_ltl: CustomLTL | None) -> Iterator[Proposal]:
     """Weaken a custom guarantee (drop it), or assume more of the environment (mined)."""
     if not custom_ltl:
         return

@@ -355,7 +355,8 @@ class SynthesisService:
             return answer, None
         return answer, KeptAnswer({**byproducts, 'json': strategy_json}, True, 'SUCCESS', warning, answer.automaton)
 
-    def _well_separation_warning(self, spec: SpecificationText | GR1Specification, job: SynthesisJob, settings: SynthesisSettings) -> tuple[str, bool]:
+    def _well_separation_warning(self, spec: SpecificationText | GR1Specification, job: SynthesisJob,
+                                 settings: SynthesisSettings) -> tuple[str, bool]:
         """The warning that the controller can win by forcing the environment to break its
         assumptions ('' when it cannot, when check_well_separation is off, or when the check
         does not end within the diagnosis time and the job's time limit: the automaton
@@ -377,7 +378,8 @@ class SynthesisService:
             self.warn(f'well-separation not checked: {error}'[:300])
             return '', False
 
-    def _diagnosed(self, details: str, spec: SpecificationText | GR1Specification, job: SynthesisJob, settings: SynthesisSettings) -> tuple[str, bool]:
+    def _diagnosed(self, details: str, spec: SpecificationText | GR1Specification, job: SynthesisJob,
+                   settings: SynthesisSettings) -> tuple[str, bool]:
         """``details`` (the synthesizer's explanation), led by why the task cannot be done: in
         the task's terms when the job carries the specification's provenance, else by its
         formulas; and whether the diagnosis was whole (its core computed). The diagnosis runs in

@@ -571,7 +571,8 @@ class EnvironmentStrategy:
             successors.append((next_values, (next_assumption, next_goal)))
         return successors
 
-    def _responses(self, state: Mapping[str, bool | None], chosen_input: dict[str, bool], responses: Node, assumption: int,
+    def _responses(self, state: Mapping[str, bool | None], chosen_input: dict[str, bool], responses: Node,
+                   assumption: int,
                    only_first: bool) -> list[tuple[tuple[bool, ...], int]]:
         """The system's responses to the chosen input (output values, in next_outputs order,
         smallest first: False before True, in declared order, as repeated ``pick``s would

@@ -78,7 +78,8 @@ class Translator:
                 continue
             kind = formula.__class__
             if kind is Var or kind is Const:
-                if kind is Var and under_next and formula.name in self.outputs:  # type: ignore[attr-defined]  # a Var: mypy narrows by isinstance, not __class__ (this loop's dispatch)
+                # A Var (mypy narrows by isinstance, not by the __class__ this hot loop dispatches on):
+                if kind is Var and under_next and formula.name in self.outputs:  # type: ignore[attr-defined]
                     next_outputs.add(formula.name)  # type: ignore[attr-defined]
                 translated[id(formula)] = self._node(formula, (), under_next, section)
                 continue

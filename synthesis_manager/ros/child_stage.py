@@ -117,7 +117,9 @@ class ChildStage:
     def _in_child(self, function, args, kwargs, deadline: float, stop: _StopFlag):
         if stop.is_set() or time.monotonic() > deadline:
             raise SynthesisCancelledError('stopped while waiting')
-        return self.processes.call(function, args, kwargs, cancel=stop, deadline=deadline,  # type: ignore[arg-type]  # it asks only is_set() (isolated.py's annotation: after its move)
+        # ``cancel`` is asked only is_set(); isolated.py annotates it as an Event (to become a
+        # Protocol once isolated.py has moved into respec and is checked).
+        return self.processes.call(function, args, kwargs, cancel=stop, deadline=deadline,  # type: ignore[arg-type]
                                    memory_limit=self.node.settings.memory_limit_mb * 2**20)
 
     def stop(self) -> None:

@@ -40,7 +40,7 @@ _STAGE_FAILURES = ((-9, 'BEHAVIOR_SYNTHESIS_FAILED'), (-19, 'SPEC_COMPILATION_FA
 def cnu_error_name(code: ErrorCode, cnu_names) -> str:
     """The CNU constant for our error ``code``: the same-named one when CNU has it, else the one
     of the same meaning (CNU_EQUIVALENTS), else its stage's generic failure."""
-    code = ErrorCode(code)  # type: ignore[call-arg]  # a lookup by value: mypy reads it as the members' constructor
+    code = ErrorCode(code)  # type: ignore[call-arg]  # a lookup by value (mypy: a constructor)
     if code.name in cnu_names:
         return code.name
     if CNU_EQUIVALENTS.get(code.name) in cnu_names:

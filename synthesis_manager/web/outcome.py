@@ -35,7 +35,7 @@ class JobOutcome:
     @classmethod
     def local(cls, error_name: ErrorCode, message: str, seconds: float) -> 'JobOutcome':
         """The outcome of a job that never got a result (``seconds`` since it was created)."""
-        return cls(ErrorCode(error_name).number, error_name,  # type: ignore[call-arg]  # a lookup by value: mypy reads it as the members' constructor
+        return cls(ErrorCode(error_name).number, error_name,  # type: ignore[call-arg]  # a lookup by value (mypy: a constructor)
                    message, seconds=round(seconds, 4))
 
     @classmethod

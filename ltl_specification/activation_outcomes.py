@@ -15,7 +15,8 @@ from __future__ import annotations
 from typing import Iterable, Mapping, Sequence
 
 from respec.ltl import FALSE, TRUE, Formula, conj, disj, iff, implies, neg, next_, var
-from respec.vocabulary.naming import COMPLETED, FAILED, FINISHED, activation, memory, outcome_proposition
+from respec.vocabulary.naming import COMPLETED as COMPLETED, FAILED, FINISHED, activation as activation, memory as memory
+from respec.vocabulary.naming import outcome_proposition as outcome_proposition  # components.py reads these four here
 
 
 

@@ -52,6 +52,7 @@ from __future__ import annotations
 
 from typing import Mapping, Sequence
 
+from respec.vocabulary.errors import CodedError
 from respec.robot.cnu import FAILURE, CapabilityConfigError, CapabilitySystem, Literal, parse_literal
 from respec.ltl import TRUE, Formula, Not, Var, conj, disj, iff, implies, neg, next_, var, variables
 from respec.vocabulary.naming import COMPLETED, FAILED, FINISHED, activation, did_you_mean, memory, remembered
@@ -98,7 +99,8 @@ class CapabilitySpecification:
     def propositions(self) -> set[str]:
         return set(self.env_props) | set(self.sys_props)
 
-    def atom(self, literal: Literal, next_step: bool, item: str, error=CapabilityConfigError) -> Formula:
+    def atom(self, literal: Literal, next_step: bool, item: str,
+             error: type[CodedError] = CapabilityConfigError) -> Formula:
         """The formula of a literal; a capability or memory name means its memory proposition."""
         if literal.value is not None:
             formula = self.integers[literal.name].equals(literal.value, next_step)
@@ -122,7 +124,8 @@ class CapabilitySpecification:
 
 def compile_capability_task(system: CapabilitySystem, library: Mapping[str, StateClass],
                             initial_conditions: Sequence[str], goals: Sequence[str],
-                            custom_ltl=None, sm_outcomes: Sequence[str] = ()) -> GR1Specification:
+                            custom_ltl: Mapping[str, Sequence[str]] | None = None,
+                            sm_outcomes: Sequence[str] = ()) -> GR1Specification:
     """The GR(1) specification of reaching ``goals`` from ``initial_conditions`` on ``system``,
     with the requested state-machine outcomes ``sm_outcomes`` (CNU's request semantics: the
     first one that is not ``failed`` is the success outcome, ``finished`` when none is given).
@@ -135,7 +138,7 @@ def compile_capability_task(system: CapabilitySystem, library: Mapping[str, Stat
     spec = CapabilitySpecification(system, capability_outcomes(system, library), sm_outcomes)
     if system.full_spec:
         return _full_specification(spec, initial_conditions, goals)
-    parts = {section: [] for section in FORMULA_SECTIONS}
+    parts: dict[str, list[Formula]] = {section: [] for section in FORMULA_SECTIONS}
     _environment(spec, parts)
     _activations(spec, parts)
     _failures(spec, parts)
@@ -174,7 +177,7 @@ def _machine_outcomes(system: CapabilitySystem, outcome_props: Mapping[str, Mapp
     return success, system.sm_outcome(FAILED), ending
 
 
-def _environment(spec: CapabilitySpecification, parts: dict) -> None:
+def _environment(spec: CapabilitySpecification, parts: dict[str, list[Formula]]) -> None:
     for name, props in spec.outcome_props.items():
         running = var(spec.activations[name])
         outcomes = list(props.values())
@@ -187,7 +190,7 @@ def _environment(spec: CapabilitySpecification, parts: dict) -> None:
             parts['env_liveness'].append(disj([neg(running), next_(var(progress))]))
 
 
-def _activations(spec: CapabilitySpecification, parts: dict) -> None:
+def _activations(spec: CapabilitySpecification, parts: dict[str, list[Formula]]) -> None:
     activities = [*spec.activations.values(), *spec.sm_props]
     parts['sys_trans'].append(disj(next_(var(a)) for a in activities))
     parts['sys_trans'] += [neg(conj([next_(var(a)), next_(var(b))]))
@@ -199,7 +202,7 @@ def _activations(spec: CapabilitySpecification, parts: dict) -> None:
                                           next_(var(active))))
 
 
-def _failures(spec: CapabilitySpecification, parts: dict) -> None:
+def _failures(spec: CapabilitySpecification, parts: dict[str, list[Formula]]) -> None:
     """A requested ``failed``: a failure no transition relation handles ends the machine there,
     and nothing else does (a failure that a transition relation handles is followed as it says)."""
     if spec.failed is None:
@@ -210,7 +213,7 @@ def _failures(spec: CapabilitySpecification, parts: dict) -> None:
     parts['sys_trans'].append(implies(next_(failed), disj([failed, *(next_(var(p)) for p in failures)])))
 
 
-def _conditions(spec: CapabilitySpecification, parts: dict) -> dict[str, list[Formula]]:
+def _conditions(spec: CapabilitySpecification, parts: dict[str, list[Formula]]) -> dict[str, list[Formula]]:
     """Preconditions, transition relations and postconditions; returns the outcomes that set
     each memory or integer (the others keep their values)."""
     system = spec.system
@@ -248,7 +251,7 @@ def _conditions(spec: CapabilitySpecification, parts: dict) -> dict[str, list[Fo
     return setters
 
 
-def _frames(spec: CapabilitySpecification, setters: dict[str, list[Formula]], parts: dict) -> None:
+def _frames(spec: CapabilitySpecification, setters: dict[str, list[Formula]], parts: dict[str, list[Formula]]) -> None:
     """Memories and system integers keep their values unless an outcome sets them."""
     variables = [(name, [memory(name)]) for name in spec.used_memories]
     variables += [(name, integer.bits) for name, integer in spec.integers.items()
@@ -280,14 +283,14 @@ def _target(spec: CapabilitySpecification, term: Literal) -> Formula:
     return neg(formula) if term.negated else formula
 
 
-def _request_literal(spec: CapabilitySpecification, text: str, what: str, error) -> Literal:
+def _request_literal(spec: CapabilitySpecification, text: str, what: str, error: type[CodedError]) -> Literal:
     try:  # one grammar for files and requests
         return parse_literal(text, text, f'{spec.system.system} {what}', spec.system.integers, False)
     except CapabilityConfigError as problem:
         raise error(str(problem), item=text) from None
 
 
-def _goals(spec: CapabilitySpecification, goals: Sequence[str], parts: dict) -> None:
+def _goals(spec: CapabilitySpecification, goals: Sequence[str], parts: dict[str, list[Formula]]) -> None:
     literals = [_request_literal(spec, goal, 'goal', InvalidGoalsError) for goal in goals]
     atoms = [spec.atom(literal, False, 'goal', UnknownPropositionError) for literal in literals]
     success = spec.success
@@ -299,7 +302,8 @@ def _goals(spec: CapabilitySpecification, goals: Sequence[str], parts: dict) -> 
     parts['sys_liveness'].append(disj([var(success), var(spec.failed)]) if spec.failed else var(success))
 
 
-def _initial_values(spec: CapabilitySpecification, initial_conditions: Sequence[str], parts: dict) -> None:
+def _initial_values(spec: CapabilitySpecification, initial_conditions: Sequence[str],
+                    parts: dict[str, list[Formula]]) -> None:
     given: dict[str, Formula] = {}    # variable -> its initial condition(s)
     for text in [*spec.system.spec_initial, *initial_conditions]:
         literal = _request_literal(spec, text, 'initial condition', InvalidInitialConditionsError)
@@ -345,7 +349,7 @@ def _parsed_spec_formulas(system: CapabilitySystem, env_props: list[str], sys_pr
     return parsed
 
 
-def _spec_file_formulas(spec: CapabilitySpecification, parts: dict) -> None:
+def _spec_file_formulas(spec: CapabilitySpecification, parts: dict[str, list[Formula]]) -> None:
     """CNU's capability pipeline: the spec file's transitions and livenesses join the capabilities'
     (its initial values are read as literals by ``_initial_values``). A memory they name is kept."""
     memories = [memory(name) for name in spec.memories]
@@ -356,7 +360,7 @@ def _spec_file_formulas(spec: CapabilitySpecification, parts: dict) -> None:
         for formula in parsed[section]:
             for name in variables(formula):
                 if name in memories:
-                    spec.used_memories.setdefault(remembered(name))
+                    spec.used_memories.setdefault(str(remembered(name)))  # a memory's: never None
             parts[section].append(formula)
 
 
@@ -372,7 +376,7 @@ def _full_specification(spec: CapabilitySpecification, initial_conditions: Seque
     parts = _parsed_spec_formulas(system, env_props, sys_props, integers, FORMULA_SECTIONS)
     known = set(env_props) | set(sys_props)
 
-    def formula_of(text: str, what: str, error, next_step: bool = False) -> tuple[str, Formula]:
+    def formula_of(text: str, what: str, error: type[CodedError], next_step: bool = False) -> tuple[str, Formula]:
         literal = _request_literal(spec, text, what, error)
         name = literal.name
         if literal.value is None and name not in known and memory(name) in known:

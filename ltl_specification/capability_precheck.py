@@ -25,7 +25,7 @@ is the whole specification, and its formulas may set any output.
 
 from __future__ import annotations
 
-from typing import Sequence
+from typing import Iterable, Sequence
 
 from respec.vocabulary.naming import activation, did_you_mean, memory
 from respec.robot import RobotSystem
@@ -40,14 +40,14 @@ REQUEST_INITIAL_CONDITIONS = "the request's initial conditions"
 def check_capability_names(system: RobotSystem, initial_conditions: Sequence[str]) -> None:
     """Raise the first ``unknown_initial_conditions`` error (the names are checked before compiling,
     so the sentence names the entry to change rather than a formula the compiler was building)."""
-    errors = [] if system.capabilities.full_spec else unknown_initial_conditions(system, initial_conditions)
+    errors = [] if system.required_capabilities().full_spec else unknown_initial_conditions(system, initial_conditions)
     if errors:
         raise errors[0]
 
 
 def check_capability_task(system: RobotSystem, initial_conditions: Sequence[str], goals: Sequence[str]) -> None:
     """Raise the first goal or precondition that can never become true (see the module doc)."""
-    if system.capabilities.full_spec:
+    if system.required_capabilities().full_spec:
         return
     errors = [*unreachable_goals(system, initial_conditions, goals),
               *unestablished_preconditions(system, initial_conditions)]
@@ -71,7 +71,7 @@ def system_names(capabilities: CapabilitySystem) -> set[str]:
 def unknown_initial_conditions(system: RobotSystem, initial_conditions: Sequence[str]) -> list[UnknownPropositionError]:
     """An initial condition of the request or the spec file that names nothing of the system: a
     misspelt or foreign name would otherwise be reported as a formula the compiler cannot build."""
-    capabilities = system.capabilities
+    capabilities = system.required_capabilities()
     known = system_names(capabilities)
     listed = sorted(n for n in known if not _is_outcome(capabilities, n))
     errors = []
@@ -90,7 +90,7 @@ def unreachable_goals(system: RobotSystem, initial_conditions: Sequence[str],
                       goals: Sequence[str]) -> list[InvalidGoalsError]:
     """A goal on a memory or integer that neither holds initially nor is set by any postcondition:
     the frame axioms keep it false forever, so synthesis could only answer "unrealizable"."""
-    capabilities = system.capabilities
+    capabilities = system.required_capabilities()
     initial = _initial_values(capabilities, initial_conditions)
     errors = []
     for goal in goals:
@@ -109,7 +109,7 @@ def unestablished_preconditions(system: RobotSystem,
                                 initial_conditions: Sequence[str]) -> list[CapabilityConfigError]:
     """A precondition entry none of whose terms can ever hold: its capability can never start, and
     a task that needs it would be refused as unrealizable without naming it."""
-    capabilities = system.capabilities
+    capabilities = system.required_capabilities()
     initial = _initial_values(capabilities, initial_conditions)
     errors = []
     for name, capability in capabilities.capabilities.items():
@@ -128,7 +128,7 @@ def unestablished_preconditions(system: RobotSystem,
 
 # --- values ----------------------------------------------------------------------------------
 
-def _can_hold(capabilities: CapabilitySystem, literal: Literal, initial: dict[str, set]) -> bool:
+def _can_hold(capabilities: CapabilitySystem, literal: Literal, initial: dict[str, set[int | bool]]) -> bool:
     """Whether ``literal`` holds initially or after some postcondition; a name the frames do not
     keep (a proposition, an environment integer, an unknown name) counts as possibly true."""
     values = _possible_values(capabilities, literal.name, initial)
@@ -139,7 +139,8 @@ def _can_hold(capabilities: CapabilitySystem, literal: Literal, initial: dict[st
     return (not literal.negated) in values
 
 
-def _possible_values(capabilities: CapabilitySystem, name: str, initial: dict[str, set]) -> set | None:
+def _possible_values(capabilities: CapabilitySystem, name: str,
+                     initial: dict[str, set[int | bool]]) -> set[int | bool] | None:
     """The values a memory or system integer can ever take (None for anything else)."""
     integer = capabilities.integers.get(name)
     if integer is not None and integer.environment:
@@ -147,7 +148,7 @@ def _possible_values(capabilities: CapabilitySystem, name: str, initial: dict[st
     if integer is None and name not in capabilities.capabilities and name not in capabilities.memory:
         return None
     values = set(initial[name])
-    everything = set(range(integer.low, integer.high + 1)) if integer else {False, True}
+    everything: set[int | bool] = set(range(integer.low, integer.high + 1)) if integer else {False, True}
     for capability in capabilities.capabilities.values():
         for literals in capability.postconditions.values():
             for literal in literals:
@@ -156,7 +157,7 @@ def _possible_values(capabilities: CapabilitySystem, name: str, initial: dict[st
     return values
 
 
-def _values_of(literal: Literal, everything: set) -> set:
+def _values_of(literal: Literal, everything: set[int | bool]) -> set[int | bool]:
     """The values a postcondition or initial literal sets its variable to."""
     if literal.choose:
         return set(everything)
@@ -165,18 +166,18 @@ def _values_of(literal: Literal, everything: set) -> set:
     return everything - {literal.value} if literal.negated else {literal.value}
 
 
-def _initial_values(capabilities: CapabilitySystem, initial_conditions: Sequence[str]) -> dict[str, set]:
+def _initial_values(capabilities: CapabilitySystem, initial_conditions: Sequence[str]) -> dict[str, set[int | bool]]:
     """Each memory's and integer's initial values, as the compiler sets them: declared (memories
     false unless the memory section says otherwise, integers at their lowest value), then the spec
     file's initial entries, then the request's (a later literal replaces an earlier one)."""
-    initial: dict[str, set] = {name: {False} for name in capabilities.capabilities}
+    initial: dict[str, set[int | bool]] = {name: {False} for name in capabilities.capabilities}
     initial.update({name: {value} for name, value in capabilities.memory.items()})
     initial.update({name: {integer.low} for name, integer in capabilities.integers.items()})
     for text in [*capabilities.spec_initial, *initial_conditions]:
         literal = _literal(capabilities, text)
         if literal is not None and literal.name in initial:
             integer = capabilities.integers.get(literal.name)
-            everything = set(range(integer.low, integer.high + 1)) if integer else {False, True}
+            everything: set[int | bool] = set(range(integer.low, integer.high + 1)) if integer else {False, True}
             initial[literal.name] = _values_of(literal, everything)
     return initial
 
@@ -194,10 +195,10 @@ def _literal(capabilities: CapabilitySystem, text: str) -> Literal | None:
 def _initial_entries(system: RobotSystem, initial_conditions: Sequence[str]) -> list[tuple[str, str]]:
     """Each initial condition with the entry a user changes: the spec file's section or the request."""
     spec_file = system.sections.get(SPEC_KEY)
-    sections = {text: section.upper() for section, text in system.capabilities.spec_formulas
+    sections = {text: section.upper() for section, text in system.required_capabilities().spec_formulas
                 if section in ('env_init', 'sys_init')}
     entries = [(text, f'specs.{sections[text]} in {spec_file}' if text in sections and spec_file
-                else f'the initial state of {system.config_file}') for text in system.capabilities.spec_initial]
+                else f'the initial state of {system.config_file}') for text in system.required_capabilities().spec_initial]
     return entries + [(text, REQUEST_INITIAL_CONDITIONS) for text in initial_conditions]
 
 
@@ -219,7 +220,7 @@ def _value_words(literal: Literal) -> str:
     return f'{memory(literal.name)} {"false" if literal.negated else "true"}'
 
 
-def _initially_words(literal: Literal, initial: dict[str, set]) -> str:
+def _initially_words(literal: Literal, initial: dict[str, set[int | bool]]) -> str:
     """How the variable starts, as the compiler sets it (``starts false``, ``starts at 0``)."""
     values = sorted(initial[literal.name])
     if literal.value is not None:
@@ -227,7 +228,7 @@ def _initially_words(literal: Literal, initial: dict[str, set]) -> str:
     return f'starts {"true" if values == [True] else "false"}'
 
 
-def clause_text(clause) -> str:
+def clause_text(clause: Iterable[Literal]) -> str:
     """A precondition clause (its literals, any of which may hold) as the files write it."""
     return ' | '.join(_term_text(term) for term in clause)
 

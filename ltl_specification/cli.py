@@ -14,6 +14,7 @@ import argparse
 import json
 import sys
 from pathlib import Path
+from typing import Any
 
 from ltl_specification.compiler import compile_task, explain
 from ltl_specification.errors import InvalidFormulaError
@@ -67,11 +68,11 @@ def run(args: argparse.Namespace) -> int:
                             custom_ltl=custom_ltl)
     except CodedError as error:  # the task's and the robot files' own errors (a state class the workspace lacks)
         # One line naming the code and the item; a refusal's diagnosis (core, play) follows it.
-        sentence, _, diagnosis = str(error).partition('\n')
+        sentence, _, details = str(error).partition('\n')
         message = ' '.join(sentence.split())
         print(f'error: {error.code}: {message} [item: {error.item!r}]', file=sys.stderr)
         if getattr(error, 'diagnosis', None) is not None:
-            print(diagnosis.rstrip('\n'), file=sys.stderr)
+            print(details.rstrip('\n'), file=sys.stderr)
         return ExitStatus.FAILED
     if args.format == 'json':
         text = json.dumps(spec.to_text_sections(), indent=2) + '\n'
@@ -111,7 +112,7 @@ MAX_CUSTOM_LTL_BYTES = 4 * 2**20
 MAX_CUSTOM_LTL_DEPTH = 8
 
 
-def read_custom_ltl(path: str | None):
+def read_custom_ltl(path: str | None) -> Any:  # untrusted: compile_task checks it
     """The ``--custom-ltl`` file's mapping (None without one); InvalidFormulaError naming the file
     when it cannot be read, is not a regular file of at most MAX_CUSTOM_LTL_BYTES, is not UTF-8
     or not YAML/JSON within the bounds (``respec.untrusted``)."""

@@ -41,7 +41,7 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass, field, fields
-from typing import Mapping, Sequence
+from typing import Any, Mapping, Sequence
 
 from respec.robot import RobotSystem, for_description
 from respec.robot.abstraction import RobotAbstraction
@@ -51,8 +51,8 @@ from ltl_specification.components import (
     control_mode_specification, goal_groups, goal_specification, initial_conditions_groups,
     initial_conditions_specification,
 )
-from respec.vocabulary.errors import quoted
-from respec.ltl import variables
+from respec.vocabulary.errors import CodedError, quoted
+from respec.ltl import Formula, variables
 from respec.vocabulary.naming import (DEFAULT_SM_OUTCOMES, FAILED, FINISHED, activation, did_you_mean,
                                       outcome_proposition, parse_names)
 from respec.parsing import ParseError, UnknownVariableError, parse_formula, spec_from_text_sections
@@ -121,21 +121,26 @@ def compile_task(system: RobotSystem, initial_conditions: Sequence[str] | str, g
                        explain_refusal)
 
 
-def _compiled_for_capabilities(system: RobotSystem, initial_conditions, goals, sm_outcomes, strict_order,
-                               custom_ltl, state_library, explain_refusal) -> CompiledSpecification:
+def _compiled_for_capabilities(system: RobotSystem, initial_conditions: Sequence[str] | str, goals: Sequence[str] | str,
+                               sm_outcomes: Sequence[str], strict_order: bool,
+                               custom_ltl: Mapping[str, Sequence[str]] | None,
+                               state_library: Mapping[str, StateClass] | None,
+                               explain_refusal: bool) -> CompiledSpecification:
     del strict_order, explain_refusal  # CNU's goals hold together; its refusals come from the pre-check
     library = workspace_state_library() if state_library is None else state_library
     initial_conditions = _names(initial_conditions, 'initial conditions', InvalidInitialConditionsError)
     goals = _names(goals, 'goals', InvalidGoalsError)
     check_capability_names(system, initial_conditions)   # first: the sentence names the entry to change
-    spec = compile_capability_task(system.capabilities, library, initial_conditions, goals, custom_ltl,
+    spec = compile_capability_task(system.required_capabilities(), library, initial_conditions, goals, custom_ltl,
                                    _names(sm_outcomes, 'state-machine outcomes', InvalidSmOutcomesError))
     check_capability_task(system, initial_conditions, goals)   # once the files' own errors are ruled out
     return CompiledSpecification(**_spec_fields(spec))
 
 
-def _compiled_for_modes(system: RobotSystem, initial_conditions, goals, sm_outcomes, strict_order,
-                        custom_ltl, state_library, explain_refusal) -> CompiledSpecification:
+def _compiled_for_modes(system: RobotSystem, initial_conditions: Sequence[str] | str, goals: Sequence[str] | str,
+                        sm_outcomes: Sequence[str], strict_order: bool, custom_ltl: Mapping[str, Sequence[str]] | None,
+                        state_library: Mapping[str, StateClass] | None,
+                        explain_refusal: bool) -> CompiledSpecification:
     del state_library  # the abstraction's flexbe: section names its states
     abstraction = load_task_abstraction(system)
     sm_outcomes = _check_sm_outcomes(sm_outcomes)
@@ -170,14 +175,14 @@ def _compiled_for_modes(system: RobotSystem, initial_conditions, goals, sm_outco
 _COMPILERS = {RobotAbstraction: _compiled_for_modes, CapabilitySystem: _compiled_for_capabilities}
 
 
-def _flexbe_states(system: RobotSystem) -> dict:
+def _flexbe_states(system: RobotSystem) -> dict[str, Any]:
     """The ``flexbe.states`` section of the system file (empty without one): it names the states
     and outcomes of a diagnosis' play."""
     states = system.section('flexbe').get('states') if system.has_section('flexbe') else None
     return states if isinstance(states, dict) else {}
 
 
-def _spec_fields(spec: GR1Specification) -> dict:
+def _spec_fields(spec: GR1Specification) -> dict[str, Any]:
     return {f.name: getattr(spec, f.name) for f in fields(GR1Specification)}
 
 
@@ -210,7 +215,7 @@ def _sub_specifications(abstraction: RobotAbstraction, pertinence: Pertinence, i
     return parts, [*mode_groups, *action_groups_, *initial_groups, *goals_groups]
 
 
-def _custom_groups(custom_formulas: dict[str, list]) -> list[FormulaGroup]:
+def _custom_groups(custom_formulas: dict[str, list[Formula]]) -> list[FormulaGroup]:
     """One group per custom formula, named by its section and index (as the request gave it)."""
     return [FormulaGroup(section, 'custom', 'custom LTL', f'{section}[{index}]', SOURCE_CUSTOM, (formula,))
             for section in FORMULA_SECTIONS for index, formula in enumerate(custom_formulas.get(section, []))]
@@ -240,7 +245,7 @@ def explain(spec: CompiledSpecification) -> str:
 
 # --- request validation ---------------------------------------------------------------------
 
-def _names(value: Sequence[str] | str | None, what: str, error) -> list[str]:
+def _names(value: Sequence[str] | str | None, what: str, error: type[CodedError]) -> list[str]:
     if value is None:
         return []
     if isinstance(value, str):
@@ -254,7 +259,7 @@ def _names(value: Sequence[str] | str | None, what: str, error) -> list[str]:
     return names
 
 
-def _check_sm_outcomes(sm_outcomes) -> tuple[str, ...]:
+def _check_sm_outcomes(sm_outcomes: Sequence[str]) -> tuple[str, ...]:
     names = _names(sm_outcomes, 'state-machine outcomes', InvalidSmOutcomesError)
     for name in names:
         if name not in (FINISHED, FAILED):
@@ -269,7 +274,7 @@ def _check_sm_outcomes(sm_outcomes) -> tuple[str, ...]:
     return normalized
 
 
-def _check_goals(abstraction: RobotAbstraction, goals) -> list[str]:
+def _check_goals(abstraction: RobotAbstraction, goals: Sequence[str] | str) -> list[str]:
     names = _names(goals, 'goals', InvalidGoalsError)
     if not names:
         raise InvalidGoalsError('no goals given: name at least one action or control mode', item='')
@@ -284,7 +289,7 @@ def _check_goals(abstraction: RobotAbstraction, goals) -> list[str]:
     return names
 
 
-def _check_initial_conditions(abstraction: RobotAbstraction, initial_conditions) -> list[str]:
+def _check_initial_conditions(abstraction: RobotAbstraction, initial_conditions: Sequence[str] | str) -> list[str]:
     names = _names(initial_conditions, 'initial conditions', InvalidInitialConditionsError)
     for name in names:
         if abstraction.kind_of(name) is None:
@@ -335,14 +340,14 @@ def _initial_mode(abstraction: RobotAbstraction, initial_conditions: list[str]) 
 
 # --- custom LTL -----------------------------------------------------------------------------------
 
-def _parse_custom_ltl(custom_ltl) -> dict[str, list]:
+def _parse_custom_ltl(custom_ltl: object) -> dict[str, list[Formula]]:
     """Parse the custom formulas (syntax only); names are checked once the task is known."""
     if not custom_ltl:
         return {}
     if not isinstance(custom_ltl, Mapping):
         raise InvalidFormulaError(f'custom LTL must map section names to lists, got {quoted(custom_ltl)}',
                                   item=quoted(custom_ltl))
-    parsed = {}
+    parsed: dict[str, list[Formula]] = {}
     for section, entries in custom_ltl.items():
         if section not in SECTIONS:
             raise InvalidFormulaError(
@@ -363,7 +368,8 @@ def _parse_custom_ltl(custom_ltl) -> dict[str, list]:
     return parsed
 
 
-def _items_mentioned(abstraction: RobotAbstraction, custom_formulas: dict[str, list]):
+def _items_mentioned(abstraction: RobotAbstraction, custom_formulas: dict[str, list[Formula]]
+                     ) -> tuple[list[str], list[str]]:
     """Actions/modes and sensors whose propositions the custom formulas use (config order)."""
     owner_of = {}
     for item in abstraction.items():
@@ -377,14 +383,15 @@ def _items_mentioned(abstraction: RobotAbstraction, custom_formulas: dict[str, l
     return items, sensors
 
 
-def _custom_specification(custom_ltl, custom_formulas: dict[str, list]) -> GR1Specification:
+def _custom_specification(custom_ltl: Mapping[str, Sequence[str]] | None,
+                          custom_formulas: dict[str, list[Formula]]) -> GR1Specification:
     if not custom_ltl:
         return GR1Specification()
     return GR1Specification(env_props=list(custom_ltl.get('env_props', [])),
                             sys_props=list(custom_ltl.get('sys_props', [])), **custom_formulas)
 
 
-def _check_custom_scopes(spec: GR1Specification, custom_ltl) -> None:
+def _check_custom_scopes(spec: GR1Specification, custom_ltl: Mapping[str, Sequence[str]] | None) -> None:
     """Re-parse the custom formulas against the task's declarations and slugs' section rules."""
     if not custom_ltl:
         return
@@ -401,9 +408,9 @@ def _check_custom_scopes(spec: GR1Specification, custom_ltl) -> None:
         raise InvalidFormulaError(f'custom LTL: {error}', item=_custom_entry(custom_ltl, error)) from error
 
 
-def _custom_entry(custom_ltl, error: ParseError) -> str:
+def _custom_entry(custom_ltl: Mapping[str, Sequence[str]], error: ParseError) -> str:
     """The custom formula (or name) a parse error is about: its filename is 'section[index]'."""
     match = re.fullmatch(r'(\w+)\[(\d+)\]', error.filename)
     if match and match[1] in custom_ltl and int(match[2]) < len(custom_ltl[match[1]]):
         return str(custom_ltl[match[1]][int(match[2])])
-    return error.item
+    return str(error.item)

@@ -66,14 +66,15 @@ def specification_from_groups(groups: Sequence[FormulaGroup], env_props: Sequenc
     return spec
 
 
-class _GroupList(list):
+class _GroupList(list[FormulaGroup]):
     """Collects groups, leaving out empty ones (an equation that adds nothing for an item)."""
 
-    def add(self, section: str, equation: str, title: str, item: str, source: str, formulas) -> None:
+    def add(self, section: str, equation: str, title: str, item: str, source: str,
+            formulas: Formula | Sequence[Formula]) -> None:
         assert section in FORMULA_SECTIONS, section
-        formulas = tuple(formulas) if isinstance(formulas, (list, tuple)) else (formulas,)
-        if formulas:
-            self.append(FormulaGroup(section, equation, title, item, source, formulas))
+        group_formulas = tuple(formulas) if isinstance(formulas, (list, tuple)) else (formulas,)
+        if group_formulas:
+            self.append(FormulaGroup(section, equation, title, item, source, group_formulas))
 
 
 def control_mode_groups(adjacency: Mapping[str, Sequence[str]], outcomes: Sequence[str],
@@ -106,7 +107,8 @@ def control_mode_groups(adjacency: Mapping[str, Sequence[str]], outcomes: Sequen
 
 
 def control_mode_specification(adjacency: Mapping[str, Sequence[str]], outcomes: Sequence[str],
-                               retry_after_failure: bool = False, groups=None) -> GR1Specification:
+                               retry_after_failure: bool = False,
+                               groups: Sequence[FormulaGroup] | None = None) -> GR1Specification:
     """Formulas (3)-(5) and (9)-(13) for the control modes in ``adjacency``.
 
     ``adjacency`` maps every mode to the modes it may change to, its own self-loop included.
@@ -143,7 +145,8 @@ def action_groups(actions: Mapping[str, Sequence[str]], outcomes: Sequence[str],
 
 
 def action_specification(actions: Mapping[str, Sequence[str]], outcomes: Sequence[str],
-                         retry_after_failure: bool = False, groups=None) -> GR1Specification:
+                         retry_after_failure: bool = False,
+                         groups: Sequence[FormulaGroup] | None = None) -> GR1Specification:
     """Formulas (3)-(8) for each action in ``actions`` (action -> its preconditions);
     ``groups`` when already built (``action_groups``)."""
     return specification_from_groups(
@@ -180,7 +183,8 @@ def goal_groups(goals: Sequence[str], sm_outcomes: Sequence[str], strict_order: 
 
 def goal_specification(goals: Sequence[str], sm_outcomes: Sequence[str], strict_order: bool,
                        failure_propositions: Sequence[str], success: str = ao.COMPLETED,
-                       finished: str = FINISHED, failed: str = FAILED, groups=None) -> GR1Specification:
+                       finished: str = FINISHED, failed: str = FAILED,
+                       groups: Sequence[FormulaGroup] | None = None) -> GR1Specification:
     """Formulas (16)-(20): goal memories, state-machine outcomes and the single liveness.
 
     ``sm_outcomes`` contains ``finished`` and optionally ``failed``; ``failure_propositions``
@@ -208,7 +212,8 @@ def initial_conditions_groups(items: Sequence[str], initially_completed: Sequenc
 
 
 def initial_conditions_specification(items: Sequence[str], initially_completed: Sequence[str],
-                                     outcomes: Sequence[str], groups=None) -> GR1Specification:
+                                     outcomes: Sequence[str],
+                                     groups: Sequence[FormulaGroup] | None = None) -> GR1Specification:
     """Formulas (14) and (15) over all ``items`` (actions and modes) of the task; ``groups``
     when already built (``initial_conditions_groups``)."""
     return specification_from_groups(

@@ -34,6 +34,7 @@ from __future__ import annotations
 import itertools
 import time
 from dataclasses import asdict, dataclass, field
+from typing import Any, Callable, Iterable, Sequence
 
 from ltl_specification.components import SOURCE_CUSTOM, FormulaGroup
 from respec.ltl import Formula, evaluate, mentions_next, to_infix, variables
@@ -112,7 +113,7 @@ class Diagnosis:
             lines += ['', self.note]
         return '\n'.join(lines)
 
-    def to_dict(self) -> dict:
+    def to_dict(self) -> dict[str, Any]:
         return asdict(self)
 
 
@@ -121,7 +122,9 @@ class Diagnosis:
 def precheck(spec: GR1Specification, provenance: Provenance | None = None) -> list[Finding]:
     """Impossible requests that the abstraction and the request alone reveal (see module doc);
     ``provenance`` is what ``spec`` was compiled from (default: its own ``provenance``)."""
-    provenance = provenance or spec.provenance
+    provenance = provenance or getattr(spec, 'provenance', None)
+    if provenance is None:  # a specification given whole: nothing to check it against
+        return []
     findings = list(provenance.findings)  # what the abstraction shows, found when compiling
     custom = [g for g in provenance.groups if g.source == SOURCE_CUSTOM]
     findings += _forbidden_activations(custom, provenance)
@@ -129,7 +132,8 @@ def precheck(spec: GR1Specification, provenance: Provenance | None = None) -> li
     return findings
 
 
-def goal_findings(system: RobotSystem, initial_conditions, goals, strict_order: bool = True) -> list[Finding]:
+def goal_findings(system: RobotSystem, initial_conditions: Sequence[str], goals: Sequence[str],
+                  strict_order: bool = True) -> list[Finding]:
     """The goal part of the pre-check, without compiling (cheap enough to run as a form changes).
 
     Names that are not actions or modes of ``system`` are skipped (compilation reports them).
@@ -138,14 +142,16 @@ def goal_findings(system: RobotSystem, initial_conditions, goals, strict_order: 
     return findings_for(system, initial_conditions, goals, strict_order)
 
 
-def _capability_goal_findings(system: RobotSystem, initial_conditions, goals, strict_order: bool) -> list[Finding]:
+def _capability_goal_findings(system: RobotSystem, initial_conditions: Sequence[str], goals: Sequence[str],
+                              strict_order: bool) -> list[Finding]:
     """A goal no capability can make true, as the compiler refuses it."""
     del strict_order  # CNU's goals hold together at the end
-    return [Finding(str(error), 'frame axiom', f'postconditions in {capability_file(system)}', error.item)
+    return [Finding(str(error), 'frame axiom', f'postconditions in {capability_file(system)}', str(error.item))
             for error in unreachable_goals(system, initial_conditions, goals)]
 
 
-def _mode_goal_findings(system: RobotSystem, initial_conditions, goals, strict_order: bool) -> list[Finding]:
+def _mode_goal_findings(system: RobotSystem, initial_conditions: Sequence[str], goals: Sequence[str],
+                        strict_order: bool) -> list[Finding]:
     """A goal mode no route from the initial mode reaches (as the compiler refuses it)."""
     abstraction = load_task_abstraction(system)
     modes = [i for i in initial_conditions if abstraction.kind_of(i) == 'control_mode']
@@ -159,8 +165,8 @@ def _mode_goal_findings(system: RobotSystem, initial_conditions, goals, strict_o
 _GOAL_FINDINGS = {RobotAbstraction: _mode_goal_findings, CapabilitySystem: _capability_goal_findings}
 
 
-def impossible_next_goals(system: RobotSystem, initial_conditions, goals, strict_order: bool = True,
-                          candidates=None) -> dict[str, str]:
+def impossible_next_goals(system: RobotSystem, initial_conditions: Sequence[str], goals: Sequence[str],
+                          strict_order: bool = True, candidates: Iterable[str] | None = None) -> dict[str, str]:
     """For every one of ``candidates`` that is not a goal yet (default: the abstraction's actions
     and modes; a capability robot's view gives what its capabilities make true): why it cannot
     be the next goal (if so)."""
@@ -177,7 +183,7 @@ def impossible_next_goals(system: RobotSystem, initial_conditions, goals, strict
     return impossible
 
 
-def _forbidden_activations(custom: list[FormulaGroup], provenance) -> list[Finding]:
+def _forbidden_activations(custom: list[FormulaGroup], provenance: Provenance) -> list[Finding]:
     """A needed item whose activation a custom guarantee forbids at every step."""
     findings = []
     needed = {**provenance.pertinence.reasons}
@@ -196,7 +202,7 @@ def _forbidden_activations(custom: list[FormulaGroup], provenance) -> list[Findi
     return findings
 
 
-def _contradictory_custom_ltl(custom: list[FormulaGroup], groups) -> list[Finding]:
+def _contradictory_custom_ltl(custom: list[FormulaGroup], groups: Sequence[FormulaGroup]) -> list[Finding]:
     """Custom formulas that cannot hold together with their section (custom and generated
     initial conditions; custom formulas of one safety section among themselves)."""
     findings = []
@@ -218,7 +224,7 @@ def _contradictory_custom_ltl(custom: list[FormulaGroup], groups) -> list[Findin
 
 def _forces_false(formula: Formula, name: str) -> bool:
     """Whether ``formula`` holds only when ``name`` is false now (or next, for a next-formula)."""
-    def with_name_true(current: dict, next_step: dict) -> bool:
+    def with_name_true(current: dict[str, bool], next_step: dict[str, bool]) -> bool:
         if mentions_next(formula):
             return evaluate(formula, current, {**next_step, name: True})
         return evaluate(formula, {**current, name: True}, next_step)
@@ -232,7 +238,7 @@ def _satisfiable(formulas: list[Formula]) -> bool | None:
     return _exists(names, lambda current, next_step: all(evaluate(f, current, next_step) for f in formulas))
 
 
-def _exists(names: set[str], holds) -> bool | None:
+def _exists(names: set[str], holds: Callable[[dict[str, bool], dict[str, bool]], bool]) -> bool | None:
     ordered = sorted(names)
     if 2 * len(ordered) > MAX_ENUMERATED_VARIABLES:
         return None
@@ -278,7 +284,7 @@ def diagnose(spec: GR1Specification, robotics_semantics: bool = True, limits: Li
     return diagnosis
 
 
-def unreported_sensors(spec: GR1Specification, core_groups) -> list[Finding]:
+def unreported_sensors(spec: GR1Specification, core_groups: Sequence[FormulaGroup]) -> list[Finding]:
     """The inputs the core reads that no assumption mentions: a sensor nothing reports (no
     ENV_TRANS ties it to anything the robot does, no ENV_LIVENESS says it ever holds), so the
     environment may hold it against the task forever and no behavior can wait it out."""
@@ -315,11 +321,11 @@ def formula_groups(spec: GR1Specification) -> list[FormulaGroup]:
             for section in FORMULA_SECTIONS for index, formula in enumerate(getattr(spec, section))]
 
 
-def play_in_words(steps: list[dict], meaning: dict[str, str]) -> list[str]:
+def play_in_words(steps: list[dict[str, bool | None]], meaning: dict[str, str]) -> list[str]:
     """Each step of an environment play as a sentence about what changed (``meaning``: what a
     proposition turning true means, e.g. ``Provenance.meanings``; others are named as they are)."""
     words = []
-    previous: dict = {}
+    previous: dict[str, bool | None] = {}
     for index, step in enumerate(steps):
         if any(value is None for value in step.values()):
             words.append('the environment answers so that no allowed move remains (deadlock)')

@@ -7,7 +7,12 @@ constant that reports it.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 from respec.vocabulary.errors import CodedError, ErrorCode
+
+if TYPE_CHECKING:
+    from ltl_specification.diagnosis import Diagnosis
 
 
 class SpecificationError(CodedError):
@@ -45,7 +50,7 @@ class ImpossibleGoalsError(InvalidGoalsError):
     whole ``diagnosis`` (``ltl_specification.diagnosis.Diagnosis``: sentence, core, play) as its
     message, so the refusal tells what synthesis would have told."""
 
-    def __init__(self, message: str, item='', diagnosis=None):
+    def __init__(self, message: str, item: str = '', diagnosis: Diagnosis | None = None) -> None:
         super().__init__(message, item)
         self.diagnosis = diagnosis
 

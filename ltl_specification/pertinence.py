@@ -26,7 +26,7 @@ from __future__ import annotations
 
 from collections import deque
 from dataclasses import dataclass, field
-from typing import Sequence
+from typing import Mapping, Sequence
 
 from respec.robot.abstraction import RobotAbstraction
 
@@ -96,7 +96,7 @@ def infer_pertinence(abstraction: RobotAbstraction, initial_mode: str | None,
         left_out=left_out)
 
 
-def mode_distances(graph: dict[str, Sequence[str]], source: str) -> dict[str, int]:
+def mode_distances(graph: Mapping[str, Sequence[str]], source: str) -> dict[str, int]:
     """Breadth-first distances from ``source``."""
     distance = {source: 0}
     queue = deque([source])
@@ -109,7 +109,7 @@ def mode_distances(graph: dict[str, Sequence[str]], source: str) -> dict[str, in
     return distance
 
 
-def _on_shortest_paths(graph: dict[str, Sequence[str]], source: str, target: str) -> list[str]:
+def _on_shortest_paths(graph: Mapping[str, Sequence[str]], source: str, target: str) -> list[str]:
     """Nodes v on some shortest source->target path: d(source, v) + d(v, target) = d(source, target)."""
     from_source = mode_distances(graph, source)
     if target not in from_source:

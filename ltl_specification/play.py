@@ -16,13 +16,13 @@ stateless: ``RobotPlay(spec, meanings).turn([2, 0, 1])``.
 from __future__ import annotations
 
 from dataclasses import asdict, dataclass, field
-from typing import Mapping, Sequence
+from typing import Any, Mapping, Sequence
 
 from respec.ltl import to_infix
 from respec.spec import GR1Specification
 from ltl_synthesizer.gr1 import Solver, solve_environment_game
 from ltl_synthesizer.interrupt import Limits
-from ltl_synthesizer.strategy import EnvironmentStrategy, losing_initial_positions
+from ltl_synthesizer.strategy import EnvironmentStrategy, Position, losing_initial_positions
 from ltl_synthesizer.symbolic import SymbolicGame
 
 MAX_MOVES = 64          # responses listed at one step (the first ones, deterministic order)
@@ -48,7 +48,7 @@ class RobotTurn:
     """Where a play stands: the position in words, and the robot's choices from here."""
 
     step: int
-    values: dict[str, int | None]        # every proposition at this position
+    values: dict[str, bool | None]       # every proposition at this position
     happened: str                        # what turned true on the way here
     environment_next: str                # what the environment does next, whatever the robot does
     moves: list[Move] = field(default_factory=list)
@@ -57,7 +57,7 @@ class RobotTurn:
     lost: str = ''                       # set when the robot has no allowed move left
     history: list[str] = field(default_factory=list)
 
-    def to_dict(self) -> dict:
+    def to_dict(self) -> dict[str, Any]:
         return asdict(self)
 
 
@@ -67,7 +67,7 @@ class RobotPlay:
     (``Provenance.meanings``); other propositions are named as they are."""
 
     def __init__(self, spec: GR1Specification, meanings: Mapping[str, str] | None = None,
-                 robotics_semantics: bool = True, limits: Limits = Limits()):
+                 robotics_semantics: bool = True, limits: Limits = Limits()) -> None:
         self.game = SymbolicGame(spec, None, limits.interrupt())
         solution = solve_environment_game(Solver(self.game))
         initial = losing_initial_positions(self.game, solution.winning, robotics_semantics)
@@ -77,13 +77,15 @@ class RobotPlay:
         self.meanings = dict(meanings or {})
         self.goals = [to_infix(goal) for goal in spec.sys_liveness]
         first, _ = self.game.pick(initial, self.game.variables)
-        self.start = (tuple(first[name] for name in self.game.variables),
+        self.start: Position = (tuple(first[name] for name in self.game.variables),
                       (0, self.environment.first_blockable_goal(first)))
 
     def turn(self, moves: Sequence[int]) -> RobotTurn:
         """The position after the robot's ``moves`` (indices into each step's moves)."""
         if len(moves) > MAX_PLAY_STEPS:
             raise PlayError(f'a play of {len(moves)} steps is longer than {MAX_PLAY_STEPS}')
+        previous: dict[str, bool | None]
+        history: list[str]
         position, previous, history = self.start, {}, []
         visited = {position}
         for step, chosen in enumerate(moves):
@@ -99,20 +101,21 @@ class RobotPlay:
 
     # --- the counter-strategy along the play ----------------------------------------------------
 
-    def _successors(self, position) -> list[tuple]:
+    def _successors(self, position: Position) -> list[Position]:
         values, rank = position
         if None in values:
             return []
         return self.environment.successors(dict(zip(self.game.variables, values)), rank, False)
 
-    def _is_dead_end(self, position) -> bool:
+    def _is_dead_end(self, position: Position) -> bool:
         following = self.environment.successors(self._values(position), position[1], True)
         return bool(following) and None in following[0][0]
 
-    def _values(self, position) -> dict:
+    def _values(self, position: Position) -> dict[str, bool | None]:
         return dict(zip(self.game.variables, position[0]))
 
-    def _describe(self, position, previous: dict, history: list[str], step: int, visited: set) -> RobotTurn:
+    def _describe(self, position: Position, previous: Mapping[str, bool | None], history: list[str], step: int,
+                  visited: set[Position]) -> RobotTurn:
         values = self._values(position)
         happened = self._changed(previous, values) if step else self._changed({}, values) or 'nothing holds'
         turn = RobotTurn(step, values, happened or 'nothing changes', '', history=history)
@@ -143,7 +146,8 @@ class RobotPlay:
                                  'holding, whichever move the robot makes')
         return turn
 
-    def _changed(self, before: dict, after: dict, only: set | None = None, with_off: bool = False) -> str:
+    def _changed(self, before: Mapping[str, bool | None], after: Mapping[str, bool | None],
+                 only: set[str] | None = None, with_off: bool = False) -> str:
         """What turned true (in words), and with ``with_off`` what turned false."""
         names = [n for n in self.game.variables if n in after and (only is None or n in only)]
         on = [self.meanings.get(n, n) for n in names if after[n] and not before.get(n)]

@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import json
 from dataclasses import asdict, dataclass, field
-from typing import Mapping
+from typing import Any, Iterable, Mapping, cast
 
 from respec.robot.abstraction import RobotAbstraction
 from ltl_specification.components import (SOURCE_ACTIONS, SOURCE_CONTROL_MODES, SOURCE_GOALS, SOURCE_INITIAL_CONDITIONS,
@@ -60,9 +60,10 @@ class Provenance:
         return self.origins[next(i for i, g in enumerate(self.groups) if g is group)]
 
 
-def task_provenance(system: str, abstraction: RobotAbstraction, where: str, initial_conditions, goals,
-                    sm_outcomes, strict_order: bool, pertinence: Pertinence, custom_sections, groups,
-                    flexbe_states: Mapping | None = None) -> Provenance:
+def task_provenance(system: str, abstraction: RobotAbstraction, where: str, initial_conditions: Iterable[str],
+                    goals: Iterable[str], sm_outcomes: Iterable[str], strict_order: bool, pertinence: Pertinence,
+                    custom_sections: Iterable[str], groups: Iterable[FormulaGroup],
+                    flexbe_states: Mapping[str, Any] | None = None) -> Provenance:
     """The provenance of a task compiled for ``system`` on its ``abstraction`` (whose file, as
     users know it, is ``where``); ``flexbe_states`` is the ``flexbe.states`` section of its file
     (if any), which names the state machine's states and outcomes in a play told in words."""
@@ -97,7 +98,7 @@ def _origin(group: FormulaGroup, provenance: Provenance, abstraction: RobotAbstr
     return 'request custom LTL'
 
 
-def _meanings(provenance: Provenance, abstraction: RobotAbstraction, flexbe_states: Mapping) -> dict[str, str]:
+def _meanings(provenance: Provenance, abstraction: RobotAbstraction, flexbe_states: Mapping[str, Any]) -> dict[str, str]:
     """Proposition -> what it turning true means (activations, outcomes, goal memories, SM outcomes),
     in the state machine's terms where the FlexBE mapping names them: the state (named after its
     action or mode, as ``sm_generation`` names it), its class and the outcome it returns."""
@@ -122,7 +123,7 @@ def _meanings(provenance: Provenance, abstraction: RobotAbstraction, flexbe_stat
     return meaning
 
 
-def _flexbe_state(flexbe_states: Mapping, proposition: str) -> tuple[str, dict[str, str]]:
+def _flexbe_state(flexbe_states: Mapping[str, Any], proposition: str) -> tuple[str, dict[str, str]]:
     """The FlexBE class of the state ``proposition`` activates ('' if unmapped) and, for each
     outcome proposition, the state outcome(s) that mean it (read leniently: sm_generation
     validates the section when it generates the machine)."""
@@ -131,7 +132,7 @@ def _flexbe_state(flexbe_states: Mapping, proposition: str) -> tuple[str, dict[s
         return '', {}
     declaration = entry['class_decl']
     state_class = declaration.get('behavior_class') if declaration.get('name') == BEHAVIOR_CLASS else declaration.get('name')
-    mapping = entry.get('output_mapping') if isinstance(entry.get('output_mapping'), Mapping) else {}
+    mapping = cast('Mapping[Any, Any]', entry.get('output_mapping')) if isinstance(entry.get('output_mapping'), Mapping) else {}
     returns = {str(name): ' or '.join(map(str, outcomes)) for name, outcomes in mapping.items()
                if isinstance(outcomes, (list, tuple)) and outcomes}
     return (str(state_class) if state_class else ''), returns
@@ -167,7 +168,7 @@ def provenance_from_json(text: str) -> Provenance:
         raise ValueError(f'not a provenance of format {FORMAT_VERSION}: {error}') from error
 
 
-def _provenance(data) -> Provenance:
+def _provenance(data: Any) -> Provenance:
     if data['format'] != FORMAT_VERSION:
         raise ValueError(f'format {data["format"]!r}')
     pertinence = data['pertinence']

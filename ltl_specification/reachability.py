@@ -9,6 +9,7 @@ sentence, naming the missing transition and the modes the robot could change to 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Sequence
 
 from respec.robot.abstraction import RobotAbstraction
 
@@ -33,7 +34,7 @@ def modes_needed_by(abstraction: RobotAbstraction, item: str) -> list[str]:
     return [p for p in abstraction.actions.get(item, ()) if abstraction.kind_of(p) == 'control_mode']
 
 
-def unreachable_goal_modes(abstraction: RobotAbstraction, goals, initial_mode: str, strict_order: bool,
+def unreachable_goal_modes(abstraction: RobotAbstraction, goals: Sequence[str], initial_mode: str, strict_order: bool,
                            where: str) -> list[Finding]:
     """Eq. (9) only allows the configured mode changes, so every goal's mode must be reachable
     from the initial mode; with eq. (20) goal i counts only after goal i-1, so it must be

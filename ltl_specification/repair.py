@@ -32,7 +32,7 @@ import itertools
 import re
 import time
 from dataclasses import dataclass, field, replace
-from typing import Callable, Iterator, Mapping, NamedTuple, Sequence
+from typing import Any, Callable, Iterable, Iterator, Mapping, NamedTuple, Sequence
 
 import yaml
 
@@ -41,6 +41,7 @@ from respec.vocabulary.naming import DEFAULT_SM_OUTCOMES, FAILED, activation, me
 from respec.robot import RobotSystem, for_description
 from respec.robot.abstraction import RobotAbstraction
 from respec.robot.cnu import CapabilitySystem
+from respec.robot.state_library import StateClass
 from respec.robot.system import robot_system_from_files
 from ltl_synthesizer.errors import SynthesisCancelledError
 from ltl_synthesizer.interrupt import Limits
@@ -59,6 +60,8 @@ MAX_PERMUTED_GOALS = 5              # all orders up to this many goals, adjacent
 MAX_PLAY_STEPS = 12                 # of the environment play that guides assumption mining
 DIAGNOSIS_SHARE = 0.2               # of the time budget, at most, for the problem's diagnosis
 MAX_PER_KIND = 2                    # proposals of one kind, so that different fixes are offered
+CustomLTL = Mapping[str, Sequence[str]]   # section -> formulas or names, as compile_task takes it
+StateLibrary = Mapping[str, StateClass]   # the capability compiler's state classes, by name
 
 # Kinds of proposals, by what they change.
 REORDER, UNORDERED, ADD_GOAL, INITIAL, OUTCOMES, DROP_GOAL = (
@@ -80,12 +83,12 @@ class TaskRequest:
     sm_outcomes: tuple[str, ...] = DEFAULT_SM_OUTCOMES
     unordered: bool = False
 
-    def to_dict(self) -> dict:
+    def to_dict(self) -> dict[str, Any]:
         return {'system': self.system, 'initial_conditions': list(self.initial_conditions),
                 'goals': list(self.goals), 'sm_outcomes': list(self.sm_outcomes), 'unordered': self.unordered}
 
     @classmethod
-    def from_dict(cls, data: Mapping) -> TaskRequest:
+    def from_dict(cls, data: Mapping[str, Any]) -> TaskRequest:
         return cls(str(data['system']), tuple(parse_names(data.get('initial_conditions', ()))),
                    tuple(parse_names(data.get('goals', ()))),
                    tuple(parse_names(data.get('sm_outcomes', ()))) or DEFAULT_SM_OUTCOMES,
@@ -102,7 +105,7 @@ class ConfigPatch:
     value: object
     previous: object = None
 
-    def to_dict(self) -> dict:
+    def to_dict(self) -> dict[str, Any]:
         return {'file': self.file, 'path': list(self.path), 'value': self.value, 'previous': self.previous,
                 'changes_robot': True}
 
@@ -116,7 +119,7 @@ class Proposal:
     edits: int                           # how much it changes (fewer is better)
     keeps_goals: bool
     request: TaskRequest | None = None   # the whole changed request, when it changes
-    custom_ltl: dict | None = None       # the whole changed mapping, when it changes
+    custom_ltl: dict[str, list[str]] | None = None   # the whole changed mapping, when it changes
     config_patch: ConfigPatch | None = None
     verified: bool = False
     synthesis_seconds: float = 0.0
@@ -125,10 +128,10 @@ class Proposal:
     def changes_robot(self) -> bool:
         return self.config_patch is not None
 
-    def rank(self) -> tuple:
+    def rank(self) -> tuple[bool, bool, int]:
         return (not self.keeps_goals, self.changes_robot, self.edits)
 
-    def to_dict(self) -> dict:
+    def to_dict(self) -> dict[str, Any]:
         data = {'kind': self.kind, 'summary': self.summary, 'keeps_goals': self.keeps_goals,
                 'changes_robot': self.changes_robot}
         if self.request is not None:
@@ -155,7 +158,7 @@ class Repairs:
     first_proposal_seconds: float | None = None
     note: str = ''                       # e.g. that the time budget ran out
 
-    def to_dict(self) -> dict:
+    def to_dict(self) -> dict[str, Any]:
         return {'request': self.request.to_dict(), 'realizable': self.realizable, 'problem': self.problem,
                 'proposals': [p.to_dict() for p in self.proposals], 'tried': self.tried,
                 'seconds': round(self.seconds, 3),
@@ -180,9 +183,9 @@ class Attempt:
     item: str = ''
 
 
-def attempt(system: RobotSystem, request: TaskRequest, custom_ltl: Mapping | None,
+def attempt(system: RobotSystem, request: TaskRequest, custom_ltl: CustomLTL | None,
             deadline: float | None = None, honest_environment: bool = False,
-            state_library: Mapping | None = None) -> Attempt:
+            state_library: StateLibrary | None = None) -> Attempt:
     """Compile and synthesize ``request`` on ``system``: realizable or the reason it is not.
 
     A specification realizable only vacuously (its initial conditions contradict each other)
@@ -216,11 +219,11 @@ def attempt(system: RobotSystem, request: TaskRequest, custom_ltl: Mapping | Non
 
 # --- the search --------------------------------------------------------------------------------
 
-def propose_repairs(system: RobotSystem, request: TaskRequest, custom_ltl: Mapping | None = None,
+def propose_repairs(system: RobotSystem, request: TaskRequest, custom_ltl: CustomLTL | None = None,
                     time_budget: float = DEFAULT_TIME_BUDGET,
                     max_proposals: int = DEFAULT_MAX_PROPOSALS,
                     on_proposal: Callable[[Proposal], None] | None = None,
-                    state_library: Mapping | None = None) -> Repairs:
+                    state_library: StateLibrary | None = None) -> Repairs:
     """Verified proposals that make ``request`` (with ``custom_ltl``) possible on ``system``.
 
     Candidates are verified cheapest first until ``max_proposals`` are found or four fifths of
@@ -287,10 +290,12 @@ def _memory_owner(system: RobotSystem, name: str) -> str | None:
 
 def _mode_memory_owner(system: RobotSystem, name: str) -> str | None:
     item = remembered(name)
-    return item if system.abstraction.kind_of(item) is not None else None
+    assert item is not None  # _memory_owner asks only about a memory's name
+    return item if system.required_abstraction().kind_of(item) is not None else None
 
 
-def _diagnosed_sentence(system: RobotSystem, request: TaskRequest, custom_ltl, state_library,
+def _diagnosed_sentence(system: RobotSystem, request: TaskRequest, custom_ltl: CustomLTL | None,
+                        state_library: StateLibrary | None,
                         deadline: float) -> str:
     """The diagnosis' leading sentence, as every channel tells the problem (its core search
     stops at ``deadline``: the proposals matter more here)."""
@@ -308,7 +313,7 @@ def _finish(repairs: Repairs, start: float) -> Repairs:
     return repairs
 
 
-def _identity(candidate: Proposal, request: TaskRequest, custom_ltl) -> str:
+def _identity(candidate: Proposal, request: TaskRequest, custom_ltl: CustomLTL | None) -> str:
     """Two candidates that change the task the same way are one proposal."""
     return yaml.safe_dump([(candidate.request or request).to_dict(),
                            custom_ltl if candidate.custom_ltl is None else candidate.custom_ltl,
@@ -348,7 +353,7 @@ def _shown_file(system: RobotSystem, relative: str) -> str:
 
 # --- candidates --------------------------------------------------------------------------------
 
-def _candidates(system: RobotSystem, request: TaskRequest, custom_ltl) -> Iterator[Proposal]:
+def _candidates(system: RobotSystem, request: TaskRequest, custom_ltl: CustomLTL | None) -> Iterator[Proposal]:
     robot = _robot_repairs(system)
     yield from _goal_order_candidates(system, request)
     yield from robot.prerequisites(system, request, custom_ltl)
@@ -366,6 +371,7 @@ def _goal_order_candidates(system: RobotSystem, request: TaskRequest) -> Iterato
         return
     yield Proposal(UNORDERED, 'Let the goals be achieved in any order (--unordered).', 1, True,
                    replace(request, unordered=True))
+    orders: Iterable[tuple[str, ...]]
     if len(goals) <= MAX_PERMUTED_GOALS:
         orders = itertools.permutations(goals)
     else:
@@ -382,11 +388,12 @@ def _swapped_pairs(original: Sequence[str], order: Sequence[str]) -> int:
     return sum(1 for a, b in itertools.combinations(order, 2) if position[a] > position[b])
 
 
-def _prerequisite_candidates(system: RobotSystem, request: TaskRequest, custom_ltl) -> Iterator[Proposal]:
+def _prerequisite_candidates(system: RobotSystem, request: TaskRequest,
+                             custom_ltl: CustomLTL | None) -> Iterator[Proposal]:
     """An item added as a goal before a goal: one whose goal memory (``<item>_m``, eq. (20))
     the custom LTL uses first, then a control mode or a precondition of a goal, which with goals
     in order takes the robot where the next goal can be reached from."""
-    abstraction = system.abstraction
+    abstraction = system.required_abstraction()
     used = _custom_names(custom_ltl)
     remembered_items = [i for i in abstraction.items() if memory(i) in used and i not in request.goals]
     preconditions = {p for g in request.goals for p in abstraction.actions.get(g, ())}
@@ -402,7 +409,7 @@ def _prerequisite_candidates(system: RobotSystem, request: TaskRequest, custom_l
                            replace(request, goals=goals))
 
 
-def _custom_names(custom_ltl) -> set[str]:
+def _custom_names(custom_ltl: CustomLTL | None) -> set[str]:
     """Every word of the custom formulas (names the parser would read as propositions)."""
     return {word for section, entries in (custom_ltl or {}).items() if section not in ('env_props', 'sys_props')
             for text in entries or () for word in re.findall(r'[A-Za-z_][A-Za-z0-9_]*', str(text))}
@@ -410,7 +417,7 @@ def _custom_names(custom_ltl) -> set[str]:
 
 def _capability_start_candidates(system: RobotSystem, request: TaskRequest) -> Iterator[Proposal]:
     """Start elsewhere: one initial condition more or less (a capability robot's memories)."""
-    capabilities = system.capabilities
+    capabilities = system.required_capabilities()
     for condition in request.initial_conditions:
         rest = tuple(c for c in request.initial_conditions if c != condition)
         yield Proposal(INITIAL, f'Drop the initial condition {condition}.', 2, True,
@@ -423,7 +430,7 @@ def _capability_start_candidates(system: RobotSystem, request: TaskRequest) -> I
 
 def _mode_start_candidates(system: RobotSystem, request: TaskRequest) -> Iterator[Proposal]:
     """Start elsewhere: another initial control mode."""
-    abstraction = system.abstraction
+    abstraction = system.required_abstraction()
     modes = [c for c in request.initial_conditions if abstraction.is_mode(c)]
     others = tuple(c for c in request.initial_conditions if not abstraction.is_mode(c))
     current = modes[0] if modes else abstraction.initial_mode
@@ -456,7 +463,8 @@ def _drop_goal_candidates(request: TaskRequest) -> Iterator[Proposal]:
 
 # --- custom LTL ------------------------------------------------------------------------------------
 
-def _custom_ltl_candidates(system: RobotSystem, request: TaskRequest, custom_ltl) -> Iterator[Proposal]:
+def _custom_ltl_candidates(system: RobotSystem, request: TaskRequest,
+                           custom_ltl: CustomLTL | None) -> Iterator[Proposal]:
     """Weaken a custom guarantee (drop it), or assume more of the environment (mined)."""
     if not custom_ltl:
         return
@@ -480,7 +488,7 @@ def _custom_ltl_candidates(system: RobotSystem, request: TaskRequest, custom_ltl
                        custom_ltl=mined)
 
 
-def _with_entries(custom_ltl: Mapping, section: str, entries: list) -> dict:
+def _with_entries(custom_ltl: CustomLTL, section: str, entries: list[str]) -> dict[str, list[str]]:
     changed = {key: list(value) for key, value in custom_ltl.items()}
     if entries:
         changed[section] = entries
@@ -489,7 +497,7 @@ def _with_entries(custom_ltl: Mapping, section: str, entries: list) -> dict:
     return changed
 
 
-def mined_assumptions(system: RobotSystem, request: TaskRequest, custom_ltl: Mapping) -> list[tuple[str, str, str]]:
+def mined_assumptions(system: RobotSystem, request: TaskRequest, custom_ltl: CustomLTL) -> list[tuple[str, str, str]]:
     """Environment assumptions on the inputs the custom LTL adds, guided by the environment's
     winning play: an input that stays at one value through the end of the play is what the
     environment wins with, so assuming it changes infinitely often (fairness) or, once it has
@@ -515,7 +523,8 @@ def mined_assumptions(system: RobotSystem, request: TaskRequest, custom_ltl: Map
     return mined
 
 
-def _held_inputs(system: RobotSystem, request: TaskRequest, custom_ltl, inputs: list[str]) -> dict[str, bool]:
+def _held_inputs(system: RobotSystem, request: TaskRequest, custom_ltl: CustomLTL | None, inputs: list[str]
+                 ) -> dict[str, bool]:
     """The inputs the environment holds constant in the second half of its winning play."""
     from ltl_synthesizer.unrealizable_core import environment_play
 
@@ -546,7 +555,7 @@ def _abstraction_candidates(system: RobotSystem, request: TaskRequest) -> Iterat
     """A missing mode change into a mode a goal needs, or a goal's precondition removed."""
     from ltl_specification.reachability import modes_needed_by
 
-    abstraction = system.abstraction
+    abstraction = system.required_abstraction()
     file = system.config_file
     needed = list(dict.fromkeys(m for g in request.goals for m in modes_needed_by(abstraction, g)))
     for target in needed:
@@ -567,7 +576,7 @@ def _abstraction_candidates(system: RobotSystem, request: TaskRequest) -> Iterat
 
 def _capability_candidates(system: RobotSystem, request: TaskRequest) -> Iterator[Proposal]:
     """A goal's memory set by a capability's successful outcome, or a precondition removed."""
-    capabilities = system.capabilities
+    capabilities = system.required_capabilities()
     if capabilities.full_spec:
         return
     relative = _capability_file(system)
@@ -597,7 +606,7 @@ def _capability_candidates(system: RobotSystem, request: TaskRequest) -> Iterato
                            f'(capabilities.{name}.preconditions in {file}).', 2, True, config_patch=patch)
 
 
-def unreported_spec_inputs(capabilities) -> list[str]:
+def unreported_spec_inputs(capabilities: CapabilitySystem) -> list[str]:
     """The spec file's INPUTs that none of its environment formulas mentions: sensors nothing
     reports (``ltl_specification.diagnosis.unreported_sensors`` names them in a diagnosis)."""
     environment = ' '.join(text for section, text in capabilities.spec_formulas if section.startswith('env_'))
@@ -612,7 +621,7 @@ def _sensor_candidates(system: RobotSystem) -> Iterator[Proposal]:
     often; both are environment assumptions, so both are checked well-separated."""
     from respec.robot.cnu import SPEC_KEY
 
-    capabilities = system.capabilities
+    capabilities = system.required_capabilities()
     relative = system.sections.get(SPEC_KEY)
     if capabilities.full_spec or not isinstance(relative, str) or relative not in system.files:
         return
@@ -643,7 +652,7 @@ def _sensor_candidates(system: RobotSystem) -> Iterator[Proposal]:
                        f'{file}).', 2, True, config_patch=patch)
 
 
-def _unbound_outcome_pairs(capabilities, environment: str) -> Iterator[tuple[str, tuple[str, str]]]:
+def _unbound_outcome_pairs(capabilities: CapabilitySystem, environment: str) -> Iterator[tuple[str, tuple[str, str]]]:
     """(capability, two of its transition outcomes) for capabilities whose outcomes no
     environment formula mentions yet, failures left out: what could report a sensor."""
     failure = capabilities.state_outcomes.get(FAILED)
@@ -660,7 +669,7 @@ def _unbound_outcome_pairs(capabilities, environment: str) -> Iterator[tuple[str
         yield name, (outcomes[0], outcomes[1])
 
 
-def _success_postconditions(entry: dict, name: str, success: str) -> tuple[tuple[str, ...], list]:
+def _success_postconditions(entry: dict[str, Any], name: str, success: str) -> tuple[tuple[str, ...], list[Any]]:
     """Where a capability's file entry lists what its success sets, and what it lists: CNU's
     files give either one list (the success's) or a mapping by transition outcome."""
     post = entry.get('postconditions')
@@ -688,14 +697,14 @@ class _RobotRepairs(NamedTuple):
     memory_owner: Callable[[RobotSystem, str], str | None]    # the goal whose memory a name (``x_m``) is
 
 
-def _nothing(*arguments) -> Iterator[Proposal]:
+def _nothing(*arguments: object) -> Iterator[Proposal]:
     del arguments
     yield from ()
 
 
 _ROBOT_REPAIRS = {
     RobotAbstraction: _RobotRepairs(_prerequisite_candidates, _mode_start_candidates, _abstraction_candidates,
-                                    lambda system: system.abstraction.sensors, _mode_memory_owner),
+                                    lambda system: system.required_abstraction().sensors, _mode_memory_owner),
     # a capability robot's sensors are bound by its capabilities instead (_sensor_candidates)
     # (and its memories are its own propositions, no goal's)
     CapabilitySystem: _RobotRepairs(_nothing, _capability_start_candidates, _capability_robot_candidates,

@@ -16,6 +16,7 @@ from __future__ import annotations
 import argparse
 import json
 import sys
+from typing import Any
 
 from respec.vocabulary.errors import CodedError, ExitStatus, exit_status_help
 from respec.vocabulary.naming import parse_names
@@ -55,9 +56,9 @@ def run(args: argparse.Namespace) -> int:
         return _refused(error)
     print(f'Searching for changes that make the task possible (at most {args.time_budget:g} s)...',
           file=sys.stderr, flush=True)
-    found = []
+    found: list[dict[str, Any]] = []
 
-    def on_proposal(proposal: dict) -> None:
+    def on_proposal(proposal: dict[str, Any]) -> None:
         found.append(proposal)
         print(f'  found: {proposal["summary"]}', file=sys.stderr, flush=True)
 
@@ -81,7 +82,7 @@ def _refused(error: CodedError) -> int:
     return ExitStatus.FAILED
 
 
-def _text(repairs: dict) -> str:
+def _text(repairs: dict[str, Any]) -> str:
     """``Repairs.to_dict()`` as the lines the command prints."""
     if repairs['realizable']:
         return 'The task can be done as asked: nothing to repair.'

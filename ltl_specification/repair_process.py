@@ -16,7 +16,9 @@ reports each verified proposal as it is found.
 from __future__ import annotations
 
 import time
-from typing import Callable
+from typing import Any, Callable
+
+from respec.robot import RobotSystem
 
 from ltl_synthesizer.errors import SynthesisError
 from ltl_synthesizer.interrupt import DEFAULT_MEMORY_LIMIT
@@ -38,8 +40,8 @@ class RepairSearchError(Exception):
     """The child ended (killed, crashed, overran its deadline) without an answer."""
 
 
-def repair_settings(system, request: dict, custom_ltl, time_budget: float, max_proposals: int,
-                    memory_limit: int | None = DEFAULT_MEMORY_LIMIT) -> dict:
+def repair_settings(system: RobotSystem, request: dict[str, Any], custom_ltl: Any, time_budget: float,
+                    max_proposals: int, memory_limit: int | None = DEFAULT_MEMORY_LIMIT) -> dict[str, Any]:
     """What a child needs for a search of ``request`` (``TaskRequest.to_dict()``) on ``system``
     (a RobotSystem: its files travel, not its name); ``memory_limit``: bytes the child may grow
     by, as a synthesis may (None: no limit)."""
@@ -53,20 +55,22 @@ class RepairSearch:
     RobotSystem's), ``request`` (TaskRequest.to_dict()), ``custom_ltl``, ``time_budget``,
     ``max_proposals``."""
 
-    def __init__(self, settings: dict):
+    def __init__(self, settings: dict[str, Any]) -> None:
         ends_at = time.monotonic() + settings['time_budget']
         self.settings = {**settings, 'ends_at': ends_at}
         self.deadline = ends_at + ANSWER_GRACE
         self.child = ChildProcess(niceness=SERVER_CHILD_NICENESS, preload=__name__, name=SYNTHESIS_PROCESS)
 
-    def run(self, on_proposal: Callable[[dict], None] | None = None) -> dict:
+    def run(self, on_proposal: Callable[[dict[str, Any]], None] | None = None) -> dict[str, Any]:
         """The search's ``Repairs.to_dict()``; ``on_proposal(proposal dict)`` as each is verified.
         A refusal of the system's files is raised as the CodedError it is. The whole search,
         its first check and the diagnosis included, ends within its time budget and ANSWER_GRACE
         (counted from this object's creation), and within its memory limit."""
         try:
-            return self.child.call(search, (self.settings,), on_progress=on_proposal or (lambda _: None),
-                                   deadline=self.deadline, memory_limit=self.settings.get('memory_limit'))
+            answer: dict[str, Any] = self.child.call(
+                search, (self.settings,), on_progress=on_proposal or (lambda _: None),
+                deadline=self.deadline, memory_limit=self.settings.get('memory_limit'))
+            return answer
         except WorkTimeoutError:  # the runner's, or the search's own synthesis timeout
             raise RepairSearchError(f'the repair search was ended at its time budget of '
                                     f'{self.settings["time_budget"]:g} s (a check was still running)') from None
@@ -81,7 +85,7 @@ class RepairSearch:
             self.child.process.kill()
 
 
-def search(settings: dict, progress: Callable[[dict], None]) -> dict:
+def search(settings: dict[str, Any], progress: Callable[[dict[str, Any]], None]) -> dict[str, Any]:
     """In the child: the verified proposals for the settings' task on the GUI's robot system."""
     from ltl_specification.repair import TaskRequest, propose_repairs
     from respec.robot import robot_system_from_files

@@ -36,6 +36,7 @@ command. Imports are lazy, so ``gr1synth --help`` starts without loading CUDD.
 """
 
 import importlib
+from typing import Any
 
 _EXPORTS = {
     **{name: 'ltl_synthesizer.synthesizer' for name in (
@@ -52,7 +53,7 @@ _EXPORTS = {
 __all__ = sorted(_EXPORTS)
 
 
-def __getattr__(name):
+def __getattr__(name: str) -> Any:
     if name not in _EXPORTS:
         raise AttributeError(f'module {__name__!r} has no attribute {name!r}')
     return getattr(importlib.import_module(_EXPORTS[name]), name)

@@ -143,7 +143,7 @@ class CacheStatistics:
 class _Flight:
     """One synthesis that identical requests wait for."""
 
-    def __init__(self):
+    def __init__(self) -> None:
         self.done = threading.Event()
         self.entry: Entry | None = None
 
@@ -245,6 +245,7 @@ class StrategyCache:
                 if leading:
                     flight = self._flights[key] = _Flight()
                     self.statistics.misses += 1
+            assert flight is not None  # found or made just now
             if leading:
                 try:
                     flight.entry = compute()
@@ -280,6 +281,7 @@ class StrategyCache:
     def _path(self, key: str) -> Path:
         if len(key) != 64 or any(c not in '0123456789abcdef' for c in key):
             raise ValueError(f'not a cache key: {key!r}')
+        assert self.directory is not None  # the files of a cache that has a folder
         return self.directory / (key + _SUFFIX)
 
     def _write(self, key: str, entry: Entry) -> None:

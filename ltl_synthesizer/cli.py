@@ -21,12 +21,13 @@ load only when a specification is synthesized, so ``--help`` is instant.
 from __future__ import annotations
 
 import sys
+from typing import Sequence
 
 from ltl_synthesizer.command import parse_arguments, run
 from respec.nesting import run_with_deep_stack
 
 
-def main(argv=None) -> int:
+def main(argv: Sequence[str] | None = None) -> int:
     if argv is None:  # run as a program: Ctrl-C ends it at once, as it ends slugs, even while
         # one long CUDD operation holds the interpreter (a Python handler would wait for it).
         import signal

@@ -14,8 +14,14 @@ import math
 import os
 import sys
 import time
+from typing import TYPE_CHECKING, Any, Callable, Iterable, Sequence
 
 from respec.vocabulary.errors import ExitStatus, exit_status_help
+
+if TYPE_CHECKING:  # loaded when a run needs them (a usage error answers without the synthesizer)
+    from respec.spec import GR1Specification
+    from ltl_synthesizer.interrupt import Limits
+    from ltl_synthesizer.synthesizer import SynthesisResult
 
 REALIZABLE_LINE = 'RESULT: Specification is realizable.'
 UNREALIZABLE_LINE = 'RESULT: Specification is unrealizable.'
@@ -68,7 +74,7 @@ def _limit(text: str) -> float:
     return value
 
 
-def parse_arguments(argv):
+def parse_arguments(argv: Sequence[str] | None) -> argparse.Namespace:
     """The parsed gr1synth command line ``argv``; usage errors exit as argparse does (2), an
     OUTPUT without a strategy to write exits 1 (as slugs)."""
     parser = _parser()
@@ -91,7 +97,8 @@ def parse_arguments(argv):
 INPUT_EXPANSION = 8
 
 
-def read_specification(path: str, check=None, deadline: float | None = None, memory_limit: int | None = None):
+def read_specification(path: str, check: Callable[[], object] | None = None, deadline: float | None = None,
+                       memory_limit: int | None = None) -> GR1Specification:
     """Parse a .slugsin or .structuredslugs file (by extension) into a GR1Specification;
     ``check`` (e.g. an ltl_synthesizer Interrupt) is called regularly while parsing. Reading
     that has not ended by ``deadline`` (a FIFO no one writes to) raises SynthesisCancelledError;
@@ -113,9 +120,9 @@ def _read_text(path: str, deadline: float | None, max_chars: int | None = None) 
         return _read_at_most(path, max_chars)
     import threading
     from ltl_synthesizer.errors import SynthesisTimeoutError
-    outcome = {}
+    outcome: dict[str, Any] = {}   # 'text', or the 'error' reading raised
 
-    def read():  # opening a FIFO blocks until a writer comes: in a thread the process may leave
+    def read() -> None:  # opening a FIFO blocks until a writer comes: in a thread the process may leave
         try:
             outcome['text'] = _read_at_most(path, max_chars)
         except BaseException as error:  # noqa: BLE001 - re-raised in the caller's thread
@@ -128,7 +135,7 @@ def _read_text(path: str, deadline: float | None, max_chars: int | None = None) 
         raise SynthesisTimeoutError(f'timeout: {path} was still being read')
     if 'error' in outcome:
         raise outcome['error']
-    return outcome['text']
+    return str(outcome['text'])
 
 
 def _read_at_most(path: str, max_chars: int | None) -> str:
@@ -148,7 +155,8 @@ def _read_at_most(path: str, max_chars: int | None) -> str:
     return text
 
 
-def synthesis_outcome(spec, args, limits, stream: bool = False):
+def synthesis_outcome(spec: GR1Specification, args: argparse.Namespace, limits: Limits,
+                      stream: bool = False) -> SynthesisResult:
     """What a run of ``args`` prints and writes, as a SynthesisResult: the verdict, and the
     strategy, counter-strategy or explanation asked for. ``stream`` (in-process only): the
     strategy is extracted while it is written (bounded memory)."""
@@ -173,7 +181,7 @@ def _write(text: str, output: str | None) -> None:
     _write_chunks([text], output)
 
 
-def _write_chunks(chunks, output: str | None) -> None:
+def _write_chunks(chunks: Iterable[str], output: str | None) -> None:
     """Write text pieces as they come (a large strategy is never one string in memory).
 
     A file appears only complete: the pieces go to a hidden file beside it, renamed at the end,
@@ -202,7 +210,7 @@ def _write_chunks(chunks, output: str | None) -> None:
         sys.stdout.flush()
 
 
-def strategy_to_text(strategy: dict) -> str:
+def strategy_to_text(strategy: dict[str, Any]) -> str:
     """slugs' plain explicit-strategy format (``State n with rank r -> <a:0, b:1>``)."""
     lines = []
     for name in sorted(strategy['nodes'], key=int):
@@ -220,7 +228,7 @@ def strategy_to_text(strategy: dict) -> str:
     return '\n'.join(lines) + ('\n' if lines else '')
 
 
-def run(args) -> int:
+def run(args: argparse.Namespace) -> int:
     """One gr1synth run of parsed arguments (not --serve): its exit status, printing as slugs."""
     from respec.parsing import ParseError
     from ltl_synthesizer.errors import (SynthesisCancelledError, SynthesisError,
@@ -281,6 +289,7 @@ def run(args) -> int:
         strategy = result.counterstrategy
     else:
         return ExitStatus.OK
+    assert strategy is not None  # asked for, so made (synthesis_outcome)
     try:
         if args.jsonOutput:
             from ltl_synthesizer.strategy import strategy_json_chunks

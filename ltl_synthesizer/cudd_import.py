@@ -12,30 +12,35 @@ from __future__ import annotations
 import importlib.util
 import sys
 import types
+from typing import Any
+
+#: A BDD of ``dd.cudd`` (a ``dd.cudd.Function``: dd has no type hints, so it is Any to mypy).
+Node = Any
 
 
-def _import_cudd():
+def _import_cudd() -> Any:  # the dd.cudd module
     if 'dd.cudd' in sys.modules or 'networkx' in sys.modules:
         from dd import cudd
         return cudd
     placeholder = types.ModuleType('networkx')
-    placeholder.MultiDiGraph = type('MultiDiGraph', (), {})  # dd reads it for a type alias
+    setattr(placeholder, 'MultiDiGraph', type('MultiDiGraph', (), {}))  # dd reads it for a type alias
     sys.modules['networkx'] = placeholder
     try:
         from dd import cudd
     finally:
         del sys.modules['networkx']
     utils = sys.modules.get('dd._utils')
-    if getattr(utils, '_nx', None) is placeholder:
-        utils._nx = _lazy_module('networkx')  # noqa: SLF001 - dd keeps its networkx import there
+    if utils is not None and getattr(utils, '_nx', None) is placeholder:
+        setattr(utils, '_nx', _lazy_module('networkx'))  # dd keeps its networkx import there
     return cudd
 
 
-def _lazy_module(name: str):
+def _lazy_module(name: str) -> types.ModuleType | None:
     """``name`` as a module that loads on first attribute access (None if not installed)."""
     spec = importlib.util.find_spec(name)
     if spec is None:
         return None
+    assert spec.loader is not None  # an installed module's
     spec.loader = importlib.util.LazyLoader(spec.loader)
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)

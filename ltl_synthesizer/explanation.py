@@ -9,10 +9,13 @@ formulas.
 
 from __future__ import annotations
 
+from typing import Any, Iterable, Sequence
+
 from respec.ltl import to_infix
 
 from ltl_synthesizer.gr1 import EnvironmentSolution, SystemSolution
 from ltl_synthesizer.strategy import enumerate_states, extract_counterstrategy, losing_initial_positions
+from ltl_synthesizer.cudd_import import Node
 from ltl_synthesizer.symbolic import SymbolicGame
 
 MAX_LISTED_STATES = 3
@@ -20,7 +23,7 @@ PLAY_LENGTH = 8
 PLAY_HEADING = 'Environment play (counter-strategy'
 
 
-def _true_set(names, values) -> str:
+def _true_set(names: Iterable[str], values: Iterable[object]) -> str:
     chosen = [name for name, value in zip(names, values) if value]
     return '{' + ', '.join(chosen) + '}'
 
@@ -51,7 +54,8 @@ def without_play(explanation: str) -> str:
     return '\n'.join(lines[:heading])
 
 
-def _initial_conditions(game, system, environment, robotics_semantics) -> list[str]:
+def _initial_conditions(game: SymbolicGame, system: SystemSolution, environment: EnvironmentSolution,
+                        robotics_semantics: bool) -> list[str]:
     initial = game.env_init & game.sys_init
     if game.env_init == game.false:
         return ['ENV_INIT is unsatisfiable.']
@@ -87,12 +91,12 @@ def _initial_conditions(game, system, environment, robotics_semantics) -> list[s
     return lines
 
 
-def _count(game: SymbolicGame, u, names) -> int:
+def _count(game: SymbolicGame, u: Node, names: Sequence[str]) -> int:
     """The number of assignments to ``names`` in ``u`` (which depends on no other variable)."""
     return int(game.bdd.count(u, nvars=len(names))) if names else int(u == game.true)
 
 
-def _blocked_goal_and_play(game: SymbolicGame, play: dict) -> list[str]:
+def _blocked_goal_and_play(game: SymbolicGame, play: dict[str, Any]) -> list[str]:
     nodes = play['nodes']
     if not nodes:
         return []
@@ -137,7 +141,7 @@ def _blocked_goal_and_play(game: SymbolicGame, play: dict) -> list[str]:
     return lines
 
 
-def _deadlock(game: SymbolicGame, before: dict, dead: dict) -> list[str]:
+def _deadlock(game: SymbolicGame, before: dict[str, Any], dead: dict[str, Any]) -> list[str]:
     """Name a minimal set of SYS_TRANS formulas that no output can satisfy together."""
     state = {name: bool(value) for name, value in zip(game.variables, before['state'])}
     for name, value in zip(game.inputs, dead['state']):

@@ -16,6 +16,7 @@ import subprocess
 import threading
 import time
 from pathlib import Path
+from typing import Any
 
 from ltl_synthesizer.errors import SynthesisCancelledError, SynthesisError, SynthesisTimeoutError
 from respec.vocabulary.errors import ErrorCode
@@ -31,9 +32,9 @@ class ExternalSynthesizerError(SynthesisError):
     code = ErrorCode.SYNTHESIZER_BACKEND_FAILED
 
 
-def run_external_synthesizer(executable: str, slugsin_path, output_path,
+def run_external_synthesizer(executable: str, slugsin_path: str | Path, output_path: str | Path,
                              robotics_semantics: bool = True, timeout: float | None = None,
-                             cancel: threading.Event | None = None) -> tuple[bool, dict | None, str]:
+                             cancel: threading.Event | None = None) -> tuple[bool, dict[str, Any] | None, str]:
     """Run ``executable`` on ``slugsin_path``; return (realizable, strategy or None, stderr).
 
     Raises ExternalSynthesizerError (code SYNTHESIZER_BACKEND_FAILED) when the executable
@@ -81,7 +82,7 @@ def run_external_synthesizer(executable: str, slugsin_path, output_path,
     return True, strategy, stderr
 
 
-def _wait(process: subprocess.Popen, executable: str, timeout: float | None,
+def _wait(process: subprocess.Popen[str], executable: str, timeout: float | None,
           cancel: threading.Event | None) -> tuple[str, str]:
     """Collect the output; kill the process group on timeout or cancellation."""
     deadline = None if timeout is None else time.monotonic() + timeout
@@ -102,7 +103,7 @@ def _wait(process: subprocess.Popen, executable: str, timeout: float | None,
             raise SynthesisTimeoutError()
 
 
-def _kill(process: subprocess.Popen) -> None:
+def _kill(process: subprocess.Popen[str]) -> None:
     try:
         os.killpg(process.pid, signal.SIGKILL)
     except (ProcessLookupError, PermissionError):

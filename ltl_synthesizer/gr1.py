@@ -16,8 +16,9 @@ from __future__ import annotations
 import itertools
 from dataclasses import dataclass, field
 from functools import cached_property
+from typing import Callable
 
-from ltl_synthesizer.cudd_import import cudd
+from ltl_synthesizer.cudd_import import Node, cudd
 from ltl_synthesizer.policy import Options, ReorderingSwitch, plan
 from ltl_synthesizer.symbolic import SymbolicGame
 
@@ -27,7 +28,7 @@ class Solver:
     the plan chosen for it (``policy.plan``), the positions that matter (``care``), the
     reordering switch, and a memo of the system's predecessors of recent position sets."""
 
-    def __init__(self, game: SymbolicGame, options: Options | None = None):
+    def __init__(self, game: SymbolicGame, options: Options | None = None) -> None:
         self.game = game
         self.options = options or Options()
         self.plan = plan(game, self.options)
@@ -36,12 +37,12 @@ class Solver:
         if self.plan.sift_once:
             game.bdd.reorder()
         self.reordering = ReorderingSwitch(game, self.plan.reordering, self.plan.reordering_from_nodes)
-        self._moves_into = {}
-        self._previous_moves_into = {}
-        self._may_violate = {}
+        self._moves_into: dict[int, tuple[Node, Node]] = {}
+        self._previous_moves_into: dict[int, tuple[Node, Node]] = {}
+        self._may_violate: dict[int, Node] = {}
 
     @cached_property
-    def care(self):
+    def care(self) -> Node:
         """The positions the solver must decide: all, or those reachable from the initial ones.
 
         Every legal move (env_trans and sys_trans) from a reachable position leads to a
@@ -50,12 +51,12 @@ class Solver:
         """
         return self.game.reachable_positions() if self.plan.reachable_only else self.game.true
 
-    def enforce(self, responses):
+    def enforce(self, responses: Node) -> Node:
         """``game.enforce``, with the reordering switch watching the BDDs grow."""
         self.reordering.observe(responses)
         return self.game.enforce(responses)
 
-    def system_can_move_into(self, positions, remember: bool = True):
+    def system_can_move_into(self, positions: Node, remember: bool = True) -> Node:
         """``exists y'. sys_trans & positions'``, memoized: the assumptions' inner fixpoints
         share start sets, and each outer iteration restarts them from the previous one's
         results (see ``start_outer_iteration``). Sets that never recur (``remember=False``)
@@ -73,7 +74,7 @@ class Solver:
             self._moves_into[key] = found
         return found[1]
 
-    def may_violate(self, assumption_index: int):
+    def may_violate(self, assumption_index: int) -> Node:
         """The positions from which some transition violates environment goal i:
         ``exists next. !A_i`` (for a capability's fairness, the positions where it runs)."""
         found = self._may_violate.get(assumption_index)
@@ -83,7 +84,7 @@ class Solver:
                 game.next_inputs + game.next_outputs, ~game.env_goals[assumption_index])
         return found
 
-    def start_outer_iteration(self):
+    def start_outer_iteration(self) -> None:
         """Keep the memo of the previous outer (Z) iteration only: older sets do not recur."""
         self._previous_moves_into = self._moves_into
         self._moves_into = {}
@@ -96,11 +97,11 @@ class AttractorStep:
     (the fixpoints never need the whole, and strategy extraction only a few moves of it)."""
 
     goal_index: int
-    goal_transitions: object
-    closer: object
-    waiting: object
-    assumption: object
-    responses: object  # exists y'. sys_trans & transitions: where the step offers a move
+    goal_transitions: Node
+    closer: Node
+    waiting: Node
+    assumption: Node
+    responses: Node  # exists y'. sys_trans & transitions: where the step offers a move
 
 
 @dataclass
@@ -109,8 +110,8 @@ class SystemSolution:
     of increasing distance to the goal (the "mY" ranks): a strategy for goal j takes, at each
     position, the first step that offers a move."""
 
-    winning: object
-    attractor_steps: list = field(default_factory=list)
+    winning: Node
+    attractor_steps: list[AttractorStep] = field(default_factory=list)
     complete: bool = True  # False when the solver stopped early because the initial check failed
     reachable_only: bool = False  # decided on the reachable positions only (Solver.care)
 
@@ -123,19 +124,19 @@ class WarmStarts:
     above; beyond the previous iteration's sweeps, its last X for (goal, assumption) does.
     """
 
-    def __init__(self):
-        self._previous: dict = {}
-        self._previous_last: dict = {}
-        self._current: dict = {}
-        self._current_last: dict = {}
+    def __init__(self) -> None:
+        self._previous: dict[tuple[int, int, int], Node] = {}
+        self._previous_last: dict[tuple[int, int], Node] = {}
+        self._current: dict[tuple[int, int, int], Node] = {}
+        self._current_last: dict[tuple[int, int], Node] = {}
 
-    def upper_bound(self, goal_index: int, sweep: int, assumption_index: int, winning):
+    def upper_bound(self, goal_index: int, sweep: int, assumption_index: int, winning: Node) -> Node:
         """The best known upper bound of this X, within ``winning`` (Z)."""
         bound = self._previous.get((goal_index, sweep, assumption_index),
                                    self._previous_last.get((goal_index, assumption_index)))
         return winning if bound is None else bound & winning
 
-    def record(self, goal_index: int, sweep: int, assumption_index: int, waiting) -> None:
+    def record(self, goal_index: int, sweep: int, assumption_index: int, waiting: Node) -> None:
         self._current[(goal_index, sweep, assumption_index)] = waiting
         self._current_last[(goal_index, assumption_index)] = waiting
 
@@ -144,7 +145,7 @@ class WarmStarts:
         self._current, self._current_last = {}, {}
 
 
-def solve_system_game(solver: Solver, stop_when_losing=None) -> SystemSolution:
+def solve_system_game(solver: Solver, stop_when_losing: Callable[[Node], bool] | None = None) -> SystemSolution:
     """The system's winning positions: the greatest fixpoint Z over all goals,
 
         nu Z. /\\_j mu Y. \\/_i nu X. cox( (G_j & Z') | Y' | (!A_i & X') ).
@@ -190,7 +191,7 @@ def solve_system_game(solver: Solver, stop_when_losing=None) -> SystemSolution:
             return SystemSolution(Z, [], complete=False, reachable_only=reachable_only)
 
 
-def _safe_positions(solver: Solver, within, stop_when_losing=None):
+def _safe_positions(solver: Solver, within: Node, stop_when_losing: Callable[[Node], bool] | None = None) -> Node:
     """``nu Z. within & cox(Z')``: positions (among ``within``) from which the system can keep
     both safety sections forever. Every winning position is one (a winning strategy stays
     among them). Stops early (returning the current Z) once ``stop_when_losing`` says the
@@ -203,7 +204,8 @@ def _safe_positions(solver: Solver, within, stop_when_losing=None):
         Z = next_Z
 
 
-def _attract_to_goal(solver: Solver, goal_index: int, goal, winning, warm_starts: WarmStarts):
+def _attract_to_goal(solver: Solver, goal_index: int, goal: Node, winning: Node,
+                     warm_starts: WarmStarts) -> tuple[Node, list[AttractorStep]]:
     """Middle least fixpoint Y: positions that can force goal ``goal`` (into Z = ``winning``)
     or keep some environment goal false forever while staying safe.
 
@@ -247,6 +249,7 @@ def _attract_to_goal(solver: Solver, goal_index: int, goal, winning, warm_starts
             return Y, steps
         if not chained:
             can_move_towards_goal = reach_goal | solver.system_can_move_into(Y)
+    raise AssertionError('unreachable: the sweeps (itertools.count) end only by the return above')
 
 
 class _NoWaitingPositions:
@@ -263,11 +266,11 @@ class _NoWaitingPositions:
     is an upper bound of it for the next Z iteration's warm start.
     """
 
-    def __init__(self, solver: Solver):
+    def __init__(self, solver: Solver) -> None:
         self.solver = solver
-        self._enforced = None  # (towards, enforce(towards)) for the last towards asked
+        self._enforced: tuple[Node, Node] | None = None  # (towards, enforce(towards)) for the last towards asked
 
-    def adds_nothing(self, start, Y, towards, assumption_index: int) -> bool:
+    def adds_nothing(self, start: Node, Y: Node, towards: Node, assumption_index: int) -> bool:
         outside = start & ~Y
         game = self.solver.game
         if outside == game.false:
@@ -276,11 +279,11 @@ class _NoWaitingPositions:
             return False
         if self._enforced is None or self._enforced[0] != towards:
             self._enforced = (towards, self.solver.game.enforce(towards))
-        return outside & self._enforced[1] == game.false
+        return bool(outside & self._enforced[1] == game.false)  # dd's BDDs are Any to mypy
 
 
-def _wait_for_assumption(solver: Solver, can_move_towards_goal, assumption, start,
-                         system_independent: bool):
+def _wait_for_assumption(solver: Solver, can_move_towards_goal: Node, assumption: Node, start: Node,
+                         system_independent: bool) -> tuple[Node, Node]:
     """Inner greatest fixpoint X: positions that can move towards the goal, or else stay in X
     on transitions that violate environment goal ``assumption``.
 
@@ -319,17 +322,17 @@ class EnvironmentLevel:
     current variables and next inputs) that work towards its assumption i while doing so.
     """
 
-    below: object  # Z_{k-1}: positions won at lower levels
-    blocking: list = field(default_factory=list)
-    moves: list = field(default_factory=list)
+    below: Node  # Z_{k-1}: positions won at lower levels
+    blocking: list[Node] = field(default_factory=list)
+    moves: list[list[list[Node]]] = field(default_factory=list)
 
 
 @dataclass
 class EnvironmentSolution:
     """Positions from which the environment wins, with the levels of its attractor."""
 
-    winning: object
-    levels: list = field(default_factory=list)
+    winning: Node
+    levels: list[EnvironmentLevel] = field(default_factory=list)
 
 
 def solve_environment_game(solver: Solver) -> EnvironmentSolution:
@@ -348,7 +351,7 @@ def solve_environment_game(solver: Solver) -> EnvironmentSolution:
     solver.reordering.stop()
     game = solver.game
     winning = game.false
-    levels = []
+    levels: list[EnvironmentLevel] = []
     while True:
         level = EnvironmentLevel(below=winning)
         next_winning = game.false
@@ -363,7 +366,7 @@ def solve_environment_game(solver: Solver) -> EnvironmentSolution:
         winning = next_winning
 
 
-def _block_goal(game: SymbolicGame, goal, winning):
+def _block_goal(game: SymbolicGame, goal: Node, winning: Node) -> tuple[Node, list[list[Node]]]:
     """Middle greatest fixpoint Y: positions where the environment keeps goal ``goal`` false
     (or reaches Z) while satisfying every one of its own goals infinitely often."""
     avoid_goal = ~goal | game.prime(winning)
@@ -381,7 +384,7 @@ def _block_goal(game: SymbolicGame, goal, winning):
         blocking = next_blocking
 
 
-def _reach_assumption(game: SymbolicGame, kept, assumption):
+def _reach_assumption(game: SymbolicGame, kept: Node, assumption: Node) -> tuple[Node, list[Node]]:
     """Inner least fixpoint X: positions from which the environment reaches a transition that
     satisfies its goal ``assumption`` while keeping within ``kept``."""
     reach = game.false

@@ -21,13 +21,17 @@ that checks none (SynthesisMemoryError).
 
 from __future__ import annotations
 
-import threading
-from typing import Any, Callable
+from typing import TYPE_CHECKING, Any, Callable
 
-from ltl_synthesizer.errors import in_synthesis_words
+from ltl_synthesizer.errors import SynthesisError, in_synthesis_words
 from ltl_synthesizer.interrupt import Limits
 from respec.child_processes.errors import ChildWorkError
-from respec.child_processes.runner import CHILD_NICENESS, IDLE_SECONDS, BuiltInChild, ChildProcesses
+from respec.child_processes.runner import CHILD_NICENESS, IDLE_SECONDS, BuiltInChild, CancelFlag, ChildProcesses
+
+if TYPE_CHECKING:
+    from ltl_synthesizer.policy import Options
+    from ltl_synthesizer.synthesizer import SynthesisResult
+    from respec.spec import GR1Specification
 
 #: What messages call the synthesizer's children.
 SYNTHESIS_PROCESS = 'synthesis process'
@@ -41,20 +45,21 @@ class SpecificationText(BuiltInChild):
     and pickling a large specification take seconds of pure Python: done in the caller, they
     hold its interpreter, uninterruptible (a 3.9 MB one, about 9 s)."""
 
-    def __init__(self, sections: dict):
+    def __init__(self, sections: dict[str, Any]) -> None:
         self.sections = sections
 
-    def built(self):
+    def built(self) -> GR1Specification:
         from respec.parsing import spec_from_text_sections
         return spec_from_text_sections(self.sections)
 
 
-def byproduct_texts(spec) -> tuple[str, str, list, list]:
+def byproduct_texts(spec: GR1Specification) -> tuple[str, str, list[str], list[str]]:
     """The ``.structuredslugs`` and ``.slugsin`` texts of ``spec``, and its inputs and outputs."""
     return spec.to_structuredslugs(), spec.to_slugsin(), list(spec.env_props), list(spec.sys_props)
 
 
-def synthesize_within(spec, robotics_semantics: bool, limits: Limits, options, max_strategy_edges: int):
+def synthesize_within(spec: GR1Specification, robotics_semantics: bool, limits: Limits, options: Options | None,
+                      max_strategy_edges: int) -> SynthesisResult:
     """:func:`ltl_synthesizer.synthesize`, refusing (StrategyTooLargeError) a strategy of more
     than ``max_strategy_edges`` edges as soon as its extraction passes them, before anything is
     sent: each edge costs the receiving server about 900 B once turned into an automaton, its
@@ -71,26 +76,29 @@ class SynthesisProcesses(ChildProcesses):
     def __init__(self, idle_seconds: float = IDLE_SECONDS, niceness: int = CHILD_NICENESS):
         super().__init__(idle_seconds, niceness, SYNTHESIZER_MODULE, SYNTHESIS_PROCESS)
 
-    def synthesize(self, spec, robotics_semantics: bool = True, limits: Limits = Limits(), options=None,
-                   max_strategy_edges: int | None = None):
+    def synthesize(self, spec: GR1Specification | SpecificationText, robotics_semantics: bool = True,
+                   limits: Limits = Limits(), options: Options | None = None,
+                   max_strategy_edges: int | None = None) -> SynthesisResult:
         """:func:`ltl_synthesizer.synthesize` in a child, killed once ``limits`` stop it; with
         ``max_strategy_edges``, a larger strategy is refused in the child (:func:`synthesize_within`)."""
         from ltl_synthesizer.synthesizer import synthesize
+        result: SynthesisResult
         if max_strategy_edges:
-            return self.call(synthesize_within, (spec, robotics_semantics, limits.without_cancel(), options,
-                                                 max_strategy_edges), cancel=limits.cancel, deadline=limits.deadline)
-        return self.call(synthesize, (spec, robotics_semantics, limits.without_cancel(), options),
-                         cancel=limits.cancel, deadline=limits.deadline)
+            result = self.call(synthesize_within, (spec, robotics_semantics, limits.without_cancel(), options,
+                                                   max_strategy_edges), cancel=limits.cancel, deadline=limits.deadline)
+        else:
+            result = self.call(synthesize, (spec, robotics_semantics, limits.without_cancel(), options),
+                               cancel=limits.cancel, deadline=limits.deadline)
+        return result
 
     def call(self, function: Callable[..., Any], args: tuple[Any, ...] | list[Any] = (),
-             kwargs: dict[str, Any] | None = None, cancel: threading.Event | None = None,
+             kwargs: dict[str, Any] | None = None, cancel: CancelFlag | None = None,
              deadline: float | None = None, memory_limit: int | None = None) -> Any:
         """``function(*args, **kwargs)`` in a child (:meth:`ChildProcesses.call`); the runner's
         stops raised as the synthesizer's errors."""
         try:
             return super().call(function, args, kwargs, cancel, deadline, memory_limit)
         except ChildWorkError as stopped:
-            synthesis_error = in_synthesis_words(stopped)
-            if synthesis_error is stopped:  # raised by the work in the child
+            if isinstance(stopped, SynthesisError):  # raised by the work in the child
                 raise
-            raise synthesis_error from None
+            raise in_synthesis_words(stopped) from None

@@ -26,7 +26,7 @@ proposition's current and next copies stay adjacent (``translation.declare_pair`
 
 from __future__ import annotations
 
-from respec.ltl import And, Next, Not, Or, Var, children
+from respec.ltl import And, Formula, Next, Not, Or, Var, children
 from respec.spec import GR1Specification
 
 # Most FORCE iterations, and how many in a row may fail to shorten the total span.
@@ -64,7 +64,7 @@ def static_order(spec: GR1Specification) -> list[str]:
     if supports is None:
         return _first_use(propositions, [])
     first_use = _first_use(propositions, supports)
-    unit_of = {name: integer_bit(name)[0] if integer_bit(name) else name for name in propositions}
+    unit_of = {name: bit[0] if (bit := integer_bit(name)) else name for name in propositions}
     widths: dict[str, int] = {}
     for name in propositions:
         if integer_bit(name):
@@ -84,7 +84,7 @@ def static_order(spec: GR1Specification) -> list[str]:
     return order
 
 
-def _conjuncts(spec: GR1Specification) -> list:
+def _conjuncts(spec: GR1Specification) -> list[Formula]:
     """The top-level conjuncts of every formula, in translation order."""
     result = []
     for section in SECTIONS:
@@ -99,7 +99,7 @@ def _conjuncts(spec: GR1Specification) -> list:
     return result
 
 
-def _supports(conjuncts: list) -> list[tuple] | None:
+def _supports(conjuncts: list[Formula]) -> list[tuple[str, ...]] | None:
     """Each conjunct's propositions (current or next), in order of appearance, each conjunct's
     DAG walked once (a walk per conjunct: memoized supports of nested subformulas would take
     quadratic space on a long nested disjunction). None when the walks would visit more than
@@ -126,18 +126,19 @@ def _supports(conjuncts: list) -> list[tuple] | None:
     return result
 
 
-def _first_use(propositions: list[str], supports: list) -> list[str]:
+def _first_use(propositions: list[str], supports: list[tuple[str, ...]]) -> list[str]:
     seen = dict.fromkeys(name for support in supports for name in support)
     return [name for name in seen if name in set(propositions)] + [p for p in propositions if p not in seen]
 
 
-def _compared_integers(supports: list, unit_of: dict, widths: dict[str, int]) -> dict[str, str]:
+def _compared_integers(supports: list[tuple[str, ...]], unit_of: dict[str, str], widths: dict[str, int]
+                       ) -> dict[str, str]:
     """Integer -> the block (its first member's name, tagged) of the integers compared with it:
     those sharing a conjunct over at most COMPARISON_UNITS units, all of them integers of at
     least MIN_INTERLEAVED_BITS bits (``widths``)."""
     parent: dict[str, str] = {}
 
-    def root(unit):
+    def root(unit: str) -> str:
         while parent.get(unit, unit) != unit:
             unit = parent[unit]
         return unit
@@ -163,15 +164,16 @@ def _compared_integers(supports: list, unit_of: dict, widths: dict[str, int]) ->
     return blocks
 
 
-def _is_integer_unit(unit: str, support, unit_of: dict) -> bool:
+def _is_integer_unit(unit: str, support: tuple[str, ...], unit_of: dict[str, str]) -> bool:
     return any(unit_of[name] == unit and integer_bit(name) for name in support if name in unit_of)
 
 
-def _hyperedges(conjuncts: list, supports: list, unit_of: dict, index: dict) -> list[tuple[tuple, float]]:
+def _hyperedges(conjuncts: list[Formula], supports: list[tuple[str, ...]], unit_of: dict[str, str],
+                index: dict[str, int]) -> list[tuple[tuple[int, ...], float]]:
     """Hyperedges (unit indices, multiplicity): one per distinct conjunct support, the
     pairwise exclusions of a group of three or more counted as one edge over the group."""
-    exclusions: dict[str, set] = {}
-    counted: dict[tuple, int] = {}
+    exclusions: dict[str, set[str]] = {}
+    counted: dict[tuple[int, ...], int] = {}
     for conjunct, support in zip(conjuncts, supports):
         units = tuple(sorted({index[unit_of[name]] for name in support if name in unit_of}))
         if len(units) < 2:
@@ -210,24 +212,25 @@ def _hyperedges(conjuncts: list, supports: list, unit_of: dict, index: dict) -> 
             for units, count in counted.items()]
 
 
-def _excluded_pair(formula) -> tuple[str, str] | None:
+def _excluded_pair(formula: Formula) -> tuple[str, str] | None:
     """``(a, b)`` when ``formula`` is ``!(a & b)`` or ``!a | !b`` over two literals."""
     if isinstance(formula, Not) and isinstance(formula.arg, And) and len(formula.arg.args) == 2:
         atoms = [_atom(arg) for arg in formula.arg.args]
     elif isinstance(formula, Or) and len(formula.args) == 2 and all(isinstance(a, Not) for a in formula.args):
-        atoms = [_atom(arg.arg) for arg in formula.args]
+        atoms = [_atom(arg.arg) for arg in formula.args if isinstance(arg, Not)]  # all are (checked above)
     else:
         return None
-    return tuple(atoms) if None not in atoms and atoms[0] != atoms[1] else None
+    first, second = atoms
+    return (first, second) if first is not None and second is not None and first != second else None
 
 
-def _atom(formula) -> str | None:
+def _atom(formula: Formula) -> str | None:
     if isinstance(formula, Next):
         formula = formula.arg
     return formula.name if isinstance(formula, Var) else None
 
 
-def _force(count: int, edges: list[tuple[tuple, int]]) -> list[int]:
+def _force(count: int, edges: list[tuple[tuple[int, ...], float]]) -> list[int]:
     """FORCE's iterations over ``count`` units (initially in index order): the ranking with the
     smallest total weighted span found."""
     position = list(range(count))
@@ -236,7 +239,7 @@ def _force(count: int, edges: list[tuple[tuple, int]]) -> list[int]:
         for unit in units:
             incident[unit].append(k)
 
-    def span(position):
+    def span(position: list[int]) -> float:
         return sum(weight * (max(position[u] for u in units) - min(position[u] for u in units))
                    for units, weight in edges)
 

@@ -6,6 +6,11 @@ always takes the same path."""
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:  # the game imports this module (and CUDD loads only with the game)
+    from ltl_synthesizer.cudd_import import Node
+    from ltl_synthesizer.symbolic import SymbolicGame
 
 # Conjuncts are merged into clusters while the cluster's BDD stays below this many nodes: fewer,
 # larger relational products are faster than many tiny ones, up to a point (see bench/): 1000
@@ -119,7 +124,7 @@ def cluster_limit(has_liveness: bool, options: Options) -> int:
     return DEFAULT_CLUSTER_LIMIT if has_liveness else SAFETY_GAME_CLUSTER_LIMIT
 
 
-def plan(game, options: Options) -> Plan:
+def plan(game: SymbolicGame, options: Options) -> Plan:
     """The plan for ``game`` (a SymbolicGame), from its shape and the options the caller set."""
     large = len(game.variables) > SMALL_GAME_PROPOSITIONS
     compact = is_compact(game, options)
@@ -149,7 +154,7 @@ def plan(game, options: Options) -> Plan:
         reordering_from_nodes=COMPACT_REORDERING_FROM_NODES if compact else DYNAMIC_REORDERING_FROM_NODES)
 
 
-def is_compact(game, options: Options) -> bool:
+def is_compact(game: SymbolicGame, options: Options) -> bool:
     """Whether the static order left the safety relations compact (see
     COMPACT_NODES_PER_PROPOSITION); only the structural order is trusted to."""
     return options.variable_order == 'structure' and \
@@ -163,7 +168,7 @@ class ReorderingSwitch:
     the BDDs have grown (BETWEEN_ITERATIONS). ``observe(responses)`` is called before every
     enforceable-predecessor step with the BDD it is about to quantify."""
 
-    def __init__(self, game, planned: str, from_nodes: int = DYNAMIC_REORDERING_FROM_NODES):
+    def __init__(self, game: SymbolicGame, planned: str, from_nodes: int = DYNAMIC_REORDERING_FROM_NODES) -> None:
         self.game = game
         self.planned = planned
         self.from_nodes = from_nodes
@@ -174,7 +179,7 @@ class ReorderingSwitch:
         if planned == FROM_START:
             game.bdd.configure(reordering=True)
 
-    def observe(self, responses) -> None:
+    def observe(self, responses: Node) -> None:
         if not self.on and self.planned == ONCE_LARGE:
             # Reading CUDD's statistics scans its unique table: look every few steps only.
             self._observed += 1

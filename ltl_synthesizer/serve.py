@@ -12,6 +12,7 @@ from __future__ import annotations
 import contextlib
 import io
 import json
+from typing import Any, Iterable, TextIO
 
 from respec.vocabulary.errors import ExitStatus
 
@@ -19,7 +20,7 @@ from ltl_synthesizer.command import parse_arguments, run
 from respec.nesting import run_with_deep_stack
 
 
-def serve(requests, answers) -> int:
+def serve(requests: Iterable[str], answers: TextIO) -> int:
     for line in requests:
         if not line.strip():
             continue
@@ -28,7 +29,7 @@ def serve(requests, answers) -> int:
     return 0
 
 
-def answer(line: str) -> dict:
+def answer(line: str) -> dict[str, Any]:
     """The outcome of one request line (a malformed request is an answer, not a crash)."""
     stdout, stderr = io.StringIO(), io.StringIO()
     try:
@@ -37,6 +38,7 @@ def answer(line: str) -> dict:
             raise ValueError('a request is a JSON list of strings')
     except ValueError as error:
         return {'status': ExitStatus.FAILED, 'stdout': '', 'stderr': f'gr1synth: error: {error}\n'}
+    status: int
     with contextlib.redirect_stdout(stdout), contextlib.redirect_stderr(stderr):
         try:
             args = parse_arguments(argv)

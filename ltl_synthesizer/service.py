@@ -27,7 +27,8 @@ import json
 import threading
 import time
 from dataclasses import dataclass, field
-from typing import Callable
+from pathlib import Path
+from typing import Any, Callable, ContextManager, Protocol
 
 from ltl_synthesizer.cache import CacheDirectoryError, Entry, StrategyCache, cache_key, source_digest
 from ltl_synthesizer.errors import SynthesisCancelledError, SynthesisError
@@ -40,6 +41,21 @@ from respec.vocabulary.errors import CodedError, ErrorCode
 from respec.parsing import spec_from_text_sections
 from respec.spec import GR1Specification
 from respec.untrusted import utf8_length
+
+class ByproductFiles(Protocol):
+    """The files of one synthesis (``synthesis_manager.byproducts.ByproductSet``)."""
+
+    name: str
+    paths: dict[str, Path]
+
+    def write(self, extension: str, text: str) -> Path: ...
+
+
+class Byproducts(Protocol):
+    """Where syntheses write their files (``synthesis_manager.byproducts.ByproductStore``)."""
+
+    def open_set(self, spec_name: str) -> ContextManager[ByproductFiles]: ...
+
 
 BACKENDS = ('builtin', 'slugs')
 DIAGNOSIS_GRACE = 1.0  # seconds past its own time limit before the diagnosis process is killed
@@ -76,9 +92,10 @@ class Explainers:
     (raises ValueError for text it cannot read); ``incomplete_mark``: what a diagnosis whose
     time ran out before its core was computed says (such an answer is not kept)."""
 
-    diagnose: Callable
-    check_well_separation: Callable
-    read_provenance: Callable
+    # a provenance is the explainers' own (ltl_specification.provenance.Provenance, or None)
+    diagnose: Callable[[str, GR1Specification, Any, bool, Limits], str]
+    check_well_separation: Callable[[GR1Specification, Any, Limits], str]
+    read_provenance: Callable[[str], Any]
     incomplete_mark: str
 
 
@@ -88,7 +105,7 @@ class SynthesisJob:
     answer is explained with, and its limits (``deadline``: time.monotonic(); ``timeout``: the
     limit it stands for, as messages name it)."""
 
-    sections: dict
+    sections: dict[str, list[str]]
     spec_name: str
     timeout: float
     deadline: float
@@ -129,17 +146,18 @@ class KeptAnswer:
     an unrealizable one's message without its spec name (``message`` is then the parts before
     and after the head naming it)."""
 
-    byproducts: dict
+    byproducts: dict[str, str]
     synthesizable: bool
     code: str
     message: str | tuple[str, str]
     automaton: Automaton | None = None
 
-    def to_entry(self) -> dict:
+    def to_entry(self) -> dict[str, bytes]:
         """The cache entry: named byte strings."""
         entry = {kind: text.encode() for kind, text in self.byproducts.items()}
         entry.update(synthesizable=b'1' if self.synthesizable else b'0', code=self.code.encode())
         if self.synthesizable:
+            assert isinstance(self.message, str) and self.automaton is not None  # a realizable answer's
             entry.update(message=self.message.encode(), automaton=_automaton_json(self.automaton).encode())
         else:
             entry.update(message_before=self.message[0].encode(), message_after=self.message[1].encode())
@@ -158,6 +176,7 @@ class KeptAnswer:
     def answer(self, spec_name: str) -> SynthesisAnswer:
         """The answer to a request naming ``spec_name``, byte-identical to the one it was kept from."""
         message = self.message if self.synthesizable else unrealizable_head(spec_name).join(self.message)
+        assert isinstance(message, str)  # a realizable answer's message is one text
         return SynthesisAnswer(ErrorCode[self.code], message, self.synthesizable, self.automaton)
 
 
@@ -177,9 +196,9 @@ class SynthesisService:
     """Answers synthesis jobs with ``settings()`` (read once per job), writing their byproducts,
     keeping answers in ``cache`` and running syntheses and explanations in ``processes``."""
 
-    def __init__(self, settings: Callable[[], SynthesisSettings], byproducts: Callable, cache: StrategyCache,
-                 processes: SynthesisProcesses, explainers: Explainers,
-                 warn: Callable[[str], None] = lambda text: None):
+    def __init__(self, settings: Callable[[], SynthesisSettings], byproducts: Callable[[], Byproducts],
+                 cache: StrategyCache, processes: SynthesisProcesses, explainers: Explainers,
+                 warn: Callable[[str], None] = lambda text: None) -> None:
         self.settings, self.byproducts, self.cache = settings, byproducts, cache
         self.processes, self.explainers, self.warn = processes, explainers, warn
         self.answering_code = (f"{source_digest(ANSWERING_PACKAGES)} dd {importlib.metadata.version('dd')}"
@@ -228,7 +247,7 @@ class SynthesisService:
             return self._synthesize(job, settings)[0]
         fresh = []
 
-        def compute():
+        def compute() -> Entry | None:
             answer, kept = self._synthesize(job, settings, keep=True)
             fresh.append(answer)
             return kept.to_entry() if kept else None
@@ -236,7 +255,10 @@ class SynthesisService:
                                        check=lambda entry: self.loaded_entry_problem(entry, job))
         if how == 'gave up':
             return job.stopped_answer()
-        return fresh[0] if how == 'computed' else self._from_entry(entry, job)
+        if how == 'computed':
+            return fresh[0]
+        assert entry is not None  # a kept or a shared answer
+        return self._from_entry(entry, job)
 
     def loaded_entry_problem(self, entry: Entry, job: SynthesisJob) -> str | None:
         """What is wrong with a realizable answer read back from the cache directory (None:
@@ -276,6 +298,7 @@ class SynthesisService:
         if job.stopped():  # e.g. after waiting for an identical request
             return job.stopped_answer(), None
         backend = settings.backend
+        spec: SpecificationText | GR1Specification
         if backend == 'builtin' and job.is_large():
             spec = SpecificationText(job.sections)  # parsed in the synthesis children
             try:
@@ -321,6 +344,7 @@ class SynthesisService:
                 if not (keep and diagnosed and found):
                     return answer, None
                 return answer, KeptAnswer(byproducts, False, 'SPEC_UNSYNTHESIZABLE', (before, after))
+            assert strategy is not None  # both backends give a realizable specification's strategy
             strategy_json = strategy_to_json(strategy)
             files.write('json', strategy_json)
         try:
@@ -332,7 +356,8 @@ class SynthesisService:
             return answer, None
         return answer, KeptAnswer({**byproducts, 'json': strategy_json}, True, 'SUCCESS', warning, answer.automaton)
 
-    def _well_separation_warning(self, spec, job: SynthesisJob, settings: SynthesisSettings) -> tuple[str, bool]:
+    def _well_separation_warning(self, spec: SpecificationText | GR1Specification, job: SynthesisJob,
+                                 settings: SynthesisSettings) -> tuple[str, bool]:
         """The warning that the controller can win by forcing the environment to break its
         assumptions ('' when it cannot, when check_well_separation is off, or when the check
         does not end within the diagnosis time and the job's time limit: the automaton
@@ -354,7 +379,8 @@ class SynthesisService:
             self.warn(f'well-separation not checked: {error}'[:300])
             return '', False
 
-    def _diagnosed(self, details: str, spec, job: SynthesisJob, settings: SynthesisSettings) -> tuple[str, bool]:
+    def _diagnosed(self, details: str, spec: SpecificationText | GR1Specification, job: SynthesisJob,
+                   settings: SynthesisSettings) -> tuple[str, bool]:
         """``details`` (the synthesizer's explanation), led by why the task cannot be done: in
         the task's terms when the job carries the specification's provenance, else by its
         formulas; and whether the diagnosis was whole (its core computed). The diagnosis runs in
@@ -379,7 +405,7 @@ class SynthesisService:
         # A diagnosis that failed says only the details; one whose time ran out says so.
         return message, message != details and self.explainers.incomplete_mark not in message
 
-    def _provenance(self, job: SynthesisJob):
+    def _provenance(self, job: SynthesisJob) -> Any:  # the explainers' provenance, or None
         """The job's provenance (None without one, or when it cannot be read: warned about)."""
         if not job.provenance:
             return None

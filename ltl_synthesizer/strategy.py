@@ -14,23 +14,28 @@ from __future__ import annotations
 
 from collections import deque
 from dataclasses import dataclass
+from typing import Any, Callable, Iterable, Iterator, Mapping
 
-from ltl_synthesizer.gr1 import EnvironmentSolution, SystemSolution
+from ltl_synthesizer.cudd_import import Node
+from ltl_synthesizer.gr1 import AttractorStep, EnvironmentSolution, SystemSolution
 from ltl_synthesizer.symbolic import SymbolicGame
 
 FORMAT_VERSION = 0
+#: A node of a counter-strategy: the propositions' values (the outputs None at a deadlock) and its
+#: rank (the assumption pursued, the system goal blocked), as ``EnvironmentStrategy.successors`` gives it.
+Position = tuple[tuple[bool | None, ...], tuple[int, int]]
 SLUGS_VERSION = '0.0.1'
 
 
-def goal_steps(game: SymbolicGame, solution: SystemSolution) -> list:
+def goal_steps(game: SymbolicGame, solution: SystemSolution) -> list[list[AttractorStep]]:
     """Per system goal, its attractor steps by increasing rank."""
-    steps = [[] for _ in game.sys_goals]
+    steps: list[list[AttractorStep]] = [[] for _ in game.sys_goals]
     for step in solution.attractor_steps:
         steps[step.goal_index].append(step)
     return steps
 
 
-def goal_moves(game: SymbolicGame, steps, env_moves, legal):
+def goal_moves(game: SymbolicGame, steps: _GoalSteps, env_moves: Node, legal: Node) -> Node:
     """The positional strategy of one goal at one position: each environment move is
     answered with the moves of the first attractor step (lowest rank) that offers a response.
 
@@ -65,11 +70,11 @@ class _GoalSteps:
     moves. A capability robot of N capabilities has O(N^2) steps of which a position uses a
     few: scanning them one by one took most of its extraction (80 capabilities: 3.4 of 4.1 s)."""
 
-    def __init__(self, game: SymbolicGame, steps: list):
+    def __init__(self, game: SymbolicGame, steps: list[_StepMoves]) -> None:
         self.game, self.steps = game, steps
-        self._unions = {}
+        self._unions: dict[tuple[int, int], Node] = {}
 
-    def offering(self, unanswered):
+    def offering(self, unanswered: Callable[[], Node]) -> Iterator[_StepMoves]:
         """The steps, in order, without ranges none of whose responses meets the environment
         moves ``unanswered()`` (asked again as the scan goes on: the moves no earlier step
         answers); a skipped step would offer no new case, and goal_moves passes over those."""
@@ -87,7 +92,7 @@ class _GoalSteps:
             middle = (low + high) // 2
             stack += [(middle, high), (low, middle)]
 
-    def _union(self, low: int, high: int):
+    def _union(self, low: int, high: int) -> Node:
         found = self._unions.get((low, high))
         if found is None:
             if high - low <= INDEXED_STEPS:
@@ -113,12 +118,12 @@ class _StepMoves:
     few moves of each position, twice per step and position, cost more (a variable swap is
     about 11 us whatever the size: 0.46 of the 2.4 s of the arbiter with 8 clients)."""
 
-    def __init__(self, game: SymbolicGame, step):
+    def __init__(self, game: SymbolicGame, step: AttractorStep) -> None:
         self.game, self.step = game, step
         self.responses = step.responses
-        self._primed = None
+        self._primed: tuple[Node, Node] | None = None
 
-    def transitions_among(self, moves):
+    def transitions_among(self, moves: Node) -> Node:
         """The ``moves`` (a small set of transitions) that are transitions of this step."""
         if self._primed is None:
             step = self.step
@@ -135,8 +140,8 @@ class StrategyPiece:
     system move allowed by sys_trans into ``target`` (transitions, over current and next
     variables)."""
 
-    offered: object
-    target: object
+    offered: Node
+    target: Node
 
 
 @dataclass
@@ -146,8 +151,8 @@ class SymbolicStrategy:
     Kept as pieces: their union conjoined with sys_trans is a far larger BDD than all of
     them together (factory 5x5: 7.3 million nodes), and nothing needs it whole."""
 
-    winning: object
-    pieces: list
+    winning: Node
+    pieces: list[list[StrategyPiece]]
 
 
 def symbolic_strategy(game: SymbolicGame, solution: SystemSolution) -> SymbolicStrategy:
@@ -175,10 +180,11 @@ def symbolic_strategy(game: SymbolicGame, solution: SystemSolution) -> SymbolicS
     return SymbolicStrategy(solution.winning, pieces)
 
 
-def enumerate_states(game: SymbolicGame, states, names, limit: int | None = None):
+def enumerate_states(game: SymbolicGame, states: Node, names: Iterable[str],
+                     limit: int | None = None) -> list[dict[str, bool]]:
     """The assignments to ``names`` in ``states`` (all, or the first ``limit``), smallest first
     (``states`` must depend only on names)."""
-    found = []
+    found: list[dict[str, bool]] = []
     while states != game.false and (limit is None or len(found) < limit):
         assignment, single = game.pick(states, names)
         found.append(assignment)
@@ -186,8 +192,8 @@ def enumerate_states(game: SymbolicGame, states, names, limit: int | None = None
     return found
 
 
-def _successor_goal(game: SymbolicGame, goals, rank: int, transition: dict[str, bool],
-                    supports: list | None = None) -> int:
+def _successor_goal(game: SymbolicGame, goals: list[Node], rank: int, transition: Mapping[str, bool | None],
+                    supports: list[set[str]] | None = None) -> int:
     """The goal pursued after ``transition``: advance past every goal it satisfies
     (``supports``: the goals' supports, when known)."""
     goal = rank
@@ -211,14 +217,14 @@ class _Responses:
     positions share them (the arbiter with 8 clients: 7,972 distinct moves at 11,264
     positions; a lift with 8 floors: 2,284 at 7,041)."""
 
-    def __init__(self, game: SymbolicGame):
+    def __init__(self, game: SymbolicGame) -> None:
         self.game, self.goals = game, len(game.sys_goals)
         names = game.next_inputs + game.next_outputs
         self._smallest = _NodeMemo(lambda moves: _smallest_responses(game, moves))
         # Outputs the responses leave unmentioned are False (see _smallest_responses).
         self._codes = _NodeMemo(lambda part: _codes(game, part, names, set(game.next_inputs)))
 
-    def __call__(self, moves, goals_here: '_GoalsAt', rank: int) -> list[int]:
+    def __call__(self, moves: Node, goals_here: '_GoalsAt', rank: int) -> list[int]:
         chosen = self._smallest(moves)
         if chosen == self.game.false:
             return []
@@ -244,11 +250,11 @@ class _NodeMemo:
     so its node is not reused for another); forgotten all at once beyond ``limit`` entries, to
     bound the memory a huge strategy takes."""
 
-    def __init__(self, function, limit: int = 2**16):
+    def __init__(self, function: Callable[[Node], Any], limit: int = 2**16) -> None:
         self.function, self.limit = function, limit
-        self.found = {}
+        self.found: dict[int, tuple[Node, Any]] = {}
 
-    def __call__(self, u):
+    def __call__(self, u: Node) -> Any:
         found = self.found.get(int(u))
         if found is None:
             if len(self.found) >= self.limit:
@@ -257,7 +263,7 @@ class _NodeMemo:
         return found[1]
 
 
-def _codes(game: SymbolicGame, u, names: list[str], either: set[str]) -> list[int]:
+def _codes(game: SymbolicGame, u: Node, names: list[str], either: set[str]) -> list[int]:
     """The valuations of ``names`` in ``u`` (a BDD over them), increasing, each coded as the
     integer whose bits are the values, the first name's the most significant (so codes
     compare as the tuples of values do, False before True), read cube by cube: a name of
@@ -279,7 +285,7 @@ def _codes(game: SymbolicGame, u, names: list[str], either: set[str]) -> list[in
 MAX_INITIAL_CODES = 2**16
 
 
-def _initial_codes(game: SymbolicGame, initial):
+def _initial_codes(game: SymbolicGame, initial: Node) -> Iterable[int]:
     """The codes (``_codes``) of the initial positions, smallest first. Beyond
     MAX_INITIAL_CODES, one at a time, each after a look at the limits: reading off a huge set
     at once (2^200 positions of a runaway specification) could not be stopped."""
@@ -291,12 +297,12 @@ def _initial_codes(game: SymbolicGame, initial):
             for state in enumerate_states(game, initial, variables))
 
 
-def _values(code: int, count: int) -> tuple:
+def _values(code: int, count: int) -> tuple[bool, ...]:
     """The ``count`` values (booleans) that ``code`` codes (see ``_codes``)."""
     return tuple(bool(code >> (count - 1 - index) & 1) for index in range(count))
 
 
-def _smallest_responses(game: SymbolicGame, moves):
+def _smallest_responses(game: SymbolicGame, moves: Node) -> Node:
     """``moves`` narrowed to the smallest output valuation of each input valuation, the outputs
     decided in declared order (False when ``moves`` allows it, as ``SymbolicGame.pick``); the
     outputs ``moves`` leaves free stay unmentioned (they are read as False). Output k may be
@@ -321,16 +327,16 @@ class _GoalsAt:
     state (and, for the environment, its chosen input), so that the position's transitions
     are split by the rest of their next step alone."""
 
-    def __init__(self, game: SymbolicGame, state: dict[str, bool], goals: list):
+    def __init__(self, game: SymbolicGame, state: Mapping[str, bool | None], goals: list[Node]) -> None:
         self.game, self.state, self.goals = game, state, goals
-        self.cofactors = {}
+        self.cofactors: dict[int, Node] = {}
 
-    def cofactor(self, goal: int):
+    def cofactor(self, goal: int) -> Node:
         if goal not in self.cofactors:
             self.cofactors[goal] = self.game.bdd.let(self.state, self.goals[goal])
         return self.cofactors[goal]
 
-    def split_by_successor_goal(self, following, rank: int):
+    def split_by_successor_goal(self, following: Node, rank: int) -> Iterator[tuple[int, Node]]:
         """``following`` (next steps of transitions from this position) split by the goal
         pursued after them, as ``_successor_goal`` decides it: pairs (goal, part), each
         non-empty part of the transitions that satisfy goals rank, rank + 1, ... up to (not
@@ -347,7 +353,7 @@ class _GoalsAt:
         yield rank, following
 
 
-def _moves_from(game: SymbolicGame, state: dict[str, bool]):
+def _moves_from(game: SymbolicGame, state: dict[str, bool]) -> tuple[Node, Node]:
     """The moves from one position allowed by env_trans, and those allowed by both safety
     sections, each as the position's state cube conjoined with the relation."""
     env_moves = game.cube(state)
@@ -363,11 +369,11 @@ class _Numbering:
     """Nodes (by a key: valuation and rank) numbered in order of discovery, breadth-first:
     ``queue`` holds the keys of the discovered nodes not yet expanded."""
 
-    def __init__(self):
-        self.index: dict = {}
-        self.queue: deque = deque()
+    def __init__(self) -> None:
+        self.index: dict[Any, int] = {}   # a key (an int, or a tuple) -> its number
+        self.queue: deque[Any] = deque()
 
-    def number(self, key) -> int:
+    def number(self, key: Any) -> int:
         found = self.index.get(key)
         if found is None:
             found = self.index[key] = len(self.index)
@@ -375,24 +381,24 @@ class _Numbering:
         return found
 
 
-def _strategy_json(variables, nodes: dict) -> dict:
+def _strategy_json(variables: Iterable[str], nodes: Any) -> dict[str, Any]:  # nodes: a dict or an iterator
     return {'version': FORMAT_VERSION, 'slugs': SLUGS_VERSION, 'variables': list(variables),
             'nodes': nodes}
 
 
-def extract_strategy(game: SymbolicGame, solution: SystemSolution) -> dict:
+def extract_strategy(game: SymbolicGame, solution: SystemSolution) -> dict[str, Any]:
     """The explicit strategy as slugs' JSON object (``nodes`` keyed by decimal strings)."""
     return _strategy_json(game.variables, dict(strategy_nodes(game, solution)))
 
 
-def streamed_strategy(game: SymbolicGame, solution: SystemSolution) -> dict:
+def streamed_strategy(game: SymbolicGame, solution: SystemSolution) -> dict[str, Any]:
     """As ``extract_strategy``, but ``nodes`` is an iterator of ``(name, node)`` pairs made as
     they are read (``strategy_json_chunks`` writes them out): memory holds the numbering of
     the nodes, not their edges."""
     return _strategy_json(game.variables, strategy_nodes(game, solution))
 
 
-def strategy_nodes(game: SymbolicGame, solution: SystemSolution):
+def strategy_nodes(game: SymbolicGame, solution: SystemSolution) -> Iterator[tuple[str, dict[str, Any]]]:
     """The strategy's nodes ``(name, node)`` in increasing number (breadth-first order)."""
     steps = [_GoalSteps(game, [_StepMoves(game, step) for step in goal]) for goal in goal_steps(game, solution)]
     variables, goals = game.variables, len(game.sys_goals)
@@ -418,7 +424,7 @@ def strategy_nodes(game: SymbolicGame, solution: SystemSolution):
 
 
 def extract_counterstrategy(game: SymbolicGame, solution: EnvironmentSolution,
-                            robotics_semantics: bool, play_length: int | None = None) -> dict:
+                            robotics_semantics: bool, play_length: int | None = None) -> dict[str, Any]:
     """The environment's explicit winning strategy (slugs' ``--counterStrategy`` as JSON).
 
     A node is (valuation, i, j) and its ``rank`` is ``[i, j]``: the environment works towards
@@ -438,11 +444,11 @@ def extract_counterstrategy(game: SymbolicGame, solution: EnvironmentSolution,
     for state in enumerate_states(game, initial, game.variables, limit=1 if one_play else None):
         numbering.number((tuple(state[name] for name in game.variables),
                           (0, environment.first_blockable_goal(state))))
-    nodes: dict[str, dict] = {}
-    while numbering.queue and not (one_play and len(nodes) >= play_length):
+    nodes: dict[str, dict[str, Any]] = {}
+    while numbering.queue and not (play_length is not None and len(nodes) >= play_length):  # one_play
         values, rank = numbering.queue.popleft()
         game.interrupt.check()
-        node = {'rank': list(rank), 'state': [None if v is None else int(v) for v in values],
+        node: dict[str, Any] = {'rank': list(rank), 'state': [None if v is None else int(v) for v in values],
                 'trans': []}
         nodes[str(numbering.index[(values, rank)])] = node
         if None in values:  # a deadlock node: nothing follows
@@ -463,7 +469,7 @@ class EnvironmentStrategy:
     so no play can satisfy every system goal.
     """
 
-    def __init__(self, game: SymbolicGame, solution: EnvironmentSolution):
+    def __init__(self, game: SymbolicGame, solution: EnvironmentSolution) -> None:
         self.game = game
         self.levels = solution.levels
         self.moves = _first_environment_moves(game, solution)
@@ -479,20 +485,23 @@ class EnvironmentStrategy:
             for blocking in level.blocking:
                 won |= blocking
             self.won_by_level.append(won)
-        self._levels_found = {}
-        self._goals_found = {}
+        self._levels_found: dict[tuple[bool | None, ...], int] = {}
+        self._goals_found: dict[tuple[tuple[bool | None, ...], int], int] = {}
         # Supports of the sets evaluated at every node (finding one walks its whole BDD).
         self._won_supports = [game.bdd.support(won) for won in self.won_by_level]
-        self._blocking_supports = {}
+        self._blocking_supports: dict[tuple[int, int], set[str]] = {}
         self._env_goal_supports = [game.bdd.support(goal) for goal in game.env_goals]
 
-    def level_of(self, state, values: tuple | None = None) -> int:
+    def level_of(self, state: Mapping[str, bool | None] | None, values: tuple[bool | None, ...] | None = None) -> int:
         """The first level whose blocking sets contain the position (``values``: its
         variables' values in order, when known). Z_k grows with k (the iterates of a least
         fixpoint), so a binary search over the Z_k finds it: a few evaluations per state
         instead of one per level and goal (remembered per state: each node's level is asked
         again by its predecessors)."""
-        key = tuple(state[name] for name in self.game.variables) if values is None else values
+        if values is None:
+            assert state is not None  # one of the two is given
+            values = tuple(state[name] for name in self.game.variables)
+        key = values
         found = self._levels_found.get(key)
         if found is None:
             state = dict(zip(self.game.variables, values)) if state is None else state
@@ -508,10 +517,13 @@ class EnvironmentStrategy:
             found = self._levels_found[key] = low
         return found
 
-    def first_blockable_goal(self, state, level: int | None = None, values: tuple | None = None) -> int:
+    def first_blockable_goal(self, state: Mapping[str, bool | None] | None, level: int | None = None,
+                             values: tuple[bool | None, ...] | None = None) -> int:
         """The first goal the environment can block at the position (on its level),
         remembered per position: many transitions lead to the same one."""
-        values = tuple(state[name] for name in self.game.variables) if values is None else values
+        if values is None:
+            assert state is not None  # one of the two is given
+            values = tuple(state[name] for name in self.game.variables)
         level = self.level_of(state, values) if level is None else level
         key = (values, level)
         found = self._goals_found.get(key)
@@ -522,7 +534,7 @@ class EnvironmentStrategy:
                 if self.game.evaluate(blocking, state, self._blocking_support(level, j)))
         return found
 
-    def _won_at(self, level: int, state) -> bool:
+    def _won_at(self, level: int, state: Mapping[str, bool | None]) -> bool:
         return self.game.evaluate(self.won_by_level[level], state, self._won_supports[level])
 
     def _blocking_support(self, level: int, goal: int) -> set[str]:
@@ -532,7 +544,7 @@ class EnvironmentStrategy:
                 self.game.bdd.support(self.levels[level].blocking[goal])
         return support
 
-    def successors(self, state: dict, rank: tuple, only_first: bool) -> list[tuple]:
+    def successors(self, state: Mapping[str, bool | None], rank: tuple[int, int], only_first: bool) -> list[Position]:
         """The successor nodes (values, rank) of node (state, rank): a deadlock node when the
         environment can leave the system no legal output, else one per system response to
         the environment's chosen input (only the first with ``only_first``)."""
@@ -550,7 +562,7 @@ class EnvironmentStrategy:
             self.responses_counted = int(game.bdd.count(game.bdd.exist(game.next_inputs, responses),
                                                         nvars=len(game.next_outputs)))
         input_values = tuple(chosen_input[name] for name in game.next_inputs)
-        successors = []
+        successors: list[Position] = []
         for output_values, next_assumption in self._responses(state, chosen_input, responses, assumption,
                                                               only_first):
             next_values = input_values + output_values
@@ -559,8 +571,9 @@ class EnvironmentStrategy:
             successors.append((next_values, (next_assumption, next_goal)))
         return successors
 
-    def _responses(self, state: dict, chosen_input: dict, responses, assumption: int,
-                   only_first: bool) -> list[tuple]:
+    def _responses(self, state: Mapping[str, bool | None], chosen_input: dict[str, bool], responses: Node,
+                   assumption: int,
+                   only_first: bool) -> list[tuple[tuple[bool, ...], int]]:
         """The system's responses to the chosen input (output values, in next_outputs order,
         smallest first: False before True, in declared order, as repeated ``pick``s would
         give) with the assumption pursued after each; only the first with ``only_first``.
@@ -585,7 +598,7 @@ class EnvironmentStrategy:
         found.sort()  # one entry per output valuation: the values never tie
         return found
 
-    def _deadlock_input(self, state: dict) -> tuple | None:
+    def _deadlock_input(self, state: Mapping[str, bool | None]) -> tuple[bool | None, ...] | None:
         """The values of a deadlock node (chosen inputs, no outputs), if the environment can
         move so that no output satisfies sys_trans."""
         game = self.game
@@ -596,7 +609,7 @@ class EnvironmentStrategy:
         return tuple(choice[game.to_next[name]] for name in game.inputs) + (None,) * len(game.outputs)
 
 
-def _first_environment_moves(game: SymbolicGame, solution: EnvironmentSolution) -> list:
+def _first_environment_moves(game: SymbolicGame, solution: EnvironmentSolution) -> list[list[list[Node]]]:
     """Per level, goal and assumption: the environment moves of lowest X rank at each position."""
     strategies = []
     for level in solution.levels:
@@ -613,7 +626,7 @@ def _first_environment_moves(game: SymbolicGame, solution: EnvironmentSolution) 
     return strategies
 
 
-def losing_initial_positions(game: SymbolicGame, environment_wins, robotics_semantics: bool):
+def losing_initial_positions(game: SymbolicGame, environment_wins: Node, robotics_semantics: bool) -> Node:
     """The set of initial positions from which the environment wins.
 
     Robotics semantics: any position allowed by both init sections. Standard semantics: the
@@ -626,12 +639,12 @@ def losing_initial_positions(game: SymbolicGame, environment_wins, robotics_sema
     return initial
 
 
-def strategy_to_json(strategy: dict) -> str:
+def strategy_to_json(strategy: dict[str, Any]) -> str:
     """Print a (counter-)strategy exactly in slugs' ``--jsonOutput`` layout."""
     return ''.join(strategy_json_chunks(strategy))
 
 
-def strategy_json_chunks(strategy: dict, nodes_per_chunk: int = 1000):
+def strategy_json_chunks(strategy: dict[str, Any], nodes_per_chunk: int = 1000) -> Iterator[str]:
     """``strategy_to_json`` in pieces of ``nodes_per_chunk`` nodes, for writing as they come.
     ``strategy['nodes']`` is a dict, or an iterator of ``(name, node)`` in increasing number
     (``streamed_strategy``)."""

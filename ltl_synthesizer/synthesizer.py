@@ -15,6 +15,7 @@ from __future__ import annotations
 import time
 from contextlib import contextmanager
 from dataclasses import dataclass, field
+from typing import Any, Iterator
 
 from respec.spec import GR1Specification
 
@@ -23,6 +24,7 @@ from ltl_synthesizer.gr1 import (EnvironmentSolution, Solver, SystemSolution, so
 from ltl_synthesizer.errors import StrategyTooLargeError
 from ltl_synthesizer.interrupt import Interrupt, Limits, memory_exceeded
 from ltl_synthesizer.policy import Options
+from ltl_synthesizer.cudd_import import Node
 from ltl_synthesizer.symbolic import SymbolicGame
 
 __all__ = ['Limits', 'Solved', 'SynthesisResult', 'counter_strategy', 'explain',
@@ -35,10 +37,10 @@ class SynthesisResult:
     """The answer of :func:`synthesize` (plain data: it may be pickled to another process)."""
 
     realizable: bool
-    strategy: dict | None = None
-    counterstrategy: dict | None = None
+    strategy: dict[str, Any] | None = None
+    counterstrategy: dict[str, Any] | None = None
     explanation: str = ''
-    stats: dict = field(default_factory=dict)
+    stats: dict[str, Any] = field(default_factory=dict)
 
 
 @dataclass
@@ -56,7 +58,7 @@ class Solved:
     solution: SystemSolution
     realizable: bool
     interrupt: Interrupt
-    stats: dict = field(default_factory=dict)
+    stats: dict[str, Any] = field(default_factory=dict)
     warnings: list[str] = field(default_factory=list)
     _environment: EnvironmentSolution | None = field(default=None, repr=False)
 
@@ -68,7 +70,7 @@ class Solved:
         return self._environment
 
 
-def initial_positions_win(game: SymbolicGame, winning, robotics_semantics: bool) -> bool:
+def initial_positions_win(game: SymbolicGame, winning: Node, robotics_semantics: bool) -> bool:
     """slugs' realizability check on the initial positions.
 
     Standard: for every initial input allowed by ENV_INIT some output allowed by SYS_INIT is
@@ -76,9 +78,9 @@ def initial_positions_win(game: SymbolicGame, winning, robotics_semantics: bool)
     (``--sysInitRoboticsSemantics``): every position allowed by both sections is winning.
     """
     if robotics_semantics:
-        return game.env_init & game.sys_init & ~winning == game.false
+        return bool(game.env_init & game.sys_init & ~winning == game.false)  # dd's BDDs are Any to mypy
     good_outputs_exist = game.bdd.exist(game.outputs, winning & game.sys_init)
-    return game.env_init & ~good_outputs_exist == game.false
+    return bool(game.env_init & ~good_outputs_exist == game.false)
 
 
 def solve(spec: GR1Specification, robotics_semantics: bool = True, limits: Limits = Limits(),
@@ -102,7 +104,7 @@ def solve(spec: GR1Specification, robotics_semantics: bool = True, limits: Limit
         interrupt.stage = 'solving the game'
         interrupt.size = game_size(game)
 
-        def still_possible(winning):
+        def still_possible(winning: Node) -> bool:
             return initial_positions_win(game, winning, robotics_semantics)
 
         solution = solve_system_game(solver, stop_when_losing=still_possible)
@@ -128,13 +130,14 @@ def is_realizable(spec: GR1Specification, robotics_semantics: bool = True, limit
 # Strategies and explanations load only when asked: a verdict alone on a tiny specification is
 # mostly start-up (5 ms less of about 120).
 
-def explicit_strategy(solved: Solved, max_edges: int | None = None) -> dict:
+def explicit_strategy(solved: Solved, max_edges: int | None = None) -> dict[str, Any]:
     """The explicit-state strategy of a realizable game (slugs ``--explicitStrategy --jsonOutput``
     shape). With ``max_edges``, StrategyTooLargeError as soon as the nodes extracted so far have
     more transitions: a strategy too large to use is not extracted to the end."""
     from ltl_synthesizer.strategy import streamed_strategy
     with _memory_failures_reported(solved.interrupt, 'extracting the strategy'):
         strategy = streamed_strategy(solved.game, _realizable(solved).solution)
+        nodes: dict[str, Any]
         nodes, edges = {}, 0
         for name, node in strategy['nodes']:
             edges += len(node['trans'])
@@ -147,7 +150,7 @@ def explicit_strategy(solved: Solved, max_edges: int | None = None) -> dict:
         return {**strategy, 'nodes': nodes}
 
 
-def stream_strategy(solved: Solved) -> dict:
+def stream_strategy(solved: Solved) -> dict[str, Any]:
     """The strategy with its ``nodes`` an iterator, made while it is read
     (``strategy_json_chunks`` writes them out; memory holds no edges)."""
     from ltl_synthesizer.strategy import streamed_strategy
@@ -155,7 +158,7 @@ def stream_strategy(solved: Solved) -> dict:
         return streamed_strategy(solved.game, _realizable(solved).solution)
 
 
-def counter_strategy(solved: Solved) -> dict:
+def counter_strategy(solved: Solved) -> dict[str, Any]:
     """The environment's explicit counter-strategy of an unrealizable game."""
     from ltl_synthesizer.strategy import extract_counterstrategy
     environment = _unrealizable(solved).environment()
@@ -211,7 +214,7 @@ def game_size(game: SymbolicGame) -> str:
 
 
 @contextmanager
-def _memory_failures_reported(interrupt: Interrupt, stage: str):
+def _memory_failures_reported(interrupt: Interrupt, stage: str) -> Iterator[None]:
     """Runs ``stage`` (named by a limit that stops it, with the interrupt's size measure).
     CUDD fails an operation beyond its memory limit; dd reports that as a NULL node."""
     interrupt.stage = stage

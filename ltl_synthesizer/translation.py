@@ -7,7 +7,9 @@ explicit stack, so formulas may be nested to any depth.
 
 from __future__ import annotations
 
-from ltl_synthesizer.cudd_import import cudd
+from typing import Callable, Iterable, Sequence
+
+from ltl_synthesizer.cudd_import import Node, cudd
 
 from respec.vocabulary.errors import quoted
 from respec.ltl import And, Const, Formula, Iff, Implies, Next, Not, Or, Var, children, to_infix
@@ -37,7 +39,8 @@ class Translator:
     it, so translating the formulas in some order places the variables in order of first use.
     """
 
-    def __init__(self, bdd: cudd.BDD, inputs: list[str], outputs: list[str], check=None):
+    def __init__(self, bdd: cudd.BDD, inputs: list[str], outputs: list[str],
+                 check: Callable[[], object] | None = None) -> None:
         self.bdd = bdd
         self.outputs = set(outputs)
         self.declared = set(inputs) | self.outputs
@@ -49,7 +52,7 @@ class Translator:
         self.check()
         return self._translate(formula, section)
 
-    def conjunction(self, formulas, section: str) -> cudd.Function:
+    def conjunction(self, formulas: Iterable[Formula], section: str) -> cudd.Function:
         result = self.bdd.true
         for formula in formulas:
             result &= self.translate(formula, section)
@@ -64,8 +67,8 @@ class Translator:
         met and children already translated are not pushed: large specifications have
         hundreds of thousands of nodes, and this loop is most of their translation time.
         """
-        done = ({}, {})  # the BDDs of subformulas by id(), outside and under next
-        next_outputs = set()
+        done: tuple[dict[int, Node], dict[int, Node]] = ({}, {})  # the BDDs of subformulas by id(), outside and under next
+        next_outputs: set[str] = set()
         stack = [(root, False, False)]
         pop, push = stack.pop, stack.append
         while stack:
@@ -75,8 +78,9 @@ class Translator:
                 continue
             kind = formula.__class__
             if kind is Var or kind is Const:
-                if kind is Var and under_next and formula.name in self.outputs:
-                    next_outputs.add(formula.name)
+                # A Var (mypy narrows by isinstance, not by the __class__ this hot loop dispatches on):
+                if kind is Var and under_next and formula.name in self.outputs:  # type: ignore[attr-defined]
+                    next_outputs.add(formula.name)  # type: ignore[attr-defined]
                 translated[id(formula)] = self._node(formula, (), under_next, section)
                 continue
             inner = under_next or kind is Next
@@ -105,7 +109,7 @@ class Translator:
                 f'{to_infix(root)}', item=bad)
         return done[False][id(root)]
 
-    def _node(self, formula: Formula, args: list, under_next: bool, section: str) -> cudd.Function:
+    def _node(self, formula: Formula, args: Sequence[Node], under_next: bool, section: str) -> cudd.Function:
         bdd = self.bdd
         if isinstance(formula, Const):
             return bdd.true if formula.value else bdd.false
@@ -138,7 +142,7 @@ class Translator:
 
 
 def check_declarations(spec: GR1Specification) -> None:
-    seen = set()
+    seen: set[str] = set()
     for name in list(spec.env_props) + list(spec.sys_props):
         if not isinstance(name, str) or not name or name.endswith("'"):
             raise UndeclaredPropositionError(f'invalid proposition name {name!r}', item=name)

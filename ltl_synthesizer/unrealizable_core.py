@@ -16,8 +16,9 @@ Realizability of each candidate is decided by the synthesizer's own game (the sa
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Callable, Sequence, TypeVar
+from typing import Callable, Generic, Protocol, Sequence, TypeVar
 
+from respec.ltl import Formula
 from respec.spec import FORMULA_SECTIONS, GR1Specification
 
 from ltl_synthesizer.gr1 import Solver, solve_environment_game
@@ -72,12 +73,25 @@ def _split(items: list[T], parts: int) -> list[list[T]]:
     return [chunk for chunk in chunks if chunk]
 
 
+class Group(Protocol):
+    """What a core is made of: formulas of one section (``ltl_specification.components.FormulaGroup``)."""
+
+    @property
+    def section(self) -> str: ...
+
+    @property
+    def formulas(self) -> Sequence[Formula]: ...
+
+
+G = TypeVar('G', bound=Group)
+
+
 @dataclass
-class Core:
+class Core(Generic[G]):
     """An unrealizable core: the guarantee groups (in the specification's order) and the
     specification made of them plus every assumption."""
 
-    groups: list
+    groups: list[G]
     specification: GR1Specification
     realizability_checks: int
 
@@ -87,7 +101,7 @@ def droppable_sections(robotics_semantics: bool) -> tuple[str, ...]:
     return ('sys_trans', 'sys_liveness') if robotics_semantics else ('sys_init', 'sys_trans', 'sys_liveness')
 
 
-def restrict_guarantees(spec: GR1Specification, groups: Sequence, sections: Sequence[str]) -> GR1Specification:
+def restrict_guarantees(spec: GR1Specification, groups: Sequence[Group], sections: Sequence[str]) -> GR1Specification:
     """``spec`` with only those formulas of ``sections`` that belong to ``groups``."""
     kept = {(group.section, formula) for group in groups for formula in group.formulas}
     restricted = GR1Specification(env_props=list(spec.env_props), sys_props=list(spec.sys_props))
@@ -99,8 +113,8 @@ def restrict_guarantees(spec: GR1Specification, groups: Sequence, sections: Sequ
     return restricted
 
 
-def unrealizable_core(spec: GR1Specification, groups: Sequence, robotics_semantics: bool = True,
-                      limits: Limits = Limits()) -> Core | None:
+def unrealizable_core(spec: GR1Specification, groups: Sequence[G], robotics_semantics: bool = True,
+                      limits: Limits = Limits()) -> Core[G] | None:
     """A 1-minimal set of guarantee ``groups`` that, with all assumptions, is unrealizable.
 
     ``groups`` are objects with ``section`` and ``formulas`` covering the specification
@@ -112,7 +126,7 @@ def unrealizable_core(spec: GR1Specification, groups: Sequence, robotics_semanti
     guarantees = [group for group in groups if group.section in sections]
     outcomes: dict[tuple[int, ...], bool] = {}
 
-    def unrealizable(subset: list) -> bool:
+    def unrealizable(subset: list[G]) -> bool:
         key = tuple(sorted(id(group) for group in subset))
         if key not in outcomes:
             outcomes[key] = not is_realizable(restrict_guarantees(spec, subset, sections), robotics_semantics,
@@ -126,7 +140,7 @@ def unrealizable_core(spec: GR1Specification, groups: Sequence, robotics_semanti
 
 
 def environment_play(spec: GR1Specification, robotics_semantics: bool = True, length: int = 8,
-                     limits: Limits = Limits()) -> list[dict]:
+                     limits: Limits = Limits()) -> list[dict[str, bool | None]]:
     """Up to ``length`` steps of a play the environment wins (``spec`` must be unrealizable).
 
     The environment follows its counter-strategy. The system plays its best: among the
@@ -150,13 +164,13 @@ def environment_play(spec: GR1Specification, robotics_semantics: bool = True, le
     def usable(name: str) -> bool:
         return not stuck(name) and not all(stuck(str(t)) for t in nodes[name]['trans'])
 
-    def achieved(name: str) -> frozenset:
+    def achieved(name: str) -> frozenset[int]:
         return frozenset(i for i, value in enumerate(nodes[name]['state'][:n_inputs]) if value)
 
     # Breadth-first over (node, inputs seen true so far): the first path found to a
     # combination is a shortest one; a play may revisit nodes, but not combinations.
     start = ('0', achieved('0'))
-    parent = {start: None}
+    parent: dict[tuple[str, frozenset[int]], tuple[str, frozenset[int]] | None] = {start: None}
     frontier = [start]
     best = start
     for _ in range(length - 1):
@@ -174,7 +188,8 @@ def environment_play(spec: GR1Specification, robotics_semantics: bool = True, le
                         best = child
         frontier = following
     path = []
-    while best is not None:
-        path.append(best[0])
-        best = parent[best]
+    at: tuple[str, frozenset[int]] | None = best
+    while at is not None:
+        path.append(at[0])
+        at = parent[at]
     return [dict(zip(game.variables, nodes[name]['state'])) for name in reversed(path)]

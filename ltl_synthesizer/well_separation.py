@@ -35,7 +35,8 @@ from dataclasses import dataclass, field, replace
 from respec.ltl import to_infix
 from respec.spec import GR1Specification
 
-from ltl_synthesizer.interrupt import Limits
+from ltl_synthesizer.interrupt import Interrupt, Limits
+from ltl_synthesizer.cudd_import import Node
 from ltl_synthesizer.symbolic import SymbolicGame
 
 # Beyond this many assumptions the involved ones are all listed rather than minimized (each
@@ -74,7 +75,7 @@ class WellSeparation:
 
 # --- the fixpoint ----------------------------------------------------------------------------
 
-def environment_controllable_predecessor(game: SymbolicGame, target):
+def environment_controllable_predecessor(game: SymbolicGame, target: Node) -> Node:
     """EnvCpre: positions from which the environment has a next input allowed by ENV_TRANS such
     that every next output SYS_TRANS allows makes the move satisfy ``target`` (a set of moves,
     over current and next variables).
@@ -85,7 +86,7 @@ def environment_controllable_predecessor(game: SymbolicGame, target):
     return ~game.cox(~target)
 
 
-def assumptions_keepable(game: SymbolicGame):
+def assumptions_keepable(game: SymbolicGame) -> Node:
     """``νZ. ⋀_j μY. EnvCpre((J_j ∧ Z') ∨ Y')``: the positions from which the environment can keep
     ENV_TRANS forever and satisfy every ENV_LIVENESS J_j infinitely often, whatever the system
     does (the generalized Büchi game of the assumptions, played by the environment)."""
@@ -99,7 +100,7 @@ def assumptions_keepable(game: SymbolicGame):
         keepable = narrowed
 
 
-def _reach_goal_then(game: SymbolicGame, goal, keepable):
+def _reach_goal_then(game: SymbolicGame, goal: Node, keepable: Node) -> Node:
     """``μY. EnvCpre((J ∧ Z') ∨ Y')``: positions from which the environment can force a move
     satisfying ``goal`` into ``keepable``, keeping ENV_TRANS on the way."""
     arrived_in = goal & game.prime(keepable)
@@ -112,7 +113,7 @@ def _reach_goal_then(game: SymbolicGame, goal, keepable):
         reaching = grown
 
 
-def cheating_initial_positions(game: SymbolicGame):
+def cheating_initial_positions(game: SymbolicGame) -> Node:
     """Initial positions (ENV_INIT ∧ SYS_INIT) from which the system can force the environment
     to break its assumptions."""
     return game.env_init & game.sys_init & ~assumptions_keepable(game)
@@ -122,7 +123,7 @@ def cheating_initial_positions(game: SymbolicGame):
 
 def is_well_separated(game: SymbolicGame) -> bool:
     """The verdict alone (no assumptions named): for callers that try many specifications."""
-    return game.env_init != game.false and cheating_initial_positions(game) == game.false
+    return bool(game.env_init != game.false and cheating_initial_positions(game) == game.false)  # dd: Any
 
 
 def check_well_separation(spec: GR1Specification, limits: Limits = Limits(),
@@ -141,7 +142,7 @@ def check_well_separation(spec: GR1Specification, limits: Limits = Limits(),
                           involved)
 
 
-def _interrupt(spec: GR1Specification, limits: Limits):
+def _interrupt(spec: GR1Specification, limits: Limits) -> Interrupt:
     """The limits' check, naming this stage and the specification's size when they stop it."""
     interrupt = limits.interrupt()
     interrupt.stage = 'checking well-separation'
@@ -155,7 +156,7 @@ def _forces_violation(spec: GR1Specification, kept: list[tuple[str, int]], limit
     restricted = replace(spec, env_trans=[spec.env_trans[i] for s, i in kept if s == 'env_trans'],
                          env_liveness=[spec.env_liveness[i] for s, i in kept if s == 'env_liveness'])
     game = SymbolicGame(restricted, None, _interrupt(spec, limits))
-    return cheating_initial_positions(game) != game.false
+    return bool(cheating_initial_positions(game) != game.false)  # dd's BDDs are Any to mypy
 
 
 def _involved_assumptions(spec: GR1Specification, limits: Limits) -> list[tuple[str, int]]:

@@ -21,7 +21,8 @@ Modules:
     cli            ``behavior-synthesis generate-sm`` / ``python -m sm_generation``
 """
 
-from sm_generation.automaton_io import Automaton, AutomatonState, load_automaton
+from respec.automaton import Automaton, AutomatonState
+from sm_generation.automaton_io import load_automaton
 from sm_generation.errors import SMGenerationError
 from sm_generation.for_system import generate_state_machine
 from sm_generation.instantiation import OutcomeCondition, StateInstantiation, count_states

@@ -31,6 +31,7 @@ from __future__ import annotations
 from collections import deque
 from dataclasses import dataclass, field
 
+from respec.automaton import AutomatonState
 from respec.vocabulary.errors import quoted
 from respec.vocabulary.naming import activation, is_memory
 from sm_generation.config import FlexBEConfig, StateConfig
@@ -72,7 +73,7 @@ class AbstractMachine:
 class AutomatonView:
     """A validated automaton read through a system's FlexBE configuration."""
 
-    def __init__(self, automaton, config: FlexBEConfig):
+    def __init__(self, automaton: object, config: FlexBEConfig) -> None:
         self.config = config
         self.output_variables = _variables(automaton, 'output_variables')
         self.input_variables = _variables(automaton, 'input_variables')
@@ -111,12 +112,12 @@ class AutomatonView:
                 raise StateConfigInvalidError(f'input proposition {prop!r} changes in the automaton but no state in '
                                               f'flexbe.states of system {config.system!r} reports it', prop)
 
-    def _true_activations(self, state) -> tuple[str, ...]:
+    def _true_activations(self, state: _State) -> tuple[str, ...]:
         true = {v for v, value in zip(self.output_variables, state.output_valuation) if value}
         return tuple(sorted((p for p in self.activation_props if p in true),
                             key=lambda p: self.config.states[p].label))
 
-    def _exit_outcome(self, state) -> str | None:
+    def _exit_outcome(self, state: _State) -> str | None:
         true = [p for p, value in zip(self.output_variables, state.output_valuation)
                 if value and p in self.config.sm_outcomes]
         if len(true) > 1:
@@ -137,7 +138,7 @@ class AutomatonView:
     def observation(self, activations: tuple[str, ...], source: str, target: str) -> Observation:
         """What FlexBE sees when the automaton moves from ``source`` to ``target``."""
         now, before = self.inputs(target), self.inputs(source)
-        pairs = []
+        pairs: list[tuple[str, str]] = []
         for active in activations:
             seen = [p for p in self.config.states[active].output_mapping if now.get(p)]
             if len(seen) > 1:
@@ -185,8 +186,9 @@ class AutomatonView:
 
     def resolve(self, name: str) -> Target:
         """The machine target standing for automaton state ``name`` (see module doc)."""
-        if self.exits[name] is not None:
-            return ('outcome', self.exits[name])
+        outcome = self.exits[name]
+        if outcome is not None:
+            return ('outcome', outcome)
         if self.activations[name]:
             return ('state', name)
         exit_state = self._first_silent_exit(name)
@@ -261,7 +263,7 @@ class AutomatonView:
         return props
 
 
-def _variables(automaton, attribute: str) -> list[str]:
+def _variables(automaton: object, attribute: str) -> list[str]:
     values = getattr(automaton, attribute, None)
     if not isinstance(values, (list, tuple)) or not all(isinstance(v, str) for v in values):
         raise AutomatonInvalidError(f'automaton.{attribute} must be a list of names',
@@ -273,7 +275,7 @@ def _variables(automaton, attribute: str) -> list[str]:
     return list(values)
 
 
-def _states(automaton, n_outputs: int, n_inputs: int) -> dict:
+def _states(automaton: object, n_outputs: int, n_inputs: int) -> dict[str, _State]:
     states = getattr(automaton, 'states', None)
     if not states:
         raise AutomatonInvalidError('the automaton has no states', 'states')
@@ -303,7 +305,7 @@ class _State:
     transitions: tuple[str, ...]
 
 
-def _normalized(state, name: str) -> _State:
+def _normalized(state: AutomatonState, name: str) -> _State:
     # Names may be ints in hand-written files; valuations may be 0/1.
     return _State(name, tuple(bool(v) for v in state.output_valuation),
                   tuple(bool(v) for v in state.input_valuation),

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
+from typing import Any
 
 import yaml
 
@@ -23,11 +24,11 @@ from respec.untrusted import BoundedYamlError, load_bounded_yaml, read_bounded_f
 from sm_generation.errors import AutomatonInvalidError
 
 
-def automaton_from_dict(data: dict, source: str = '<dict>') -> Automaton:
+def automaton_from_dict(data: object, source: str = '<dict>') -> Automaton:
     """Build an Automaton from our file format (already parsed)."""
     if not isinstance(data, dict):
         raise AutomatonInvalidError(f'{source}: expected a mapping', source)
-    states = data.get('automaton', data.get('states'))
+    states: Any = data.get('automaton', data.get('states'))  # checked to be a list below
     for key, value in (('output_variables', data.get('output_variables')),
                        ('input_variables', data.get('input_variables')),
                        ('automaton', states)):
@@ -50,7 +51,7 @@ def automaton_from_dict(data: dict, source: str = '<dict>') -> Automaton:
                      initial_states=[str(s) for s in data.get('initial_states') or []])
 
 
-def automaton_to_dict(automaton: Automaton) -> dict:
+def automaton_to_dict(automaton: Automaton) -> dict[str, Any]:
     """Our file format for ``automaton`` (valuations as 0/1)."""
     return {
         'output_variables': list(automaton.output_variables),
@@ -85,7 +86,7 @@ def load_automaton(path: str | Path, spec_path: str | Path | None = None) -> Aut
     return automaton_from_dict(data, str(path))
 
 
-def _automaton_from_strategy_file(strategy: dict, path: Path, spec_path) -> Automaton:
+def _automaton_from_strategy_file(strategy: dict[str, Any], path: Path, spec_path: str | Path | None) -> Automaton:
     if spec_path is None:
         raise AutomatonInvalidError(f'{path} is a slugs strategy: give the '
                                     '.structuredslugs specification it was synthesized from', str(path))

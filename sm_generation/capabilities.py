@@ -20,7 +20,7 @@ the outcomes of the states that observe it (the spec's ``ENV_TRANS`` binds them)
 from __future__ import annotations
 
 import re
-from typing import Mapping
+from typing import Iterable, Mapping
 
 from respec.automaton import Automaton, AutomatonState
 from respec.robot.cnu import CapabilitySystem
@@ -36,7 +36,7 @@ DEFAULT_AUTONOMY = 1
 _UNSAFE = re.compile(r'[^A-Za-z0-9_]+')
 
 
-def generate_capability_machine(automaton, system: CapabilitySystem, library: Mapping[str, StateClass],
+def generate_capability_machine(automaton: Automaton, system: CapabilitySystem, library: Mapping[str, StateClass],
                                 reduce: bool | None = None) -> StateMachine:
     """The FlexBE state machine implementing ``automaton`` on a capability system."""
     outcomes = capability_outcomes(system, library)
@@ -46,7 +46,7 @@ def generate_capability_machine(automaton, system: CapabilitySystem, library: Ma
     return generate_from_config(flexbe_automaton, config, None, system.reduce if reduce is None else reduce)
 
 
-def parameter_source(value) -> str:
+def parameter_source(value: object) -> str:
     """A capability parameter as the Python source FlexBE's behavior code takes."""
     if isinstance(value, str):
         if value == 'None':
@@ -57,7 +57,7 @@ def parameter_source(value) -> str:
     return repr(value)
 
 
-def _reported_inputs(system: CapabilitySystem, outcomes) -> set[str]:
+def _reported_inputs(system: CapabilitySystem, outcomes: Mapping[str, tuple[str, ...]]) -> set[str]:
     """The inputs FlexBE sees: the capabilities' outcomes. A sensor (a spec ``INPUT``) reaches the
     machine through the outcomes of the states that observe it, as the spec's ``ENV_TRANS`` binds
     them (CNU's coffee maker: ``bd_c' <-> bu' & bd_a``, the button detector completes when the
@@ -66,7 +66,8 @@ def _reported_inputs(system: CapabilitySystem, outcomes) -> set[str]:
             for name in system.capabilities for outcome in outcomes[name]}
 
 
-def _with_parameter_variants(automaton, system: CapabilitySystem, reported: set[str]):
+def _with_parameter_variants(automaton: Automaton, system: CapabilitySystem, reported: set[str]
+                             ) -> tuple[Automaton, dict[str, tuple[str, dict[str, int | str]]]]:
     """The automaton with only what FlexBE sees: one activation per (capability, @var values),
     the SM outcomes the specification has (the request chose them) and the ``reported`` inputs.
     Returns it and the variants: proposition -> (capability, values)."""
@@ -75,7 +76,7 @@ def _with_parameter_variants(automaton, system: CapabilitySystem, reported: set[
     seen = [k for k, name in enumerate(inputs) if name in reported]
     integers = {name: IntegerVariable(name, r.low, r.high) for name, r in system.integers.items()}
     sm_props = [o for o in system.possible_sm_outcomes() if o in outputs]
-    variants: dict[str, tuple[str, dict[str, object]]] = {}
+    variants: dict[str, tuple[str, dict[str, int | str]]] = {}
     rows = []
     for state in automaton.states:
         values = dict(zip(outputs, state.output_valuation))
@@ -105,7 +106,7 @@ def _with_parameter_variants(automaton, system: CapabilitySystem, reported: set[
     return reduced, variants
 
 
-def _check_observable(automaton, seen: Automaton, hidden: list[str], impossible: set[str]) -> None:
+def _check_observable(automaton: Automaton, seen: Automaton, hidden: list[str], impossible: set[str]) -> None:
     """FlexBE chooses a state's successor from the outcome it returns: two successors that return
     the same outcomes must run the same states. A strategy that tells them apart by an input no
     state reports (a sensor no ENV_TRANS binds to an outcome) cannot be a FlexBE machine.
@@ -118,7 +119,7 @@ def _check_observable(automaton, seen: Automaton, hidden: list[str], impossible:
     never = [k for name, k in zip(hidden, hidden_index) if name in impossible]
     visible = {s.name: s for s in seen.states}
     for state in seen.states:
-        chosen: dict[tuple, str] = {}
+        chosen: dict[tuple[bool, ...], str] = {}
         for successor in state.transitions:
             if any(full[successor].input_valuation[k] for k in never):
                 continue
@@ -135,12 +136,14 @@ def _check_observable(automaton, seen: Automaton, hidden: list[str], impossible:
                 (differing or hidden)[0])
 
 
-def _integer_value(integer: IntegerVariable, values: dict, names: dict[int, str]):
+def _integer_value(integer: IntegerVariable, values: dict[str, bool], names: dict[int, str]) -> int | str:
     number = integer.low + sum(1 << k for k, bit in enumerate(integer.bits) if values.get(bit))
     return names.get(number, number)
 
 
-def _flexbe_config(system: CapabilitySystem, outcomes, library, variants, sm_outcomes) -> FlexBEConfig:
+def _flexbe_config(system: CapabilitySystem, outcomes: Mapping[str, tuple[str, ...]],
+                   library: Mapping[str, StateClass], variants: dict[str, tuple[str, dict[str, int | str]]],
+                   sm_outcomes: list[str]) -> FlexBEConfig:
     states = {}
     for proposition, (name, chosen) in variants.items():
         capability = system.capabilities[name]
@@ -160,7 +163,7 @@ def _flexbe_config(system: CapabilitySystem, outcomes, library, variants, sm_out
 
 def capability_flexbe_config(system: CapabilitySystem, library: Mapping[str, StateClass],
                              states: dict[str, StateConfig] | None = None,
-                             sm_outcomes=None) -> FlexBEConfig:
+                             sm_outcomes: Iterable[str] | None = None) -> FlexBEConfig:
     """The FlexBE side of a capability system: its SM outcomes (``sm_outcomes``, those of one
     machine; default: its mappings') and the package of each state class (what
     ``sm_generation.flexbe_behavior`` needs to export a machine as a behavior)."""

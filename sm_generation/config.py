@@ -36,7 +36,7 @@ from __future__ import annotations
 
 from contextlib import contextmanager
 from dataclasses import dataclass, field
-from typing import Iterator
+from typing import Any, Iterator
 
 from respec.vocabulary.naming import activated
 from sm_generation.instantiation import StateInstantiation
@@ -147,7 +147,7 @@ def flexbe_config(system: RobotSystem) -> FlexBEConfig:
     return parse_flexbe_config(section, system.name)
 
 
-def parse_flexbe_config(section: dict, system: str = '') -> FlexBEConfig:
+def parse_flexbe_config(section: object, system: str = '') -> FlexBEConfig:
     """Validate an already-parsed ``flexbe:`` mapping."""
     if not isinstance(section, dict):
         raise FlexBEConfigInvalidError('the flexbe section must be a mapping', 'flexbe')
@@ -174,7 +174,7 @@ def parse_flexbe_config(section: dict, system: str = '') -> FlexBEConfig:
                         userdata=_userdata(section.get('userdata')))
 
 
-def _userdata(raw) -> dict[str, str]:
+def _userdata(raw: object) -> dict[str, str]:
     key = 'flexbe.userdata'
     if raw is None:
         return {}
@@ -190,7 +190,7 @@ def _userdata(raw) -> dict[str, str]:
     return {name: 'None' if default is None else str(default) for name, default in raw.items()}
 
 
-def _packages(raw) -> dict:
+def _packages(raw: object) -> dict[str, Any]:
     key = 'flexbe.packages'
     if raw is None:
         return {}
@@ -208,7 +208,7 @@ def _packages(raw) -> dict:
     return raw
 
 
-def _sm_outcomes(raw) -> dict[str, str]:
+def _sm_outcomes(raw: object) -> dict[str, str]:
     key = 'flexbe.sm_outcomes'
     if not isinstance(raw, dict) or not raw:
         raise FlexBEConfigInvalidError(f'{key} must map SM-outcome propositions to outcome names', key)
@@ -219,7 +219,7 @@ def _sm_outcomes(raw) -> dict[str, str]:
     return dict(raw)
 
 
-def _string_list(value, key: str, error: type[SMGenerationError]) -> tuple[str, ...]:
+def _string_list(value: object, key: str, error: type[SMGenerationError]) -> tuple[str, ...]:
     if value is None:
         return ()
     if not isinstance(value, list) or any(isinstance(v, (list, dict)) or v is None for v in value):
@@ -228,7 +228,7 @@ def _string_list(value, key: str, error: type[SMGenerationError]) -> tuple[str, 
     return tuple(str(v) for v in value)
 
 
-def _state_config(proposition: str, entry) -> StateConfig:
+def _state_config(proposition: str, entry: object) -> StateConfig:
     where = f'flexbe.states.{proposition}'
     invalid = StateConfigInvalidError
     if not isinstance(entry, dict):
@@ -274,11 +274,12 @@ def _state_config(proposition: str, entry) -> StateConfig:
                        userdata_keys=keys, userdata_remapping=remapping, writes=writes)
 
 
-def _output_mapping(raw, where: str) -> dict[str, tuple[str, ...]]:
+def _output_mapping(raw: object, where: str) -> dict[str, tuple[str, ...]]:
     invalid = StateConfigInvalidError
     if not isinstance(raw, dict) or not raw:
         raise invalid(f'{where} must map outcome propositions to state outcomes', where)
-    mapping, seen = {}, {}
+    mapping: dict[str, tuple[str, ...]] = {}
+    seen: dict[str, object] = {}
     for proposition, outcomes in raw.items():
         if isinstance(outcomes, str):
             outcomes = [outcomes]
@@ -294,8 +295,8 @@ def _output_mapping(raw, where: str) -> dict[str, tuple[str, ...]]:
     return mapping
 
 
-def _autonomy(raw, outcomes: list[str], where: str) -> dict[str, int]:
-    def level(value) -> int:
+def _autonomy(raw: object, outcomes: list[str], where: str) -> dict[str, int]:
+    def level(value: object) -> int:
         if isinstance(value, bool) or not isinstance(value, int) or value not in AUTONOMY_LEVELS:
             raise AutonomyConfigInvalidError(f'{where}: autonomy must be an integer 0..3, got {value!r}', where)
         return value

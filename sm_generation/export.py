@@ -15,6 +15,7 @@ import math
 import shutil
 import subprocess
 from pathlib import Path
+from typing import AbstractSet
 
 import yaml
 
@@ -126,14 +127,14 @@ def to_dot(machine: StateMachine) -> str:
         for index, (target, outcomes) in enumerate(outcome_groups(state)):
             head = ('state:' + target if target in names else
                     _outcome_node(target, column_of.get(state.name, 0) if target in copies else 0))
-            failing = target != FINISHED and target not in names
-            if failing and columns:
+            to_failure = target != FINISHED and target not in names
+            if to_failure and columns:
                 continue  # the red cell and the column's own failure outcome say it (the rail)
             attributes = [f'id={_quote(f"edge:{state.name}->{target}")}']
             level = _autonomy(state, outcomes)
             if level is not None:
                 attributes.append(f'class="autonomy-{AUTONOMY_NAMES[level].lower()}", color="{AUTONOMY_COLOURS[level]}"')
-            if failing:
+            if to_failure:
                 attributes.append('style=dashed' if level is not None else f'color="{BAD_COLOUR}", style=dashed')
             if columns and column_of.get(state.name) != column_of.get(target, column_of.get(state.name)):
                 # An arrow across the grid would wind around whole columns: a connector says where
@@ -181,6 +182,7 @@ def _grid(top: list[State], initial: str) -> list[list[str]]:
     if len(top) <= WRAP_AFTER:
         return []
     by_name = {s.name: s for s in top}
+    current: str | None
     order, current = [], initial if initial in by_name else top[0].name
     while current in by_name and current not in order:
         order.append(current)
@@ -208,7 +210,7 @@ def _grid_lines(columns: list[list[str]], failure_copies: dict[str, list[str]], 
     return lines
 
 
-def _outcome_cells(state: StateInstantiation, failing: set[int] = frozenset()) -> str:
+def _outcome_cells(state: StateInstantiation, failing: AbstractSet[int] = frozenset()) -> str:
     cells = []
     for index, (_, outcomes) in enumerate(outcome_groups(state)):
         text = (', ' if len(outcomes) <= 2 else ',<BR/>').join(_html(o) for o in outcomes)
@@ -218,7 +220,7 @@ def _outcome_cells(state: StateInstantiation, failing: set[int] = frozenset()) -
     return ''.join(cells)
 
 
-def _state_label(state: StateInstantiation, failing: set[int] = frozenset(), padding: int = 5) -> str:
+def _state_label(state: StateInstantiation, failing: AbstractSet[int] = frozenset(), padding: int = 5) -> str:
     columns = max(1, len(outcome_groups(state)))
     return (f'<TABLE BORDER="1" CELLBORDER="0" CELLSPACING="0" CELLPADDING="{padding}" STYLE="ROUNDED" BGCOLOR="white">'
             f'<TR><TD COLSPAN="{columns}"><B>{_html(state.name)}</B></TD></TR>'
@@ -226,7 +228,7 @@ def _state_label(state: StateInstantiation, failing: set[int] = frozenset(), pad
             f'</FONT></TD></TR><TR>{_outcome_cells(state, failing)}</TR></TABLE>')
 
 
-def _container_label(state: StateMachine, failing: set[int] = frozenset()) -> str:
+def _container_label(state: State, failing: AbstractSet[int] = frozenset()) -> str:
     columns = max(1, len(outcome_groups(state)))
     boxes = ''.join(
         f'<TD><TABLE BORDER="1" CELLBORDER="0" CELLSPACING="0" CELLPADDING="4" STYLE="ROUNDED" BGCOLOR="white">'

@@ -28,6 +28,7 @@ import re
 import zipfile
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Iterable
 
 from sm_generation.config import FlexBEConfig
 from sm_generation.errors import SMGenerationError, StateConfigInvalidError
@@ -86,7 +87,7 @@ def behavior_module_name(behavior_name: str) -> str:
     return re.sub(r'[^\w]', '_', behavior_name.lower()) + '_sm'
 
 
-def default_behavior_name(goals) -> str:
+def default_behavior_name(goals: Iterable[str]) -> str:
     """A behavior name from the goals: 'look_down', 'pickup_object' -> 'Look Down Pickup Object'."""
     return ' '.join(word.capitalize() for goal in goals for word in goal.split('_') if word) or 'Synthesized'
 
@@ -203,7 +204,7 @@ def _behavior_code(machine: StateMachine, config: FlexBEConfig, behavior_name: s
     return '\n'.join(lines) + '\n'
 
 
-def _positions(entries) -> str:
+def _positions(entries: Iterable[StateInstantiation]) -> str:
     return ', '.join(f'x:{round(e.position[0])} y:{round(e.position[1])}' for e in entries)
 
 
@@ -291,7 +292,7 @@ def _add_state(state: State, variables: dict[str, str]) -> list[str]:
     return lines + ['']
 
 
-def _list(names) -> str:
+def _list(names: Iterable[str]) -> str:
     return '[' + ', '.join(f"'{name}'" for name in names) + ']'
 
 

@@ -9,19 +9,23 @@ with the FlexBE side of that mapping (``behavior_flexbe_config``).
 
 from __future__ import annotations
 
+from typing import Mapping
 
+from respec.automaton import Automaton
 from respec.robot import RobotSystem, for_description
 from respec.robot.abstraction import RobotAbstraction
 from respec.robot.cnu import CapabilitySystem
-from respec.robot.state_library import capability_outcomes, workspace_state_library
+from respec.robot.state_library import StateClass, capability_outcomes, workspace_state_library
 from sm_generation.capabilities import capability_flexbe_config, generate_capability_machine
 from sm_generation.config import FlexBEConfig, flexbe_config
 from sm_generation.generator import generate_from_config
 from sm_generation.state_machine import StateMachine
 
+StateLibrary = Mapping[str, StateClass]  # a state class's name -> the class (workspace_state_library)
 
-def generate_state_machine(automaton, system: RobotSystem, initial_conditions: list[str] | None = None,
-                           reduce: bool = False, state_library=None) -> StateMachine:
+
+def generate_state_machine(automaton: Automaton, system: RobotSystem, initial_conditions: list[str] | None = None,
+                           reduce: bool = False, state_library: StateLibrary | None = None) -> StateMachine:
     """The FlexBE state machine implementing ``automaton`` on ``system``, as its tree (its
     StateInstantiation list, FlexBE's wire format, is ``to_instantiations()``).
 
@@ -36,16 +40,16 @@ def generate_state_machine(automaton, system: RobotSystem, initial_conditions: l
     return generate(automaton, system, initial_conditions, reduce, state_library)
 
 
-def _generated_from_capabilities(automaton, system: RobotSystem, initial_conditions, reduce: bool,
-                                 state_library) -> StateMachine:
+def _generated_from_capabilities(automaton: Automaton, system: RobotSystem, initial_conditions: list[str] | None,
+                                 reduce: bool, state_library: StateLibrary | None) -> StateMachine:
     del initial_conditions  # the automaton's initial state is the spec's
     library = workspace_state_library() if state_library is None else state_library
-    capabilities = system.capabilities
+    capabilities = system.required_capabilities()
     return generate_capability_machine(automaton, capabilities, library, reduce or capabilities.reduce)
 
 
-def _generated_from_flexbe_section(automaton, system: RobotSystem, initial_conditions, reduce: bool,
-                                   state_library) -> StateMachine:
+def _generated_from_flexbe_section(automaton: Automaton, system: RobotSystem, initial_conditions: list[str] | None,
+                                   reduce: bool, state_library: StateLibrary | None) -> StateMachine:
     del state_library  # the flexbe: section names each state's class and package
     return generate_from_config(automaton, flexbe_config(system), initial_conditions, reduce)
 
@@ -53,7 +57,7 @@ def _generated_from_flexbe_section(automaton, system: RobotSystem, initial_condi
 _GENERATORS = {RobotAbstraction: _generated_from_flexbe_section, CapabilitySystem: _generated_from_capabilities}
 
 
-def behavior_flexbe_config(system: RobotSystem, state_library=None) -> FlexBEConfig:
+def behavior_flexbe_config(system: RobotSystem, state_library: StateLibrary | None = None) -> FlexBEConfig:
     """The FlexBE side of ``system``'s mapping, as ``sm_generation.flexbe_behavior.behavior_package``
     needs it to write a machine of this system as a behavior package.
 
@@ -67,13 +71,14 @@ def behavior_flexbe_config(system: RobotSystem, state_library=None) -> FlexBECon
     return behavior_config(system, state_library)
 
 
-def _capability_behavior_config(system: RobotSystem, state_library) -> FlexBEConfig:
+def _capability_behavior_config(system: RobotSystem, state_library: StateLibrary | None) -> FlexBEConfig:
     library = workspace_state_library() if state_library is None else state_library
-    capability_outcomes(system.capabilities, library)
-    return capability_flexbe_config(system.capabilities, library)
+    capabilities = system.required_capabilities()
+    capability_outcomes(capabilities, library)
+    return capability_flexbe_config(capabilities, library)
 
 
-def _flexbe_section_config(system: RobotSystem, state_library) -> FlexBEConfig:
+def _flexbe_section_config(system: RobotSystem, state_library: StateLibrary | None) -> FlexBEConfig:
     del state_library
     return flexbe_config(system)
 

@@ -29,13 +29,15 @@ Names come from the activated propositions without ``_a`` (sorted, joined with
 from __future__ import annotations
 
 import logging
+from typing import Callable
 
+from respec.automaton import Automaton
 from sm_generation.config import FlexBEConfig, StateConfig
 from sm_generation.errors import SMGenerationError
 from sm_generation.instantiation import DECISION_CLASS, NOTHING_CLASS, OutcomeCondition, StateInstantiation
 from sm_generation.layout import inner_positions, layered_positions
 from sm_generation.abstract_machine import (
-    DECISION, NOTHING_TO_DO, AutomatonView, AbstractMachine, AbstractState, Target, build_machine)
+    DECISION, NOTHING_TO_DO, AutomatonView, AbstractMachine, AbstractState, Observation, Target, build_machine)
 from sm_generation.reduction import bisimulation_blocks, reduce_machine, target_class
 from sm_generation.state_machine import State, StateMachine
 
@@ -50,7 +52,7 @@ DECISION_AUTONOMY = 3  # Full: the operator confirms where to start at every lev
 NOTHING_NAME = 'nothing_to_do'
 
 
-def generate_from_config(automaton, config: FlexBEConfig, initial_conditions: list[str] | None = None,
+def generate_from_config(automaton: Automaton, config: FlexBEConfig, initial_conditions: list[str] | None = None,
                          reduce: bool = False) -> StateMachine:
     """The FlexBE state machine implementing ``automaton`` with the FlexBE mapping ``config``.
 
@@ -89,7 +91,7 @@ def machine_from_view(view: AutomatonView, initial_conditions: list[str] | None)
     if len(starts) > 1:
         # Starts that behave the same need no choice: keep the first of each kind.
         blocks = bisimulation_blocks(build_machine(view, starts))
-        first_of_class = {}
+        first_of_class: dict[tuple[str, int | str], Target] = {}
         for target in starts:
             first_of_class.setdefault(target_class(target, blocks), target)
         starts = list(first_of_class.values())
@@ -97,7 +99,8 @@ def machine_from_view(view: AutomatonView, initial_conditions: list[str] | None)
         return build_machine(view, starts)
     machine = build_machine(view, starts)
     helper = DECISION if len(starts) > 1 else NOTHING_TO_DO
-    transitions = [((('', f'choice{index}'),), target) for index, target in enumerate(starts)]
+    transitions: list[tuple[Observation, Target]] = [((('', f'choice{index}'),), target)
+                                                     for index, target in enumerate(starts)]
     start = AbstractState(key=f'<{helper}>', parts=(), transitions=transitions, helper=helper)
     machine.states = {start.key: start, **machine.states}
     machine.initial = start.key
@@ -120,6 +123,8 @@ def _assign_names(machine: AbstractMachine) -> dict[str, str]:
     for base in bases.values():
         counts[base] = counts.get(base, 0) + 1
     taken = set(machine.outcomes)
+    names: dict[str, str]
+    next_index: dict[str, int]
     names, next_index, plain = {}, {}, set(bases.values())
     for key, base in bases.items():
         if counts[base] == 1 and base not in taken:
@@ -176,7 +181,7 @@ def _part_entry(part: StateConfig, path: str) -> State:
         userdata_keys=list(part.userdata_keys), userdata_remapping=list(part.userdata_remapping))
 
 
-def _single_entry(state: AbstractState, path: str, target_name) -> State:
+def _single_entry(state: AbstractState, path: str, target_name: Callable[[Target], str]) -> State:
     part = state.parts[0]
     entry = _part_entry(part, path)
     by_proposition = {observation[0][1]: target for observation, target in state.transitions}
@@ -189,7 +194,7 @@ def _single_entry(state: AbstractState, path: str, target_name) -> State:
     return entry
 
 
-def _concurrency_container(state: AbstractState, name: str, target_name) -> StateMachine:
+def _concurrency_container(state: AbstractState, name: str, target_name: Callable[[Target], str]) -> StateMachine:
     parts = {part.proposition: part for part in state.parts}
     labels = _inner_labels(state.parts)
     container = StateMachine(state_path=f'/{name}', state_class=StateInstantiation.CLASS_CONCURRENCY)
@@ -198,10 +203,10 @@ def _concurrency_container(state: AbstractState, name: str, target_name) -> Stat
         outcome_name = _container_outcome(observation)
         autonomy = 0
         for combination in _combinations([parts[p].output_mapping[prop] for p, prop in observation]):
-            inner = [labels[p] for p, _ in observation]
+            inner_names = [labels[p] for p, _ in observation]
             container.cond_outcome.append(outcome_name)
-            container.cond_transition.append(OutcomeCondition(state_name=inner, state_outcome=list(combination)))
-            for (p, _), outcome, label in zip(observation, combination, inner):
+            container.cond_transition.append(OutcomeCondition(state_name=inner_names, state_outcome=list(combination)))
+            for (p, _), outcome, label in zip(observation, combination, inner_names):
                 autonomy = max(autonomy, parts[p].autonomy[outcome])
                 first_use.setdefault((label, outcome), outcome_name)
         container.outcomes.append(outcome_name)
@@ -225,7 +230,7 @@ def _concurrency_container(state: AbstractState, name: str, target_name) -> Stat
     return container
 
 
-def _container_outcome(observation) -> str:
+def _container_outcome(observation: Observation) -> str:
     """Container outcome of an observation: its outcome propositions, joined.
 
     A sensor event (observed as the pair (sensor, sensor)) is written ``<sensor>_true``,
@@ -243,13 +248,13 @@ def _inner_labels(parts: tuple[StateConfig, ...]) -> dict[str, str]:
 
 
 def _combinations(choices: list[tuple[str, ...]]) -> list[tuple[str, ...]]:
-    result = [()]
+    result: list[tuple[str, ...]] = [()]
     for options in choices:
         result = [(*prefix, option) for prefix in result for option in options]
     return result
 
 
-def _helper_entry(state: AbstractState, name: str, target_name) -> State:
+def _helper_entry(state: AbstractState, name: str, target_name: Callable[[Target], str]) -> State:
     targets = [target_name(target) for _, target in state.transitions]
     if state.helper == DECISION:
         return State(

@@ -8,6 +8,7 @@ The fields are exactly those of ``flexbe_msgs/StateInstantiation`` and
 from __future__ import annotations
 
 from dataclasses import dataclass, field, fields
+from typing import Any, Iterable, Mapping
 
 from respec.vocabulary.naming import (BEHAVIOR_CLASS, CONCURRENCY_CLASS, OUTCOME_CLASS, PRIORITY_CLASS,
                                       STATEMACHINE_CLASS)
@@ -20,11 +21,11 @@ class OutcomeCondition:
     state_name: list[str] = field(default_factory=list)
     state_outcome: list[str] = field(default_factory=list)
 
-    def to_dict(self) -> dict:
+    def to_dict(self) -> dict[str, Any]:
         return {'state_name': list(self.state_name), 'state_outcome': list(self.state_outcome)}
 
     @classmethod
-    def from_dict(cls, data: dict) -> OutcomeCondition:
+    def from_dict(cls, data: Mapping[str, Any]) -> OutcomeCondition:
         return cls(state_name=[str(n) for n in data.get('state_name', [])],
                    state_outcome=[str(o) for o in data.get('state_outcome', [])])
 
@@ -73,7 +74,7 @@ class StateInstantiation:
         parent = self.state_path.rsplit('/', 1)[0]
         return parent or '/'
 
-    def to_dict(self) -> dict:
+    def to_dict(self) -> dict[str, Any]:
         """All 16 fields, in message order; ``cond_transition`` as a list of dicts."""
         result = {}
         for f in fields(self):
@@ -90,7 +91,7 @@ class StateInstantiation:
         return result
 
     @classmethod
-    def from_dict(cls, data: dict) -> StateInstantiation:
+    def from_dict(cls, data: Mapping[str, Any]) -> StateInstantiation:
         """Inverse of ``to_dict``; unknown keys are rejected so typos do not pass silently."""
         known = {f.name for f in fields(cls)}
         unknown = sorted(set(data) - known)
@@ -118,14 +119,14 @@ NOTHING_CLASS = 'LogState'
 HELPER_STATE_CLASSES = (DECISION_CLASS, NOTHING_CLASS)
 
 
-def count_states(entries) -> int:
+def count_states(entries: Iterable[object]) -> int:
     """How many states a machine has: every entry but the machine itself ('/') and its outcomes.
 
     States inside containers count, and so do the containers. ``entries`` are
     StateInstantiations, their dicts or messages. Every report of a machine's size (progress,
     result summary, command line) uses this one count.
     """
-    def field(entry, name):
+    def field(entry: object, name: str) -> object:
         return entry[name] if isinstance(entry, dict) else getattr(entry, name)
 
     return sum(1 for entry in entries

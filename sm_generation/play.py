@@ -13,7 +13,7 @@ A play is the list of outcomes reported so far, so the HTTP API above it is stat
 from __future__ import annotations
 
 from dataclasses import asdict, dataclass, field
-from typing import Sequence
+from typing import Any, Sequence
 
 from sm_generation.state_machine import StateMachine
 
@@ -34,7 +34,7 @@ class MachineTurn:
     ended: str | None = None           # the machine's own outcome once it ended
     history: list[tuple[str, str]] = field(default_factory=list)   # (state path, outcome)
 
-    def to_dict(self) -> dict:
+    def to_dict(self) -> dict[str, Any]:
         return asdict(self)
 
 
@@ -51,6 +51,7 @@ def play_machine(machine: StateMachine, outcomes: Sequence[str]) -> MachineTurn:
                                    f'{", ".join(active.outcomes)}): move {outcome!r} at step {step} does not exist')
         history.append((active.state_path, outcome))
         target = active.next_target(outcome)
+        assert target is not None  # the outcome is one of the active state's
         active = machine.state(target)
         if active is None:               # the machine's own outcome: the behavior ended
             ended = target

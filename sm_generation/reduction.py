@@ -13,7 +13,7 @@ from __future__ import annotations
 
 from collections import defaultdict, deque
 
-from sm_generation.abstract_machine import AbstractMachine, AbstractState, Target
+from sm_generation.abstract_machine import AbstractMachine, AbstractState, Observation, Target
 
 
 def bisimulation_blocks(machine: AbstractMachine) -> dict[str, int]:
@@ -22,12 +22,12 @@ def bisimulation_blocks(machine: AbstractMachine) -> dict[str, int]:
     # Machine outcomes take part as states without transitions, one block each.
     nodes: list[Target] = [('state', key) for key in keys]
     nodes += sorted({t for s in machine.states.values() for _, t in s.transitions if t[0] == 'outcome'})
-    predecessors: dict[Target, dict[tuple, list[Target]]] = defaultdict(lambda: defaultdict(list))
+    predecessors: dict[Target, dict[Observation, list[Target]]] = defaultdict(lambda: defaultdict(list))
     for key, state in machine.states.items():
         for observation, target in state.transitions:
             predecessors[target][observation].append(('state', key))
 
-    initial: dict[tuple, set[Target]] = {}
+    initial: dict[tuple[object, ...], set[Target]] = {}
     for node in nodes:
         signature = _local_signature(machine.states[node[1]]) if node[0] == 'state' else node
         initial.setdefault(signature, set()).add(node)
@@ -38,7 +38,7 @@ def bisimulation_blocks(machine: AbstractMachine) -> dict[str, int]:
     while pending:
         splitter = pending.popleft()
         waiting.discard(splitter)
-        entering: dict[tuple, set[Target]] = defaultdict(set)  # observation -> states moving into splitter
+        entering: dict[Observation, set[Target]] = defaultdict(set)  # observation -> states moving into splitter
         for node in list(blocks[splitter]):
             for observation, sources in predecessors[node].items():
                 entering[observation].update(sources)
@@ -67,12 +67,12 @@ def bisimulation_blocks(machine: AbstractMachine) -> dict[str, int]:
     return {key: numbers.setdefault(block_of[('state', key)], len(numbers)) for key in keys}
 
 
-def _local_signature(state: AbstractState) -> tuple:
+def _local_signature(state: AbstractState) -> tuple[str, tuple[str, ...], tuple[Observation, ...]]:
     return (state.helper, tuple(part.proposition for part in state.parts),
             tuple(observation for observation, _ in state.transitions))
 
 
-def target_class(target: Target, blocks: dict[str, int]) -> tuple:
+def target_class(target: Target, blocks: dict[str, int]) -> tuple[str, int | str]:
     """What a transition target is up to equivalence (a block, or a machine outcome)."""
     kind, name = target
     return (kind, blocks[name]) if kind == 'state' else (kind, name)

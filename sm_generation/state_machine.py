@@ -28,7 +28,7 @@ from __future__ import annotations
 import copy
 from collections import deque
 from dataclasses import dataclass
-from typing import Iterator
+from typing import Any, Iterator, Mapping, Sequence
 
 from sm_generation.errors import SMGenerationError
 from sm_generation.instantiation import FIELD_NAMES, OutcomeCondition, StateInstantiation
@@ -75,7 +75,7 @@ class State(StateInstantiation):
         """A plain copy of this node's entry."""
         return StateInstantiation(**{name: copy.deepcopy(getattr(self, name)) for name in FIELD_NAMES})
 
-    def to_dict(self) -> dict:
+    def to_dict(self) -> dict[str, Any]:
         """The entry's 16 fields, its ``name`` ('/' for the root) and its ``children`` (the GUI's tree)."""
         return {**super().to_dict(), 'name': self.name or ROOT_PATH,
                 'children': [child.to_dict() for child in self.children]}
@@ -86,7 +86,7 @@ class StateMachine(State):
     owning its ``states`` and the ``:OUTCOME`` entries that place its outcomes."""
 
     @classmethod
-    def from_instantiations(cls, states) -> StateMachine:
+    def from_instantiations(cls, states: Sequence[StateInstantiation | Mapping[str, Any]]) -> StateMachine:
         """The tree of ``states`` (StateInstantiations or their dicts), validated.
 
         Raises :class:`SMGenerationError` naming the offending path (``item``) for the
@@ -103,10 +103,11 @@ class StateMachine(State):
                 label = _label(node, index)
                 raise SMGenerationError(f'{label}: {problems[0]}', label)
             nodes.append(node)
-        root, problems = _build(nodes)
-        fatal = next((p for p in problems if p.fatal), None)
+        root, found = _build(nodes)
+        fatal = next((p for p in found if p.fatal), None)
         if fatal is not None:
             raise SMGenerationError(fatal.message, fatal.item)
+        assert root is not None  # a machine without a root container has a fatal problem
         return root
 
     # --- the list and the GUI's JSON ------------------------------------------------------------
@@ -184,7 +185,7 @@ def validate_state_machine(states: list[StateInstantiation]) -> list[str]:
     """
     if not states:
         return ['the state machine is empty']
-    problems = []
+    problems: list[str] = []
     for index, state in enumerate(states):
         if not isinstance(state, StateInstantiation):
             problems.append(f'{_label(state, index)}: not a StateInstantiation: {type(state).__name__}')
@@ -205,7 +206,7 @@ class _Problem:
     fatal: bool  # no runnable tree (from_instantiations raises); else only the editor minds
 
 
-def _node(entry, index: int) -> State:
+def _node(entry: object, index: int) -> State:
     """A fresh node (StateMachine for container classes) copied from ``entry`` or its dict."""
     if isinstance(entry, dict):
         try:
@@ -223,7 +224,7 @@ def _node(entry, index: int) -> State:
     return node_class(**{name: copy.deepcopy(getattr(data, name)) for name in FIELD_NAMES})
 
 
-def _label(state, index: int) -> str:
+def _label(state: object, index: int) -> str:
     """The entry's path, or its place in the list when it has none."""
     path = getattr(state, 'state_path', None)
     return path if isinstance(path, str) and path else f'entry #{index}'

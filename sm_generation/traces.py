@@ -9,6 +9,8 @@ set of runs up to ``depth`` cannot be told apart by any sequence of that many ou
 
 from __future__ import annotations
 
+from typing import Any
+
 from sm_generation.instantiation import StateInstantiation
 from sm_generation.state_machine import State, StateMachine
 
@@ -21,7 +23,7 @@ def _part(state: StateInstantiation) -> Part:
     return (state.state_class, state.behavior_class, tuple(state.parameter_values))
 
 
-def _moves(state: State) -> tuple[tuple, list[tuple]]:
+def _moves(state: State) -> tuple[tuple[Part, ...], list[tuple[tuple[tuple[Part, str], ...], str]]]:
     """What ``state`` runs, and its possible (report, target) moves."""
     if state.state_class != StateInstantiation.CLASS_CONCURRENCY:
         part = _part(state)
@@ -36,13 +38,13 @@ def _moves(state: State) -> tuple[tuple, list[tuple]]:
     return tuple(sorted(parts.values())), moves
 
 
-def runs(root: StateMachine, depth: int) -> set[tuple]:
+def runs(root: StateMachine, depth: int) -> set[tuple[Any, ...]]:
     """All runs of ``root`` of at most ``depth`` steps: tuples of steps, then ('exit', outcome) or TRUNCATED."""
     top = {s.name: s for s in root.states}
     moves = {name: _moves(state) for name, state in top.items()}
-    result: set[tuple] = set()
+    result: set[tuple[Any, ...]] = set()
 
-    def walk(name: str, prefix: tuple) -> None:
+    def walk(name: str, prefix: tuple[Any, ...]) -> None:
         if name in root.outcomes and name not in top:
             result.add(prefix + (('exit', name),))
             return

@@ -75,7 +75,7 @@ def private_directory(directory: Path) -> Path:
 
 def unwritable(path: Path, error: OSError) -> ByproductsDirectoryError:
     """The coded error for a byproduct that cannot be written (disk full, read-only, ...)."""
-    reason = errno.errorcode.get(error.errno, 'error')
+    reason = errno.errorcode.get(error.errno, 'error') if error.errno is not None else 'error'
     return ByproductsDirectoryError(f'cannot write {quoted(path.name)} in the byproducts directory: '
                                     f'{error.strerror or error} ({reason})', 'byproducts_dir')
 
@@ -191,7 +191,7 @@ class ByproductStore:
             files = ByproductSet(self.directory, stem)
             if files.is_marked():
                 newest[stem] = self._last_written(files)
-        by_age = sorted(newest, key=newest.get, reverse=True)
+        by_age = sorted(newest, key=lambda stem: newest[stem], reverse=True)
         doomed = by_age[self.keep_last:]
         if self.max_age > 0:
             cutoff = (time.time() if now is None else now) - self.max_age
@@ -220,7 +220,8 @@ class ByproductStore:
         with os.scandir(self.directory) as entries:
             for entry in entries:
                 part, marker = _PART_FILE.match(entry.name), _MARKER_FILE.match(entry.name)
-                stem = (part or marker)['stem'] if part or marker else ''
+                match = part or marker
+                stem = match['stem'] if match else ''
                 if not is_spec_name(stem) or not entry.is_file(follow_symlinks=False):
                     continue
                 info = entry.stat(follow_symlinks=False)

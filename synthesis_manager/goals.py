@@ -8,7 +8,7 @@ from __future__ import annotations
 import contextlib
 import threading
 from dataclasses import dataclass, field
-from typing import Callable
+from typing import Any, Callable
 
 from ltl_specification.repair import REPAIRABLE
 from respec.vocabulary.errors import ErrorCode
@@ -32,8 +32,8 @@ class PipelineOutcome:
 
     code: ErrorCode = ErrorCode.SUCCESS
     message: str = ''
-    ltl_specification: object = None
-    automaton: object = None
+    ltl_specification: Any = None      # synthesis_msgs' LTLSpecification (generated, untyped)
+    automaton: Any = None              # synthesis_msgs' FSAutomaton
     states: list = field(default_factory=list)
     notes: list = field(default_factory=list)  # what the result should tell, e.g. detected initial conditions
     fixes: list = field(default_factory=list)  # verified fixes of a refused task, one sentence each

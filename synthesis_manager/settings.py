@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import argparse
 from dataclasses import dataclass
-from typing import Callable
+from typing import Any, Callable
 
 from atlas_sim.simulator.node_names import STATE_TOPIC
 from ltl_synthesizer.cache import DEFAULT_MAX_BYTES
@@ -51,7 +51,8 @@ class Setting:
             return str(self.default).lower()
         if self.type is float:
             return f'{self.default:g}'
-        return f'{self.default:,}' if self.type is int and abs(self.default) >= 10_000 else str(self.default)
+        return (f'{self.default:,}' if self.type is int and isinstance(self.default, int) and abs(self.default) >= 10_000
+                else str(self.default))
 
 
 CONFIG_DIR = Setting('config_dir', str, '', 'directories of robot system files (joined with `:`), searched before '
@@ -207,7 +208,7 @@ class SuiteFlag:
             return self.add(parser)
         first = setting(*self.sets[0])
         kind = self.type or first.type
-        options = {'type': kind} if kind is not str else {}
+        options: dict[str, Any] = {'type': kind} if kind is not str else {}
         if first.choices:
             options['choices'] = first.choices
         if self.metavar:

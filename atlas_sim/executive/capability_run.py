@@ -107,7 +107,7 @@ class CapabilityRun:
         self.nodes = {str(state['name']): state for state in automaton.get('states', automaton.get('automaton', ()))}
         self.initial = list(automaton['initial_states'])
         self.choose = choose  # (state path, outcomes) -> an outcome or None: the operator's choice
-        self._asked = None    # (capability, state, node) ``choose`` is asked about
+        self._asked: tuple[str, State, dict] | None = None    # (capability, state, node) ``choose`` is asked about
         self.result = CapabilityRunResult(None, [])  # the run so far (its steps), for a caller's progress
         self.sensors = dict(script.sensors)  # the sensors now: the script's, as the environment changes them
         self.max_steps = max_steps
@@ -135,6 +135,7 @@ class CapabilityRun:
             if successor is None:
                 return result
             target = state.next_target(outcome)
+            assert target is not None  # the outcome is one of the state's own
             if target in self.machine.outcomes:
                 result.outcome = target
                 if not self._output(successor, target):

@@ -84,6 +84,7 @@ class EngineTraceRecorder:
         with self._lock:
             self._observe(snapshot)
             step = self._current
+            assert step is not None  # entered() came first
             if forced:
                 record_forced(step, step.state, outcome, self.parts[name])
             step.state_outcome, step.transition = outcome, target

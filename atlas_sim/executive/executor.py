@@ -93,7 +93,7 @@ class Part:
 
     @property
     def capability(self) -> str:
-        return activated(self.proposition) if self.kind == 'capability' else ''
+        return (activated(self.proposition) or '') if self.kind == 'capability' else ''
 
 
 class StateMapping:
@@ -140,7 +140,7 @@ class StateMapping:
 
 @dataclass
 class ExecutionResult:
-    outcome: str
+    outcome: str | None          # None while a run watched on FlexBE's engine goes on (engine_trace)
     trace: Trace
     robot_time: float            # robot clock at the end
     min_pelvis_height: float
@@ -255,6 +255,7 @@ class Executive:
         self._activate(step.capabilities)
         sensors_at_entry = dict(self.tracker.sensors)
         returned: dict[str, str] = {}          # part path -> state outcome returned
+        outcome: str | None
         while True:
             forced = self._forced(state, parts)
             if forced is not None:
@@ -304,10 +305,13 @@ class Executive:
             return outcome
         index = state.outcomes.index(outcome) if outcome in state.outcomes else -1
         required = state.autonomy[index] if 0 <= index < len(state.autonomy) else 0
-        return self.control.confirm(state.state_path, outcome, required, list(state.outcomes), self.wall_deadline)
+        chosen = self.control.confirm(state.state_path, outcome, required, list(state.outcomes), self.wall_deadline)
+        assert chosen is not None  # without ``until`` the wait ends only with an outcome
+        return chosen
 
     def _ask_inputs(self, parts: list[Part]) -> None:
         """Ask the operator for the data of each InputState among ``parts`` before they start."""
+        assert self.control is not None  # asked only with an operator (_run_state)
         for part in parts:
             if part.kind != 'capability' or part.node.state_class != INPUT_STATE_CLASS:
                 continue
@@ -340,6 +344,7 @@ class Executive:
             if part.node.state_class == DECISION_CLASS:
                 return self.decide(part.node.state_path, list(part.node.outcomes))
             return part.node.outcomes[0] if part.node.outcomes else None
+        assert part.output_mapping is not None  # a sensor's and a capability's part have one
         if part.kind == 'sensor':  # sensors are events: the reading turns true
             if self.tracker.sensors.get(part.proposition) and not sensors_at_entry.get(part.proposition):
                 return part.output_mapping[part.proposition][0]
@@ -362,6 +367,7 @@ class Executive:
     def _state_outcome(state: State, returned: dict[str, str]) -> str | None:
         if state.state_class != StateInstantiation.CLASS_CONCURRENCY:
             return returned.get(state.state_path)
+        assert isinstance(state, StateMachine)  # a concurrency container
         by_name = {path.rsplit('/', 1)[-1]: outcome for path, outcome in returned.items()}
         for outcome, condition in state.conditions:  # FlexBE returns the first that holds
             if all(by_name.get(name) == wanted for name, wanted in condition):

@@ -34,6 +34,8 @@ def mode_segments(trace: Trace) -> list[tuple[str, float, float]]:
 
 def capability_bars(trace: Trace) -> list[tuple[str, float, float, str | None]]:
     """(capability, activated at, ended at, outcome or None) for every activation."""
+    bars: list[tuple[str, float, float, str | None]]
+    open_bars: dict[str, float]
     bars, open_bars = [], {}  # capability -> start of an activation carried over to the next state
     for step in trace.steps:
         ended = {r['capability']: r for r in step.results if not r.get('abandoned')}

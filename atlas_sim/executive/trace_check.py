@@ -129,6 +129,7 @@ def least_violating_assignments(formulas, current: dict, next_known: dict, unkno
     is the number of violated formulas (0: the assignments satisfy all of them);
     ``first_only`` stops at the first satisfying assignment (when existence is enough).
     """
+    best: list[dict[str, bool]]
     best_cost, best = len(formulas) + 1, []
 
     def search(depth: int, assignment: dict):
@@ -237,7 +238,7 @@ def check_trace(trace: Trace, spec: GR1Specification, goals: list[str] | None = 
     checker = _Checker(trace, spec)
     violations = checker.run()
     goals = list(goals) if goals is not None else [
-        remembered(p) for p in spec.sys_props if remembered(p)]
+        str(remembered(p)) for p in spec.sys_props if remembered(p)]
     completed_at, goal_violations = check_goal_order(trace, goals, ordered)
     violations.extend(goal_violations)
     violations.extend(incident_violations(trace))
@@ -402,7 +403,7 @@ class _Checker:
         cost, assignments = least_violating_assignments(
             [Next(f) for f in self.spec.sys_init], {}, current, self._hidden(first))
         if cost:
-            starts = [({**current, **a}, {}) for a in assignments]
+            starts: list[tuple[dict[str, bool], dict[str, bool]]] = [({**current, **a}, {}) for a in assignments]
             blamed = self._blame([(f, f) for f in self.spec.sys_init], starts)
             violations.append(self._violation('sys_init', first, first, blamed,
                                               'the state machine did not start as the specification requires: '
@@ -450,6 +451,7 @@ class _Checker:
         known = {**target.env, **target.visible_sys}
         unknown = self._hidden(target)
         checks = [checked for checked, _ in self.sys_checks]
+        found: dict[tuple[tuple[str, bool], ...], dict[str, bool]]
         best_cost, found = len(checks) + 1, {}
         for valuation in valuations:
             cost, assignments = least_violating_assignments(checks, valuation, known, unknown, first_only)
@@ -479,6 +481,7 @@ class _Checker:
     def _via_idle(self, valuations, target: _Position):
         """Valuations of ``target`` reached through idle positions (nothing activated)."""
         idle = _Position('idle', target.step, target.env, self._sys([]))
+        seen: dict[tuple[tuple[str, bool], ...], dict[str, bool]]
         frontier, seen = valuations, {}
         for _ in range(len(self.memory_props) + 2):  # the hidden part can change that often at most
             cost, reached = self._successors(frontier, idle)

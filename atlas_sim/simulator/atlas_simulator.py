@@ -42,6 +42,7 @@ from .operator_data import TEMPLATE_ID, datum_refusal, operator_answer, provided
 from .motions import (
     DEFAULT_ACTION_ENTRY,
     DEFAULT_MODE_ENTRY,
+    GaitMotion,
     Motion,
     OperatorInputMotion,
     build_motion,
@@ -155,7 +156,7 @@ class AtlasSimulator:
     def _validate_settings(self) -> None:
         """Fail early on names or motion entries the simulator cannot use."""
         settings = self.settings
-        named = {
+        named: Dict[str, Iterable[str]] = {
             "modes": settings.modes,
             "actions": settings.actions,
             "faults": settings.faults,
@@ -278,6 +279,7 @@ class AtlasSimulator:
         if self._fall_reason:
             return f"robot has fallen: {self._fall_reason}"
         needs = self.needed_data(name)
+        values: Mapping[str, Any]
         if data is None:  # the in-process operator: input actions ran on the simulator
             refusal = self.semantics.refusal(self.state, name)
             values = self.answers
@@ -332,6 +334,7 @@ class AtlasSimulator:
         elif isinstance(motion, OperatorInputMotion) and not self.operator_inputs.get(name, False):
             self._plan_failure(request, now + motion.duration, f"operator did not provide {name}")
         else:
+            assert motion is not None  # a request without a motion was refused above
             motion.start(self.physics)
         self._running.append(request)
         self._notify("started", request)
@@ -346,6 +349,7 @@ class AtlasSimulator:
 
     def _busy_reason(self, motion: Motion) -> Optional[str]:
         for other in self._running:
+            assert other.motion is not None  # every running request has one (_start)
             shared = motion.groups & other.motion.groups
             if shared:  # requests planned to fail hold an empty motion, so no groups
                 return f"busy: {', '.join(sorted(shared))} used by {other.name}"
@@ -372,6 +376,7 @@ class AtlasSimulator:
                                                        side_margin=0.0)
                 if sideways is None and self.physics.obstacle_ahead(motion.advance, scene.clearance,
                                                                     shift=detour) is None:
+                    assert isinstance(motion, GaitMotion)  # the motion that advances
                     motion.plan_detour(detour)
                     return None
         return (f"{name}: the way is blocked by {obstacle.body} ({obstacle.free_distance:.2f} m free ahead, "
@@ -404,6 +409,7 @@ class AtlasSimulator:
             if request.fail_at is not None and self.time >= request.fail_at - 1e-9:
                 finished.append(self._finish(request, FAILED, request.fail_reason))
             else:
+                assert request.motion is not None  # every running request has one (_start)
                 request.motion.update(self.physics, self.time - request.started_at)
         self.physics.step(self._substeps)
         if self._push_until and self.time >= self._push_until[1] - 1e-9:
@@ -438,6 +444,7 @@ class AtlasSimulator:
 
     def _check_settled(self, request: Request) -> Optional[RequestResult]:
         motion = request.motion
+        assert motion is not None  # every running request has one (_start)
         elapsed = self.time - request.started_at
         if elapsed < motion.duration:
             return None
@@ -463,6 +470,7 @@ class AtlasSimulator:
 
     def _finish(self, request: Request, outcome: str, reason: str) -> RequestResult:
         self._running.remove(request)
+        assert request.motion is not None  # every running request has one (_start)
         request.motion.stop(self.physics)
         self.semantics.finish(self.state, request.name, outcome)
         if outcome == COMPLETED:
@@ -512,7 +520,7 @@ class AtlasSimulator:
             self.step()
         if not all(r.done for r in requests):
             raise TimeoutError(f"requests still running after {timeout} s: {requests}")
-        return {r.name: r.result for r in requests}
+        return {r.name: r.result for r in requests if r.result is not None}  # all done: every one
 
     def hold(self, seconds: float) -> List[RequestResult]:
         """Let time pass (running requests continue)."""

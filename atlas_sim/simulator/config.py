@@ -146,7 +146,10 @@ class SimulationConfig:
     stand_in: Optional[str] = None
 
     @classmethod
-    def from_dict(cls, section: Optional[Mapping[str, Any]]) -> "SimulationConfig":
+    def from_dict(cls, section: object) -> "SimulationConfig":
+        if section is not None and not isinstance(section, Mapping):  # a file's section, as read
+            raise SimulationConfigError(f"the simulation section must be a mapping, got {section!r}",
+                                        item="simulation")
         section = dict(section or {})
         unknown = set(section) - _SIMULATION_KEYS
         if unknown:

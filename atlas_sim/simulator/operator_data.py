@@ -142,7 +142,8 @@ def parse_answers(entries, source: str) -> dict:
             try:
                 items.append((request_type.strip(), yaml.safe_load(value)))
             except yaml.YAMLError as error:
-                raise SimulationConfigError(f'{source}: {quoted(value)} is no YAML value ({error.problem})',
+                raise SimulationConfigError(f'{source}: {quoted(value)} is no YAML value '
+                                            f'({error.problem if isinstance(error, yaml.MarkedYAMLError) else error})',
                                             item=str(text)) from None
     answers = {}
     for request_type, value in items:

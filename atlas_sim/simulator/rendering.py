@@ -142,7 +142,7 @@ class KeyFrameRecorder:
         self.paths: List[Path] = []
         self.times: List[float] = []
         self.motion_period = 1.0 / motion_fps if motion_fps > 0 else None
-        self._next_motion_frame = None
+        self._next_motion_frame: float | None = None
         simulator.add_listener(self._on_event)
 
     def _on_event(self, event: str, request) -> None:

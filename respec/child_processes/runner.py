@@ -51,11 +51,19 @@ import sys
 import threading
 import time
 import traceback
-from typing import IO, Any, Callable, cast
+from typing import IO, Any, Callable, Protocol, cast
 
 from respec.child_processes.errors import ChildDiedError, ChildWorkError, WorkCancelledError, WorkMemoryError, \
     WorkTimeoutError
 from respec.child_processes.memory import released_memory, resident_memory
+
+
+
+class CancelFlag(Protocol):
+    """What stops work when it is set: a threading.Event, or a caller's own flag."""
+
+    def is_set(self) -> bool: ...
+
 
 # How often the caller looks at its cancel flag and deadline while a child works.
 POLL_SECONDS = 0.02
@@ -182,7 +190,7 @@ class ChildProcess:
             env={**environment, **os.environ} if environment else None)
 
     def call(self, function: Callable[..., Any], args: tuple[Any, ...] | list[Any] = (),
-             kwargs: dict[str, Any] | None = None, cancel: threading.Event | None = None,
+             kwargs: dict[str, Any] | None = None, cancel: CancelFlag | None = None,
              deadline: float | None = None, on_progress: Callable[[Any], None] | None = None,
              wants_commands: bool = False, memory_limit: int | None = None) -> Any:
         """``function(*args, **kwargs)`` in this child; with ``on_progress``, ``function`` is
@@ -378,7 +386,7 @@ class ChildProcesses:
             self._wake_reaper.clear()
 
     def call(self, function: Callable[..., Any], args: tuple[Any, ...] | list[Any] = (),
-             kwargs: dict[str, Any] | None = None, cancel: threading.Event | None = None,
+             kwargs: dict[str, Any] | None = None, cancel: CancelFlag | None = None,
              deadline: float | None = None, memory_limit: int | None = None) -> Any:
         """``function(*args, **kwargs)`` in a child (:meth:`ChildProcess.call`)."""
         child = self._take()

@@ -107,6 +107,13 @@ class RobotSystem:
         naming what is missing (a capability system, a file without an ``abstraction:`` section)."""
         return self.abstraction or abstraction_from_document(self.sections, self.name)
 
+    def required_capabilities(self) -> CapabilitySystem:
+        """The capability system, for a stage that ``for_description`` chose by it (a system of
+        another kind there is a programming error, a TypeError)."""
+        if self.capabilities is None:
+            raise TypeError(f'{self.name} is not described by capabilities')
+        return self.capabilities
+
 
 def for_description(registry: Mapping[type, Entry], system: RobotSystem, missing: Entry) -> Entry:
     """A layer's entry for ``system``'s description, by its class (``respec.robot.description``);

@@ -35,6 +35,7 @@ from rclpy.action import ActionServer, CancelResponse, GoalResponse
 from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.node import Node
 
+from atlas_sim.simulator.atlas_simulator import Request
 from atlas_sim.simulator.factory import make_simulator, parse_faults
 from atlas_sim.simulator.node_names import ACTION_NAME, CAPABILITY_ACTION_PREFIX, NODE_NAME, STATE_TOPIC
 from atlas_sim.simulator.operator_data import decode_userdata
@@ -67,8 +68,14 @@ class _Job:
         self.capability = capability
         self.sensor = sensor      # wait until the sensor reads true (no request)
         self.data = data          # the requesting state's userdata (None: it sent none)
-        self.request = None
+        self.request: Request | None = None
         self.finished = threading.Event()
+
+    @property
+    def started(self) -> Request:
+        """The simulator's request of a capability's job (every running one has it)."""
+        assert self.request is not None, self.capability
+        return self.request
 
     @property
     def done(self) -> bool:
@@ -160,7 +167,8 @@ class AtlasSimNode(Node):
             result.outcome, result.reason = 'failed', 'simulator shut down'
             return result
         goal_handle.succeed()
-        done = job.request.result
+        done = job.started.result
+        assert done is not None  # job.done
         result.outcome, result.reason, result.stamp = done.outcome, done.reason, float(done.finished_at)
         return result
 
@@ -230,7 +238,7 @@ class AtlasSimNode(Node):
     def _running_requests(self) -> dict:
         """Capability -> its running request."""
         return {job.capability: job.request for job in self._running
-                if not job.sensor and job.request.result is None}
+                if not job.sensor and job.started.result is None}
 
     def _finish_jobs(self):
         for job in [j for j in self._running if self._job_finished(j)]:
@@ -240,7 +248,7 @@ class AtlasSimNode(Node):
     def _job_finished(self, job: _Job) -> bool:
         if job.sensor:
             return bool(self.simulator.sensors.get(job.capability))
-        return job.request.result is not None
+        return job.started.result is not None
 
 
 def main():

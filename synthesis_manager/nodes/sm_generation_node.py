@@ -18,6 +18,7 @@ from respec.vocabulary.errors import ErrorCode
 from respec.robot import SystemCatalog
 from sm_generation import generate_state_machine
 from sm_generation.config import generation_system_errors
+from sm_generation.state_machine import StateMachine
 from synthesis_manager.limits import check_message, check_timeout
 from synthesis_manager.ros.child_stage import ChildStage, StageStopped
 from synthesis_manager.ros.conversions import error_code, msg_to_automaton, state_to_msg
@@ -36,7 +37,7 @@ SMALL_AUTOMATON_STATES = 2000
 
 
 def generated_states(automaton, system: str, catalog: SystemCatalog, initial_conditions: list[str] | None,
-                     reduce: bool) -> list:
+                     reduce: bool) -> StateMachine:
     """The machine of ``automaton`` on ``catalog``'s system of that name (the node's edge: in a
     child process too, so it takes the name)."""
     with generation_system_errors():

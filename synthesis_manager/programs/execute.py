@@ -43,6 +43,7 @@ import json
 import os
 import sys
 from pathlib import Path
+from typing import Any
 
 from atlas_sim.closed_loop import DeferredEvents, run_and_check
 from atlas_sim.executive.errors import ExecutionError
@@ -217,7 +218,7 @@ def execute_capability_robot(args, system) -> int:
 
 def print_capability_run(run, stream=sys.stdout) -> None:
     print('trace:', file=stream)
-    shown = list(enumerate(run.steps, start=1))
+    shown: list[tuple[int, Any] | None] = list(enumerate(run.steps, start=1))
     if len(shown) > 30:  # a failure retried until the step limit: its start and its end
         shown = [*shown[:20], None, *shown[-5:]]
     for entry in shown:

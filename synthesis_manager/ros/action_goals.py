@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass
-from typing import Callable
+from typing import Any, Callable
 
 from rclpy.node import Node
 from rclpy.time import Time
@@ -23,7 +23,7 @@ from synthesis_msgs.msg import FSAutomaton, LTLSpecification
 class ActionInterface:
     """An action type served by this node: how its goals and results map to the pipeline's."""
 
-    action_type: type
+    action_type: type[Any]      # a generated action class (its Goal, Result, Feedback)
     action_name: str
     read_goal: Callable        # (goal, default_system) -> SynthesisTask
     make_result: Callable      # (PipelineOutcome) -> action_type.Result

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass
+from typing import Any, Sequence
 
 from respec.vocabulary.errors import ErrorCode
 from synthesis_manager.ros.conversions import constants
@@ -39,7 +40,7 @@ _STAGE_FAILURES = ((-9, 'BEHAVIOR_SYNTHESIS_FAILED'), (-19, 'SPEC_COMPILATION_FA
 def cnu_error_name(code: ErrorCode, cnu_names) -> str:
     """The CNU constant for our error ``code``: the same-named one when CNU has it, else the one
     of the same meaning (CNU_EQUIVALENTS), else its stage's generic failure."""
-    code = ErrorCode(code)
+    code = ErrorCode(code)  # type: ignore[call-arg]  # a lookup by value (mypy: a constructor)
     if code.name in cnu_names:
         return code.name
     if CNU_EQUIVALENTS.get(code.name) in cnu_names:
@@ -75,7 +76,7 @@ def copy_message(message, target_type, nested: dict[str, type] | None = None):
 class FlexBESynthesisInterface:
     """The FlexBESynthesis action type offered, with the message types its results hold."""
 
-    action_type: type
+    action_type: type[Any]      # a generated action class (its Goal, Result, Feedback)
     request_type: type
     error_code_type: type
     state_type: type
@@ -99,7 +100,7 @@ class FlexBESynthesisInterface:
         return [copy_message(state, self.state_type, {'cond_transition': self.condition_type})
                 for state in states]
 
-    def result(self, code: ErrorCode, message: str, states: list, notes: list, fixes: list = ()):
+    def result(self, code: ErrorCode, message: str, states: list, notes: list, fixes: Sequence[str] = ()):
         """The action's result: CNU's code, the states, and on failure ``NAME: message`` followed
         by the suggested ``fixes`` (one message each; the FlexBE WebUI shows them in its dialog)."""
         failure = [] if code == ErrorCode.SUCCESS else [f'{code}: {message}', *fixes]

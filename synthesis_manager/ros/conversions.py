@@ -17,7 +17,7 @@ LTL_SECTIONS = ('sys_props', 'env_props', 'sys_init', 'env_init', 'sys_trans', '
 def error_code(code: ErrorCode | str = ErrorCode.SUCCESS, message: str = '') -> SynthesisErrorCodes:
     """The SynthesisErrorCodes message of ``code`` (an ErrorCode or its name; any other name
     is a programming error: ValueError)."""
-    return SynthesisErrorCodes(value=ErrorCode(code).number, message=message)
+    return SynthesisErrorCodes(value=ErrorCode(code).number, message=message)  # type: ignore[call-arg]  # a lookup by value (mypy: a constructor)
 
 
 def constants(message_type) -> dict[str, int]:

@@ -95,6 +95,7 @@ def load_behavior_class(package, directory: Path):
     source = package.write(directory) / package.package / f'{package.module}.py'
     module_name = f'{package.package}_{package.module}_{id(package):x}'  # fresh per run, like onboard's tmp_<id>
     spec = importlib.util.spec_from_file_location(module_name, source)
+    assert spec is not None and spec.loader is not None  # a .py file's
     module = importlib.util.module_from_spec(spec)
     sys.modules[module_name] = module
     spec.loader.exec_module(module)

@@ -14,9 +14,16 @@ from __future__ import annotations
 
 import contextlib
 import threading
+from typing import TYPE_CHECKING
 
 from synthesis_manager.ros.env import prepare_ros_environment
 from synthesis_manager.ros.node_main import stop_executor
+
+if TYPE_CHECKING:  # rclpy loads when the harness starts
+    from rclpy import Context
+    from rclpy.node import Node
+
+    from synthesis_manager.ros.executor import SuiteExecutor
 
 
 class RosHarness:
@@ -32,10 +39,10 @@ class RosHarness:
         self.domain_id = domain_id
         self._default_context = default_context
         self._stack = contextlib.ExitStack()
-        self.nodes = []
-        self.context = None
-        self.executor = None
-        self._thread = None
+        self.nodes: list[Node] = []
+        self.context: Context | None = None
+        self.executor: SuiteExecutor | None = None
+        self._thread: threading.Thread | None = None
         self._closing = threading.Event()
 
     def __enter__(self) -> 'RosHarness':

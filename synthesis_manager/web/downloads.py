@@ -30,9 +30,9 @@ class Downloads:
         if not job.finished:
             raise NotAvailableError(f'job {quoted(job_id)} has not finished yet', job_id)
         kind = ARTIFACTS[name]
-        if not kind.present(job.outcome):
+        if not kind.present(job.finished_outcome):
             raise NotAvailableError(
-                f'job {quoted(job_id)} ({job.outcome.error_name}) has no {name}', name)
+                f'job {quoted(job_id)} ({job.finished_outcome.error_name}) has no {name}', name)
         key = (job_id, name)
         with self._lock:
             built = self._built.get(key)

@@ -12,7 +12,7 @@ from respec.vocabulary.errors import CodedError, ErrorCode, quoted
 from synthesis_manager.limits import BusyError
 
 
-def http_answer(error: CodedError) -> tuple[int, dict, dict | None]:
+def http_answer(error: GuiRequestError | BusyError) -> tuple[int, dict, dict | None]:
     """Status, JSON body and headers answering ``error`` (a GuiRequestError or BusyError)."""
     if isinstance(error, BusyError):
         headers = {'Retry-After': str(error.retry_after)} if error.retry_after else None

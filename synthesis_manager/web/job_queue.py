@@ -66,7 +66,7 @@ class JobQueue:
         job = self.job(job_id)
         if job.finished:
             raise NotAvailableError(f'job {quoted(job_id)} has already finished '
-                                    f'({job.outcome.error_name})', job_id)
+                                    f'({job.finished_outcome.error_name})', job_id)
         job.cancel_requested.set()
         self._note(job, 'Cancel requested', job.progress)
         return job
@@ -99,9 +99,11 @@ class JobQueue:
     def state_machine(self, job_id: str) -> StateMachine:
         """The job's state machine (its tree, as the job's outcome holds it)."""
         job = self.finished_job(job_id)
-        if job.outcome.machine is None:
-            raise NotAvailableError(f'job {quoted(job_id)} ({job.outcome.error_name}) has no state machine', job_id)
-        return job.outcome.machine
+        machine = job.finished_outcome.machine
+        if machine is None:
+            raise NotAvailableError(f'job {quoted(job_id)} ({job.finished_outcome.error_name}) has no state machine',
+                                    job_id)
+        return machine
 
     def _forget_old_jobs(self):
         """Drop the oldest finished jobs beyond max_jobs, and what hangs on them. Holds _lock."""

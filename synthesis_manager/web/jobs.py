@@ -229,6 +229,12 @@ class Job:
     def finished(self) -> bool:
         return self.state == 'finished'
 
+    @property
+    def finished_outcome(self) -> JobOutcome:
+        """The outcome of a job that has finished (every finished job has one)."""
+        assert self.outcome is not None, f'job {self.id} has not finished'
+        return self.outcome
+
     def seconds_since_created(self) -> float:
         return round(time.monotonic() - self.created, 4)
 

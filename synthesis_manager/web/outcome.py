@@ -35,7 +35,8 @@ class JobOutcome:
     @classmethod
     def local(cls, error_name: ErrorCode, message: str, seconds: float) -> 'JobOutcome':
         """The outcome of a job that never got a result (``seconds`` since it was created)."""
-        return cls(ErrorCode(error_name).number, error_name, message, seconds=round(seconds, 4))
+        return cls(ErrorCode(error_name).number, error_name,  # type: ignore[call-arg]  # a lookup by value (mypy: a constructor)
+                   message, seconds=round(seconds, 4))
 
     @classmethod
     def from_result(cls, data: dict, machine: StateMachine | None) -> 'JobOutcome':

@@ -77,7 +77,7 @@ class Plays:
 
     def turn(self, job: Job, moves: list) -> dict:
         """The turn after ``moves``, with ``play`` saying whom the user plays."""
-        outcome = job.outcome
+        outcome = job.finished_outcome
         if outcome.machine is not None:
             return {'play': ENVIRONMENT, **self._machine_turn(job, moves)}
         if outcome.error_name == ErrorCode.SPEC_UNSYNTHESIZABLE:
@@ -88,8 +88,10 @@ class Plays:
     def _machine_turn(self, job: Job, moves: list) -> dict:
         if not all(isinstance(move, str) for move in moves):
             raise InvalidJobRequestError('the moves of a machine play are outcome names', 'moves')
+        machine = job.finished_outcome.machine
+        assert machine is not None  # turn() plays a machine only where there is one
         try:
-            return play_machine(job.outcome.machine, moves).to_dict()
+            return play_machine(machine, moves).to_dict()
         except MachinePlayError as error:
             raise MoveError(str(error), 'moves') from error
 

@@ -92,7 +92,7 @@ class CapabilityRobotView:
 
     def __init__(self, robot: RobotSystem):
         self.robot = robot
-        self.capabilities = robot.capabilities
+        self.capabilities = robot.required_capabilities()
 
     def choices(self) -> dict:
         capabilities = self.capabilities
@@ -181,7 +181,8 @@ class CapabilityRobotView:
                 'faults': 'this capability answers the outcome it fails with, every time (fault injection)'}
 
 
-_VIEWS = {RobotAbstraction: ModeRobotView, CapabilitySystem: CapabilityRobotView}
+_VIEWS: dict[type, type[ModeRobotView] | type[CapabilityRobotView]] = {
+    RobotAbstraction: ModeRobotView, CapabilitySystem: CapabilityRobotView}
 
 
 def robot_view(robot: RobotSystem) -> ModeRobotView | CapabilityRobotView:

@@ -26,12 +26,16 @@ import dataclasses
 import logging
 import time
 from pathlib import Path
-from typing import Callable
+from typing import TYPE_CHECKING, Any, Callable
 
 from atlas_sim.executive.runtime_control import FULL, RuntimeControl
 from respec.child_processes.errors import ChildWorkError
 from respec.child_processes.runner import ChildProcess
 from respec.vocabulary.errors import INTERNAL_ERROR, CodedError
+
+if TYPE_CHECKING:  # the child imports them when it runs (simulate, simulate_capability_robot)
+    from atlas_sim.executive.capability_run import CapabilityRun
+    from atlas_sim.executive.executor import Executive
 
 #: Seconds past its own wall-time limit a child is given before it is killed.
 KILL_GRACE = 30.0
@@ -93,9 +97,12 @@ class SimulationProcess:
 def simulate(settings: dict, progress: Callable[[dict], None], commands: Callable[[float], list] | None = None) -> dict:
     """In the child: run the machine on atlas_sim's robot with the operator's ``commands``,
     reporting ``progress``; the final message."""
+    simulator: Any  # the AtlasSimulator (made below, where the child imports atlas_sim)
+    executive: Executive | None
+    sent: list[Any]
     simulator, executive, sent = None, None, [0, 0, None]
     frames_dir = Path(settings['record_dir']) / 'frames'
-    listed = [0.0, []]
+    listed: list[Any] = [0.0, []]
 
     def frames(now: bool = False) -> list[str]:  # the recorder's files so far, looked up 20 times a second
         if now or time.monotonic() - listed[0] > 0.05:
@@ -169,6 +176,8 @@ def simulate_capability_robot(settings: dict, progress: Callable[[dict], None],
     machine_steps: list[dict] = []
     control = RuntimeControl(commands, report=lambda status: report(), autonomy_level=settings.get('autonomy', FULL)) \
         if commands else None
+    run: CapabilityRun | None
+    active: list[Any]
     run, active = None, ['', -1]   # the state being answered and the steps taken before it
 
     def report(pending: str = ''):
@@ -189,7 +198,7 @@ def simulate_capability_robot(settings: dict, progress: Callable[[dict], None],
         from respec.robot import robot_system_from_files
         from respec.robot.state_library import capability_outcomes, workspace_state_library
         system = robot_system_from_files(settings['system'], settings['files'], settings['config_file'])
-        capabilities = system.capabilities
+        capabilities = system.required_capabilities()
         script = parse_script(capabilities, capability_outcomes(capabilities, workspace_state_library()),
                               list(settings['fail_first']),
                               [f'{name}={"true" if value else "false"}' for name, value in settings['sensors'].items()])
@@ -219,6 +228,7 @@ def simulate_capability_robot(settings: dict, progress: Callable[[dict], None],
             capability = by_path[path][1]
             before = len(control.events)
             answer = None
+            assert run is not None  # asked by run.run()
             while answer is None:  # asked again with the robot's new answer when the operator sets a sensor
                 proposed = run.proposed
                 required = capabilities.capabilities[capability].autonomy.get(proposed, 0) if capability else 0

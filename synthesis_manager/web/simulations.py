@@ -100,7 +100,7 @@ class SimulationRuns:
         autonomy = body.get('autonomy', FULL)
         if autonomy not in AUTONOMY_LEVELS.values() or isinstance(autonomy, bool):
             raise InvalidJobRequestError('autonomy is 0 (Off), 1 (Low), 2 (High) or 3 (Full)', 'autonomy')
-        if not (job.finished and job.outcome.machine is not None):
+        if not (job.finished and job.finished_outcome.machine is not None):
             raise NotAvailableError(f'job {quoted(job_id)} has no state machine to simulate', job_id)
         try:
             robot = self.catalog.load(job.request.system)
@@ -203,13 +203,13 @@ class SimulationRuns:
         files as read here, not a path to read them again, and the machine as its tree."""
         request, started = job.request, time.monotonic()
         child = SimulationProcess({
-            'machine': job.outcome.machine,
-            'ltl_specification': job.outcome.ltl_specification,
+            'machine': job.finished_outcome.machine,
+            'ltl_specification': job.finished_outcome.ltl_specification,
             'system': robot.name, 'files': dict(robot.files), 'config_file': robot.config_file,
             'initial_conditions': list(request.initial_conditions), 'goals': list(request.goals),
             'ordered': not request.unordered, 'fail_first': list(simulation.fail_first),
             'record_dir': str(self._record_dir(simulation.id)), 'max_robot_time': 300.0, 'max_wall_time': 300.0,
-            'autonomy': simulation.operator['autonomy'], 'automaton': job.outcome.automaton,
+            'autonomy': simulation.operator['autonomy'], 'automaton': job.finished_outcome.automaton,
             'sensors': dict(simulation.sensors)}, simulator)
         with self._lock:
             self._processes.add(child)

@@ -209,3 +209,12 @@ def test_simulation_section_typos_are_rejected():
 
     with pytest.raises(ValueError, match="unknown keys"):
         SimulationConfig.from_dict({"fautls": {}})
+
+
+@pytest.mark.parametrize("section", [5, ["modes"], "modes"])
+def test_a_simulation_section_that_is_no_mapping_is_refused_naming_it(section):
+    from atlas_sim.simulator.config import SimulationConfig, SimulationConfigError
+
+    with pytest.raises(SimulationConfigError, match="must be a mapping") as raised:
+        SimulationConfig.from_dict(section)
+    assert raised.value.item == "simulation"

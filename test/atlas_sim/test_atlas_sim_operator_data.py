@@ -138,7 +138,8 @@ def test_the_configured_operator_answers_by_request_type():
 
 
 @pytest.mark.parametrize('entries, item', [
-    (['0'], '0'), (['x=1'], 'x'), (['300=1'], '300'), (['0=[1,'], '0=[1,'), ({'zero': 1}, 'zero')])
+    (['0'], '0'), (['x=1'], 'x'), (['300=1'], '300'), (['0=[1,'], '0=[1,'), ({'zero': 1}, 'zero'),
+    (['0=\x07'], '0=\x07')])  # a character YAML refuses to read (its ReaderError has no ``problem``)
 def test_bad_answers_name_the_entry(entries, item):
     from atlas_sim.simulator.operator_data import parse_answers
 

@@ -47,6 +47,12 @@ def test_precheck_accepts_possible_orders_and_unordered_goals():
     assert precheck(compile_task(robot_system('atlas'), [], ['walk', 'look_down', 'pickup_object'])) == []
 
 
+def test_precheck_of_a_specification_given_whole_finds_nothing_to_check():
+    # No provenance: nothing says which robot and request the formulas come from.
+    spec = spec_from_text_sections({'sys_props': ['a'], 'sys_liveness': ['a']})
+    assert precheck(spec) == []
+
+
 def test_precheck_names_forbidden_preconditions_and_contradictory_custom_ltl():
     forbidden = precheck(compile_task(robot_system('atlas'), [], ['look_down'], custom_ltl={'sys_trans': ['!stand_a']}))
     assert [f.item for f in forbidden] == ['stand']

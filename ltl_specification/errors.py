@@ -7,12 +7,16 @@ constant that reports it.
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from typing import Protocol
 
 from respec.vocabulary.errors import CodedError, ErrorCode
 
-if TYPE_CHECKING:
-    from ltl_specification.diagnosis import Diagnosis
+
+class Explained(Protocol):
+    """A refusal's whole explanation (``ltl_specification.diagnosis.Diagnosis``, which imports
+    this module: named by what the error needs of it)."""
+
+    def message(self) -> str: ...
 
 
 class SpecificationError(CodedError):
@@ -50,7 +54,7 @@ class ImpossibleGoalsError(InvalidGoalsError):
     whole ``diagnosis`` (``ltl_specification.diagnosis.Diagnosis``: sentence, core, play) as its
     message, so the refusal tells what synthesis would have told."""
 
-    def __init__(self, message: str, item: str = '', diagnosis: Diagnosis | None = None) -> None:
+    def __init__(self, message: str, item: str = '', diagnosis: Explained | None = None) -> None:
         super().__init__(message, item)
         self.diagnosis = diagnosis
 

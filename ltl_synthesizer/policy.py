@@ -6,11 +6,26 @@ always takes the same path."""
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import Any, Protocol, Sequence
 
-if TYPE_CHECKING:  # the game imports this module (and CUDD loads only with the game)
-    from ltl_synthesizer.cudd_import import Node
-    from ltl_synthesizer.symbolic import SymbolicGame
+from ltl_synthesizer.cudd_import import Node
+
+
+class GameShape(Protocol):
+    """What the policy reads of a game (``ltl_synthesizer.symbolic.SymbolicGame``, which
+    imports this module)."""
+
+    @property
+    def variables(self) -> Sequence[str]: ...
+    @property
+    def has_liveness(self) -> bool: ...
+    @property
+    def relation_nodes(self) -> int: ...
+    @property
+    def sys_goals(self) -> Sequence[Node]: ...
+    @property
+    def bdd(self) -> Any: ...
+    def statistics(self) -> dict[str, Any]: ...
 
 # Conjuncts are merged into clusters while the cluster's BDD stays below this many nodes: fewer,
 # larger relational products are faster than many tiny ones, up to a point (see bench/): 1000
@@ -124,8 +139,8 @@ def cluster_limit(has_liveness: bool, options: Options) -> int:
     return DEFAULT_CLUSTER_LIMIT if has_liveness else SAFETY_GAME_CLUSTER_LIMIT
 
 
-def plan(game: SymbolicGame, options: Options) -> Plan:
-    """The plan for ``game`` (a SymbolicGame), from its shape and the options the caller set."""
+def plan(game: GameShape, options: Options) -> Plan:
+    """The plan for ``game``, from its shape and the options the caller set."""
     large = len(game.variables) > SMALL_GAME_PROPOSITIONS
     compact = is_compact(game, options)
     # A pure safety game is solved by one greatest fixpoint, no dearer than the
@@ -154,7 +169,7 @@ def plan(game: SymbolicGame, options: Options) -> Plan:
         reordering_from_nodes=COMPACT_REORDERING_FROM_NODES if compact else DYNAMIC_REORDERING_FROM_NODES)
 
 
-def is_compact(game: SymbolicGame, options: Options) -> bool:
+def is_compact(game: GameShape, options: Options) -> bool:
     """Whether the static order left the safety relations compact (see
     COMPACT_NODES_PER_PROPOSITION); only the structural order is trusted to."""
     return options.variable_order == 'structure' and \
@@ -168,7 +183,7 @@ class ReorderingSwitch:
     the BDDs have grown (BETWEEN_ITERATIONS). ``observe(responses)`` is called before every
     enforceable-predecessor step with the BDD it is about to quantify."""
 
-    def __init__(self, game: SymbolicGame, planned: str, from_nodes: int = DYNAMIC_REORDERING_FROM_NODES) -> None:
+    def __init__(self, game: GameShape, planned: str, from_nodes: int = DYNAMIC_REORDERING_FROM_NODES) -> None:
         self.game = game
         self.planned = planned
         self.from_nodes = from_nodes

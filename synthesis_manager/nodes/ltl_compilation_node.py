@@ -104,6 +104,7 @@ class LTLCompilationNode(Node):
                             callback_group=group, qos_profile=service_qos())
         self._systems_publisher = create_systems_publisher(self)
         self._published_systems = None
+        self._systems_fingerprint: tuple | None = None  # of the files the last list was read from
         self.publish_systems()
         self.create_timer(self.SYSTEMS_PERIOD, self.publish_systems)
 
@@ -122,12 +123,18 @@ class LTLCompilationNode(Node):
         return SystemCatalog(self.settings.config_dir or None)
 
     def publish_systems(self) -> None:
-        """Publish the systems when they changed (a system file edited, added or removed)."""
+        """Publish the systems when they changed (a system file edited, added or removed); while
+        no file under the config folders changed, nothing is read again."""
         try:
-            text = catalog_to_json(self.catalog())
+            catalog = self.catalog()
+            fingerprint = catalog.fingerprint()
+            if fingerprint == self._systems_fingerprint:
+                return
+            text = catalog_to_json(catalog)
         except (OSError, SystemConfigError) as error:  # e.g. a config directory vanished: keep the last list
             self.get_logger().warning(f'cannot read the robot systems: {error}')
             return
+        self._systems_fingerprint = fingerprint
         if text != self._published_systems:
             self._systems_publisher.publish(String(data=text))
             self._published_systems = text

@@ -125,6 +125,28 @@ def test_the_catalog_lists_and_loads_the_systems_of_its_folders(tmp_path):
     assert list(catalog.load('tiny').abstraction.actions) == ['wave', 'nod']
 
 
+def test_the_catalogs_fingerprint_changes_with_any_file_under_its_folders(tmp_path):
+    """What a node watching for changes compares instead of loading every system again: the
+    same while nothing changed; another one after an edit, a new file or a removed one, in a
+    subfolder too (CNU's files sit beside their system file)."""
+    catalog = SystemCatalog(tmp_path)
+    (tmp_path / 'tiny.yaml').write_text('abstraction:\n  actions: {wave: []}\n')
+    (tmp_path / 'vending').mkdir()
+    (tmp_path / 'vending' / 'capabilities.yaml').write_text('capabilities: {}\n')
+    first = catalog.fingerprint()
+    assert catalog.fingerprint() == first
+    assert str(tmp_path / 'vending' / 'capabilities.yaml') in {path for path, _, _ in first}
+    assert str(CONFIG / 'atlas.yaml') in {path for path, _, _ in first}  # the shipped folder too
+    before = first
+    for change in (lambda: (tmp_path / 'tiny.yaml').write_text('abstraction:\n  actions: {wave: [], nod: []}\n'),
+                   lambda: (tmp_path / 'vending' / 'capabilities.yaml').write_text('capabilities: {a: 1}\n'),
+                   lambda: (tmp_path / 'other.yaml').write_text('abstraction: {}\n'),
+                   lambda: (tmp_path / 'other.yaml').unlink()):
+        change()
+        assert catalog.fingerprint() != before
+        before = catalog.fingerprint()
+    assert before == catalog.fingerprint()
+
 def tiny_system(directory: Path, action: str) -> Path:
     directory.mkdir(parents=True, exist_ok=True)
     (directory / 'tiny.yaml').write_text(f'abstraction:\n  actions: {{{action}: []}}\n')

@@ -232,14 +232,14 @@ def test_a_killed_node_is_reported_by_name_and_the_suite_recovers(tmp_path):
 
 # --- memory ---------------------------------------------------------------------------------
 
-# Not 2x faster (issue 50): the runaway synthesis must grow to the 64 MB limit in its child, then a next goal must
-# succeed (9.0 s).
 def test_a_synthesis_over_its_memory_limit_ends_with_a_clear_error(ros, tmp_path):
-    client = start_suite(ros, tmp_path, synthesis_parameters=[Parameter('memory_limit_mb', value=64)])
+    # 32 MB, not 64: the same failure, sooner (measured back to back beside other jobs: 16 MB
+    # reached in 0.5 s, 32 in 11 s, 64 in 43 s); the paper task afterwards needs less than 16.
+    client = start_suite(ros, tmp_path, synthesis_parameters=[Parameter('memory_limit_mb', value=32)])
     started = time.monotonic()
     outcome = client.run(runaway_goal(120.0), timeout=180)
     assert outcome.error_name == 'SYNTHESIS_FAILED', outcome.message
-    assert '64' in outcome.message and 'memory' in outcome.message
+    assert '32' in outcome.message and 'memory' in outcome.message
     assert time.monotonic() - started < 120
     assert client.run(make_goal(**PAPER_TASK), timeout=60).error_name == 'SUCCESS'
 

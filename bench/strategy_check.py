@@ -95,6 +95,7 @@ def check_strategy(spec, strategy: dict, limit: int = 20) -> list[str]:
         return [f'strategy variables {names} are not the specification\'s']
     inputs = list(spec.env_props)
     env_init, sys_init, env_trans, sys_trans, assumptions, goals = formulas.game(spec)
+    labels_of = _Labels(bdd, assumptions, goals)
     nodes = strategy['nodes']
     problems = []
 
@@ -114,22 +115,37 @@ def check_strategy(spec, strategy: dict, limit: int = 20) -> list[str]:
     if initial_inputs & ~covered_inputs != bdd.false:
         problems.append('some initial input valuation has no initial node')
 
-    # 2. Moves, 3. edge labels for the fairness check.
+    # 2. Moves, 3. edge labels for the fairness check. Nodes differ from one another in their
+    # goal counter, not always in their state: what a state or a pair of states gives is worked
+    # out once (an explicit AMBA strategy has thousands of nodes over far fewer states).
+    next_sys = [v + "'" for v in spec.sys_props]
+    per_state: dict = {}
+    per_move: dict = {}
     edges = {name: [] for name in nodes}
     for name in nodes:
-        state = state_of(name)
-        env_here = bdd.let(state, env_trans)
-        sys_here = bdd.let(state, sys_trans)
-        answered = bdd.false
-        for successor in nodes[name]['trans']:
-            successor_name = str(successor)
-            move = next_cube(state_of(successor_name))
-            if bdd.let(move_values(move, bdd), sys_here) != bdd.true:
+        here = tuple(nodes[name]['state'])
+        if here not in per_state:
+            state = state_of(name)
+            per_state[here] = (state, bdd.let(state, sys_trans),
+                               bdd.exist(next_sys, bdd.let(state, env_trans)), {})
+        state, sys_here, allowed_inputs, answered_by = per_state[here]
+        successors = tuple(str(successor) for successor in nodes[name]['trans'])
+        for successor_name in successors:
+            there = tuple(nodes[successor_name]['state'])
+            if there not in per_move:
+                move = next_cube(state_of(successor_name))
+                per_move[there] = (move, move_values(move, bdd), bdd.exist(next_sys, move))
+            move, values, _ = per_move[there]
+            if (here, there) not in answered_by:
+                answered_by[(here, there)] = (bdd.let(values, sys_here) == bdd.true,
+                                              labels_of({**state, **values}))
+            follows_sys_trans, labels = answered_by[(here, there)]
+            if not follows_sys_trans:
                 problems.append(f'node {name} -> {successor_name} violates SYS_TRANS')
-            answered |= bdd.exist([v + "'" for v in spec.sys_props], move)
-            transition = {**state, **move_values(move, bdd)}
-            edges[name].append((successor_name, _labels(bdd, transition, assumptions, goals)))
-        allowed_inputs = bdd.exist([v + "'" for v in spec.sys_props], env_here)
+            edges[name].append((successor_name, labels))
+        answered = bdd.false
+        for there in {tuple(nodes[s]['state']) for s in successors}:
+            answered |= per_move[there][2]
         if allowed_inputs & ~answered != bdd.false:
             problems.append(f'node {name}: some next input allowed by ENV_TRANS has no successor')
         if len(problems) >= limit:
@@ -167,6 +183,7 @@ def check_counterstrategy(spec, strategy: dict, robotics_semantics: bool = False
     sys_parts = [formulas.translate(f) for f in spec.sys_trans]
     assumptions = [formulas.translate(f) for f in spec.env_liveness] or [bdd.true]
     goals = [formulas.translate(f) for f in spec.sys_liveness] or [bdd.true]
+    labels_of = _Labels(bdd, assumptions, goals)
     nodes = strategy['nodes']
     problems = []
 
@@ -229,7 +246,7 @@ def check_counterstrategy(spec, strategy: dict, robotics_semantics: bool = False
                 problems.append(f'node {name} -> {successor} violates SYS_TRANS')
             answered |= bdd.cube(move)
             transition = {**state, **{v + "'": following[v] for v in names}}
-            edges[name].append((successor, _labels(bdd, transition, assumptions, goals)))
+            edges[name].append((successor, labels_of(transition)))
         if sys_answers & ~answered != bdd.false:
             problems.append(f'node {name}: some system answer allowed by SYS_TRANS has no successor')
         if len(problems) >= limit:
@@ -498,8 +515,23 @@ if __name__ == '__main__':
     sys.exit(main())
 
 
-def _labels(bdd, transition: dict, assumptions, goals) -> tuple[tuple, tuple]:
+class _Labels:
     """Which assumptions and which goals an edge (a full transition's values) satisfies: what the
-    fairness checks of strategies and counter-strategies read off their cycles."""
-    return (tuple(bdd.let(transition, a) == bdd.true for a in assumptions),
-            tuple(bdd.let(transition, g) == bdd.true for g in goals))
+    fairness checks of strategies and counter-strategies read off their cycles. Each formula is
+    evaluated once per valuation of the variables it depends on (strategies have hundreds of
+    thousands of edges, liveness formulas a few variables)."""
+
+    def __init__(self, bdd, assumptions, goals):
+        self.bdd = bdd
+        self.assumption_count = len(assumptions)
+        self.formulas = [(formula, sorted(bdd.support(formula)), {}) for formula in (*assumptions, *goals)]
+
+    def __call__(self, transition: dict) -> tuple[tuple, tuple]:
+        holds = []
+        for formula, support, memo in self.formulas:
+            key = tuple(transition.get(variable) for variable in support)
+            if key not in memo:
+                values = {variable: transition[variable] for variable in support if variable in transition}
+                memo[key] = (self.bdd.let(values, formula) if values else formula) == self.bdd.true
+            holds.append(memo[key])
+        return tuple(holds[:self.assumption_count]), tuple(holds[self.assumption_count:])

@@ -60,6 +60,8 @@ def onboard(ros, flexbe, tmp_path, monkeypatch, request):
         system.stop()
 
 
+# Not 2x faster (issue 50): FlexBE's onboard engine, the robot, the operator and be_launcher start as processes, and
+# the behavior runs to its end (14.7 s).
 def test_be_launcher_starts_the_installed_behavior(ros, onboard, flexbe_sources):
     """FlexBE's own command line (flexbe_widget's be_launcher), as README tells users to start it."""
     from flexbe_msgs.msg import BEStatus

@@ -58,7 +58,9 @@ READ_CONTAINER = """path => {
 @contextlib.contextmanager
 def running(command, environment, ready, timeout: float, log_path: Path):
     """A subprocess (output to ``log_path``) that ``ready()`` confirms up; stopped with SIGINT to
-    its process group (``make webui`` waits for the WebUI it started)."""
+    its process group (``make webui`` waits for the WebUI it started), then SIGTERM: after the
+    Runtime Control test the WebUI 4.0.3's executor never woke for the SIGINT (it ended only at
+    the 20 s SIGKILL); SIGTERM wakes it and it runs its KeyboardInterrupt shutdown at once."""
     with open(log_path, 'w') as log:
         process = subprocess.Popen(command, env=environment, stdout=log, stderr=subprocess.STDOUT,
                                    start_new_session=True)
@@ -70,11 +72,13 @@ def running(command, environment, ready, timeout: float, log_path: Path):
                 time.sleep(0.2)
             yield process
         finally:
-            with contextlib.suppress(ProcessLookupError):
-                os.killpg(process.pid, signal.SIGINT)
-            try:
-                process.wait(timeout=20)
-            except subprocess.TimeoutExpired:
+            for signal_number, grace in ((signal.SIGINT, 3), (signal.SIGTERM, 20)):
+                with contextlib.suppress(ProcessLookupError):
+                    os.killpg(process.pid, signal_number)
+                with contextlib.suppress(subprocess.TimeoutExpired):
+                    process.wait(timeout=grace)
+                    break
+            else:
                 os.killpg(process.pid, signal.SIGKILL)
                 process.wait()
 
@@ -283,6 +287,8 @@ def add_manual_imports(page, lines):
     page.click('#button_to_sm')
 
 
+# Not 2x faster (issue 50): a five-goal synthesis in the WebUI, its save and the saved behavior's run on FlexBE's
+# onboard engine (7.3 s; the WebUI, the suite and the browser are shared by the module).
 def test_a_five_goal_synthesis_saves_in_the_webui_and_runs_onboard(editor, exported_behavior, ros, flexbe, tmp_path,
                                                                     monkeypatch):
     """Every key the synthesized states read is written in the machine: the WebUI's check accepts
@@ -333,6 +339,8 @@ def test_a_five_goal_synthesis_saves_in_the_webui_and_runs_onboard(editor, expor
         system.stop()
 
 
+# Not 2x faster (issue 50): FlexBE's onboard engine starts on the WebUI's domain and the WebUI's failure line is
+# awaited (3.4 s; the module's teardown is 4 s, no longer 20).
 def test_runtime_control_cannot_start_a_behavior_on_engine_2_3_3(editor, exported_behavior, ros_domain, flexbe,
                                                                    webui_log, tmp_path):
     """README's upstream mismatch: with FlexBE's onboard executive up on the WebUI's domain, Runtime

@@ -82,6 +82,8 @@ def webui_answers() -> bool:
     return False
 
 
+# Not 2x faster (issue 50): every step of the section runs once, as written: export, pip install, the suite's, the
+# WebUI's and FlexBE's launches, a behavior run (30.6 s).
 @pytest.mark.flexbe
 def test_the_section_runs_in_order_to_a_finished_behavior(ros, flexbe, flexbe_sources, tmp_path):
     from flexbe_msgs.msg import BEStatus

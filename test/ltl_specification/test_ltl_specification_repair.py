@@ -5,6 +5,9 @@ request (and custom LTL, and robot patch in a copy of the config directory) comp
 ``behavior-synthesis compile`` and synthesized by ``gr1synth``, which must say realizable.
 """
 
+import contextlib
+import functools
+import io
 import json
 import os
 import shutil
@@ -29,6 +32,18 @@ def command(program, *args, env=None):
     environment = dict(os.environ, PYTHONPATH=str(ROOT), **(env or {}))
     return subprocess.run([sys.executable, '-m', module, *map(str, args)], cwd=ROOT, env=environment,
                           capture_output=True, text=True, timeout=120)
+
+
+def in_process(program, *args):
+    """``program`` run through its own ``main`` in this process: what a user's check runs, without
+    starting an interpreter per proposal (the checks, not the subject of these tests)."""
+    from ltl_synthesizer.cli import main as gr1synth
+    from synthesis_manager.programs.cli import main as behavior_synthesis
+    main = {'behavior-synthesis': behavior_synthesis, 'gr1synth': gr1synth}[program]
+    stdout, stderr = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(stdout), contextlib.redirect_stderr(stderr):
+        status = main([str(arg) for arg in args])
+    return subprocess.CompletedProcess([program, *args], status, stdout.getvalue(), stderr.getvalue())
 
 
 def repair_json(*task, env=None):
@@ -56,9 +71,11 @@ def realizable_by_the_tools(tmp_path, proposal, task: dict, config_dir=None, cus
     if config_dir is not None:
         arguments += ['--config-dir', config_dir]
     spec = tmp_path / f'spec-{id(proposal)}.slugsin'
-    compiled = command('behavior-synthesis', 'compile', *arguments, '--format', 'slugsin', '-o', spec, env=env)
+    # With an environment of its own (AMENT_PREFIX_PATH) the compile runs as a process of its own.
+    compile_spec = functools.partial(command, env=env) if env else in_process
+    compiled = compile_spec('behavior-synthesis', 'compile', *arguments, '--format', 'slugsin', '-o', spec)
     assert compiled.returncode == 0, compiled.stderr
-    synthesized = command('gr1synth', '--sysInitRoboticsSemantics', spec)
+    synthesized = in_process('gr1synth', '--sysInitRoboticsSemantics', spec)
     assert synthesized.returncode == 0, synthesized.stderr
     return 'RESULT: Specification is realizable.' in synthesized.stderr
 

@@ -50,6 +50,8 @@ def assert_each_goal_answered_once(round_):
     return figures
 
 
+# Not 2x faster (issue 50): four namespaced hosts, DDS discovery across them and three rounds with their faults (a 5 s
+# pulled cable, a killed host, restarted nodes) are the subject (20.7 s).
 def test_a_fleet_across_four_hosts_answers_every_goal_once_through_faults(tmp_path):
     assert network_namespaces_available(), \
         'the across-hosts test builds network namespaces: run the suite as root with `ip` (iproute2) installed'

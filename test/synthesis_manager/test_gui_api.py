@@ -205,6 +205,7 @@ def test_cancel_a_running_synthesis(client, runaway_synthesis):
     assert final['outcome']['seconds'] < 30
 
 
+# Not 2x faster (issue 50): a synthesis and two simulations, with and without a fault (3.9 s).
 def test_simulate_the_synthesized_machine_with_and_without_a_fault(client, backend):
     assert client.get('/api/info').json()['simulation'] is True
     _, job = run_job(client, PAPER_TASK)

@@ -41,6 +41,8 @@ def state_at(spans, time):
     return entered[-1] if entered else spans[0][0]
 
 
+# Not 2x faster (issue 50): a synthesis and a simulation, then a play at robot speed over more than 2 s of robot time,
+# which it asserts (9.2 s).
 def test_play_is_motion_at_robot_speed_with_the_active_state_in_step_and_scrubbing(page):
     choose_task(page, ['look_down', 'pickup_object'])
     page.click('#synthesize')

@@ -72,6 +72,7 @@ def test_a_click_anywhere_in_the_cell_forces_and_the_details_keep_clear_of_the_a
         assert page.inner_text('#simulation-check').startswith('Trace check against the specification: ok')
 
 
+# Not 2x faster (issue 50): a synthesis and an operated simulation in the browser, per window size (3.8 s).
 @pytest.mark.parametrize('size', SIZES, ids=lambda s: f"{s['width']}x{s['height']}")
 def test_keys_force_the_active_states_outcomes_and_the_check_names_the_operators_choice(
         gui, browser_context, size):

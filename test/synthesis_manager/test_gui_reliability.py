@@ -167,6 +167,7 @@ def test_posts_a_cross_site_form_could_send_are_refused(gui):
                     'application/json; charset=utf-8')[0] == 200
 
 
+# Not 2x faster (issue 50): a synthesized job and the two simulations the bound lets run, really started (5.3 s).
 def test_simulations_are_bounded_at_once_and_per_job(gui):
     from synthesis_manager.web.simulations import Simulation
 

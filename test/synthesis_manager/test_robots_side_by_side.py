@@ -106,6 +106,7 @@ def test_without_namespaces_the_suite_is_placed_as_before(tmp_path):
     assert all('cli_args' not in factory.keywords for factory in one)
 
 
+# Not 2x faster (issue 50): the documented commands start two serve processes, two robots and the clients (3.5 s).
 def test_the_documented_commands_serve_two_robots_and_the_clients_pick_one(tmp_path):
     """docs/deployment.md: one synthesis service in /fleet (``serve --ros-args -r __ns:=/fleet``),
     both robots' other nodes in one ``serve --namespace /robot1 --namespace /robot2

@@ -106,6 +106,7 @@ def test_fast_goals_are_not_starved_by_slow_ones(ros, tmp_path):
         assert time.monotonic() - started < 45
 
 
+# Not 2x faster (issue 50): 300 goals, ten in flight, are the soak; fewer would be a shorter soak (5.4 s).
 def test_a_short_soak_loses_no_goal(ros, tmp_path):
     """300 goals back to back, ten in flight (the 2,000-goal soak is in bench/)."""
     client = start_suite(ros, tmp_path, synthesis_parameters=[Parameter('keep_byproducts', value=20)])
@@ -192,6 +193,8 @@ def test_keeping_no_byproducts_leaves_the_directory_empty(ros, tmp_path):
 
 # --- faults -------------------------------------------------------------------------------
 
+# Not 2x faster (issue 50): ltl_synthesis is a serve process of its own, killed 1 s into a synthesis, then the suite
+# recovers for a next goal (6.4 s).
 def test_a_killed_node_is_reported_by_name_and_the_suite_recovers(tmp_path):
     """ltl_synthesis runs in its own process and is killed (SIGKILL) mid-synthesis."""
     serve = [str(Path(sys.executable).parent / 'behavior-synthesis'), 'serve', '--nodes', 'ltl_synthesis',
@@ -230,11 +233,13 @@ def test_a_killed_node_is_reported_by_name_and_the_suite_recovers(tmp_path):
 # --- memory ---------------------------------------------------------------------------------
 
 def test_a_synthesis_over_its_memory_limit_ends_with_a_clear_error(ros, tmp_path):
-    client = start_suite(ros, tmp_path, synthesis_parameters=[Parameter('memory_limit_mb', value=64)])
+    # 32 MB, not 64: the same failure, sooner (measured back to back beside other jobs: 16 MB
+    # reached in 0.5 s, 32 in 11 s, 64 in 43 s); the paper task afterwards needs less than 16.
+    client = start_suite(ros, tmp_path, synthesis_parameters=[Parameter('memory_limit_mb', value=32)])
     started = time.monotonic()
     outcome = client.run(runaway_goal(120.0), timeout=180)
     assert outcome.error_name == 'SYNTHESIS_FAILED', outcome.message
-    assert '64' in outcome.message and 'memory' in outcome.message
+    assert '32' in outcome.message and 'memory' in outcome.message
     assert time.monotonic() - started < 120
     assert client.run(make_goal(**PAPER_TASK), timeout=60).error_name == 'SUCCESS'
 

@@ -72,7 +72,7 @@ def big_robot(folder, extra_actions: int = 60_000) -> str:
 
 
 # Not 2x faster (issue 50): 9.9 s of its 10.3 s are the suite's start, where ltl_compilation's systems catalog
-# (publish_systems) reads the 2 MB robot file in the node (5-8 s measured apart): the node's to change, not the test's.
+# (publish_systems) reads the 2 MB robot file in the node once (5-8 s measured apart; no longer at each 2 s look).
 def test_a_large_robot_file_is_read_and_compiled_in_a_child(ros, tmp_path):
     """Issue 48, item 3: a robot file of megabytes is read and checked (seconds, hundreds of MB)
     where the work can be stopped and bounded, not in the node: here the child's 1 MB memory

@@ -109,10 +109,11 @@ def test_synthesize_then_simulate_with_runtime_control_forcing_low_and_a_failing
     wait_for_question(page, 'charge returned')
     asked = 'charge returned'
     while not asked.startswith('drive returned'):   # on to the drive (a new battery check first, perhaps)
+        answered = page.inner_text('#operator-question')  # read before the click: the next may come at once
         page.click('#operator-confirm')
         page.wait_for_function("asked => !document.getElementById('operator-request').hidden && "
                                "document.getElementById('operator-question').textContent !== asked",
-                               arg=page.inner_text('#operator-question'), timeout=60_000)
+                               arg=answered, timeout=60_000)
         asked = page.inner_text('#operator-question')
     docs_shot(page, 'gui-capability-run.png')
     force(page, 'failed')                  # the drive fails

@@ -239,5 +239,7 @@ def test_the_diagnosis_time_limit_keeps_the_synthesizers_verdict(suite, endless_
     assert outcome.error_name == 'SPEC_UNSYNTHESIZABLE'
     assert 'Details from the synthesizer' not in outcome.message  # no diagnosis: the synthesizer's account
     assert outcome.message.strip()
-    assert answered - diagnosing[0] < 1.0 + DIAGNOSIS_GRACE + 1.0
+    # Stopped at its 1 s (not the default 20 s): killed DIAGNOSIS_GRACE later, and the answer's
+    # way back through the nodes took up to 1.6 s more beside another test run at load 5 (3.6 s).
+    assert answered - diagnosing[0] < 1.0 + DIAGNOSIS_GRACE + 3.0
     assert process_gone(int(endless_diagnosis.read_text()), within=1.0)

@@ -94,7 +94,14 @@ def check_strategy(spec, strategy: dict, limit: int = 20) -> list[str]:
     if sorted(names) != sorted(formulas.variables):
         return [f'strategy variables {names} are not the specification\'s']
     inputs = list(spec.env_props)
-    env_init, sys_init, env_trans, sys_trans, assumptions, goals = formulas.game(spec)
+    # The safety sections stay lists, never one BDD: in the declared order (all inputs, then
+    # all outputs) a capability robot's relation is exponential (every completion input is
+    # far from its memory output), and the checker must not borrow the synthesizer's order.
+    # ENV_TRANS is cofactored by each node's state; SYS_TRANS is evaluated on each edge.
+    env_init, sys_init = formulas.conjunction(spec.env_init), formulas.conjunction(spec.sys_init)
+    env_parts = [formulas.translate(f) for f in spec.env_trans]
+    assumptions = [formulas.translate(f) for f in spec.env_liveness] or [bdd.true]
+    goals = [formulas.translate(f) for f in spec.sys_liveness] or [bdd.true]
     nodes = strategy['nodes']
     problems = []
 
@@ -118,13 +125,15 @@ def check_strategy(spec, strategy: dict, limit: int = 20) -> list[str]:
     edges = {name: [] for name in nodes}
     for name in nodes:
         state = state_of(name)
-        env_here = bdd.let(state, env_trans)
-        sys_here = bdd.let(state, sys_trans)
+        env_here = bdd.true
+        for part in env_parts:
+            env_here &= bdd.let(state, part)
         answered = bdd.false
         for successor in nodes[name]['trans']:
             successor_name = str(successor)
-            move = next_cube(state_of(successor_name))
-            if bdd.let(move_values(move, bdd), sys_here) != bdd.true:
+            following = state_of(successor_name)
+            move = next_cube(following)
+            if not all(_holds(f, state, following) for f in spec.sys_trans):
                 problems.append(f'node {name} -> {successor_name} violates SYS_TRANS')
             answered |= bdd.exist([v + "'" for v in spec.sys_props], move)
             transition = {**state, **move_values(move, bdd)}
@@ -136,6 +145,28 @@ def check_strategy(spec, strategy: dict, limit: int = 20) -> list[str]:
             return problems
     problems += _fairness_problems(edges, len(assumptions), len(goals))
     return problems[:limit]
+
+
+def _holds(formula, current: dict, following: dict) -> bool:
+    """The value of a formula on a transition (``following``: the next step's values), read
+    off its tree: no BDD, so no variable order."""
+    if isinstance(formula, Var):
+        return current[formula.name]
+    if isinstance(formula, Not):
+        return not _holds(formula.arg, current, following)
+    if isinstance(formula, And):
+        return all(_holds(arg, current, following) for arg in formula.args)
+    if isinstance(formula, Or):
+        return any(_holds(arg, current, following) for arg in formula.args)
+    if isinstance(formula, Implies):
+        return not _holds(formula.left, current, following) or _holds(formula.right, current, following)
+    if isinstance(formula, Iff):
+        return _holds(formula.left, current, following) == _holds(formula.right, current, following)
+    if isinstance(formula, Next):
+        return _holds(formula.arg, following, following)
+    if isinstance(formula, Const):
+        return formula.value
+    raise TypeError(f'unexpected formula node {type(formula).__name__}')
 
 
 def check_counterstrategy(spec, strategy: dict, robotics_semantics: bool = False,

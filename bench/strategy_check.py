@@ -32,7 +32,7 @@ from __future__ import annotations
 
 from dd import cudd
 
-from respec.ltl import And, Const, Iff, Implies, Next, Not, Or, Var
+from respec.ltl import And, Const, Iff, Implies, Next, Not, Or, Var, evaluate
 
 
 class _Formulas:
@@ -133,7 +133,7 @@ def check_strategy(spec, strategy: dict, limit: int = 20) -> list[str]:
             successor_name = str(successor)
             following = state_of(successor_name)
             move = next_cube(following)
-            if not all(_holds(f, state, following) for f in spec.sys_trans):
+            if not all(evaluate(f, state, following) for f in spec.sys_trans):
                 problems.append(f'node {name} -> {successor_name} violates SYS_TRANS')
             answered |= bdd.exist([v + "'" for v in spec.sys_props], move)
             transition = {**state, **move_values(move, bdd)}
@@ -145,28 +145,6 @@ def check_strategy(spec, strategy: dict, limit: int = 20) -> list[str]:
             return problems
     problems += _fairness_problems(edges, len(assumptions), len(goals))
     return problems[:limit]
-
-
-def _holds(formula, current: dict, following: dict) -> bool:
-    """The value of a formula on a transition (``following``: the next step's values), read
-    off its tree: no BDD, so no variable order."""
-    if isinstance(formula, Var):
-        return current[formula.name]
-    if isinstance(formula, Not):
-        return not _holds(formula.arg, current, following)
-    if isinstance(formula, And):
-        return all(_holds(arg, current, following) for arg in formula.args)
-    if isinstance(formula, Or):
-        return any(_holds(arg, current, following) for arg in formula.args)
-    if isinstance(formula, Implies):
-        return not _holds(formula.left, current, following) or _holds(formula.right, current, following)
-    if isinstance(formula, Iff):
-        return _holds(formula.left, current, following) == _holds(formula.right, current, following)
-    if isinstance(formula, Next):
-        return _holds(formula.arg, following, following)
-    if isinstance(formula, Const):
-        return formula.value
-    raise TypeError(f'unexpected formula node {type(formula).__name__}')
 
 
 def check_counterstrategy(spec, strategy: dict, robotics_semantics: bool = False,

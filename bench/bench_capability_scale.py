@@ -163,8 +163,9 @@ def measure_capabilities(args, directory: Path, rows: list, series: dict) -> Non
                                cwd=ROOT, check=True)
             results.update(solved_by_both(slugsin, args, given_up))
             strategy = Path(str(slugsin) + '.strategy.json')
-            if strategy.exists() and 'check' not in given_up:
+            if strategy.exists() and 'check' not in given_up and size <= args.check_up_to:
                 results['check'] = checked(slugsin, strategy, args.timeout)
+            strategy.unlink(missing_ok=True)
             _finish_row(row, results, given_up, series)
             rows.append(row)
             print(_row_line(row, args.timeout), flush=True)
@@ -197,7 +198,6 @@ print(json.dumps(check_strategy(spec, json.loads(open(sys.argv[2]).read()))))
 def checked(slugsin: Path, strategy: Path, timeout: float) -> dict:
     """The independent check of the pipeline's explicit strategy: its problems (none: passed)."""
     run = run_wall([sys.executable, '-c', _CHECK, str(slugsin), str(strategy)], timeout)
-    strategy.unlink()
     if not run['timeout']:
         if run['code'] == 0:
             run['problems'] = json.loads(run['out'].strip().splitlines()[-1])
@@ -297,6 +297,8 @@ def main() -> None:
     parser.add_argument('--shapes', default=','.join(capability_robots.SHAPES))
     parser.add_argument('--sizes', default=','.join(map(str, SIZES)))
     parser.add_argument('--grids', default=','.join(f'{w}x{h}' for w, h in GRIDS), help="'' for none")
+    parser.add_argument('--check-up-to', type=int, default=80,
+                        help='check the explicit strategies of robots up to this size (default 80)')
     parser.add_argument('--markdown', help=f'write the table here (e.g. {RESULTS.relative_to(ROOT)})')
     args = parser.parse_args()
     if args.pipeline_child:

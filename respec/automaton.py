@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from respec.errors import CodedError, ErrorCode
-from respec.ltl import Not, Var, conj, evaluate
+from respec.ltl import Formula, Not, Var, conj, evaluate
 from respec.naming import is_memory
 from respec.spec import GR1Specification
 
@@ -87,7 +87,7 @@ def _initial_nodes(strategy: dict[str, Any], spec: GR1Specification) -> list[str
                              'variable of the strategy', item=unknown.args[0]) from None
 
 
-def _is_literal(formula) -> bool:
+def _is_literal(formula: Formula) -> bool:
     return isinstance(formula, Var) or isinstance(formula, Not) and isinstance(formula.arg, Var)
 
 

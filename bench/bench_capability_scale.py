@@ -13,7 +13,12 @@ and size N, each in a fresh process, wall seconds:
   check, the automaton, the FlexBE machine (stage seconds in the notes);
 - "gr1synth": ``python -m ltl_synthesizer --sysInitRoboticsSemantics`` on the compiled slugsin
   (realizability only, as slugs' default);
-- "slugs": slugs with the same flag on the same file.
+- "gr1synth + strategy": the same with ``--explicitStrategy --jsonOutput`` (the synthesis the
+  pipeline needs: the verdict and the explicit strategy, written out);
+- "slugs": slugs with the same flag on the same file (realizability only);
+- "ratio": pipeline / (gr1synth + strategy), the pipeline's cost over the synthesis it needs;
+- "check": ``strategy_check.check_strategy`` (an independent check that shares no code with
+  the synthesizer) on the pipeline's explicit strategy, in its own process after the run.
 
 The per-cell gridworld rows (capability_robots.per_cell_gridworld) have no pipeline (no robot):
 gr1synth and slugs only. Verdicts are compared on every row both tools finish. A tool that
@@ -104,6 +109,7 @@ def pipeline_child(config_dir: str, shape: str, size: int, slugsin: str) -> None
                                         state_library=capability_robots.STATE_LIBRARY)
         stages['generate'] = time.perf_counter() - mark
         report['machine_states'] = len(states.to_instantiations())
+        Path(slugsin + '.strategy.json').write_text(json.dumps(result.strategy))
     report['stages'] = stages
     print(json.dumps(report))
 
@@ -156,6 +162,10 @@ def measure_capabilities(args, directory: Path, rows: list, series: dict) -> Non
                 subprocess.run([python, '-c', _COMPILE_ONLY, str(directory), shape, str(size), str(slugsin)],
                                cwd=ROOT, check=True)
             results.update(solved_by_both(slugsin, args, given_up))
+            strategy = Path(str(slugsin) + '.strategy.json')
+            if strategy.exists() and 'check' not in given_up and size <= args.check_up_to:
+                results['check'] = checked(slugsin, strategy, args.timeout)
+            strategy.unlink(missing_ok=True)
             _finish_row(row, results, given_up, series)
             rows.append(row)
             print(_row_line(row, args.timeout), flush=True)
@@ -175,12 +185,39 @@ open(out, 'w').write(spec.to_slugsin())
 '''
 
 
-def solved_by_both(slugsin: Path, args, given_up: set) -> dict:
-    """gr1synth's and slugs' runs on ``slugsin`` (those not given up on), each with its verdict
-    or, when it gave none, its last line of errors."""
+_CHECK = '''
+import json, sys
+sys.path[:0] = ['.', 'bench']
+from respec.parsing import parse_slugsin
+from strategy_check import check_strategy
+spec = parse_slugsin(open(sys.argv[1]).read())
+print(json.dumps(check_strategy(spec, json.loads(open(sys.argv[2]).read()))))
+'''
+
+
+def checked(slugsin: Path, strategy: Path, timeout: float) -> dict:
+    """The independent check of the pipeline's explicit strategy: its problems (none: passed)."""
+    run = run_wall([sys.executable, '-c', _CHECK, str(slugsin), str(strategy)], timeout)
+    if not run['timeout']:
+        if run['code'] == 0:
+            run['problems'] = json.loads(run['out'].strip().splitlines()[-1])
+        else:
+            run['failed'] = (run['err'].strip().splitlines() or ['?'])[-1][:80]
+    return run
+
+
+def solved_by_both(slugsin: Path, args, given_up: set, with_strategy: bool = True) -> dict:
+    """gr1synth's (with the explicit strategy too, if ``with_strategy``) and slugs' runs on
+    ``slugsin`` (those not given up on), each with its verdict or, when it gave none, its last
+    line of errors."""
     results = {}
+    if not with_strategy:
+        given_up = given_up | {'gr1synth + strategy'}
     for tool, command in (('gr1synth', [sys.executable, '-m', 'ltl_synthesizer', '--sysInitRoboticsSemantics',
                                         str(slugsin)]),
+                          ('gr1synth + strategy', [sys.executable, '-m', 'ltl_synthesizer',
+                                                   '--sysInitRoboticsSemantics', '--explicitStrategy',
+                                                   '--jsonOutput', str(slugsin), os.devnull]),
                           ('slugs', [args.slugs, '--sysInitRoboticsSemantics', str(slugsin)])):
         if tool in given_up:
             continue
@@ -204,7 +241,7 @@ def measure_gridworlds(args, directory: Path, rows: list, series: dict) -> None:
             row = {'family': family, 'size': width * height, 'label': f'{family} {width}x{height}',
                    'props': f'{math.ceil(math.log2(width * height))} + {math.ceil(math.log2(width * height))} bits',
                    'kb': len(text) // 1024}
-            results = solved_by_both(slugsin, args, given_up)
+            results = solved_by_both(slugsin, args, given_up, with_strategy=False)
             _finish_row(row, results, given_up, series)
             rows.append(row)
             print(_row_line(row, args.timeout), flush=True)
@@ -213,7 +250,7 @@ def measure_gridworlds(args, directory: Path, rows: list, series: dict) -> None:
 def _finish_row(row: dict, results: dict, given_up: set, series: dict) -> None:
     row['results'] = results
     verdicts = {tool: r.get('verdict', r.get('realizable')) for tool, r in results.items()
-                if not r['timeout'] and not r.get('failed')}
+                if tool != 'check' and not r['timeout'] and not r.get('failed')}
     verdicts = {tool: v for tool, v in verdicts.items() if v is not None}
     row['agree'] = len(set(verdicts.values())) <= 1
     if 'verdict' not in row and verdicts:
@@ -231,9 +268,25 @@ def _row_line(row: dict, timeout: float) -> str:
     if not row['agree']:
         verdict += ' (VERDICTS DIFFER)'
     stages = ', '.join(f'{k} {v:.2f}' for k, v in row.get('stages', {}).items())
+    ratio = ''
+    pipeline, synthesis = results.get('pipeline'), results.get('gr1synth + strategy')
+    if pipeline and synthesis and not pipeline['timeout'] and not synthesis['timeout'] \
+            and not pipeline.get('failed') and not synthesis.get('failed'):
+        ratio = f"{pipeline['seconds'] / synthesis['seconds']:.2f}"
+    check = results.get('check')
+    if check is None:
+        check_cell = ''
+    elif check['timeout'] or check.get('failed'):
+        check_cell = cell(check, timeout)
+    else:
+        problems = check['problems']
+        check_cell = f"passed ({check['seconds']:.1f} s)" if not problems else f'{len(problems)} problems: {problems[0]}'
     return (f"| {row['label']} | {row.get('props', '')} | {verdict} | "
-            + ' | '.join(cell(results.get(tool), timeout) for tool in ('pipeline', 'gr1synth', 'slugs'))
-            + f' | {stages} |')
+            + ' | '.join(cell(results.get(tool), timeout) for tool in TOOLS)
+            + f' | {ratio} | {check_cell} | {stages} |')
+
+
+TOOLS = ('pipeline', 'gr1synth', 'gr1synth + strategy', 'slugs')
 
 
 def main() -> None:
@@ -244,6 +297,8 @@ def main() -> None:
     parser.add_argument('--shapes', default=','.join(capability_robots.SHAPES))
     parser.add_argument('--sizes', default=','.join(map(str, SIZES)))
     parser.add_argument('--grids', default=','.join(f'{w}x{h}' for w, h in GRIDS), help="'' for none")
+    parser.add_argument('--check-up-to', type=int, default=80,
+                        help='check the explicit strategies of robots up to this size (default 80)')
     parser.add_argument('--markdown', help=f'write the table here (e.g. {RESULTS.relative_to(ROOT)})')
     args = parser.parse_args()
     if args.pipeline_child:
@@ -253,17 +308,18 @@ def main() -> None:
     args.shapes = [s for s in args.shapes.split(',') if s]
     args.sizes = [int(s) for s in args.sizes.split(',') if s]
     args.grids = [tuple(int(v) for v in g.split('x')) for g in args.grids.split(',') if g]
-    header = ('| task | env / sys props | verdict | pipeline (s) | gr1synth (s) | slugs (s) | pipeline stages (s) |\n'
-              '|---|---|---|---|---|---|---|')
+    header = ('| task | env / sys props | verdict | pipeline (s) | gr1synth (s) | gr1synth + strategy (s) '
+              '| slugs (s) | ratio | check | pipeline stages (s) |\n'
+              '|---|---|---|---|---|---|---|---|---|---|')
     print(header, flush=True)
     rows, series = [], {}
     with tempfile.TemporaryDirectory() as directory:
         measure_capabilities(args, Path(directory), rows, series)
         measure_gridworlds(args, Path(directory), rows, series)
-    exponents = ['| family | pipeline | gr1synth | slugs |', '|---|---|---|---|']
+    exponents = ['| family | pipeline | gr1synth | gr1synth + strategy | slugs |', '|---|---|---|---|---|']
     for family in dict.fromkeys(row['family'] for row in rows):
         values = []
-        for tool in ('pipeline', 'gr1synth', 'slugs'):
+        for tool in TOOLS:
             slope = fitted_exponent(series.get((family, tool), []))
             values.append('-' if slope is None else f'{slope:.1f}')
         exponents.append(f'| {family} | ' + ' | '.join(values) + ' |')

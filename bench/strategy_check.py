@@ -32,7 +32,7 @@ from __future__ import annotations
 
 from dd import cudd
 
-from respec.ltl import And, Const, Iff, Implies, Next, Not, Or, Var
+from respec.ltl import And, Const, Iff, Implies, Next, Not, Or, Var, evaluate
 
 
 class _Formulas:
@@ -94,7 +94,14 @@ def check_strategy(spec, strategy: dict, limit: int = 20) -> list[str]:
     if sorted(names) != sorted(formulas.variables):
         return [f'strategy variables {names} are not the specification\'s']
     inputs = list(spec.env_props)
-    env_init, sys_init, env_trans, sys_trans, assumptions, goals = formulas.game(spec)
+    # The safety sections stay lists, never one BDD: in the declared order (all inputs, then
+    # all outputs) a capability robot's relation is exponential (every completion input is
+    # far from its memory output), and the checker must not borrow the synthesizer's order.
+    # ENV_TRANS is cofactored by each node's state; SYS_TRANS is evaluated on each edge.
+    env_init, sys_init = formulas.conjunction(spec.env_init), formulas.conjunction(spec.sys_init)
+    env_parts = [formulas.translate(f) for f in spec.env_trans]
+    assumptions = [formulas.translate(f) for f in spec.env_liveness] or [bdd.true]
+    goals = [formulas.translate(f) for f in spec.sys_liveness] or [bdd.true]
     labels_of = _Labels(bdd, assumptions, goals)
     nodes = strategy['nodes']
     problems = []
@@ -126,18 +133,21 @@ def check_strategy(spec, strategy: dict, limit: int = 20) -> list[str]:
         here = tuple(nodes[name]['state'])
         if here not in per_state:
             state = state_of(name)
-            per_state[here] = (state, bdd.let(state, sys_trans),
-                               bdd.exist(next_sys, bdd.let(state, env_trans)), {})
-        state, sys_here, allowed_inputs, answered_by = per_state[here]
+            env_here = bdd.true
+            for part in env_parts:
+                env_here &= bdd.let(state, part)
+            per_state[here] = (state, bdd.exist(next_sys, env_here), {})
+        state, allowed_inputs, answered_by = per_state[here]
         successors = tuple(str(successor) for successor in nodes[name]['trans'])
         for successor_name in successors:
             there = tuple(nodes[successor_name]['state'])
             if there not in per_move:
-                move = next_cube(state_of(successor_name))
-                per_move[there] = (move, move_values(move, bdd), bdd.exist(next_sys, move))
-            move, values, _ = per_move[there]
+                following = state_of(successor_name)
+                move = next_cube(following)
+                per_move[there] = (following, move_values(move, bdd), bdd.exist(next_sys, move))
+            following, values, _ = per_move[there]
             if (here, there) not in answered_by:
-                answered_by[(here, there)] = (bdd.let(values, sys_here) == bdd.true,
+                answered_by[(here, there)] = (all(evaluate(f, state, following) for f in spec.sys_trans),
                                               labels_of({**state, **values}))
             follows_sys_trans, labels = answered_by[(here, there)]
             if not follows_sys_trans:

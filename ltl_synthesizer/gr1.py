@@ -40,6 +40,7 @@ class Solver:
         self._moves_into: dict[int, tuple[Node, Node]] = {}
         self._previous_moves_into: dict[int, tuple[Node, Node]] = {}
         self._may_violate: dict[int, Node] = {}
+        self.waits = _waits(self) if self.options.chained_sweeps else ungrouped(self)
 
     @cached_property
     def care(self) -> Node:
@@ -82,6 +83,13 @@ class Solver:
             game = self.game
             found = self._may_violate[assumption_index] = game.bdd.exist(
                 game.next_inputs + game.next_outputs, ~game.env_goals[assumption_index])
+        return found
+
+    def may_violate_any(self, wait: _Wait) -> Node:
+        """The positions from which some transition violates one of the wait's assumptions."""
+        found = self.game.false
+        for index in wait.members:
+            found |= self.may_violate(index)
         return found
 
     def start_outer_iteration(self) -> None:
@@ -165,9 +173,21 @@ def solve_system_game(solver: Solver, stop_when_losing: Callable[[Node], bool] |
     reachable_only = solver.plan.reachable_only
     # Every set below stays within the positions not lost at once, where the system's
     # responses need not repeat its invariant (see SymbolicGame.system_can_respond).
-    Z = safe = _safe_positions(solver, solver.care & game.not_lost_at_once, stop_when_losing)
+    safe = _safe_positions(solver, solver.care & game.not_lost_at_once, stop_when_losing)
     if stop_when_losing is not None and not stop_when_losing(safe):
         return SystemSolution(safe, [], complete=False, reachable_only=reachable_only)
+    try:
+        return _solve_from(solver, safe, stop_when_losing)
+    except _GroupTooLarge:
+        solver.waits = ungrouped(solver)
+        return _solve_from(solver, safe, stop_when_losing)
+
+
+def _solve_from(solver: Solver, safe: Node, stop_when_losing: Callable[[Node], bool] | None) -> SystemSolution:
+    """The outer fixpoint Z of ``solve_system_game``, from the safe positions."""
+    game = solver.game
+    reachable_only = solver.plan.reachable_only
+    Z = safe
     warm_starts = WarmStarts()
     while True:
         solver.start_outer_iteration()
@@ -224,15 +244,17 @@ def _attract_to_goal(solver: Solver, goal_index: int, goal: Node, winning: Node,
     moving_on = _NoWaitingPositions(solver)
     for sweep in itertools.count():
         Y_before_sweep = Y
-        for assumption_index, assumption in enumerate(game.env_goals):
+        for wait in solver.waits:
+            assumption_index, assumption = wait.index, wait.assumption
             start = warm_starts.upper_bound(goal_index, sweep, assumption_index, winning)
-            if chained and moving_on.adds_nothing(start, Y, can_move_towards_goal, assumption_index):
+            if chained and moving_on.adds_nothing(start, Y, can_move_towards_goal, wait):
                 # X lies within Y: no step, and Y & start bounds X from above (see the class).
                 warm_starts.record(goal_index, sweep, assumption_index, Y & start)
                 continue
             X, responses = _wait_for_assumption(
-                solver, can_move_towards_goal, assumption, start,
-                game.env_goal_ignores_outputs[assumption_index])
+                solver, can_move_towards_goal, assumption, start, wait.ignores_outputs)
+            if len(wait.members) > 1 and len(X) > GROUPED_NODES_PER_PROPOSITION * len(game.variables):
+                raise _GroupTooLarge()
             warm_starts.record(goal_index, sweep, assumption_index, X)
             closer = Y if chained else Y_before_sweep
             new_positions = X & ~Y != game.false
@@ -270,16 +292,98 @@ class _NoWaitingPositions:
         self.solver = solver
         self._enforced: tuple[Node, Node] | None = None  # (towards, enforce(towards)) for the last towards asked
 
-    def adds_nothing(self, start: Node, Y: Node, towards: Node, assumption_index: int) -> bool:
+    def adds_nothing(self, start: Node, Y: Node, towards: Node, wait: _Wait) -> bool:
         outside = start & ~Y
         game = self.solver.game
         if outside == game.false:
             return True
-        if outside & self.solver.may_violate(assumption_index) != game.false:
+        if outside & self.solver.may_violate_any(wait) != game.false:
             return False
         if self._enforced is None or self._enforced[0] != towards:
             self._enforced = (towards, self.solver.game.enforce(towards))
         return bool(outside & self._enforced[1] == game.false)  # dd's BDDs are Any to mypy
+
+
+@dataclass
+class _Wait:
+    """What one inner fixpoint X waits for: the environment goals ``members`` (by index; one,
+    or a group, see ``_waits``), violated forever; ``assumption`` is their conjunction (a
+    transition violates it when it violates one of them)."""
+
+    index: int  # the first member's: the key of the fixpoint's warm starts
+    members: list[int]
+    assumption: Node
+    ignores_outputs: bool
+
+
+# Games with more environment goals than this wait for the goals of a group in one inner
+# fixpoint (see _waits); with fewer, every goal has its own, and small specifications keep the
+# attractor steps, and so the strategies, they always had.
+GROUPED_WAITS_FROM = 16
+
+
+# A group's fixpoint holds the positions of all its goals in one BDD. Where the goals'
+# positions combine freely (a fan-out of N independent capabilities: any set of them may have
+# ended), that BDD grows with each sweep (the fan-out of 80: 8,000 nodes, 3x the solving time of
+# separate fixpoints); past this many nodes per proposition the solve goes on without groups
+# (a chain of 160 capabilities stays below 2 per proposition): the solve starts again without.
+GROUPED_NODES_PER_PROPOSITION = 16
+
+
+class _GroupTooLarge(Exception):
+    """A group's fixpoint grew past GROUPED_NODES_PER_PROPOSITION."""
+
+
+def ungrouped(solver: Solver) -> list[_Wait]:
+    """One inner fixpoint per environment goal."""
+    game = solver.game
+    return [_Wait(i, [i], goal, game.env_goal_ignores_outputs[i]) for i, goal in enumerate(game.env_goals)]
+
+
+def _waits(solver: Solver) -> list[_Wait]:
+    """The inner fixpoints of a sweep: one per environment goal, except that goals whose
+    violations are confined to disjoint parts of the game are waited for together.
+
+    A capability robot has an assumption per capability ("a running capability ends"), and a
+    capability can be started again after it ended: at N capabilities the attractor holds
+    about N^2/2 kinds of positions (capability i running after j have ended), each added by
+    its own goal's fixpoint, so every sweep ran a fixpoint for almost every goal (the chain
+    of 80: 3,319 fixpoints, 3 relational products each). Where goal i can be violated only at
+    positions M_i = ``exists next. !A_i``, no legal transition ends where two M_i meet, and
+    none that violates A_i ends in another goal's M_j, a play that keeps to transitions
+    violating some goal of the group from some point on violates one goal forever (from M_i
+    it moves on such transitions to M_i, or to where no goal of the group can be violated, and
+    so cannot go on; in M_i no other goal can be violated). Then the union of the goals'
+    fixpoints is the one fixpoint of ``towards | (!(A_1 & ... & A_k) & X')``: the same Y,
+    reached in one fixpoint per sweep, and a strategy that stays in X waits for one goal.
+    """
+    game = solver.game
+    singles = ungrouped(solver)
+    if len(singles) <= GROUPED_WAITS_FROM:
+        return singles
+    group, covered = [], game.false
+    for wait in singles:
+        violable = solver.may_violate(wait.index)
+        if not _legal_transition_into(game, game.prime(violable & covered)):
+            group.append(wait)
+            covered |= violable
+    group = [wait for wait in group if not _legal_transition_into(
+        game, ~wait.assumption & game.prime(covered & ~solver.may_violate(wait.index)))]
+    if len(group) < 2:
+        return singles
+    assumption = game.true
+    for wait in group:
+        assumption &= wait.assumption
+    grouped = _Wait(group[0].index, [wait.index for wait in group], assumption,
+                    all(wait.ignores_outputs for wait in group))
+    grouped_members = set(grouped.members)
+    return [grouped if wait is group[0] else wait for wait in singles
+            if wait is group[0] or wait.index not in grouped_members]
+
+
+def _legal_transition_into(game: SymbolicGame, transitions: Node) -> bool:
+    """Whether some transition allowed by both safety sections is among ``transitions``."""
+    return bool(game.sys_invariant & ~game.enforce(~game.system_can_respond(transitions)) != game.false)
 
 
 def _wait_for_assumption(solver: Solver, can_move_towards_goal: Node, assumption: Node, start: Node,

@@ -436,7 +436,8 @@ def test_the_capability_precheck_sentence_reaches_both_actions(cnu_package, flex
     assert sentence.startswith("Goal 'br' can never be reached: no capability sets br_m true")
     with RosHarness() as ros:
         args = Namespace(config_dir=str(tmp_path), byproducts_dir=str(tmp_path / 'byproducts'), backend='builtin',
-                         slugs_executable='slugs', synthesis_timeout=60.0, service_timeout=2.0, default_system='')
+                         slugs_executable='slugs', synthesis_timeout=60.0, service_timeout=2.0, default_system='',
+                         repair_time_budget=8.0)  # the default 3 s ended before the first fix at load 8
         for factory in suite_node_factories(args):
             ros.add_node(factory)
         ours = SynthesisClient(ros.add_node(Node, 'precheck_client'), 'behavior_synthesis')

@@ -242,6 +242,7 @@ def _attract_to_goal(solver: Solver, goal_index: int, goal: Node, winning: Node,
     can_move_towards_goal = reach_goal  # moves into the goal, or into Y
     steps = []
     moving_on = _NoWaitingPositions(solver)
+    group_sizes: dict[int, int] = {}  # sweep -> nodes of the group's X (see _check_group_growth)
     for sweep in itertools.count():
         Y_before_sweep = Y
         for wait in solver.waits:
@@ -253,8 +254,9 @@ def _attract_to_goal(solver: Solver, goal_index: int, goal: Node, winning: Node,
                 continue
             X, responses = _wait_for_assumption(
                 solver, can_move_towards_goal, assumption, start, wait.ignores_outputs)
-            if len(wait.members) > 1 and len(X) > GROUPED_NODES_PER_PROPOSITION * len(game.variables):
-                raise _GroupTooLarge()
+            if len(wait.members) > 1:
+                group_sizes[sweep] = len(X)
+                _check_group_growth(group_sizes, sweep, len(game.variables))
             warm_starts.record(goal_index, sweep, assumption_index, X)
             closer = Y if chained else Y_before_sweep
             new_positions = X & ~Y != game.false
@@ -325,13 +327,34 @@ GROUPED_WAITS_FROM = 16
 # A group's fixpoint holds the positions of all its goals in one BDD. Where the goals'
 # positions combine freely (a fan-out of N independent capabilities: any set of them may have
 # ended), that BDD grows with each sweep (the fan-out of 80: 8,000 nodes, 3x the solving time of
-# separate fixpoints); past this many nodes per proposition the solve goes on without groups
-# (a chain of 160 capabilities stays below 2 per proposition): the solve starts again without.
-GROUPED_NODES_PER_PROPOSITION = 16
+# separate fixpoints); past this many nodes per proposition the solve starts again without
+# groups (a chain of 160 capabilities stays below 2 per proposition; the diamonds, which
+# grouping solves 4x faster at 80, reach 28 at 160): a memory guard; the growth rule decides first.
+GROUPED_NODES_PER_PROPOSITION = 64
+# The sign that comes early: between the second and the fourth sweep of a goal, the group's X
+# grows by more than this many nodes per proposition and sweep. Where the goals' positions
+# combine (the fan-out of 80: 1.3; the mix of 80, whose branches run side by side: 0.67), the
+# grouped solve is the slower one (mix 80: 16.3 s against 6.2 s), and it stops after a few
+# cheap sweeps instead of after half the solve; where they follow each other (chains: 0.02,
+# diamonds of 80: 0.04) the group stays, and is 4-10x faster.
+GROUP_GROWTH_PER_PROPOSITION = 0.25
+GROUP_GROWTH_SWEEPS = (1, 3)
 
 
 class _GroupTooLarge(Exception):
-    """A group's fixpoint grew past GROUPED_NODES_PER_PROPOSITION."""
+    """A group's fixpoint grows too fast (GROUP_GROWTH_PER_PROPOSITION) or is too large
+    (GROUPED_NODES_PER_PROPOSITION)."""
+
+
+def _check_group_growth(group_sizes: dict[int, int], sweep: int, propositions: int) -> None:
+    """Raise _GroupTooLarge when the group's X (``group_sizes[sweep]``, nodes) is too large,
+    or has grown too fast since sweep GROUP_GROWTH_SWEEPS[0]."""
+    if group_sizes[sweep] > GROUPED_NODES_PER_PROPOSITION * propositions:
+        raise _GroupTooLarge()
+    first, last = GROUP_GROWTH_SWEEPS
+    if sweep == last and first in group_sizes and group_sizes[sweep] - group_sizes[first] > \
+            GROUP_GROWTH_PER_PROPOSITION * (last - first) * propositions:
+        raise _GroupTooLarge()
 
 
 def ungrouped(solver: Solver) -> list[_Wait]:

@@ -32,6 +32,8 @@ def _compiled(shape: str, size: int, directory: Path):
 @pytest.mark.parametrize('shape', ['chain', 'retry', 'sensor', 'diamond', 'fanout', 'mix'])
 def test_grouped_waits_win_where_separate_ones_do_and_their_strategy_passes_the_check(shape, tmp_path, monkeypatch):
     spec = _compiled(shape, 20, tmp_path)
+    # Grouped throughout, even where the group grows fast (the fan-out: see the test below).
+    monkeypatch.setattr(gr1, 'GROUP_GROWTH_PER_PROPOSITION', 10**6)
     solved = solve(spec, True)
     assert solved.realizable
     assert max(len(wait.members) for wait in solved.solver.waits) >= 19  # all but a sensor's
@@ -46,3 +48,15 @@ def test_grouped_waits_win_where_separate_ones_do_and_their_strategy_passes_the_
 def test_small_robots_keep_one_fixpoint_per_assumption(tmp_path):
     solved = solve(_compiled('chain', 10, tmp_path), True)
     assert all(len(wait.members) == 1 for wait in solved.solver.waits)
+
+
+@pytest.mark.parametrize('shape, keeps_group', [('fanout', False), ('chain', True), ('diamond', True)])
+def test_a_group_growing_fast_is_given_up_after_a_few_sweeps(shape, keeps_group, tmp_path):
+    # The fan-out's capabilities end in any combination: its group's X grows by about 1.3
+    # nodes per proposition and sweep (a chain's or a diamond's by under 0.1).
+    spec = _compiled(shape, 20, tmp_path)
+    solved = solve(spec, True)
+    assert solved.realizable
+    grouped = max(len(wait.members) for wait in solved.solver.waits) > 1
+    assert grouped == keeps_group
+    assert check_strategy(spec, explicit_strategy(solved)) == []

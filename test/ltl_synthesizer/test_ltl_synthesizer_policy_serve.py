@@ -245,3 +245,15 @@ def test_synthesis_does_not_load_networkx():
     done = subprocess.run([sys.executable, '-c', code], capture_output=True, text=True,
                           cwd=REPOSITORY, timeout=60)
     assert done.stdout.strip() == 'False'
+
+
+def test_one_goal_games_are_compact_up_to_a_looser_bound():
+    # The chain of 160 capabilities retrying on failure: 30 nodes per proposition, one goal.
+    from types import SimpleNamespace
+    from ltl_synthesizer.policy import is_compact
+    one_goal = SimpleNamespace(variables=['p'] * 100, sys_goals=[None], relation_nodes=3000)
+    many_goals = SimpleNamespace(variables=['p'] * 100, sys_goals=[None] * 20, relation_nodes=3000)
+    assert is_compact(one_goal, Options())
+    assert not is_compact(many_goals, Options())
+    assert not is_compact(SimpleNamespace(variables=['p'] * 100, sys_goals=[None], relation_nodes=3300), Options())
+    assert not is_compact(one_goal, Options(variable_order='affinity'))

@@ -285,10 +285,16 @@ def test_working_children_together_stay_under_the_sum_limit(monkeypatch):
         tree = runner.resident_memory() + sum(runner.resident_memory(pid) for pid in runner._child_pids())
         # The work may add 450 MB to the tree (the test process, whatever its size, and its children).
         monkeypatch.setattr(runner, 'WORKING_CHILDREN_MEMORY', runner.WorkingChildrenMemory(limit=tree + 450 * 2**20))
-        sizes = {'big': (400, 3.0), 'small one': (100, 1.5), 'small two': (100, 1.5)}
         with ThreadPoolExecutor(3) as threads:
-            answers = {name: threads.submit(pool.call, exec, (grow_and_wait(megabytes, seconds), {}))
-                       for name, (megabytes, seconds) in sizes.items()}
+            # The big one first, holding its memory before the small ones start: the child holding
+            # the most when the sum is passed is ended, and started together on a loaded machine
+            # a small one could be the largest at that moment (failed once beside another run).
+            answers = {'big': threads.submit(pool.call, exec, (grow_and_wait(400, 10.0), {}))}
+            wait_until(lambda: answers['big'].done() or any(
+                runner.resident_memory(pid) > 300 * 2**20 for pid in runner._child_pids()),
+                30, 'the big work holding its memory')
+            for name in ('small one', 'small two'):
+                answers[name] = threads.submit(pool.call, exec, (grow_and_wait(100, 1.5), {}))
         with pytest.raises(SynthesisMemoryError) as refused:
             answers['big'].result()
         assert refused.value.item == 'memory_sum_limit' and 'all work at once may hold' in str(refused.value)

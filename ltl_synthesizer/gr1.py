@@ -21,6 +21,7 @@ from typing import Callable
 from ltl_synthesizer.cudd_import import Node, cudd
 from ltl_synthesizer.policy import Options, ReorderingSwitch, plan
 from ltl_synthesizer.symbolic import SymbolicGame
+from respec.vocabulary.errors import ControlFlowSignal
 
 
 class Solver:
@@ -341,9 +342,9 @@ GROUP_GROWTH_PER_PROPOSITION = 0.25
 GROUP_GROWTH_SWEEPS = (1, 3)
 
 
-class _GroupTooLarge(Exception):
-    """A group's fixpoint grows too fast (GROUP_GROWTH_PER_PROPOSITION) or is too large
-    (GROUPED_NODES_PER_PROPOSITION)."""
+class _GroupTooLarge(ControlFlowSignal):
+    """Not an error: a group's fixpoint grew past GROUPED_NODES_PER_PROPOSITION (or fast), and the
+    solve starts again with one fixpoint per assumption."""
 
 
 def _check_group_growth(group_sizes: dict[int, int], sweep: int, propositions: int) -> None:

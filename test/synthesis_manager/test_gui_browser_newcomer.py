@@ -63,7 +63,13 @@ def test_the_drawing_and_the_robot_side_by_side_then_the_run_played_at_robot_spe
                            timeout=int((times[-1] - times[0]) * 1000 + 20_000))
     shown = [(at, int(index)) for at, index in page.evaluate('window.shown')]
     shown = [entry for number, entry in enumerate(shown) if number == 0 or entry[1] != shown[number - 1][1]]
-    assert [index for _, index in shown] == list(range(len(times)))  # every frame once, in order
+    indices = [index for _, index in shown]
+    assert indices[0] == 0 and indices[-1] == len(times) - 1 and indices == sorted(set(indices))  # in order, once
+    for (at, index), (_, before) in zip(shown[1:], shown):
+        if index > before + 1:  # frames passed over only to catch up: the page was over 0.1 s behind the
+            # robot clock (frames.js); it was, at load 3 beside another test worker (110 of 112 shown)
+            behind = (at - shown[0][0]) / 1000 - (times[before + 2] - times[0])
+            assert behind > 0.1 - 0.05, (before, index, behind)
     played = (shown[-1][0] - shown[1][0]) / 1000
     robot = times[-1] - times[1]
     assert played == pytest.approx(robot, rel=0.25, abs=0.5), (played, robot)  # robot speed, not a slideshow

@@ -343,8 +343,8 @@ GROUP_GROWTH_SWEEPS = (1, 3)
 
 
 class _GroupTooLarge(ControlFlowSignal):
-    """Not an error: a group's fixpoint grew past GROUPED_NODES_PER_PROPOSITION (or fast), and the
-    solve starts again with one fixpoint per assumption."""
+    """Not an error: a group's fixpoint grows too fast (GROUP_GROWTH_PER_PROPOSITION) or is too
+    large (GROUPED_NODES_PER_PROPOSITION); the solve starts again with one fixpoint per assumption."""
 
 
 def _check_group_growth(group_sizes: dict[int, int], sweep: int, propositions: int) -> None:

@@ -59,11 +59,11 @@ setup: $(VENV)/.project-installed $(VENV)/.msgs-installed $(GRAPHVIZ_WASM)/.inst
 run: setup
 	$(BIN)/behavior-synthesis demo
 
-# Two workers (pytest-xdist), each taking whole modules (module-scoped servers stay shared):
-# most tests wait on processes, ROS discovery or a browser, so two at once fill the two cores
-# (docs/testing.md: 13.1 min alone, 10.6 min so beside a benchmark).
+# Serially: with two pytest-xdist workers (`-n 2 --dist loadfile`) the suite takes 7.6 min
+# instead of 13, but one of three fresh-clone runs failed an onboard-engine test not yet
+# understood (docs/testing.md), so CI keeps the order every earlier run passed in.
 test: setup system-packages $(if $(FLEXBE_SOURCES),flexbe) lint
-	$(if $(FLEXBE_SOURCES),FLEXBE_SOURCES=$(abspath $(FLEXBE_SOURCES))) $(BIN)/python -m pytest -q -n 2 --dist loadfile
+	$(if $(FLEXBE_SOURCES),FLEXBE_SOURCES=$(abspath $(FLEXBE_SOURCES))) $(BIN)/python -m pytest -q
 
 # Static checks (docs/testing.md): `make lint` runs them all; each also runs alone.
 lint: lint-py lint-js lint-types

@@ -59,11 +59,11 @@ setup: $(VENV)/.project-installed $(VENV)/.msgs-installed $(GRAPHVIZ_WASM)/.inst
 run: setup
 	$(BIN)/behavior-synthesis demo
 
-# Serially: with two pytest-xdist workers (`-n 2 --dist loadfile`) the suite takes 7.6 min
-# instead of 13, but one of three fresh-clone runs failed an onboard-engine test not yet
-# understood (docs/testing.md), so CI keeps the order every earlier run passed in.
+# Two pytest-xdist workers, each taking whole modules (module fixtures start servers once):
+# most tests wait on processes, ROS discovery or a browser, so the suite takes about 8 min
+# instead of 13 (docs/testing.md). Each ROS test has its own reserved domain (test/conftest.py).
 test: setup system-packages $(if $(FLEXBE_SOURCES),flexbe) lint
-	$(if $(FLEXBE_SOURCES),FLEXBE_SOURCES=$(abspath $(FLEXBE_SOURCES))) $(BIN)/python -m pytest -q
+	$(if $(FLEXBE_SOURCES),FLEXBE_SOURCES=$(abspath $(FLEXBE_SOURCES))) $(BIN)/python -m pytest -q -n 2 --dist loadfile
 
 # Static checks (docs/testing.md): `make lint` runs them all; each also runs alone.
 lint: lint-py lint-js lint-types

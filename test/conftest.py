@@ -91,11 +91,26 @@ def declares_what_it_starts(request):
         pytest.fail('\n'.join(complaints), pytrace=False)
 
 
+@pytest.fixture(autouse=True)
+def ros_domain_of_test(request, monkeypatch):
+    """A test marked ``ros`` runs on a ROS_DOMAIN_ID reserved for it, in os.environ too: the
+    processes it starts with this environment (``execute --engine flexbe`` starts FlexBE's
+    onboard engine) meet no other test's, even one running beside it under pytest-xdist."""
+    if request.node.get_closest_marker('ros') is None:
+        yield None
+        return
+    from synthesis_manager.ros.harness import reserve_domain_id
+
+    with reserve_domain_id() as domain:
+        monkeypatch.setenv('ROS_DOMAIN_ID', str(domain))
+        yield domain
+
+
 @pytest.fixture
-def ros():
+def ros(ros_domain_of_test):
     from synthesis_manager.ros.harness import RosHarness
 
-    with RosHarness() as harness:
+    with RosHarness(domain_id=ros_domain_of_test) as harness:
         yield harness
 
 

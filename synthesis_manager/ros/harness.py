@@ -13,6 +13,7 @@ machine never talk to each other and nothing is left running afterwards::
 from __future__ import annotations
 
 import contextlib
+import os
 import threading
 from typing import TYPE_CHECKING
 
@@ -48,6 +49,9 @@ class RosHarness:
     def __enter__(self) -> 'RosHarness':
         if self.domain_id is None:
             self.domain_id = self._stack.enter_context(reserve_domain_id())
+        # Processes started while the harness runs join its domain; afterwards the domain may be
+        # another process's reservation, so later ones must not inherit it.
+        self._stack.callback(_restore_environment_variable, 'ROS_DOMAIN_ID', os.environ.get('ROS_DOMAIN_ID'))
         prepare_ros_environment(self.domain_id)
         import rclpy
         from rclpy.signals import SignalHandlerOptions
@@ -113,6 +117,13 @@ class RosHarness:
         return False
 
 
+def _restore_environment_variable(name: str, value: str | None) -> None:
+    if value is None:
+        os.environ.pop(name, None)
+    else:
+        os.environ[name] = value
+
+
 def retrieve_teardown_exceptions(executor) -> None:
     """Take the exceptions of callbacks that failed as the executor stopped (typically "cannot use
     Destroyable", or a flexbe_core proxy already torn down). rclpy fetches a callback's exception
@@ -134,8 +145,6 @@ def wait_for(future, timeout: float = 10.0):
 
 def environment_domain_id() -> int:
     """The ROS_DOMAIN_ID of this process's environment (0 when unset), as clients use."""
-    import os
-
     return int(os.environ.get('ROS_DOMAIN_ID') or 0)
 
 
@@ -148,8 +157,6 @@ class _RotatingDomainSelector:
     """
 
     def __init__(self):
-        import os
-
         self._next = os.getpid() % 100
 
     def __call__(self) -> int:

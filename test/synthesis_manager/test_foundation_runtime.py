@@ -1,6 +1,7 @@
 """The ROS runtime foundation: loopback-only DDS settings and the command line."""
 
 import os
+import socket
 import subprocess
 import sys
 
@@ -94,3 +95,29 @@ def test_harness_applies_loopback_before_rclpy_init(monkeypatch):
         with RosHarness():
             pass
     assert seen['ROS_AUTOMATIC_DISCOVERY_RANGE'] == 'LOCALHOST'
+
+
+def test_a_ros_test_runs_on_a_domain_reserved_for_it(ros_domain_of_test):
+    """The processes a test starts with os.environ (``execute --engine flexbe`` and its onboard
+    engine) are on a domain no other test may reserve while it runs, under pytest-xdist too."""
+    from domain_coordinator.impl import PORT_BASE
+
+    from synthesis_manager.ros.harness import environment_domain_id
+
+    assert environment_domain_id() == ros_domain_of_test
+    with socket.socket() as other_reservation, pytest.raises(OSError):
+        other_reservation.bind(('', PORT_BASE + ros_domain_of_test))
+
+
+def test_a_finished_harness_leaves_no_domain_behind(monkeypatch):
+    """After the harness its domain is free for others: processes started later must not join it."""
+    from synthesis_manager.ros.harness import RosHarness
+
+    monkeypatch.setenv('ROS_DOMAIN_ID', '0')
+    with RosHarness() as ros:
+        assert os.environ['ROS_DOMAIN_ID'] == str(ros.domain_id) != '0'
+    assert os.environ['ROS_DOMAIN_ID'] == '0'
+    monkeypatch.delenv('ROS_DOMAIN_ID')
+    with RosHarness():
+        pass
+    assert 'ROS_DOMAIN_ID' not in os.environ

@@ -317,15 +317,17 @@ def test_a_burst_with_short_limits_is_answered_within_a_second_of_them(ros, tmp_
 def test_a_goal_asking_for_forever_gets_the_servers_cap(ros, tmp_path):
     """Issue 34 item 5: a goal asking for 1e9 s runs under max_goal_timeout, and its feedback and
     result name the cap."""
-    client = start_suite(ros, tmp_path, server_parameters=[Parameter('max_goal_timeout', value=2.0)])
+    # A cap of 4 s: the paper task under it took over 2 s at load 7 on the 2 cores.
+    client = start_suite(ros, tmp_path, server_parameters=[Parameter('max_goal_timeout', value=4.0)])
     statuses = []
     started = time.monotonic()
     outcome = client.run(runaway_goal(1e9), feedback=lambda status, _progress: statuses.append(status), timeout=60)
     assert outcome.error_name == 'SYNTHESIS_TIMEOUT', outcome.message
-    assert 'time limit of 2 s passed' in outcome.message and 'max_goal_timeout' in outcome.message
+    assert 'time limit of 4 s passed' in outcome.message and 'max_goal_timeout' in outcome.message
     assert 'asked for 1e+09 s' in statuses[0]
-    assert time.monotonic() - started < 2.0 + 1.0
-    assert client.run(make_goal(**PAPER_TASK, timeout=1e9), timeout=60).error_name == 'SUCCESS'
+    assert time.monotonic() - started < 4.0 + 1.0
+    capped = client.run(make_goal(**PAPER_TASK, timeout=1e9), timeout=60)
+    assert capped.error_name == 'SUCCESS', capped.message
 
 
 def test_a_flood_is_rejected_on_arrival_and_reported_busy(ros, tmp_path):
@@ -418,16 +420,20 @@ def test_one_clients_runaways_leave_another_clients_goal_its_usual_latency(ros, 
             assert time.monotonic() < deadline, 'the runaways were never demoted to the lowest CPU priority'
             time.sleep(0.1)
         outcome = victim.run(make_goal(**PAPER_TASK, name='during', timeout=30.0))
-        print(f'another client: {usual:.2f} s usually, {outcome.seconds:.2f} s beside 8 runaways of one client')
         assert outcome.succeeded, outcome.message
-        # bench_reliability measures it against the 1 s target on a quiet machine; this margin
-        # also holds beside other jobs on 2 cores (before: SYNTHESIS_TIMEOUT after 30 s).
-        assert outcome.seconds < usual + 2.0
         assert any('this goal is number 4 of its waiting goals' in status for status in statuses), statuses
     finally:
         cancel.set()
         for thread in runaways:
             thread.join(timeout=60)
+    # The usual latency once more, now: other jobs on the machine come and go (at load 7 one
+    # took the paper task from 1.9 to 10 s), and the runaways' share is the question.
+    after = victim.run(make_goal(**PAPER_TASK, name='after')).seconds
+    print(f'another client: {usual:.2f} s before, {outcome.seconds:.2f} s beside 8 runaways of one client, '
+          f'{after:.2f} s after')
+    # bench_reliability measures it against the 1 s target on a quiet machine; this margin
+    # also holds beside other jobs on 2 cores (before: SYNTHESIS_TIMEOUT after 30 s).
+    assert outcome.seconds < max(usual, after) + 2.0
 
 
 def children_at_lowest_priority() -> list[int]:

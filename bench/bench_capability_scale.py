@@ -10,7 +10,8 @@ and size N, each in a fresh process, wall seconds:
 
 - "pipeline": what export-behavior / the synthesis node does for the request, in one process:
   compile the task, synthesize (robotics semantics, explicit strategy), the well-separation
-  check, the automaton, the FlexBE machine (stage seconds in the notes);
+  check (on the solved game, as the node's synthesis child does it), the automaton, the FlexBE
+  machine (stage seconds in the notes);
 - "gr1synth": ``python -m ltl_synthesizer --sysInitRoboticsSemantics`` on the compiled slugsin
   (realizability only, as slugs' default);
 - "gr1synth + strategy": the same with ``--explicitStrategy --jsonOutput`` (the synthesis the
@@ -80,8 +81,8 @@ def pipeline_child(config_dir: str, shape: str, size: int, slugsin: str) -> None
     """The pipeline of one request (run in a fresh process): prints its stages as JSON."""
     from ltl_specification import compile_task
     from ltl_specification.diagnosis import explain_well_separation
-    from ltl_synthesizer import synthesize
     from ltl_synthesizer.interrupt import Limits
+    from ltl_synthesizer.synthesizer import solve, synthesis_result
     from respec.automaton import automaton_from_strategy
     from sm_generation import generate_state_machine
 
@@ -95,13 +96,15 @@ def pipeline_child(config_dir: str, shape: str, size: int, slugsin: str) -> None
     stages['compile'] = time.perf_counter() - start
     Path(slugsin).write_text(text)
     mark = time.perf_counter()
-    result = synthesize(spec, True, Limits(memory_limit=MEMORY_LIMIT))
+    solved = solve(spec, True, Limits(memory_limit=MEMORY_LIMIT))
+    result = synthesis_result(solved, None, mark)
     stages['synthesize'] = time.perf_counter() - mark
     report = {'realizable': result.realizable, 'env': len(spec.env_props), 'sys': len(spec.sys_props),
               'strategy_nodes': result.stats.get('strategy_nodes', 0)}
     if result.realizable:
         mark = time.perf_counter()
-        explain_well_separation(spec, None, Limits(memory_limit=MEMORY_LIMIT))
+        # On the solved game, as the synthesis node's child checks it (isolated.synthesize_then_check).
+        explain_well_separation(spec, None, Limits(memory_limit=MEMORY_LIMIT), solved.game)
         stages['well_separation'] = time.perf_counter() - mark
         mark = time.perf_counter()
         automaton = automaton_from_strategy(result.strategy, spec)

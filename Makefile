@@ -54,8 +54,8 @@ COMPOSITION_INTERFACES := $(FLEXBE_SOURCES)/composition_interfaces/composition_i
 COMPOSITION_INTERFACES_BUILD := build/composition_interfaces
 LAUNCH_PACKAGE := behavior_synthesis_bringup
 
-# The project's packages (pyproject.toml's [tool.setuptools.packages.find]).
-PROJECT_PACKAGES := respec ltl_specification ltl_synthesizer sm_generation synthesis_manager atlas_sim
+# The project's packages (pyproject.toml's [tool.setuptools.packages.find]), and the benches' modules.
+PROJECT_PACKAGES := respec ltl_specification ltl_synthesizer sm_generation synthesis_manager atlas_sim bench
 
 # setup also brings the packages' bytecode up to date, as installing a wheel would (an editable
 # install does not): where PYTHONDONTWRITEBYTECODE is set, every fresh process (gr1synth, a

@@ -69,6 +69,8 @@ DEFAULT_MAX_STRATEGY_EDGES = 100_000
 #: The code an answer comes from: part of every cache key, so that entries kept on disk by
 #: other code miss (ltl_synthesizer.cache.source_digest).
 ANSWERING_PACKAGES = ('respec', 'ltl_specification', 'ltl_synthesizer', 'synthesis_manager')
+#: A job's provenance not read yet (None is one read: there is none, or it is unreadable).
+_NOT_READ: Any = object()
 
 
 @dataclass(frozen=True)
@@ -320,11 +322,13 @@ class SynthesisService:
             del structuredslugs, slugsin
             robotics = settings.robotics_semantics
             checked_in_synthesis: WellSeparationOutcome | None = None
+            provenance: Any = _NOT_READ
             if backend == 'builtin':
                 limits = Limits(job.cancel, job.deadline, memory_limit)
                 try:
                     if settings.check_well_separation:  # on the solved game, in the synthesis's child
-                        check = WellSeparationCheck(self.explainers.check_well_separation, self._provenance(job),
+                        provenance = self._provenance(job)  # read once: the diagnosis needs it too
+                        check = WellSeparationCheck(self.explainers.check_well_separation, provenance,
                                                     job.diagnosis_timeout or settings.diagnosis_timeout)
                         result, checked_in_synthesis = self.processes.synthesize_then_check(
                             spec, robotics, limits, check, max_strategy_edges=settings.max_strategy_edges,
@@ -347,7 +351,7 @@ class SynthesisService:
                 head = unrealizable_head(files.name)
                 details = f'{head}: {explanation}'.rstrip(': ')
                 try:
-                    message, diagnosed = self._diagnosed(details, spec, job, settings)
+                    message, diagnosed = self._diagnosed(details, spec, job, settings, provenance)
                 except SynthesisCancelledError as stopped:
                     return job.stopped_answer(stopped.reason, getattr(stopped, 'during', '')), None
                 answer = SynthesisAnswer(ErrorCode.SPEC_UNSYNTHESIZABLE, message)
@@ -396,14 +400,16 @@ class SynthesisService:
             return '', False
 
     def _diagnosed(self, details: str, spec: SpecificationText | GR1Specification, job: SynthesisJob,
-                   settings: SynthesisSettings) -> tuple[str, bool]:
+                   settings: SynthesisSettings, provenance: Any = _NOT_READ) -> tuple[str, bool]:
         """``details`` (the synthesizer's explanation), led by why the task cannot be done: in
         the task's terms when the job carries the specification's provenance, else by its
         formulas; and whether the diagnosis was whole (its core computed). The diagnosis runs in
         a synthesis child process, with the memory limit, and ends by diagnosis_timeout and
         before the job's time limit; without an answer by then the verdict stands with
-        ``details``. A cancel raises SynthesisCancelledError."""
-        provenance = self._provenance(job)
+        ``details``. A cancel raises SynthesisCancelledError. ``provenance``: the job's, if read
+        already (else _NOT_READ)."""
+        if provenance is _NOT_READ:
+            provenance = self._provenance(job)
         limit = job.diagnosis_timeout or settings.diagnosis_timeout
         diagnosis_deadline = min(time.monotonic() + limit, job.deadline - DIAGNOSIS_GRACE)
         if diagnosis_deadline <= time.monotonic():

@@ -150,7 +150,10 @@ def test_unreadable_provenance_is_warned_about_and_the_formulas_explain(tmp_path
     service = make_service(tmp_path, processes)
     answer = service.answer(job_of(IMPOSSIBLE, provenance='not json'))
     assert answer.code == ErrorCode.SPEC_UNSYNTHESIZABLE
-    assert any(warning.startswith('request.provenance ignored') for warning in service.warnings)
+    # read once for the job (the well-separation check and the diagnosis share it): one warning
+    assert sum(warning.startswith('request.provenance ignored') for warning in service.warnings) == 1
+    assert service.answer(job_of(CHEATING, provenance='not json')).message == explain_well_separation(CHEATING)
+    assert sum(warning.startswith('request.provenance ignored') for warning in service.warnings) == 2
 
 
 # y forces the next x, which the environment promises to leave infinitely often: a controller

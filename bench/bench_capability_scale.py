@@ -2,7 +2,7 @@
 our synthesizer alone and slugs, side by side in one run, with the fitted growth exponents.
 
     python bench/bench_capability_scale.py --slugs /tmp/slugs/src/slugs [--timeout 60]
-        [--shapes chain,retry] [--sizes 10,20,40] [--grids 7x5,19x16] [--markdown FILE]
+        [--shapes chain,retry] [--sizes 10,20,40] [--grids 7x5,19x16] [--warm-up-to 80] [--markdown FILE]
 
 For every capability robot (bench/capability_robots.py: N capabilities bound to FlexBE's
 OperatorDecisionState, a request with no initial conditions, the goal, outcomes finished,failed)
@@ -10,13 +10,18 @@ and size N, each in a fresh process, wall seconds:
 
 - "pipeline": what export-behavior / the synthesis node does for the request, in one process:
   compile the task, synthesize (robotics semantics, explicit strategy), the well-separation
-  check, the automaton, the FlexBE machine (stage seconds in the notes);
+  check (on the solved game, as the node's synthesis child does it), the automaton, the FlexBE
+  machine (stage seconds in the notes);
 - "gr1synth": ``python -m ltl_synthesizer --sysInitRoboticsSemantics`` on the compiled slugsin
   (realizability only, as slugs' default);
 - "gr1synth + strategy": the same with ``--explicitStrategy --jsonOutput`` (the synthesis the
   pipeline needs: the verdict and the explicit strategy, written out);
 - "slugs": slugs with the same flag on the same file (realizability only);
 - "ratio": pipeline / (gr1synth + strategy), the pipeline's cost over the synthesis it needs;
+- "warm": the same request answered again in one process (imports done, as in a long-running
+  server; robots up to ``--warm-up-to``, default 80): the pipeline three times in one child,
+  gr1synth + strategy three times by its resident mode (``gr1synth --serve``'s answer); wall
+  seconds of the faster of the second and third answers, timed in the process, and their ratio;
 - "check": ``strategy_check.check_strategy`` (an independent check that shares no code with
   the synthesizer) on the pipeline's explicit strategy, in its own process after the run.
 
@@ -76,42 +81,84 @@ def verdict_of(text: str) -> bool | None:
     return None
 
 
-def pipeline_child(config_dir: str, shape: str, size: int, slugsin: str) -> None:
-    """The pipeline of one request (run in a fresh process): prints its stages as JSON."""
+def pipeline_child(config_dir: str, shape: str, size: int, slugsin: str, runs: int = 1) -> None:
+    """The pipeline of one request (run in a fresh process): prints its stages as JSON. With
+    ``runs`` > 1 the same request is answered that many times in the process, and the seconds
+    of the fastest answer after the first are printed too as ``warm_seconds`` (a long-running
+    server's cost of a request, its imports done)."""
     from ltl_specification import compile_task
     from ltl_specification.diagnosis import explain_well_separation
-    from ltl_synthesizer import synthesize
     from ltl_synthesizer.interrupt import Limits
+    from ltl_synthesizer.synthesizer import solve, synthesis_result
     from respec.automaton import automaton_from_strategy
     from sm_generation import generate_state_machine
 
     robot = capability_robots.SHAPES[shape](size)
-    stages = {}
-    start = time.perf_counter()
-    spec = compile_task(robot_system(robot.name, config_dir), robot.initial_conditions, robot.goals,
-                        sm_outcomes=capability_robots.REQUEST_OUTCOMES,
-                        state_library=capability_robots.STATE_LIBRARY)
-    text = spec.to_slugsin()
-    stages['compile'] = time.perf_counter() - start
-    Path(slugsin).write_text(text)
-    mark = time.perf_counter()
-    result = synthesize(spec, True, Limits(memory_limit=MEMORY_LIMIT))
-    stages['synthesize'] = time.perf_counter() - mark
-    report = {'realizable': result.realizable, 'env': len(spec.env_props), 'sys': len(spec.sys_props),
-              'strategy_nodes': result.stats.get('strategy_nodes', 0)}
-    if result.realizable:
+    warm = []
+    for _ in range(runs):
+        stages = {}
+        start = time.perf_counter()
+        spec = compile_task(robot_system(robot.name, config_dir), robot.initial_conditions, robot.goals,
+                            sm_outcomes=capability_robots.REQUEST_OUTCOMES,
+                            state_library=capability_robots.STATE_LIBRARY)
+        text = spec.to_slugsin()
+        stages['compile'] = time.perf_counter() - start
+        Path(slugsin).write_text(text)
         mark = time.perf_counter()
-        explain_well_separation(spec, None, Limits(memory_limit=MEMORY_LIMIT))
-        stages['well_separation'] = time.perf_counter() - mark
-        mark = time.perf_counter()
-        automaton = automaton_from_strategy(result.strategy, spec)
-        states = generate_state_machine(automaton, robot_system(robot.name, config_dir),
-                                        state_library=capability_robots.STATE_LIBRARY)
-        stages['generate'] = time.perf_counter() - mark
-        report['machine_states'] = len(states.to_instantiations())
-        Path(slugsin + '.strategy.json').write_text(json.dumps(result.strategy))
-    report['stages'] = stages
+        solved = solve(spec, True, Limits(memory_limit=MEMORY_LIMIT))
+        result = synthesis_result(solved, None, mark)
+        stages['synthesize'] = time.perf_counter() - mark
+        report = {'realizable': result.realizable, 'env': len(spec.env_props), 'sys': len(spec.sys_props),
+                  'strategy_nodes': result.stats.get('strategy_nodes', 0)}
+        if result.realizable:
+            mark = time.perf_counter()
+            # On the solved game, as the synthesis node's child checks it (isolated.synthesize_then_check).
+            explain_well_separation(spec, None, Limits(memory_limit=MEMORY_LIMIT), solved.game)
+            stages['well_separation'] = time.perf_counter() - mark
+            mark = time.perf_counter()
+            automaton = automaton_from_strategy(result.strategy, spec)
+            states = generate_state_machine(automaton, robot_system(robot.name, config_dir),
+                                            state_library=capability_robots.STATE_LIBRARY)
+            stages['generate'] = time.perf_counter() - mark
+            report['machine_states'] = len(states.to_instantiations())
+            Path(slugsin + '.strategy.json').write_text(json.dumps(result.strategy))
+        report['stages'] = stages
+        warm.append(time.perf_counter() - start)
+    if runs > 1:
+        report['warm_seconds'] = min(warm[1:])
     print(json.dumps(report))
+
+
+_SYNTHESIS_WARM = '''
+import json, sys, time
+from ltl_synthesizer.serve import answer
+request = json.dumps(sys.argv[1:])
+answer(request)
+seconds = []
+for _ in range(2):
+    start = time.perf_counter()
+    reply = answer(request)
+    seconds.append(time.perf_counter() - start)
+print(json.dumps({'warm_seconds': min(seconds), 'stderr': reply['stderr']}))
+'''
+
+
+def warm_runs(directory: Path, shape: str, size: int, slugsin: Path, timeout: float) -> dict:
+    """A request's seconds in a process that has answered it once already (its imports done, as
+    in a long-running server), the faster of two such answers: the pipeline (``--pipeline-child``
+    three times in one process), and gr1synth + strategy in its resident mode (``gr1synth
+    --serve``'s answers to a request repeated three times)."""
+    runs = {}
+    pipeline = run_wall([sys.executable, __file__, '--pipeline-child', str(directory), shape, str(size),
+                         str(slugsin) + '.warm', '--runs', '3'], timeout)
+    synthesis = run_wall([sys.executable, '-c', _SYNTHESIS_WARM, '--sysInitRoboticsSemantics', '--explicitStrategy',
+                          '--jsonOutput', str(slugsin), os.devnull], timeout)
+    for name, run in (('pipeline', pipeline), ('gr1synth + strategy', synthesis)):
+        if not run['timeout'] and run['code'] == 0:
+            runs[name] = json.loads(run['out'].strip().splitlines()[-1])['warm_seconds']
+    for leftover in (Path(str(slugsin) + '.warm'), Path(str(slugsin) + '.warm.strategy.json')):
+        leftover.unlink(missing_ok=True)
+    return runs
 
 
 def fitted_exponent(points: list[tuple[int, float]]) -> float | None:
@@ -162,6 +209,9 @@ def measure_capabilities(args, directory: Path, rows: list, series: dict) -> Non
                 subprocess.run([python, '-c', _COMPILE_ONLY, str(directory), shape, str(size), str(slugsin)],
                                cwd=ROOT, check=True)
             results.update(solved_by_both(slugsin, args, given_up))
+            pipeline = results.get('pipeline')
+            if pipeline and not pipeline['timeout'] and not pipeline.get('failed') and size <= args.warm_up_to:
+                row['warm'] = warm_runs(directory, shape, size, slugsin, args.timeout)
             strategy = Path(str(slugsin) + '.strategy.json')
             if strategy.exists() and 'check' not in given_up and size <= args.check_up_to:
                 results['check'] = checked(slugsin, strategy, args.timeout)
@@ -273,6 +323,12 @@ def _row_line(row: dict, timeout: float) -> str:
     if pipeline and synthesis and not pipeline['timeout'] and not synthesis['timeout'] \
             and not pipeline.get('failed') and not synthesis.get('failed'):
         ratio = f"{pipeline['seconds'] / synthesis['seconds']:.2f}"
+    warm = row.get('warm', {})
+    warm_cell = ' / '.join(f'{warm[tool]:.3f}' if tool in warm else '-' for tool in ('pipeline', 'gr1synth + strategy'))
+    warm_ratio = f"{warm['pipeline'] / warm['gr1synth + strategy']:.2f}" \
+        if 'pipeline' in warm and warm.get('gr1synth + strategy') else ''
+    if not warm:
+        warm_cell = ''
     check = results.get('check')
     if check is None:
         check_cell = ''
@@ -283,7 +339,7 @@ def _row_line(row: dict, timeout: float) -> str:
         check_cell = f"passed ({check['seconds']:.1f} s)" if not problems else f'{len(problems)} problems: {problems[0]}'
     return (f"| {row['label']} | {row.get('props', '')} | {verdict} | "
             + ' | '.join(cell(results.get(tool), timeout) for tool in TOOLS)
-            + f' | {ratio} | {check_cell} | {stages} |')
+            + f' | {ratio} | {warm_cell} | {warm_ratio} | {check_cell} | {stages} |')
 
 
 TOOLS = ('pipeline', 'gr1synth', 'gr1synth + strategy', 'slugs')
@@ -292,6 +348,10 @@ TOOLS = ('pipeline', 'gr1synth', 'gr1synth + strategy', 'slugs')
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument('--pipeline-child', nargs=4, help=argparse.SUPPRESS)
+    parser.add_argument('--runs', type=int, default=1, help=argparse.SUPPRESS)  # of --pipeline-child
+    parser.add_argument('--warm-up-to', type=int, default=80,
+                        help='measure warm runs (a second request in the same process) of robots up to '
+                             'this size (default 80)')
     parser.add_argument('--slugs', default='/tmp/slugs/src/slugs')
     parser.add_argument('--timeout', type=float, default=60.0, help='wall seconds per run (default 60)')
     parser.add_argument('--shapes', default=','.join(capability_robots.SHAPES))
@@ -303,14 +363,15 @@ def main() -> None:
     args = parser.parse_args()
     if args.pipeline_child:
         config_dir, shape, size, slugsin = args.pipeline_child
-        pipeline_child(config_dir, shape, int(size), slugsin)
+        pipeline_child(config_dir, shape, int(size), slugsin, args.runs)
         return
     args.shapes = [s for s in args.shapes.split(',') if s]
     args.sizes = [int(s) for s in args.sizes.split(',') if s]
     args.grids = [tuple(int(v) for v in g.split('x')) for g in args.grids.split(',') if g]
     header = ('| task | env / sys props | verdict | pipeline (s) | gr1synth (s) | gr1synth + strategy (s) '
-              '| slugs (s) | ratio | check | pipeline stages (s) |\n'
-              '|---|---|---|---|---|---|---|---|---|---|')
+              '| slugs (s) | ratio | warm: pipeline / gr1synth + strategy (s) | warm ratio | check '
+              '| pipeline stages (s) |\n'
+              '|---|---|---|---|---|---|---|---|---|---|---|---|')
     print(header, flush=True)
     rows, series = [], {}
     with tempfile.TemporaryDirectory() as directory:

@@ -34,7 +34,7 @@ from __future__ import annotations
 import itertools
 import time
 from dataclasses import asdict, dataclass, field
-from typing import Any, Callable, Iterable, Sequence
+from typing import TYPE_CHECKING, Any, Callable, Iterable, Sequence
 
 from ltl_specification.components import SOURCE_CUSTOM, FormulaGroup
 from respec.ltl import Formula, evaluate, mentions_next, to_infix, variables
@@ -53,6 +53,9 @@ from ltl_specification.capability_precheck import capability_file, unreachable_g
 from ltl_specification.systems import load_task_abstraction
 from ltl_specification.provenance import Provenance
 from ltl_specification.reachability import Finding, unreachable_goal_modes
+
+if TYPE_CHECKING:
+    from ltl_synthesizer.symbolic import SymbolicGame
 
 PLAY_LENGTH = 8
 # Seconds the compiler spends diagnosing a task it refuses (the core search is cut there; the
@@ -363,12 +366,13 @@ def refusal_diagnosis(spec: GR1Specification, sentence: str,
 
 
 def explain_well_separation(spec: GR1Specification, provenance: Provenance | None = None,
-                            limits: Limits = Limits()) -> str:
+                            limits: Limits = Limits(), game: SymbolicGame | None = None) -> str:
     """The warning for a realizable ``spec`` whose controller can win by forcing the environment
     to break its assumptions ('' when it cannot; ``ltl_synthesizer.well_separation``), naming each
     assumption as the core names a requirement (paper equation, configuration entry, formula)
-    when ``provenance`` (default: the spec's own) records it."""
-    report = check_well_separation(spec, limits)
+    when ``provenance`` (default: the spec's own) records it; ``game``: the game of ``spec``, if
+    one is built already (the one synthesis solved)."""
+    report = check_well_separation(spec, limits, game)
     provenance = provenance or getattr(spec, 'provenance', None)
     if report.well_separated or provenance is None:
         return report.warning()

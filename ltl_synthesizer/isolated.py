@@ -21,10 +21,12 @@ that checks none (SynthesisMemoryError).
 
 from __future__ import annotations
 
+import time
+from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, Callable
 
 from ltl_synthesizer.errors import SynthesisError, in_synthesis_words
-from ltl_synthesizer.interrupt import Limits
+from ltl_synthesizer.interrupt import Limits, memory_exceeded
 from respec.child_processes.errors import ChildWorkError
 from respec.child_processes.runner import CHILD_NICENESS, IDLE_SECONDS, BuiltInChild, CancelFlag, ChildProcesses
 
@@ -69,6 +71,55 @@ def synthesize_within(spec: GR1Specification, robotics_semantics: bool, limits: 
     return synthesize(spec, robotics_semantics, limits, options, max_edges=max_strategy_edges)
 
 
+@dataclass(frozen=True)
+class WellSeparationCheck:
+    """The well-separation check a synthesis child runs on the game it has just solved, when it
+    is realizable: ``check(spec, provenance, limits, game) -> warning`` (a top-level function,
+    e.g. ``ltl_specification.diagnosis.explain_well_separation``), ending within ``seconds`` of
+    its start and by the synthesis's deadline, with its memory limit. Run in a child of its own,
+    the check built the game again: 60-80 % of its time, a fifth of a small robot's pipeline."""
+
+    check: Callable[..., str]
+    provenance: Any
+    seconds: float
+
+
+@dataclass(frozen=True)
+class WellSeparationOutcome:
+    """What the check said: its ``warning`` ('' when well-separated), or, when a limit stopped
+    it first, why (``stopped``; its warning is then '')."""
+
+    warning: str = ''
+    stopped: str = ''
+
+
+def synthesize_then_check(spec: GR1Specification, robotics_semantics: bool, limits: Limits, options: Options | None,
+                          max_strategy_edges: int | None,
+                          well_separation: WellSeparationCheck) -> tuple[SynthesisResult, WellSeparationOutcome | None]:
+    """:func:`synthesize_within`, then ``well_separation`` on the solved game when realizable
+    (None when not run). A limit that stops the check leaves the synthesis's answer standing."""
+    from ltl_synthesizer.synthesizer import solve, synthesis_result
+    start = time.perf_counter()
+    solved = solve(spec, robotics_semantics, limits, options)
+    result = synthesis_result(solved, max_strategy_edges, start)
+    if not result.realizable:
+        return result, None
+    deadline = time.monotonic() + well_separation.seconds
+    if limits.deadline is not None:
+        deadline = min(deadline, limits.deadline)
+    try:
+        warning = well_separation.check(spec, well_separation.provenance,
+                                        Limits(deadline=deadline, memory_limit=limits.memory_limit), solved.game)
+    except SynthesisError as stopped:
+        return result, WellSeparationOutcome(stopped=str(stopped))
+    except ValueError as error:  # CUDD failed an operation beyond the memory limit (dd: a NULL node)
+        if limits.memory_limit is None or 'NULL' not in str(error):
+            raise
+        return result, WellSeparationOutcome(stopped=str(memory_exceeded(limits.memory_limit,
+                                                                         'checking well-separation')))
+    return result, WellSeparationOutcome(warning)
+
+
 class SynthesisProcesses(ChildProcesses):
     """A pool of synthesis child processes, one per synthesis running at the same time, each
     ``niceness`` below its parent's CPU priority."""
@@ -89,6 +140,18 @@ class SynthesisProcesses(ChildProcesses):
         else:
             result = self.call(synthesize, (spec, robotics_semantics, limits.without_cancel(), options),
                                cancel=limits.cancel, deadline=limits.deadline)
+        return result
+
+    def synthesize_then_check(self, spec: GR1Specification | SpecificationText, robotics_semantics: bool,
+                              limits: Limits, well_separation: WellSeparationCheck, options: Options | None = None,
+                              max_strategy_edges: int | None = None, grace: float = 0.0,
+                              ) -> tuple[SynthesisResult, WellSeparationOutcome | None]:
+        """:func:`synthesize_then_check` in a child, killed once ``limits`` stop it (its deadline:
+        ``grace`` seconds later, for the check to say it ran out of time)."""
+        deadline = None if limits.deadline is None else limits.deadline + grace
+        result: tuple[SynthesisResult, WellSeparationOutcome | None] = self.call(
+            synthesize_then_check, (spec, robotics_semantics, limits.without_cancel(), options, max_strategy_edges,
+                                    well_separation), cancel=limits.cancel, deadline=deadline)
         return result
 
     def call(self, function: Callable[..., Any], args: tuple[Any, ...] | list[Any] = (),

@@ -34,7 +34,8 @@ from ltl_synthesizer.cache import CacheDirectoryError, Entry, StrategyCache, cac
 from ltl_synthesizer.errors import SynthesisCancelledError, SynthesisError
 from ltl_synthesizer.external import run_external_synthesizer
 from ltl_synthesizer.interrupt import Limits
-from ltl_synthesizer.isolated import SpecificationText, SynthesisProcesses, byproduct_texts
+from ltl_synthesizer.isolated import (SpecificationText, SynthesisProcesses, WellSeparationCheck, WellSeparationOutcome,
+                                     byproduct_texts)
 from ltl_synthesizer.strategy import strategy_to_json
 from respec.automaton import Automaton, AutomatonState, automaton_from_strategy, strategy_move_problems
 from respec.vocabulary.errors import CodedError, ErrorCode
@@ -68,6 +69,8 @@ DEFAULT_MAX_STRATEGY_EDGES = 100_000
 #: The code an answer comes from: part of every cache key, so that entries kept on disk by
 #: other code miss (ltl_synthesizer.cache.source_digest).
 ANSWERING_PACKAGES = ('respec', 'ltl_specification', 'ltl_synthesizer', 'synthesis_manager')
+#: A job's provenance not read yet (None is one read: there is none, or it is unreadable).
+_NOT_READ: Any = object()
 
 
 @dataclass(frozen=True)
@@ -88,13 +91,14 @@ class Explainers:
     """How an answer is explained: picklable top-level functions, run in a synthesis child.
 
     ``diagnose(details, spec, provenance, robotics_semantics, limits) -> message``;
-    ``check_well_separation(spec, provenance, limits) -> warning``; ``read_provenance(text)``
+    ``check_well_separation(spec, provenance, limits, game=None) -> warning`` (``game``: the
+    solved game, when the builtin synthesis's child checks it); ``read_provenance(text)``
     (raises ValueError for text it cannot read); ``incomplete_mark``: what a diagnosis whose
     time ran out before its core was computed says (such an answer is not kept)."""
 
     # a provenance is the explainers' own (ltl_specification.provenance.Provenance, or None)
     diagnose: Callable[[str, GR1Specification, Any, bool, Limits], str]
-    check_well_separation: Callable[[GR1Specification, Any, Limits], str]
+    check_well_separation: Callable[..., str]
     read_provenance: Callable[[str], Any]
     incomplete_mark: str
 
@@ -317,10 +321,21 @@ class SynthesisService:
             slugsin_path = files.write('slugsin', slugsin)
             del structuredslugs, slugsin
             robotics = settings.robotics_semantics
+            checked_in_synthesis: WellSeparationOutcome | None = None
+            provenance: Any = _NOT_READ
             if backend == 'builtin':
+                limits = Limits(job.cancel, job.deadline, memory_limit)
                 try:
-                    result = self.processes.synthesize(spec, robotics, Limits(job.cancel, job.deadline, memory_limit),
-                                                       max_strategy_edges=settings.max_strategy_edges)
+                    if settings.check_well_separation:  # on the solved game, in the synthesis's child
+                        provenance = self._provenance(job)  # read once: the diagnosis needs it too
+                        check = WellSeparationCheck(self.explainers.check_well_separation, provenance,
+                                                    job.diagnosis_timeout or settings.diagnosis_timeout)
+                        result, checked_in_synthesis = self.processes.synthesize_then_check(
+                            spec, robotics, limits, check, max_strategy_edges=settings.max_strategy_edges,
+                            grace=DIAGNOSIS_GRACE)
+                    else:
+                        result = self.processes.synthesize(spec, robotics, limits,
+                                                           max_strategy_edges=settings.max_strategy_edges)
                 except SynthesisCancelledError as stopped:
                     return job.stopped_answer(stopped.reason, getattr(stopped, 'during', '')), None
                 realizable, strategy, explanation = result.realizable, result.strategy, result.explanation
@@ -336,7 +351,7 @@ class SynthesisService:
                 head = unrealizable_head(files.name)
                 details = f'{head}: {explanation}'.rstrip(': ')
                 try:
-                    message, diagnosed = self._diagnosed(details, spec, job, settings)
+                    message, diagnosed = self._diagnosed(details, spec, job, settings, provenance)
                 except SynthesisCancelledError as stopped:
                     return job.stopped_answer(stopped.reason, getattr(stopped, 'during', '')), None
                 answer = SynthesisAnswer(ErrorCode.SPEC_UNSYNTHESIZABLE, message)
@@ -348,7 +363,12 @@ class SynthesisService:
             strategy_json = strategy_to_json(strategy)
             files.write('json', strategy_json)
         try:
-            warning, checked = self._well_separation_warning(spec, job, settings)
+            if checked_in_synthesis is None:
+                warning, checked = self._well_separation_warning(spec, job, settings)
+            else:
+                warning, checked = checked_in_synthesis.warning, not checked_in_synthesis.stopped
+                if checked_in_synthesis.stopped:
+                    self.warn(f'well-separation not checked: {checked_in_synthesis.stopped}'[:300])
         except SynthesisCancelledError as stopped:
             return job.stopped_answer(stopped.reason, getattr(stopped, 'during', ''), synthesizable=True), None
         answer = SynthesisAnswer(ErrorCode.SUCCESS, warning, True, automaton_from_strategy(strategy, variables))
@@ -380,14 +400,16 @@ class SynthesisService:
             return '', False
 
     def _diagnosed(self, details: str, spec: SpecificationText | GR1Specification, job: SynthesisJob,
-                   settings: SynthesisSettings) -> tuple[str, bool]:
+                   settings: SynthesisSettings, provenance: Any = _NOT_READ) -> tuple[str, bool]:
         """``details`` (the synthesizer's explanation), led by why the task cannot be done: in
         the task's terms when the job carries the specification's provenance, else by its
         formulas; and whether the diagnosis was whole (its core computed). The diagnosis runs in
         a synthesis child process, with the memory limit, and ends by diagnosis_timeout and
         before the job's time limit; without an answer by then the verdict stands with
-        ``details``. A cancel raises SynthesisCancelledError."""
-        provenance = self._provenance(job)
+        ``details``. A cancel raises SynthesisCancelledError. ``provenance``: the job's, if read
+        already (else _NOT_READ)."""
+        if provenance is _NOT_READ:
+            provenance = self._provenance(job)
         limit = job.diagnosis_timeout or settings.diagnosis_timeout
         diagnosis_deadline = min(time.monotonic() + limit, job.deadline - DIAGNOSIS_GRACE)
         if diagnosis_deadline <= time.monotonic():

@@ -29,7 +29,7 @@ from ltl_synthesizer.symbolic import SymbolicGame
 
 __all__ = ['Limits', 'Solved', 'SynthesisResult', 'counter_strategy', 'explain',
            'explicit_strategy', 'initial_positions_win', 'is_realizable', 'solve', 'stream_strategy',
-           'synthesize']
+           'synthesis_result', 'synthesize']
 
 
 @dataclass
@@ -179,8 +179,15 @@ def synthesize(spec: GR1Specification, robotics_semantics: bool = True, limits: 
     """Solve ``spec``; its explicit strategy when realizable (at most ``max_edges`` transitions,
     see :func:`explicit_strategy`), else the explanation why not (limits and errors as :func:`solve`)."""
     start = time.perf_counter()
-    solved = solve(spec, robotics_semantics, limits, options)
+    return synthesis_result(solve(spec, robotics_semantics, limits, options), max_edges, start)
+
+
+def synthesis_result(solved: Solved, max_edges: int | None = None, start: float | None = None) -> SynthesisResult:
+    """:func:`synthesize`'s answer from a game solved already (``start``: when the solve began,
+    for its total seconds), for callers that use the solved game afterwards (the well-separation
+    check of ``ltl_synthesizer.isolated.synthesize_then_check``)."""
     extracting = time.perf_counter()
+    start = extracting if start is None else start
     result = SynthesisResult(solved.realizable)
     if solved.realizable:
         result.strategy = explicit_strategy(solved, max_edges)

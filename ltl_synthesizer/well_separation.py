@@ -129,8 +129,18 @@ def is_well_separated(game: SymbolicGame) -> bool:
 def check_well_separation(spec: GR1Specification, limits: Limits = Limits(),
                           game: SymbolicGame | None = None) -> WellSeparation:
     """Whether ``spec`` is well-separated (see the module doc), naming the assumptions involved
-    when it is not; ``game``: the game of ``spec`` if one is built already (a solved one)."""
-    game = game or SymbolicGame(spec, None, _interrupt(spec, limits))
+    when it is not; ``game``: the game of ``spec`` if one is built already (a solved one: the
+    check then stops by ``limits``, not by the game's own, and names its own stage)."""
+    if game is None:
+        return _checked(spec, limits, SymbolicGame(spec, None, _interrupt(spec, limits)))
+    solver_interrupt, game.interrupt = game.interrupt, _interrupt(spec, limits)
+    try:
+        return _checked(spec, limits, game)
+    finally:
+        game.interrupt = solver_interrupt
+
+
+def _checked(spec: GR1Specification, limits: Limits, game: SymbolicGame) -> WellSeparation:
     if game.env_init == game.false:
         return WellSeparation(False, ['env_init (unsatisfiable: the environment breaks it at once)'])
     if is_well_separated(game):

@@ -18,7 +18,7 @@ from ltl_synthesizer.service import (Explainers, KeptAnswer, SynthesisJob, Synth
                                      answer_cache, unrealizable_head)
 from respec.automaton import automaton_from_strategy
 from respec.vocabulary.errors import ErrorCode
-from respec.ltl import Next, Not, iff, var
+from respec.ltl import Next, Not, iff, implies, var
 from respec.spec import GR1Specification
 
 EXPLAINERS = Explainers(explain_unsynthesizable, explain_well_separation, provenance_from_json, CORE_NOT_COMPUTED)
@@ -150,4 +150,30 @@ def test_unreadable_provenance_is_warned_about_and_the_formulas_explain(tmp_path
     service = make_service(tmp_path, processes)
     answer = service.answer(job_of(IMPOSSIBLE, provenance='not json'))
     assert answer.code == ErrorCode.SPEC_UNSYNTHESIZABLE
-    assert any(warning.startswith('request.provenance ignored') for warning in service.warnings)
+    # read once for the job (the well-separation check and the diagnosis share it): one warning
+    assert sum(warning.startswith('request.provenance ignored') for warning in service.warnings) == 1
+    assert service.answer(job_of(CHEATING, provenance='not json')).message == explain_well_separation(CHEATING)
+    assert sum(warning.startswith('request.provenance ignored') for warning in service.warnings) == 2
+
+
+# y forces the next x, which the environment promises to leave infinitely often: a controller
+# that keeps y wins by cheating (not well-separated), and is realizable.
+CHEATING = GR1Specification(env_props=['x'], sys_props=['y'], env_trans=[implies(var('y'), Next(var('x')))],
+                            env_liveness=[Not(var('x'))], sys_liveness=[var('y')])
+
+
+def test_the_well_separation_warning_comes_from_the_synthesis_child_as_from_a_check_of_its_own(tmp_path, processes):
+    # The builtin backend checks the game its child solved (issue 44): the same warning.
+    answer = make_service(tmp_path, processes).answer(job_of(CHEATING))
+    assert (answer.code, answer.synthesizable) == (ErrorCode.SUCCESS, True)
+    assert answer.message == explain_well_separation(CHEATING) != ''
+    assert make_service(tmp_path, processes).answer(job_of(FOLLOWER)).message == ''
+
+
+def test_a_well_separation_check_out_of_time_leaves_the_automaton_unwarned_and_unkept(tmp_path, processes):
+    service = make_service(tmp_path, processes)
+    answer, kept = service._synthesize(job_of(CHEATING, diagnosis_timeout=1e-9), service.settings(), keep=True)
+    assert (answer.code, answer.message, answer.synthesizable) == (ErrorCode.SUCCESS, '', True)
+    assert answer.automaton is not None and kept is None
+    assert service.warnings == ['well-separation not checked: synthesis timeout while checking well-separation '
+                                '(1 inputs and 1 outputs)']

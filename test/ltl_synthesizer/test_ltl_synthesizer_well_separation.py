@@ -5,12 +5,15 @@ the generated ATLAS specifications are well-separated."""
 import itertools
 import subprocess
 import sys
+import time
 
 import pytest
 
 from ltl_specification import compile_task
 from ltl_specification.systems import load_task_abstraction
-from ltl_synthesizer.synthesizer import is_realizable
+from ltl_synthesizer.errors import SynthesisTimeoutError
+from ltl_synthesizer.interrupt import Limits
+from ltl_synthesizer.synthesizer import is_realizable, solve
 from ltl_synthesizer.well_separation import check_well_separation
 from respec.vocabulary.errors import CodedError
 from respec.parsing import spec_from_text_sections
@@ -58,6 +61,25 @@ def test_a_safety_assumption_the_system_can_make_impossible_is_flagged_alone():
 def test_specifications_where_the_environment_can_always_keep_its_assumptions_are_well_separated(sections):
     report = check_well_separation(spec(**sections))
     assert report.well_separated and report.assumptions == [] and report.warning() == ''
+
+
+@pytest.mark.parametrize('sections', [
+    CHEATING, dict(env_liveness=['x'], sys_trans=['next(y) <-> next(x)'], sys_liveness=['y']),
+    dict(env_trans=['y -> next(x)', 'y -> next(!x)', 'x -> next(x) | next(!x)'], env_liveness=['x | !x'],
+         sys_liveness=['y'])])
+def test_the_check_on_the_solved_game_answers_as_on_a_game_of_its_own(sections):
+    # The synthesis child checks the game it solved (not built again); the answer is the same.
+    solved = solve(spec(**sections))
+    assert solved.realizable
+    assert check_well_separation(spec(**sections), Limits(), solved.game) == check_well_separation(spec(**sections))
+
+
+def test_the_check_on_a_solved_game_stops_by_its_own_limits_and_says_so():
+    solved = solve(spec(**CHEATING), limits=Limits(deadline=time.monotonic() + 600))
+    interrupt = solved.game.interrupt
+    with pytest.raises(SynthesisTimeoutError, match='checking well-separation'):
+        check_well_separation(spec(**CHEATING), Limits(deadline=time.monotonic() - 1), solved.game)
+    assert solved.game.interrupt is interrupt   # the game's own is back
 
 
 def test_a_system_that_can_only_block_itself_does_not_cheat():

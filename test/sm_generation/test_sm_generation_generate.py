@@ -212,6 +212,26 @@ def test_positions_are_layered_from_the_initial_state():
     assert len({tuple(p) for p in top}) == len(top)  # no two states on top of each other
 
 
+def test_layers_are_distances_from_the_initial_state_with_unreachable_states_last():
+    from sm_generation.layout import COLUMN_SPACING, LAYER_SPACING, layered_positions
+    edges = {'a': ['c', 'b', 'a', 'done'], 'b': ['d'], 'c': ['d', 'b'], 'd': ['a'], 'lost': ['a']}
+    positions = layered_positions(edges, 'a', ['done'])
+    row = {node: round((y - positions['a'][1]) / LAYER_SPACING) for node, (_, y) in positions.items()}
+    assert row == {'a': 0, 'b': 1, 'c': 1, 'd': 2, 'lost': 3, 'done': 4}
+    assert positions['c'][0] - positions['b'][0] == COLUMN_SPACING  # a layer keeps the order of ``edges``
+
+
+def test_generation_does_not_load_networkx():
+    # Its import was most of a small machine's generation (0.1 s); the layout needs a search only.
+    code = ('import sys; from sm_generation import generate_state_machine, load_automaton; '
+            'from respec.robot import robot_system; '
+            f'generate_state_machine(load_automaton({str(AUTOMATA / "sensors.yaml")!r}), robot_system("atlas")); '
+            'print("networkx" in sys.modules)')
+    done = subprocess.run([sys.executable, '-c', code], capture_output=True, text=True,
+                          cwd=Path(__file__).resolve().parents[2], timeout=60)
+    assert done.stdout.strip() == 'False', done.stderr
+
+
 def test_autonomy_levels_come_from_the_configuration(tmp_path):
     config = yaml.safe_load((REPO_CONFIG / 'atlas.yaml').read_text())
     config['flexbe']['states']['stand_a']['autonomy'] = [2, 1]

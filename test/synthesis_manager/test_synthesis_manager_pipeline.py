@@ -240,6 +240,6 @@ def test_the_diagnosis_time_limit_keeps_the_synthesizers_verdict(suite, endless_
     assert 'Details from the synthesizer' not in outcome.message  # no diagnosis: the synthesizer's account
     assert outcome.message.strip()
     # Stopped at its 1 s (not the default 20 s): killed DIAGNOSIS_GRACE later, and the answer's
-    # way back through the nodes took up to 1.6 s more beside another test run at load 5 (3.6 s).
-    assert answered - diagnosing[0] < 1.0 + DIAGNOSIS_GRACE + 3.0
+    # way back through the nodes took up to 3.2 s more at load 7 (5.2 s): 10 s in all, half the default.
+    assert answered - diagnosing[0] < 1.0 + DIAGNOSIS_GRACE + 8.0
     assert process_gone(int(endless_diagnosis.read_text()), within=1.0)

@@ -2,7 +2,8 @@
 our synthesizer alone and slugs, side by side in one run, with the fitted growth exponents.
 
     python bench/bench_capability_scale.py --slugs /tmp/slugs/src/slugs [--timeout 60]
-        [--shapes chain,retry] [--sizes 10,20,40] [--grids 7x5,19x16] [--warm-up-to 80] [--markdown FILE]
+        [--slugs-timeout 300] [--shapes chain,retry] [--sizes 10,20,40] [--grids 7x5,19x16]
+        [--warm-up-to 80] [--markdown FILE]
 
 For every capability robot (bench/capability_robots.py: N capabilities bound to FlexBE's
 OperatorDecisionState, a request with no initial conditions, the goal, outcomes finished,failed)
@@ -70,7 +71,7 @@ def run_wall(command: list[str], timeout: float) -> dict:
         out, err = process.communicate()
         timed_out = True
     return {'seconds': time.monotonic() - start, 'timeout': timed_out, 'code': process.returncode,
-            'out': out, 'err': err}
+            'out': out, 'err': err, 'limit': timeout}
 
 
 def verdict_of(text: str) -> bool | None:
@@ -177,7 +178,7 @@ def cell(result: dict | None, timeout: float) -> str:
     if result is None:
         return 'skipped'
     if result['timeout']:
-        return f'> {timeout:g}'
+        return f"> {result.get('limit', timeout):g}"
     if result.get('failed'):
         return f"failed ({result['failed']})"
     return f"{result['seconds']:.2f}"
@@ -271,7 +272,7 @@ def solved_by_both(slugsin: Path, args, given_up: set, with_strategy: bool = Tru
                           ('slugs', [args.slugs, '--sysInitRoboticsSemantics', str(slugsin)])):
         if tool in given_up:
             continue
-        run = run_wall(command, args.timeout)
+        run = run_wall(command, args.slugs_timeout if tool == 'slugs' else args.timeout)
         if not run['timeout']:
             run['verdict'] = verdict_of(run['out'] + run['err'])
             if run['verdict'] is None:
@@ -354,6 +355,7 @@ def main() -> None:
                              'this size (default 80)')
     parser.add_argument('--slugs', default='/tmp/slugs/src/slugs')
     parser.add_argument('--timeout', type=float, default=60.0, help='wall seconds per run (default 60)')
+    parser.add_argument('--slugs-timeout', type=float, help="slugs' wall seconds per run (default: --timeout)")
     parser.add_argument('--shapes', default=','.join(capability_robots.SHAPES))
     parser.add_argument('--sizes', default=','.join(map(str, SIZES)))
     parser.add_argument('--grids', default=','.join(f'{w}x{h}' for w, h in GRIDS), help="'' for none")
@@ -361,6 +363,8 @@ def main() -> None:
                         help='check the explicit strategies of robots up to this size (default 80)')
     parser.add_argument('--markdown', help=f'write the table here (e.g. {RESULTS.relative_to(ROOT)})')
     args = parser.parse_args()
+    if args.slugs_timeout is None:
+        args.slugs_timeout = args.timeout
     if args.pipeline_child:
         config_dir, shape, size, slugsin = args.pipeline_child
         pipeline_child(config_dir, shape, int(size), slugsin, args.runs)

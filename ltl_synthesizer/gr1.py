@@ -42,6 +42,8 @@ class Solver:
         self._previous_moves_into: dict[int, tuple[Node, Node]] = {}
         self._may_violate: dict[int, Node] = {}
         self.waits = _waits(self) if self.options.chained_sweeps else ungrouped(self)
+        # See _sweep_order.
+        self.alternating_sweeps = self.options.chained_sweeps and len(game.env_goals) > GROUPED_WAITS_FROM
 
     @cached_property
     def care(self) -> Node:
@@ -233,7 +235,8 @@ def _attract_to_goal(solver: Solver, goal_index: int, goal: Node, winning: Node,
     Returns Y and its attractor steps by increasing rank. With ``chained_sweeps`` each inner
     fixpoint already uses the positions the previous ones of the same sweep added (a
     Gauss-Seidel iteration: the same least fixpoint, reached in far fewer sweeps, and each
-    step's ``closer`` set still only holds positions of lower rank).
+    step's ``closer`` set still only holds positions of lower rank), in the order of
+    ``_sweep_order``.
     """
     game = solver.game
     chained = solver.options.chained_sweeps
@@ -243,10 +246,9 @@ def _attract_to_goal(solver: Solver, goal_index: int, goal: Node, winning: Node,
     can_move_towards_goal = reach_goal  # moves into the goal, or into Y
     steps = []
     moving_on = _NoWaitingPositions(solver)
-    group_sizes: dict[int, int] = {}  # sweep -> nodes of the group's X (see _check_group_growth)
     for sweep in itertools.count():
         Y_before_sweep = Y
-        for wait in solver.waits:
+        for wait in _sweep_order(solver, sweep):
             assumption_index, assumption = wait.index, wait.assumption
             start = warm_starts.upper_bound(goal_index, sweep, assumption_index, winning)
             if chained and moving_on.adds_nothing(start, Y, can_move_towards_goal, wait):
@@ -255,12 +257,11 @@ def _attract_to_goal(solver: Solver, goal_index: int, goal: Node, winning: Node,
                 continue
             X, responses = _wait_for_assumption(
                 solver, can_move_towards_goal, assumption, start, wait.ignores_outputs)
-            if len(wait.members) > 1:
-                group_sizes[sweep] = len(X)
-                _check_group_growth(group_sizes, sweep, len(game.variables))
             warm_starts.record(goal_index, sweep, assumption_index, X)
             closer = Y if chained else Y_before_sweep
             new_positions = X & ~Y != game.false
+            if len(wait.members) > 1:
+                _check_group(X, new_positions, sweep, len(game.variables))
             if new_positions or not chained:  # else every position of X has a lower rank
                 steps.append(AttractorStep(
                     goal_index, goal_transitions, closer, X, assumption, responses))
@@ -275,6 +276,25 @@ def _attract_to_goal(solver: Solver, goal_index: int, goal: Node, winning: Node,
         if not chained:
             can_move_towards_goal = reach_goal | solver.system_can_move_into(Y)
     raise AssertionError('unreachable: the sweeps (itertools.count) end only by the return above')
+
+
+def _sweep_order(solver: Solver, sweep: int) -> list[_Wait]:
+    """The inner fixpoints of one sweep, in order: with many environment goals, every other
+    sweep runs backwards (a symmetric Gauss-Seidel iteration).
+
+    A chained sweep finds in one pass the positions whose waits come after those of the
+    positions they move on to; the rest waits for the next sweep. A capability robot's
+    capabilities are listed in the order they run, and each waits for the next one's
+    positions: forwards only, a chain of N capabilities took N sweeps of N fixpoints (the mix
+    of 80: 3,157 fixpoints, 9 s), while the backward sweep after the first finds the whole
+    chain (237 fixpoints, 0.8 s), whichever way the specification lists it. Where the listed
+    order was right already, a backward sweep may cost one more sweep (the fan-out of 160: 3
+    sweeps instead of 2). Games with few environment goals keep one direction, and the
+    strategies they always had.
+    """
+    if solver.alternating_sweeps and sweep % 2 == 1:
+        return solver.waits[::-1]
+    return solver.waits
 
 
 class _NoWaitingPositions:
@@ -325,36 +345,31 @@ class _Wait:
 GROUPED_WAITS_FROM = 16
 
 
-# A group's fixpoint holds the positions of all its goals in one BDD. Where the goals'
-# positions combine freely (a fan-out of N independent capabilities: any set of them may have
-# ended), that BDD grows with each sweep (the fan-out of 80: 8,000 nodes, 3x the solving time of
-# separate fixpoints); past this many nodes per proposition the solve starts again without
-# groups (a chain of 160 capabilities stays below 2 per proposition; the diamonds, which
-# grouping solves 4x faster at 80, reach 28 at 160): a memory guard; the growth rule decides first.
+# A group's fixpoint is one per sweep: it pays where its goals' positions are found side by
+# side in the first sweeps (the arbiter: any client may be waiting, and one grouped sweep
+# finds them all: 64 clients solve in 0.25 s grouped, 4.9 s with 64 fixpoints per sweep).
+# Where they follow each other (a chain of capabilities: each capability's positions move on
+# to the next one's), the group finds one capability per sweep, N sweeps of a BDD that may
+# grow with each (the diamonds of 160: 24 s, 9,000 nodes), while single fixpoints in
+# alternating sweeps (_sweep_order) find the chain in two or three (1.9 s). A group that still
+# adds positions in this sweep of a goal (counted from 0) is given up, and the solve starts
+# again with one fixpoint per assumption.
+GROUP_SWEEPS = 3
+# ... and a group's X past this many nodes per proposition, at any sweep: a memory guard (where
+# the goals' positions combine freely, as in a fan-out, the group's BDD grows with each sweep).
 GROUPED_NODES_PER_PROPOSITION = 64
-# The sign that comes early: between the second and the fourth sweep of a goal, the group's X
-# grows by more than this many nodes per proposition and sweep. Where the goals' positions
-# combine (the fan-out of 80: 1.3; the mix of 80, whose branches run side by side: 0.67), the
-# grouped solve is the slower one (mix 80: 16.3 s against 6.2 s), and it stops after a few
-# cheap sweeps instead of after half the solve; where they follow each other (chains: 0.02,
-# diamonds of 80: 0.04) the group stays, and is 4-10x faster.
-GROUP_GROWTH_PER_PROPOSITION = 0.25
-GROUP_GROWTH_SWEEPS = (1, 3)
 
 
 class _GroupTooLarge(ControlFlowSignal):
-    """Not an error: a group's fixpoint grows too fast (GROUP_GROWTH_PER_PROPOSITION) or is too
-    large (GROUPED_NODES_PER_PROPOSITION); the solve starts again with one fixpoint per assumption."""
+    """Not an error: a group's fixpoint still adds positions after GROUP_SWEEPS sweeps, or is
+    too large (GROUPED_NODES_PER_PROPOSITION); the solve starts again with one fixpoint per
+    assumption."""
 
 
-def _check_group_growth(group_sizes: dict[int, int], sweep: int, propositions: int) -> None:
-    """Raise _GroupTooLarge when the group's X (``group_sizes[sweep]``, nodes) is too large,
-    or has grown too fast since sweep GROUP_GROWTH_SWEEPS[0]."""
-    if group_sizes[sweep] > GROUPED_NODES_PER_PROPOSITION * propositions:
-        raise _GroupTooLarge()
-    first, last = GROUP_GROWTH_SWEEPS
-    if sweep == last and first in group_sizes and group_sizes[sweep] - group_sizes[first] > \
-            GROUP_GROWTH_PER_PROPOSITION * (last - first) * propositions:
+def _check_group(X: Node, new_positions: bool, sweep: int, propositions: int) -> None:
+    """Raise _GroupTooLarge when the group's X of this sweep is too large, or adds positions
+    at sweep GROUP_SWEEPS or later."""
+    if (new_positions and sweep >= GROUP_SWEEPS) or len(X) > GROUPED_NODES_PER_PROPOSITION * propositions:
         raise _GroupTooLarge()
 
 
@@ -380,6 +395,8 @@ def _waits(solver: Solver) -> list[_Wait]:
     so cannot go on; in M_i no other goal can be violated). Then the union of the goals'
     fixpoints is the one fixpoint of ``towards | (!(A_1 & ... & A_k) & X')``: the same Y,
     reached in one fixpoint per sweep, and a strategy that stays in X waits for one goal.
+    (A robot's capabilities, which run one after another, are found sooner by single fixpoints
+    in alternating sweeps: its group is given up after GROUP_SWEEPS sweeps.)
     """
     game = solver.game
     singles = ungrouped(solver)

@@ -89,6 +89,12 @@ def test_a_large_robot_file_is_read_and_compiled_in_a_child(ros, tmp_path):
     assert client.run(make_goal(**PAPER_TASK), timeout=60).error_name == 'SUCCESS'
 
 
+# The huge goals' time limit, and what the paper task beside one may take: waiting behind it, it
+# would end after the limit; served meanwhile it took 2.4-2.8 s at load 5-7 on the 2 cores.
+HUGE_LIMIT = 5.0
+SERVED_MEANWHILE = 4.0
+
+
 def normal_goal_beside(client, huge):
     """Send ``huge``, and once it is in its stage the paper task: (its result, its seconds, and the
     huge goal's result and seconds as ``answers['huge']``, ``answers['huge seconds']``)."""
@@ -111,16 +117,16 @@ def normal_goal_beside(client, huge):
 
 
 def test_a_huge_compilation_stops_at_its_limit_and_a_normal_goal_is_served_meanwhile(ros, tmp_path):
-    client = start(ros, tmp_path, compile_timeout=2.0)
+    client = start(ros, tmp_path, compile_timeout=HUGE_LIMIT)
     huge = make_goal(**PAPER_TASK, option='ltl_compilation_only',
                      ltl_specification={'sys_trans': custom_formulas(3_900_000)})  # about 8 s to compile
     normal, normal_seconds, answers = normal_goal_beside(client, huge)
     print(f'normal goal: {normal_seconds:.2f} s during a huge compilation; the huge one: '
           f'{answers["huge"].error_name} after {answers["huge seconds"]:.2f} s')
-    assert normal.error_name == 'SUCCESS' and normal_seconds < 2.0, normal.message
+    assert normal.error_name == 'SUCCESS' and normal_seconds < SERVED_MEANWHILE, normal.message
     assert answers['huge'].error_name == 'TIMEOUT', answers['huge'].message
     assert 'LTL compilation' in answers['huge'].message
-    assert answers['huge seconds'] < 2.0 + 2.0  # its limit, sending 4 MB and the answer
+    assert answers['huge seconds'] < HUGE_LIMIT + 2.0  # its limit, sending 4 MB and the answer
 
 
 def test_the_synthesis_service_caps_a_requests_time_limit(ros, tmp_path):
@@ -187,14 +193,14 @@ def test_a_large_specification_is_read_in_the_synthesis_child_to_the_same_automa
 
 def test_a_huge_specification_stops_at_its_limit_and_a_normal_goal_is_served_meanwhile(ros, tmp_path):
     client = start(ros, tmp_path)
-    huge = make_goal('atlas', [], [], option='ltl_synthesis_only', timeout=2.0,
+    huge = make_goal('atlas', [], [], option='ltl_synthesis_only', timeout=HUGE_LIMIT,
                      ltl_specification=large_spec(3_900_000))  # about 9 s to parse and print
     normal, normal_seconds, answers = normal_goal_beside(client, huge)
     print(f'normal goal: {normal_seconds:.2f} s beside a huge specification; the huge one: '
           f'{answers["huge"].error_name} after {answers["huge seconds"]:.2f} s')
-    assert normal.error_name == 'SUCCESS' and normal_seconds < 2.0, normal.message
+    assert normal.error_name == 'SUCCESS' and normal_seconds < SERVED_MEANWHILE, normal.message
     assert answers['huge'].error_name in ('SYNTHESIS_TIMEOUT', 'TIMEOUT'), answers['huge'].message
-    assert answers['huge seconds'] < 2.0 + 2.0
+    assert answers['huge seconds'] < HUGE_LIMIT + 2.0
 
 
 def chain_automaton_message(steps: int):

@@ -419,8 +419,11 @@ class ChildProcesses:
                 child.kill()
             child = self._new_child()
         with self._lock:
-            self._busy.add(child)
-        return child
+            if not self._closed:
+                self._busy.add(child)
+                return child
+        child.kill()  # close() came while this child was readied, out of its sight: it would outlive the pool
+        raise WorkCancelledError('cancelled')
 
     def _give_back(self, child: ChildProcess, reusable: bool) -> None:
         with self._lock:

@@ -36,6 +36,24 @@ def test_a_cancel_and_the_deadline_stop_work_in_the_runners_words():
         pool.call(operator.add, (1, 1))
 
 
+def test_a_close_while_a_child_is_readied_for_work_leaves_no_child(monkeypatch):
+    """close() (a server's shutdown) may come while a call readies its child outside the pool's
+    lock: the call is cancelled and the child killed, not left running work nobody stops."""
+    pool = ChildProcesses()
+    pool.prepare(1)
+    readied = []
+
+    def settle_during_close(child, timeout=0.0):
+        readied.append(child)
+        pool.close()
+        return True
+    monkeypatch.setattr(ChildProcess, 'settle', settle_during_close)
+    with pytest.raises(WorkCancelledError):
+        pool.call(time.sleep, (60,))
+    [child] = readied
+    child.process.wait(timeout=10)  # killed: no runaway work outlives the pool
+
+
 def test_a_child_that_dies_is_named_as_its_caller_calls_it():
     child = ChildProcess(name='simulation process')
     try:

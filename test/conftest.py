@@ -18,9 +18,9 @@ A test that starts ROS, a browser, MuJoCo, the real FlexBE or (without any of th
 program that is not Python, and lacks the marker, fails with a message naming it
 (test/declared_kinds.py).
 
-The pure-core tests alone (Python only)::
+The pure-core tests alone (Python only; -n 2: both cores, pytest-xdist)::
 
-    .venv/bin/python -m pytest -m "not (ros or browser or mujoco or flexbe or external or slow)"
+    .venv/bin/python -m pytest -n 2 -m "not (ros or browser or mujoco or flexbe or external or slow)"
 
 Tests against the real FlexBE find its pinned sources through FLEXBE_SOURCES, by default
 ../shared/third_party beside the repository when present; `make flexbe` (run by `make test`)

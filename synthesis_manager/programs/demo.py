@@ -57,7 +57,7 @@ def run(args) -> int:
         with in_process_suite(args, 'demo_client') as (_, client):
             progress = ProgressBar()
             outcome = client.run(goal_from_args(args), feedback=progress)
-            progress.close()
+            progress.close(outcome)
     except SuiteUnavailableError as error:
         print(f'demo: {error}', file=sys.stderr)
         return ExitStatus.UNAVAILABLE

@@ -182,7 +182,7 @@ def execute_capability_robot(args, system) -> int:
             progress = None if args.json else ProgressBar()
             outcome = client.run(goal_from_args(Namespace(**vars(args))), feedback=progress)
             if progress:
-                progress.close()
+                progress.close(outcome)
     except SuiteUnavailableError as error:
         print(f'execute: {error}', file=sys.stderr)
         return ExitStatus.UNAVAILABLE

@@ -66,6 +66,7 @@ def run(args) -> int:
         print(f'export-behavior: {error.code}: {error}', file=sys.stderr)
         return ExitStatus.FAILED
     progress = ProgressBar(stream=sys.stderr)  # the stream of now (the default is the one at import)
+    outcome = None
     try:
         with in_process_suite(args, 'export_behavior_client') as (_, client):
             outcome = client.run(goal_from_args(args), feedback=progress)
@@ -73,7 +74,7 @@ def run(args) -> int:
         print(f'export-behavior: {error}', file=sys.stderr)
         return ExitStatus.UNAVAILABLE
     finally:
-        progress.close()
+        progress.close(outcome)
     if not outcome.succeeded:
         print(f'export-behavior: synthesis failed: {outcome.error_name}: {outcome.message}', file=sys.stderr)
         return ExitStatus.for_error(outcome.error_name)

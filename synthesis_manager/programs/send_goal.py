@@ -136,19 +136,37 @@ CANCEL_GRACE = 2.0
 
 
 class ProgressBar:
-    """A one-line progress bar on stderr driven by the action's feedback."""
+    """A one-line progress bar on stderr driven by the action's feedback.
+
+    Feedback and result travel apart (a topic and a service), so the server's last feedback
+    can reach the client after the result: ``close(outcome)`` draws a successful goal's bar
+    full, and the bar ignores feedback that comes after it is closed."""
 
     def __init__(self, stream=sys.stderr, width: int = 30):
         self.stream, self.width = stream, width
+        self.progress, self.closed = 0.0, False
+        self._lock = threading.Lock()  # feedback comes on the executor's thread, close on the caller's
 
     def __call__(self, status: str, progress: float):
+        with self._lock:
+            if not self.closed:
+                self._draw(status, progress)
+
+    def _draw(self, status: str, progress: float):
+        self.progress = progress
         filled = int(round(progress * self.width))
         self.stream.write(f'\r[{"#" * filled}{"." * (self.width - filled)}] {progress:4.0%} {status:<60.60}')
         self.stream.flush()
 
-    def close(self):
-        self.stream.write('\n')
-        self.stream.flush()
+    def close(self, outcome=None):
+        with self._lock:
+            if self.closed:
+                return
+            if outcome is not None and outcome.succeeded and self.progress < 1.0:
+                self._draw('Finished', 1.0)
+            self.closed = True
+            self.stream.write('\n')
+            self.stream.flush()
 
 
 def print_summary(outcome, stream=sys.stdout):
@@ -207,7 +225,7 @@ def run(args) -> int:
             cancel.set()
             finished.wait(CANCEL_GRACE)
         if progress:
-            progress.close()
+            progress.close(outcome_box.get('outcome'))
     outcome = outcome_box.get('outcome')
     if outcome is None:
         print(f"send-goal: no result: {outcome_box.get('error', 'interrupted')}", file=sys.stderr)

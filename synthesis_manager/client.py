@@ -16,7 +16,7 @@ from sm_generation.state_machine import StateMachine
 from synthesis_manager.client_shares import new_origin, tagged_goal_id
 from synthesis_manager.limits import check_texts
 from synthesis_manager.requests import InvalidRequestError
-from synthesis_manager.ros.action_client import RaceFreeActionClient
+from synthesis_manager.ros.action_client import GOAL_RESPONSE_GRACE, RaceFreeActionClient
 from synthesis_manager.ros.cnu_interface import load_flexbe_synthesis_interface
 from synthesis_manager.ros.conversions import error_name, msg_to_sections, msg_to_state_dict
 from synthesis_msgs.action import BehaviorSynthesis
@@ -186,7 +186,7 @@ class SynthesisClient:
         on_feedback = (lambda msg: feedback(msg.feedback.status, msg.feedback.progress)) if feedback else None
         goal_id = UUID(uuid=list(tagged_goal_id(self.origin)))
         handle = self._accepted(self.action_client.send_goal_async(goal, feedback_callback=on_feedback,
-                                                                   goal_uuid=goal_id), started, timeout)
+                                                                   goal_uuid=goal_id), goal_id, started, timeout)
         if handle is None:
             return self.server_lost(time.monotonic() - started)
         if not handle.accepted:
@@ -231,22 +231,27 @@ class SynthesisClient:
         response = next((answer for answer in answers if answer.status != GOAL_STATUS_UNKNOWN), answers[0])
         return outcome_from_response(response, time.monotonic() - started)
 
-    def _accepted(self, sent, started: float, timeout: float):
+    def _accepted(self, sent, goal_id, started: float, timeout: float):
         """The goal handle of the goal request ``sent``, or None when the server left the ROS
         graph (killed, crashed, stopped) before answering it: a stalled server must not hold a
         caller until its timeout."""
         answered = threading.Event()
         sent.add_done_callback(lambda _: answered.set())
         server_seen = time.monotonic()
-        while not answered.wait(LIVENESS_PERIOD):
-            now = time.monotonic()
-            if self.action_client.server_is_ready():
-                server_seen = now
-            elif now - server_seen >= SERVER_LOST_SECONDS:
-                return None
-            if now - started > timeout:
-                raise TimeoutError(f'the goal was not accepted within {timeout:g} s')
-        return sent.result()
+        try:
+            while not answered.wait(LIVENESS_PERIOD):
+                now = time.monotonic()
+                if self.action_client.server_is_ready():
+                    server_seen = now
+                elif now - server_seen >= SERVER_LOST_SECONDS:
+                    return None
+                if now - started > timeout:
+                    raise TimeoutError(f'the goal was not accepted within {timeout:g} s')
+                if now - started > GOAL_RESPONSE_GRACE and self.action_client.accepted_without_response(goal_id):
+                    break
+            return sent.result()
+        finally:
+            self.action_client.stop_awaiting(goal_id)
 
     def server_lost(self, seconds: float) -> SynthesisOutcome:
         """The outcome of a goal whose server left the ROS graph before answering."""

@@ -18,11 +18,10 @@ from __future__ import annotations
 import threading
 import time
 
-from rclpy.action import ActionClient
-
 from atlas_sim.executive.robot import CapabilityResult
 from respec.vocabulary.errors import CodedError, ErrorCode
 from synthesis_manager.nodes.atlas_sim_node import ACTION_NAME, STATE_TOPIC
+from synthesis_manager.ros.action_client import GOAL_RESPONSE_GRACE, RaceFreeActionClient, new_goal_id
 from synthesis_msgs.action import ExecuteCapability
 from synthesis_msgs.msg import RobotState
 
@@ -48,7 +47,8 @@ class RosRobot:
                  poll_period: float = 0.002):
         self.node = node
         self.poll_period = poll_period
-        self.client = ActionClient(node, ExecuteCapability, action_name)
+        self.client = RaceFreeActionClient(node, ExecuteCapability, action_name)
+        self._unanswered: dict[bytes, tuple[object, float]] = {}  # goal id -> (its UUID, when sent)
         self._state: RobotState | None = None
         self._latest_result_time = 0.0  # results may arrive before the next state message
         self._changed = threading.Condition()
@@ -75,12 +75,18 @@ class RosRobot:
         # Sent back to back: the node starts goals arriving within its batch window together.
         goals = [_Goal(c) for c in capabilities]
         for goal in goals:
-            future = self.client.send_goal_async(ExecuteCapability.Goal(capability=goal.capability))
+            goal_id = new_goal_id()
+            with self._changed:
+                self._unanswered[bytes(goal_id.uuid)] = (goal_id, time.monotonic())
+            future = self.client.send_goal_async(ExecuteCapability.Goal(capability=goal.capability),
+                                                 goal_uuid=goal_id)
             future.add_done_callback(lambda f, goal=goal: self._on_goal_response(goal, f))
         return goals
 
     def _on_goal_response(self, goal: _Goal, future) -> None:
         handle = future.result()
+        with self._changed:
+            self._unanswered.pop(bytes(handle.goal_id.uuid), None)
         if not handle.accepted:
             self._finish(goal, 'failed', 'the simulator node rejected the goal', self.time())
             return
@@ -97,9 +103,14 @@ class RosRobot:
             self._changed.notify_all()
 
     def step(self) -> None:
-        """Wait briefly for news (a result or a state message)."""
+        """Wait briefly for news (a result or a state message); a goal whose response was lost
+        on the way goes on once the node's status lists it (ros/action_client.py)."""
         with self._changed:
             self._changed.wait(self.poll_period)
+            overdue = [goal_id for goal_id, sent in self._unanswered.values()
+                       if time.monotonic() - sent > GOAL_RESPONSE_GRACE]
+        for goal_id in overdue:
+            self.client.accepted_without_response(goal_id)
 
     def result(self, handle: _Goal) -> CapabilityResult | None:
         return handle.result

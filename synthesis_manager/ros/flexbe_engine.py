@@ -48,17 +48,19 @@ class SimulatedOperator:
 
     def __init__(self, node, request_capabilities: dict[int, str], answers: dict[int, object]):
         from flexbe_msgs.action import BehaviorInput
-        from rclpy.action import ActionClient, ActionServer
+        from rclpy.action import ActionServer
         from rclpy.callback_groups import ReentrantCallbackGroup
 
+        from synthesis_manager.ros.action_client import RaceFreeActionClient
         from synthesis_msgs.action import ExecuteCapability
 
         self._types = (BehaviorInput, ExecuteCapability)
         group = ReentrantCallbackGroup()
         self.request_capabilities = dict(request_capabilities)
         self.answers = dict(answers)
-        self.clients = {capability: ActionClient(node, ExecuteCapability, CAPABILITY_ACTION_PREFIX + capability,
-                                                 callback_group=group)
+        # rclpy's own ActionClient can lose a goal's response (rclpy#1123).
+        self.clients = {capability: RaceFreeActionClient(node, ExecuteCapability,
+                                                         CAPABILITY_ACTION_PREFIX + capability, callback_group=group)
                         for capability in set(self.request_capabilities.values())}
         self.server = ActionServer(node, BehaviorInput, BEHAVIOR_INPUT_ACTION, self.answer, callback_group=group)
 

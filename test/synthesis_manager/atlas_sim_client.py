@@ -3,10 +3,10 @@
 import threading
 import time
 
-from rclpy.action import ActionClient
 from rclpy.node import Node
 
 from synthesis_manager.nodes.atlas_sim_node import ACTION_NAME, STATE_TOPIC
+from synthesis_manager.ros.action_client import RaceFreeActionClient
 from synthesis_manager.ros.harness import wait_for
 from synthesis_msgs.action import ExecuteCapability
 from synthesis_msgs.msg import RobotState
@@ -17,7 +17,8 @@ class Client:
 
     def __init__(self, ros, name='sim_client'):
         self.node = ros.add_node(Node, name)
-        self.action = ActionClient(self.node, ExecuteCapability, ACTION_NAME)
+        # The product's client: rclpy's own can lose a goal's response (rclpy#1123).
+        self.action = RaceFreeActionClient(self.node, ExecuteCapability, ACTION_NAME)
         assert self.action.wait_for_server(timeout_sec=10.0)
         self.states = []
         self.received = threading.Event()

@@ -247,7 +247,7 @@ class SynthesisClient:
                     return None
                 if now - started > timeout:
                     raise TimeoutError(f'the goal was not accepted within {timeout:g} s')
-                if now - started > GOAL_RESPONSE_GRACE and self.action_client.accepted_without_response(goal_id):
+                if now - started > GOAL_RESPONSE_GRACE and self.action_client.accepted_without_response(sent):
                     break
             return sent.result()
         finally:

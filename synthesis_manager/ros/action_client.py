@@ -52,24 +52,25 @@ class RaceFreeActionClient(ActionClient):
             self._awaited[bytes(goal_uuid.uuid)] = None
             return super().send_goal_async(goal, feedback_callback, goal_uuid)
 
-    def accepted_without_response(self, goal_id) -> bool:
-        """Whether the server's status lists the goal ``goal_id`` although its goal response
-        has not come: then its request's future gets an accepted handle now (status updates
-        keep going to the handle rclpy makes if the response still comes)."""
+    def accepted_without_response(self, sent) -> bool:
+        """Whether the server's status lists the goal of the request ``sent`` (a future of
+        ``send_goal_async``) although its goal response has not come: then ``sent`` gets an
+        accepted handle now (status updates keep going to the handle rclpy makes if the
+        response still comes)."""
         with self._registering:
-            stamp = self._awaited.get(bytes(goal_id.uuid))
             # The executor removes answered requests without this lock: copies, and a done future is left alone.
-            sequence = next((number for number, awaited in list(self._goal_sequence_number_to_goal_id.items())
-                             if awaited == goal_id), None)
-            future = self._pending_goal_requests.get(sequence)
-            if stamp is None or sequence is None or future is None or future.done():
+            sequence = next((number for number, pending in list(self._pending_goal_requests.items())
+                             if pending is sent), None)
+            goal_id = self._goal_sequence_number_to_goal_id.get(sequence)
+            stamp = self._awaited.get(bytes(goal_id.uuid)) if goal_id is not None else None
+            if stamp is None or sequence is None or goal_id is None or sent.done():
                 return False
-            self._remove_pending_goal_request(future)
+            self._remove_pending_goal_request(sent)
             self._answered_by_status.add(sequence)
             del self._awaited[bytes(goal_id.uuid)]
         # Outside the lock: a done callback may send the result request, which takes it.
         response = self._action_type.Impl.SendGoalService.Response(accepted=True, stamp=stamp)
-        future.set_result(ClientGoalHandle(self, goal_id, response))
+        sent.set_result(ClientGoalHandle(self, goal_id, response))
         return True
 
     def stop_awaiting(self, goal_id) -> None:

@@ -17,11 +17,12 @@ from __future__ import annotations
 
 import threading
 import time
+from typing import Any
 
 from atlas_sim.executive.robot import CapabilityResult
 from respec.vocabulary.errors import CodedError, ErrorCode
 from synthesis_manager.nodes.atlas_sim_node import ACTION_NAME, STATE_TOPIC
-from synthesis_manager.ros.action_client import GOAL_RESPONSE_GRACE, RaceFreeActionClient, new_goal_id
+from synthesis_manager.ros.action_client import GOAL_RESPONSE_GRACE, RaceFreeActionClient
 from synthesis_msgs.action import ExecuteCapability
 from synthesis_msgs.msg import RobotState
 
@@ -48,7 +49,7 @@ class RosRobot:
         self.node = node
         self.poll_period = poll_period
         self.client = RaceFreeActionClient(node, ExecuteCapability, action_name)
-        self._unanswered: dict[bytes, tuple[object, float]] = {}  # goal id -> (its UUID, when sent)
+        self._unanswered: list[tuple[Any, float]] = []  # goal requests' futures and when they were sent
         self._state: RobotState | None = None
         self._latest_result_time = 0.0  # results may arrive before the next state message
         self._changed = threading.Condition()
@@ -75,18 +76,14 @@ class RosRobot:
         # Sent back to back: the node starts goals arriving within its batch window together.
         goals = [_Goal(c) for c in capabilities]
         for goal in goals:
-            goal_id = new_goal_id()
+            future = self.client.send_goal_async(ExecuteCapability.Goal(capability=goal.capability))
             with self._changed:
-                self._unanswered[bytes(goal_id.uuid)] = (goal_id, time.monotonic())
-            future = self.client.send_goal_async(ExecuteCapability.Goal(capability=goal.capability),
-                                                 goal_uuid=goal_id)
+                self._unanswered.append((future, time.monotonic()))
             future.add_done_callback(lambda f, goal=goal: self._on_goal_response(goal, f))
         return goals
 
     def _on_goal_response(self, goal: _Goal, future) -> None:
         handle = future.result()
-        with self._changed:
-            self._unanswered.pop(bytes(handle.goal_id.uuid), None)
         if not handle.accepted:
             self._finish(goal, 'failed', 'the simulator node rejected the goal', self.time())
             return
@@ -107,10 +104,10 @@ class RosRobot:
         on the way goes on once the node's status lists it (ros/action_client.py)."""
         with self._changed:
             self._changed.wait(self.poll_period)
-            overdue = [goal_id for goal_id, sent in self._unanswered.values()
-                       if time.monotonic() - sent > GOAL_RESPONSE_GRACE]
-        for goal_id in overdue:
-            self.client.accepted_without_response(goal_id)
+            self._unanswered = [(sent, when) for sent, when in self._unanswered if not sent.done()]
+            overdue = [sent for sent, when in self._unanswered if time.monotonic() - when > GOAL_RESPONSE_GRACE]
+        for sent in overdue:
+            self.client.accepted_without_response(sent)
 
     def result(self, handle: _Goal) -> CapabilityResult | None:
         return handle.result

@@ -6,7 +6,7 @@ import time
 from rclpy.node import Node
 
 from synthesis_manager.nodes.atlas_sim_node import ACTION_NAME, STATE_TOPIC
-from synthesis_manager.ros.action_client import RaceFreeActionClient
+from synthesis_manager.ros.action_client import GOAL_RESPONSE_GRACE, RaceFreeActionClient
 from synthesis_manager.ros.harness import wait_for
 from synthesis_msgs.action import ExecuteCapability
 from synthesis_msgs.msg import RobotState
@@ -41,8 +41,18 @@ class Client:
         return self.action.send_goal_async(ExecuteCapability.Goal(capability=capability))
 
     def results(self, futures, timeout=60.0):
-        handles = [wait_for(f, 10.0) for f in futures]
+        handles = [self.accepted(f) for f in futures]
         return [wait_for(h.get_result_async(), timeout).result if h.accepted else None for h in handles]
+
+    def accepted(self, sent, timeout=10.0):
+        """The goal handle of the request ``sent``; a response lost on the way is made up from
+        the node's status, as the product's clients do (ros/action_client.py)."""
+        deadline, grace = time.monotonic() + timeout, time.monotonic() + GOAL_RESPONSE_GRACE
+        while not sent.done() and time.monotonic() < deadline:
+            if time.monotonic() > grace:
+                self.action.accepted_without_response(sent)
+            time.sleep(0.02)
+        return wait_for(sent, 0.1)
 
     def execute(self, *capabilities):
         return self.results([self.send(c) for c in capabilities])

@@ -15,6 +15,7 @@ from respec.vocabulary.errors import ExitStatus
 from respec.parsing import spec_from_text_sections
 from synthesis_manager.programs.cli import main as cli_main
 from synthesis_manager.client import SynthesisClient, make_goal
+from lost_responses import GoalResponseLosingClient
 from synthesis_manager.nodes.atlas_sim_node import AtlasSimNode
 from synthesis_manager.ros.atlas_sim_robot import RosRobot
 from synthesis_manager.suite import suite_node_factories
@@ -51,6 +52,20 @@ def test_pickup_task_over_ros(ros, fail, expected):
     assert 0.6 < run.min_pelvis_height and 0.6 < node.simulator.snapshot()['pelvis_height'] < 1.1
     assert [s.state for s in run.trace.steps][-1] == '/pickup_object'
     assert node.simulator.snapshot()['holding_object'] == (expected == 'finished')
+
+
+def test_the_robot_adapter_goes_on_when_its_goal_responses_are_lost(ros, monkeypatch):
+    goals = ['look_down', 'pickup_object']
+    outcome = synthesize_over_ros(ros, ['stand_prep'], goals)
+    ros.add_node(AtlasSimNode, parameter_overrides=[
+        Parameter('speed', value=20.0), Parameter('state_rate', value=50.0),
+        Parameter('initial_conditions', value='stand_prep')])
+    monkeypatch.setattr('synthesis_manager.ros.atlas_sim_robot.RaceFreeActionClient', GoalResponseLosingClient)
+    robot = RosRobot(ros.add_node(Node, 'executive'))
+    robot.wait_until_ready()
+    run = execute_state_machine(outcome.machine, robot, robot_system('atlas'), max_wall_time=60.0)
+    assert run.outcome == 'finished' and robot.client.lost >= len(goals)  # one goal per capability, or more
+    assert check_trace(run.trace, spec_from_text_sections(outcome.ltl_specification), goals=goals).ok
 
 
 def run_cli(capsys, *arguments):

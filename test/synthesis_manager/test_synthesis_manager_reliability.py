@@ -21,6 +21,7 @@ import pytest
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 
+from lost_responses import GoalResponseLosingClient
 from runaway_requests import runaway_goal
 from suite_in_process import PAPER_TASK, start_suite
 from waiting import wait_until
@@ -28,9 +29,7 @@ from synthesis_manager.client import SynthesisClient, make_goal
 from synthesis_manager.limits import MAX_LIST_LENGTH, MAX_STRING_BYTES
 from synthesis_manager.requests import byproduct_file_stem
 from synthesis_manager.ros.env import prepare_ros_environment
-from synthesis_manager.ros.action_client import RaceFreeActionClient
 from synthesis_manager.ros.harness import RosHarness, reserve_domain_id
-from synthesis_msgs.action import BehaviorSynthesis
 from synthesis_msgs.srv import SynthesizeAutomaton
 
 pytestmark = pytest.mark.ros
@@ -121,22 +120,10 @@ def test_a_short_soak_loses_no_goal(ros, tmp_path):
     assert len({path.name.split('.')[0] for path in tmp_path.glob('*.json')}) == 20
 
 
-class GoalResponseLosingClient(RaceFreeActionClient):
-    """An action client whose goal responses are all lost on the way, as when rmw_fastrtps's
-    server gives up on matching a client's response reader (100 ms) on a loaded machine."""
-
-    lost = 0
-
-    async def execute(self, taken_data):
-        if taken_data.pop('goal', None) is not None:
-            self.lost += 1
-        await super().execute(taken_data)
-
-
-def test_a_goal_whose_response_is_lost_goes_on_from_the_servers_status(ros, tmp_path):
-    client = start_suite(ros, tmp_path)
-    client.action_client.destroy()
-    client.action_client = GoalResponseLosingClient(client.node, BehaviorSynthesis, 'behavior_synthesis')
+def test_a_goal_whose_response_is_lost_goes_on_from_the_servers_status(ros, tmp_path, monkeypatch):
+    start_suite(ros, tmp_path)
+    monkeypatch.setattr('synthesis_manager.client.RaceFreeActionClient', GoalResponseLosingClient)
+    client = SynthesisClient(ros.add_node(Node, 'losing_client'))
     assert client.wait_for_server(timeout=10.0)
     started = time.monotonic()
     outcome = client.run(make_goal(**PAPER_TASK), timeout=30)

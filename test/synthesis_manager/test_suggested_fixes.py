@@ -70,7 +70,8 @@ def test_the_propose_repairs_service_answers_the_whole_search(ros, tmp_path):
                                                 custom_ltl=custom, max_proposals=2), timeout_sec=60)
     assert answer.error_code.value == 1, answer.error_code.message
     repairs = json.loads(answer.repairs)
-    assert [p['summary'] for p in repairs['proposals']] == list(answer.summaries) and len(answer.summaries) == 2
+    assert [p['summary'] for p in repairs['proposals']] == list(answer.summaries) and len(answer.summaries) == 2, \
+        answer.repairs
     assert repairs['proposals'][0]['custom_ltl'] == {'env_props': ['door_open'], 'sys_liveness': ['door_open'],
                                                      'env_liveness': ['door_open']}
     assert all(p['verified'] for p in repairs['proposals'])

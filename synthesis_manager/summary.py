@@ -2,8 +2,13 @@
 
 from __future__ import annotations
 
-from sm_generation.instantiation import StateInstantiation
+from sm_generation.instantiation import StateInstantiation, count_states
 from sm_generation.state_machine import State, StateMachine
+
+
+def generated_summary(states: list) -> str:
+    """A goal's last progress note: the state machine it generated (StateInstantiation entries)."""
+    return f'Generated a state machine with {count_states(states)} states'
 
 
 def state_machine_tree(machine: StateMachine) -> str:

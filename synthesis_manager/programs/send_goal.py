@@ -20,7 +20,7 @@ from synthesis_manager.limits import MAX_MESSAGE_BYTES
 from synthesis_manager.requests import DEFAULT_SYSTEM, InvalidRequestError, resolve_system
 from synthesis_manager.ros.harness import RosHarness, environment_domain_id
 from synthesis_manager.ros.namespaces import namespace_placement
-from synthesis_manager.summary import spec_size, state_machine_tree
+from synthesis_manager.summary import generated_summary, spec_size, state_machine_tree
 
 
 # The paper's task, which a command runs when no --goals are given (and says so).
@@ -138,22 +138,22 @@ CANCEL_GRACE = 2.0
 class ProgressBar:
     """A one-line progress bar on stderr driven by the action's feedback.
 
-    Feedback and result travel apart (a topic and a service), so the server's last feedback
-    can reach the client after the result: ``close(outcome)`` draws a successful goal's bar
-    full, and the bar ignores feedback that comes after it is closed."""
+    Feedback and result travel apart (a topic and a service), so the server's last feedback,
+    sent just before the result, can reach the client after it: the bar's full line is drawn
+    from the result (``close(outcome)``), the same whichever comes first, and feedback after
+    that is ignored."""
 
     def __init__(self, stream=sys.stderr, width: int = 30):
         self.stream, self.width = stream, width
-        self.progress, self.closed = 0.0, False
+        self.closed = False
         self._lock = threading.Lock()  # feedback comes on the executor's thread, close on the caller's
 
     def __call__(self, status: str, progress: float):
         with self._lock:
-            if not self.closed:
+            if not self.closed and progress < 1.0:
                 self._draw(status, progress)
 
     def _draw(self, status: str, progress: float):
-        self.progress = progress
         filled = int(round(progress * self.width))
         self.stream.write(f'\r[{"#" * filled}{"." * (self.width - filled)}] {progress:4.0%} {status:<60.60}')
         self.stream.flush()
@@ -162,8 +162,8 @@ class ProgressBar:
         with self._lock:
             if self.closed:
                 return
-            if outcome is not None and outcome.succeeded and self.progress < 1.0:
-                self._draw('Finished', 1.0)
+            if outcome is not None and outcome.succeeded:
+                self._draw(generated_summary(outcome.states) if outcome.states else 'Finished', 1.0)
             self.closed = True
             self.stream.write('\n')
             self.stream.flush()

@@ -16,7 +16,6 @@ from ltl_specification.initial_conditions import (asks_for_robot_state, detected
                                                   initial_conditions_from_robot_state, reads_robot_state)
 from respec.vocabulary.errors import CodedError, ErrorCode
 from respec.robot import RobotSystem, robot_system
-from sm_generation.instantiation import count_states
 from synthesis_manager.goals import (MAX_SUGGESTED_FIXES, SYNTHESIS_ANSWER_GRACE, PipelineOutcome, byproduct_name,
                                      repair_wait, wants_fixes)
 from synthesis_manager.limits import MAX_STRING_BYTES, GoalDeadline, GoalTimeoutError, utf8_length
@@ -24,6 +23,7 @@ from synthesis_manager.requests import InvalidRequestError, SynthesisTask
 from synthesis_manager.ros.conversions import error_code, error_name, is_empty_spec
 from synthesis_manager.ros.qos import service_qos
 from synthesis_manager.ros.robot_state import RobotStateListener
+from synthesis_manager.summary import generated_summary
 from synthesis_manager.ros.stage_calls import (Preempted, ServerStoppingError, StageCaller, StageFailedError,
                                               StageTimeoutError)
 from synthesis_msgs.msg import LTLSpecification
@@ -160,7 +160,7 @@ class GoalPipeline:
             deadline=deadline)
         check(generated.error_code)
         outcome.states = list(generated.state_definition)
-        feedback(f'Generated a state machine with {count_states(outcome.states)} states', 1.0)
+        feedback(generated_summary(outcome.states), 1.0)
 
     def readable_system(self, name: str) -> RobotSystem | None:
         """The robot system of that name, or None when it cannot be read (compiling the task reports why)."""

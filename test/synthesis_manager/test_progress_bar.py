@@ -1,25 +1,43 @@
 """The command line's progress bar: the server's last feedback may reach a client after the
-result (a topic and a service travel apart), so the bar ends from the result itself."""
+result (a topic and a service travel apart), so the bar's full line is drawn from the result,
+the same whichever comes first."""
 
 import io
 
+import pytest
+
 from synthesis_manager.client import SynthesisOutcome
 from synthesis_manager.programs.send_goal import ProgressBar
+
+MACHINE = [{'state_path': '/look_down', 'state_class': 'LookDownState'}]  # one state's StateInstantiation entry
+LAST_FEEDBACK = ('Generated a state machine with 1 states', 1.0)  # the server's, just before its result
 
 
 def drawn(stream: io.StringIO) -> list[str]:
     return [line for line in stream.getvalue().split('\r') if line]
 
 
-def test_a_successful_goal_ends_full_when_its_last_feedback_is_still_on_the_way():
+@pytest.mark.parametrize('last_feedback_first', [True, False])
+def test_a_successful_goal_ends_with_the_same_full_line_whether_its_last_feedback_comes_first_or_not(
+        last_feedback_first):
     stream = io.StringIO()
     bar = ProgressBar(stream=stream, width=10)
-    bar('Synthesizing', 0.7)
-    bar.close(SynthesisOutcome(1, 'SUCCESS', ''))
-    bar('Generated a state machine with 3 states', 1.0)  # the late feedback
-    lines = drawn(stream)
-    assert lines[-1].startswith('[##########] 100% Finished') and lines[-1].endswith('\n')
-    assert 'Generated' not in stream.getvalue()  # nothing after the closing newline
+    bar('Generating the state machine', 0.7)
+    if last_feedback_first:
+        bar(*LAST_FEEDBACK)
+    bar.close(SynthesisOutcome(1, 'SUCCESS', '', states=MACHINE))
+    if not last_feedback_first:
+        bar(*LAST_FEEDBACK)
+    assert drawn(stream) == ['[#######...]  70% ' + f'{"Generating the state machine":<60}',
+                             '[##########] 100% ' + f'{"Generated a state machine with 1 states":<60}' + '\n']
+
+
+def test_a_goal_that_stops_before_generation_ends_full_when_it_succeeds():
+    stream = io.StringIO()
+    bar = ProgressBar(stream=stream, width=10)
+    bar('Compiling the specification', 0.1)
+    bar.close(SynthesisOutcome(1, 'SUCCESS', ''))  # --compile-only: no state machine
+    assert drawn(stream)[-1].startswith('[##########] 100% Finished')
 
 
 def test_a_failed_goal_keeps_the_progress_it_reached():
@@ -27,13 +45,6 @@ def test_a_failed_goal_keeps_the_progress_it_reached():
     bar = ProgressBar(stream=stream, width=10)
     bar('Synthesizing', 0.4)
     bar.close(SynthesisOutcome(6, 'SYNTHESIS_FAILED', 'unrealizable'))
-    assert '100%' not in stream.getvalue() and drawn(stream)[-1].startswith('[####......]  40% Synthesizing')
-
-
-def test_a_bar_already_full_is_not_drawn_twice():
-    stream = io.StringIO()
-    bar = ProgressBar(stream=stream, width=10)
-    bar('Generated a state machine with 3 states', 1.0)
-    bar.close(SynthesisOutcome(1, 'SUCCESS', ''))
     bar.close()
-    assert len(drawn(stream)) == 1 and stream.getvalue().count('\n') == 1
+    assert '100%' not in stream.getvalue() and drawn(stream)[-1].startswith('[####......]  40% Synthesizing')
+    assert stream.getvalue().count('\n') == 1

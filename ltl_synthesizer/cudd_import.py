@@ -1,12 +1,13 @@
 """``dd.cudd`` without the modules it loads only for features the synthesizer never uses.
 
 dd imports at start-up, for graph conversions, its pure-Python BDDs, its expression parser
-(ply), copying and dumping (json, shelve, pickle), pretty-printing and running Graphviz
-(subprocess, shlex), modules that cost more than the rest of a tiny synthesis: networkx 0.4 s
-of CPU, the others about 15 ms (``python -X importtime``). While dd loads, a stand-in takes
-the place of each of them that is not loaded yet; dd keeps the stand-ins, and a stand-in loads
-its module by the ordinary import (so there is only ever one copy) the first time dd uses
-it. Any other ``import`` of those modules, later, gets the real module.
+(ply), copying and dumping (json, shelve, pickle), pretty-printing, running Graphviz
+(subprocess, shlex) and its messages (textwrap), modules that cost more than the rest of a
+tiny synthesis: networkx 0.4 s of CPU, the others about 15 ms (``python -X importtime``).
+While dd loads, a stand-in takes the place of each of them that is not loaded yet; dd keeps
+the stand-ins, and a stand-in loads its module by the ordinary import (so there is only ever
+one copy) the first time dd uses it. Any other ``import`` of those modules, later, gets the
+real module.
 """
 
 from __future__ import annotations
@@ -22,7 +23,7 @@ Node = Any
 #: What dd imports that the synthesizer never uses (dd.cudd, dd._utils and dd.bdd import them at
 #: the top, but only functions that the synthesizer does not call use them).
 _DEFERRED = ('networkx', 'dd.autoref', 'dd.bdd', 'dd._copy', 'dd._parser',
-             'pickle', 'pprint', 'subprocess', 'shlex')
+             'pickle', 'pprint', 'subprocess', 'shlex', 'textwrap')
 
 
 class _StandIn(types.ModuleType):

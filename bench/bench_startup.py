@@ -18,7 +18,8 @@ Sections, printed as markdown:
   per-cell gridworlds and capability robots of 10 and 20 capabilities, ours against slugs;
 - pipeline: ``bench/pipeline_child.py`` (the pipeline of the request in one fresh process)
   against ``gr1synth --sysInitRoboticsSemantics --explicitStrategy --jsonOutput`` on the same
-  compiled file, and their ratio.
+  compiled file, and their ratio;
+- warm: the same two answered again in one process (a long-running server's cost).
 
 CPU time counts the work of a process wherever it ran, so it is far less sensitive to the load
 of a shared machine than wall time; it is not insensitive (caches, frequency).
@@ -27,6 +28,7 @@ of a shared machine than wall time; it is not insensitive (caches, frequency).
 from __future__ import annotations
 
 import argparse
+import json
 import os
 import statistics
 import subprocess
@@ -174,12 +176,58 @@ def pipeline(args, files: dict[str, Path], directory: Path) -> list[str]:
     return lines
 
 
+_WARM_PIPELINE = '''
+import sys, time
+sys.path[:0] = [sys.argv[1] + '/bench']
+from pipeline_child import pipeline_child
+pipeline_child(sys.argv[2], sys.argv[3], int(sys.argv[4]), sys.argv[5], 3, clock=time.process_time)
+'''
+_WARM_SYNTHESIS = '''
+import json, sys, time
+from ltl_synthesizer.serve import answer
+request = json.dumps(sys.argv[1:])
+answer(request)
+seconds = []
+for _ in range(2):
+    start = time.process_time()
+    answer(request)
+    seconds.append(time.process_time() - start)
+print(json.dumps({'warm_seconds': min(seconds)}))
+'''
+
+
+def warm(args, files: dict[str, Path], directory: Path) -> list[str]:
+    """CPU seconds of a request answered again in one process (its imports done, as in a
+    long-running server): the faster of the second and third answers, of the pipeline and of
+    gr1synth + strategy (the resident mode's answer), and their ratio."""
+    lines = ['| task | warm: pipeline / gr1synth + strategy (ms CPU) | warm ratio |', '|---|---|---|']
+    print('\n'.join(lines), flush=True)
+    for shape in SHAPES:
+        for size in SIZES:
+            label = f'{shape} N={size}'
+            found = {}
+            for name, command in (
+                    ('pipeline', [PYTHON, '-c', _WARM_PIPELINE, str(ROOT), str(directory), shape, str(size),
+                                  str(directory / 'warm.slugsin')]),
+                    ('synthesis', [PYTHON, '-c', _WARM_SYNTHESIS, *STRATEGY, str(files[label]), os.devnull])):
+                runs = []
+                for _ in range(args.repeats):
+                    done = subprocess.run(command, capture_output=True, text=True, check=True, cwd=str(ROOT))
+                    runs.append(json.loads(done.stdout.strip().splitlines()[-1])['warm_seconds'])
+                found[name] = statistics.median(runs)
+            row = (f"| {label} | {found['pipeline'] * 1000:.1f} / {found['synthesis'] * 1000:.1f} | "
+                   f"{found['pipeline'] / found['synthesis']:.2f} |")
+            print(row, flush=True)
+            lines.append(row)
+    return lines
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument('--slugs', help='slugs executable (compared when given)')
     parser.add_argument('--old', help='a tree of older code to run beside this one')
     parser.add_argument('--repeats', type=int, default=7)
-    parser.add_argument('--sections', default='floors,specifications,pipeline')
+    parser.add_argument('--sections', default='floors,specifications,pipeline,warm')
     parser.add_argument('--only', default='', help='specification labels to run (comma-separated prefixes)')
     args = parser.parse_args(argv)
     if args.old and not (Path(args.old) / 'bench' / 'pipeline_child.py').exists():
@@ -199,6 +247,8 @@ def main(argv=None) -> int:
             specifications(args, files, labels)
         if 'pipeline' in sections:
             pipeline(args, files, directory)
+        if 'warm' in sections:
+            warm(args, files, directory)
     with open('/proc/loadavg') as load:
         print(f'load average after: {load.read().split()[:3]}')
     return 0

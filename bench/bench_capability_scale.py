@@ -50,12 +50,12 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path[:0] = [str(ROOT), str(ROOT / 'bench')]
 
 import capability_robots
-from respec.robot import robot_system
+from pipeline_child import pipeline_child
 
 RESULTS = ROOT / 'bench' / 'results' / 'capability_scale.md'
 SIZES = [10, 20, 40, 80, 160]
 GRIDS = [(7, 5), (13, 10), (19, 16), (21, 18)]
-MEMORY_LIMIT = 2 * 2**30
+PIPELINE_CHILD = str(ROOT / 'bench' / 'pipeline_child.py')
 
 
 def run_wall(command: list[str], timeout: float) -> dict:
@@ -82,54 +82,6 @@ def verdict_of(text: str) -> bool | None:
     return None
 
 
-def pipeline_child(config_dir: str, shape: str, size: int, slugsin: str, runs: int = 1) -> None:
-    """The pipeline of one request (run in a fresh process): prints its stages as JSON. With
-    ``runs`` > 1 the same request is answered that many times in the process, and the seconds
-    of the fastest answer after the first are printed too as ``warm_seconds`` (a long-running
-    server's cost of a request, its imports done)."""
-    from ltl_specification import compile_task
-    from ltl_specification.diagnosis import explain_well_separation
-    from ltl_synthesizer.interrupt import Limits
-    from ltl_synthesizer.synthesizer import solve, synthesis_result
-    from respec.automaton import automaton_from_strategy
-    from sm_generation import generate_state_machine
-
-    robot = capability_robots.SHAPES[shape](size)
-    warm = []
-    for _ in range(runs):
-        stages = {}
-        start = time.perf_counter()
-        spec = compile_task(robot_system(robot.name, config_dir), robot.initial_conditions, robot.goals,
-                            sm_outcomes=capability_robots.REQUEST_OUTCOMES,
-                            state_library=capability_robots.STATE_LIBRARY)
-        text = spec.to_slugsin()
-        stages['compile'] = time.perf_counter() - start
-        Path(slugsin).write_text(text)
-        mark = time.perf_counter()
-        solved = solve(spec, True, Limits(memory_limit=MEMORY_LIMIT))
-        result = synthesis_result(solved, None, mark)
-        stages['synthesize'] = time.perf_counter() - mark
-        report = {'realizable': result.realizable, 'env': len(spec.env_props), 'sys': len(spec.sys_props),
-                  'strategy_nodes': result.stats.get('strategy_nodes', 0)}
-        if result.realizable:
-            mark = time.perf_counter()
-            # On the solved game, as the synthesis node's child checks it (isolated.synthesize_then_check).
-            explain_well_separation(spec, None, Limits(memory_limit=MEMORY_LIMIT), solved.game)
-            stages['well_separation'] = time.perf_counter() - mark
-            mark = time.perf_counter()
-            automaton = automaton_from_strategy(result.strategy, spec)
-            states = generate_state_machine(automaton, robot_system(robot.name, config_dir),
-                                            state_library=capability_robots.STATE_LIBRARY)
-            stages['generate'] = time.perf_counter() - mark
-            report['machine_states'] = len(states.to_instantiations())
-            Path(slugsin + '.strategy.json').write_text(json.dumps(result.strategy))
-        report['stages'] = stages
-        warm.append(time.perf_counter() - start)
-    if runs > 1:
-        report['warm_seconds'] = min(warm[1:])
-    print(json.dumps(report))
-
-
 _SYNTHESIS_WARM = '''
 import json, sys, time
 from ltl_synthesizer.serve import answer
@@ -146,12 +98,12 @@ print(json.dumps({'warm_seconds': min(seconds), 'stderr': reply['stderr']}))
 
 def warm_runs(directory: Path, shape: str, size: int, slugsin: Path, timeout: float) -> dict:
     """A request's seconds in a process that has answered it once already (its imports done, as
-    in a long-running server), the faster of two such answers: the pipeline (``--pipeline-child``
+    in a long-running server), the faster of two such answers: the pipeline (``pipeline_child.py``
     three times in one process), and gr1synth + strategy in its resident mode (``gr1synth
     --serve``'s answers to a request repeated three times)."""
     runs = {}
-    pipeline = run_wall([sys.executable, __file__, '--pipeline-child', str(directory), shape, str(size),
-                         str(slugsin) + '.warm', '--runs', '3'], timeout)
+    pipeline = run_wall([sys.executable, PIPELINE_CHILD, str(directory), shape, str(size),
+                         str(slugsin) + '.warm', '3'], timeout)
     synthesis = run_wall([sys.executable, '-c', _SYNTHESIS_WARM, '--sysInitRoboticsSemantics', '--explicitStrategy',
                           '--jsonOutput', str(slugsin), os.devnull], timeout)
     for name, run in (('pipeline', pipeline), ('gr1synth + strategy', synthesis)):
@@ -195,7 +147,7 @@ def measure_capabilities(args, directory: Path, rows: list, series: dict) -> Non
             row = {'family': shape, 'size': size, 'label': f'{shape} N={size}'}
             results = {}
             if 'pipeline' not in given_up:
-                run = run_wall([python, __file__, '--pipeline-child', str(directory), shape, str(size),
+                run = run_wall([python, PIPELINE_CHILD, str(directory), shape, str(size),
                                 str(slugsin)], args.timeout)
                 if not run['timeout'] and run['code'] == 0:
                     report = json.loads(run['out'].strip().splitlines()[-1])

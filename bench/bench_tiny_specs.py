@@ -6,8 +6,8 @@ counter-strategy, and of one synthesis in the server's own synthesis processes (
 
     nice -n 10 python bench/bench_tiny_specs.py [--slugs /path/to/slugs]
 
-Fresh processes: the best CPU seconds (user + system) of ``--repeats`` runs, alternating the
-two tools. Resident: the median wall time of ``--repeats`` requests after a first one (which
+Fresh processes: the median CPU seconds (user + system) of ``--repeats`` runs, alternating the
+two tools (bench_startup.py has the interpreter's floors and more specifications). Resident: the median wall time of ``--repeats`` requests after a first one (which
 loads the modules), and the mean CPU time of the answering process over ``--cpu-batch``
 requests (the kernel counts CPU time in 10 ms ticks: a batch makes that fine enough; on a
 shared machine the wall time also holds the time other work took the cores). Table:
@@ -45,10 +45,6 @@ SPECS = {
 
 # The resident requests: what gr1synth is asked, by verdict.
 REQUESTS = {True: ['--explicitStrategy', '--jsonOutput'], False: ['--counterStrategy', '--jsonOutput']}
-
-
-def fresh_cpu(command: list[str], repeats: int) -> float:
-    return min(run_timed(command, 60)['cpu'] for _ in range(repeats))
 
 
 def process_cpu(pid: int) -> float:
@@ -140,10 +136,11 @@ def main(argv=None) -> int:
     parser.add_argument('--repeats', type=int, default=7)
     parser.add_argument('--cpu-batch', type=int, default=40,
                         help='requests per CPU measurement of the resident process and the server child')
+    parser.add_argument('--markdown', default=str(RESULTS / 'tiny_specs.md'), help='where to write the table')
     args = parser.parse_args(argv)
     from respec.parsing import parse_structuredslugs
     lines = ['# Tiny specifications: a fresh process and the resident mode', '',
-             'Fresh: best CPU seconds (user + system) of a fresh process over '
+             'Fresh: median CPU seconds (user + system) of a fresh process over '
              f'{args.repeats} runs, verdict only, ours and slugs alternating. Resident: median wall '
              f'milliseconds per request (of {args.repeats}) to one `gr1synth --serve` process, for '
              'the verdict and for the strategy (`--explicitStrategy --jsonOutput` when realizable, '
@@ -163,11 +160,13 @@ def main(argv=None) -> int:
             slugsin.write_text(parse_structuredslugs(text, filename='t.structuredslugs').to_slugsin())
             first = run_timed(GR1SYNTH + [str(slugsin)], 60)
             realizable = 'is realizable' in first['stderr']
-            ours = slugs = None
+            ours_runs, slugs_runs = [], []
             for _ in range(args.repeats):  # alternating, so both see the same load
-                ours = min(filter(None, [ours, run_timed(GR1SYNTH + [str(slugsin)], 60)['cpu']]))
+                ours_runs.append(run_timed(GR1SYNTH + [str(slugsin)], 60)['cpu'])
                 if args.slugs:
-                    slugs = min(filter(None, [slugs, run_timed([args.slugs, str(slugsin)], 60)['cpu']]))
+                    slugs_runs.append(run_timed([args.slugs, str(slugsin)], 60)['cpu'])
+            ours = statistics.median(ours_runs)
+            slugs = statistics.median(slugs_runs) if slugs_runs else None
             output = str(Path(directory) / 'strategy.json')
             (verdict_wall, strategy_wall), strategy_cpu = resident_wall(
                 [[str(slugsin)], REQUESTS[realizable] + [str(slugsin), output]], args.repeats, args.cpu_batch)
@@ -179,8 +178,8 @@ def main(argv=None) -> int:
                    f'{child_wall * 1000:.1f} ms | {child_cpu * 1000:.1f} ms |')
             print(row, flush=True)
             lines.append(row)
-    RESULTS.mkdir(parents=True, exist_ok=True)
-    (RESULTS / 'tiny_specs.md').write_text('\n'.join(lines) + '\n')
+    Path(args.markdown).parent.mkdir(parents=True, exist_ok=True)
+    Path(args.markdown).write_text('\n'.join(lines) + '\n')
     return 0
 
 

@@ -44,9 +44,7 @@ from respec.robot.abstraction import RobotAbstraction
 from respec.robot.cnu import CapabilitySystem
 from respec.spec import FORMULA_SECTIONS, GR1Specification
 from ltl_synthesizer.errors import SynthesisCancelledError
-from ltl_synthesizer.explanation import without_play
 from ltl_synthesizer.interrupt import Limits
-from ltl_synthesizer.unrealizable_core import environment_play, unrealizable_core
 from ltl_synthesizer.well_separation import check_well_separation
 
 from ltl_specification.capability_precheck import capability_file, unreachable_goals
@@ -263,6 +261,8 @@ def diagnose(spec: GR1Specification, robotics_semantics: bool = True, limits: Li
     When ``limits`` stop the core search (a cancel, the deadline), the pre-check's findings
     are still returned and the note says the core was not computed.
     """
+    # only an unrealizable specification needs them (not the compiler's or a realizable answer's)
+    from ltl_synthesizer.unrealizable_core import environment_play, unrealizable_core
     provenance = provenance or getattr(spec, 'provenance', None)
     findings = precheck(spec, provenance) if provenance else []
     groups = provenance.groups if provenance else formula_groups(spec)
@@ -400,5 +400,6 @@ def explain_unsynthesizable(details: str, spec: GR1Specification, provenance: Pr
     if diagnosis is None:
         return details
     if diagnosis.play:  # one play in the message: the diagnosis' is a play of the same counter-strategy
+        from ltl_synthesizer.explanation import without_play
         details = without_play(details)
     return f'{diagnosis.message()}\n\nDetails from the synthesizer:\n{details}'

@@ -27,6 +27,22 @@ REALIZABLE_LINE = 'RESULT: Specification is realizable.'
 UNREALIZABLE_LINE = 'RESULT: Specification is unrealizable.'
 
 
+#: The command's switches (flags without a value): name, help.
+SWITCHES = (
+    ('--explicitStrategy', 'write an explicit-state strategy when realizable'),
+    ('--jsonOutput', "strategies in slugs' JSON format"),
+    ('--sysInitRoboticsSemantics', 'every state allowed by both init sections must be winning'),
+    ('--counterStrategy', 'write a counter-strategy when unrealizable'),
+    ('--convert', 'only convert INPUT.structuredslugs to slugsin'),
+    ('--explain', 'when unrealizable, say why (losing initial states, blocked goal, a play)'),
+    ('--check-well-separation', 'when realizable, check that the system cannot win by forcing the environment '
+                                'to break its assumptions (Maoz & Ringert); print the result, or a warning '
+                                'naming the assumptions involved'),
+)
+#: What a command line without --timeout or --memory-limit gets (argparse's defaults below).
+DEFAULTS = {'timeout': None, 'memory_limit': 2048, 'serve': False}
+
+
 @functools.cache
 def _parser() -> argparse.ArgumentParser:
     """The command's argument parser, made once per process (0.6 ms: a tenth of a tiny
@@ -36,24 +52,11 @@ def _parser() -> argparse.ArgumentParser:
         formatter_class=argparse.RawDescriptionHelpFormatter,
         epilog=exit_status_help(ExitStatus.OK, ExitStatus.FAILED, ExitStatus.USAGE, ExitStatus.TIMED_OUT,
                                 ExitStatus.OUT_OF_MEMORY))
-    parser.add_argument('--explicitStrategy', action='store_true',
-                        help='write an explicit-state strategy when realizable')
-    parser.add_argument('--jsonOutput', action='store_true', help="strategies in slugs' JSON format")
-    parser.add_argument('--sysInitRoboticsSemantics', action='store_true',
-                        help='every state allowed by both init sections must be winning')
-    parser.add_argument('--counterStrategy', action='store_true',
-                        help='write a counter-strategy when unrealizable')
-    parser.add_argument('--convert', action='store_true',
-                        help='only convert INPUT.structuredslugs to slugsin')
-    parser.add_argument('--explain', action='store_true',
-                        help='when unrealizable, say why (losing initial states, blocked goal, a play)')
-    parser.add_argument('--check-well-separation', action='store_true',
-                        help='when realizable, check that the system cannot win by forcing the environment '
-                             'to break its assumptions (Maoz & Ringert); print the result, or a warning '
-                             'naming the assumptions involved')
-    parser.add_argument('--timeout', type=_limit, default=None, metavar='SECONDS',
+    for switch, meaning in SWITCHES:
+        parser.add_argument(switch, action='store_true', help=meaning)
+    parser.add_argument('--timeout', type=_limit, default=DEFAULTS['timeout'], metavar='SECONDS',
                         help='give up after this many seconds, reading the input included (exit status 3)')
-    parser.add_argument('--memory-limit', type=_limit, default=2048, metavar='MB',
+    parser.add_argument('--memory-limit', type=_limit, default=DEFAULTS['memory_limit'], metavar='MB',
                         help='give up beyond this much memory (default 2048, 0: none; exit status 4)')
     parser.add_argument('--serve', action='store_true',
                         help='resident mode: read one request per line on stdin (a JSON list of '
@@ -61,6 +64,25 @@ def _parser() -> argparse.ArgumentParser:
     parser.add_argument('input', metavar='INPUT', nargs='?')
     parser.add_argument('output', metavar='OUTPUT', nargs='?')
     return parser
+
+
+def _plain_arguments(argv: Sequence[str]) -> argparse.Namespace | None:
+    """``argv`` parsed without argparse when it is only switches (SWITCHES or --serve, spelled
+    out) followed by at most two file names (not starting with '-'), as argparse would parse
+    it; None for anything else (argparse parses it: making the parser costs more than a tiny
+    synthesis, 5 ms of CPU with the help texts, gettext's lookups and the terminal's size)."""
+    switches = [switch for switch, _ in SWITCHES]
+    given = 0
+    while given < len(argv) and argv[given] in (*switches, '--serve'):
+        given += 1
+    files = argv[given:]
+    if len(files) > 2 or any(name.startswith('-') for name in files):
+        return None
+    # in argparse's order (the parser's), so that even the Namespace's repr is the same
+    values: dict[str, Any] = {switch[2:].replace('-', '_'): switch in argv[:given] for switch in switches}
+    values.update(DEFAULTS, serve='--serve' in argv[:given], input=None, output=None)
+    values.update(zip(('input', 'output'), files))
+    return argparse.Namespace(**values)
 
 
 def _limit(text: str) -> float:
@@ -77,13 +99,12 @@ def _limit(text: str) -> float:
 def parse_arguments(argv: Sequence[str] | None) -> argparse.Namespace:
     """The parsed gr1synth command line ``argv``; usage errors exit as argparse does (2), an
     OUTPUT without a strategy to write exits 1 (as slugs)."""
-    parser = _parser()
-    args = parser.parse_args(argv)
+    args = _plain_arguments(sys.argv[1:] if argv is None else argv) or _parser().parse_args(argv)
     if args.serve:
         if args.input:
-            parser.error('--serve reads its requests from stdin: no INPUT')
+            _parser().error('--serve reads its requests from stdin: no INPUT')
     elif not args.input:
-        parser.error('the following arguments are required: INPUT')
+        _parser().error('the following arguments are required: INPUT')
     elif args.output and not (args.explicitStrategy or args.counterStrategy or args.convert):
         # As slugs ("too many file names"): an output file is only ever a strategy's.
         print('gr1synth: error: an OUTPUT file is written only with --explicitStrategy, '

@@ -1,15 +1,18 @@
-"""``dd.cudd`` without its 0.4 s import of networkx.
+"""``dd.cudd`` without the modules it loads only for features the synthesizer never uses.
 
-dd imports networkx at start-up only for graph conversions the synthesizer never uses, and that
-import is most of a tiny synthesis's CPU time (``python -X importtime``). While dd loads, a
-placeholder stands in for networkx; dd is then given networkx as a lazy module, so its
-conversions still work (loading networkx on first use), and any later ``import networkx``
-elsewhere gets the real module.
+dd imports at start-up, for graph conversions, its pure-Python BDDs, its expression parser
+(ply), copying and dumping (json, shelve, pickle), pretty-printing, running Graphviz
+(subprocess, shlex) and its messages (textwrap), modules that cost more than the rest of a
+tiny synthesis: networkx 0.4 s of CPU, the others about 15 ms (``python -X importtime``).
+While dd loads, a stand-in takes the place of each of them that is not loaded yet; dd keeps
+the stand-ins, and a stand-in loads its module by the ordinary import (so there is only ever
+one copy) the first time dd uses it. Any other ``import`` of those modules, later, gets the
+real module.
 """
 
 from __future__ import annotations
 
-import importlib.util
+import importlib
 import sys
 import types
 from typing import Any
@@ -17,34 +20,36 @@ from typing import Any
 #: A BDD of ``dd.cudd`` (a ``dd.cudd.Function``: dd has no type hints, so it is Any to mypy).
 Node = Any
 
+#: What dd imports that the synthesizer never uses (dd.cudd, dd._utils and dd.bdd import them at
+#: the top, but only functions that the synthesizer does not call use them).
+_DEFERRED = ('networkx', 'dd.autoref', 'dd.bdd', 'dd._copy', 'dd._parser',
+             'pickle', 'pprint', 'subprocess', 'shlex', 'textwrap')
 
-def _import_cudd() -> Any:  # the dd.cudd module
-    if 'dd.cudd' in sys.modules or 'networkx' in sys.modules:
-        from dd import cudd
-        return cudd
-    placeholder = types.ModuleType('networkx')
-    setattr(placeholder, 'MultiDiGraph', type('MultiDiGraph', (), {}))  # dd reads it for a type alias
-    sys.modules['networkx'] = placeholder
+
+class _StandIn(types.ModuleType):
+    """Stands in for the module of its name; loads it on the first use of an attribute."""
+
+    def __getattr__(self, attribute: str) -> Any:
+        if sys.modules.get(self.__name__) is self:  # used while dd loads: the real one now
+            del sys.modules[self.__name__]
+        return getattr(sys.modules.get(self.__name__) or _import_deferring(self.__name__), attribute)
+
+
+def _import_deferring(name: str) -> Any:
+    """The module ``name``, imported with stand-ins for the _DEFERRED modules not loaded yet (so
+    dd.bdd, which dd.cudd needs to enumerate cubes, comes without dd's parser too)."""
+    stand_ins = {deferred: _StandIn(deferred) for deferred in _DEFERRED
+                 if deferred != name and deferred not in sys.modules}
+    graphs: Any = stand_ins.get('networkx', types.SimpleNamespace())
+    graphs.MultiDiGraph = None  # dd reads it as it loads, for a type alias only
+    sys.modules.update(stand_ins)
     try:
-        from dd import cudd
+        return importlib.import_module(name)
     finally:
-        del sys.modules['networkx']
-    utils = sys.modules.get('dd._utils')
-    if utils is not None and getattr(utils, '_nx', None) is placeholder:
-        setattr(utils, '_nx', _lazy_module('networkx'))  # dd keeps its networkx import there
-    return cudd
+        del graphs.MultiDiGraph  # read from networkx from now on
+        for deferred, stand_in in stand_ins.items():
+            if sys.modules.get(deferred) is stand_in:
+                del sys.modules[deferred]
 
 
-def _lazy_module(name: str) -> types.ModuleType | None:
-    """``name`` as a module that loads on first attribute access (None if not installed)."""
-    spec = importlib.util.find_spec(name)
-    if spec is None:
-        return None
-    assert spec.loader is not None  # an installed module's
-    spec.loader = importlib.util.LazyLoader(spec.loader)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
-
-
-cudd = _import_cudd()
+cudd = _import_deferring('dd.cudd')

@@ -13,14 +13,16 @@ repository's ``config/``. A name found in an earlier directory shadows the same 
 
 from __future__ import annotations
 
-import argparse
 import os
 import re
 from pathlib import Path
-from typing import Any, Sequence, Union
+from typing import TYPE_CHECKING, Any, Sequence, Union
 
 from respec.untrusted import BoundedFileError, BoundedYamlError, load_bounded_yaml, read_bounded_file
 from respec.vocabulary.errors import CodedError, ErrorCode, quoted
+
+if TYPE_CHECKING:  # only the commands parse arguments (a robot file's reader needs no argparse)
+    import argparse
 
 CONFIG_DIR_ENV = 'BEHAVIOR_SYNTHESIS_CONFIG_DIR'
 #: The systems shipped with the repository; always last on the search path.
@@ -111,18 +113,19 @@ def system_file(system: str, search_path: Sequence[Path]) -> Path:
         f'(known systems: {known})', item=system)
 
 
-class _AddConfigDir(argparse.Action):
-    """Each ``--config-dir`` adds a directory; kept as one os.pathsep-joined string (a ROS parameter's type)."""
-
-    def __call__(self, parser: argparse.ArgumentParser, namespace: argparse.Namespace,
-                 value: str | Sequence[Any] | None, option_string: str | None = None) -> None:
-        assert isinstance(value, str)  # one DIR per option (no nargs)
-        setattr(namespace, self.dest, os.pathsep.join(filter(None, [getattr(namespace, self.dest, ''), value])))
-
-
 def add_config_dir_argument(parser: argparse.ArgumentParser) -> None:
     """The ``--config-dir DIR`` option every command shares (repeatable; see ``config_search_path``)."""
-    parser.add_argument('--config-dir', action=_AddConfigDir, default='', metavar='DIR',
+    import argparse
+
+    class AddConfigDir(argparse.Action):
+        """Each ``--config-dir`` adds a directory; kept as one os.pathsep-joined string (a ROS parameter's type)."""
+
+        def __call__(self, parser: argparse.ArgumentParser, namespace: argparse.Namespace,
+                     value: str | Sequence[Any] | None, option_string: str | None = None) -> None:
+            assert isinstance(value, str)  # one DIR per option (no nargs)
+            setattr(namespace, self.dest, os.pathsep.join(filter(None, [getattr(namespace, self.dest, ''), value])))
+
+    parser.add_argument('--config-dir', action=AddConfigDir, default='', metavar='DIR',
                         help='a directory of robot system files (<system>.yaml), searched before the shipped '
                              'config/; repeat it, or join directories with ' + repr(os.pathsep) + ', to add several')
 

@@ -11,7 +11,6 @@ from __future__ import annotations
 import enum
 import reprlib
 import sys
-import textwrap
 from typing import Callable
 
 #: How much of a user's value any message quotes: a refused value may be megabytes long.
@@ -187,6 +186,7 @@ class ExitStatus(enum.IntEnum):
 
 def exit_status_help(*statuses: ExitStatus) -> str:
     """The ``Exit status:`` paragraph of a command's help, for the statuses it can end with."""
+    import textwrap  # only for a help text (gr1synth synthesizes without it)
     lines = [textwrap.fill(f'{int(status)}  {status.meaning.replace("`", "")}', width=88,
                            initial_indent='  ', subsequent_indent='     ') for status in statuses]
     return '\n'.join(['Exit status:', *lines, '  130, 143  stopped by SIGINT (Ctrl-C) or SIGTERM'])

@@ -8,7 +8,6 @@ machine's outcomes (by default ``finished`` and ``failed``).
 
 from __future__ import annotations
 
-import difflib
 import re
 from typing import Iterable
 
@@ -77,5 +76,6 @@ def parse_names(text: str | list[str] | tuple[str, ...] | None) -> list[str]:
 
 def did_you_mean(name: str, known: Iterable[str]) -> str:
     """``'; did you mean look_down?'`` for a misspelled ``name`` close to one of ``known``, else ''."""
+    import difflib  # only for a misspelled name (3 ms of a fresh process's start-up, with heapq)
     close = difflib.get_close_matches(name, list(known), n=2, cutoff=0.7)
     return f'; did you mean {" or ".join(close)}?' if close else ''

@@ -236,3 +236,28 @@ def test_formulas_nested_beyond_the_limit_are_malformed(tmp_path):
     done = gr1synth(write(tmp_path, 'too_deep.structuredslugs', text))
     assert done.returncode == 1 and f'nested deeper than {MAX_FORMULA_NESTING}' in done.stderr
     assert 'Traceback' not in done.stderr and len(done.stderr) < 300
+
+
+def test_plain_command_lines_parse_as_argparse_parses_them():
+    # Switches then file names are parsed without argparse (making the parser costs more than a
+    # tiny synthesis); every command line of up to three words from these parses to the same
+    # Namespace (values and order), and anything else is left to argparse.
+    import io
+    from contextlib import redirect_stderr, redirect_stdout
+    from itertools import product
+    from ltl_synthesizer.command import SWITCHES, _parser, _plain_arguments
+    words = [switch for switch, _ in SWITCHES] + ['--serve', 'in.slugsin', 'out.json', '', '-', '--',
+                                                  '--explicit', '-h', '--timeout', '5', '--memory-limit=9']
+    plain = 0
+    for length in range(4):
+        for argv in product(words, repeat=length):
+            fast = _plain_arguments(list(argv))
+            if fast is None:
+                continue
+            plain += 1
+            with redirect_stderr(io.StringIO()), redirect_stdout(io.StringIO()):
+                assert repr(fast) == repr(_parser().parse_args(list(argv))), argv
+    assert plain > 1000
+    assert _plain_arguments(['--sysInitRoboticsSemantics', '--explicitStrategy', '--jsonOutput', 'a', 'b'])
+    assert _plain_arguments(['a', '--explicitStrategy']) is None  # a switch after a file: argparse's
+    assert _plain_arguments(['--timeout', '5', 'a']) is None

@@ -247,6 +247,43 @@ def test_synthesis_does_not_load_networkx():
     assert done.stdout.strip() == 'False'
 
 
+def test_synthesis_loads_none_of_what_dd_imports_for_features_it_does_not_use():
+    # The verdict needs none of them; an explicit strategy only dd.bdd (dd.cudd enumerates cubes
+    # with it), without dd's parser (ply) and the rest.
+    code = ('import sys; from ltl_synthesizer import is_realizable, synthesize\n'
+            'from ltl_synthesizer.cudd_import import _DEFERRED\n'
+            'from respec.parsing import parse_structuredslugs\n'
+            'spec = parse_structuredslugs("[INPUT]\\nx\\n[OUTPUT]\\ny\\n[SYS_TRANS]\\ny\' <-> x\'\\n")\n'
+            'assert is_realizable(spec)\n'
+            'print(sorted(name for name in _DEFERRED if name in sys.modules))\n'
+            'assert synthesize(spec).strategy["nodes"]\n'
+            'print(sorted(name for name in _DEFERRED if name in sys.modules), "ply" in sys.modules)')
+    done = subprocess.run([sys.executable, '-c', code], capture_output=True, text=True,
+                          cwd=REPOSITORY, timeout=60)
+    assert done.stdout.splitlines() == ['[]', "['dd.bdd'] False"], done.stderr
+
+
+def test_dd_features_behind_the_stand_ins_still_work(tmp_path):
+    # dd's parser (ply), JSON dump (dd._copy), enumeration (dd.bdd) and networkx export load on
+    # first use, as the one copy that a plain import of the same modules gets.
+    code = f'''
+import sys
+from ltl_synthesizer.cudd_import import cudd
+bdd = cudd.BDD()
+bdd.declare('x', 'y')
+u = bdd.add_expr(r'x /\\ ~ y')
+print(list(bdd.pick_iter(u)))
+bdd.dump({str(tmp_path / 'u.json')!r}, [u])
+import dd._copy, dd.bdd, dd._utils, networkx, pickle
+print(cudd._copy.load_json is dd._copy.load_json, cudd._bdd.BDD is dd.bdd.BDD, cudd.pickle.dump is pickle.dump)
+print(dd._utils.import_module('networkx').MultiDiGraph is networkx.MultiDiGraph)
+'''
+    done = subprocess.run([sys.executable, '-c', code], capture_output=True, text=True,
+                          cwd=REPOSITORY, timeout=60)
+    assert done.stdout.split('\n')[:3] == ["[{'x': True, 'y': False}]", 'True True True', 'True'], done.stderr
+    assert '"roots"' in (tmp_path / 'u.json').read_text()
+
+
 def test_one_goal_games_are_compact_up_to_a_looser_bound():
     # The chain of 160 capabilities retrying on failure: 30 nodes per proposition, one goal.
     from types import SimpleNamespace

@@ -270,11 +270,12 @@ def _codes(game: SymbolicGame, u: Node, names: list[str], either: set[str]) -> l
     compare as the tuples of values do, False before True), read cube by cube: a name of
     ``either`` that ``u`` leaves free takes both values, any other is False."""
     support = game.bdd.support(u)
-    bits = [(name, 1 << (len(names) - 1 - index)) for index, name in enumerate(names)]
-    free = [bit for name, bit in bits if name in either and name not in support]
+    bit_of = {name: 1 << (len(names) - 1 - index) for index, name in enumerate(names)}
+    free = [bit_of[name] for name in names if name in either and name not in support]
     codes = []
     for cube in game.bdd._pick_iter(u):  # noqa: SLF001 - dd.cudd's cube iterator without the public copy of each cube
-        found = [sum([bit for name, bit in bits if cube.get(name)])]
+        # The cube's True names (a capability robot's moves: a few of hundreds).
+        found = [sum([bit_of.get(name, 0) for name, value in cube.items() if value])]
         for bit in free:  # each free name doubles the valuations
             found += [code | bit for code in found]
         codes += found
@@ -313,14 +314,38 @@ def _smallest_responses(game: SymbolicGame, moves: Node) -> Node:
     bdd = game.bdd
     support = bdd.support(moves)
     decided = [name for name in game.next_outputs if name in support]
+    free = _free_names(game, moves, decided)
     chosen = moves
     for index, name in enumerate(decided):
+        if name not in free:
+            continue  # every move (and so every chosen one) has the same value
         low_moves = chosen & ~bdd.var(name)
         if low_moves == chosen or low_moves == game.false:
             continue
         can_be_low = bdd.exist(decided[index:], low_moves)
         chosen = bdd.ite(can_be_low, low_moves, chosen)
     return chosen
+
+
+def _free_names(game: SymbolicGame, u: Node, names: list[str]) -> set[str]:
+    """The ``names`` that take both values in ``u`` (not FALSE): those of one of its cubes
+    that leaves them out, and those whose literal in that cube ``u`` does not imply, found a
+    half at a time. Testing the names one by one cost most of the responses' choice (a chain
+    of 160 capabilities: 322 outputs per position, of which 2-3 free)."""
+    bdd = game.bdd
+    sample = next(bdd._pick_iter(u))  # noqa: SLF001 - dd.cudd's cube iterator (as _codes)
+    free = {name for name in names if name not in sample}
+    stack = [[name for name in names if name in sample]]
+    while stack:
+        group = stack.pop()
+        if not group or u & ~bdd.cube({name: sample[name] for name in group}) == game.false:
+            continue  # u implies the group's literals: none is free
+        if len(group) == 1:
+            free.add(group[0])
+            continue
+        middle = len(group) // 2
+        stack += [group[:middle], group[middle:]]
+    return free
 
 
 class _GoalsAt:

@@ -353,13 +353,18 @@ class _GoalsAt:
     state (and, for the environment, its chosen input), so that the position's transitions
     are split by the rest of their next step alone."""
 
-    def __init__(self, game: SymbolicGame, state: Mapping[str, bool | None], goals: list[Node]) -> None:
-        self.game, self.state, self.goals = game, state, goals
+    def __init__(self, game: SymbolicGame, state: Mapping[str, bool | None], goals: list[Node],
+                 supports: list[list[str]] | None = None) -> None:
+        self.game, self.state, self.goals, self.supports = game, state, goals, supports
         self.cofactors: dict[int, Node] = {}
 
     def cofactor(self, goal: int) -> Node:
+        """Goal ``goal`` cofactored by the state (by the variables it mentions, when their
+        list ``supports[goal]`` is known: a cube of a few variables, not of all)."""
         if goal not in self.cofactors:
-            self.cofactors[goal] = self.game.bdd.let(self.state, self.goals[goal])
+            state = self.state if self.supports is None else \
+                {name: self.state[name] for name in self.supports[goal]}
+            self.cofactors[goal] = self.game.bdd.let(state, self.goals[goal]) if state else self.goals[goal]
         return self.cofactors[goal]
 
     def split_by_successor_goal(self, following: Node, rank: int) -> Iterator[tuple[int, Node]]:
@@ -473,6 +478,10 @@ def strategy_nodes(game: SymbolicGame, solution: SystemSolution) -> Iterator[tup
     variables, goals = game.variables, len(game.sys_goals)
     responses = _Responses(game)
     safety = _SafetyAt(game)
+    # The current variables each goal mentions: cofactoring by them alone (_GoalsAt) saves
+    # building a cube of every variable per goal and position.
+    goal_supports = [[name for name in variables if name in support]
+                     for support in map(game.bdd.support, game.sys_goals)]
     numbering = _Numbering()
     for code in _initial_codes(game, solution.winning & game.env_init & game.sys_init):
         numbering.number(_node_key(code, 0, goals))
@@ -488,7 +497,7 @@ def strategy_nodes(game: SymbolicGame, solution: SystemSolution) -> Iterator[tup
         # Without the state cube, the picks below work on smaller BDDs.
         moves = game.bdd.exist(variables, goal_moves(game, steps[rank], env_moves, legal))
         successors = [number(successor) for successor in
-                      responses(moves, _GoalsAt(game, state, game.sys_goals), rank)]
+                      responses(moves, _GoalsAt(game, state, game.sys_goals, goal_supports), rank)]
         yield str(numbering.index[key]), {
             'rank': rank, 'state': list(map(int, values)), 'trans': successors}
 

@@ -36,32 +36,62 @@ def goal_steps(game: SymbolicGame, solution: SystemSolution) -> list[list[Attrac
     return steps
 
 
-def goal_moves(game: SymbolicGame, steps: _GoalSteps, env_moves: Node, legal: Node) -> Node:
-    """The positional strategy of one goal at one position: each environment move is
-    answered with the moves of the first attractor step (lowest rank) that offers a response.
+def goal_moves(game: SymbolicGame, steps: _GoalSteps, at_state: Callable[[Node], Node], env_moves: Node,
+               legal: Node) -> Node:
+    """The positional strategy of one goal at one position: each environment move is answered
+    with the moves of the first attractor step (lowest rank) that offers a response.
 
-    ``env_moves`` (the position's state cube conjoined with env_trans) and ``legal`` (with
-    sys_trans too) are small, and every operation here is conjoined with them, so a step
-    costs little. Building the strategy relation over all positions costs far more than the
-    few positions a strategy visits (seconds on multi-goal tasks), and so does the union of
-    the steps' responses that bisecting for the answering steps would need. Conjoining
-    rather than cofactoring by the state (``let``) saves a Python-level pass over all
-    variables per step. The scan ends at the latest at the first step whose waiting set
-    holds the position: that step answers every environment move.
+    ``env_moves`` (env_trans at the position) and ``legal`` (with sys_trans too) are small,
+    and every operation here is on them and on the steps' sets at the position
+    (``at_state``), so a step costs little. The position is given either as cofactors by its
+    state (``at_state``: an _AtState; the moves are then over next-step variables), or as the
+    state's cube conjoined with env_moves and legal (``at_state``: ``_unchanged``), cheaper
+    for games of few variables (COFACTORED_FROM). Building the strategy relation over all positions costs
+    far more than the few positions a strategy visits (seconds on multi-goal tasks), and so
+    does the union of the steps' responses that bisecting for the answering steps would need.
+    Cofactors have no current variables: conjoined with the state's cube instead, every set
+    held the cube's chain of nodes, one per current variable (a chain of 160 capabilities:
+    322), and making those nodes took most of the extraction. The scan ends at the latest
+    at the first step whose waiting set holds the position: that step answers every
+    environment move.
     """
     moves = answered = game.false
     unanswered = env_moves
-    for step in steps.offering(lambda: unanswered):
-        offered = step.responses & env_moves
+    for step in steps.offering(lambda: unanswered, at_state):
+        offered = at_state(step.responses) & env_moves
         new_cases = offered & ~answered
         if new_cases == game.false:
             continue
-        moves |= step.transitions_among(new_cases & legal)
+        moves |= step.transitions_among(new_cases & legal, at_state)
         answered |= offered
         if answered == env_moves:
             break  # every environment move is answered
         unanswered = env_moves & ~answered
     return moves
+
+
+#: Games of more variables than this extract their strategies on cofactors by the state
+#: (goal_moves), those of fewer on the state's cube: a cofactor costs a cube built afresh
+#: (about 20 us, most of a gridworld's step), a conjunction with the cube a chain of nodes.
+COFACTORED_FROM = 64
+
+
+def _unchanged(u: Node) -> Node:
+    return u
+
+
+class _AtState:
+    """Sets of transitions cofactored by one position's state (each once)."""
+
+    def __init__(self, game: SymbolicGame, state: Mapping[str, bool]) -> None:
+        self.let, self.state = game.bdd.let, state
+        self.found: dict[int, tuple[Node, Node]] = {}
+
+    def __call__(self, u: Node) -> Node:
+        found = self.found.get(int(u))
+        if found is None:
+            found = self.found[int(u)] = (u, self.let(self.state, u))
+        return found[1]
 
 
 class _GoalSteps:
@@ -75,17 +105,18 @@ class _GoalSteps:
         self.game, self.steps = game, steps
         self._unions: dict[tuple[int, int], Node] = {}
 
-    def offering(self, unanswered: Callable[[], Node]) -> Iterator[_StepMoves]:
+    def offering(self, unanswered: Callable[[], Node], at_state: Callable[[Node], Node]) -> Iterator[_StepMoves]:
         """The steps, in order, without ranges none of whose responses meets the environment
         moves ``unanswered()`` (asked again as the scan goes on: the moves no earlier step
-        answers); a skipped step would offer no new case, and goal_moves passes over those."""
+        answers; over next-step variables, as the unions cofactored by ``at_state``); a
+        skipped step would offer no new case, and goal_moves passes over those."""
         if len(self.steps) <= INDEXED_STEPS:
             yield from self.steps
             return
         stack = [(0, len(self.steps))]
         while stack:
             low, high = stack.pop()
-            if self._union(low, high) & unanswered() == self.game.false:
+            if at_state(self._union(low, high)) & unanswered() == self.game.false:
                 continue
             if high - low <= INDEXED_STEPS:
                 yield from self.steps[low:high]
@@ -124,14 +155,17 @@ class _StepMoves:
         self.responses = step.responses
         self._primed: tuple[Node, Node] | None = None
 
-    def transitions_among(self, moves: Node) -> Node:
-        """The ``moves`` (a small set of transitions) that are transitions of this step."""
+    def transitions_among(self, moves: Node, at_state: Callable[[Node], Node]) -> Node:
+        """The ``moves`` (a small set of next steps from one position, over next-step
+        variables) that are transitions of this step from there (``at_state``: the
+        position's cofactors)."""
         if self._primed is None:
             step = self.step
             self._primed = (self.game.prime(step.closer),
                             self.game.prime(step.waiting) & ~step.assumption)
         into_closer, into_waiting = self._primed
-        return (moves & self.step.goal_transitions) | (moves & into_closer) | (moves & into_waiting)
+        return (moves & at_state(self.step.goal_transitions)) | (moves & into_closer) | \
+            (moves & at_state(into_waiting))
 
 
 @dataclass
@@ -314,7 +348,8 @@ def _smallest_responses(game: SymbolicGame, moves: Node) -> Node:
     bdd = game.bdd
     support = bdd.support(moves)
     decided = [name for name in game.next_outputs if name in support]
-    free = _free_names(game, moves, decided)
+    # Few outputs are tested one by one at once (a gridworld's 9: a search costs more).
+    free = _free_names(game, moves, decided) if len(decided) > FREE_NAMES_SEARCHED_FROM else set(decided)
     chosen = moves
     for index, name in enumerate(decided):
         if name not in free:
@@ -325,6 +360,10 @@ def _smallest_responses(game: SymbolicGame, moves: Node) -> Node:
         can_be_low = bdd.exist(decided[index:], low_moves)
         chosen = bdd.ite(can_be_low, low_moves, chosen)
     return chosen
+
+
+#: From this many outputs on, _smallest_responses first finds those its moves leave free.
+FREE_NAMES_SEARCHED_FROM = 32
 
 
 def _free_names(game: SymbolicGame, u: Node, names: list[str]) -> set[str]:
@@ -384,16 +423,27 @@ class _GoalsAt:
         yield rank, following
 
 
+def _moves_from(game: SymbolicGame, state: dict[str, bool]) -> tuple[Node, Node]:
+    """The moves from one position allowed by env_trans, and those allowed by both safety
+    sections, each as the position's state cube conjoined with the relation."""
+    env_moves = game.cube(state)
+    for cluster in game.env_partition.clusters:
+        env_moves &= cluster
+    legal = env_moves & game.sys_invariant
+    for cluster in game.sys_partition.clusters:
+        legal &= cluster
+    return env_moves, legal
+
+
 class _SafetyAt:
     """The moves from one position allowed by env_trans, and those allowed by both safety
-    sections (``moves_from``), each as the position's state cube conjoined with the relation.
+    sections (``moves_from``), each as the relation cofactored by the position's state.
 
     Each cluster is cofactored by the values of the current variables it mentions, and the
     cofactors (and their conjunctions) are remembered by those values: a cluster mentions a
     part of the state, whose values recur across the strategy's positions (the mix of 80
     capabilities: 10-88 distinct values per cluster over 597 positions). Conjoining the state
-    cube with every cluster at every position took half of its extraction. The result is the
-    same BDD: ``cube & C == cube & C|state``."""
+    cube with every cluster at every position took half of its extraction."""
 
     def __init__(self, game: SymbolicGame, limit: int = 2**16) -> None:
         self.game, self.limit = game, limit
@@ -424,8 +474,7 @@ class _SafetyAt:
             # The cofactors are kept with their conjunctions, so that their nodes (the key)
             # are not reused for other functions.
             found = self._conjunctions[key] = (env_moves, legal, parts)
-        cube = self.game.cube(state)
-        return cube & found[0], cube & found[1]
+        return found[0], found[1]
 
     def _cofactor(self, index: int, part: Node, state: Mapping[str, bool]) -> Node:
         support = self.supports[index]
@@ -478,6 +527,7 @@ def strategy_nodes(game: SymbolicGame, solution: SystemSolution) -> Iterator[tup
     variables, goals = game.variables, len(game.sys_goals)
     responses = _Responses(game)
     safety = _SafetyAt(game)
+    by_cofactors = len(variables) > COFACTORED_FROM
     # The current variables each goal mentions: cofactoring by them alone (_GoalsAt) saves
     # building a cube of every variable per goal and position.
     goal_supports = [[name for name in variables if name in support]
@@ -493,9 +543,12 @@ def strategy_nodes(game: SymbolicGame, solution: SystemSolution) -> Iterator[tup
         code, rank = divmod(key, goals)
         values = _values(code, len(variables))
         state = dict(zip(variables, values))
-        env_moves, legal = safety.moves_from(state)
-        # Without the state cube, the picks below work on smaller BDDs.
-        moves = game.bdd.exist(variables, goal_moves(game, steps[rank], env_moves, legal))
+        if by_cofactors:
+            env_moves, legal = safety.moves_from(state)
+            moves = goal_moves(game, steps[rank], _AtState(game, state), env_moves, legal)
+        else:  # the same moves, from the transitions conjoined with the state's cube
+            env_moves, legal = _moves_from(game, state)
+            moves = game.bdd.exist(variables, goal_moves(game, steps[rank], _unchanged, env_moves, legal))
         successors = [number(successor) for successor in
                       responses(moves, _GoalsAt(game, state, game.sys_goals, goal_supports), rank)]
         yield str(numbering.index[key]), {

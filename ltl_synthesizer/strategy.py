@@ -92,9 +92,8 @@ class _AtState:
     def __call__(self, u: Node) -> Node:
         found = self.found.get(int(u))
         if found is None:
-            state = self.state
-            names = self.supports(u)
-            found = self.found[int(u)] = (u, self.let({name: state[name] for name in names}, u) if names else u)
+            names, values = self.supports(u)
+            found = self.found[int(u)] = (u, self.let(dict(zip(names, values(self.state))), u) if names else u)
         return found[1]
 
 
@@ -562,10 +561,12 @@ def strategy_nodes(game: SymbolicGame, solution: SystemSolution) -> Iterator[tup
             'rank': rank, 'state': list(map(int, values)), 'trans': successors}
 
 
-def _mentioned(game: SymbolicGame, u: Node) -> list[str]:
-    """The current variables ``u`` mentions, in declared order."""
+def _mentioned(game: SymbolicGame, u: Node) -> tuple[list[str], Callable[[Mapping[str, bool]], Any]]:
+    """The current variables ``u`` mentions, in declared order, and a function reading their
+    values off a state (as a tuple)."""
     support = game.bdd.support(u)
-    return [name for name in game.variables if name in support]
+    names = [name for name in game.variables if name in support]
+    return names, (itemgetter(*names) if len(names) > 1 else lambda state: tuple(state[name] for name in names))
 
 
 def extract_counterstrategy(game: SymbolicGame, solution: EnvironmentSolution,

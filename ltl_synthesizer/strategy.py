@@ -76,6 +76,10 @@ def goal_moves(game: SymbolicGame, steps: _GoalSteps, at_state: Callable[[Node],
 COFACTORED_FROM = 64
 
 
+def _no_values(state: Mapping[str, bool]) -> tuple[()]:
+    return ()
+
+
 def _unchanged(u: Node) -> Node:
     return u
 
@@ -455,8 +459,10 @@ class _SafetyAt:
         supports = [game.bdd.support(part) for part in self.env_parts + self.sys_parts]
         # The current variables each part mentions, in declared order.
         self.supports = [[name for name in game.variables if name in support] for support in supports]
-        self._projections = [itemgetter(*support) if support else None for support in self.supports]
-        self._cofactors: dict[tuple[int, tuple[bool, ...]], Node] = {}
+        # Each reads the values of those variables off a state (of one: the value).
+        self._projections: list[Callable[[Mapping[str, bool]], Any]] = [
+            itemgetter(*support) if support else _no_values for support in self.supports]
+        self._cofactors: dict[tuple[int, Any], Node] = {}
         self._conjunctions: dict[tuple[int, ...], tuple[Node, Node, list[Node]]] = {}
 
     def moves_from(self, state: Mapping[str, bool]) -> tuple[Node, Node]:

@@ -46,9 +46,10 @@ def goal_moves(game: SymbolicGame, steps: _GoalSteps, at_state: Callable[[Node],
     (``at_state``), so a step costs little. The position is given either as cofactors by its
     state (``at_state``: an _AtState; the moves are then over next-step variables), or as the
     state's cube conjoined with env_moves and legal (``at_state``: ``_unchanged``), cheaper
-    for games of few variables (COFACTORED_FROM). Building the strategy relation over all positions costs
-    far more than the few positions a strategy visits (seconds on multi-goal tasks), and so
-    does the union of the steps' responses that bisecting for the answering steps would need.
+    for games of few variables (COFACTORED_FROM). Building the strategy relation over all
+    positions costs far more than the few positions a strategy visits (seconds on multi-goal
+    tasks), and so does the union of the steps' responses that bisecting for the answering
+    steps would need.
     Cofactors have no current variables: conjoined with the state's cube instead, every set
     held the cube's chain of nodes, one per current variable (a chain of 160 capabilities:
     322), and making those nodes took most of the extraction. The scan ends at the latest
@@ -355,7 +356,7 @@ def _smallest_responses(game: SymbolicGame, moves: Node) -> Node:
     bdd = game.bdd
     support = bdd.support(moves)
     decided = [name for name in game.next_outputs if name in support]
-    # Few outputs are tested one by one at once (a gridworld's 9: a search costs more).
+    # Few outputs are all tested one by one (a gridworld's 9: the search costs more).
     free = _free_names(game, moves, decided) if len(decided) > FREE_NAMES_SEARCHED_FROM else set(decided)
     chosen = moves
     for index, name in enumerate(decided):

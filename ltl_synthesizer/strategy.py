@@ -13,6 +13,7 @@ result is deterministic.
 from __future__ import annotations
 
 from collections import deque
+from operator import itemgetter
 from dataclasses import dataclass
 from typing import Any, Callable, Iterable, Iterator, Mapping
 
@@ -35,32 +36,70 @@ def goal_steps(game: SymbolicGame, solution: SystemSolution) -> list[list[Attrac
     return steps
 
 
-def goal_moves(game: SymbolicGame, steps: _GoalSteps, env_moves: Node, legal: Node) -> Node:
-    """The positional strategy of one goal at one position: each environment move is
-    answered with the moves of the first attractor step (lowest rank) that offers a response.
+def goal_moves(game: SymbolicGame, steps: _GoalSteps, at_state: Callable[[Node], Node], env_moves: Node,
+               legal: Node) -> Node:
+    """The positional strategy of one goal at one position: each environment move is answered
+    with the moves of the first attractor step (lowest rank) that offers a response.
 
-    ``env_moves`` (the position's state cube conjoined with env_trans) and ``legal`` (with
-    sys_trans too) are small, and every operation here is conjoined with them, so a step
-    costs little. Building the strategy relation over all positions costs far more than the
-    few positions a strategy visits (seconds on multi-goal tasks), and so does the union of
-    the steps' responses that bisecting for the answering steps would need. Conjoining
-    rather than cofactoring by the state (``let``) saves a Python-level pass over all
-    variables per step. The scan ends at the latest at the first step whose waiting set
-    holds the position: that step answers every environment move.
+    ``env_moves`` (env_trans at the position) and ``legal`` (with sys_trans too) are small,
+    and every operation here is on them and on the steps' sets at the position
+    (``at_state``), so a step costs little. The position is given either as cofactors by its
+    state (``at_state``: an _AtState; the moves are then over next-step variables), or as the
+    state's cube conjoined with env_moves and legal (``at_state``: ``_unchanged``), cheaper
+    for games of few variables (COFACTORED_FROM). Building the strategy relation over all
+    positions costs far more than the few positions a strategy visits (seconds on multi-goal
+    tasks), and so does the union of the steps' responses that bisecting for the answering
+    steps would need.
+    Cofactors have no current variables: conjoined with the state's cube instead, every set
+    held the cube's chain of nodes, one per current variable (a chain of 160 capabilities:
+    322), and making those nodes took most of the extraction. The scan ends at the latest
+    at the first step whose waiting set holds the position: that step answers every
+    environment move.
     """
     moves = answered = game.false
     unanswered = env_moves
-    for step in steps.offering(lambda: unanswered):
-        offered = step.responses & env_moves
+    for step in steps.offering(lambda: unanswered, at_state):
+        offered = at_state(step.responses) & env_moves
         new_cases = offered & ~answered
         if new_cases == game.false:
             continue
-        moves |= step.transitions_among(new_cases & legal)
+        moves |= step.transitions_among(new_cases & legal, at_state)
         answered |= offered
         if answered == env_moves:
             break  # every environment move is answered
         unanswered = env_moves & ~answered
     return moves
+
+
+#: Games of more variables than this extract their strategies on cofactors by the state
+#: (goal_moves), those of fewer on the state's cube: a cofactor costs a cube built afresh
+#: (about 20 us, most of a gridworld's step), a conjunction with the cube a chain of nodes.
+COFACTORED_FROM = 64
+
+
+def _no_values(state: Mapping[str, bool]) -> tuple[()]:
+    return ()
+
+
+def _unchanged(u: Node) -> Node:
+    return u
+
+
+class _AtState:
+    """Sets of transitions cofactored by one position's state (each once), by the values of
+    the current variables they mention (``supports``): building the cube of all of them took
+    two thirds of a cofactor (48 of 70 us at the sensor chain of 80)."""
+
+    def __init__(self, game: SymbolicGame, state: Mapping[str, bool], supports: _NodeMemo) -> None:
+        self.let, self.state, self.supports = game.bdd.let, state, supports
+        self.found: dict[int, tuple[Node, Node]] = {}
+
+    def __call__(self, u: Node) -> Node:
+        found = self.found.get(int(u))
+        if found is None:
+            names, values = self.supports(u)
+            found = self.found[int(u)] = (u, self.let(dict(zip(names, values(self.state))), u) if names else u)
+        return found[1]
 
 
 class _GoalSteps:
@@ -74,17 +113,18 @@ class _GoalSteps:
         self.game, self.steps = game, steps
         self._unions: dict[tuple[int, int], Node] = {}
 
-    def offering(self, unanswered: Callable[[], Node]) -> Iterator[_StepMoves]:
+    def offering(self, unanswered: Callable[[], Node], at_state: Callable[[Node], Node]) -> Iterator[_StepMoves]:
         """The steps, in order, without ranges none of whose responses meets the environment
         moves ``unanswered()`` (asked again as the scan goes on: the moves no earlier step
-        answers); a skipped step would offer no new case, and goal_moves passes over those."""
+        answers; over next-step variables, as the unions cofactored by ``at_state``); a
+        skipped step would offer no new case, and goal_moves passes over those."""
         if len(self.steps) <= INDEXED_STEPS:
             yield from self.steps
             return
         stack = [(0, len(self.steps))]
         while stack:
             low, high = stack.pop()
-            if self._union(low, high) & unanswered() == self.game.false:
+            if at_state(self._union(low, high)) & unanswered() == self.game.false:
                 continue
             if high - low <= INDEXED_STEPS:
                 yield from self.steps[low:high]
@@ -123,14 +163,17 @@ class _StepMoves:
         self.responses = step.responses
         self._primed: tuple[Node, Node] | None = None
 
-    def transitions_among(self, moves: Node) -> Node:
-        """The ``moves`` (a small set of transitions) that are transitions of this step."""
+    def transitions_among(self, moves: Node, at_state: Callable[[Node], Node]) -> Node:
+        """The ``moves`` (a small set of next steps from one position, over next-step
+        variables) that are transitions of this step from there (``at_state``: the
+        position's cofactors)."""
         if self._primed is None:
             step = self.step
             self._primed = (self.game.prime(step.closer),
                             self.game.prime(step.waiting) & ~step.assumption)
         into_closer, into_waiting = self._primed
-        return (moves & self.step.goal_transitions) | (moves & into_closer) | (moves & into_waiting)
+        return (moves & at_state(self.step.goal_transitions)) | (moves & into_closer) | \
+            (moves & at_state(into_waiting))
 
 
 @dataclass
@@ -269,11 +312,12 @@ def _codes(game: SymbolicGame, u: Node, names: list[str], either: set[str]) -> l
     compare as the tuples of values do, False before True), read cube by cube: a name of
     ``either`` that ``u`` leaves free takes both values, any other is False."""
     support = game.bdd.support(u)
-    bits = [(name, 1 << (len(names) - 1 - index)) for index, name in enumerate(names)]
-    free = [bit for name, bit in bits if name in either and name not in support]
+    bit_of = {name: 1 << (len(names) - 1 - index) for index, name in enumerate(names)}
+    free = [bit_of[name] for name in names if name in either and name not in support]
     codes = []
     for cube in game.bdd._pick_iter(u):  # noqa: SLF001 - dd.cudd's cube iterator without the public copy of each cube
-        found = [sum([bit for name, bit in bits if cube.get(name)])]
+        # The cube's True names (a capability robot's moves: a few of hundreds).
+        found = [sum([bit_of.get(name, 0) for name, value in cube.items() if value])]
         for bit in free:  # each free name doubles the valuations
             found += [code | bit for code in found]
         codes += found
@@ -299,7 +343,7 @@ def _initial_codes(game: SymbolicGame, initial: Node) -> Iterable[int]:
 
 def _values(code: int, count: int) -> tuple[bool, ...]:
     """The ``count`` values (booleans) that ``code`` codes (see ``_codes``)."""
-    return tuple(bool(code >> (count - 1 - index) & 1) for index in range(count))
+    return tuple(map('1'.__eq__, format(code, f'0{count}b')))  # its binary digits, first name first
 
 
 def _smallest_responses(game: SymbolicGame, moves: Node) -> Node:
@@ -312,8 +356,12 @@ def _smallest_responses(game: SymbolicGame, moves: Node) -> Node:
     bdd = game.bdd
     support = bdd.support(moves)
     decided = [name for name in game.next_outputs if name in support]
+    # Few outputs are all tested one by one (a gridworld's 9: the search costs more).
+    free = _free_names(game, moves, decided) if len(decided) > FREE_NAMES_SEARCHED_FROM else set(decided)
     chosen = moves
     for index, name in enumerate(decided):
+        if name not in free:
+            continue  # every move (and so every chosen one) has the same value
         low_moves = chosen & ~bdd.var(name)
         if low_moves == chosen or low_moves == game.false:
             continue
@@ -322,18 +370,48 @@ def _smallest_responses(game: SymbolicGame, moves: Node) -> Node:
     return chosen
 
 
+#: From this many outputs on, _smallest_responses first finds those its moves leave free.
+FREE_NAMES_SEARCHED_FROM = 32
+
+
+def _free_names(game: SymbolicGame, u: Node, names: list[str]) -> set[str]:
+    """The ``names`` that take both values in ``u`` (not FALSE): those of one of its cubes
+    that leaves them out, and those whose literal in that cube ``u`` does not imply, found a
+    half at a time. Testing the names one by one cost most of the responses' choice (a chain
+    of 160 capabilities: 322 outputs per position, of which 2-3 free)."""
+    bdd = game.bdd
+    sample = next(bdd._pick_iter(u))  # noqa: SLF001 - dd.cudd's cube iterator (as _codes)
+    free = {name for name in names if name not in sample}
+    stack = [[name for name in names if name in sample]]
+    while stack:
+        group = stack.pop()
+        if not group or u & ~bdd.cube({name: sample[name] for name in group}) == game.false:
+            continue  # u implies the group's literals: none is free
+        if len(group) == 1:
+            free.add(group[0])
+            continue
+        middle = len(group) // 2
+        stack += [group[:middle], group[middle:]]
+    return free
+
+
 class _GoalsAt:
     """Goals (the system's, or the environment's assumptions) cofactored by one position's
     state (and, for the environment, its chosen input), so that the position's transitions
     are split by the rest of their next step alone."""
 
-    def __init__(self, game: SymbolicGame, state: Mapping[str, bool | None], goals: list[Node]) -> None:
-        self.game, self.state, self.goals = game, state, goals
+    def __init__(self, game: SymbolicGame, state: Mapping[str, bool | None], goals: list[Node],
+                 supports: list[list[str]] | None = None) -> None:
+        self.game, self.state, self.goals, self.supports = game, state, goals, supports
         self.cofactors: dict[int, Node] = {}
 
     def cofactor(self, goal: int) -> Node:
+        """Goal ``goal`` cofactored by the state (by the variables it mentions, when their
+        list ``supports[goal]`` is known: a cube of a few variables, not of all)."""
         if goal not in self.cofactors:
-            self.cofactors[goal] = self.game.bdd.let(self.state, self.goals[goal])
+            state = self.state if self.supports is None else \
+                {name: self.state[name] for name in self.supports[goal]}
+            self.cofactors[goal] = self.game.bdd.let(state, self.goals[goal]) if state else self.goals[goal]
         return self.cofactors[goal]
 
     def split_by_successor_goal(self, following: Node, rank: int) -> Iterator[tuple[int, Node]]:
@@ -363,6 +441,61 @@ def _moves_from(game: SymbolicGame, state: dict[str, bool]) -> tuple[Node, Node]
     for cluster in game.sys_partition.clusters:
         legal &= cluster
     return env_moves, legal
+
+
+class _SafetyAt:
+    """The moves from one position allowed by env_trans, and those allowed by both safety
+    sections (``moves_from``), each as the relation cofactored by the position's state.
+
+    Each cluster is cofactored by the values of the current variables it mentions, and the
+    cofactors (and their conjunctions) are remembered by those values: a cluster mentions a
+    part of the state, whose values recur across the strategy's positions (the mix of 80
+    capabilities: 10-88 distinct values per cluster over 597 positions). Conjoining the state
+    cube with every cluster at every position took half of its extraction."""
+
+    def __init__(self, game: SymbolicGame, limit: int = 2**16) -> None:
+        self.game, self.limit = game, limit
+        self.env_parts = list(game.env_partition.clusters)
+        self.sys_parts = [game.sys_invariant] + list(game.sys_partition.clusters)
+        supports = [game.bdd.support(part) for part in self.env_parts + self.sys_parts]
+        # The current variables each part mentions, in declared order.
+        self.supports = [[name for name in game.variables if name in support] for support in supports]
+        # Each reads the values of those variables off a state (of one: the value).
+        self._projections: list[Callable[[Mapping[str, bool]], Any]] = [
+            itemgetter(*support) if support else _no_values for support in self.supports]
+        self._cofactors: dict[tuple[int, Any], Node] = {}
+        self._conjunctions: dict[tuple[int, ...], tuple[Node, Node, list[Node]]] = {}
+
+    def moves_from(self, state: Mapping[str, bool]) -> tuple[Node, Node]:
+        if len(self._cofactors) + len(self._conjunctions) >= self.limit:
+            self._cofactors.clear()  # bounds the memory of a huge strategy
+            self._conjunctions.clear()
+        parts = [self._cofactor(index, part, state)
+                 for index, part in enumerate(self.env_parts + self.sys_parts)]
+        key = tuple(int(part) for part in parts)
+        found = self._conjunctions.get(key)
+        if found is None:
+            env_moves = self.game.true
+            for part in parts[:len(self.env_parts)]:
+                env_moves &= part
+            legal = env_moves
+            for part in parts[len(self.env_parts):]:
+                legal &= part
+            # The cofactors are kept with their conjunctions, so that their nodes (the key)
+            # are not reused for other functions.
+            found = self._conjunctions[key] = (env_moves, legal, parts)
+        return found[0], found[1]
+
+    def _cofactor(self, index: int, part: Node, state: Mapping[str, bool]) -> Node:
+        support = self.supports[index]
+        if not support:
+            return part
+        values = self._projections[index](state)
+        found = self._cofactors.get((index, values))
+        if found is None:
+            found = self._cofactors[index, values] = \
+                self.game.bdd.let({name: state[name] for name in support}, part)
+        return found
 
 
 class _Numbering:
@@ -403,6 +536,15 @@ def strategy_nodes(game: SymbolicGame, solution: SystemSolution) -> Iterator[tup
     steps = [_GoalSteps(game, [_StepMoves(game, step) for step in goal]) for goal in goal_steps(game, solution)]
     variables, goals = game.variables, len(game.sys_goals)
     responses = _Responses(game)
+    safety = _SafetyAt(game)
+    by_cofactors = len(variables) > COFACTORED_FROM
+    # The current variables each step's set mentions (_AtState; the steps' sets live as long
+    # as the extraction, and finding a support walks the whole BDD).
+    current_supports = _NodeMemo(lambda u: _mentioned(game, u))
+    # The current variables each goal mentions: cofactoring by them alone (_GoalsAt) saves
+    # building a cube of every variable per goal and position.
+    goal_supports = [[name for name in variables if name in support]
+                     for support in map(game.bdd.support, game.sys_goals)]
     numbering = _Numbering()
     for code in _initial_codes(game, solution.winning & game.env_init & game.sys_init):
         numbering.number(_node_key(code, 0, goals))
@@ -414,13 +556,24 @@ def strategy_nodes(game: SymbolicGame, solution: SystemSolution) -> Iterator[tup
         code, rank = divmod(key, goals)
         values = _values(code, len(variables))
         state = dict(zip(variables, values))
-        env_moves, legal = _moves_from(game, state)
-        # Without the state cube, the picks below work on smaller BDDs.
-        moves = game.bdd.exist(variables, goal_moves(game, steps[rank], env_moves, legal))
+        if by_cofactors:
+            env_moves, legal = safety.moves_from(state)
+            moves = goal_moves(game, steps[rank], _AtState(game, state, current_supports), env_moves, legal)
+        else:  # the same moves, from the transitions conjoined with the state's cube
+            env_moves, legal = _moves_from(game, state)
+            moves = game.bdd.exist(variables, goal_moves(game, steps[rank], _unchanged, env_moves, legal))
         successors = [number(successor) for successor in
-                      responses(moves, _GoalsAt(game, state, game.sys_goals), rank)]
+                      responses(moves, _GoalsAt(game, state, game.sys_goals, goal_supports), rank)]
         yield str(numbering.index[key]), {
-            'rank': rank, 'state': [int(v) for v in values], 'trans': successors}
+            'rank': rank, 'state': list(map(int, values)), 'trans': successors}
+
+
+def _mentioned(game: SymbolicGame, u: Node) -> tuple[list[str], Callable[[Mapping[str, bool]], Any]]:
+    """The current variables ``u`` mentions, in declared order, and a function reading their
+    values off a state (as a tuple)."""
+    support = game.bdd.support(u)
+    names = [name for name in game.variables if name in support]
+    return names, (itemgetter(*names) if len(names) > 1 else lambda state: tuple(state[name] for name in names))
 
 
 def extract_counterstrategy(game: SymbolicGame, solution: EnvironmentSolution,
@@ -658,7 +811,9 @@ def strategy_json_chunks(strategy: dict[str, Any], nodes_per_chunk: int = 1000) 
     for position, (node_name, node) in enumerate(nodes, start=1):
         rank = node['rank']
         rank_text = f'[{rank[0]}, {rank[1]}]' if isinstance(rank, (list, tuple)) else str(rank)
-        state = ', '.join('null' if v is None else str(v) for v in node['state'])
+        state = node['state']
+        state = ', '.join(map(str, state) if None not in state else
+                          ('null' if v is None else str(v) for v in state))
         trans = ', '.join(map(str, node['trans']))
         # The separator goes before each node but the first: the last is not known ahead.
         separator = ',\n\n' if position > 1 else ''

@@ -177,14 +177,10 @@ def measure_capabilities(args, directory: Path, rows: list, series: dict) -> Non
 _COMPILE_ONLY = '''
 import sys
 sys.path[:0] = ['.', 'bench']
+from pathlib import Path
 import capability_robots
-from ltl_specification import compile_task
-from respec.robot import robot_system
 directory, shape, size, out = sys.argv[1], sys.argv[2], int(sys.argv[3]), sys.argv[4]
-robot = capability_robots.SHAPES[shape](size)
-spec = compile_task(robot_system(robot.name, directory), robot.initial_conditions, robot.goals,
-                    sm_outcomes=capability_robots.REQUEST_OUTCOMES, state_library=capability_robots.STATE_LIBRARY)
-open(out, 'w').write(spec.to_slugsin())
+open(out, 'w').write(capability_robots.compiled_spec(shape, size, Path(directory)).to_slugsin())
 '''
 
 

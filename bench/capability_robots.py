@@ -102,6 +102,18 @@ class Robot:
         return self.name
 
 
+def compiled_spec(shape: str, size: int, config_dir: Path):
+    """The project's specification of the ``shape`` robot of ``size`` capabilities, its files
+    written into ``config_dir`` (a respec GR(1) specification)."""
+    from ltl_specification import compile_task
+    from respec.robot import robot_system
+
+    robot = SHAPES[shape](size)
+    robot.write(config_dir)
+    return compile_task(robot_system(robot.name, str(config_dir)), robot.initial_conditions, robot.goals,
+                        sm_outcomes=REQUEST_OUTCOMES, state_library=STATE_LIBRARY)
+
+
 def _name(index: int) -> str:
     return f'c{index:03d}'
 

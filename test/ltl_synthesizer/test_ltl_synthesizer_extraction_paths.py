@@ -16,22 +16,12 @@ from ltl_synthesizer import strategy
 from ltl_synthesizer.strategy import strategy_to_json
 from ltl_synthesizer.synthesizer import explicit_strategy, solve
 from respec.parsing import parse_slugsin
-from respec.robot import robot_system
 
 REPOSITORY = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(REPOSITORY / 'bench'))
 
 import capability_robots  # noqa: E402
 from strategy_check import check_strategy  # noqa: E402
-from ltl_specification import compile_task  # noqa: E402
-
-
-def _compiled(shape: str, size: int, directory: Path):
-    robot = capability_robots.SHAPES[shape](size)
-    robot.write(directory)
-    return compile_task(robot_system(robot.name, str(directory)), robot.initial_conditions, robot.goals,
-                        sm_outcomes=capability_robots.REQUEST_OUTCOMES,
-                        state_library=capability_robots.STATE_LIBRARY)
 
 
 def _both_ways(spec, monkeypatch) -> tuple[str, str]:
@@ -44,7 +34,7 @@ def _both_ways(spec, monkeypatch) -> tuple[str, str]:
 
 @pytest.mark.parametrize('shape', ['chain', 'sensor', 'mix'])
 def test_a_capability_robot_has_the_same_strategy_on_cofactors_and_on_the_cube(shape, tmp_path, monkeypatch):
-    spec = _compiled(shape, 36, tmp_path)
+    spec = capability_robots.compiled_spec(shape, 36, tmp_path)
     assert len(spec.env_props) + len(spec.sys_props) > strategy.COFACTORED_FROM  # the default takes cofactors
     on_cofactors, on_cube = _both_ways(spec, monkeypatch)
     assert on_cofactors == on_cube
@@ -60,7 +50,7 @@ def test_a_gridworld_has_the_same_strategy_on_cofactors_and_on_the_cube(monkeypa
 
 
 def test_free_names_are_exactly_the_names_taking_both_values(tmp_path):
-    game = solve(_compiled('chain', 20, tmp_path), True).game
+    game = solve(capability_robots.compiled_spec('chain', 20, tmp_path), True).game
     bdd, names = game.bdd, game.next_outputs[:40]
     literals = [bdd.var(name) for name in names]
     # Names 3, 17 and 30 are free (in two different ways), name 8 takes both values only

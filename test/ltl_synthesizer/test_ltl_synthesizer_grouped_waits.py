@@ -13,7 +13,6 @@ import pytest
 
 from ltl_synthesizer import gr1, solve
 from ltl_synthesizer.synthesizer import explicit_strategy
-from respec.robot import robot_system
 
 REPOSITORY = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(REPOSITORY / 'bench'))
@@ -21,21 +20,12 @@ sys.path.insert(0, str(REPOSITORY / 'bench'))
 import capability_robots  # noqa: E402
 import gr1_families  # noqa: E402
 from strategy_check import check_strategy  # noqa: E402
-from ltl_specification import compile_task  # noqa: E402
 from respec.parsing import parse_structuredslugs  # noqa: E402
-
-
-def _compiled(shape: str, size: int, directory: Path):
-    robot = capability_robots.SHAPES[shape](size)
-    robot.write(directory)
-    return compile_task(robot_system(robot.name, str(directory)), robot.initial_conditions, robot.goals,
-                        sm_outcomes=capability_robots.REQUEST_OUTCOMES,
-                        state_library=capability_robots.STATE_LIBRARY)
 
 
 @pytest.mark.parametrize('shape', ['chain', 'retry', 'sensor', 'diamond', 'fanout', 'mix'])
 def test_grouped_waits_win_where_separate_ones_do_and_their_strategy_passes_the_check(shape, tmp_path, monkeypatch):
-    spec = _compiled(shape, 20, tmp_path)
+    spec = capability_robots.compiled_spec(shape, 20, tmp_path)
     # Grouped throughout, even where the group still adds positions late (see the test below).
     monkeypatch.setattr(gr1, 'GROUP_SWEEPS', 10**6)
     solved = solve(spec, True)
@@ -50,7 +40,7 @@ def test_grouped_waits_win_where_separate_ones_do_and_their_strategy_passes_the_
 
 
 def test_small_robots_keep_one_fixpoint_per_assumption(tmp_path):
-    solved = solve(_compiled('chain', 10, tmp_path), True)
+    solved = solve(capability_robots.compiled_spec('chain', 10, tmp_path), True)
     assert all(len(wait.members) == 1 for wait in solved.solver.waits)
 
 
@@ -58,7 +48,7 @@ def test_small_robots_keep_one_fixpoint_per_assumption(tmp_path):
 def test_a_robots_group_still_adding_positions_after_a_few_sweeps_is_given_up(shape, tmp_path):
     # A robot's capabilities run one after another: a grouped fixpoint per sweep finds one
     # more capability's positions in each sweep, single fixpoints in alternating sweeps all.
-    spec = _compiled(shape, 20, tmp_path)
+    spec = capability_robots.compiled_spec(shape, 20, tmp_path)
     solved = solve(spec, True)
     assert solved.realizable
     assert all(len(wait.members) == 1 for wait in solved.solver.waits)
@@ -80,7 +70,7 @@ def test_the_arbiters_clients_stay_grouped():
     ('chain', True), ('retry', True), ('sensor', True), ('diamond', True), ('mix', True), ('fanout', False)])
 def test_alternating_sweeps_win_where_one_direction_does_with_fewer_fixpoints(shape, one_after_another, tmp_path,
                                                                               monkeypatch):
-    spec = _compiled(shape, 40, tmp_path)
+    spec = capability_robots.compiled_spec(shape, 40, tmp_path)
     game = solve(spec, True).game
     computed = []
     wait_for_assumption = gr1._wait_for_assumption

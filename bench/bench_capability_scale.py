@@ -50,7 +50,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path[:0] = [str(ROOT), str(ROOT / 'bench')]
 
 import capability_robots
-from pipeline_child import pipeline_child
+from pipeline_child import pipeline_child, warm_synthesis_script
 
 RESULTS = ROOT / 'bench' / 'results' / 'capability_scale.md'
 SIZES = [10, 20, 40, 80, 160]
@@ -82,18 +82,6 @@ def verdict_of(text: str) -> bool | None:
     return None
 
 
-_SYNTHESIS_WARM = '''
-import json, sys, time
-from ltl_synthesizer.serve import answer
-request = json.dumps(sys.argv[1:])
-answer(request)
-seconds = []
-for _ in range(2):
-    start = time.perf_counter()
-    reply = answer(request)
-    seconds.append(time.perf_counter() - start)
-print(json.dumps({'warm_seconds': min(seconds), 'stderr': reply['stderr']}))
-'''
 
 
 def warm_runs(directory: Path, shape: str, size: int, slugsin: Path, timeout: float) -> dict:
@@ -104,7 +92,7 @@ def warm_runs(directory: Path, shape: str, size: int, slugsin: Path, timeout: fl
     runs = {}
     pipeline = run_wall([sys.executable, PIPELINE_CHILD, str(directory), shape, str(size),
                          str(slugsin) + '.warm', '3'], timeout)
-    synthesis = run_wall([sys.executable, '-c', _SYNTHESIS_WARM, '--sysInitRoboticsSemantics', '--explicitStrategy',
+    synthesis = run_wall([sys.executable, '-c', warm_synthesis_script('perf_counter'), '--sysInitRoboticsSemantics', '--explicitStrategy',
                           '--jsonOutput', str(slugsin), os.devnull], timeout)
     for name, run in (('pipeline', pipeline), ('gr1synth + strategy', synthesis)):
         if not run['timeout'] and run['code'] == 0:

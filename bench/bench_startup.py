@@ -41,6 +41,7 @@ sys.path[:0] = [str(ROOT), str(ROOT / 'bench')]
 
 import capability_robots
 from bench_tiny_specs import SPECS
+from pipeline_child import warm_synthesis_script
 
 PYTHON = sys.executable
 GR1SYNTH = str(Path(PYTHON).with_name('gr1synth'))
@@ -182,18 +183,6 @@ sys.path[:0] = [sys.argv[1] + '/bench']
 from pipeline_child import pipeline_child
 pipeline_child(sys.argv[2], sys.argv[3], int(sys.argv[4]), sys.argv[5], 3, clock=time.process_time)
 '''
-_WARM_SYNTHESIS = '''
-import json, sys, time
-from ltl_synthesizer.serve import answer
-request = json.dumps(sys.argv[1:])
-answer(request)
-seconds = []
-for _ in range(2):
-    start = time.process_time()
-    answer(request)
-    seconds.append(time.process_time() - start)
-print(json.dumps({'warm_seconds': min(seconds)}))
-'''
 
 
 def warm(args, files: dict[str, Path], directory: Path) -> list[str]:
@@ -209,7 +198,7 @@ def warm(args, files: dict[str, Path], directory: Path) -> list[str]:
             for name, command in (
                     ('pipeline', [PYTHON, '-c', _WARM_PIPELINE, str(ROOT), str(directory), shape, str(size),
                                   str(directory / 'warm.slugsin')]),
-                    ('synthesis', [PYTHON, '-c', _WARM_SYNTHESIS, *STRATEGY, str(files[label]), os.devnull])):
+                    ('synthesis', [PYTHON, '-c', warm_synthesis_script('process_time'), *STRATEGY, str(files[label]), os.devnull])):
                 runs = []
                 for _ in range(args.repeats):
                     done = subprocess.run(command, capture_output=True, text=True, check=True, cwd=str(ROOT))

@@ -314,7 +314,7 @@ class _Session:
 
         outcome = self.client.run(goal, feedback=on_feedback)
         if progress:
-            progress.close()
+            progress.close(outcome)
         detected = next(filter(None, map(initial_conditions_in_status, statuses)), None)
         if detected is not None:  # the server read them from the robot state topic
             source, requested = detected

@@ -6,10 +6,11 @@ registration, logs "Ignoring unexpected goal response" and drops it: the caller'
 never completes (3 of ~800 sequential goals here). This subclass makes sending and
 registering one step under a lock that the response handling waits for.
 
-A goal response can also be lost on the way: rmw_fastrtps gives the server 100 ms to match
-the client's response reader, and on a loaded machine discovery can take longer, so the
-server accepts and runs the goal while its client waits for an answer that never comes (a
-send-goal waited 120 s so). The server's status topic lists every accepted goal, so a goal
+A goal response can also be lost on the way: rmw_fastrtps gives the server the response
+writer's max_blocking_time (Fast DDS: 100 ms; the suite's profile: 5 s) to match the client's
+response reader, and on a loaded machine discovery can take longer, so the server accepts and
+runs the goal while its client waits for an answer that never comes (a send-goal waited 120 s
+so). The server's status topic lists every accepted goal, so a goal
 seen there is accepted whatever became of its response (``accepted_without_response``).
 """
 
@@ -68,6 +69,11 @@ class RaceFreeActionClient(ActionClient):
             self._remove_pending_goal_request(sent)
             self._answered_by_status.add(sequence)
             del self._awaited[bytes(goal_id.uuid)]
+        # Rare (a server without the suite's DDS profile, or discovery slower than its 5 s):
+        # said so that a slow goal can be told from a slow server.
+        self._node.get_logger().warning(
+            f'no goal response from {self._node.resolve_service_name(self._action_name)}; its status '
+            'lists the goal as accepted, so it goes on')
         # Outside the lock: a done callback may send the result request, which takes it.
         response = self._action_type.Impl.SendGoalService.Response(accepted=True, stamp=stamp)
         sent.set_result(ClientGoalHandle(self, goal_id, response))

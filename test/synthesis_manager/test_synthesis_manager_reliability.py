@@ -120,7 +120,7 @@ def test_a_short_soak_loses_no_goal(ros, tmp_path):
     assert len({path.name.split('.')[0] for path in tmp_path.glob('*.json')}) == 20
 
 
-def test_a_goal_whose_response_is_lost_goes_on_from_the_servers_status(ros, tmp_path, monkeypatch):
+def test_a_goal_whose_response_is_lost_goes_on_from_the_servers_status(ros, tmp_path, monkeypatch, capfd):
     start_suite(ros, tmp_path)
     monkeypatch.setattr('synthesis_manager.client.RaceFreeActionClient', GoalResponseLosingClient)
     client = SynthesisClient(ros.add_node(Node, 'losing_client'))
@@ -130,6 +130,7 @@ def test_a_goal_whose_response_is_lost_goes_on_from_the_servers_status(ros, tmp_
     assert client.action_client.lost == 1 and outcome.error_name == 'SUCCESS', outcome.message
     assert outcome.states  # the whole result: the state machine
     assert time.monotonic() - started < 25  # the grace, not the 30 s time limit
+    assert 'its status lists the goal as accepted, so it goes on' in capfd.readouterr().err
 
 
 # --- bad input ----------------------------------------------------------------------------

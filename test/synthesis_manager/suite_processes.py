@@ -89,6 +89,23 @@ def descendants(pid: int) -> set[int]:
     return found
 
 
+def stacks(pid: int) -> str:
+    """The Python and native stacks of every thread of ``pid`` and its descendants, for the
+    failure message of a process that did not stop: a hang is then told by where it waits.
+    py-spy (a test dependency) reads them from outside; without it, gdb's native stacks."""
+    spy = Path(sys.executable).parent / 'py-spy'
+    dumps = []
+    for process in [pid, *sorted(descendants(pid))]:
+        command = ([str(spy), 'dump', '--native', '--pid', str(process)] if spy.exists()
+                   else ['gdb', '-p', str(process), '-batch', '-ex', 'thread apply all bt 30'])
+        try:
+            dumped = subprocess.run(command, capture_output=True, text=True, timeout=60)
+            dumps.append(f'--- process {process}:\n{dumped.stdout}{dumped.stderr}')
+        except (OSError, subprocess.TimeoutExpired) as error:
+            dumps.append(f'--- process {process}: no stacks ({error})')
+    return '\n'.join(dumps)
+
+
 def cpu_seconds(pid: int) -> float:
     """User + system CPU time of process ``pid`` so far."""
     fields = Path(f'/proc/{pid}/stat').read_text().rsplit(')', 1)[1].split()

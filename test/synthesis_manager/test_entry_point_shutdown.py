@@ -36,7 +36,7 @@ from respec.robot import robot_system
 from atlas_sim_client import Client as SimClient
 from runaway_requests import RUNAWAY_SPEC, many_parts_config, runaway_gui_job, runaway_goal
 from suite_processes import (BIN, GUI_URL, assert_busy_synthesizing, cpu_seconds, descendants, loopback_domain,
-                             started, synthesis_processes)
+                             stacks, started, synthesis_processes)
 from waiting import wait_until
 
 pytestmark = pytest.mark.ros
@@ -106,7 +106,7 @@ def stop_all(processes: dict, stop_signal) -> dict:
                 process.wait()  # reaps it: only now, its schedstat was still to be read
         time.sleep(0.01)
     for name, process in processes.items():
-        assert name in wall, f'{name} still running 30 s after {stop_signal.name}'
+        assert name in wall, f'{name} still running 30 s after {stop_signal.name}; its stacks:\n{stacks(process.pid)}'
         print(f'{name}: {stop_signal.name} -> exit {process.returncode} in {seconds[name]:.2f} s '
               f'({wall[name]:.2f} s with waits for a CPU)')
     for name, process in processes.items():

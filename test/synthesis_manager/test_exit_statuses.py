@@ -17,6 +17,7 @@ import pytest
 from respec.vocabulary.errors import ExitStatus
 from synthesis_manager.ros.env import prepare_ros_environment
 from synthesis_manager.ros.harness import reserve_domain_id
+from suite_processes import stacks
 
 pytestmark = pytest.mark.ros
 
@@ -44,7 +45,10 @@ def stopped(process, stop_signal) -> tuple[int, float]:
     """Send ``stop_signal`` to ``process``: its exit status and the seconds it took to exit."""
     signalled = time.monotonic()
     process.send_signal(stop_signal)
-    return process.wait(30), time.monotonic() - signalled
+    try:
+        return process.wait(30), time.monotonic() - signalled
+    except subprocess.TimeoutExpired:
+        raise AssertionError(f'still running 30 s after {stop_signal.name}; its stacks:\n{stacks(process.pid)}') from None
 
 
 def ended(process) -> None:

@@ -44,6 +44,13 @@ COMPARISON_UNITS = 2
 # bits. Narrower integers keep their first-use places, where the sifting passes place them
 # better than interleaved (evasion 48x16, 6-bit positions: 3.4 s, interleaved 6.6 s).
 MIN_INTERLEAVED_BITS = 8
+# ... or when both have this many bits and the same width (two positions on one grid, as the
+# per-cell gridworld's robot and adversary): their no-swap conjunct separated is 3,072 nodes
+# at 5 bits and 12,288 at 6, most of the relations of the 5x4 and 7x5 gridworlds, whose
+# solves take 2-3x longer so (issue 44). Evasion's obstacle coordinates, compared in
+# "mox' = mox | moy' = moy", are of different widths and stay apart (interleaved from 5 bits,
+# evasion 64x24 took 79 s instead of 25 s).
+MIN_INTERLEAVED_EQUAL_BITS = 5
 SECTIONS = ('sys_trans', 'env_trans', 'sys_liveness', 'env_liveness', 'env_init', 'sys_init')
 
 
@@ -135,7 +142,8 @@ def _compared_integers(supports: list[tuple[str, ...]], unit_of: dict[str, str],
                        ) -> dict[str, str]:
     """Integer -> the block (its first member's name, tagged) of the integers compared with it:
     those sharing a conjunct over at most COMPARISON_UNITS units, all of them integers of at
-    least MIN_INTERLEAVED_BITS bits (``widths``)."""
+    least MIN_INTERLEAVED_BITS bits (``widths``), or two of MIN_INTERLEAVED_EQUAL_BITS bits or
+    more and the same width."""
     parent: dict[str, str] = {}
 
     def root(unit: str) -> str:
@@ -145,9 +153,9 @@ def _compared_integers(supports: list[tuple[str, ...]], unit_of: dict[str, str],
 
     for support in supports:
         units = dict.fromkeys(unit_of[name] for name in support if name in unit_of)
-        integers = [unit for unit in units if _is_integer_unit(unit, support, unit_of)
-                    and widths.get(unit, 0) >= MIN_INTERLEAVED_BITS]
-        if 2 <= len(units) <= COMPARISON_UNITS and len(integers) == len(units):
+        integers = [unit for unit in units if _is_integer_unit(unit, support, unit_of)]
+        if 2 <= len(units) <= COMPARISON_UNITS and len(integers) == len(units) \
+                and _wide_enough([widths.get(unit, 0) for unit in integers]):
             first = root(integers[0])
             for other in integers[1:]:
                 top = root(other)
@@ -162,6 +170,13 @@ def _compared_integers(supports: list[tuple[str, ...]], unit_of: dict[str, str],
         for member in [top, *members]:
             blocks[member] = name
     return blocks
+
+
+def _wide_enough(widths: list[int]) -> bool:
+    """Whether integers of these widths, compared, are interleaved (MIN_INTERLEAVED_BITS,
+    MIN_INTERLEAVED_EQUAL_BITS)."""
+    return min(widths) >= MIN_INTERLEAVED_BITS or (
+        len(set(widths)) == 1 and widths[0] >= MIN_INTERLEAVED_EQUAL_BITS)
 
 
 def _is_integer_unit(unit: str, support: tuple[str, ...], unit_of: dict[str, str]) -> bool:

@@ -10,22 +10,22 @@ from respec.spec import GR1Specification
 BITS = 8
 
 
-def bits(name: str) -> list[str]:
-    """Structured slugs' bits of an integer ``name: 0...255``."""
-    return [f'{name}@0.0.255'] + [f'{name}@{k}' for k in range(1, BITS)]
+def bits(name: str, width: int = BITS) -> list[str]:
+    """Structured slugs' bits of an integer ``name: 0...2^width - 1``."""
+    return [f'{name}@0.0.{2 ** width - 1}'] + [f'{name}@{k}' for k in range(1, width)]
 
 
 def equal(left, right):
     return conj(iff(a, b) for a, b in zip(left, right))
 
 
-def swap_spec() -> GR1Specification:
-    """Two 8-bit positions that never coincide nor swap: ``rob' != adv'``,
+def swap_spec(rob_width: int = BITS, adv_width: int = BITS) -> GR1Specification:
+    """Two positions (8-bit by default) that never coincide nor swap: ``rob' != adv'``,
     ``!((rob' = adv) & (adv' = rob))`` (as structured slugs bit-blasts them)."""
-    rob, adv = [var(b) for b in bits('rob')], [var(b) for b in bits('adv')]
+    rob, adv = [var(b) for b in bits('rob', rob_width)], [var(b) for b in bits('adv', adv_width)]
     following = [next_(v) for v in rob], [next_(v) for v in adv]
     # The first conjunct names every bit of rob before any of adv: the order of first use.
-    return GR1Specification(env_props=bits('adv'), sys_props=bits('rob'), sys_trans=[
+    return GR1Specification(env_props=bits('adv', adv_width), sys_props=bits('rob', rob_width), sys_trans=[
         neg(conj(following[0] + following[1])),
         neg(equal(following[0], following[1])),
         neg(conj([equal(following[0], adv), equal(following[1], rob)]))])
@@ -35,6 +35,20 @@ def test_integers_a_conjunct_compares_are_interleaved_bit_by_bit():
     order = [integer_bit(name) for name in static_order(swap_spec())]
     assert [{order[2 * bit], order[2 * bit + 1]} for bit in range(BITS)] == \
         [{('rob', bit), ('adv', bit)} for bit in range(BITS)]
+
+
+def test_narrower_integers_are_interleaved_only_when_of_the_same_width():
+    """5 to 7 bits: two positions on one grid (the 5x4 and 7x5 gridworlds' robot and
+    adversary) interleave; integers of different widths (evasion's obstacle coordinates) keep
+    their first-use places, all of rob's bits before adv's."""
+    for width in (5, 6, 7):
+        order = [integer_bit(name) for name in static_order(swap_spec(width, width))]
+        assert [{order[2 * bit], order[2 * bit + 1]} for bit in range(width)] == \
+            [{('rob', bit), ('adv', bit)} for bit in range(width)]
+    order = [integer_bit(name)[0] for name in static_order(swap_spec(6, 5))]
+    assert order == ['rob'] * 6 + ['adv'] * 5
+    order = [integer_bit(name)[0] for name in static_order(swap_spec(4, 4))]
+    assert order == ['rob'] * 4 + ['adv'] * 4
 
 
 def test_the_no_swap_conjunct_is_small_interleaved_and_exponential_in_first_use_order():

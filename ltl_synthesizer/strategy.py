@@ -380,9 +380,21 @@ def _free_names(game: SymbolicGame, u: Node, names: list[str]) -> set[str]:
     half at a time. Testing the names one by one cost most of the responses' choice (a chain
     of 160 capabilities: 322 outputs per position, of which 2-3 free)."""
     bdd = game.bdd
-    sample = next(bdd._pick_iter(u))  # noqa: SLF001 - dd.cudd's cube iterator (as _codes)
+    assignments = bdd._pick_iter(u)  # noqa: SLF001 - dd.cudd's cube iterator (as _codes)
+    sample = next(assignments)
     free = {name for name in names if name not in sample}
-    stack = [[name for name in names if name in sample]]
+    # A literal that every assignment (over u's support) has is one u implies: read a few
+    # of them first (a capability robot's moves have 1-3), and search only if there are more.
+    common = set(sample.items())
+    for _ in range(FREE_NAMES_READ):
+        assignment = next(assignments, None)
+        if assignment is None:
+            break
+        common.intersection_update(assignment.items())
+    free |= {name for name in names if name in sample and (name, sample[name]) not in common}
+    if assignment is None:
+        return free
+    stack = [[name for name in names if name in sample and name not in free]]
     while stack:
         group = stack.pop()
         if not group or u & ~bdd.cube({name: sample[name] for name in group}) == game.false:
@@ -393,6 +405,10 @@ def _free_names(game: SymbolicGame, u: Node, names: list[str]) -> set[str]:
         middle = len(group) // 2
         stack += [group[:middle], group[middle:]]
     return free
+
+
+#: _free_names reads up to this many more assignments before it searches.
+FREE_NAMES_READ = 8
 
 
 class _GoalsAt:

@@ -402,9 +402,11 @@ FREE_NAMES_SEARCHED_FROM = 32
 
 def _free_names(game: SymbolicGame, u: Node, names: list[str]) -> set[str]:
     """The ``names`` that take both values in ``u`` (not FALSE): those of one of its cubes
-    that leaves them out, and those whose literal in that cube ``u`` does not imply, found a
-    half at a time. Testing the names one by one cost most of the responses' choice (a chain
-    of 160 capabilities: 322 outputs per position, of which 2-3 free)."""
+    that leaves them out, and those whose literal in that cube ``u`` does not imply: read off
+    its assignments when it has few, else found a half at a time. Testing the names one by one
+    cost most of the responses' choice (a chain of 160 capabilities: 322 outputs per position,
+    of which 2-3 free), and so did the halves' cubes (each over all variables: six times the
+    reading of a chain's 1-3 assignments)."""
     bdd = game.bdd
     assignments = bdd._pick_iter(u)  # noqa: SLF001 - dd.cudd's cube iterator (as _codes)
     sample = next(assignments)
@@ -412,13 +414,15 @@ def _free_names(game: SymbolicGame, u: Node, names: list[str]) -> set[str]:
     # A literal that every assignment (over u's support) has is one u implies: read a few
     # of them first (a capability robot's moves have 1-3), and search only if there are more.
     common = set(sample.items())
+    read_all = False
     for _ in range(FREE_NAMES_READ):
         assignment = next(assignments, None)
-        if assignment is None:
+        read_all = assignment is None
+        if read_all:
             break
         common.intersection_update(assignment.items())
     free |= {name for name in names if name in sample and (name, sample[name]) not in common}
-    if assignment is None:
+    if read_all:
         return free
     stack = [[name for name in names if name in sample and name not in free]]
     while stack:

@@ -417,8 +417,8 @@ def _free_names(game: SymbolicGame, u: Node, names: list[str]) -> set[str]:
     read_all = False
     for _ in range(FREE_NAMES_READ):
         assignment = next(assignments, None)
-        read_all = assignment is None
-        if read_all:
+        if assignment is None:
+            read_all = True
             break
         common.intersection_update(assignment.items())
     free |= {name for name in names if name in sample and (name, sample[name]) not in common}

@@ -88,18 +88,44 @@ def _unchanged(u: Node) -> Node:
 class _AtState:
     """Sets of transitions cofactored by one position's state (each once), by the values of
     the current variables they mention (``supports``): building the cube of all of them took
-    two thirds of a cofactor (48 of 70 us at the sensor chain of 80)."""
+    two thirds of a cofactor (48 of 70 us at the sensor chain of 80). The cofactors are
+    shared by the positions (``shared``, by set and values): a set mentions a part of the
+    state, whose values recur (the sensor chain of 80: 2,154 distinct cofactors of 11,496)."""
 
-    def __init__(self, game: SymbolicGame, state: Mapping[str, bool], supports: _NodeMemo) -> None:
-        self.let, self.state, self.supports = game.bdd.let, state, supports
+    def __init__(self, game: SymbolicGame, state: Mapping[str, bool], supports: _NodeMemo,
+                 shared: _Cofactors) -> None:
+        self.let, self.state, self.supports, self.shared = game.bdd.let, state, supports, shared
         self.found: dict[int, tuple[Node, Node]] = {}
 
     def __call__(self, u: Node) -> Node:
         found = self.found.get(int(u))
         if found is None:
             names, values = self.supports(u)
-            found = self.found[int(u)] = (u, self.let(dict(zip(names, values(self.state))), u) if names else u)
+            if not names:
+                found = self.found[int(u)] = (u, u)
+            else:
+                key = (int(u), values(self.state))
+                found = self.shared.found.get(key)
+                if found is None:
+                    found = self.shared.remember(key, (u, self.let(dict(zip(names, key[1])), u)))
+                self.found[int(u)] = found
         return found[1]
+
+
+class _Cofactors:
+    """Cofactors of sets by the values of the variables they mention (keyed by the set's node
+    and the values, the set kept with its cofactor, so that its node is not reused); forgotten
+    all at once beyond ``limit`` entries, to bound the memory of a huge strategy."""
+
+    def __init__(self, limit: int = 2**16) -> None:
+        self.limit = limit
+        self.found: dict[tuple[int, Any], tuple[Node, Node]] = {}
+
+    def remember(self, key: tuple[int, Any], found: tuple[Node, Node]) -> tuple[Node, Node]:
+        if len(self.found) >= self.limit:
+            self.found.clear()
+        self.found[key] = found
+        return found
 
 
 class _GoalSteps:
@@ -376,13 +402,29 @@ FREE_NAMES_SEARCHED_FROM = 32
 
 def _free_names(game: SymbolicGame, u: Node, names: list[str]) -> set[str]:
     """The ``names`` that take both values in ``u`` (not FALSE): those of one of its cubes
-    that leaves them out, and those whose literal in that cube ``u`` does not imply, found a
-    half at a time. Testing the names one by one cost most of the responses' choice (a chain
-    of 160 capabilities: 322 outputs per position, of which 2-3 free)."""
+    that leaves them out, and those whose literal in that cube ``u`` does not imply: read off
+    its assignments when it has few, else found a half at a time. Testing the names one by one
+    cost most of the responses' choice (a chain of 160 capabilities: 322 outputs per position,
+    of which 2-3 free), and so did the halves' cubes (each over all variables: six times the
+    reading of a chain's 1-3 assignments)."""
     bdd = game.bdd
-    sample = next(bdd._pick_iter(u))  # noqa: SLF001 - dd.cudd's cube iterator (as _codes)
+    assignments = bdd._pick_iter(u)  # noqa: SLF001 - dd.cudd's cube iterator (as _codes)
+    sample = next(assignments)
     free = {name for name in names if name not in sample}
-    stack = [[name for name in names if name in sample]]
+    # A literal that every assignment (over u's support) has is one u implies: read a few
+    # of them first (a capability robot's moves have 1-3), and search only if there are more.
+    common = set(sample.items())
+    read_all = False
+    for _ in range(FREE_NAMES_READ):
+        assignment = next(assignments, None)
+        if assignment is None:
+            read_all = True
+            break
+        common.intersection_update(assignment.items())
+    free |= {name for name in names if name in sample and (name, sample[name]) not in common}
+    if read_all:
+        return free
+    stack = [[name for name in names if name in sample and name not in free]]
     while stack:
         group = stack.pop()
         if not group or u & ~bdd.cube({name: sample[name] for name in group}) == game.false:
@@ -393,6 +435,10 @@ def _free_names(game: SymbolicGame, u: Node, names: list[str]) -> set[str]:
         middle = len(group) // 2
         stack += [group[:middle], group[middle:]]
     return free
+
+
+#: _free_names reads up to this many more assignments before it searches.
+FREE_NAMES_READ = 8
 
 
 class _GoalsAt:
@@ -541,6 +587,7 @@ def strategy_nodes(game: SymbolicGame, solution: SystemSolution) -> Iterator[tup
     # The current variables each step's set mentions (_AtState; the steps' sets live as long
     # as the extraction, and finding a support walks the whole BDD).
     current_supports = _NodeMemo(lambda u: _mentioned(game, u))
+    cofactors = _Cofactors()
     # The current variables each goal mentions: cofactoring by them alone (_GoalsAt) saves
     # building a cube of every variable per goal and position.
     goal_supports = [[name for name in variables if name in support]
@@ -558,7 +605,8 @@ def strategy_nodes(game: SymbolicGame, solution: SystemSolution) -> Iterator[tup
         state = dict(zip(variables, values))
         if by_cofactors:
             env_moves, legal = safety.moves_from(state)
-            moves = goal_moves(game, steps[rank], _AtState(game, state, current_supports), env_moves, legal)
+            at_state = _AtState(game, state, current_supports, cofactors)
+            moves = goal_moves(game, steps[rank], at_state, env_moves, legal)
         else:  # the same moves, from the transitions conjoined with the state's cube
             env_moves, legal = _moves_from(game, state)
             moves = game.bdd.exist(variables, goal_moves(game, steps[rank], _unchanged, env_moves, legal))

@@ -66,3 +66,22 @@ def test_free_names_are_exactly_the_names_taking_both_values(tmp_path):
     expected = {name for name, literal in zip(names, literals)
                 if u & literal != game.false and u & ~literal != game.false}
     assert found == expected == {names[index] for index in (3, 8, 9, 17, 30)}
+
+
+def test_free_names_of_moves_with_many_assignments_are_found_by_the_search(tmp_path):
+    # More assignments than _free_names reads (FREE_NAMES_READ) before its search: five pairs
+    # of names whose values differ (32 assignments), one name fixed by all of them.
+    game = solve(capability_robots.compiled_spec('chain', 20, tmp_path), True).game
+    bdd, names = game.bdd, game.next_outputs[:40]
+    literals = [bdd.var(name) for name in names]
+    u = bdd.true
+    for index, literal in enumerate(literals):
+        if index >= 10:
+            u &= literal if index % 3 else ~literal
+        elif index % 2:
+            u &= (literals[index - 1] & ~literal) | (~literals[index - 1] & literal)
+    assert 2**5 > strategy.FREE_NAMES_READ + 1
+    found = strategy._free_names(game, u, names)
+    expected = {name for name, literal in zip(names, literals)
+                if u & literal != game.false and u & ~literal != game.false}
+    assert found == expected == set(names[:10])

@@ -19,6 +19,8 @@ and size N, each in a fresh process, wall seconds:
   pipeline needs: the verdict and the explicit strategy, written out);
 - "slugs": slugs with the same flag on the same file (realizability only);
 - "ratio": pipeline / (gr1synth + strategy), the pipeline's cost over the synthesis it needs;
+  "CPU ratio" the same in CPU seconds (user + system of each process), which other jobs on the
+  machine do not stretch as they stretch wall seconds;
 - "warm": the same request answered again in one process (imports done, as in a long-running
   server; robots up to ``--warm-up-to``, default 80): the pipeline three times in one child,
   gr1synth + strategy three times by its resident mode (``gr1synth --serve``'s answer); wall
@@ -39,6 +41,7 @@ import argparse
 import json
 import math
 import os
+import resource
 import signal
 import subprocess
 import sys
@@ -59,7 +62,8 @@ PIPELINE_CHILD = str(ROOT / 'bench' / 'pipeline_child.py')
 
 
 def run_wall(command: list[str], timeout: float) -> dict:
-    """Run ``command`` in its own session; wall seconds, exit status, stdout, timeout."""
+    """Run ``command`` in its own session; wall and CPU seconds, exit status, stdout, timeout."""
+    used_before = resource.getrusage(resource.RUSAGE_CHILDREN)
     start = time.monotonic()
     process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, cwd=ROOT,
                                start_new_session=True, text=True)
@@ -70,7 +74,10 @@ def run_wall(command: list[str], timeout: float) -> dict:
         os.killpg(process.pid, signal.SIGKILL)
         out, err = process.communicate()
         timed_out = True
-    return {'seconds': time.monotonic() - start, 'timeout': timed_out, 'code': process.returncode,
+    seconds = time.monotonic() - start
+    used = resource.getrusage(resource.RUSAGE_CHILDREN)  # the process is reaped: its CPU is counted
+    cpu = used.ru_utime - used_before.ru_utime + used.ru_stime - used_before.ru_stime
+    return {'seconds': seconds, 'cpu': cpu, 'timeout': timed_out, 'code': process.returncode,
             'out': out, 'err': err, 'limit': timeout}
 
 
@@ -255,11 +262,12 @@ def _row_line(row: dict, timeout: float) -> str:
     if not row['agree']:
         verdict += ' (VERDICTS DIFFER)'
     stages = ', '.join(f'{k} {v:.2f}' for k, v in row.get('stages', {}).items())
-    ratio = ''
+    ratio = cpu_ratio = ''
     pipeline, synthesis = results.get('pipeline'), results.get('gr1synth + strategy')
     if pipeline and synthesis and not pipeline['timeout'] and not synthesis['timeout'] \
             and not pipeline.get('failed') and not synthesis.get('failed'):
         ratio = f"{pipeline['seconds'] / synthesis['seconds']:.2f}"
+        cpu_ratio = f"{pipeline['cpu'] / synthesis['cpu']:.2f}"
     warm = row.get('warm', {})
     warm_cell = ' / '.join(f'{warm[tool]:.3f}' if tool in warm else '-' for tool in ('pipeline', 'gr1synth + strategy'))
     warm_ratio = f"{warm['pipeline'] / warm['gr1synth + strategy']:.2f}" \
@@ -276,7 +284,7 @@ def _row_line(row: dict, timeout: float) -> str:
         check_cell = f"passed ({check['seconds']:.1f} s)" if not problems else f'{len(problems)} problems: {problems[0]}'
     return (f"| {row['label']} | {row.get('props', '')} | {verdict} | "
             + ' | '.join(cell(results.get(tool), timeout) for tool in TOOLS)
-            + f' | {ratio} | {warm_cell} | {warm_ratio} | {check_cell} | {stages} |')
+            + f' | {ratio} | {cpu_ratio} | {warm_cell} | {warm_ratio} | {check_cell} | {stages} |')
 
 
 TOOLS = ('pipeline', 'gr1synth', 'gr1synth + strategy', 'slugs')
@@ -309,9 +317,9 @@ def main() -> None:
     args.sizes = [int(s) for s in args.sizes.split(',') if s]
     args.grids = [tuple(int(v) for v in g.split('x')) for g in args.grids.split(',') if g]
     header = ('| task | env / sys props | verdict | pipeline (s) | gr1synth (s) | gr1synth + strategy (s) '
-              '| slugs (s) | ratio | warm: pipeline / gr1synth + strategy (s) | warm ratio | check '
+              '| slugs (s) | ratio | CPU ratio | warm: pipeline / gr1synth + strategy (s) | warm ratio | check '
               '| pipeline stages (s) |\n'
-              '|---|---|---|---|---|---|---|---|---|---|---|---|')
+              '|---|---|---|---|---|---|---|---|---|---|---|---|---|')
     print(header, flush=True)
     rows, series = [], {}
     with tempfile.TemporaryDirectory() as directory:

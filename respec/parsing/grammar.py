@@ -15,8 +15,6 @@ from __future__ import annotations
 from respec.vocabulary.errors import quoted
 from respec.ltl import Formula
 from respec.parsing.errors import ParseError
-from respec.parsing.infix import InfixParser
-from respec.parsing.prefix import PrefixParser
 from respec.parsing.scope import ANY, Scope, Source
 
 
@@ -32,8 +30,12 @@ def parse_formula(text: str, syntax: str = 'infix') -> Formula:
 
 def parse_in_scope(text: str, syntax: str, scope: Scope, source: Source) -> Formula:
     """Parse one formula whose propositions ``scope`` allows, placing errors by ``source``."""
+    # The reference readers load on first use: a well-formed slugsin file is read by the quick
+    # readers alone, and a gr1synth run would otherwise pay for compiling the infix tokenizer.
     if syntax == 'infix':
+        from respec.parsing.infix import InfixParser
         return InfixParser(text, scope, source).parse()
     if syntax == 'prefix':
+        from respec.parsing.prefix import PrefixParser
         return PrefixParser(text, scope, source).parse()
     raise ValueError(f"unknown formula syntax {syntax!r} (expected 'infix' or 'prefix')")

@@ -284,6 +284,22 @@ print(dd._utils.import_module('networkx').MultiDiGraph is networkx.MultiDiGraph)
     assert '"roots"' in (tmp_path / 'u.json').read_text()
 
 
+def test_dd_logs_through_logging_once_logging_is_configured():
+    # dd's loggers come without logging; its info messages are dropped only while nothing has
+    # loaded (so configured) logging, as the root logger's default level would drop them.
+    code = (
+        'import sys\n'
+        'from ltl_synthesizer.cudd_import import cudd\n'
+        'cudd.BDD()\n'
+        'print("logging" in sys.modules)\n'
+        'import logging\n'
+        'logging.basicConfig(level=logging.INFO, stream=sys.stdout, format="%(name)s %(levelname)s")\n'
+        'cudd.BDD()\n')
+    done = subprocess.run([sys.executable, '-c', code], capture_output=True, text=True,
+                          cwd=REPOSITORY, timeout=60)
+    assert done.stdout.splitlines() == ['False', 'dd.cudd INFO'], done.stderr
+
+
 def test_one_goal_games_are_compact_up_to_a_looser_bound():
     # The chain of 160 capabilities retrying on failure: 30 nodes per proposition, one goal.
     from types import SimpleNamespace

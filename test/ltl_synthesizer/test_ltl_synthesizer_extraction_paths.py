@@ -49,13 +49,18 @@ def test_a_gridworld_has_the_same_strategy_on_cofactors_and_on_the_cube(monkeypa
     assert len(json.loads(on_cube)['nodes']) > 10
 
 
-def test_free_names_are_exactly_the_names_taking_both_values(tmp_path):
+def chain_outputs(tmp_path):
+    """The solved game of the 20-capability chain, its first 40 next outputs and their literals."""
     game = solve(capability_robots.compiled_spec('chain', 20, tmp_path), True).game
-    bdd, names = game.bdd, game.next_outputs[:40]
-    literals = [bdd.var(name) for name in names]
+    names = game.next_outputs[:40]
+    return game, names, [game.bdd.var(name) for name in names]
+
+
+def test_free_names_are_exactly_the_names_taking_both_values(tmp_path):
+    game, names, literals = chain_outputs(tmp_path)
     # Names 3, 17 and 30 are free (in two different ways), name 8 takes both values only
     # together with name 9; every other name is fixed, alternately False and True.
-    u = bdd.true
+    u = game.bdd.true
     for index, literal in enumerate(literals):
         if index not in (3, 8, 9, 17, 30):
             u &= literal if index % 2 else ~literal
@@ -71,10 +76,8 @@ def test_free_names_are_exactly_the_names_taking_both_values(tmp_path):
 def test_free_names_of_moves_with_many_assignments_are_found_by_the_search(tmp_path):
     # More assignments than _free_names reads (FREE_NAMES_READ) before its search: five pairs
     # of names whose values differ (32 assignments), one name fixed by all of them.
-    game = solve(capability_robots.compiled_spec('chain', 20, tmp_path), True).game
-    bdd, names = game.bdd, game.next_outputs[:40]
-    literals = [bdd.var(name) for name in names]
-    u = bdd.true
+    game, names, literals = chain_outputs(tmp_path)
+    u = game.bdd.true
     for index, literal in enumerate(literals):
         if index >= 10:
             u &= literal if index % 3 else ~literal

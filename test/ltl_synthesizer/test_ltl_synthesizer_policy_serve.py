@@ -239,11 +239,15 @@ def test_the_symbolic_check_catches_broken_strategies():
 
 # --- start-up -------------------------------------------------------------------------------
 
+def fresh_python(code: str) -> subprocess.CompletedProcess:
+    """``code`` run by a fresh interpreter in the repository: what importing it loads."""
+    return subprocess.run([sys.executable, '-c', code], capture_output=True, text=True, cwd=REPOSITORY, timeout=60)
+
+
 def test_synthesis_does_not_load_networkx():
     code = ('import sys; from ltl_synthesizer import synthesize; import ltl_synthesizer.symbolic; '
             'print("networkx" in sys.modules)')
-    done = subprocess.run([sys.executable, '-c', code], capture_output=True, text=True,
-                          cwd=REPOSITORY, timeout=60)
+    done = fresh_python(code)
     assert done.stdout.strip() == 'False'
 
 
@@ -258,8 +262,7 @@ def test_synthesis_loads_none_of_what_dd_imports_for_features_it_does_not_use():
             'print(sorted(name for name in _DEFERRED if name in sys.modules))\n'
             'assert synthesize(spec).strategy["nodes"]\n'
             'print(sorted(name for name in _DEFERRED if name in sys.modules), "ply" in sys.modules)')
-    done = subprocess.run([sys.executable, '-c', code], capture_output=True, text=True,
-                          cwd=REPOSITORY, timeout=60)
+    done = fresh_python(code)
     assert done.stdout.splitlines() == ['[]', "['dd.bdd'] False"], done.stderr
 
 
@@ -278,8 +281,7 @@ import dd._copy, dd.bdd, dd._utils, networkx, pickle
 print(cudd._copy.load_json is dd._copy.load_json, cudd._bdd.BDD is dd.bdd.BDD, cudd.pickle.dump is pickle.dump)
 print(dd._utils.import_module('networkx').MultiDiGraph is networkx.MultiDiGraph)
 '''
-    done = subprocess.run([sys.executable, '-c', code], capture_output=True, text=True,
-                          cwd=REPOSITORY, timeout=60)
+    done = fresh_python(code)
     assert done.stdout.split('\n')[:3] == ["[{'x': True, 'y': False}]", 'True True True', 'True'], done.stderr
     assert '"roots"' in (tmp_path / 'u.json').read_text()
 
@@ -295,8 +297,7 @@ def test_dd_logs_through_logging_once_logging_is_configured():
         'import logging\n'
         'logging.basicConfig(level=logging.INFO, stream=sys.stdout, format="%(name)s %(levelname)s")\n'
         'cudd.BDD()\n')
-    done = subprocess.run([sys.executable, '-c', code], capture_output=True, text=True,
-                          cwd=REPOSITORY, timeout=60)
+    done = fresh_python(code)
     assert done.stdout.splitlines() == ['False', 'dd.cudd INFO'], done.stderr
 
 

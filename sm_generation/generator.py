@@ -28,7 +28,6 @@ Names come from the activated propositions without ``_a`` (sorted, joined with
 
 from __future__ import annotations
 
-import logging
 from typing import Callable
 
 from respec.automaton import Automaton
@@ -41,7 +40,6 @@ from sm_generation.abstract_machine import (
 from sm_generation.reduction import bisimulation_blocks, reduce_machine, target_class
 from sm_generation.state_machine import State, StateMachine
 
-_LOG = logging.getLogger(__name__)
 
 NAME_SEPARATOR = '_and_'
 CONDITION_SEPARATOR = '__'
@@ -69,8 +67,10 @@ def generate_from_config(automaton: Automaton, config: FlexBEConfig, initial_con
     view = AutomatonView(automaton, config)
     machine = machine_from_view(view, initial_conditions)
     for source, target in machine.dropped:
-        _LOG.warning('automaton step %s -> %s changes the activations without any outcome or sensor event; '
-                     'FlexBE cannot take it, so it is left out', source, target)
+        import logging  # only here: the rare warning is not worth logging's import in every process
+        logging.getLogger(__name__).warning(
+            'automaton step %s -> %s changes the activations without any outcome or sensor event; '
+            'FlexBE cannot take it, so it is left out', source, target)
     if reduce:
         machine = reduce_machine(machine)
     root = _instantiate(machine)

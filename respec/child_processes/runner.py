@@ -355,8 +355,8 @@ class ChildProcesses:
         return ChildProcess(self.niceness, self.preload, name=self.name)
 
     def prepare(self, count: int = 1) -> None:
-        """Keep ``count`` idle children ready, started now, so that calls need not wait for a
-        child's start-up: a call that takes one, or an idle one that is ended, is replaced."""
+        """Start ``count`` idle children now, so that the first calls need not wait; as many
+        fresh ones replace idle children that are ended."""
         with self._lock:
             self._prepared = count
             while len(self._idle) < count and not self._closed:
@@ -414,10 +414,6 @@ class ChildProcesses:
             if self._closed:
                 raise WorkCancelledError('cancelled')
             child = self._idle.pop() if self._idle else None
-            # The prepared number stays ready while children work: the next call (another
-            # client's goal beside long-running ones) need not wait for a fresh child's start-up.
-            while len(self._idle) < self._prepared:
-                self._idle.append(self._new_child())
         if child is None or not child.settle():
             if child is not None:
                 child.kill()

@@ -54,29 +54,6 @@ def test_a_close_while_a_child_is_readied_for_work_leaves_no_child(monkeypatch):
     child.process.wait(timeout=10)  # killed: no runaway work outlives the pool
 
 
-def test_a_prepared_child_is_replaced_as_soon_as_a_call_takes_it():
-    """Another client's goal beside long-running ones found no idle child and waited for a
-    fresh one's start-up (2.8 s beside eight runaways at load 7): a taken child is replaced."""
-    from waiting import wait_until  # here: a child imports this module without the tests' path
-
-    pool = ChildProcesses()
-    pool.prepare(1)
-    cancel = threading.Event()
-    running = threading.Thread(target=lambda: pytest.raises(WorkCancelledError, pool.call, time.sleep, (60,),
-                                                            cancel=cancel))
-    try:
-        prepared = list(pool._idle)  # which child the call takes
-        running.start()
-        wait_until(lambda: pool._busy, 30, 'the call took a child')
-        assert pool._busy == set(prepared)  # the prepared one, already started
-        assert pool.idle_count == 1  # and a fresh one is ready for the next call
-        assert pool.call(operator.add, (2, 3)) == 5
-    finally:
-        cancel.set()
-        running.join(timeout=30)
-        pool.close()
-
-
 def test_a_child_that_dies_is_named_as_its_caller_calls_it():
     child = ChildProcess(name='simulation process')
     try:
